@@ -1,0 +1,192 @@
+// tridex — Z-maps: height fields on a regular grid in a spindle frame (Step 1 of the method,
+// Inui, Chen and Umezu, CAD&A 19(4) 2022, §3.1).
+//
+// Grid point (i, j) lies at frame-local (x0 + i·cell, y0 + j·cell); its height is the frame-
+// local z of the material's top surface above it. A point with no material above it (outside
+// the stock's projection, or cut through) holds `empty_height`, which lies below the stock.
+// Heights are float: a 5000×5000 map takes 100 MB.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "tridex/error.hpp"
+#include "tridex/geometry.hpp"
+#include "tridex/mesh.hpp"
+
+namespace tridex {
+
+struct ZMapGrid {
+  Frame frame;            // heights are measured along frame.axis()
+  double x0 = 0, y0 = 0;  // frame-local x, y of grid point (0, 0)
+  double cell = 1;        // spacing of grid points along x and y
+  int nx = 0, ny = 0;     // grid points along x and y
+
+  std::size_t size() const { return static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny); }
+  std::size_t index(int i, int j) const {
+    return static_cast<std::size_t>(i) + static_cast<std::size_t>(nx) * static_cast<std::size_t>(j);
+  }
+  double x(int i) const { return x0 + i * cell; }
+  double y(int j) const { return y0 + j * cell; }
+
+  // The grid whose points cover the local x-y rectangle of `local_box` with spacing `cell`.
+  static ZMapGrid covering(const Frame& frame, const Aabb& local_box, double cell);
+};
+
+struct ZMapLimits {
+  std::size_t max_points = std::size_t{1} << 30;  // 4 GiB of heights
+};
+
+class ZMap {
+ public:
+  ZMapGrid grid;
+  float empty_height = 0;      // height of points with no material above them
+  std::vector<float> heights;  // point (i, j) at heights[grid.index(i, j)]
+
+  ZMap() = default;
+  ZMap(const ZMapGrid& g, float initial_height, float empty, ZMapLimits limits = {})
+      : grid(g), empty_height(empty) {
+    validate(g, limits);
+    if (!std::isfinite(initial_height) || !std::isfinite(empty))
+      detail::fail("Z-map: heights must be finite");
+    heights.assign(g.size(), initial_height);
+  }
+
+  float height(int i, int j) const { return heights[grid.index(i, j)]; }
+  bool is_empty(int i, int j) const { return height(i, j) <= empty_height; }
+
+  // Step 1 initialisation from a box stock: each point holds the top of the (possibly tilted)
+  // box above it, exactly, or `empty_height` outside the box's projection.
+  static ZMap from_box(const Frame& frame, const Aabb& stock, double cell, ZMapLimits limits = {});
+
+  // Initialisation from the top surface of a closed mesh seen along the frame's z.
+  static ZMap from_mesh(const Frame& frame, const Mesh& stock, double cell,
+                        ZMapLimits limits = {});
+
+  static void validate(const ZMapGrid& g, ZMapLimits limits) {
+    detail::require_positive(g.cell, "Z-map cell size");
+    detail::require_finite(g.x0, "Z-map origin x");
+    detail::require_finite(g.y0, "Z-map origin y");
+    if (g.nx < 1 || g.ny < 1)
+      detail::fail("Z-map grid is empty (", g.nx, " x ", g.ny, " points)");
+    if (g.size() > limits.max_points)
+      detail::fail("Z-map grid of ", g.nx, " x ", g.ny, " points needs ",
+                   static_cast<double>(g.size()) * 4.0 / (1 << 20), " MiB, over the limit of ",
+                   limits.max_points, " points");
+  }
+};
+
+// ---------------------------------------------------------------------------------------------
+
+namespace detail {
+
+// Empty points sit this far below the stock: far enough that the polyhedron built on them
+// (Step 2) has a slab of non-zero thickness under the stock, and a few cells so that it is not
+// confused with a cut.
+inline double empty_margin(double cell) { return 2.0 * cell; }
+
+// The interval of s where the line p + s·d lies inside the box (slab method); false if none.
+inline bool line_box_interval(const Vec3& p, const Vec3& d, const Aabb& box, double& s0,
+                              double& s1) {
+  s0 = -std::numeric_limits<double>::infinity();
+  s1 = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    if (std::abs(d[a]) < 1e-15) {
+      if (p[a] < box.min[a] || p[a] > box.max[a]) return false;
+      continue;
+    }
+    double t0 = (box.min[a] - p[a]) / d[a], t1 = (box.max[a] - p[a]) / d[a];
+    if (t0 > t1) std::swap(t0, t1);
+    s0 = std::max(s0, t0);
+    s1 = std::min(s1, t1);
+  }
+  return s0 <= s1;
+}
+
+inline int grid_count(double extent, double cell, const char* what) {
+  double n = std::floor(extent / cell + 1e-9) + 2;  // one point beyond the far side
+  if (!(n < 1e9)) fail(what, ": grid of ", n, " points along one side is too large");
+  return static_cast<int>(n);
+}
+
+}  // namespace detail
+
+inline ZMapGrid ZMapGrid::covering(const Frame& frame, const Aabb& local_box, double cell) {
+  detail::require_positive(cell, "Z-map cell size");
+  if (local_box.empty() || !is_finite(local_box.min) || !is_finite(local_box.max))
+    detail::fail("Z-map: stock bounds are empty or not finite");
+  ZMapGrid g;
+  g.frame = frame;
+  g.cell = cell;
+  g.x0 = local_box.min.x;
+  g.y0 = local_box.min.y;
+  g.nx = detail::grid_count(local_box.max.x - local_box.min.x, cell, "Z-map");
+  g.ny = detail::grid_count(local_box.max.y - local_box.min.y, cell, "Z-map");
+  return g;
+}
+
+inline ZMap ZMap::from_box(const Frame& frame, const Aabb& stock, double cell, ZMapLimits limits) {
+  Aabb local = local_bounds(frame, stock);
+  ZMapGrid g = ZMapGrid::covering(frame, local, cell);
+  float empty = static_cast<float>(local.min.z - detail::empty_margin(cell));
+  ZMap map(g, empty, empty, limits);
+  const Vec3 up = frame.axis();
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) {
+      double s0, s1;
+      Vec3 p = frame.to_world(Vec3(g.x(i), g.y(j), 0));
+      if (detail::line_box_interval(p, up, stock, s0, s1))
+        map.heights[g.index(i, j)] = static_cast<float>(s1);
+    }
+  return map;
+}
+
+inline ZMap ZMap::from_mesh(const Frame& frame, const Mesh& stock, double cell,
+                            ZMapLimits limits) {
+  if (stock.triangles.empty()) detail::fail("Z-map: stock mesh has no triangles");
+  std::vector<Vec3> local(stock.positions.size());
+  Aabb box;
+  for (std::size_t v = 0; v < local.size(); ++v) {
+    local[v] = frame.to_local(Vec3(stock.positions[v]));
+    if (!is_finite(local[v])) detail::fail("Z-map: stock mesh vertex ", v, " is not finite");
+    box.extend(local[v]);
+  }
+  ZMapGrid g = ZMapGrid::covering(frame, box, cell);
+  float empty = static_cast<float>(box.min.z - detail::empty_margin(cell));
+  ZMap map(g, empty, empty, limits);
+  // Rasterise each triangle's projection; the top surface above a point is the highest hit.
+  // Barycentric tests are inclusive with a small tolerance so that points on shared edges or
+  // vertices are never lost (a doubled hit does no harm to a maximum).
+  for (const glm::uvec3& t : stock.triangles) {
+    if (t.x >= local.size() || t.y >= local.size() || t.z >= local.size())
+      detail::fail("Z-map: stock mesh triangle refers to a missing vertex");
+    const Vec3 &a = local[t.x], &b = local[t.y], &c = local[t.z];
+    double det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+    if (std::abs(det) < 1e-18) continue;  // seen edge-on: adds no height of its own
+    double lox = std::min({a.x, b.x, c.x}), hix = std::max({a.x, b.x, c.x});
+    double loy = std::min({a.y, b.y, c.y}), hiy = std::max({a.y, b.y, c.y});
+    int i0 = std::max(0, static_cast<int>(std::ceil((lox - g.x0) / cell - 1e-9)));
+    int i1 = std::min(g.nx - 1, static_cast<int>(std::floor((hix - g.x0) / cell + 1e-9)));
+    int j0 = std::max(0, static_cast<int>(std::ceil((loy - g.y0) / cell - 1e-9)));
+    int j1 = std::min(g.ny - 1, static_cast<int>(std::floor((hiy - g.y0) / cell + 1e-9)));
+    const double eps = 1e-9;
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        double px = g.x(i), py = g.y(j);
+        double wb = ((px - a.x) * (c.y - a.y) - (c.x - a.x) * (py - a.y)) / det;
+        double wc = ((b.x - a.x) * (py - a.y) - (px - a.x) * (b.y - a.y)) / det;
+        double wa = 1 - wb - wc;
+        if (wa < -eps || wb < -eps || wc < -eps) continue;
+        float z = static_cast<float>(wa * a.z + wb * b.z + wc * c.z);
+        float& h = map.heights[g.index(i, j)];
+        h = std::max(h, z);
+      }
+  }
+  return map;
+}
+
+}  // namespace tridex

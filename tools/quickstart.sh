@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# tridex quick start.
+#   tools/quickstart.sh demo   install what is missing, build, run the main job on the bundled example
+#   tools/quickstart.sh test   install what is missing, build, run the whole test suite (also under
+#                              ASan+UBSan)
+# Works on a fresh Debian 12 machine as root or with sudo. Builds go to build/ and build-asan/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+mode=${1:-demo}
+case "$mode" in demo|test) ;; *) echo "usage: $0 demo|test" >&2; exit 2 ;; esac
+
+sudo=""
+[ "$(id -u)" -eq 0 ] || sudo="sudo"
+lists=(tools/deps/build.txt)
+[ "$mode" = test ] && lists+=(tools/deps/test.txt)
+mapfile -t wanted < <(grep -hv '^\s*#' "${lists[@]}" | sed '/^\s*$/d')
+missing=()
+for p in "${wanted[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "== installing: ${missing[*]}"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+jobs=$(nproc)
+if [ "$mode" = demo ]; then
+  cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DTRIDEX_BUILD_TESTS=OFF -DTRIDEX_BUILD_BENCH=OFF
+  cmake --build build -j "$jobs"
+  exec bash tools/demo.sh
+fi
+
+echo "== release build and tests"
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
+cmake --build build -j "$jobs"
+ctest --test-dir build --output-on-failure -j "$jobs"
+
+echo "== ASan+UBSan build and tests"
+cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTRIDEX_SANITIZE=ON -DTRIDEX_BUILD_BENCH=OFF
+cmake --build build-asan -j "$jobs"
+ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+  ctest --test-dir build-asan --output-on-failure -j "$jobs"
