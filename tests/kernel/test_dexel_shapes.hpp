@@ -1,0 +1,101 @@
+// Closed test meshes with shared vertices, counter-clockwise from outside: box, UV sphere,
+// capped cylinder, torus. Shared by the mesh-check, dexel, STL and machine tests.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <random>
+
+#include "tridex/mesh.hpp"
+
+namespace tridex_test {
+
+using tridex::Mesh;
+using tridex::Vec3;
+
+inline std::uint32_t add_vertex(Mesh& m, const Vec3& p) {
+  m.positions.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z));
+  return static_cast<std::uint32_t>(m.positions.size() - 1);
+}
+
+// Quad a-b-c-d counter-clockwise from outside, as two triangles.
+inline void add_quad(Mesh& m, std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d) {
+  m.triangles.emplace_back(a, b, c);
+  m.triangles.emplace_back(a, c, d);
+}
+
+inline Mesh box_mesh(const Vec3& lo, const Vec3& hi) {
+  Mesh m;
+  for (int i = 0; i < 8; ++i)
+    add_vertex(m, Vec3((i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z));
+  add_quad(m, 0, 2, 3, 1);  // z = lo
+  add_quad(m, 4, 5, 7, 6);  // z = hi
+  add_quad(m, 0, 1, 5, 4);  // y = lo
+  add_quad(m, 2, 6, 7, 3);  // y = hi
+  add_quad(m, 0, 4, 6, 2);  // x = lo
+  add_quad(m, 1, 3, 7, 5);  // x = hi
+  return m;
+}
+
+inline Mesh sphere_mesh(const Vec3& c, double r, int slices = 48, int stacks = 24) {
+  Mesh m;
+  std::uint32_t south = add_vertex(m, c - Vec3(0, 0, r));
+  for (int s = 1; s < stacks; ++s) {
+    double phi = std::numbers::pi * s / stacks - std::numbers::pi / 2;
+    for (int k = 0; k < slices; ++k) {
+      double theta = 2 * std::numbers::pi * k / slices;
+      add_vertex(m, c + r * Vec3(std::cos(phi) * std::cos(theta), std::cos(phi) * std::sin(theta), std::sin(phi)));
+    }
+  }
+  std::uint32_t north = add_vertex(m, c + Vec3(0, 0, r));
+  auto at = [&](int s, int k) { return static_cast<std::uint32_t>(1 + (s - 1) * slices + (k % slices)); };
+  for (int k = 0; k < slices; ++k) {
+    m.triangles.emplace_back(south, at(1, k + 1), at(1, k));
+    m.triangles.emplace_back(north, at(stacks - 1, k), at(stacks - 1, k + 1));
+    for (int s = 1; s + 1 < stacks; ++s) add_quad(m, at(s, k), at(s, k + 1), at(s + 1, k + 1), at(s + 1, k));
+  }
+  return m;
+}
+
+// Volume of the inscribed polyhedron is what a mesh test should compare against; these give the
+// analytic solid, and the tests allow for the facetting.
+inline Mesh cylinder_mesh(const Vec3& base, double r, double h, int slices = 64) {
+  Mesh m;
+  std::uint32_t bottom = add_vertex(m, base), top = add_vertex(m, base + Vec3(0, 0, h));
+  for (int k = 0; k < slices; ++k) {
+    double theta = 2 * std::numbers::pi * k / slices;
+    Vec3 d(r * std::cos(theta), r * std::sin(theta), 0);
+    add_vertex(m, base + d);
+    add_vertex(m, base + d + Vec3(0, 0, h));
+  }
+  auto lo = [&](int k) { return static_cast<std::uint32_t>(2 + 2 * (k % slices)); };
+  auto hi = [&](int k) { return static_cast<std::uint32_t>(3 + 2 * (k % slices)); };
+  for (int k = 0; k < slices; ++k) {
+    m.triangles.emplace_back(bottom, lo(k + 1), lo(k));
+    m.triangles.emplace_back(top, hi(k), hi(k + 1));
+    add_quad(m, lo(k), lo(k + 1), hi(k + 1), hi(k));
+  }
+  return m;
+}
+
+inline Mesh torus_mesh(const Vec3& c, double major, double minor, int nu = 64, int nv = 32) {
+  Mesh m;
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j) {
+      double u = 2 * std::numbers::pi * i / nu, v = 2 * std::numbers::pi * j / nv;
+      double rr = major + minor * std::cos(v);
+      add_vertex(m, c + Vec3(rr * std::cos(u), rr * std::sin(u), minor * std::sin(v)));
+    }
+  auto at = [&](int i, int j) { return static_cast<std::uint32_t>((i % nu) * nv + (j % nv)); };
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j) add_quad(m, at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+  return m;
+}
+
+// Volumes of the meshes above as polyhedra (exact for the facetted solids, up to float rounding).
+inline double cylinder_mesh_volume(double r, double h, int slices = 64) {
+  return 0.5 * slices * r * r * std::sin(2 * std::numbers::pi / slices) * h;
+}
+
+}  // namespace tridex_test
