@@ -1,0 +1,171 @@
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <random>
+
+#include "reference.hpp"
+#include "tridex/mill.hpp"
+
+using namespace tridex;
+
+namespace {
+
+struct KindCase {
+  Cutter cutter;
+  test::RadiusFunction reference;
+};
+
+// A random cutter of kind `kind` (0..5 cycles through every kind).
+KindCase random_cutter(int kind, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0, 1);
+  double r = 0.6 + 2.5 * u(rng);
+  switch (kind % 6) {
+    case 0: return {Cutter::flat(r), test::flat_rho(r)};
+    case 1: return {Cutter::ball(r), test::ball_rho(r)};
+    case 2: {
+      double c = r * (0.1 + 0.8 * u(rng));
+      return {Cutter::bull_nose(r, c), test::bull_rho(r, c)};
+    }
+    case 3: {
+      double a = 20 + 50 * u(rng);
+      return {Cutter::cone(r, a), test::chamfer_rho(r, 0, a)};
+    }
+    case 4: {
+      double tip = r * 0.5 * u(rng), a = 20 + 50 * u(rng);
+      return {Cutter::chamfer(r, tip, a), test::chamfer_rho(r, tip, a)};
+    }
+    default: {
+      double tip = r * (0.2 + 0.5 * u(rng)), a = 3 + 30 * u(rng);
+      return {Cutter::tapered_ball(r, tip, a), test::tapered_ball_rho(r, tip, a)};
+    }
+  }
+}
+
+// Random moves over a grid spanning [0, 12] × [0, 10]: long and short, tilted, horizontal,
+// vertical plunges, zero-length, and moves that leave the grid.
+std::vector<Segment> random_segments(std::mt19937& rng, int count) {
+  std::uniform_real_distribution<double> x(-3, 15), y(-3, 13), z(0, 4), u(0, 1);
+  std::vector<Segment> s;
+  for (int k = 0; k < count; ++k) {
+    Vec3 a(x(rng), y(rng), z(rng)), b(x(rng), y(rng), z(rng));
+    switch (k % 6) {
+      case 0: b = Vec3(a.x, a.y, z(rng)); break;                     // plunge or retract
+      case 1: b = a; break;                                          // zero length
+      case 2: b.z = a.z; break;                                      // horizontal
+      case 3: b = a + Vec3(0.5 * u(rng), 0.5 * u(rng), 0.3 * u(rng)); break;  // short
+      case 4: b = Vec3(a.x + 1e-9, a.y, z(rng)); break;              // nearly vertical
+      default: break;
+    }
+    s.push_back({a, b});
+  }
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("milled heights are the exact lowest point of the swept cutter (every cutter kind)") {
+  std::mt19937 rng(2026);
+  for (int trial = 0; trial < 12; ++trial) {
+    KindCase kind = random_cutter(trial, rng);
+    CAPTURE(kind.cutter.name());
+    CAPTURE(trial);
+    ZMapGrid g;
+    g.x0 = -0.13 * trial, g.y0 = 0.07 * trial, g.cell = 0.25, g.nx = 49, g.ny = 41;
+    const float top = 5, empty = -0.5f;
+    ZMap map(g, top, empty);
+    std::vector<Segment> segments = random_segments(rng, 12);
+    std::vector<CutMove> moves;
+    for (const Segment& s : segments) moves.push_back({s, 0});
+    std::vector<Cutter> cutters{kind.cutter};
+    mill(map, cutters, moves, {.threads = 2});
+
+    int lowered = 0;
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i) {
+        double x = g.x(i), y = g.y(j);
+        double exact = top, sampled = top;
+        for (const Segment& s : segments) {
+          exact = std::min(exact, test::refined_lowest(kind.reference, s, x, y));
+          sampled = std::min(sampled, test::sampled_lowest(kind.reference, s, x, y, 64));
+        }
+        exact = std::max(exact, double(empty));
+        sampled = std::max(sampled, double(empty));
+        double got = map.height(i, j);
+        CAPTURE(x);
+        CAPTURE(y);
+        // Never above any sampled position of the cutter (method-independent)...
+        REQUIRE(got <= sampled + 1e-5);
+        // ...and equal to the refined minimum within float resolution.
+        REQUIRE(got == doctest::Approx(exact).epsilon(0).scale(1).epsilon(2e-5));
+        if (got < top) ++lowered;
+      }
+    CHECK(lowered > 0);
+  }
+}
+
+TEST_CASE("milling gives identical heights for any thread count and any move order") {
+  std::mt19937 rng(99);
+  std::vector<Cutter> cutters;
+  for (int k = 0; k < 6; ++k) cutters.push_back(random_cutter(k, rng).cutter);
+  ZMapGrid g;
+  g.cell = 0.05, g.nx = 260, g.ny = 220;  // several tiles and work blocks
+  std::vector<CutMove> moves;
+  std::uniform_int_distribution<std::uint32_t> pick(0, 5);
+  for (const Segment& s : random_segments(rng, 300)) moves.push_back({s, pick(rng)});
+
+  ZMap reference(g, 5, -1);
+  mill(reference, cutters, moves, {.threads = 1});
+  for (unsigned threads : {2u, 3u, 8u}) {
+    ZMap map(g, 5, -1);
+    mill(map, cutters, moves, {.threads = threads});
+    CHECK(map.heights == reference.heights);
+  }
+  std::shuffle(moves.begin(), moves.end(), rng);
+  ZMap shuffled(g, 5, -1);
+  mill(shuffled, cutters, moves, {.threads = 2});
+  CHECK(shuffled.heights == reference.heights);
+  // Milling in two halves is the same as milling at once.
+  ZMap halves(g, 5, -1);
+  std::span<const CutMove> all(moves);
+  mill(halves, cutters, all.first(moves.size() / 2));
+  mill(halves, cutters, all.subspan(moves.size() / 2));
+  CHECK(halves.heights == reference.heights);
+}
+
+TEST_CASE("a tilted Z-map: a flat end plunge in the frame leaves a flat-bottomed hole") {
+  Frame f = Frame::from_axis(Vec3(1, 0, 0));
+  ZMap map = ZMap::from_box(f, Aabb{Vec3(0), Vec3(10, 10, 10)}, 0.1);
+  Vec3 centre_local = f.to_local(Vec3(10, 5, 5));
+  std::vector<Cutter> cutters{Cutter::flat(2)};
+  std::vector<CutMove> moves{{Segment{centre_local + Vec3(0, 0, 5), centre_local - Vec3(0, 0, 3)}, 0}};
+  mill(map, cutters, moves);
+  int i = static_cast<int>(std::lround((centre_local.x - map.grid.x0) / map.grid.cell));
+  int j = static_cast<int>(std::lround((centre_local.y - map.grid.y0) / map.grid.cell));
+  CHECK(map.height(i, j) == doctest::Approx(centre_local.z - 3).epsilon(1e-6));
+  CHECK(map.height(i + 15, j) == doctest::Approx(centre_local.z - 3).epsilon(1e-6));
+  CHECK(map.height(i + 25, j) == doctest::Approx(centre_local.z).epsilon(1e-6));
+}
+
+TEST_CASE("bad moves are rejected before anything is milled") {
+  ZMapGrid g;
+  g.nx = 10, g.ny = 10;
+  ZMap map(g, 1, -1);
+  std::vector<Cutter> cutters{Cutter::ball(1)};
+  std::vector<CutMove> nan_move{{Segment{Vec3(1, 1, 0), Vec3(NAN, 1, 0)}, 0}};
+  std::vector<CutMove> inf_move{{Segment{Vec3(1, 1, -INFINITY), Vec3(1, 1, 0)}, 0}};
+  std::vector<CutMove> bad_cutter{{Segment{Vec3(1, 1, 0), Vec3(2, 1, 0)}, 0},
+                                  {Segment{Vec3(1, 1, 0), Vec3(2, 1, 0)}, 3}};
+  CHECK_THROWS_WITH_AS(mill(map, cutters, nan_move), doctest::Contains("move 0"), Error);
+  CHECK_THROWS_AS(mill(map, cutters, inf_move), Error);
+  CHECK_THROWS_WITH_AS(mill(map, cutters, bad_cutter), doctest::Contains("cutter 3"), Error);
+  CHECK(std::all_of(map.heights.begin(), map.heights.end(), [](float h) { return h == 1; }));
+  // Far-away and enormous coordinates are fine: they simply miss the grid.
+  std::vector<CutMove> far{{Segment{Vec3(1e300, 1e300, 0), Vec3(-1e300, 1e300, 0)}, 0}};
+  mill(map, cutters, far);
+  CHECK(std::all_of(map.heights.begin(), map.heights.end(), [](float h) { return h == 1; }));
+  // Cuts below the stock stop at the empty height.
+  std::vector<CutMove> deep{{Segment{Vec3(4, 4, -100), Vec3(4, 4, -100)}, 0}};
+  mill(map, cutters, deep);
+  CHECK(map.is_empty(4, 4));
+  CHECK(map.height(4, 4) == -1);
+}
