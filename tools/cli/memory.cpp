@@ -1,0 +1,63 @@
+#include "memory.hpp"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+
+#include "errors.hpp"
+#include "numbers.hpp"
+
+namespace tridex::cli {
+
+std::uint64_t physical_memory_bytes() {
+  long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
+  if (pages <= 0 || page <= 0) return std::uint64_t{8} << 30;  // unknown: assume 8 GiB
+  return static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page);
+}
+
+double peak_rss_mib() {
+  rusage usage{};
+  ::getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux reports KiB
+}
+
+std::uint64_t parse_memory(const std::string& text) {
+  std::size_t end = text.size();
+  while (end > 0 && std::isalpha(static_cast<unsigned char>(text[end - 1]))) --end;
+  std::string suffix = text.substr(end);
+  for (char& c : suffix) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  double value = parse_number(text.substr(0, end), "--max-memory");
+  double scale = 0;
+  if (suffix.empty() || suffix == "M" || suffix == "MB" || suffix == "MIB") scale = 1 << 20;
+  else if (suffix == "G" || suffix == "GB" || suffix == "GIB") scale = 1 << 30;
+  else if (suffix == "K" || suffix == "KB" || suffix == "KIB") scale = 1 << 10;
+  else input_error("--max-memory: unknown unit \"", suffix, "\" (use K, M or G)");
+  if (!(value > 0)) input_error("--max-memory: must be positive, got ", text);
+  double bytes = value * scale;
+  if (!(bytes < 1e19)) input_error("--max-memory: ", text, " is too large");
+  return static_cast<std::uint64_t>(bytes);
+}
+
+MemoryEstimate estimate_memory(double zmap_points, double nx, double ny, double nz) {
+  MemoryEstimate e;
+  e.zmaps = 4.0 * zmap_points * 1.02;  // float heights plus tile maxima
+  // A ray costs a 4-byte offset and, typically, one or two 8-byte intervals; four triple dexels
+  // are alive at the peak (stock, one direction's, the running result and its successor).
+  double rays = nx * ny + ny * nz + nz * nx;
+  e.dexels = 4.0 * rays * (4.0 + 2 * 8.0);
+  // The surface crosses about as many lattice cells as the box's faces hold; two triangles per
+  // cell, a vertex per triangle (12 + 12 bytes), and as much again while it is built.
+  e.mesh = 2.0 * (2.0 * rays) * 2 * 24.0;
+  return e;
+}
+
+std::string format_mib(double bytes) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.0f MiB", bytes / (1 << 20));
+  return text;
+}
+
+}  // namespace tridex::cli

@@ -1,0 +1,48 @@
+// tridex command — output files written whole or not at all.
+//
+// Every output goes to a temporary file next to its destination and is renamed over it only once
+// complete, so a failed or interrupted run leaves no partial or empty file and an existing file
+// is replaced atomically (rename(2) within one directory).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace tridex::cli {
+
+class AtomicOutput {
+ public:
+  // Opens a temporary file beside `path`; throws tridex::Error if it cannot be created.
+  explicit AtomicOutput(std::filesystem::path path);
+  AtomicOutput(const AtomicOutput&) = delete;
+  AtomicOutput& operator=(const AtomicOutput&) = delete;
+  ~AtomicOutput();  // removes the temporary file unless commit() succeeded
+
+  std::ostream& stream() { return stream_; }
+  // Flushes, checks for write errors, closes and renames onto the destination.
+  void commit();
+
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+  std::filesystem::path temporary_;
+  std::ofstream stream_;
+  bool committed_ = false;
+};
+
+// Writes `bytes` to `path` through an AtomicOutput.
+void write_file_atomically(const std::filesystem::path& path, std::span<const std::uint8_t> bytes);
+void write_file_atomically(const std::filesystem::path& path, const std::string& text);
+
+// Checks up front, before any work, that `path` can be written: its directory exists and is
+// writable, it is not a directory, and it is none of `inputs` (a run never overwrites an input).
+// Throws InputError naming `option` and the path.
+void check_output_path(const std::string& option, const std::filesystem::path& path,
+                       std::span<const std::filesystem::path> inputs);
+
+}  // namespace tridex::cli

@@ -1,0 +1,95 @@
+#include "project.hpp"
+
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "errors.hpp"
+
+namespace tridex::cli {
+
+namespace fs = std::filesystem;
+
+bool is_project_file(const fs::path& path) {
+  if (path.extension() == ".camotics") return true;
+  std::ifstream in(path, std::ios::binary);
+  char c = 0;
+  while (in.get(c))
+    if (!std::isspace(static_cast<unsigned char>(c))) return c == '{';
+  return false;
+}
+
+namespace {
+
+Vec3 read_point(const nlohmann::json& value, const std::string& where) {
+  if (!value.is_array() || value.size() != 3)
+    input_error(where, ": expected [x, y, z]");
+  Vec3 p;
+  for (int a = 0; a < 3; ++a) {
+    const auto& v = value[static_cast<std::size_t>(a)];
+    if (!v.is_number()) input_error(where, ": coordinate ", a, " is not a number");
+    p[a] = v.get<double>();
+  }
+  if (!is_finite(p)) input_error(where, ": coordinates must be finite");
+  return p;
+}
+
+}  // namespace
+
+Project read_project(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) input_error(path.string(), ": cannot open the project file");
+  nlohmann::json json;
+  try {
+    json = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::parse_error& e) {
+    input_error(path.string(), ": not a valid CAMotics project (", e.what(), ")");
+  }
+  if (!json.is_object()) input_error(path.string(), ": a CAMotics project must be a JSON object");
+  const std::string source = path.string();
+  Project project;
+  fs::path folder = path.parent_path();
+  auto files = json.find("files");
+  if (files == json.end() || !files->is_array() || files->empty())
+    input_error(source, ": \"files\" must list the program file(s)");
+  for (const auto& f : *files) {
+    // CAMotics writes plain strings; some versions write {"path": ...}.
+    std::string name;
+    if (f.is_string()) name = f.get<std::string>();
+    else if (f.is_object() && f.contains("path") && f["path"].is_string()) name = f["path"].get<std::string>();
+    else input_error(source, ": \"files\" entries must be file names");
+    fs::path file = name;
+    if (file.is_relative()) file = folder / file;
+    std::error_code error;
+    if (!fs::is_regular_file(file, error))
+      input_error(source, ": program file ", file.string(), " does not exist");
+    project.files.push_back(file);
+  }
+  if (auto tools = json.find("tools"); tools != json.end())
+    project.tools = ToolTable::from_json(*tools, source + ": \"tools\"");
+  if (auto work = json.find("workpiece"); work != json.end()) {
+    if (!work->is_object()) input_error(source, ": \"workpiece\" must be an object");
+    StockSpec stock;
+    bool automatic = work->value("automatic", true);
+    if (auto margin = work->find("margin"); margin != work->end()) {
+      if (!margin->is_number() || margin->get<double>() < 0)
+        input_error(source, ": workpiece \"margin\" must be a non-negative number (percent)");
+      stock.margin_percent = margin->get<double>();
+    }
+    auto bounds = work->find("bounds");
+    if (!automatic) {
+      if (bounds == work->end() || !bounds->is_object())
+        input_error(source, ": a workpiece that is not automatic needs \"bounds\"");
+      stock.kind = StockSpec::Kind::box;
+      stock.box = Aabb{read_point(bounds->value("min", nlohmann::json()), source + ": workpiece bounds min"),
+                       read_point(bounds->value("max", nlohmann::json()), source + ": workpiece bounds max")};
+      for (int a = 0; a < 3; ++a)
+        if (!(stock.box.min[a] < stock.box.max[a]))
+          input_error(source, ": workpiece bounds min must be below max on every axis");
+    }
+    project.stock = stock;
+  }
+  return project;
+}
+
+}  // namespace tridex::cli

@@ -1,0 +1,33 @@
+// tridex command — the workpiece: `--stock box:…`, `--stock FILE.stl` or `--stock auto[:MARGIN]`.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "tridex/geometry.hpp"
+
+namespace tridex::cli {
+
+struct StockSpec {
+  enum class Kind { box, mesh, automatic };
+  Kind kind = Kind::automatic;
+  Aabb box;                          // Kind::box: the stock, mm, work frame
+  std::filesystem::path mesh_path;   // Kind::mesh: a closed STL
+  // Kind::automatic: the margin added on every side of the box around the cutting moves, in mm;
+  // unset means 5 % of each side (the CAMotics default), and then the top gets no margin.
+  std::optional<double> margin_mm;
+  std::optional<double> margin_percent;  // from a CAMotics project ("margin", percent)
+};
+
+// Parses the option text; throws InputError naming the option and the offending part.
+StockSpec parse_stock(const std::string& text);
+
+// The automatic stock around `cutting_bounds` (the tool-tip box of the cutting moves), following
+// CAMotics: the top is the highest cut or z = 0 whichever is higher when the cuts go below 0, at
+// least 2 mm thick, then a margin on every side but the top when it is a percentage.
+Aabb automatic_stock(const Aabb& cutting_bounds, const StockSpec& spec);
+
+std::string describe(const StockSpec& spec);
+
+}  // namespace tridex::cli
