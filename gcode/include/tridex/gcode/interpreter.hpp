@@ -1,0 +1,107 @@
+// tridex::gcode — the modal interpreter: a milling program in, a stream of tool-tip moves out.
+//
+// Codes (the list): G0 G1 G2 G3 (I/J/K and R, full circles, helices) in G17/G18/G19,
+// G20/G21, G90/G91, G90.1/G91.1, G54–G59 and G54.1 Pn, G10 L2/L20, G43/G44/G49 H, T, M6, F, S,
+// M3/M4/M5, M0/M1/M2/M30, G28/G30/G53, canned cycles G73 G81 G82 G83 G85 G86 G89 with G98/G99 and
+// repeats (L or K), M98 P L / M99 with O numbers, G4; tilted planes Fanuc G68.2 (Euler Z-X-Z),
+// G53.1, G53.6, G69 and Haas G268 (Q123), G253, G269. Accepted without effect on the tool path:
+// G15 G40 G49 G61 G64 G80 G94 G97, M7 M8 M9. Anything else is an error naming file, line, column
+// and word (a warning in lenient mode, which then skips the word).
+//
+// Conventions (../shared/DESIGN.md): the programmed point is the tool tip after work offsets;
+// G20 values are converted to mm; G68.2 R = Rz(I)·Rx(J)·Rz(K) and the tool axis is R·(0,0,1)
+// once G53.1/G53.6 orient the tool; G268 R = Rz(K)·Ry(J)·Rx(I), oriented by G253. A home return
+// (G28, G30, a G53 move of an axis along the tool) and a change of spindle direction leave the tip
+// "far" along the tool axis; moves that leave the coordinate along the tool axis unset stay far
+// and emit nothing; the first move that sets it comes straight back along the axis to its end.
+// The program starts far along +Z (unless InterpreterOptions::start_position says otherwise).
+//
+// Emitted points are in the work frame: machine coordinates minus the G54 offset configured in
+// MachineConfig (the machine frame itself when none is configured).
+#pragma once
+
+#include <functional>
+#include <iosfwd>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "tridex/gcode/diagnostic.hpp"
+#include "tridex/gcode/move.hpp"
+#include "tridex/geometry.hpp"
+
+namespace tridex::gcode {
+
+struct MachineConfig {
+  static constexpr double kDefaultFar = 1e4;  // mm
+
+  // G28 and G30 P2 positions in machine coordinates. The defaults lie far above the work along
+  // +Z, so that the usual `G28 G91 Z0` retract cuts nothing; using them raises a warning.
+  Vec3 home{0.0, 0.0, kDefaultFar};
+  Vec3 reference2{0.0, 0.0, kDefaultFar};
+  bool home_is_default = true;
+  bool reference2_is_default = true;
+
+  // Work offsets (machine coordinates of each work zero), keyed as G10 numbers them:
+  // 1..6 = G54..G59 (G10 L2 P1..P6), 100 + n = G54.1 Pn (G10 L20 Pn, n = 1..300). Absent = 0.
+  std::map<int, Vec3> work_offsets;
+
+  // How far "far along the tool axis" is: the start of the approach move that brings the tool
+  // back from a retract. Must exceed the size of the work.
+  double far_distance = kDefaultFar;
+
+  void set_home(const Vec3& p) {
+    home = p;
+    home_is_default = false;
+  }
+  void set_reference2(const Vec3& p) {
+    reference2 = p;
+    reference2_is_default = false;
+  }
+  static int g54_key(int n) { return n; }          // n = 1..6 for G54..G59
+  static int g54_1_key(int p) { return 100 + p; }  // G54.1 Pp
+};
+
+struct InterpreterOptions {
+  double arc_tolerance = 0.001;         // mm, largest chord error of a linearised arc
+  double arc_radius_tolerance = 0.002;  // mm, allowed |end radius − start radius| of I/J/K arcs
+  bool lenient = false;        // unsupported words become warnings and are skipped
+  bool block_delete = true;    // skip blocks that start with '/' (the switch on)
+  bool tool_change_retracts = true;  // M6 leaves the tip far along the tool axis
+  std::optional<Vec3> start_position;  // tip at program start, work frame; default: far along +Z
+  int max_call_depth = 16;     // nested M98 calls
+  double peck_clearance = 0.254;  // mm, G73 back-off and G83 re-entry gap (LinuxCNC's 0.010 in)
+};
+
+class Interpreter {
+ public:
+  explicit Interpreter(InterpreterOptions options = {}, MachineConfig machine = {});
+  ~Interpreter();
+  Interpreter(Interpreter&&) noexcept;
+  Interpreter& operator=(Interpreter&&) noexcept;
+
+  // Streams every move of the program to `sink` in program order; throws GcodeError (or its
+  // SyntaxError) on bad input. Memory does not grow with the program's length. Each call starts
+  // from a fresh machine state. M98 needs a seekable stream (files and string streams are).
+  void run(std::istream& program, const std::string& file_name,
+           const std::function<void(const Move&)>& sink);
+
+  const std::vector<Diagnostic>& warnings() const;
+  const std::set<int>& tools_used() const;              // tools of the emitted moves
+  const std::map<int, int>& tool_first_line() const;    // tool -> line of the M6 that loaded it
+                                                        // (its first move's line if none)
+  long long blocks() const;                             // blocks executed by the last run
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+// Reads a whole program file into memory as moves (convenient for small programs and tests).
+std::vector<Move> read_moves(const std::string& path, InterpreterOptions options = {},
+                             MachineConfig machine = {});
+
+}  // namespace tridex::gcode

@@ -1,0 +1,33 @@
+// tridex::gcode — one tool-tip move, the unit the interpreter streams to the simulator.
+#pragma once
+
+#include "tridex/geometry.hpp"
+
+namespace tridex::gcode {
+
+// rapid: G0 (and the returns of G28/G30/G53); feed: G1; arc: one chord of a linearised G2/G3;
+// cycle: one straight piece of an expanded canned cycle (feed == 0 marks its rapid pieces).
+enum class MoveKind { rapid, feed, arc, cycle };
+
+inline const char* to_string(MoveKind kind) {
+  switch (kind) {
+    case MoveKind::rapid: return "rapid";
+    case MoveKind::feed: return "feed";
+    case MoveKind::arc: return "arc";
+    case MoveKind::cycle: return "cycle";
+  }
+  return "?";
+}
+
+struct Move {
+  int line = 0;                  // 1-based source line of the block that made the move
+  MoveKind kind = MoveKind::rapid;
+  int tool = 0;                  // the tool in the spindle (last M6); 0 before any tool change
+  Vec3 start{0.0};               // tool tip, mm, in the work frame (the simulation's world frame:
+  Vec3 end{0.0};                 //   machine table frame after the G54 offset, no tilted plane)
+  Vec3 axis{0.0, 0.0, 1.0};      // unit spindle direction (tip towards holder), work frame
+  double feed = 0;               // mm/min; 0 for rapids and the rapid pieces of cycles
+  double spindle = 0;            // rpm, signed: + for M3, − for M4, 0 while stopped (M5)
+};
+
+}  // namespace tridex::gcode
