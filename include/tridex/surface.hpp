@@ -1,0 +1,673 @@
+// tridex — surface extraction: triple dexel → closed, outward-oriented triangle mesh (Step 4 of
+// the method in ../shared/DESIGN.md).
+//
+// Method. Marching cubes (Lorensen & Cline, SIGGRAPH 1987) on the triple-dexel lattice, with the
+// two refinements that triple dexels make natural:
+//  * every lattice edge lies on a dexel ray, so its crossing is a dexel end point: exact, not
+//    interpolated (the surface error is bounded by the spacing, not by half a voxel);
+//  * sharp edges and corners are kept as in Extended Marching Cubes (Kobbelt, Botsch,
+//    Schwanecke & Seidel, SIGGRAPH 2001): where the normals of a cell's crossings spread by more
+//    than SurfaceOptions::feature_angle, the cell's loop is fanned around the point that
+//    minimises Σ (n_i·(x − p_i))² (a quadric error function solved with a truncated
+//    pseudo-inverse), and edges between two such fans are flipped so that the fans' apexes join
+//    along the feature. Normals come from the neighbouring rays' end points (one-sided or central
+//    differences of the end-point heights, whichever side is smoother), not from any field.
+//
+// Consistency. Node inside/outside comes from ONE rule: the z ray through the node, with closed
+// intervals [enter, exit]. Topology is derived from these states alone (surface_tables.hpp: a
+// per-face rule that never depends on the neighbouring cell), so the mesh is closed and
+// manifold whatever the rays say; the x and y rays only place crossings. Where a ray disagrees
+// with the node states (a node within rounding of the surface), the crossing goes to the node
+// the ray disagrees about. Crossings are kept a small fraction of the spacing away from nodes so
+// that no two vertices coincide and no triangle degenerates (three points interior to distinct
+// cube edges are never collinear). The solid is clipped to the lattice box: where it reaches the
+// outer nodes, caps on the box faces close it.
+//
+// Cost. Node states of one lattice layer are kept as bit rows updated by the z rays' state
+// changes; cells whose eight corners agree are skipped 64 at a time, so only cells next to the
+// surface are visited. Layers are cut into a fixed number of slabs that run on threads; slabs are
+// joined in order, and their shared vertices matched by lattice edge, so the output does not
+// depend on the thread count.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <exception>
+#include <limits>
+#include <mutex>
+#include <span>
+#include <thread>
+#include <unordered_set>
+#include <utility>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "tridex/dexel.hpp"
+#include "tridex/dexel_ops.hpp"
+#include "tridex/error.hpp"
+#include "tridex/mesh.hpp"
+#include "tridex/surface_tables.hpp"
+
+namespace tridex {
+
+struct SurfaceOptions {
+  unsigned threads = 0;          // 0: one per hardware thread; the output does not depend on it
+  bool sharp_features = true;    // Extended Marching Cubes feature points and edge flips
+  double feature_angle = 35.0;   // degrees; normals spreading more than this mark a feature
+};
+
+namespace detail::surface {
+
+constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+
+// Closed-interval membership of coordinate x on one ray.
+inline bool ray_contains(std::span<const DexelInterval> ray, double x) {
+  auto it = std::lower_bound(ray.begin(), ray.end(), x,
+                             [](const DexelInterval& s, double value) { return double(s.exit) < value; });
+  return it != ray.end() && double(it->enter) <= x;
+}
+
+// Symmetric 3×3 eigen-decomposition by cyclic Jacobi rotations (the QEF is tiny; no library).
+inline void symmetric_eigen(Mat3 a, Vec3& values, Mat3& vectors) {
+  vectors = Mat3(1.0);
+  for (int sweep = 0; sweep < 16; ++sweep) {
+    double off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+    if (off < 1e-24) break;
+    for (int p = 0; p < 2; ++p)
+      for (int q = p + 1; q < 3; ++q) {
+        if (std::abs(a[p][q]) < 1e-30) continue;
+        double theta = (a[q][q] - a[p][p]) / (2 * a[p][q]);
+        double t = (theta >= 0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1));
+        double c = 1 / std::sqrt(t * t + 1), s = t * c;
+        Mat3 r(1.0);
+        r[p][p] = c, r[q][q] = c, r[q][p] = s, r[p][q] = -s;  // glm: r[column][row]
+        a = glm::transpose(r) * a * r;
+        vectors = vectors * r;
+      }
+  }
+  values = Vec3(a[0][0], a[1][1], a[2][2]);
+}
+
+struct SlabMesh {
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;  // per vertex: estimated outward normal, zero if unknown
+  std::vector<glm::uvec3> triangles;
+  std::vector<std::uint32_t> feature_triangles;  // triangles fanned from a feature point (apex first)
+  // Vertices on the slab's bottom and top node layers, keyed by lattice element, sorted by key;
+  // the bottom ones duplicate the previous slab's top ones and are matched when slabs are joined.
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> bottom, top;
+};
+
+class Extractor {
+ public:
+  Extractor(const TripleDexel& d, const SurfaceOptions& options)
+      : d_(d), nx_(d.n.x), ny_(d.n.y), nz_(d.n.z), h_(d.spacing), words_((d.n.x + 63) / 64) {
+    sharp_ = options.sharp_features;
+    cos_feature_ = std::cos(options.feature_angle * 3.14159265358979323846 / 180.0);
+    double extent = 0;
+    for (int a = 0; a < 3; ++a)
+      extent = std::max(extent, std::abs(d.origin[a]) + h_ * (d.n[a] - 1));
+    // Keep crossings at least 32 float ulps away from nodes (and never more than 1% of a cell).
+    delta_ = std::clamp(32.0 * double(std::numeric_limits<float>::epsilon()) * extent / h_, 1e-4, 1e-2);
+    build_flips();
+  }
+
+  Mesh run(unsigned threads) {
+    const int layers = nz_ - 1;  // cell layers
+    const int slab = std::max(8, (layers + 31) / 32);
+    const int slabs = (layers + slab - 1) / slab;
+    std::vector<SlabMesh> parts(static_cast<std::size_t>(slabs));
+    std::atomic<int> next{0};
+    std::exception_ptr error;
+    std::mutex error_mutex;
+    auto worker = [&] {
+      try {
+        Scratch scratch(*this);
+        for (int s; (s = next.fetch_add(1)) < slabs;)
+          process_slab(s * slab, std::min(layers, (s + 1) * slab), scratch, parts[static_cast<std::size_t>(s)]);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (!error) error = std::current_exception();
+      }
+    };
+    unsigned count = std::min<unsigned>(threads ? threads : std::max(1u, std::thread::hardware_concurrency()),
+                                        static_cast<unsigned>(slabs));
+    std::vector<std::thread> pool;
+    for (unsigned t = 1; t < count; ++t) pool.emplace_back(worker);
+    worker();
+    for (std::thread& t : pool) t.join();
+    if (error) std::rethrow_exception(error);
+    return join(parts);
+  }
+
+ private:
+  struct Scratch {
+    std::vector<std::uint64_t> s0, s1;                        // node states, layers k and k+1
+    std::array<std::vector<std::uint32_t>, 2> xe, ye, nodes;  // vertex ids on node layers k, k+1
+    std::vector<std::uint32_t> ze;                             // vertex ids on z edges k → k+1
+    std::array<std::vector<std::uint32_t>, 2> xe_used, ye_used, nodes_used;
+    std::vector<std::uint32_t> ze_used;
+    explicit Scratch(const Extractor& e) {
+      std::size_t layer = static_cast<std::size_t>(e.nx_) * static_cast<std::size_t>(e.ny_);
+      s0.assign(static_cast<std::size_t>(e.ny_) * static_cast<std::size_t>(e.words_), 0);
+      s1 = s0;
+      for (int l = 0; l < 2; ++l) xe[l].assign(layer, kNone), ye[l].assign(layer, kNone), nodes[l].assign(layer, kNone);
+      ze.assign(layer, kNone);
+    }
+  };
+
+  double coord(int a, int m) const { return d_.origin[a] + h_ * m; }
+  std::size_t column(int i, int j) const { return static_cast<std::size_t>(i) + static_cast<std::size_t>(nx_) * static_cast<std::size_t>(j); }
+
+  // The node range [first, last] of the z axis whose nodes lie in [enter, exit].
+  int first_node_at_or_above(double value) const {
+    double f = std::ceil((value - d_.origin.z) / h_);
+    int k = static_cast<int>(std::clamp(f, 0.0, double(nz_)));
+    while (k > 0 && coord(2, k - 1) >= value) --k;
+    while (k < nz_ && coord(2, k) < value) ++k;
+    return k;
+  }
+  int last_node_at_or_below(double value) const {
+    double f = std::floor((value - d_.origin.z) / h_);
+    int k = static_cast<int>(std::clamp(f, -1.0, double(nz_ - 1)));
+    while (k + 1 < nz_ && coord(2, k + 1) <= value) ++k;
+    while (k >= 0 && coord(2, k) > value) --k;
+    return k;
+  }
+
+  // For every z ray, the layers where its node state changes (state(k) = state(k−1) xor flip).
+  void build_flips() {
+    const DexelGrid& g = d_.grids[2];
+    flip_offsets_.assign(static_cast<std::size_t>(nz_) + 1, 0);
+    for (int pass = 0; pass < 2; ++pass) {
+      std::vector<std::uint32_t> fill;
+      if (pass == 1) {
+        for (int k = 0; k < nz_; ++k) flip_offsets_[static_cast<std::size_t>(k) + 1] += flip_offsets_[static_cast<std::size_t>(k)];
+        flip_columns_.resize(flip_offsets_.back());
+        fill.assign(flip_offsets_.begin(), flip_offsets_.end() - 1);
+      }
+      auto flip = [&](int k, std::size_t col) {
+        if (k <= 0 || k >= nz_) return;  // layer 0 is evaluated directly; beyond the top is nothing
+        if (pass == 0) ++flip_offsets_[static_cast<std::size_t>(k) + 1];
+        else flip_columns_[fill[static_cast<std::size_t>(k)]++] = static_cast<std::uint32_t>(col);
+      };
+      for (int j = 0; j < ny_; ++j)
+        for (int i = 0; i < nx_; ++i) {
+          std::size_t col = column(i, j);
+          int start = 0, end = -2;  // merged node range, closed
+          for (const DexelInterval& s : g.ray(i, j)) {
+            int a = first_node_at_or_above(double(s.enter)), b = last_node_at_or_below(double(s.exit));
+            if (a > b) continue;
+            if (a <= end + 1) {
+              end = std::max(end, b);
+            } else {
+              if (end >= start) flip(start, col), flip(end + 1, col);
+              start = a, end = b;
+            }
+          }
+          if (end >= start) flip(start, col), flip(end + 1, col);
+        }
+    }
+  }
+
+  static bool bit(const std::vector<std::uint64_t>& s, int words, int i, int j) {
+    return (s[static_cast<std::size_t>(j) * static_cast<std::size_t>(words) + static_cast<std::size_t>(i >> 6)] >> (i & 63)) & 1u;
+  }
+
+  // Corner states of cell (i, j, ·) from the two node layers: bit c = bx + 2·by + 4·bz.
+  unsigned cell_mask(const Scratch& s, int i, int j) const {
+    unsigned m = 0;
+    for (int c = 0; c < 8; ++c) {
+      const std::vector<std::uint64_t>& layer = (c & 4) ? s.s1 : s.s0;
+      m |= unsigned(bit(layer, words_, i + (c & 1), j + ((c >> 1) & 1))) << c;
+    }
+    return m;
+  }
+
+  void init_layer(std::vector<std::uint64_t>& s, int k) const {
+    std::fill(s.begin(), s.end(), 0);
+    double z = coord(2, k);
+    for (int j = 0; j < ny_; ++j)
+      for (int i = 0; i < nx_; ++i)
+        if (ray_contains(d_.grids[2].ray(i, j), z))
+          s[static_cast<std::size_t>(j) * static_cast<std::size_t>(words_) + static_cast<std::size_t>(i >> 6)] |= std::uint64_t(1) << (i & 63);
+  }
+
+  // ---- vertices ------------------------------------------------------------------------------
+
+  struct SlabState {
+    Scratch& s;
+    SlabMesh& out;
+    int k;  // current cell layer
+  };
+
+  std::uint32_t add_vertex(SlabMesh& out, const Vec3& p, const glm::vec3& normal) const {
+    out.positions.emplace_back(p);
+    if (sharp_) out.normals.push_back(normal);
+    return static_cast<std::uint32_t>(out.positions.size() - 1);
+  }
+
+  // Vertex on the lattice edge along axis a that starts at node (n0, n1, n2).
+  std::uint32_t edge_vertex(SlabState& st, int a, glm::ivec3 node, bool start_inside) const {
+    std::size_t slot = column(node.x, node.y);
+    std::uint32_t* id;
+    std::vector<std::uint32_t>* used;
+    if (a == 2) {
+      id = &st.s.ze[slot], used = &st.s.ze_used;
+    } else {
+      int l = node.z - st.k;
+      id = a == 0 ? &st.s.xe[static_cast<std::size_t>(l)][slot] : &st.s.ye[static_cast<std::size_t>(l)][slot];
+      used = a == 0 ? &st.s.xe_used[static_cast<std::size_t>(l)] : &st.s.ye_used[static_cast<std::size_t>(l)];
+    }
+    if (*id != kNone) return *id;
+    const int u = TripleDexel::u_axis(a), v = TripleDexel::v_axis(a);
+    std::span<const DexelInterval> ray = d_.grids[a].ray(node[u], node[v]);
+    double x0 = coord(a, node[a]), x1 = coord(a, node[a] + 1), x = 0;
+    bool found = false;
+    if (start_inside) {  // leaving the solid: the first exit after the inside node
+      auto it = std::lower_bound(ray.begin(), ray.end(), x0,
+                                 [](const DexelInterval& s, double value) { return double(s.exit) < value; });
+      if (it != ray.end() && double(it->exit) <= x1) x = it->exit, found = true;
+    } else {  // entering: the last enter before the inside node
+      auto it = std::upper_bound(ray.begin(), ray.end(), x1,
+                                 [](double value, const DexelInterval& s) { return value < double(s.enter); });
+      if (it != ray.begin() && double((it - 1)->enter) >= x0) x = (it - 1)->enter, found = true;
+    }
+    if (!found) x = ray_contains(ray, x0) == start_inside ? x1 : x0;  // at the node the ray disputes
+    double t = std::clamp((x - x0) / h_, delta_, 1 - delta_);
+    Vec3 p(coord(0, node.x), coord(1, node.y), coord(2, node.z));
+    p[a] = x0 + t * h_;
+    glm::vec3 normal(0.0f);
+    if (sharp_) normal = crossing_normal(a, node[u], node[v], x, !start_inside);
+    *id = add_vertex(st.out, p, normal);
+    used->push_back(static_cast<std::uint32_t>(slot));
+    return *id;
+  }
+
+  // Outward normal at the end point x of ray (iu, iv) of grid a, from the neighbouring rays' end
+  // points of the same kind: the surface is locally x = f(u, v), with normal ±(e_a − f_u e_u −
+  // f_v e_v). Zero when no neighbour has a matching end point within two spacings.
+  glm::vec3 crossing_normal(int a, int iu, int iv, double x, bool enter) const {
+    const DexelGrid& g = d_.grids[a];
+    auto slope = [&](int du, int dv, double& out) {
+      double best[2];
+      bool have[2] = {false, false};
+      for (int side = 0; side < 2; ++side) {
+        int su = side ? 1 : -1;
+        int ju = iu + su * du, jv = iv + su * dv;
+        if (ju < 0 || jv < 0 || ju >= g.nu || jv >= g.nv) continue;
+        std::span<const DexelInterval> ray = g.ray(ju, jv);
+        auto end_point = [&](const DexelInterval& s) { return double(enter ? s.enter : s.exit); };
+        auto it = std::lower_bound(ray.begin(), ray.end(), x,
+                                   [&](const DexelInterval& s, double value) { return end_point(s) < value; });
+        double nearest = std::numeric_limits<double>::infinity();
+        if (it != ray.end()) nearest = end_point(*it) - x;
+        if (it != ray.begin() && std::abs(end_point(*(it - 1)) - x) < std::abs(nearest)) nearest = end_point(*(it - 1)) - x;
+        if (std::abs(nearest) <= 2 * h_) have[side] = true, best[side] = su * nearest / h_;
+      }
+      if (have[0] && have[1]) {
+        out = std::abs(best[0] - best[1]) <= 0.5 ? 0.5 * (best[0] + best[1])
+              : std::abs(best[0]) < std::abs(best[1]) ? best[0] : best[1];
+        return true;
+      }
+      if (have[0] || have[1]) {
+        out = have[0] ? best[0] : best[1];
+        return true;
+      }
+      return false;
+    };
+    double fu = 0, fv = 0;
+    if (!slope(1, 0, fu) || !slope(0, 1, fv)) return glm::vec3(0.0f);
+    Vec3 n(0);
+    n[a] = 1, n[TripleDexel::u_axis(a)] = -fu, n[TripleDexel::v_axis(a)] = -fv;
+    n = glm::normalize(n);
+    return glm::vec3(enter ? -n : n);
+  }
+
+  std::uint32_t node_vertex(SlabState& st, glm::ivec3 node) const {
+    int l = node.z - st.k;
+    std::size_t slot = column(node.x, node.y);
+    std::uint32_t& id = st.s.nodes[static_cast<std::size_t>(l)][slot];
+    if (id == kNone) {
+      id = add_vertex(st.out, Vec3(coord(0, node.x), coord(1, node.y), coord(2, node.z)), glm::vec3(0.0f));
+      st.s.nodes_used[static_cast<std::size_t>(l)].push_back(static_cast<std::uint32_t>(slot));
+    }
+    return id;
+  }
+
+  std::uint32_t cube_edge_vertex(SlabState& st, int i, int j, unsigned mask, int e) const {
+    const CubeTables& t = kCubeTables;
+    int a = e / 4, bu = e & 1, bv = (e >> 1) & 1;
+    glm::ivec3 node(i, j, st.k);
+    node[TripleDexel::u_axis(a)] += bu;
+    node[TripleDexel::v_axis(a)] += bv;
+    return edge_vertex(st, a, node, (mask >> t.edge_corners[static_cast<std::size_t>(e)][0]) & 1u);
+  }
+
+  // ---- polygons ------------------------------------------------------------------------------
+
+  void emit(SlabMesh& out, std::uint32_t a, std::uint32_t b, std::uint32_t c) const { out.triangles.emplace_back(a, b, c); }
+
+  // True when every triangle (apex, p_i, p_i+1) has a clearly non-zero area and faces the way
+  // the surface does there: along the estimated normals of its two loop vertices where known
+  // (a tall corner apex tilts its triangles far from the loop's mean normal), else along `n`.
+  bool fan_is_valid(const Vec3& apex, std::span<const Vec3> p, const glm::vec3* normals, const Vec3& n) const {
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      std::size_t j = (i + 1) % p.size();
+      Vec3 c = glm::cross(p[i] - apex, p[j] - apex);
+      Vec3 ref = n;
+      if (normals && normals[i] != glm::vec3(0.0f) && normals[j] != glm::vec3(0.0f)) {
+        Vec3 sum = Vec3(normals[i]) + Vec3(normals[j]);
+        if (glm::dot(sum, sum) > 1e-6) ref = sum;
+      }
+      if (!(glm::length(c) > 1e-7 * h_ * h_) || !(glm::dot(c, ref) > 0)) return false;
+    }
+    return true;
+  }
+
+  void emit_loop(SlabState& st, int i, int j, const std::uint8_t* edges, int size, int fan_start, unsigned mask) const {
+    std::array<std::uint32_t, 12> id{};
+    std::array<Vec3, 12> p{};
+    std::array<glm::vec3, 12> normal{};
+    for (int q = 0; q < size; ++q) {
+      std::size_t sq = static_cast<std::size_t>(q);
+      id[sq] = cube_edge_vertex(st, i, j, mask, edges[q]);
+      p[sq] = Vec3(st.out.positions[id[sq]]);
+      if (sharp_) normal[sq] = st.out.normals[id[sq]];
+    }
+    const std::size_t n = static_cast<std::size_t>(size);
+    Vec3 centroid(0), newell(0);
+    for (std::size_t q = 0; q < n; ++q) centroid += p[q], newell += glm::cross(p[q], p[(q + 1) % n]);
+    centroid /= double(size);
+    std::span<const Vec3> ring(p.data(), n);
+    auto fan_around = [&](const Vec3& apex, bool feature) {
+      std::uint32_t c = add_vertex(st.out, apex, glm::vec3(0.0f));
+      for (std::size_t q = 0; q < n; ++q) {
+        if (feature) st.out.feature_triangles.push_back(static_cast<std::uint32_t>(st.out.triangles.size()));
+        emit(st.out, c, id[q], id[(q + 1) % n]);
+      }
+    };
+    if (sharp_) {
+      Vec3 apex;
+      if (feature_point(st, id.data(), ring, centroid, i, j, apex) && fan_is_valid(apex, ring, normal.data(), newell)) {
+        fan_around(apex, true);
+        return;
+      }
+    }
+    if (size == 3) {
+      emit(st.out, id[0], id[1], id[2]);
+    } else if (fan_start != 255) {
+      std::size_t r = static_cast<std::size_t>(fan_start);
+      for (std::size_t q = 1; q + 1 < n; ++q) emit(st.out, id[r], id[(r + q) % n], id[(r + q + 1) % n]);
+    } else {
+      fan_around(centroid, false);
+    }
+  }
+
+  // Extended Marching Cubes: when the crossings' normals spread beyond the feature angle, the
+  // minimiser of Σ (n_i·(x − p_i))² nearest the centroid (pseudo-inverse, small eigenvalues
+  // dropped), if it lies in the cell.
+  bool feature_point(const SlabState& st, const std::uint32_t* id, std::span<const Vec3> p, const Vec3& centroid,
+                     int i, int j, Vec3& out) const {
+    std::array<Vec3, 12> n{};
+    std::size_t count = 0;
+    for (std::size_t q = 0; q < p.size(); ++q) {
+      glm::vec3 normal = st.out.normals[id[q]];
+      if (normal != glm::vec3(0.0f)) n[count++] = Vec3(normal);
+    }
+    if (count < 2) return false;
+    double min_dot = 1;
+    for (std::size_t a = 0; a < count; ++a)
+      for (std::size_t b = a + 1; b < count; ++b) min_dot = std::min(min_dot, glm::dot(n[a], n[b]));
+    if (min_dot >= cos_feature_) return false;
+    Mat3 ata(0.0);
+    Vec3 atb(0);
+    for (std::size_t q = 0, c = 0; q < p.size(); ++q) {
+      glm::vec3 normal = st.out.normals[id[q]];
+      if (normal == glm::vec3(0.0f)) continue;
+      const Vec3& m = n[c++];
+      ata += glm::outerProduct(m, m);
+      atb += m * glm::dot(m, p[q] - centroid);
+    }
+    Vec3 values;
+    Mat3 vectors;
+    symmetric_eigen(ata, values, vectors);
+    double largest = std::max({values.x, values.y, values.z});
+    Vec3 x(0);
+    for (int e = 0; e < 3; ++e)
+      if (values[e] > 0.02 * largest) x += vectors[e] * (glm::dot(vectors[e], atb) / values[e]);
+    out = centroid + x;
+    Vec3 lo(coord(0, i), coord(1, j), coord(2, st.k)), hi(coord(0, i + 1), coord(1, j + 1), coord(2, st.k + 1));
+    double tol = 1e-9 * h_;
+    return out.x >= lo.x - tol && out.y >= lo.y - tol && out.z >= lo.z - tol && out.x <= hi.x + tol &&
+           out.y <= hi.y + tol && out.z <= hi.z + tol;
+  }
+
+  void emit_cell(SlabState& st, int i, int j, unsigned mask) const {
+    const CubeCase& cc = kCubeTables.cases[mask];
+    int first = 0;
+    for (int l = 0; l < cc.loop_count; ++l) {
+      int size = cc.loop_size[static_cast<std::size_t>(l)];
+      emit_loop(st, i, j, cc.edges.data() + first, size, cc.fan_start[static_cast<std::size_t>(l)], mask);
+      first += size;
+    }
+  }
+
+  // The part of face f of cell (i, j, k) inside the solid, on the lattice's outer boundary.
+  void emit_cap(SlabState& st, int i, int j, unsigned mask, int f) const {
+    const CubeTables& t = kCubeTables;
+    unsigned face_mask = 0;
+    for (int q = 0; q < 4; ++q) face_mask |= ((mask >> t.face_corners[static_cast<std::size_t>(f)][static_cast<std::size_t>(q)]) & 1u) << q;
+    const FaceCap& cap = t.caps[static_cast<std::size_t>(f)][face_mask];
+    int first = 0;
+    for (int g = 0; g < cap.polygon_count; ++g) {
+      int size = cap.polygon_size[static_cast<std::size_t>(g)];
+      std::array<std::uint32_t, 6> id{};
+      for (int q = 0; q < size; ++q) {
+        int item = cap.items[static_cast<std::size_t>(first + q)];
+        if (item < 4) {
+          int c = t.face_corners[static_cast<std::size_t>(f)][static_cast<std::size_t>(item)];
+          id[static_cast<std::size_t>(q)] = node_vertex(st, glm::ivec3(i + (c & 1), j + ((c >> 1) & 1), st.k + (c >> 2)));
+        } else {
+          id[static_cast<std::size_t>(q)] = cube_edge_vertex(st, i, j, mask, t.face_edges[static_cast<std::size_t>(f)][static_cast<std::size_t>(item - 4)]);
+        }
+      }
+      for (int q = 1; q + 1 < size; ++q) emit(st.out, id[0], id[static_cast<std::size_t>(q)], id[static_cast<std::size_t>(q + 1)]);
+      first += size;
+    }
+  }
+
+  // ---- slabs ---------------------------------------------------------------------------------
+
+  static std::uint64_t shifted(const std::uint64_t* row, int w, int words) {
+    return (row[w] >> 1) | (w + 1 < words ? row[w + 1] << 63 : 0);
+  }
+
+  void record_keys(const Scratch& s, int l, std::vector<std::pair<std::uint64_t, std::uint32_t>>& keys) const {
+    const std::uint64_t layer = static_cast<std::uint64_t>(nx_) * static_cast<std::uint64_t>(ny_);
+    const std::vector<std::uint32_t>* used[3] = {&s.xe_used[static_cast<std::size_t>(l)], &s.ye_used[static_cast<std::size_t>(l)], &s.nodes_used[static_cast<std::size_t>(l)]};
+    const std::vector<std::uint32_t>* ids[3] = {&s.xe[static_cast<std::size_t>(l)], &s.ye[static_cast<std::size_t>(l)], &s.nodes[static_cast<std::size_t>(l)]};
+    for (int type = 0; type < 3; ++type)
+      for (std::uint32_t slot : *used[type]) keys.emplace_back(type * layer + slot, (*ids[type])[slot]);
+    std::sort(keys.begin(), keys.end());
+  }
+
+  void process_slab(int k0, int k1, Scratch& s, SlabMesh& out) const {
+    for (int l = 0; l < 2; ++l) {
+      for (std::uint32_t slot : s.xe_used[static_cast<std::size_t>(l)]) s.xe[static_cast<std::size_t>(l)][slot] = kNone;
+      for (std::uint32_t slot : s.ye_used[static_cast<std::size_t>(l)]) s.ye[static_cast<std::size_t>(l)][slot] = kNone;
+      for (std::uint32_t slot : s.nodes_used[static_cast<std::size_t>(l)]) s.nodes[static_cast<std::size_t>(l)][slot] = kNone;
+      s.xe_used[static_cast<std::size_t>(l)].clear(), s.ye_used[static_cast<std::size_t>(l)].clear(), s.nodes_used[static_cast<std::size_t>(l)].clear();
+    }
+    init_layer(s.s0, k0);
+    const std::size_t row_words = static_cast<std::size_t>(words_);
+    for (int k = k0; k < k1; ++k) {
+      SlabState st{s, out, k};
+      s.s1 = s.s0;
+      for (std::uint32_t f = flip_offsets_[static_cast<std::size_t>(k) + 1]; f < flip_offsets_[static_cast<std::size_t>(k) + 2]; ++f) {
+        std::uint32_t col = flip_columns_[f];
+        int i = static_cast<int>(col % static_cast<std::uint32_t>(nx_)), j = static_cast<int>(col / static_cast<std::uint32_t>(nx_));
+        s.s1[static_cast<std::size_t>(j) * row_words + static_cast<std::size_t>(i >> 6)] ^= std::uint64_t(1) << (i & 63);
+      }
+      const std::uint64_t last_mask = ((nx_ - 1) & 63) ? (std::uint64_t(1) << ((nx_ - 1) & 63)) - 1 : ~std::uint64_t(0);
+      const int cell_words = (nx_ - 1 + 63) / 64;  // words holding cells 0 .. nx−2
+      auto for_cells = [&](const std::vector<std::uint64_t>* const* layers, int nlayers, bool any, int j, auto&& body) {
+        for (int w = 0; w < cell_words; ++w) {
+          std::uint64_t acc = 0, ref = 0;
+          bool first = true;
+          for (int l = 0; l < nlayers; ++l)
+            for (int r = 0; r < 2; ++r) {
+              const std::uint64_t* row = layers[l]->data() + static_cast<std::size_t>(j + r) * row_words;
+              std::uint64_t x = row[w], y = shifted(row, w, words_);
+              if (any) {
+                acc |= x | y;
+              } else {
+                if (first) ref = x, first = false;
+                acc |= (x ^ ref) | (y ^ ref);
+              }
+            }
+          if (w == cell_words - 1) acc &= last_mask;
+          while (acc) {
+            int b = std::countr_zero(acc);
+            acc &= acc - 1;
+            body(w * 64 + b);
+          }
+        }
+      };
+      const std::vector<std::uint64_t>* both[2] = {&s.s0, &s.s1};
+      const std::vector<std::uint64_t>* lower[1] = {&s.s0};
+      const std::vector<std::uint64_t>* upper[1] = {&s.s1};
+      if (k == 0)
+        for (int j = 0; j + 1 < ny_; ++j)
+          for_cells(lower, 1, true, j, [&](int i) { emit_cap(st, i, j, cell_mask(s, i, j), 4); });
+      for (int j = 0; j + 1 < ny_; ++j)
+        for_cells(both, 2, false, j, [&](int i) { emit_cell(st, i, j, cell_mask(s, i, j)); });
+      for (int j = 0; j + 1 < ny_; ++j) {
+        emit_cap(st, 0, j, cell_mask(s, 0, j), 0);
+        emit_cap(st, nx_ - 2, j, cell_mask(s, nx_ - 2, j), 1);
+      }
+      for (int i = 0; i + 1 < nx_; ++i) {
+        emit_cap(st, i, 0, cell_mask(s, i, 0), 2);
+        emit_cap(st, i, ny_ - 2, cell_mask(s, i, ny_ - 2), 3);
+      }
+      if (k == nz_ - 2)
+        for (int j = 0; j + 1 < ny_; ++j)
+          for_cells(upper, 1, true, j, [&](int i) { emit_cap(st, i, j, cell_mask(s, i, j), 5); });
+      if (k == k0 && k0 > 0) record_keys(s, 0, out.bottom);
+      if (k == k1 - 1 && k1 < nz_ - 1) record_keys(s, 1, out.top);
+      // Roll: node layer k+1 becomes the lower layer.
+      std::swap(s.s0, s.s1);
+      for (std::uint32_t slot : s.ze_used) s.ze[slot] = kNone;
+      s.ze_used.clear();
+      for (std::uint32_t slot : s.xe_used[0]) s.xe[0][slot] = kNone;
+      for (std::uint32_t slot : s.ye_used[0]) s.ye[0][slot] = kNone;
+      for (std::uint32_t slot : s.nodes_used[0]) s.nodes[0][slot] = kNone;
+      s.xe_used[0].clear(), s.ye_used[0].clear(), s.nodes_used[0].clear();
+      std::swap(s.xe[0], s.xe[1]), std::swap(s.ye[0], s.ye[1]), std::swap(s.nodes[0], s.nodes[1]);
+      std::swap(s.xe_used[0], s.xe_used[1]), std::swap(s.ye_used[0], s.ye_used[1]), std::swap(s.nodes_used[0], s.nodes_used[1]);
+    }
+  }
+
+  // Concatenates the slabs in order; a slab's bottom vertices are the previous slab's top ones.
+  Mesh join(std::vector<SlabMesh>& parts) const {
+    Mesh mesh;
+    std::size_t vertices = 0, triangles = 0;
+    for (const SlabMesh& p : parts) vertices += p.positions.size() - p.bottom.size(), triangles += p.triangles.size();
+    mesh.positions.reserve(vertices);
+    mesh.triangles.reserve(triangles);
+    std::vector<std::uint32_t> feature_triangles;
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> previous_top;  // key → global id
+    std::vector<std::uint32_t> map;
+    for (SlabMesh& p : parts) {
+      map.assign(p.positions.size(), kNone);
+      std::size_t q = 0;
+      for (const auto& [key, local] : p.bottom) {
+        while (q < previous_top.size() && previous_top[q].first < key) ++q;
+        if (q < previous_top.size() && previous_top[q].first == key) map[local] = previous_top[q].second;
+      }
+      for (std::size_t v = 0; v < p.positions.size(); ++v)
+        if (map[v] == kNone) {
+          map[v] = static_cast<std::uint32_t>(mesh.positions.size());
+          mesh.positions.push_back(p.positions[v]);
+        }
+      std::uint32_t base = static_cast<std::uint32_t>(mesh.triangles.size());
+      for (const glm::uvec3& t : p.triangles) mesh.triangles.emplace_back(map[t.x], map[t.y], map[t.z]);
+      for (std::uint32_t t : p.feature_triangles) feature_triangles.push_back(base + t);
+      previous_top.clear();
+      for (const auto& [key, local] : p.top) previous_top.emplace_back(key, map[local]);
+      p = SlabMesh{};
+    }
+    if (sharp_) flip_feature_edges(mesh, feature_triangles);
+    return mesh;
+  }
+
+  // EMC's edge flip: two fans from feature points A and B that meet on a face segment (p, q)
+  // become (A, p, B) and (B, q, A), so the mesh edge A–B follows the sharp edge instead of
+  // dipping to the cell face. Skipped when it would duplicate an edge, fold, or degenerate.
+  static void flip_feature_edges(Mesh& mesh, const std::vector<std::uint32_t>& feature_triangles) {
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> by_edge;
+    by_edge.reserve(feature_triangles.size());
+    for (std::uint32_t t : feature_triangles) {
+      const glm::uvec3& tri = mesh.triangles[t];  // apex first
+      std::uint64_t lo = std::min(tri.y, tri.z), hi = std::max(tri.y, tri.z);
+      by_edge.emplace_back((lo << 32) | hi, t);
+    }
+    std::sort(by_edge.begin(), by_edge.end());
+    std::unordered_set<std::uint64_t> joined;
+    for (std::size_t e = 0; e + 1 < by_edge.size(); ++e) {
+      if (by_edge[e].first != by_edge[e + 1].first) continue;
+      glm::uvec3& t1 = mesh.triangles[by_edge[e].second];
+      glm::uvec3& t2 = mesh.triangles[by_edge[e + 1].second];
+      std::uint32_t a = t1.x, p = t1.y, q = t1.z, b = t2.x;
+      if (t2.y != q || t2.z != p || a == b) continue;
+      std::uint64_t key = (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
+      if (joined.count(key)) continue;
+      auto normal = [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+        Vec3 px(mesh.positions[x]), py(mesh.positions[y]), pz(mesh.positions[z]);
+        return glm::cross(py - px, pz - px);
+      };
+      Vec3 before = normal(a, p, q) + normal(b, q, p);
+      Vec3 n1 = normal(a, p, b), n2 = normal(b, q, a);
+      double scale = glm::dot(before, before);
+      if (!(glm::dot(n1, before) > 1e-6 * scale) || !(glm::dot(n2, before) > 1e-6 * scale)) continue;
+      t1 = glm::uvec3(a, p, b);
+      t2 = glm::uvec3(b, q, a);
+      joined.insert(key);
+      ++e;
+    }
+  }
+
+  const TripleDexel& d_;
+  int nx_, ny_, nz_;
+  double h_;
+  int words_;
+  bool sharp_ = true;
+  double cos_feature_ = 0;
+  double delta_ = 1e-3;
+  std::vector<std::uint32_t> flip_offsets_;  // per node layer k: flips into layer k
+  std::vector<std::uint32_t> flip_columns_;
+};
+
+}  // namespace detail::surface
+
+// The boundary of the solid sampled by `dexel` (clipped to the lattice box) as a closed,
+// 2-manifold, outward-oriented triangle mesh without degenerate triangles. Vertices are dexel
+// end points (kept a tiny fraction of the spacing off the nodes), lattice nodes where the solid
+// reaches the lattice boundary, and per-cell feature or centre points. Features thinner than
+// one spacing between nodes may be lost (as in any marching-cubes method). Throws tridex::Error
+// for a malformed triple dexel or options.
+inline Mesh extract_surface(const TripleDexel& dexel, SurfaceOptions options = {}) {
+  validate(dexel);
+  if (!(options.feature_angle > 0 && options.feature_angle < 180))
+    detail::fail("extract_surface: feature_angle must be in (0, 180) degrees, got ", options.feature_angle);
+  if (dexel.n.x < 2 || dexel.n.y < 2 || dexel.n.z < 2) return Mesh{};  // a flat lattice holds no volume
+  detail::surface::Extractor extractor(dexel, options);
+  return extractor.run(options.threads);
+}
+
+}  // namespace tridex
