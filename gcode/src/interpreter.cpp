@@ -647,7 +647,7 @@ struct Interpreter::State {
       emit(MoveKind::cycle, pos, to, feed);
       pos = to;
     };
-    if (!far && current[n] < r_level) rapid(at(current[u], current[v], r_level));
+    if (!far && current[n] < r_level - 1e-9) rapid(at(current[u], current[v], r_level));
     for (long long k = 0; k < repeats; ++k) {
       if (incremental) {
         hole_u += du;
@@ -755,7 +755,7 @@ struct Interpreter::State {
 
 Flow Interpreter::State::execute(const Block& block) {
   gather(block);
-  motion_column = 1;
+  motion_column = 0;
   int motion_code = -1, nonmodal = -1, tilt = -1, orient = -1;
   for (int i = 0; i < w.g_count; ++i) {
     const Code& g = w.g[static_cast<std::size_t>(i)];
@@ -772,7 +772,8 @@ Flow Interpreter::State::execute(const Block& block) {
       orient = g.code;
     }
   }
-  if (motion_column == 1) {
+  if (motion_column == 0) {
+    motion_column = 1;
     for (char c : {'X', 'Y', 'Z'})
       if (w.has(c)) {
         motion_column = w.col(c);

@@ -1,0 +1,174 @@
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "helpers.hpp"
+
+using namespace tridex;
+using namespace tridex::gcode;
+using namespace tridex::gcode::test;
+
+namespace {
+
+struct ArcCase {
+  int plane;     // 17, 18, 19
+  bool ccw;
+  Vec2 centre;   // in the plane's (u, v) = G17 (X,Y), G18 (Z,X), G19 (Y,Z)
+  double radius;
+  double a0;     // start angle
+  double sweep;  // (0, 2π]
+  double w0, w1; // helix: normal coordinate at start and end
+};
+
+std::array<int, 3> axes(int plane) {
+  if (plane == 18) return {2, 0, 1};
+  if (plane == 19) return {1, 2, 0};
+  return {0, 1, 2};
+}
+
+Vec3 point(const ArcCase& c, double angle, double w) {
+  auto [u, v, n] = axes(c.plane);
+  Vec3 p;
+  p[u] = c.centre.x + c.radius * std::cos(angle);
+  p[v] = c.centre.y + c.radius * std::sin(angle);
+  p[n] = w;
+  return p;
+}
+
+ArcCase random_arc(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u01(0, 1);
+  ArcCase c;
+  c.plane = 17 + static_cast<int>(rng() % 3);
+  c.ccw = rng() % 2;
+  c.centre = Vec2(u01(rng) * 100 - 50, u01(rng) * 100 - 50);
+  c.radius = 0.5 + u01(rng) * 40;
+  c.a0 = u01(rng) * 2 * std::numbers::pi;
+  c.sweep = 0.05 + u01(rng) * (2 * std::numbers::pi - 0.1);
+  c.w0 = u01(rng) * 10;
+  c.w1 = rng() % 2 ? c.w0 : c.w0 - u01(rng) * 5;
+  return c;
+}
+
+std::string header(const ArcCase& c, const Vec3& start) {
+  return "G21 G90 G" + std::to_string(c.plane) + " F100\nG0 X" + fmt(start.x) + " Y" +
+         fmt(start.y) + " Z" + fmt(start.z) + "\n";
+}
+
+// Exact decimal text: the points are rounded to the 4 decimals the program carries.
+Vec3 rounded(const Vec3& p) {
+  return Vec3(std::stod(fmt(p.x)), std::stod(fmt(p.y)), std::stod(fmt(p.z)));
+}
+
+}  // namespace
+
+TEST_CASE("arcs (I/J/K): on the circle, within the chord tolerance, turning the right way") {
+  std::mt19937_64 rng(3);
+  for (int trial = 0; trial < 300; ++trial) {
+    ArcCase c = random_arc(rng);
+    auto [u, v, n] = axes(c.plane);
+    double a1 = c.a0 + (c.ccw ? c.sweep : -c.sweep);
+    Vec3 start = rounded(point(c, c.a0, c.w0));
+    Vec3 end = rounded(point(c, a1, c.w1));
+    // Centre offsets from the rounded start; the rounded end lies within 1e-4 of the circle.
+    Vec2 offset = c.centre - Vec2(start[u], start[v]);
+    const char* letters = "IJK";
+    std::string program = header(c, start) + (c.ccw ? "G3" : "G2") + " X" + fmt(end.x) + " Y" +
+                          fmt(end.y) + " Z" + fmt(end.z) + " " + letters[u] + fmt(offset.x) +
+                          " " + letters[v] + fmt(offset.y) + "\nM30\n";
+    Vec2 centre = Vec2(start[u], start[v]) + Vec2(std::stod(fmt(offset.x)), std::stod(fmt(offset.y)));
+    InterpreterOptions options = at_origin();
+    Result r = run_program(program, options);
+    REQUIRE(r.moves.size() >= 2);
+    CHECK(near(r.moves.back().end, end, 1e-12));
+    double turned = 0, r0 = glm::length(Vec2(start[u], start[v]) - centre);
+    for (std::size_t k = 1; k < r.moves.size(); ++k) {
+      const Move& m = r.moves[k];
+      CHECK(m.kind == MoveKind::arc);
+      CHECK(near(m.start, r.moves[k - 1].end));
+      Vec2 a = Vec2(m.start[u], m.start[v]) - centre, b = Vec2(m.end[u], m.end[v]) - centre;
+      CHECK(glm::length(b) == doctest::Approx(r0).epsilon(0).scale(0).epsilon(1e-3));
+      // Sagitta of the chord: the midpoint must stay within the tolerance of the circle.
+      double mid = glm::length(0.5 * (a + b));
+      CHECK(0.5 * (glm::length(a) + glm::length(b)) - mid <= options.arc_tolerance + 1e-9);
+      double step = std::atan2(a.x * b.y - a.y * b.x, glm::dot(a, b));
+      CHECK((c.ccw ? step > 0 : step < 0));
+      turned += std::abs(step);
+      // Helix: the normal coordinate moves in proportion to the angle.
+      CHECK(m.end[n] <= std::max(c.w0, c.w1) + 1e-4);
+      CHECK(m.end[n] >= std::min(c.w0, c.w1) - 1e-4);
+    }
+    CHECK(turned == doctest::Approx(c.sweep).epsilon(1e-4));
+  }
+}
+
+TEST_CASE("arcs: the R form gives the same path as the I/J/K form") {
+  std::mt19937_64 rng(5);
+  for (int trial = 0; trial < 300; ++trial) {
+    ArcCase c = random_arc(rng);
+    if (c.sweep > 2 * std::numbers::pi - 0.05) continue;
+    auto [u, v, n] = axes(c.plane);
+    (void)n;
+    double a1 = c.a0 + (c.ccw ? c.sweep : -c.sweep);
+    Vec3 start = point(c, c.a0, c.w0), end = point(c, a1, c.w1);
+    Vec2 offset = c.centre - Vec2(start[u], start[v]);
+    char text[512];
+    const char* letters = "IJK";
+    std::snprintf(text, sizeof text, "G0 X%.12f Y%.12f Z%.12f\n%s X%.12f Y%.12f Z%.12f ", start.x,
+                  start.y, start.z, c.ccw ? "G3" : "G2", end.x, end.y, end.z);
+    std::string base = "G21 G90 G" + std::to_string(c.plane) + " F100\n" + text;
+    char ijk[128], r[64];
+    std::snprintf(ijk, sizeof ijk, "%c%.12f %c%.12f\nM30\n", letters[u], offset.x, letters[v],
+                  offset.y);
+    std::snprintf(r, sizeof r, "R%.12f\nM30\n", c.sweep > std::numbers::pi ? -c.radius : c.radius);
+    Result a = run_program(base + ijk, at_origin());
+    Result b = run_program(base + r, at_origin());
+    REQUIRE(a.moves.size() == b.moves.size());
+    for (std::size_t k = 0; k < a.moves.size(); ++k) CHECK(near(a.moves[k].end, b.moves[k].end, 1e-6));
+  }
+}
+
+TEST_CASE("arcs: full circles, G90.1 centres, G20, and the chord tolerance option") {
+  InterpreterOptions options = at_origin();
+  Result r = run_program("G17 G90 F100\nG0 X10 Y0 Z0\nG2 I-10 J0\nM30\n", options);
+  CHECK(near(r.moves.back().end, Vec3(10, 0, 0)));
+  double turned = 0;
+  for (std::size_t k = 1; k < r.moves.size(); ++k) {
+    Vec2 a(r.moves[k].start), b(r.moves[k].end);
+    turned += std::atan2(a.x * b.y - a.y * b.x, glm::dot(a, b));
+  }
+  CHECK(turned == doctest::Approx(-2 * std::numbers::pi));
+  std::size_t fine = r.moves.size();
+  options.arc_tolerance = 0.1;
+  r = run_program("G17 G90 F100\nG0 X10 Y0 Z0\nG2 I-10 J0\nM30\n", options);
+  CHECK(r.moves.size() < fine / 5);
+  // Absolute centre (G90.1) and inches.
+  r = run_program("G20 G17 G90 G90.1 F10\nG0 X1 Y0 Z0\nG3 X0 Y1 I0 J0\nM30\n", at_origin());
+  CHECK(near(r.moves.back().end, Vec3(0, 25.4, 0)));
+  for (const Move& m : r.moves) CHECK(glm::length(Vec2(m.end)) == doctest::Approx(25.4));
+}
+
+TEST_CASE("arcs: bad arcs are errors with their position") {
+  Diagnostic d = error_of("G17 G90 F100\nG0 X10 Y0 Z0\nG2 X0 Y10.1 I-10 J0\n");
+  CHECK(d.line == 3);
+  CHECK(d.column == 1);
+  CHECK(d.message.find("radius") != std::string::npos);
+  d = error_of("G17 G90 F100\nG0 X10 Y0 Z0\nG2 X0 Y0 I0 J0\n");
+  CHECK(d.message.find("zero-radius") != std::string::npos);
+  d = error_of("G17 G90 F100\nG0 X10 Y0 Z0\nG2 X0 Y0\n");
+  CHECK(d.message.find("needs") != std::string::npos);
+  d = error_of("G17 G90 F100\nG0 X10 Y0 Z0\nG2 X0 Y0 R0\n");
+  CHECK(d.message.find("zero-radius") != std::string::npos);
+  d = error_of("G17 G90 F100\nG0 X10 Y0 Z0\nG2 X-10 Y0 R2\n");
+  CHECK(d.message.find("too small") != std::string::npos);
+  d = error_of("G17 G90 F100\nG0 X10 Y0 Z0\nG2 R5\n");
+  CHECK(d.message.find("full circle") != std::string::npos);
+  d = error_of("G17 G90 F100\nG0 X10 Y0 Z0\nG2 X0 Y0 I-5 K3\n");
+  CHECK(d.message.find("K3") != std::string::npos);  // K is not a G17 centre word
+  d = error_of("G17 G90 F100\nG0 X10 Y0 Z0\nG2 X0 Y0 I-5 R5\n");
+  CHECK(d.message.find("both") != std::string::npos);
+  d = error_of("G17 G90\nG0 X10 Y0 Z0\nG2 X0 Y0 I-5\n");
+  CHECK(d.message.find("feed") != std::string::npos);
+  d = error_of("G17 G90 F100\nG0 X10 Y0\nG2 X0 Y0 I-5\n");  // Z never set: still far
+  CHECK(d.message.find("retracted") != std::string::npos);
+}
