@@ -696,24 +696,24 @@ struct Interpreter::State {
   }
 
   // ---- returns and machine-coordinate moves ----
-  // Moves the machine axes in `mask` (bit i = axis i) to `target` (machine coordinates). A move
-  // of an axis with a component along the tool leaves the tip far; others are rapids.
+  // The machine's Z is the spindle's own axis (on a table-tilting machine it stays along the tool
+  // in the work frame; on a head-tilting one it retracts the head), so a machine-coordinate move
+  // of Z is a retract: the tip goes far along the tool axis. X/Y alone move the tip in machine
+  // coordinates, which is only unambiguous with the tool along +Z.
   void machine_move(const Vec3& target, unsigned mask, MoveKind kind, double move_feed) {
     Vec3 end = pos;
-    bool along = false;
-    for (int i = 0; i < 3; ++i) {
-      if (!((mask >> i) & 1u)) continue;
-      end[i] = target[i];
-      if (std::abs(axis[i]) > kAxisEps) along = true;
-    }
-    if (along) {
+    for (int i = 0; i < 3; ++i)
+      if ((mask >> i) & 1u) end[i] = target[i];
+    if ((mask & 4u) || far) {
       pos = end;
       far = true;
       return;
     }
-    std::array<bool, 3> set{};
-    for (int i = 0; i < 3; ++i) set[static_cast<std::size_t>(i)] = (mask >> i) & 1u;
-    move_to(end, set, Mat3(1.0), Vec3(0.0), kind, move_feed);
+    if (glm::dot(axis, Vec3(0, 0, 1)) < 1 - kSameDirection)
+      error(motion_column, "G53 X/Y with a tilted tool depends on the machine's kinematics; "
+                           "retract with G53 Z (or G28) first");
+    emit(kind, pos, end, move_feed);
+    pos = end;
   }
 
   void home_return(bool second) {
@@ -736,7 +736,11 @@ struct Interpreter::State {
                        "set it in the machine configuration if the machine differs");
       warned = true;
     }
-    if (mask) machine_move(target, mask, MoveKind::rapid, 0.0);
+    // A home return is a retract whatever the axes: the tip goes far along the tool axis, the
+    // homed axes' coordinates kept for the lateral position.
+    for (int i = 0; i < 3; ++i)
+      if ((mask >> i) & 1u) pos[i] = target[i];
+    far = true;
     if (rotary) {
       // Rotary axes home: the spindle returns to the machine's +Z, and the tip goes far.
       for (char c : {'A', 'B', 'C'})
