@@ -5,9 +5,12 @@
 #include <cmath>
 #include <cstdint>
 #include <numbers>
+#include <algorithm>
 #include <random>
+#include <vector>
 
 #include "tridex/mesh.hpp"
+#include <glm/glm.hpp>
 
 namespace tridex_test {
 
@@ -96,6 +99,58 @@ inline Mesh torus_mesh(const Vec3& c, double major, double minor, int nu = 64, i
 // Volumes of the meshes above as polyhedra (exact for the facetted solids, up to float rounding).
 inline double cylinder_mesh_volume(double r, double h, int slices = 64) {
   return 0.5 * slices * r * r * std::sin(2 * std::numbers::pi / slices) * h;
+}
+
+}  // namespace tridex_test
+
+namespace tridex_test {
+
+// Every crossing of the ray o + t·d with the mesh's triangles (Möller–Trumbore in double),
+// sorted: the brute-force reference for ray queries on meshes in general position.
+inline std::vector<double> brute_force_hits(const Mesh& m, const Vec3& o, const Vec3& d) {
+  std::vector<double> hits;
+  for (const glm::uvec3& t : m.triangles) {
+    Vec3 a(m.positions[t.x]), b(m.positions[t.y]), c(m.positions[t.z]);
+    Vec3 e1 = b - a, e2 = c - a, p = glm::cross(d, e2);
+    double det = glm::dot(e1, p);
+    if (std::abs(det) < 1e-300) continue;
+    Vec3 s = o - a;
+    double bu = glm::dot(s, p) / det;
+    if (bu < 0 || bu > 1) continue;
+    Vec3 q = glm::cross(s, e1);
+    double bv = glm::dot(d, q) / det;
+    if (bv < 0 || bu + bv > 1) continue;
+    hits.push_back(glm::dot(e2, q) / det);
+  }
+  std::sort(hits.begin(), hits.end());
+  return hits;
+}
+
+// The distance from the ray o + t·d to the nearest mesh edge: rays farther than a small
+// tolerance from every edge are in general position for the brute-force reference.
+inline double distance_to_edges(const Mesh& m, const Vec3& o, const Vec3& d) {
+  double best = 1e300;
+  for (const glm::uvec3& t : m.triangles)
+    for (int e = 0; e < 3; ++e) {
+      Vec3 a(m.positions[t[e]]), b(m.positions[t[(e + 1) % 3]]);
+      // Distance between a line and a segment: sample the segment's closest point analytically.
+      Vec3 ab = b - a, w = a - o;
+      Vec3 n = glm::cross(ab, d);
+      double nn = glm::dot(n, n);
+      double dist;
+      if (nn < 1e-30) {
+        Vec3 perp = w - glm::dot(w, d) * d;
+        dist = glm::length(perp);
+      } else {
+        // Closest point parameters between line a + s·ab and o + t·d.
+        double s_par = glm::dot(glm::cross(d, w), n) / nn;
+        s_par = std::clamp(s_par, 0.0, 1.0);
+        Vec3 p = a + s_par * ab - o;
+        dist = glm::length(p - glm::dot(p, d) * d);
+      }
+      best = std::min(best, dist);
+    }
+  return best;
 }
 
 }  // namespace tridex_test

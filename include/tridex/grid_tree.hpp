@@ -1,0 +1,266 @@
+// tridex — the hierarchical AABB tree over a Z-map grid (Inui, Chen and Umezu, CAD&A 19(4)
+// 2022, §4.2) and exact ray queries against the Z-map's polyhedron (polyhedron.hpp).
+//
+// The tree is built on the grid itself: the root covers all cells; a node is halved alternately
+// along x and y (along the other axis once one side is down to 4 cells) until it has at most
+// 4 × 4 cells. A node stores only the lowest and highest top height over its points; its x-y
+// extent follows from the split rule, so a node costs 12 bytes.
+//
+// Query. Instead of collecting triangle hits and pairing them (which can lose or double a hit
+// where a ray grazes a shared edge or vertex), the ray's solid part is found as a 1-D sign
+// analysis: inside the grid's rectangle and above the bottom, the ray is in the solid where
+// g(t) = z(t) − H(x(t), y(t)) ≤ 0, H the piecewise-linear top. The traversal cuts the ray's
+// parameter range at the same split lines as the tree (each cut computed once, by the parent),
+// so the pieces tile the range exactly; a node whose height range lies wholly above or below
+// the ray's z over its piece is settled without descending (the paper's pruning), and a leaf
+// walks its cells, cutting at grid lines and cell diagonals, where g is linear. The result is a
+// sorted list of disjoint intervals — boundary crossings come out paired by construction.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "tridex/error.hpp"
+#include "tridex/polyhedron.hpp"
+#include "tridex/zmap.hpp"
+
+namespace tridex {
+
+// A span [enter, exit] of ray parameter inside the solid.
+struct RaySpan {
+  double enter;
+  double exit;
+};
+
+// One crossing of the polyhedron's boundary: t along the ray and whether the ray enters there.
+struct RayHit {
+  double t;
+  bool entering;
+};
+
+class GridTree {
+ public:
+  static constexpr int kLeafCells = 4;
+
+  struct Node {
+    float lo, hi;        // lowest and highest top height over the node's points
+    std::uint32_t left;  // first child (the second is left + 1); 0 for a leaf
+  };
+
+  explicit GridTree(const ZMap& map) : map_(&map) {
+    detail::require_solid_zmap(map, "grid tree");
+    bottom_ = detail::zmap_bottom(map);
+    // The node count is below twice the leaf count; reserve for it.
+    std::size_t cells = static_cast<std::size_t>(map.grid.nx - 1) * static_cast<std::size_t>(map.grid.ny - 1);
+    nodes_.reserve(2 * (cells / (kLeafCells * kLeafCells) + 1) + 64);
+    nodes_.push_back({});
+    build(0, Range{0, 0, map.grid.nx - 1, map.grid.ny - 1, 0});
+  }
+
+  const ZMap& map() const { return *map_; }
+  const std::vector<Node>& nodes() const { return nodes_; }
+  double bottom() const { return bottom_; }
+
+  // The spans of o + t·d (frame-local origin and direction, d non-zero) inside the polyhedron,
+  // sorted and disjoint, for t in [t_min, t_max]; appended to `out`.
+  void spans(const Vec3& o, const Vec3& d, std::vector<RaySpan>& out,
+             double t_min = -std::numeric_limits<double>::infinity(),
+             double t_max = std::numeric_limits<double>::infinity()) const {
+    const ZMapGrid& g = map_->grid;
+    double ta = t_min, tb = t_max;
+    // Clip to the box: the grid's rectangle, and the bottom up to the highest top.
+    const double lo[3] = {g.x(0), g.y(0), bottom_}, hi[3] = {g.x(g.nx - 1), g.y(g.ny - 1), double(nodes_[0].hi)};
+    for (int a = 0; a < 3; ++a) {
+      if (d[a] == 0) {
+        if (o[a] < lo[a] || o[a] > hi[a]) return;
+        continue;
+      }
+      double t0 = (lo[a] - o[a]) / d[a], t1 = (hi[a] - o[a]) / d[a];
+      if (t0 > t1) std::swap(t0, t1);
+      ta = std::max(ta, t0), tb = std::min(tb, t1);
+    }
+    if (!(ta <= tb)) return;
+    std::size_t first = out.size();
+    Walker w{*this, o, d, out, first};
+    w.visit(0, Range{0, 0, g.nx - 1, g.ny - 1, 0}, ta, tb);
+  }
+
+  // Every crossing of the ray o + t·d with the polyhedron's boundary, sorted by t: the ends of
+  // the spans, so entering and leaving alternate.
+  std::vector<RayHit> hits(const Vec3& o, const Vec3& d) const {
+    std::vector<RaySpan> s;
+    spans(o, d, s);
+    std::vector<RayHit> out;
+    out.reserve(2 * s.size());
+    for (const RaySpan& span : s) out.push_back({span.enter, true}), out.push_back({span.exit, false});
+    return out;
+  }
+
+ private:
+  // Cells [i0, i1) × [j0, j1) and the depth that picks the split axis.
+  struct Range {
+    int i0, j0, i1, j1, depth;
+    bool leaf() const { return i1 - i0 <= kLeafCells && j1 - j0 <= kLeafCells; }
+    // Split along x at even depths, along y at odd ones, along the other axis once one side is
+    // down to a leaf's width. Returns the axis (0 = x, 1 = y) and the split grid line.
+    int split(int& at) const {
+      bool x = (depth % 2 == 0) ? (i1 - i0 > kLeafCells) : !(j1 - j0 > kLeafCells);
+      at = x ? (i0 + i1) / 2 : (j0 + j1) / 2;
+      return x ? 0 : 1;
+    }
+    Range child(int axis, int at, bool upper) const {
+      Range r = *this;
+      ++r.depth;
+      if (axis == 0) (upper ? r.i0 : r.i1) = at;
+      else (upper ? r.j0 : r.j1) = at;
+      return r;
+    }
+  };
+
+  void build(std::uint32_t index, const Range& r) {
+    if (r.leaf()) {
+      float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+      for (int j = r.j0; j <= r.j1; ++j)
+        for (int i = r.i0; i <= r.i1; ++i) {
+          float h = static_cast<float>(detail::zmap_top(*map_, map_->grid.index(i, j)));
+          lo = std::min(lo, h), hi = std::max(hi, h);
+        }
+      nodes_[index] = {lo, hi, 0};
+      return;
+    }
+    int at;
+    int axis = r.split(at);
+    auto left = static_cast<std::uint32_t>(nodes_.size());
+    nodes_.push_back({}), nodes_.push_back({});
+    build(left, r.child(axis, at, false));
+    build(left + 1, r.child(axis, at, true));
+    nodes_[index] = {std::min(nodes_[left].lo, nodes_[left + 1].lo), std::max(nodes_[left].hi, nodes_[left + 1].hi), left};
+  }
+
+  struct Walker {
+    const GridTree& tree;
+    Vec3 o, d;
+    std::vector<RaySpan>& out;
+    std::size_t first;  // spans before this index belong to earlier queries: never merge into them
+
+    void emit(double t0, double t1) {
+      if (!(t0 <= t1)) return;
+      // Pieces arrive in order and share their end values exactly: a span that starts where the
+      // last ended continues it.
+      // A lone zero-length piece is a touch, not a span.
+      if (out.size() > first && t0 <= out.back().exit) out.back().exit = std::max(out.back().exit, t1);
+      else if (t0 < t1) out.push_back({t0, t1});
+    }
+
+    void visit(std::uint32_t index, const Range& r, double ta, double tb) {
+      const Node& node = tree.nodes_[index];
+      double za = o.z + ta * d.z, zb = o.z + tb * d.z;
+      if (std::min(za, zb) > node.hi) return;  // wholly above the top: outside
+      if (std::max(za, zb) < node.lo) {         // wholly below the top: inside
+        emit(ta, tb);
+        return;
+      }
+      if (node.left == 0) {
+        leaf(r, ta, tb);
+        return;
+      }
+      int at;
+      int axis = r.split(at);
+      const ZMapGrid& g = tree.map_->grid;
+      double line = axis == 0 ? g.x(at) : g.y(at);
+      double oa = o[axis], da = d[axis];
+      Range lower = r.child(axis, at, false), upper = r.child(axis, at, true);
+      if (da == 0) {  // parallel to the split line: wholly on one side (the line itself: upper)
+        if (oa < line) visit(node.left, lower, ta, tb);
+        else visit(node.left + 1, upper, ta, tb);
+        return;
+      }
+      double tm = std::clamp((line - oa) / da, ta, tb);
+      if (da > 0) {
+        visit(node.left, lower, ta, tm);
+        visit(node.left + 1, upper, tm, tb);
+      } else {
+        visit(node.left + 1, upper, ta, tm);
+        visit(node.left, lower, tm, tb);
+      }
+    }
+
+    // The cells of a leaf: cut [ta, tb] at the grid lines inside the leaf, then at each cell's
+    // diagonal, and solve the linear g on each piece.
+    void leaf(const Range& r, double ta, double tb) {
+      const ZMapGrid& g = tree.map_->grid;
+      double cuts[2 * kLeafCells + 2];
+      int count = 0;
+      cuts[count++] = ta;
+      for (int i = r.i0 + 1; i < r.i1; ++i)
+        if (d.x != 0) {
+          double t = (g.x(i) - o.x) / d.x;
+          if (t > ta && t < tb) cuts[count++] = t;
+        }
+      for (int j = r.j0 + 1; j < r.j1; ++j)
+        if (d.y != 0) {
+          double t = (g.y(j) - o.y) / d.y;
+          if (t > ta && t < tb) cuts[count++] = t;
+        }
+      // At most 2·3 cuts: insertion sort (std::sort on a tiny array trips GCC's bounds warning).
+      for (int k = 2; k < count; ++k)
+        for (int m = k; m > 1 && cuts[m] < cuts[m - 1]; --m) std::swap(cuts[m], cuts[m - 1]);
+      cuts[count++] = tb;
+      for (int k = 0; k + 1 < count; ++k) cell_piece(r, cuts[k], cuts[k + 1]);
+    }
+
+    void cell_piece(const Range& r, double t0, double t1) {
+      const ZMapGrid& g = tree.map_->grid;
+      double tm = 0.5 * (t0 + t1);
+      int i = std::clamp(static_cast<int>(std::floor((o.x + tm * d.x - g.x0) / g.cell)), r.i0, r.i1 - 1);
+      int j = std::clamp(static_cast<int>(std::floor((o.y + tm * d.y - g.y0) / g.cell)), r.j0, r.j1 - 1);
+      const ZMap& map = *tree.map_;
+      double h00 = detail::zmap_top(map, g.index(i, j)), h10 = detail::zmap_top(map, g.index(i + 1, j));
+      double h01 = detail::zmap_top(map, g.index(i, j + 1)), h11 = detail::zmap_top(map, g.index(i + 1, j + 1));
+      // Cell-local coordinates along the ray: f(t) = (o + t·d − corner) / cell.
+      double fx0 = (o.x - g.x(i)) / g.cell, fdx = d.x / g.cell;
+      double fy0 = (o.y - g.y(j)) / g.cell, fdy = d.y / g.cell;
+      auto g_lower = [&](double t) {  // triangle fx ≥ fy
+        return o.z + t * d.z - (h00 + (fx0 + t * fdx) * (h10 - h00) + (fy0 + t * fdy) * (h11 - h10));
+      };
+      auto g_upper = [&](double t) {  // triangle fx < fy
+        return o.z + t * d.z - (h00 + (fx0 + t * fdx) * (h11 - h01) + (fy0 + t * fdy) * (h01 - h00));
+      };
+      // The diagonal fx = fy splits the piece where (fx0 − fy0) + t·(fdx − fdy) changes sign.
+      double c0 = fx0 - fy0, cd = fdx - fdy;
+      double split = cd != 0 ? -c0 / cd : std::numeric_limits<double>::quiet_NaN();
+      // Each sub-piece picks its triangle at its own midpoint, so a split that rounding puts a
+      // hair inside the piece cannot send the long part to the wrong triangle.
+      auto solve_on = [&](double a, double b) {
+        if ((c0 + 0.5 * (a + b) * cd) >= 0) solve(g_lower, a, b);
+        else solve(g_upper, a, b);
+      };
+      if (split > t0 && split < t1) {
+        solve_on(t0, split);
+        solve_on(split, t1);
+      } else {
+        solve_on(t0, t1);
+      }
+    }
+
+    // Emits the part of [t0, t1] where the linear function gf is ≤ 0.
+    template <class F>
+    void solve(const F& gf, double t0, double t1) {
+      double g0 = gf(t0), g1 = gf(t1);
+      if (g0 <= 0 && g1 <= 0) return emit(t0, t1);
+      if (g0 > 0 && g1 > 0) return;
+      double root = std::clamp(t0 + (t1 - t0) * (g0 / (g0 - g1)), t0, t1);
+      if (g0 <= 0) emit(t0, root);
+      else emit(root, t1);
+    }
+  };
+
+  const ZMap* map_;
+  double bottom_ = 0;
+  std::vector<Node> nodes_;
+};
+
+}  // namespace tridex
