@@ -78,37 +78,70 @@ struct MoveGeometry {
 
   double lowest_tip() const { return std::min(az, az + w); }
 
-  // The lowest point of the swept cutter above (x, y), or +infinity if it does not pass over it.
-  double lowest_above(double x, double y) const {
+  // The lowest point of the swept cutter above (x, y): its height z (+infinity if the cutter
+  // does not pass over the point) and the move parameter t where it is reached.
+  struct Lowest {
+    double z, t;
+  };
+
+  Lowest lowest(double x, double y) const {
     double ux = x - ax, uy = y - ay;
     double uu = ux * ux + uy * uy;
     if (vertical) {
-      if (uu > radius2) return kInf;
-      return lowest_tip() + cutter->lower_height(std::sqrt(uu));
+      if (uu > radius2) return {kInf, 0};
+      return {lowest_tip() + cutter->lower_height(std::sqrt(uu)), w < 0 ? 1.0 : 0.0};
     }
     double t_foot = (ux * vx + uy * vy) * inv_vv;           // foot of q on the move's line
     double e2 = std::max(0.0, uu - t_foot * t_foot * vv);   // squared distance to the line
-    if (e2 > radius2) return kInf;
+    if (e2 > radius2) return {kInf, 0};
     double k = std::sqrt(radius2 - e2);
     double lo = std::max(0.0, t_foot - k * inv_len), hi = std::min(1.0, t_foot + k * inv_len);
-    if (lo > hi) return kInf;
+    if (lo > hi) return {kInf, 0};
     switch (cutter->shape()) {
-      case CutterShape::flat:
-        return az + (w > 0 ? lo : hi) * w;
+      case CutterShape::flat: {
+        double t = w > 0 ? lo : hi;
+        return {az + t * w, t};
+      }
       case CutterShape::ball: {
         double t = std::clamp(t_foot - w * k * ball_factor, lo, hi);
         double s = t - t_foot;
         double d2 = e2 + s * s * vv;
-        return az + t * w + radius - std::sqrt(std::max(0.0, radius2 - d2));
+        return {az + t * w + radius - std::sqrt(std::max(0.0, radius2 - d2)), t};
       }
       default:
         return convex_minimum(e2, t_foot, lo, hi);
     }
   }
 
+  double lowest_above(double x, double y) const { return lowest(x, y).z; }
+
+  // A supporting plane of the swept lower surface S at (x, y), where S(x, y) = p.z is finite:
+  // S(q) ≥ p.z + gradient·(q − (x, y)) for every q. S is convex (the lower surface of a convex
+  // swept solid), and where the cutter's lower surface is differentiable at the minimiser, the
+  // gradient is h'(d)·(q − C(t*))/d (joint convexity in (q, t) plus optimality of t*). False
+  // where that does not hold: at the rim (d = R) and at kinks of the profile.
+  bool supporting_plane(double x, double y, const Lowest& p, Vec2& gradient) const {
+    CutterShape shape = cutter->shape();
+    if (shape == CutterShape::flat) {
+      gradient = Vec2(0);
+      return w == 0;  // level: S is constant where the end face covers
+    }
+    if (shape != CutterShape::ball && shape != CutterShape::bull_nose) return false;
+    double dx = x - (ax + p.t * vx), dy = y - (ay + p.t * vy);
+    double d2 = dx * dx + dy * dy;
+    if (d2 >= radius2 * (1 - 1e-7)) return false;
+    if (shape == CutterShape::ball) {  // h'(d)/d = 1/√(R² − d²)
+      gradient = Vec2(dx, dy) / std::sqrt(radius2 - d2);
+      return true;
+    }
+    double d = std::sqrt(d2);
+    gradient = d > 0 ? (cutter->lower_slope(d) / d) * Vec2(dx, dy) : Vec2(0);
+    return true;
+  }
+
   // min over t ∈ [lo, hi] of f(t) = az + t·w + h(√(e² + (t − t⊥)²·|v|²)) by bisection on the
   // sign of f', which is non-decreasing because f is convex.
-  double convex_minimum(double e2, double t_foot, double lo, double hi) const {
+  Lowest convex_minimum(double e2, double t_foot, double lo, double hi) const {
     auto f = [&](double t) {
       double s = t - t_foot;
       return az + t * w + cutter->lower_height(std::sqrt(e2 + s * s * vv));
@@ -121,13 +154,14 @@ struct MoveGeometry {
       double dh = cutter->lower_slope(std::min(d, radius));
       return w + (ds == 0 ? 0 : dh * ds);
     };
-    if (slope(lo) >= 0) return f(lo);
-    if (slope(hi) <= 0) return f(hi);
+    if (slope(lo) >= 0) return {f(lo), lo};
+    if (slope(hi) <= 0) return {f(hi), hi};
     for (int iteration = 0; iteration < 64 && hi - lo > 1e-15; ++iteration) {
       double mid = 0.5 * (lo + hi);
       (slope(mid) > 0 ? hi : lo) = mid;
     }
-    return std::min(f(lo), f(hi));
+    double f_lo = f(lo), f_hi = f(hi);
+    return f_lo <= f_hi ? Lowest{f_lo, lo} : Lowest{f_hi, hi};
   }
 };
 
@@ -160,45 +194,8 @@ inline double distance_move_rect(const MoveGeometry& m, double x0, double y0, do
   return best;
 }
 
-// The x-interval where the cutter's footprint (a capsule of the cutter radius around the move)
-// meets the row y; false if it does not.
-inline bool footprint_row(const MoveGeometry& m, double y, double& x_lo, double& x_hi) {
-  x_lo = kInf, x_hi = -kInf;
-  auto disc = [&](double cx, double cy) {
-    double dy = y - cy;
-    if (dy * dy > m.radius2) return;
-    double half = std::sqrt(m.radius2 - dy * dy);
-    x_lo = std::min(x_lo, cx - half), x_hi = std::max(x_hi, cx + half);
-  };
-  disc(m.ax, m.ay);
-  disc(m.ax + m.vx, m.ay + m.vy);
-  if (!m.vertical && m.vy != 0) {
-    // The band between the end discs: 0 ≤ (p − a)·v ≤ |v|² and |(p − a) × v| ≤ R·|v|. The
-    // rectangle's x-extent on this row lies between its two long sides' crossings.
-    double uy = y - m.ay, len = std::sqrt(m.vv);
-    // (x − ax)·vx + uy·vy ∈ [0, vv] and (x − ax)·vy − uy·vx ∈ [−R·len, R·len]
-    double lo = -kInf, hi = kInf;
-    auto constrain = [&](double coefficient, double offset, double low, double high) {
-      if (coefficient == 0) {
-        if (offset < low || offset > high) lo = kInf;
-        return;
-      }
-      double r0 = (low - offset) / coefficient, r1 = (high - offset) / coefficient;
-      if (r0 > r1) std::swap(r0, r1);
-      lo = std::max(lo, r0), hi = std::min(hi, r1);
-    };
-    constrain(m.vx, uy * m.vy, 0, m.vv);
-    constrain(m.vy, -uy * m.vx, -m.radius * len, m.radius * len);
-    if (lo <= hi) x_lo = std::min(x_lo, m.ax + lo), x_hi = std::max(x_hi, m.ax + hi);
-  } else if (!m.vertical) {
-    // A move along x: the band is the rows within R of the line.
-    if (std::abs(y - m.ay) <= m.radius)
-      x_lo = std::min(x_lo, std::min(m.ax, m.ax + m.vx)),
-      x_hi = std::max(x_hi, std::max(m.ax, m.ax + m.vx));
-  }
-  return x_lo <= x_hi;
-}
-
+// The milling of one Z-map: moves are binned to work blocks; each block is milled by one thread,
+// tile by tile, each tile with every move that reaches it (see `mill_tile_with_candidates`).
 class Miller {
  public:
   Miller(ZMap& map, std::span<const Cutter> cutters, std::span<const CutMove> moves)
@@ -211,11 +208,11 @@ class Miller {
 
   void run(unsigned threads) {
     bin_moves();
-    tile_max_.assign(static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(tiles_y_), 0);
     std::atomic<std::size_t> next_bin{0};
     std::size_t bin_count = static_cast<std::size_t>(bins_x_) * static_cast<std::size_t>(bins_y_);
     auto worker = [&] {
-      for (std::size_t b; (b = next_bin.fetch_add(1)) < bin_count;) mill_bin(b);
+      BlockScratch scratch;
+      for (std::size_t b; (b = next_bin.fetch_add(1)) < bin_count;) mill_bin(b, scratch);
     };
     threads = std::max(1u, std::min<unsigned>(threads, static_cast<unsigned>(bin_count)));
     std::vector<std::thread> pool;
@@ -225,8 +222,27 @@ class Miller {
   }
 
  private:
+  struct IndexBox {
+    int i0, j0, i1, j1;
+  };
+
+  // A move that reaches a tile, with lower bounds of its swept surface over the tile.
+  struct Candidate {
+    const MoveGeometry* move;
+    double bound;        // lower bound of the swept surface over the tile
+    double centre_z;     // the swept surface at the tile's centre (+inf if not covered)
+    Vec2 gradient;       // its supporting plane's slope there, if `has_plane`
+    bool has_plane;
+  };
+
+  struct BlockScratch {
+    std::vector<MoveGeometry> moves;
+    std::vector<IndexBox> boxes;
+    std::vector<Candidate> candidates;
+  };
+
   // Grid-index box of a move's footprint, clipped to the grid; false if it misses the grid.
-  bool footprint_box(const CutMove& move, int& i0, int& j0, int& i1, int& j1) const {
+  bool footprint_box(const CutMove& move, IndexBox& box) const {
     double r = cutters_[move.cutter].radius();
     double x_lo = std::min(move.tip.a.x, move.tip.b.x) - r, x_hi = std::max(move.tip.a.x, move.tip.b.x) + r;
     double y_lo = std::min(move.tip.a.y, move.tip.b.y) - r, y_hi = std::max(move.tip.a.y, move.tip.b.y) + r;
@@ -236,8 +252,7 @@ class Miller {
     fi0 = std::max(fi0 - 1, 0.0), fj0 = std::max(fj0 - 1, 0.0);
     fi1 = std::min(fi1 + 1, g_.nx - 1.0), fj1 = std::min(fj1 + 1, g_.ny - 1.0);
     if (fi0 > fi1 || fj0 > fj1) return false;
-    i0 = static_cast<int>(fi0), i1 = static_cast<int>(fi1);
-    j0 = static_cast<int>(fj0), j1 = static_cast<int>(fj1);
+    box = {static_cast<int>(fi0), static_cast<int>(fj0), static_cast<int>(fi1), static_cast<int>(fj1)};
     return true;
   }
 
@@ -247,10 +262,10 @@ class Miller {
     bin_start_.assign(bin_count + 1, 0);
     const int span = kTile * kBinTiles;
     auto for_each_bin = [&](const CutMove& move, auto&& visit) {
-      int i0, j0, i1, j1;
-      if (!footprint_box(move, i0, j0, i1, j1)) return;
-      for (int by = j0 / span; by <= j1 / span; ++by)
-        for (int bx = i0 / span; bx <= i1 / span; ++bx)
+      IndexBox b;
+      if (!footprint_box(move, b)) return;
+      for (int by = b.j0 / span; by <= b.j1 / span; ++by)
+        for (int bx = b.i0 / span; bx <= b.i1 / span; ++bx)
           visit(static_cast<std::size_t>(bx) + static_cast<std::size_t>(bins_x_) * static_cast<std::size_t>(by));
     };
     for (const CutMove& move : moves_) for_each_bin(move, [&](std::size_t b) { ++bin_start_[b + 1]; });
@@ -261,70 +276,147 @@ class Miller {
       for_each_bin(moves_[m], [&](std::size_t b) { bin_moves_[fill[b]++] = static_cast<std::uint32_t>(m); });
   }
 
-  float tile_maximum(int tx, int ty) const {
-    float top = -std::numeric_limits<float>::infinity();
-    int i_end = std::min(g_.nx, (tx + 1) * kTile), j_end = std::min(g_.ny, (ty + 1) * kTile);
-    for (int j = ty * kTile; j < j_end; ++j) {
-      const float* row = &map_.heights[g_.index(0, j)];
-      for (int i = tx * kTile; i < i_end; ++i) top = std::max(top, row[i]);
-    }
-    return top;
-  }
-
-  void mill_bin(std::size_t bin) {
-    int bx = static_cast<int>(bin % static_cast<std::size_t>(bins_x_));
-    int by = static_cast<int>(bin / static_cast<std::size_t>(bins_x_));
-    int tx0 = bx * kBinTiles, ty0 = by * kBinTiles;
-    int tx1 = std::min(tiles_x_, tx0 + kBinTiles) - 1, ty1 = std::min(tiles_y_, ty0 + kBinTiles) - 1;
+  void mill_bin(std::size_t bin, BlockScratch& scratch) {
     if (bin_start_[bin] == bin_start_[bin + 1]) return;
-    for (int ty = ty0; ty <= ty1; ++ty)
-      for (int tx = tx0; tx <= tx1; ++tx) tile_max_[tile_index(tx, ty)] = tile_maximum(tx, ty);
-
-    const float empty = map_.empty_height;
+    scratch.moves.clear();
+    scratch.boxes.clear();
     for (std::size_t k = bin_start_[bin]; k < bin_start_[bin + 1]; ++k) {
       const CutMove& move = moves_[bin_moves_[k]];
-      MoveGeometry m(cutters_[move.cutter], move.tip);
-      int i0 = 0, j0 = 0, i1 = -1, j1 = -1;
-      footprint_box(move, i0, j0, i1, j1);
-      int mtx0 = std::max(tx0, i0 / kTile), mtx1 = std::min(tx1, i1 / kTile);
-      int mty0 = std::max(ty0, j0 / kTile), mty1 = std::min(ty1, j1 / kTile);
-      double lowest_tip = m.lowest_tip();
-      for (int ty = mty0; ty <= mty1; ++ty)
-        for (int tx = mtx0; tx <= mtx1; ++tx) {
-          float& top = tile_max_[tile_index(tx, ty)];
-          int ti0 = tx * kTile, tj0 = ty * kTile;
-          int ti1 = std::min(g_.nx, ti0 + kTile) - 1, tj1 = std::min(g_.ny, tj0 + kTile) - 1;
-          // The lowest the cutter can reach over this tile; h is non-decreasing in distance.
-          double distance = distance_move_rect(m, g_.x(ti0), g_.y(tj0), g_.x(ti1), g_.y(tj1));
-          if (distance > m.radius) continue;
-          if (lowest_tip + m.cutter->lower_height(distance) >= top) continue;
-          if (mill_tile(m, ti0, tj0, ti1, tj1, empty)) top = tile_maximum(tx, ty);
-        }
+      scratch.moves.emplace_back(cutters_[move.cutter], move.tip);
+      scratch.boxes.emplace_back();
+      footprint_box(move, scratch.boxes.back());
+    }
+    int bx = static_cast<int>(bin % static_cast<std::size_t>(bins_x_));
+    int by = static_cast<int>(bin / static_cast<std::size_t>(bins_x_));
+    int tx1 = std::min(tiles_x_, (bx + 1) * kBinTiles), ty1 = std::min(tiles_y_, (by + 1) * kBinTiles);
+    for (int ty = by * kBinTiles; ty < ty1; ++ty)
+      for (int tx = bx * kBinTiles; tx < tx1; ++tx) {
+        IndexBox tile{tx * kTile, ty * kTile, std::min(g_.nx, (tx + 1) * kTile) - 1,
+                      std::min(g_.ny, (ty + 1) * kTile) - 1};
+        mill_tile_with_candidates(tile, scratch);
+      }
+  }
+
+  // Mills one tile with every move of its block that reaches it, lowest first, skipping the
+  // moves that provably cannot lower any point of it:
+  //   * each move's swept surface S has a lower bound over the tile: the lowest tip plus h at the
+  //     tile's distance, tightened by S's supporting plane at the tile's centre;
+  //   * moves are taken in order of that bound, so once a bound reaches the tile's highest point
+  //     every later move is skipped;
+  //   * once a smooth move has cut the tile, its supporting plane P approximates the tile's
+  //     surface, and a move is skipped when min(S − P) over the tile ≥ max(height − P): this
+  //     keeps skipping effective on sloped surfaces, where the tile's highest point is far above
+  //     most of it.
+  void mill_tile_with_candidates(const IndexBox& tile, BlockScratch& scratch) {
+    const double x_lo = g_.x(tile.i0), x_hi = g_.x(tile.i1), y_lo = g_.y(tile.j0), y_hi = g_.y(tile.j1);
+    const double xc = 0.5 * (x_lo + x_hi), yc = 0.5 * (y_lo + y_hi);
+    const double hx = 0.5 * (x_hi - x_lo), hy = 0.5 * (y_hi - y_lo);
+    const float empty = map_.empty_height;
+    TilePlane plane;
+    TileState state = scan_tile(tile, xc, yc, plane);
+    std::vector<Candidate>& candidates = scratch.candidates;
+    candidates.clear();
+    for (std::size_t k = 0; k < scratch.moves.size(); ++k) {
+      const IndexBox& b = scratch.boxes[k];
+      if (b.i1 < tile.i0 || b.i0 > tile.i1 || b.j1 < tile.j0 || b.j0 > tile.j1) continue;
+      const MoveGeometry& m = scratch.moves[k];
+      if (m.lowest_tip() >= state.top) continue;
+      Candidate c{&m, kInf, kInf, Vec2(0), false};
+      MoveGeometry::Lowest centre = m.lowest(xc, yc);
+      if (centre.z < kInf && m.supporting_plane(xc, yc, centre, c.gradient)) {
+        // The supporting plane at the centre bounds S over the whole tile.
+        c.centre_z = centre.z;
+        c.has_plane = true;
+        c.bound = centre.z - std::abs(c.gradient.x) * hx - std::abs(c.gradient.y) * hy;
+      } else {
+        double distance = distance_move_rect(m, x_lo, y_lo, x_hi, y_hi);
+        if (distance > m.radius) continue;
+        c.bound = m.lowest_tip() + m.cutter->lower_height(distance);
+      }
+      if (c.bound < state.top) candidates.push_back(c);
+    }
+    if (candidates.empty()) return;
+
+    // The lowest-bound move first: it usually cuts the tile close to its final shape, and its
+    // supporting plane then follows the tile's surface.
+    std::iter_swap(candidates.begin(),
+                   std::min_element(candidates.begin(), candidates.end(),
+                                    [](const Candidate& a, const Candidate& b) { return a.bound < b.bound; }));
+    auto can_cut = [&](const Candidate& c) {
+      if (c.bound >= state.top) return false;
+      if (!plane.valid) return true;
+      double lower = c.has_plane ? (c.centre_z - plane.z) - std::abs(c.gradient.x - plane.gradient.x) * hx -
+                                       std::abs(c.gradient.y - plane.gradient.y) * hy
+                                 : c.bound - (plane.z + std::abs(plane.gradient.x) * hx +
+                                              std::abs(plane.gradient.y) * hy);
+      return lower < state.excess;
+    };
+    auto cut = [&](const Candidate& c) {
+      if (!plane.valid && c.has_plane) plane = {true, c.centre_z, c.gradient};
+      state = mill_tile(c, tile, xc, yc, plane, empty);
+    };
+    cut(candidates.front());
+    // Then the others that can still cut, lowest bound first.
+    auto rest = std::remove_if(candidates.begin() + 1, candidates.end(),
+                               [&](const Candidate& c) { return !can_cut(c); });
+    std::sort(candidates.begin() + 1, rest,
+              [](const Candidate& a, const Candidate& b) { return a.bound < b.bound; });
+    for (auto c = candidates.begin() + 1; c != rest; ++c) {
+      if (c->bound >= state.top) break;
+      if (can_cut(*c)) cut(*c);
     }
   }
 
-  // Lowers the points of one tile; true if any point changed.
-  bool mill_tile(const MoveGeometry& m, int ti0, int tj0, int ti1, int tj1, float empty) {
-    bool changed = false;
-    for (int j = tj0; j <= tj1; ++j) {
-      double y = g_.y(j), x_lo, x_hi;
-      if (!footprint_row(m, y, x_lo, x_hi)) continue;
-      int i_lo = std::max(ti0, static_cast<int>(std::ceil((x_lo - g_.x0) / g_.cell)) - 1);
-      int i_hi = std::min(ti1, static_cast<int>(std::floor((x_hi - g_.x0) / g_.cell)) + 1);
-      float* row = &map_.heights[g_.index(0, j)];
-      for (int i = i_lo; i <= i_hi; ++i) {
-        double z = m.lowest_above(g_.x(i), y);
-        if (z < row[i]) {
-          float lowered = std::max(static_cast<float>(z), empty);
-          if (lowered < row[i]) row[i] = lowered, changed = true;
-        }
+  // A plane P through (centre, z) with slope `gradient` that approximates a tile's surface.
+  struct TilePlane {
+    bool valid = false;
+    double z = 0;
+    Vec2 gradient{0};
+  };
+  struct TileState {
+    double top;     // the highest point of the tile
+    double excess;  // max(height − P) over the tile, if the plane is valid
+  };
+
+  TileState scan_tile(const IndexBox& t, double xc, double yc, const TilePlane& plane) const {
+    float top = -std::numeric_limits<float>::infinity();
+    double excess = -kInf;
+    for (int j = t.j0; j <= t.j1; ++j) {
+      const float* row = &map_.heights[g_.index(0, j)];
+      double row_plane = plane.z + plane.gradient.y * (g_.y(j) - yc);
+      for (int i = t.i0; i <= t.i1; ++i) {
+        top = std::max(top, row[i]);
+        if (plane.valid) excess = std::max(excess, row[i] - (row_plane + plane.gradient.x * (g_.x(i) - xc)));
       }
     }
-    return changed;
+    return {top, excess};
   }
 
-  std::size_t tile_index(int tx, int ty) const {
-    return static_cast<std::size_t>(tx) + static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(ty);
+  // Lowers the points of one tile to one move's swept surface, and returns the tile's state
+  // after it (measured against `plane`) from the same pass. Where the move has a supporting
+  // plane, a point already below that plane is not evaluated.
+  TileState mill_tile(const Candidate& c, const IndexBox& t, double xc, double yc,
+                      const TilePlane& plane, float empty) {
+    const MoveGeometry& m = *c.move;
+    const double move_plane_z = c.has_plane ? c.centre_z : -kInf;
+    float top = -std::numeric_limits<float>::infinity();
+    double excess = -kInf;
+    for (int j = t.j0; j <= t.j1; ++j) {
+      const double y = g_.y(j);
+      const double move_row = move_plane_z + c.gradient.y * (y - yc);
+      const double tile_row = plane.z + plane.gradient.y * (y - yc);
+      float* row = &map_.heights[g_.index(0, j)];
+      for (int i = t.i0; i <= t.i1; ++i) {
+        const double x = g_.x(i);
+        if (move_row + c.gradient.x * (x - xc) < row[i]) {
+          float lowered = std::max(static_cast<float>(m.lowest_above(x, y)), empty);
+          row[i] = std::min(row[i], lowered);
+        }
+        top = std::max(top, row[i]);
+        excess = std::max(excess, row[i] - (tile_row + plane.gradient.x * (x - xc)));
+      }
+    }
+    return {top, plane.valid ? excess : -kInf};
   }
 
   ZMap& map_;
@@ -332,7 +424,6 @@ class Miller {
   std::span<const Cutter> cutters_;
   std::span<const CutMove> moves_;
   int tiles_x_, tiles_y_, bins_x_, bins_y_;
-  std::vector<float> tile_max_;
   std::vector<std::size_t> bin_start_;
   std::vector<std::uint32_t> bin_moves_;
 };
