@@ -597,7 +597,7 @@ struct Interpreter::State {
       if (!has_cycle_q || !(cycle_q > 0))
         error(motion_column, code_name('G', code) + " needs a positive peck depth Q");
     }
-    if ((code == 820 || code == 890) && w.has('P')) {
+    if ((code == 820 || code == 860 || code == 890) && w.has('P')) {
       if (w.take('P') < 0) error(w.col('P'), "dwell P must not be negative");
     }
     if (!has_cycle_r) error(motion_column, code_name('G', code) + " needs R (retract plane)");
