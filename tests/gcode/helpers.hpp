@@ -54,6 +54,14 @@ inline bool near(const Vec3& a, const Vec3& b, double eps = 1e-9) {
   return glm::length(a - b) <= eps;
 }
 
+// Concatenation through a stream (GCC 12 warns falsely on "literal" + std::string chains).
+template <class... Parts>
+std::string cat(const Parts&... parts) {
+  std::ostringstream out;
+  (out << ... << parts);
+  return out.str();
+}
+
 inline std::string fmt(double v) {
   char text[40];
   std::snprintf(text, sizeof text, "%.4f", v);
