@@ -79,8 +79,10 @@ struct TripleDexel {
 
   // No material: every ray without intervals.
   static TripleDexel empty(const DexelLattice& lattice);
-  // The closed box `box` (clipped to nothing else): a ray gets [box.min, box.max] along its axis
-  // when its transverse position lies within the box's closed cross-section.
+  // The box `box`: a ray gets [box.min, box.max] along its axis when its transverse position
+  // (pu, pv) satisfies min ≤ p < max on both axes — half-open, the same rule the mesh
+  // dexelizer's perturbation applies to a ray on a face, so that a box whose faces lie on
+  // lattice rays counts exactly size/spacing rays across.
   static TripleDexel box(const DexelLattice& lattice, const Aabb& box);
 };
 
@@ -151,10 +153,17 @@ inline TripleDexel TripleDexel::box(const DexelLattice& lattice, const Aabb& sol
     DexelGrid& g = d.grids[a];
     int u = u_axis(a), v = v_axis(a);
     DexelInterval span{static_cast<float>(solid.min[a]), static_cast<float>(solid.max[a])};
+    // In lattice units, with faces within 1e-9 spacings of a node snapped onto it (so that a face
+    // meant to lie on a ray is not lost to rounding of origin + spacing·i).
+    auto first_index = [&](int axis_, double x) {
+      double c = (x - lattice.origin[axis_]) / lattice.spacing, r = std::round(c);
+      return std::ceil(std::abs(c - r) < 1e-9 ? r : c);
+    };
+    double u0 = first_index(u, solid.min[u]), u1 = first_index(u, solid.max[u]);
+    double v0 = first_index(v, solid.min[v]), v1 = first_index(v, solid.max[v]);
     for (int iv = 0; iv < g.nv; ++iv)
       for (int iu = 0; iu < g.nu; ++iu) {
-        double pu = lattice.origin[u] + lattice.spacing * iu, pv = lattice.origin[v] + lattice.spacing * iv;
-        bool inside = pu >= solid.min[u] && pu <= solid.max[u] && pv >= solid.min[v] && pv <= solid.max[v];
+        bool inside = iu >= u0 && iu < u1 && iv >= v0 && iv < v1;
         if (inside) g.intervals.push_back(span);
         g.offsets[g.ray_index(iu, iv) + 1] = static_cast<std::uint32_t>(g.intervals.size());
       }
