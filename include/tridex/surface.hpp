@@ -13,8 +13,10 @@
 //    along the feature. Normals come from the neighbouring rays' end points (one-sided or central
 //    differences of the end-point heights, whichever side is smoother), not from any field.
 //
-// Consistency. Node inside/outside comes from ONE rule: the z ray through the node, with closed
-// intervals [enter, exit]. Topology is derived from these states alone (surface_tables.hpp: a
+// Consistency. Node inside/outside comes from ONE rule: the z ray through the node, with
+// half-open intervals [enter, exit) — the convention of dexel_ops.hpp's `contains` and of
+// TripleDexel::box, so a face lying on a node plane puts its nodes on the same side in all three
+// families. Topology is derived from these states alone (surface_tables.hpp: a
 // per-face rule that never depends on the neighbouring cell), so the mesh is closed and
 // manifold whatever the rays say; the x and y rays only place crossings. Where a ray disagrees
 // with the node states (a node within rounding of the surface), the crossing goes to the node
@@ -65,10 +67,10 @@ namespace detail::surface {
 
 constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 
-// Closed-interval membership of coordinate x on one ray.
+// Half-open membership of coordinate x on one ray: enter ≤ x < exit.
 inline bool ray_contains(std::span<const DexelInterval> ray, double x) {
-  auto it = std::lower_bound(ray.begin(), ray.end(), x,
-                             [](const DexelInterval& s, double value) { return double(s.exit) < value; });
+  auto it = std::upper_bound(ray.begin(), ray.end(), x,
+                             [](double value, const DexelInterval& s) { return value < double(s.exit); });
   return it != ray.end() && double(it->enter) <= x;
 }
 
@@ -91,6 +93,14 @@ inline void symmetric_eigen(Mat3 a, Vec3& values, Mat3& vectors) {
       }
   }
   values = Vec3(a[0][0], a[1][1], a[2][2]);
+}
+
+// A triangle that will survive as such in float: its doubled area, computed from the float
+// positions it will have, is clearly above rounding noise relative to its longest edge.
+inline bool well_shaped(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 fa{glm::vec3(a)}, fb{glm::vec3(b)}, fc{glm::vec3(c)};
+  double longest = std::max({glm::dot(fb - fa, fb - fa), glm::dot(fc - fb, fc - fb), glm::dot(fa - fc, fa - fc)});
+  return glm::length(glm::cross(fb - fa, fc - fa)) > 1e-8 * longest;
 }
 
 struct SlabMesh {
@@ -164,7 +174,7 @@ class Extractor {
   double coord(int a, int m) const { return d_.origin[a] + h_ * m; }
   std::size_t column(int i, int j) const { return static_cast<std::size_t>(i) + static_cast<std::size_t>(nx_) * static_cast<std::size_t>(j); }
 
-  // The node range [first, last] of the z axis whose nodes lie in [enter, exit].
+  // The node range [first, last] of the z axis whose nodes lie in [enter, exit).
   int first_node_at_or_above(double value) const {
     double f = std::ceil((value - d_.origin.z) / h_);
     int k = static_cast<int>(std::clamp(f, 0.0, double(nz_)));
@@ -172,11 +182,11 @@ class Extractor {
     while (k < nz_ && coord(2, k) < value) ++k;
     return k;
   }
-  int last_node_at_or_below(double value) const {
+  int last_node_below(double value) const {
     double f = std::floor((value - d_.origin.z) / h_);
     int k = static_cast<int>(std::clamp(f, -1.0, double(nz_ - 1)));
-    while (k + 1 < nz_ && coord(2, k + 1) <= value) ++k;
-    while (k >= 0 && coord(2, k) > value) --k;
+    while (k + 1 < nz_ && coord(2, k + 1) < value) ++k;
+    while (k >= 0 && coord(2, k) >= value) --k;
     return k;
   }
 
@@ -201,7 +211,7 @@ class Extractor {
           std::size_t col = column(i, j);
           int start = 0, end = -2;  // merged node range, closed
           for (const DexelInterval& s : g.ray(i, j)) {
-            int a = first_node_at_or_above(double(s.enter)), b = last_node_at_or_below(double(s.exit));
+            int a = first_node_at_or_above(double(s.enter)), b = last_node_below(double(s.exit));
             if (a > b) continue;
             if (a <= end + 1) {
               end = std::max(end, b);
@@ -270,8 +280,8 @@ class Extractor {
     double x0 = coord(a, node[a]), x1 = coord(a, node[a] + 1), x = 0;
     bool found = false;
     if (start_inside) {  // leaving the solid: the first exit after the inside node
-      auto it = std::lower_bound(ray.begin(), ray.end(), x0,
-                                 [](const DexelInterval& s, double value) { return double(s.exit) < value; });
+      auto it = std::upper_bound(ray.begin(), ray.end(), x0,
+                                 [](double value, const DexelInterval& s) { return value < double(s.exit); });
       if (it != ray.end() && double(it->exit) <= x1) x = it->exit, found = true;
     } else {  // entering: the last enter before the inside node
       auto it = std::upper_bound(ray.begin(), ray.end(), x1,
@@ -365,7 +375,7 @@ class Extractor {
         Vec3 sum = Vec3(normals[i]) + Vec3(normals[j]);
         if (glm::dot(sum, sum) > 1e-6) ref = sum;
       }
-      if (!(glm::length(c) > 1e-7 * h_ * h_) || !(glm::dot(c, ref) > 0)) return false;
+      if (!well_shaped(apex, p[i], p[j]) || !(glm::dot(c, ref) > 0)) return false;
     }
     return true;
   }
@@ -635,6 +645,8 @@ class Extractor {
       Vec3 n1 = normal(a, p, b), n2 = normal(b, q, a);
       double scale = glm::dot(before, before);
       if (!(glm::dot(n1, before) > 1e-6 * scale) || !(glm::dot(n2, before) > 1e-6 * scale)) continue;
+      Vec3 pa(mesh.positions[a]), pp(mesh.positions[p]), pq(mesh.positions[q]), pb(mesh.positions[b]);
+      if (!well_shaped(pa, pp, pb) || !well_shaped(pb, pq, pa)) continue;
       t1 = glm::uvec3(a, p, b);
       t2 = glm::uvec3(b, q, a);
       joined.insert(key);

@@ -141,6 +141,24 @@ TripleDexel dexelize_solid(const Solid& s, const DexelLattice& lattice) {
   return d;
 }
 
+// The box [lo, hi) as a triple dexel: a ray gets [lo, hi] along its axis when its transverse
+// position p satisfies lo <= p < hi on both other axes (the half-open rule of dexel_ops.hpp).
+TripleDexel box_dexel(const DexelLattice& lattice, const Aabb& b) {
+  TripleDexel d = TripleDexel::empty(lattice);
+  for (int a = 0; a < 3; ++a) {
+    DexelGrid& g = d.grids[a];
+    int u = TripleDexel::u_axis(a), v = TripleDexel::v_axis(a);
+    for (int iv = 0; iv < g.nv; ++iv)
+      for (int iu = 0; iu < g.nu; ++iu) {
+        double pu = lattice.origin[u] + lattice.spacing * iu, pv = lattice.origin[v] + lattice.spacing * iv;
+        if (pu >= b.min[u] && pu < b.max[u] && pv >= b.min[v] && pv < b.max[v])
+          g.intervals.push_back({float(b.min[a]), float(b.max[a])});
+        g.offsets[g.ray_index(iu, iv) + 1] = static_cast<std::uint32_t>(g.intervals.size());
+      }
+  }
+  return d;
+}
+
 double point_triangle_distance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
   // Ericson, Real-Time Collision Detection, §5.1.5.
   Vec3 ab = b - a, ac = c - a, ap = p - a;
@@ -249,17 +267,17 @@ TEST_CASE("extract_surface: an empty triple dexel gives an empty mesh") {
   CHECK(m.triangles.empty());
   // A lattice one node thick holds no volume either.
   DexelLattice flat{Vec3(0), 1.0, glm::ivec3(5, 1, 5)};
-  CHECK(extract_surface(TripleDexel::box(flat, Aabb{Vec3(-1), Vec3(10)})).triangles.empty());
+  CHECK(extract_surface(box_dexel(flat, Aabb{Vec3(-1), Vec3(10)})).triangles.empty());
 }
 
 TEST_CASE("extract_surface: a full lattice gives its six faces with the exact volume") {
   std::mt19937 rng(7);
   for (int trial = 0; trial < 6; ++trial) {
-    // Dyadic origin and spacing: node coordinates are exact in float, so every node is inside.
     std::uniform_int_distribution<int> count(2, 13), shift(-40, 40);
     DexelLattice lattice{Vec3(shift(rng), shift(rng), shift(rng)) * 0.125, 0.25 * (1 + trial % 3),
                          glm::ivec3(count(rng), count(rng), count(rng))};
-    TripleDexel d = TripleDexel::box(lattice, lattice.bounds());
+    // Every ray spans the lattice with half a spacing to spare: every node is inside.
+    TripleDexel d = box_dexel(lattice, lattice.bounds().inflated(0.5 * lattice.spacing));
     for (bool sharp : {false, true}) {
       Mesh m = extract_surface(d, {.threads = 2, .sharp_features = sharp});
       check_closed(m);
@@ -312,6 +330,10 @@ TEST_CASE("extract_surface: analytic solids are closed, without degenerate trian
       double in = surface_to_mesh(m, s, rng, 150);
       CHECK(out <= h);
       CHECK(in <= h);
+      if (kind == 0 || kind == 3) {  // smooth solids: exact crossings keep the mesh much closer
+        CHECK(out <= 0.25 * h);
+        CHECK(in <= 0.25 * h);
+      }
     }
   }
 }
@@ -331,12 +353,45 @@ TEST_CASE("extract_surface: sharp features keep a box's edges and corners") {
     double sharp_error = std::abs(sharp.signed_volume() - s.volume);
     CAPTURE(plain_error);
     CAPTURE(sharp_error);
-    CHECK(sharp_error < 0.25 * plain_error);
+    CHECK(plain_error > 0);
+    // Edges and corners come out exact: the volume to float precision, every vertex on the box.
+    CHECK(sharp_error <= 1e-5 * s.volume);
+    for (const glm::vec3& p : sharp.positions) CHECK(std::abs(s.sdf(Vec3(p))) <= 1e-5);
     // Every box corner is a vertex of the sharp mesh (to float precision).
     for (const Vec3& corner : s.bounds.corners()) {
       double nearest = std::numeric_limits<double>::infinity();
       for (const glm::vec3& p : sharp.positions) nearest = std::min(nearest, glm::length(Vec3(p) - corner));
       CHECK(nearest < 1e-4 * h);
+    }
+  }
+}
+
+TEST_CASE("extract_surface: pockets from dexel Booleans, with faces between or exactly on lattice nodes") {
+  // Box A minus box B (a pocket open at the top): concave edges and corners. With `snap`, every
+  // face lies on a lattice plane, so rays run inside faces and end points sit on nodes.
+  std::mt19937 rng(4);
+  const double h = 0.25;
+  DexelLattice lattice{Vec3(-0.5), h, glm::ivec3(30)};
+  auto volume_of = [](const Aabb& b) { return b.empty() ? 0.0 : b.size().x * b.size().y * b.size().z; };
+  for (int trial = 0; trial < 16; ++trial) {
+    bool snap = trial % 2;
+    auto coord = [&](double lo, double hi) {
+      double x = std::uniform_real_distribution<double>(lo, hi)(rng);
+      return snap ? std::round((x + 0.5) / h) * h - 0.5 : x;
+    };
+    Aabb a{Vec3(coord(0.3, 1.5), coord(0.3, 1.5), coord(0.3, 1.5)), Vec3(coord(4, 6.5), coord(4, 6.5), coord(4, 6.5))};
+    Aabb b{Vec3(coord(1.5, 3), coord(1.5, 3), coord(2.5, 3.8)), Vec3(coord(3.2, 5), coord(3.2, 5), coord(6.8, 6.9))};
+    TripleDexel d = subtract(box_dexel(lattice, a), box_dexel(lattice, b));
+    Aabb common{glm::max(a.min, b.min), glm::min(a.max, b.max)};
+    double exact = volume_of(a) - volume_of(common);
+    Vec3 e = a.size(), p = common.size();
+    double area = 2 * (e.x * e.y + e.y * e.z + e.z * e.x) + 2 * p.z * (p.x + p.y);
+    for (bool sharp : {false, true}) {
+      CAPTURE(snap);
+      CAPTURE(sharp);
+      Mesh m = extract_surface(d, {.sharp_features = sharp});
+      check_closed(m);
+      CHECK(std::abs(m.signed_volume() - exact) <= 0.05 * area * h);
     }
   }
 }
@@ -415,7 +470,7 @@ TEST_CASE("extract_surface: rays that disagree with each other still give a clos
 
 TEST_CASE("extract_surface: malformed input is rejected") {
   DexelLattice lattice{Vec3(0), 1.0, glm::ivec3(4, 4, 4)};
-  TripleDexel d = TripleDexel::box(lattice, Aabb{Vec3(0.5), Vec3(2.5)});
+  TripleDexel d = box_dexel(lattice, Aabb{Vec3(0.5), Vec3(2.5)});
   CHECK_THROWS_AS(extract_surface(d, {.feature_angle = 0}), Error);
   CHECK_THROWS_AS(extract_surface(d, {.feature_angle = std::nan("")}), Error);
   TripleDexel unsorted = d;
