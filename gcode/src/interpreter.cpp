@@ -206,7 +206,7 @@ std::string code_name(char letter, int code10) {
 
 std::string format_number(double v) {
   char text[48];
-  std::snprintf(text, sizeof text, "%.6g", v);
+  std::snprintf(text, sizeof text, "%.10g", v);
   return text;
 }
 
@@ -329,10 +329,11 @@ struct Interpreter::State {
     std::array<int, kMGroupCount> m_seen{};
     for (const Word& word : block.words) {
       if (word.letter == 'G' || word.letter == 'M') {
+        // Codes are small; anything else is unsupported before it reaches an int (fuzz finding).
         double scaled = word.value * 10;
         double rounded = std::round(scaled);
-        int code = static_cast<int>(rounded);
-        bool integral = std::abs(scaled - rounded) < 1e-6 && word.value >= 0;
+        bool integral = std::abs(scaled - rounded) < 1e-6 && word.value >= 0 && word.value < 10000;
+        int code = integral ? static_cast<int>(rounded) : -1;
         if (word.letter == 'M' && code % 10) integral = false;
         int group = !integral ? -1 : word.letter == 'G' ? g_group(code) : m_group(code / 10);
         if (group < 0) {
@@ -483,7 +484,8 @@ struct Interpreter::State {
       error(motion_column,
             "arc from a retracted position: the tool is far along its axis; position it first");
     require_feed();
-    auto [u, v, n] = plane_axes(plane);
+    const std::array<int, 3> axes = plane_axes(plane);
+    const int u = axes[0], v = axes[1], n = axes[2];
     Vec3 start = to_program(pos);
     Vec3 end = start;
     for (int i = 0; i < 3; ++i) {
@@ -575,7 +577,8 @@ struct Interpreter::State {
 
   // ---- canned cycles ----
   void cycle(int code) {
-    auto [u, v, n] = plane_axes(plane);
+    const std::array<int, 3> axes = plane_axes(plane);
+    const int u = axes[0], v = axes[1], n = axes[2];
     Vec3 drill = rotation[n];  // cycle axis in machine coordinates
     if (glm::dot(drill, axis) < 1 - 1e-9)
       error(motion_column, code_name('G', code) + " drills along the " + code_name('G', plane) +
@@ -1098,7 +1101,8 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
       break;
     }
     started = true;
-    ++s.blocks;
+    if (++s.blocks > s.options.max_blocks && s.options.max_blocks > 0)
+      s.error(0, "more than " + std::to_string(s.options.max_blocks) + " blocks executed (max_blocks)");
     Flow flow = s.execute(block);
     if (flow == Flow::end) {
       ended = true;

@@ -74,6 +74,7 @@ struct InterpreterOptions {
   std::optional<Vec3> start_position;  // tip at program start, work frame; default: far along +Z
   int max_call_depth = 16;     // nested M98 calls
   double peck_clearance = 0.254;  // mm, G73 back-off and G83 re-entry gap (LinuxCNC's 0.010 in)
+  long long max_blocks = 0;    // > 0: error once this many blocks ran (bounds M98 L loops)
 };
 
 class Interpreter {

@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer harness of the G-code front end with clang and runs it for a bounded time.
+#   gcode/fuzz/run.sh [SECONDS=60] [BUILD_DIR=build-fuzz]
+# Exit status 0: no crash in that time. A crash leaves its input as BUILD_DIR/crash-* (and the
+# status is non-zero); turn it into a named case in tests/gcode/test_bad_input.cpp.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+seconds=${1:-60}
+build=${2:-build-fuzz}
+mkdir -p "$build/fuzz_corpus"
+clang++ -std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
+  -Iinclude -Igcode/include gcode/fuzz/fuzz_gcode.cpp gcode/src/lexer.cpp \
+  gcode/src/interpreter.cpp gcode/src/grouping.cpp -o "$build/fuzz_gcode"
+exec "$build/fuzz_gcode" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=4096 \
+  -dict=gcode/fuzz/gcode.dict -artifact_prefix="$build/" -print_final_stats=1 \
+  "$build/fuzz_corpus" gcode/fuzz/seeds tests/data/gcode/linuxcnc
