@@ -17,12 +17,13 @@
 // half-open intervals [enter, exit) — the convention of dexel_ops.hpp's `contains` and of
 // TripleDexel::box, so a face lying on a node plane puts its nodes on the same side in all three
 // families. Topology is derived from these states alone (surface_tables.hpp: a
-// per-face rule that never depends on the neighbouring cell), so the mesh is closed and
-// manifold whatever the rays say; the x and y rays only place crossings. Where a ray disagrees
+// per-face rule that never depends on the neighbouring cell), so every mesh edge joins exactly
+// two triangles, in opposite directions, whatever the rays say; the x and y rays only place crossings. Where a ray disagrees
 // with the node states (a node within rounding of the surface), the crossing goes to the node
 // the ray disagrees about. Crossings are kept a small fraction of the spacing away from nodes so
 // that no two vertices coincide and no triangle degenerates (three points interior to distinct
-// cube edges are never collinear). The solid is clipped to the lattice box: where it reaches the
+// cube edges are never collinear); triangles around feature or centre points, and flipped ones,
+// are checked in float before they are kept. The solid is clipped to the lattice box: where it reaches the
 // outer nodes, caps on the box faces close it.
 //
 // Cost. Node states of one lattice layer are kept as bit rows updated by the z rays' state
@@ -415,7 +416,17 @@ class Extractor {
       std::size_t r = static_cast<std::size_t>(fan_start);
       for (std::size_t q = 1; q + 1 < n; ++q) emit(st.out, id[r], id[(r + q) % n], id[(r + q + 1) % n]);
     } else {
-      fan_around(centroid, false);
+      // A centre point; nudged off the loop's mean plane in the rare case that it falls in line
+      // with two neighbouring loop vertices.
+      Vec3 lift = glm::length(newell) > 0 ? 0.05 * h_ * glm::normalize(newell) : Vec3(0);
+      Vec3 apex = centroid;
+      for (const Vec3& offset : {Vec3(0), lift, -lift}) {
+        apex = centroid + offset;
+        bool ok = true;
+        for (std::size_t q = 0; q < n && ok; ++q) ok = well_shaped(apex, p[q], p[(q + 1) % n]);
+        if (ok) break;
+      }
+      fan_around(apex, false);
     }
   }
 

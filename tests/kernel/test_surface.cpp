@@ -338,6 +338,32 @@ TEST_CASE("extract_surface: analytic solids are closed, without degenerate trian
   }
 }
 
+TEST_CASE("extract_surface: vertices on lattice edges are the rays' end points") {
+  std::mt19937 rng(17);
+  for (int kind : {0, 3, 5}) {
+    Solid s = random_solid(kind, rng);
+    DexelLattice lattice = DexelLattice::covering(s.bounds, 0.3);
+    TripleDexel d = dexelize_solid(s, lattice);
+    Mesh m = extract_surface(d, {.sharp_features = false});
+    std::size_t on_edges = 0;
+    for (const glm::vec3& p : m.positions) {
+      Vec3 g = (Vec3(p) - lattice.origin) / lattice.spacing;
+      int off_node = -1, count = 0;
+      for (int a = 0; a < 3; ++a)
+        if (std::abs(g[a] - std::round(g[a])) > 1e-4) off_node = a, ++count;
+      if (count != 1) continue;  // a loop's centre point
+      ++on_edges;
+      int u = TripleDexel::u_axis(off_node), v = TripleDexel::v_axis(off_node);
+      double nearest = std::numeric_limits<double>::infinity();
+      for (DexelInterval x : d.grids[off_node].ray(int(std::lround(g[u])), int(std::lround(g[v]))))
+        nearest = std::min({nearest, std::abs(double(x.enter) - p[off_node]), std::abs(double(x.exit) - p[off_node])});
+      // Exact up to float rounding, or moved by at most 1% of a spacing off a node.
+      CHECK(nearest <= 0.011 * lattice.spacing);
+    }
+    CHECK(double(on_edges) >= 0.99 * double(m.positions.size()));
+  }
+}
+
 TEST_CASE("extract_surface: sharp features keep a box's edges and corners") {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> c(-2, 2), e(1.5, 4);
