@@ -1,6 +1,7 @@
 // tridex::gcode — grouping moves by spindle direction (see grouping.hpp).
 #include "tridex/gcode/grouping.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -12,7 +13,8 @@ DirectionGrouper::DirectionGrouper(double angle_tolerance_deg) {
   if (!std::isfinite(angle_tolerance_deg) || angle_tolerance_deg < 0 || angle_tolerance_deg >= 90)
     detail::fail("group_by_direction: angle_tolerance_deg must be in [0, 90), got ",
                  angle_tolerance_deg);
-  cos_tolerance_ = std::cos(glm::radians(angle_tolerance_deg));
+  // A zero tolerance still has to group equal unit vectors whose dot product rounds below 1.
+  cos_tolerance_ = std::min(std::cos(glm::radians(angle_tolerance_deg)), 1.0 - 1e-15);
 }
 
 std::size_t DirectionGrouper::add(const Move& move) {

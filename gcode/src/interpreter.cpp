@@ -818,6 +818,7 @@ Flow Interpreter::State::execute(const Block& block) {
     char c = w.has('P') ? 'P' : w.has('X') ? 'X' : 0;
     if (!c) error(w.find_g(40), "G4 needs a dwell time P");
     if (w.take(c) < 0) error(w.col(c), "dwell time must not be negative");
+    if (c == 'X') w.present &= ~(1u << letter_index('X'));  // a time here, not a coordinate
   }
 
   for (int code : {170, 180, 190})
@@ -828,6 +829,10 @@ Flow Interpreter::State::execute(const Block& block) {
   if (w.find_g(911)) arc_absolute = false;
   if (w.find_g(430) || w.find_g(440)) {
     if (w.has('H')) integer('H', "tool length offset number", 0, 99'999'999);
+  }
+  if (w.find_g(640)) {  // path blending tolerances (LinuxCNC G64 P Q): no effect on the path
+    if (w.has('P')) w.take('P');
+    if (w.has('Q')) w.take('Q');
   }
   if (w.find_g(980)) retract_to_r = false;
   if (w.find_g(990)) retract_to_r = true;
