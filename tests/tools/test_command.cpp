@@ -1,0 +1,609 @@
+// The `tridex` command end to end: every exit path, `moves` and `groups` on G68.2 programs, and
+// `simulate` against a direct point-membership reference built from the moves.
+#include <doctest/doctest.h>
+
+// GCC 12 warns falsely on `"text" + std::string + "text"` (bug 105329) under -Werror=restrict.
+#if defined(__GNUC__) && !defined(__clang__) && __GNUC__ == 12
+#pragma GCC diagnostic ignored "-Wrestrict"
+#endif
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <regex>
+
+#include <nlohmann/json.hpp>
+
+#include "command_harness.hpp"
+#include "tool_table.hpp"
+#include "tridex/gcode/interpreter.hpp"
+#include "tridex/mesh_check.hpp"
+#include "tridex/mill.hpp"
+
+using namespace tridex;
+using namespace tridex::test;
+using nlohmann::json;
+
+namespace {
+
+const std::string kTools = R"({
+  "1": {"units": "mm", "shape": "cylindrical", "diameter": 6, "length": 20},
+  "2": {"units": "mm", "shape": "ballnose", "diameter": 4, "length": 20},
+  "3": {"units": "inch", "shape": "bullnose", "diameter": 0.25, "corner-radius": 0.05, "length": 1}
+})";
+
+// G68.2 Euler angles (Z-X-Z) and a feature origin on each face of the 40 x 30 x 20 test stock.
+struct Direction {
+  const char* name;
+  Vec3 origin;
+  double a, b, c;
+};
+const Direction kDirections[] = {
+    {"+Z", {20, 15, 20}, 0, 0, 0},       {"+X tilted 20", {40, 15, 12}, 90, 70, 0},
+    {"+Y", {20, 30, 10}, 180, 90, 0},    {"-X", {0, 15, 10}, -90, 90, 0},
+    {"-Y", {20, 0, 10}, 0, 90, 0},
+};
+const char* kStock = "box:0,0,0,40,30,20";
+
+// The feature work for one direction, as a CAM post writes it: a flat-end slot with a ramp, a
+// ball-end arc groove, a bull-nose plunge.
+std::string direction_block(const Direction& d) {
+  std::ostringstream p;
+  p << "G28 G91 Z0.\nG90\nG69\nT1 M6\nS8000 M3\n"
+    << "G68.2 X" << d.origin.x << " Y" << d.origin.y << " Z" << d.origin.z << " I" << d.a << " J" << d.b
+    << " K" << d.c << "\nG53.1\n"
+    << "G0 X-9 Y-2\nG43 Z8 H1\nG1 Z-2 F500\nG1 X7\nG1 Y3 Z-1\nG0 Z8\n"
+    << "T2 M6\nG0 X2 Y-3\nG43 Z8 H2\nG1 Z-1.5\nG2 X8 Y3 I0 J6\nG3 X2 Y-3 I-6 J0\nG0 Z8\n"
+    << "T3 M6\nG0 X-6 Y4\nG43 Z8 H3\nG1 Z-2.5\nG1 X-3 Y5\nG0 Z8\n"
+    << "G28 G91 Z0.\nG69\n";
+  return p.str();
+}
+
+std::string program_of(std::initializer_list<const Direction*> directions) {
+  std::string text = "%\nG21 G17 G90\n";
+  for (const Direction* d : directions) text += direction_block(*d);
+  return text + "M30\n%\n";
+}
+
+// ---- the reference: is a world point removed by any move? ------------------------------------
+
+struct Reference {
+  std::vector<Cutter> cutters;
+  std::vector<detail::MoveGeometry> moves;
+  std::vector<Frame> frames;
+  // Moves bucketed by a uniform grid over the stock, each in every cell its removal region
+  // (everything within the cutter radius of the segment and above it along the axis) can reach.
+  Aabb box;
+  double cell = 4;
+  glm::ivec3 n;
+  std::vector<std::vector<std::uint32_t>> buckets;
+
+  Reference(const std::vector<gcode::Move>& program, const cli::ToolTable& table, const Aabb& stock)
+      : box(stock) {
+    std::map<int, std::size_t> index;
+    for (const auto& [number, spec] : table.tools()) {
+      index[number] = cutters.size();
+      cutters.push_back(spec.cutter);
+    }
+    frames.reserve(program.size());
+    moves.reserve(program.size());
+    for (int a = 0; a < 3; ++a) n[a] = std::max(1, static_cast<int>(std::ceil(box.size()[a] / cell)));
+    buckets.resize(static_cast<std::size_t>(n.x) * n.y * n.z);
+    double reach = glm::length(box.size());
+    for (const gcode::Move& m : program) {
+      if (m.tool == 0) continue;  // no tool in the spindle
+      frames.push_back(Frame::from_axis(m.axis));
+      const Frame& f = frames.back();
+      const Cutter& cutter = cutters[index.at(m.tool)];
+      moves.emplace_back(cutter, Segment{f.to_local(m.start), f.to_local(m.end)});
+      Aabb region;
+      for (const Vec3& p : {m.start, m.end}) {
+        // Clip "far" points to the stock's neighbourhood along the move's own line.
+        region.extend(p);
+        region.extend(p + reach * f.axis());
+      }
+      region = region.inflated(cutter.radius());
+      glm::ivec3 lo, hi;
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::clamp(static_cast<int>(std::floor((region.min[a] - box.min[a]) / cell)), 0, n[a] - 1);
+        hi[a] = std::clamp(static_cast<int>(std::floor((region.max[a] - box.min[a]) / cell)), 0, n[a] - 1);
+        if (region.max[a] < box.min[a] || region.min[a] > box.max[a]) lo[a] = 1, hi[a] = 0;
+      }
+      for (int k = lo.z; k <= hi.z; ++k)
+        for (int j = lo.y; j <= hi.y; ++j)
+          for (int i = lo.x; i <= hi.x; ++i)
+            buckets[static_cast<std::size_t>(i + n.x * (j + n.y * k))].push_back(
+                static_cast<std::uint32_t>(moves.size() - 1));
+    }
+  }
+
+  bool removed(const Vec3& p) const {
+    glm::ivec3 c;
+    for (int a = 0; a < 3; ++a)
+      c[a] = std::clamp(static_cast<int>(std::floor((p[a] - box.min[a]) / cell)), 0, n[a] - 1);
+    for (std::uint32_t m : buckets[static_cast<std::size_t>(c.x + n.x * (c.y + n.y * c.z))]) {
+      Vec3 q = frames[m].to_local(p);
+      if (q.z >= moves[m].lowest_above(q.x, q.y)) return true;
+    }
+    return false;
+  }
+  bool kept(const Vec3& p) const { return box.contains(p) && !removed(p); }
+};
+
+// Point membership in a closed mesh by the parity of crossings of a ray along +z, with the
+// triangles bucketed by their x-y boxes.
+struct MeshInside {
+  const Mesh& mesh;
+  Aabb box;
+  double cell;
+  int nx, ny;
+  std::vector<std::vector<std::uint32_t>> buckets;
+
+  MeshInside(const Mesh& m, double bucket) : mesh(m), box(m.bounds()), cell(bucket) {
+    nx = std::max(1, static_cast<int>(std::ceil(box.size().x / cell)) + 1);
+    ny = std::max(1, static_cast<int>(std::ceil(box.size().y / cell)) + 1);
+    buckets.resize(static_cast<std::size_t>(nx) * ny);
+    for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+      Aabb tb;
+      for (int k = 0; k < 3; ++k) tb.extend(Vec3(mesh.positions[mesh.triangles[t][k]]));
+      for (int j = bin(tb.min.y, box.min.y, ny); j <= bin(tb.max.y, box.min.y, ny); ++j)
+        for (int i = bin(tb.min.x, box.min.x, nx); i <= bin(tb.max.x, box.min.x, nx); ++i)
+          buckets[static_cast<std::size_t>(i + nx * j)].push_back(t);
+    }
+  }
+  int bin(double v, double lo, int count) const {
+    return std::clamp(static_cast<int>(std::floor((v - lo) / cell)), 0, count - 1);
+  }
+  bool inside(const Vec3& p) const {
+    if (!box.contains(p)) return false;
+    int crossings = 0;
+    for (std::uint32_t t : buckets[static_cast<std::size_t>(bin(p.x, box.min.x, nx) + nx * bin(p.y, box.min.y, ny))]) {
+      Vec3 a(mesh.positions[mesh.triangles[t].x]), b(mesh.positions[mesh.triangles[t].y]),
+          c(mesh.positions[mesh.triangles[t].z]);
+      double det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+      if (det == 0) continue;
+      double wb = ((p.x - a.x) * (c.y - a.y) - (c.x - a.x) * (p.y - a.y)) / det;
+      double wc = ((b.x - a.x) * (p.y - a.y) - (p.x - a.x) * (b.y - a.y)) / det;
+      double wa = 1 - wb - wc;
+      if (wa < 0 || wb < 0 || wc < 0) continue;
+      if (wa * a.z + wb * b.z + wc * c.z > p.z) ++crossings;
+    }
+    return crossings % 2 == 1;
+  }
+};
+
+struct Simulated {
+  json report;
+  Mesh mesh;
+};
+
+Simulated simulate(const fs::path& dir, const fs::path& program, const fs::path& tools,
+                   const std::string& stock, int dexel_res, double zmap_cell) {
+  fs::path stl = dir / "result.stl", report = dir / "report.json";
+  CommandResult r = run_tridex({"simulate", program.string(), "--tools", tools.string(), "--stock", stock,
+                                "--dexel-res", std::to_string(dexel_res), "--zmap-cell",
+                                std::to_string(zmap_cell), "-o", stl.string(), "--report",
+                                report.string(), "--quiet"},
+                               dir);
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  CHECK(r.out.empty());  // --quiet
+  Simulated s;
+  s.report = json::parse(slurp(report));
+  s.mesh = read_binary_stl(stl);
+  return s;
+}
+
+// The result against the reference: watertight, the same volume within what the dexel spacing
+// h allows on the cut surfaces, and the same membership at points at least 2h from any change
+// of the reference classification.
+void check_against_reference(const Simulated& s, const Reference& ref, std::uint32_t seed) {
+  const json& result = s.report["result"];
+  CHECK(result["watertight"].get<bool>());
+  Mesh welded = weld_vertices(s.mesh);
+  CHECK(check_mesh(welded).closed());
+  double volume = result["volume_mm3"].get<double>();
+  CHECK(s.mesh.signed_volume() == doctest::Approx(volume).epsilon(1e-4));
+  const double h = s.report["dexel"]["cell_mm"].get<double>();
+
+  // Volume on a jittered regular grid of spacing g; the cut-surface area from the number of
+  // neighbouring samples that differ (each face of the surface is crossed by ≤ √3·A/g² pairs,
+  // ≥ A/g²: the estimate over-counts by at most √3).
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> unit(0, 1);
+  const Aabb& box = ref.box;
+  const double g = 0.5;
+  glm::ivec3 n = glm::ivec3(glm::floor(box.size() / g));
+  Vec3 jitter(unit(random) * g, unit(random) * g, unit(random) * g);
+  std::vector<char> kept(static_cast<std::size_t>(n.x) * n.y * n.z);
+  auto at = [&](int i, int j, int k) -> char& { return kept[static_cast<std::size_t>(i + n.x * (j + n.y * k))]; };
+  for (int k = 0; k < n.z; ++k)
+    for (int j = 0; j < n.y; ++j)
+      for (int i = 0; i < n.x; ++i) at(i, j, k) = !ref.removed(box.min + jitter + g * Vec3(i, j, k));
+  std::size_t kept_count = 0, differing = 0;
+  for (int k = 0; k < n.z; ++k)
+    for (int j = 0; j < n.y; ++j)
+      for (int i = 0; i < n.x; ++i) {
+        kept_count += at(i, j, k) ? 1 : 0;
+        if (i + 1 < n.x && at(i, j, k) != at(i + 1, j, k)) ++differing;
+        if (j + 1 < n.y && at(i, j, k) != at(i, j + 1, k)) ++differing;
+        if (k + 1 < n.z && at(i, j, k) != at(i, j, k + 1)) ++differing;
+      }
+  Vec3 size = box.size();
+  double stock_volume = size.x * size.y * size.z;
+  // Samples cover n·g along each side; scale the kept fraction to the whole box.
+  double reference_volume = stock_volume * static_cast<double>(kept_count) / static_cast<double>(kept.size());
+  // The surface lies within h of the true one (exact dexel crossings), so the volume is within
+  // h/2 · area on average; the sampled reference adds about g³·√(samples on the surface)/2.
+  double cut_area = static_cast<double>(differing) * g * g;
+  double sampling = 0.5 * g * g * g * std::sqrt(static_cast<double>(differing));
+  double tolerance = 0.5 * h * cut_area + 4 * sampling;
+  INFO("reference volume " << reference_volume << ", result " << volume << ", tolerance " << tolerance
+                           << " (cut area about " << cut_area << " mm^2, h " << h << ")");
+  CHECK(std::abs(volume - reference_volume) <= tolerance);
+  CHECK(stock_volume - reference_volume > 3 * tolerance);  // the test cuts something real
+
+  // Point membership wherever the reference classification does not change within h.
+  MeshInside inside(s.mesh, 1.0);
+  int compared = 0, wrong = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    Vec3 p = box.min + Vec3(unit(random), unit(random), unit(random)) * box.size();
+    bool reference = ref.kept(p), clear = true;
+    for (int a = 0; a < 3 && clear; ++a)
+      for (double sign : {-1.0, 1.0}) {
+        Vec3 q = p;
+        q[a] += sign * h;
+        if (ref.kept(q) != reference) clear = false;
+      }
+    if (!clear) continue;
+    ++compared;
+    if (inside.inside(p) != reference) {
+      ++wrong;
+      if (wrong <= 5) MESSAGE("mismatch at " << p.x << ", " << p.y << ", " << p.z << ": reference kept " << reference);
+    }
+  }
+  CHECK(compared > 1000);
+  CHECK(wrong == 0);
+}
+
+}  // namespace
+
+TEST_CASE("--version, --help and option errors") {
+  fs::path dir = scratch("options");
+  CommandResult version = run_tridex({"--version"}, dir);
+  CHECK(version.status == 0);
+  CHECK(version.out.rfind("tridex ", 0) == 0);
+  CHECK(run_tridex({"--help"}, dir).status == 0);
+  for (const char* command : {"simulate", "moves", "groups"}) {
+    CommandResult help = run_tridex({command, "--help"}, dir);
+    CHECK(help.status == 0);
+    CHECK(help.out.find("PROGRAM") != std::string::npos);
+  }
+  CHECK(run_tridex({"simulate", "--help"}, dir).out.find("--dexel-res") != std::string::npos);
+  fs::path program = dir / "p.nc";
+  write_text(program, "G0 X0\n");
+  CHECK(run_tridex({}, dir).status == 2);
+  CHECK(run_tridex({"frobnicate"}, dir).status == 2);
+  CHECK(run_tridex({"simulate"}, dir).status == 2);
+  CHECK(run_tridex({"simulate", program.string(), "--no-such-option"}, dir).status == 2);
+  CHECK(run_tridex({"simulate", program.string(), "--dexel-res", "100", "--dexel-cell", "1"}, dir).status == 2);
+  CHECK(run_tridex({"simulate", program.string(), "--zmap-cell", "-1"}, dir).status == 2);
+  CHECK(run_tridex({"simulate", program.string(), "--quiet", "--progress"}, dir).status == 2);
+  CHECK(run_tridex({"simulate", program.string(), "--max-memory", "lots"}, dir).status == 2);
+  CommandResult missing = run_tridex({"moves", (dir / "absent.nc").string()}, dir);
+  CHECK(missing.status == 2);
+  CHECK(missing.err.find("absent.nc") != std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("a bad program exits 2 with file:line:col, and leaves no output behind") {
+  fs::path dir = scratch("bad-program");
+  fs::path program = dir / "bad.nc", tools = dir / "tools.json", stl = dir / "out.stl";
+  write_text(tools, kTools);
+  write_text(program, "G21 G90\nT1 M6\nG0 X1 Y2 Z30\nG1 X5 F100 G987\nM30\n");
+  write_text(stl, "the previous result");
+  for (const char* command : {"simulate", "moves", "groups"}) {
+    std::vector<std::string> args{command, program.string()};
+    if (std::string(command) == "simulate") args.insert(args.end(), {"--tools", tools.string()});
+    args.insert(args.end(), {"-o", stl.string()});
+    CommandResult r = run_tridex(args, dir);
+    CHECK(r.status == 2);
+    INFO(r.err);
+    CHECK(std::regex_search(r.err, std::regex("bad\\.nc:4:[0-9]+: ")));
+    CHECK(slurp(stl) == "the previous result");
+  }
+  // Nothing but the three files: no temporary file left.
+  CHECK(std::distance(fs::directory_iterator(dir), fs::directory_iterator()) == 3);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("bad tool tables, missing tools and bad stocks exit 2 naming the problem") {
+  fs::path dir = scratch("bad-input");
+  fs::path program = dir / "p.nc", tools = dir / "tools.json";
+  write_text(program, "G21 G90\nT1 M6\nG0 X1 Y2 Z30\nG1 Z5 F100\nT5 M6\nG0 X3 Y3 Z30\nG1 Z4\nM30\n");
+  auto simulate_with = [&](const std::string& table, const std::string& stock) {
+    write_text(tools, table);
+    return run_tridex({"simulate", program.string(), "--tools", tools.string(), "--stock", stock,
+                       "--dexel-res", "32", "-o", (dir / "out.stl").string()},
+                      dir);
+  };
+  CommandResult not_json = simulate_with("{\"1\": {", "auto");
+  CHECK(not_json.status == 2);
+  CHECK(not_json.err.find("tools.json") != std::string::npos);
+  CommandResult bad_shape = simulate_with(R"({"1": {"shape": "drill", "diameter": 3}})", "auto");
+  CHECK(bad_shape.status == 2);
+  CHECK(bad_shape.err.find("tool 1: unknown shape") != std::string::npos);
+  CommandResult missing_tool = simulate_with(R"({"1": {"shape": "ballnose", "diameter": 3}})", "auto");
+  CHECK(missing_tool.status == 2);
+  INFO(missing_tool.err);
+  CHECK(missing_tool.err.find("p.nc:5") != std::string::npos);
+  CHECK(missing_tool.err.find("tool 5") != std::string::npos);
+  CHECK(run_tridex({"simulate", program.string(), "--dexel-res", "32"}, dir).status == 2);  // no table
+
+  const std::string good = R"({"1": {"shape": "ballnose", "diameter": 3}, "5": {"shape": "cylindrical", "diameter": 2}})";
+  for (const char* stock : {"box:0,0,0,10,10", "box:0,0,0,10,10,a", "box:0,0,5,10,10,5", "cube:1", "auto:-2"})
+    CHECK(simulate_with(good, stock).status == 2);
+  fs::path broken = dir / "broken.stl";
+  write_text(broken, "solid broken\n  facet normal 0 0 1\n    outer loop\n      vertex 0 0 0\n");
+  CommandResult bad_stl = simulate_with(good, broken.string());
+  CHECK(bad_stl.status == 2);
+  CHECK(bad_stl.err.find("broken.stl") != std::string::npos);
+  CHECK(!fs::exists(dir / "out.stl"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("unwritable outputs and inputs named as outputs are refused before any work") {
+  fs::path dir = scratch("outputs");
+  fs::path program = dir / "p.nc", tools = dir / "tools.json";
+  write_text(program, program_of({&kDirections[0]}));
+  write_text(tools, kTools);
+  std::string before = slurp(program);
+  std::vector<std::string> base{"simulate", program.string(), "--tools", tools.string(), "--stock", kStock,
+                                "--dexel-res", "32"};
+  auto with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = base;
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run_tridex(args, dir);
+  };
+  CommandResult no_dir = with({"-o", (dir / "missing" / "out.stl").string()});
+  CHECK(no_dir.status == 2);
+  CHECK(no_dir.err.find("does not exist") != std::string::npos);
+  CHECK(with({"--png", dir.string()}).status == 2);
+  CommandResult over_input = with({"-o", program.string()});
+  CHECK(over_input.status == 2);
+  CHECK(over_input.err.find("would overwrite the input") != std::string::npos);
+  CHECK(with({"--report", tools.string()}).status == 2);
+  CHECK(slurp(program) == before);
+  CHECK(run_tridex({"moves", program.string(), "-o", program.string()}, dir).status == 2);
+  CHECK(slurp(program) == before);
+  if (::geteuid() != 0) {
+    fs::create_directories(dir / "locked");
+    fs::permissions(dir / "locked", fs::perms::owner_read | fs::perms::owner_exec);
+    CHECK(with({"-o", (dir / "locked" / "out.stl").string()}).status == 2);
+    fs::permissions(dir / "locked", fs::perms::owner_all);
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("a resolution over --max-memory is refused up front with the figure") {
+  fs::path dir = scratch("memory");
+  fs::path program = dir / "p.nc", tools = dir / "tools.json", stl = dir / "out.stl";
+  write_text(program, program_of({&kDirections[0], &kDirections[1]}));
+  write_text(tools, kTools);
+  CommandResult r = run_tridex({"simulate", program.string(), "--tools", tools.string(), "--stock", kStock,
+                                "--dexel-res", "4000", "--max-memory", "512M", "-o", stl.string()},
+                               dir);
+  CHECK(r.status == 2);
+  INFO(r.err);
+  CHECK(std::regex_search(r.err, std::regex("needs an estimated [0-9]+ MiB")));
+  CHECK(r.err.find("--max-memory 512 MiB") != std::string::npos);
+  CHECK(!fs::exists(stl));
+  // The same run fits with the default resolution.
+  CHECK(run_tridex({"simulate", program.string(), "--tools", tools.string(), "--stock", kStock,
+                    "--dexel-res", "48", "--zmap-cell", "0.2", "--max-memory", "512M", "-o", stl.string(), "--quiet"},
+                   dir)
+            .status == 0);
+  CHECK(fs::file_size(stl) > 84);
+  fs::remove_all(dir);
+}
+
+namespace {
+
+// G68.2's rotation written out independently: R = Rz(a)·Rx(b)·Rz(c), row-major here.
+std::array<std::array<double, 3>, 3> euler_zxz(double a, double b, double c) {
+  auto rz = [](double t) {
+    double r = t * M_PI / 180;
+    return std::array<std::array<double, 3>, 3>{{{std::cos(r), -std::sin(r), 0}, {std::sin(r), std::cos(r), 0}, {0, 0, 1}}};
+  };
+  auto rx = [](double t) {
+    double r = t * M_PI / 180;
+    return std::array<std::array<double, 3>, 3>{{{1, 0, 0}, {0, std::cos(r), -std::sin(r)}, {0, std::sin(r), std::cos(r)}}};
+  };
+  auto mul = [](const auto& p, const auto& q) {
+    std::array<std::array<double, 3>, 3> m{};
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        for (int k = 0; k < 3; ++k) m[i][j] += p[i][k] * q[k][j];
+    return m;
+  };
+  return mul(mul(rz(a), rx(b)), rz(c));
+}
+
+Vec3 rotate_by(const std::array<std::array<double, 3>, 3>& m, const Vec3& p) {
+  return Vec3(m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z, m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z,
+              m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z);
+}
+
+Vec3 vec(const json& j) { return Vec3(j[0].get<double>(), j[1].get<double>(), j[2].get<double>()); }
+
+}  // namespace
+
+TEST_CASE("moves: JSON Lines in the work frame under random G68.2 planes") {
+  fs::path dir = scratch("moves");
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> angle(-180, 180), tilt(0, 120), offset(-50, 50), local(-10, 10);
+  for (int trial = 0; trial < 8; ++trial) {
+    double a = angle(random), b = tilt(random), c = angle(random);
+    Vec3 origin(offset(random), offset(random), offset(random));
+    std::vector<Vec3> points;
+    std::ostringstream text;
+    text.precision(10);
+    text << "G21 G90 G17\nT2 M6\nS5000 M3\nG68.2 X" << origin.x << " Y" << origin.y << " Z" << origin.z
+         << " I" << a << " J" << b << " K" << c << "\nG53.1\n";
+    for (int k = 0; k < 6; ++k) {
+      Vec3 p(local(random), local(random), local(random));
+      points.push_back(p);
+      text << "G1 X" << p.x << " Y" << p.y << " Z" << p.z << " F700\n";
+    }
+    // A half circle of radius 5 about the last point, in the feature XY plane.
+    Vec3 centre = points.back() + Vec3(5, 0, 0), last = points.back() + Vec3(10, 0, 0);
+    text << "G3 X" << last.x << " Y" << last.y << " I5 J0\nG69\nM30\n";
+    fs::path program = dir / ("p" + std::to_string(trial) + ".ngc");
+    write_text(program, text.str());
+    CommandResult r = run_tridex({"moves", program.string(), "--arc-tolerance", "0.01"}, dir);
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    auto R = euler_zxz(a, b, c);
+    Vec3 axis(std::sin(a * M_PI / 180) * std::sin(b * M_PI / 180), -std::cos(a * M_PI / 180) * std::sin(b * M_PI / 180),
+              std::cos(b * M_PI / 180));
+    std::istringstream lines(r.out);
+    std::string line;
+    std::vector<json> records;
+    while (std::getline(lines, line)) records.push_back(json::parse(line));
+    // The feed moves, in order; the first comes straight down the tool axis from far away.
+    std::vector<json> feeds, arcs;
+    for (const json& m : records) {
+      for (const char* key : {"line", "kind", "tool", "start", "end", "axis", "feed"}) REQUIRE(m.contains(key));
+      if (m["kind"] == "feed") feeds.push_back(m);
+      if (m["kind"] == "arc") arcs.push_back(m);
+    }
+    REQUIRE(feeds.size() == points.size());
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      Vec3 expected = origin + rotate_by(R, points[k]);
+      Vec3 end = vec(feeds[k]["end"]);
+      CHECK(glm::length(end - expected) < 1e-6);
+      CHECK(glm::length(vec(feeds[k]["axis"]) - axis) < 1e-9);
+      CHECK(feeds[k]["tool"] == 2);
+      CHECK(feeds[k]["feed"].get<double>() == doctest::Approx(700));
+      CHECK(feeds[k]["line"] == 6 + static_cast<int>(k));
+    }
+    Vec3 approach = vec(feeds[0]["start"]) - vec(feeds[0]["end"]);
+    CHECK(glm::length(approach) > 1000);
+    CHECK(glm::dot(glm::normalize(approach), axis) == doctest::Approx(1));
+    // Arc pieces: chained, on the circle about the rotated centre, ending at the rotated end.
+    REQUIRE(arcs.size() >= 8);
+    Vec3 world_centre = origin + rotate_by(R, centre);
+    for (std::size_t k = 0; k < arcs.size(); ++k) {
+      CHECK(glm::length(vec(arcs[k]["end"]) - world_centre) == doctest::Approx(5).epsilon(1e-6));
+      if (k > 0) CHECK(glm::length(vec(arcs[k]["start"]) - vec(arcs[k - 1]["end"])) < 1e-9);
+      CHECK(arcs[k]["line"] == 12);
+    }
+    CHECK(glm::length(vec(arcs.back()["end"]) - (origin + rotate_by(R, last))) < 1e-6);
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("groups: one group per spindle direction with its moves and tools") {
+  fs::path dir = scratch("groups");
+  fs::path program = dir / "five.nc", out = dir / "groups.json";
+  write_text(program, program_of({&kDirections[0], &kDirections[1], &kDirections[2], &kDirections[3],
+                                  &kDirections[4], &kDirections[2]}));
+  CommandResult r = run_tridex({"groups", program.string(), "-o", out.string()}, dir);
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  json doc = json::parse(slurp(out));
+  REQUIRE(doc["groups"].size() == 5);  // +Y appears twice in the program but is one direction
+  CommandResult moves = run_tridex({"moves", program.string()}, dir);
+  long long lines = std::count(moves.out.begin(), moves.out.end(), '\n');
+  CHECK(doc["segments"].get<long long>() == lines);
+  long long total = 0;
+  for (std::size_t g = 0; g < 5; ++g) {
+    const Direction& d = kDirections[g];
+    const json& group = doc["groups"][g];
+    double a = d.a * M_PI / 180, b = d.b * M_PI / 180;
+    Vec3 axis(std::sin(a) * std::sin(b), -std::cos(a) * std::sin(b), std::cos(b));
+    CHECK(glm::length(vec(group["axis"]) - axis) < 1e-9);
+    CHECK(glm::length(vec(group["frame"]["z"]) - axis) < 1e-9);
+    CHECK(group["tools"] == json::array({1, 2, 3}));
+    total += group["moves"].get<long long>();
+    long long by_kind = 0;
+    for (const auto& [kind, count] : group["by_kind"].items()) by_kind += count.get<long long>();
+    CHECK(by_kind == group["moves"].get<long long>());
+    CHECK(group["by_kind"]["arc"].get<long long>() > 0);
+  }
+  CHECK(total == lines);
+  CHECK(doc["groups"][2]["moves"].get<long long>() > doc["groups"][3]["moves"].get<long long>());
+  fs::remove_all(dir);
+}
+
+TEST_CASE("simulate: each direction alone matches the point-membership reference") {
+  fs::path dir = scratch("directions");
+  fs::path tools = dir / "tools.json";
+  write_text(tools, kTools);
+  cli::ToolTable table = cli::ToolTable::read(tools);
+  const Aabb stock{Vec3(0, 0, 0), Vec3(40, 30, 20)};
+  std::uint32_t seed = 100;
+  for (const Direction& d : kDirections) {
+    INFO("direction " << d.name);
+    fs::path program = dir / "one.nc";
+    write_text(program, program_of({&d}));
+    Simulated s = simulate(dir, program, tools, kStock, 128, 0.08);
+    REQUIRE(s.report["groups"].size() == 1);
+    Reference ref(gcode::read_moves(program.string()), table, stock);
+    check_against_reference(s, ref, seed++);
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("simulate: all five directions together, and the report's schema") {
+  fs::path dir = scratch("five");
+  fs::path tools = dir / "tools.json", program = dir / "five.nc";
+  write_text(tools, kTools);
+  write_text(program, program_of({&kDirections[0], &kDirections[1], &kDirections[2], &kDirections[3], &kDirections[4]}));
+  Simulated s = simulate(dir, program, tools, kStock, 128, 0.08);
+  const json& report = s.report;
+  for (const char* key : {"program", "segments", "groups", "dexel", "timings_s", "peak_rss_mib", "result", "warnings"})
+    CHECK(report.contains(key));
+  for (const char* key : {"parse", "zmap", "dexelize", "intersect", "mesh", "total"})
+    CHECK(report["timings_s"][key].get<double>() >= 0);
+  for (const char* key : {"volume_mm3", "removed_mm3", "triangles", "watertight"}) CHECK(report["result"].contains(key));
+  CHECK(report["result"]["volume_mm3"].get<double>() + report["result"]["removed_mm3"].get<double>() ==
+        doctest::Approx(40 * 30 * 20));
+  CHECK(report["result"]["triangles"].get<std::size_t>() == s.mesh.triangles.size());
+  CHECK(report["groups"].size() == 5);
+  long long moves = 0;
+  for (const json& g : report["groups"]) {
+    moves += g["moves"].get<long long>();
+    CHECK(g["zmap"][0].get<int>() > 100);
+    CHECK(g["cell_mm"].get<double>() == doctest::Approx(0.08));
+  }
+  CHECK(moves == report["segments"].get<long long>());
+  CHECK(report["dexel"]["res"][0].get<int>() >= 128);
+  cli::ToolTable table = cli::ToolTable::read(tools);
+  Reference ref(gcode::read_moves(program.string()), table, Aabb{Vec3(0, 0, 0), Vec3(40, 30, 20)});
+  check_against_reference(s, ref, 7);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("simulate: the bundled example, from its CAMotics project, matches the reference") {
+  fs::path dir = scratch("example");
+  const std::string examples = TRIDEX_SOURCE_DIR "/gcode/examples/";
+  fs::path stl = dir / "example.stl", png = dir / "example.png", report = dir / "example.json", maps = dir / "maps";
+  CommandResult r = run_tridex({"simulate", examples + "mold_3plus2.camotics", "--dexel-res", "200", "--zmap-cell",
+                                "0.2", "-o", stl.string(), "--png", png.string(), "--report", report.string(),
+                                "--dump-zmaps", maps.string()},
+                               dir);
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  CHECK(r.out.find("watertight") != std::string::npos);  // the one-line summary
+  Simulated s{json::parse(slurp(report)), read_binary_stl(stl)};
+  CHECK(s.report["groups"].size() == 5);
+  CHECK(slurp(png).substr(1, 3) == "PNG");
+  std::size_t dumped = 0;
+  for (const auto& entry : fs::directory_iterator(maps)) dumped += entry.path().extension() == ".stl" || entry.path().extension() == ".png";
+  CHECK(dumped == 10);
+  cli::ToolTable table = cli::ToolTable::read(examples + "mold_3plus2.tools.json");
+  Reference ref(gcode::read_moves(examples + "mold_3plus2.nc"), table, Aabb{Vec3(0, 0, 0), Vec3(100, 80, 50)});
+  check_against_reference(s, ref, 11);
+  fs::remove_all(dir);
+}

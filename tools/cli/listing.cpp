@@ -1,0 +1,140 @@
+// tridex moves / tridex groups: the interpreted program as JSON, for scripts and post checks.
+#include <iostream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "errors.hpp"
+#include "json_text.hpp"
+#include "output.hpp"
+#include "program_input.hpp"
+#include "tridex/gcode/grouping.hpp"
+
+namespace tridex::cli {
+
+namespace {
+
+gcode::InterpreterOptions interpreter_options(const CommonOptions& options) {
+  gcode::InterpreterOptions o;
+  o.arc_tolerance = options.arc_tolerance;
+  o.lenient = options.lenient;
+  return o;
+}
+
+// Writes through an atomic file, or to stdout for "-".
+template <class Write>
+void write_output(const std::string& path, Write&& write) {
+  if (path == "-") {
+    write(std::cout);
+    std::cout.flush();
+    return;
+  }
+  AtomicOutput out(path);
+  write(out.stream());
+  out.commit();
+}
+
+void check_output(const std::string& path, const ProgramInput& input) {
+  if (path == "-") return;
+  std::vector<std::filesystem::path> inputs(input.files.begin(), input.files.end());
+  inputs.push_back(input.program);
+  check_output_path("-o", path, inputs);
+}
+
+void print_warnings(const std::vector<std::string>& warnings, bool quiet) {
+  if (quiet) return;
+  for (const std::string& w : warnings) std::cerr << "warning: " << w << '\n';
+}
+
+}  // namespace
+
+int run_moves(const ListOptions& options) {
+  ProgramInput input = resolve_program(options.program);
+  check_output(options.output, input);
+  InterpretResult result;
+  write_output(options.output, [&](std::ostream& out) {
+    std::string record;
+    bool several_files = input.files.size() > 1;
+    result = interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t file) {
+      record.clear();
+      record += "{\"line\":";
+      record += std::to_string(m.line);
+      if (several_files) {
+        record += ",\"file\":";
+        record += Json(input.files[file].string()).dump();
+      }
+      record += ",\"kind\":\"";
+      record += gcode::to_string(m.kind);
+      record += "\",\"tool\":";
+      record += std::to_string(m.tool);
+      record += ",\"start\":";
+      append_vec3(record, m.start);
+      record += ",\"end\":";
+      append_vec3(record, m.end);
+      record += ",\"axis\":";
+      append_vec3(record, m.axis);
+      record += ",\"feed\":";
+      append_number(record, m.feed);
+      record += ",\"spindle\":";
+      append_number(record, m.spindle);
+      record += "}\n";
+      out << record;
+    });
+  });
+  print_warnings(result.warnings, options.quiet);
+  return kSuccess;
+}
+
+int run_groups(const ListOptions& options) {
+  ProgramInput input = resolve_program(options.program);
+  check_output(options.output, input);
+  gcode::DirectionGrouper grouper;
+  struct Extra {
+    long long kinds[4] = {0, 0, 0, 0};
+    int first_line = 0, last_line = 0;
+    Aabb local;  // tool-tip box of the cutting moves in the group's frame
+  };
+  std::vector<Extra> extras;
+  InterpretResult result = interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t) {
+    std::size_t g = grouper.add(m);
+    if (g >= extras.size()) extras.resize(g + 1);
+    Extra& e = extras[g];
+    ++e.kinds[static_cast<int>(m.kind)];
+    if (e.first_line == 0) e.first_line = m.line;
+    e.last_line = m.line;
+    if (m.kind != gcode::MoveKind::rapid) {
+      const Frame& frame = grouper.groups()[g].frame;
+      e.local.extend(frame.to_local(m.start));
+      e.local.extend(frame.to_local(m.end));
+    }
+  });
+  Json groups = Json::array();
+  const auto& list = grouper.groups();
+  for (std::size_t g = 0; g < list.size(); ++g) {
+    const gcode::MoveGroup& group = list[g];
+    const Extra& e = extras[g];
+    Json j;
+    j["axis"] = to_json(group.axis);
+    j["frame"] = {{"x", to_json(group.frame.rotation[0])},
+                  {"y", to_json(group.frame.rotation[1])},
+                  {"z", to_json(group.frame.rotation[2])}};
+    j["moves"] = group.moves.size();
+    j["by_kind"] = {{"rapid", e.kinds[0]}, {"feed", e.kinds[1]}, {"arc", e.kinds[2]}, {"cycle", e.kinds[3]}};
+    j["tools"] = group.tools;
+    j["lines"] = {e.first_line, e.last_line};
+    if (!e.local.empty())
+      j["cutting_bounds_local"] = {{"min", to_json(e.local.min)}, {"max", to_json(e.local.max)}};
+    groups.push_back(std::move(j));
+  }
+  Json document;
+  document["program"] = input.program.string();
+  document["segments"] = result.moves;
+  document["groups"] = std::move(groups);
+  document["warnings"] = result.warnings;
+  write_output(options.output, [&](std::ostream& out) { out << document.dump(2) << '\n'; });
+  print_warnings(result.warnings, options.quiet);
+  return kSuccess;
+}
+
+}  // namespace tridex::cli

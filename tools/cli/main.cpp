@@ -1,0 +1,112 @@
+// tridex — the command: `simulate`, `moves`, `groups` (see README.md for the full story).
+//
+// Exit status: 0 on success, 2 for bad input (program, tool table, stock, options), 1 for
+// anything else. Program errors are printed as file:line:col: message.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <iostream>
+#include <new>
+
+#include "commands.hpp"
+#include "errors.hpp"
+#include "tridex/gcode/diagnostic.hpp"
+
+#ifndef TRIDEX_VERSION
+#define TRIDEX_VERSION "unknown"
+#endif
+
+namespace {
+
+using namespace tridex::cli;
+
+void add_common(CLI::App& command, CommonOptions& options) {
+  command.add_option("PROGRAM", options.program,
+                     "G-code file (.nc, .ngc, .tap, .gcode, any name) or CAMotics project (.camotics)")
+      ->required();
+  command.add_option("--arc-tolerance", options.arc_tolerance,
+                     "largest chord error of linearised arcs, mm (default 0.001)")
+      ->check(CLI::PositiveNumber);
+  command.add_flag("--lenient", options.lenient,
+                   "unsupported G-code words become warnings and are skipped");
+  command.add_flag("--progress", options.progress,
+                   "show progress on stderr even when it is not a terminal");
+  command.add_flag("-q,--quiet", options.quiet, "print nothing but errors")->excludes("--progress");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"tridex: simulate 3+2-axis milling (G68.2 tilted planes) from a G-code program to a\n"
+               "watertight STL, a picture and a report. Method: Inui, Chen and Umezu, CAD&A 19(4) 2022.",
+               "tridex"};
+  app.set_version_flag("--version", "tridex " TRIDEX_VERSION);
+  app.require_subcommand(1);
+  app.footer("Exit status: 0 success, 2 bad input (program, tool table, stock, options), 1 other failure.\n"
+             "Run `tridex COMMAND --help` for a command's options.");
+
+  SimulateOptions simulate;
+  CLI::App* sim = app.add_subcommand("simulate", "mill the program into its stock and write the machined solid");
+  add_common(*sim, simulate);
+  sim->add_option("--tools", simulate.tools,
+                  "tool table, JSON in the CAMotics schema (overrides a project's tools)");
+  sim->add_option("--stock", simulate.stock,
+                  "box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX | FILE.stl | auto[:MARGIN] (default auto: the box around\n"
+                  "the cutting moves plus MARGIN mm, or 5 % of each side without one)");
+  sim->add_option("--zmap-cell", simulate.zmap_cell,
+                  "Z-map grid spacing, mm (default: stock diagonal / 1000)")
+      ->check(CLI::PositiveNumber);
+  auto* dexel_cell = sim->add_option("--dexel-cell", simulate.dexel_cell, "triple-dexel spacing, mm")
+                         ->check(CLI::PositiveNumber);
+  sim->add_option("--dexel-res", simulate.dexel_res,
+                  "triple-dexel cells along the stock's longest side (default " +
+                      std::to_string(kDefaultDexelRes) + ": the bundled example in seconds on 2 cores)")
+      ->check(CLI::Range(1, 1 << 20))
+      ->excludes(dexel_cell);
+  sim->add_option("-o,--output", simulate.output, "write the result as binary STL");
+  sim->add_option("--png", simulate.png, "write a shaded picture of the result (off-screen OSMesa)");
+  sim->add_option("--report", simulate.report, "write the JSON report");
+  sim->add_option("--dump-zmaps", simulate.dump_zmaps,
+                  "write each direction's milled Z-map to DIR as STL and as a height picture");
+  sim->add_option("--threads", simulate.threads, "worker threads (default: every hardware thread)")
+      ->check(CLI::Range(0u, 4096u));
+  sim->add_option("--max-memory", simulate.max_memory,
+                  "refuse resolutions whose estimated memory exceeds this (e.g. 4G; default 80 % of RAM)");
+
+  ListOptions moves;
+  CLI::App* mov = app.add_subcommand("moves", "print the interpreted moves as JSON Lines, one object per move");
+  add_common(*mov, moves);
+  mov->add_option("-o,--output", moves.output, "write to a file instead of stdout");
+
+  ListOptions groups;
+  CLI::App* grp = app.add_subcommand("groups", "print the spindle-direction groups as JSON");
+  add_common(*grp, groups);
+  grp->add_option("-o,--output", groups.output, "write to a file instead of stdout");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    std::cerr << "tridex: " << e.what() << "\n(run `tridex --help` or `tridex COMMAND --help`)\n";
+    return kBadInput;
+  }
+
+  try {
+    if (sim->parsed()) return run_simulate(simulate);
+    if (mov->parsed()) return run_moves(moves);
+    if (grp->parsed()) return run_groups(groups);
+  } catch (const tridex::gcode::GcodeError& e) {
+    std::cerr << e.what() << '\n';
+    return kBadInput;
+  } catch (const InputError& e) {
+    std::cerr << "tridex: " << e.what() << '\n';
+    return kBadInput;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "tridex: out of memory (lower the resolution or --max-memory)\n";
+    return kFailure;
+  } catch (const std::exception& e) {
+    std::cerr << "tridex: " << e.what() << '\n';
+    return kFailure;
+  }
+  return kFailure;
+}

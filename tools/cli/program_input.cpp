@@ -1,0 +1,48 @@
+#include "program_input.hpp"
+
+#include <fstream>
+
+#include "errors.hpp"
+#include "project.hpp"
+
+namespace tridex::cli {
+
+namespace fs = std::filesystem;
+
+ProgramInput resolve_program(const std::string& program) {
+  ProgramInput input;
+  input.program = program;
+  std::error_code error;
+  if (!fs::is_regular_file(input.program, error))
+    input_error(program, ": no such program file");
+  if (is_project_file(input.program)) {
+    Project project = read_project(input.program);
+    input.files = std::move(project.files);
+    input.tools = std::move(project.tools);
+    input.stock = project.stock;
+  } else {
+    input.files.push_back(input.program);
+  }
+  return input;
+}
+
+InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOptions& options,
+                          const std::function<void(const gcode::Move&, std::size_t file)>& sink) {
+  InterpretResult result;
+  gcode::Interpreter interpreter(options);
+  for (std::size_t f = 0; f < input.files.size(); ++f) {
+    const fs::path& path = input.files[f];
+    std::ifstream in(path, std::ios::binary);
+    if (!in) input_error(path.string(), ": cannot open the program file");
+    interpreter.run(in, path.string(), [&](const gcode::Move& move) {
+      ++result.moves;
+      sink(move, f);
+    });
+    for (const gcode::Diagnostic& d : interpreter.warnings()) result.warnings.push_back(d.to_string());
+    for (const auto& [tool, line] : interpreter.tool_first_line())
+      result.tool_first_line.try_emplace(tool, ToolSelection{path.string(), line});
+  }
+  return result;
+}
+
+}  // namespace tridex::cli

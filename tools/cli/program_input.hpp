@@ -1,0 +1,44 @@
+// tridex command — PROGRAM: a G-code file or a CAMotics project, interpreted into moves.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "stock.hpp"
+#include "tool_table.hpp"
+#include "tridex/gcode/interpreter.hpp"
+
+namespace tridex::cli {
+
+struct ProgramInput {
+  std::filesystem::path program;              // what the user named
+  std::vector<std::filesystem::path> files;   // the G-code file(s), in order
+  std::optional<ToolTable> tools;             // from a project
+  std::optional<StockSpec> stock;             // from a project
+};
+
+// Throws InputError if the file is missing or the project is malformed.
+ProgramInput resolve_program(const std::string& program);
+
+// Where each tool was first selected, for messages: "file:line".
+struct ToolSelection {
+  std::string file;
+  int line = 0;
+};
+
+struct InterpretResult {
+  std::vector<std::string> warnings;           // "file:line:col: message"
+  std::map<int, ToolSelection> tool_first_line;
+  long long moves = 0;
+};
+
+// Runs every file of the program through the interpreter, streaming moves to `sink` with the
+// index of the file they came from. GcodeError propagates (exit status 2).
+InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOptions& options,
+                          const std::function<void(const gcode::Move&, std::size_t file)>& sink);
+
+}  // namespace tridex::cli
