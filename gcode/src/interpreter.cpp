@@ -684,16 +684,20 @@ struct Interpreter::State {
           }
           cut(at(hole_u, hole_v, bottom));
           break;
-        case 850:
-        case 890:
+        case 850:  // out at feed to R (then rapid to the clear level)
           cut(at(hole_u, hole_v, bottom));
           cut(at(hole_u, hole_v, r_level));
+          break;
+        case 890:  // out at feed all the way to the clear level, as LinuxCNC does
+          cut(at(hole_u, hole_v, bottom));
+          cut(at(hole_u, hole_v, clear_far ? r_level : clear));
           break;
         default:  // 810, 820, 860: down at feed, out at rapid
           cut(at(hole_u, hole_v, bottom));
           break;
       }
-      rapid(at(hole_u, hole_v, clear));
+      Vec3 out = at(hole_u, hole_v, clear);
+      if (out != pos) rapid(out);
       if (clear_far) far = true;
     }
   }

@@ -8,7 +8,9 @@
 // Agreement is to rs274's printed precision: 0.5e-4 program units plus 1e-6.
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <cstdio>
+#include <random>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -144,7 +146,106 @@ std::vector<fs::path> corpus() {
   return files;
 }
 
+// A random 3-axis program: rapids, feeds, arcs (I/J/K and R, all planes, helical), units,
+// distance modes and drilling cycles, all with exact 4-decimal coordinates.
+std::string random_program(std::mt19937_64& rng) {
+  using tridex::gcode::test::cat;
+  using tridex::gcode::test::fmt;
+  std::uniform_real_distribution<double> u01(0, 1);
+  auto coord = [&](double span) { return std::round((u01(rng) * 2 - 1) * span * 1e4) / 1e4; };
+  std::string text = "G21 G90 G17 F300 S1000 M3\nG0 X0 Y0 Z10\n";
+  Vec3 p(0, 0, 10);
+  for (int i = 0; i < 60; ++i) {
+    int kind = static_cast<int>(rng() % 10);
+    if (kind < 4) {
+      Vec3 q(coord(50), coord(50), coord(10));
+      text += cat(kind == 0 ? "G0" : "G1", " X", fmt(q.x), " Y", fmt(q.y), " Z", fmt(q.z), "\n");
+      p = q;
+    } else if (kind < 6) {
+      // Incremental feed.
+      Vec3 d(coord(5), coord(5), coord(1));
+      text += cat("G91 G1 X", fmt(d.x), " Y", fmt(d.y), " Z", fmt(d.z), "\nG90\n");
+      p += Vec3(std::stod(fmt(d.x)), std::stod(fmt(d.y)), std::stod(fmt(d.z)));
+    } else if (kind < 9) {
+      // An arc in a random plane: the centre offset and the end on the same circle (as printed
+      // to 4 decimals the radii differ by < 1e-4, within both interpreters' tolerance).
+      int plane = static_cast<int>(rng() % 3);
+      int a = plane == 0 ? 0 : plane == 1 ? 2 : 1, b = plane == 0 ? 1 : plane == 1 ? 0 : 2;
+      int n = 3 - a - b;
+      const char* letters = "IJK";
+      const char* axes = "XYZ";
+      double r = 1 + u01(rng) * 20, start_angle = u01(rng) * 6.283, sweep = 0.2 + u01(rng) * 5.8;
+      bool ccw = rng() % 2;
+      Vec2 centre(p[a] - r * std::cos(start_angle), p[b] - r * std::sin(start_angle));
+      double end_angle = start_angle + (ccw ? sweep : -sweep);
+      Vec3 e = p;
+      e[a] = std::stod(fmt(centre.x + r * std::cos(end_angle)));
+      e[b] = std::stod(fmt(centre.y + r * std::sin(end_angle)));
+      if (rng() % 3 == 0) e[n] = std::stod(fmt(p[n] - u01(rng) * 3));
+      std::string words = cat(plane == 0 ? "G17" : plane == 1 ? "G18" : "G19", ccw ? " G3" : " G2");
+      for (int k = 0; k < 3; ++k) words += cat(" ", axes[k], fmt(e[k]));
+      if (rng() % 2 || sweep > 6.0) {
+        words += cat(" ", letters[a], fmt(centre.x - p[a]), " ", letters[b], fmt(centre.y - p[b]));
+      } else {
+        double chord_r = glm::length(Vec2(e[a], e[b]) - Vec2(p[a], p[b])) / 2;
+        double radius = std::max(std::stod(fmt(r)), chord_r);  // printable, never too short
+        words += cat(" R", fmt(sweep > 3.14159265 ? -radius : radius));
+      }
+      text += words + "\nG17\n";
+      p = e;
+      if (words.find(" R") != std::string::npos) {  // R arcs: refetch where it really ended
+        text += cat("G0 X", fmt(p.x), " Y", fmt(p.y), " Z", fmt(p.z), "\n");
+      }
+    } else {
+      double r_level = std::round(u01(rng) * 30) / 10, bottom = -std::round(u01(rng) * 80) / 10;
+      const char* cycles[] = {"G81", "G82 P0.1", "G83 Q1.5", "G73 Q0.7", "G85", "G86 P0", "G89 P0"};
+      text += cat(rng() % 2 ? "G98 " : "G99 ", cycles[rng() % 7], " X", fmt(coord(40)), " Y",
+                  fmt(coord(40)), " Z", fmt(bottom), " R", fmt(r_level), "\nG80\n");
+      text += cat("G0 X", fmt(p.x), " Y", fmt(p.y), " Z", fmt(p.z), "\n");
+    }
+  }
+  return text + "M2\n";
+}
+
 }  // namespace
+
+TEST_CASE("differential: random programs agree with rs274") {
+  if (!rs274_available()) {
+    MESSAGE("SKIPPED: rs274 not found (install the Debian package linuxcnc-uspace); the LinuxCNC "
+            "differential test did not run");
+    return;
+  }
+  std::mt19937_64 rng(31);
+  std::size_t compared = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    fs::path program = fs::temp_directory_path() /
+                       ("tridex_random_" + std::to_string(::getpid()) + "_" + std::to_string(trial) + ".ngc");
+    {
+      std::ofstream out(program);
+      out << random_program(rng);
+    }
+    CAPTURE(trial);
+    std::string log;
+    std::vector<Point> theirs = run_rs274(program, log);
+    std::vector<Point> ours = run_tridex(program);
+    INFO("rs274 log: " << log.substr(0, 600));
+    CHECK(ours.size() == theirs.size());
+    std::size_t n = std::min(ours.size(), theirs.size());
+    int reported = 0;
+    for (std::size_t i = 0; i < n && reported < 3; ++i) {
+      Vec3 d = glm::abs(ours[i].p - theirs[i].p);
+      if (std::max(d.x, std::max(d.y, d.z)) > theirs[i].tolerance) {
+        ++reported;
+        FAIL_CHECK("move " << i << ": tridex (line " << ours[i].record << ") " << ours[i].p.x << " "
+                           << ours[i].p.y << " " << ours[i].p.z << " vs rs274 " << theirs[i].p.x
+                           << " " << theirs[i].p.y << " " << theirs[i].p.z);
+      }
+    }
+    compared += n;
+    if (reported == 0 && ours.size() == theirs.size()) fs::remove(program);
+  }
+  MESSAGE("random programs: " << compared << " end points compared");
+}
 
 TEST_CASE("differential: LinuxCNC rs274 and tridex agree on every move end point") {
   if (!rs274_available()) {
