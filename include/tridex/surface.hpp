@@ -382,9 +382,9 @@ class Extractor {
   }
 
   void emit_loop(SlabState& st, int i, int j, const std::uint8_t* edges, int size, int fan_start, unsigned mask) const {
-    std::array<std::uint32_t, 12> id{};
-    std::array<Vec3, 12> p{};
-    std::array<glm::vec3, 12> normal{};
+    std::array<std::uint32_t, 12> id;  // filled up to `size`; left uninitialised on purpose (hot path)
+    std::array<Vec3, 12> p;
+    std::array<glm::vec3, 12> normal;
     for (int q = 0; q < size; ++q) {
       std::size_t sq = static_cast<std::size_t>(q);
       id[sq] = cube_edge_vertex(st, i, j, mask, edges[q]);
@@ -435,7 +435,7 @@ class Extractor {
   // dropped), if it lies in the cell.
   bool feature_point(const SlabState& st, const std::uint32_t* id, std::span<const Vec3> p, const Vec3& centroid,
                      int i, int j, Vec3& out) const {
-    std::array<Vec3, 12> n{};
+    std::array<Vec3, 12> n;
     std::size_t count = 0;
     for (std::size_t q = 0; q < p.size(); ++q) {
       glm::vec3 normal = st.out.normals[id[q]];
