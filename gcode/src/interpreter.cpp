@@ -743,8 +743,14 @@ struct Interpreter::State {
                        "set it in the machine configuration if the machine differs");
       warned = true;
     }
-    // A home return is a retract whatever the axes: the tip goes far along the tool axis, the
-    // homed axes' coordinates kept for the lateral position.
+    // With the tool along +Z, returning X/Y only is a plain rapid at the current height (on any
+    // machine). Anything else is a retract: the tip goes far along the tool axis, the homed
+    // axes' coordinates kept for the lateral position.
+    if (mask && !(mask & 4u) && !rotary && !far &&
+        glm::dot(axis, Vec3(0, 0, 1)) >= 1 - kSameDirection) {
+      machine_move(target, mask, MoveKind::rapid, 0.0);
+      return;
+    }
     for (int i = 0; i < 3; ++i)
       if ((mask >> i) & 1u) pos[i] = target[i];
     far = true;

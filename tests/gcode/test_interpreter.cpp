@@ -95,19 +95,22 @@ TEST_CASE("program start and home returns: far along the tool axis, approach str
   CHECK(r.warnings[0].message.find("default") != std::string::npos);
 }
 
-TEST_CASE("G28 X Y: far, at the configured home; G53 moves in machine coordinates") {
+TEST_CASE("G28 X Y with a vertical tool rapids to home X Y; G53 moves in machine coordinates") {
   MachineConfig machine;
   machine.set_home(Vec3(-10, -20, 0));
   machine.work_offsets[1] = Vec3(100, 100, -100);
   Result r = run_program(
-      "G0 X0 Y0 Z10\nG28 X5 Y5\nZ3\nG53 G0 X0 Y0\nG53 Z0\nX1 Y1\nZ2\nM30\n",
+      "G0 X0 Y0 Z10\nG28 X5 Y5\nZ3\nG53 G0 X0 Y0\nG53 Z0\nX1 Y1\nZ2\nG28 Y0\nX0 Y0 Z1\nM30\n",
       InterpreterOptions{}, machine);
-  REQUIRE(r.moves.size() == 5);
-  CHECK(near(r.moves[1].end, Vec3(5, 5, 10)));  // intermediate point
-  // After the return the tip is far above home X Y (machine -> G54 frame).
-  CHECK(near(r.moves[2].start, Vec3(-110, -120, 3 + machine.far_distance)));
-  CHECK(near(r.moves[3].end, Vec3(-100, -100, 3)));  // G53 X0 Y0
-  CHECK(near(r.moves[4].start, Vec3(1, 1, 2 + machine.far_distance)));  // after G53 Z: far
+  REQUIRE(r.moves.size() == 9);
+  CHECK(near(r.moves[1].end, Vec3(5, 5, 10)));          // intermediate point
+  CHECK(near(r.moves[2].end, Vec3(-110, -120, 10)));    // home X Y (machine -> G54), same height
+  CHECK(near(r.moves[3].end, Vec3(-110, -120, 3)));
+  CHECK(near(r.moves[4].end, Vec3(-100, -100, 3)));     // G53 X0 Y0
+  CHECK(near(r.moves[5].start, Vec3(1, 1, 2 + machine.far_distance)));  // after G53 Z: far
+  CHECK(near(r.moves[6].end, Vec3(1, 0, 2)));           // G28 Y0: intermediate point,
+  CHECK(near(r.moves[7].end, Vec3(1, -120, 2)));        // then home Y at the same height
+  CHECK(near(r.moves[8].end, Vec3(0, 0, 1)));
   CHECK(r.warnings.empty());
   Diagnostic d = error_of("G68.2 X0 Y0 Z0 I0 J30 K0\nG53.1\nG0 X0 Y0 Z5\nG53 X0\n");
   CHECK(d.line == 4);

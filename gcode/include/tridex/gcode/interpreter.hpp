@@ -11,8 +11,8 @@
 // Conventions (../shared/DESIGN.md): the programmed point is the tool tip after work offsets;
 // G20 values are converted to mm; G68.2 R = Rz(I)·Rx(J)·Rz(K) and the tool axis is R·(0,0,1)
 // once G53.1/G53.6 orient the tool; G268 R = Rz(K)·Ry(J)·Rx(I), oriented by G253. A home return
-// (G28, G30, a G53 move of an axis along the tool) and a change of spindle direction leave the tip
-// "far" along the tool axis; moves that leave the coordinate along the tool axis unset stay far
+// (G28, G30 — but X/Y alone with the tool along +Z is a rapid at the current height — and G53
+// Z), a tool change and a change of spindle direction leave the tip "far" along the tool axis; moves that leave the coordinate along the tool axis unset stay far
 // and emit nothing; the first move that sets it comes straight back along the axis to its end.
 // The program starts far along +Z (unless InterpreterOptions::start_position says otherwise).
 //
