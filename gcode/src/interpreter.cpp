@@ -157,7 +157,8 @@ struct Words {
 // Modal groups (RS274/NGC table 4, plus the tilted-plane codes); -1: not supported.
 enum Group {
   kNonModal, kMotion, kPlane, kDistance, kArcDistance, kFeedMode, kUnits, kCutterComp,
-  kToolLength, kReturn, kWork, kSpindleMode, kPolar, kPath, kTilt, kOrient, kGroupCount
+  kToolLength, kReturn, kWork, kSpindleMode, kPolar, kPath, kTilt, kOrient, kSmoothing,
+  kGroupCount
 };
 
 int g_group(int code) {
@@ -179,6 +180,7 @@ int g_group(int code) {
     case 610: case 640: return kPath;
     case 682: case 690: case 2680: case 2690: return kTilt;
     case 531: case 536: case 2530: return kOrient;
+    case 51: case 80: case 1870: return kSmoothing;  // Fanuc G5.1 Q / G8 P, Haas G187 P E
     default: return -1;
   }
 }
@@ -840,6 +842,16 @@ Flow Interpreter::State::execute(const Block& block) {
   if (w.find_g(430) || w.find_g(440)) {
     if (w.has('H')) integer('H', "tool length offset number", 0, 99'999'999);
   }
+  // Look-ahead and smoothing modes change how the control follows the path, not the path.
+  if (w.find_g(51)) {
+    for (char c : {'Q', 'R'})
+      if (w.has(c)) w.take(c);
+  }
+  if (w.find_g(80) && w.has('P')) w.take('P');
+  if (w.find_g(1870)) {
+    for (char c : {'P', 'E'})
+      if (w.has(c)) w.take(c);
+  }
   if (w.find_g(640)) {  // path blending tolerances (LinuxCNC G64 P Q): no effect on the path
     if (w.has('P')) w.take('P');
     if (w.has('Q')) w.take('Q');
@@ -1081,6 +1093,7 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
   };
 
   while (read(text)) {
+    if (line == 1 && text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 BOM
     if (!lex_line(text, block, lex_error))
       throw SyntaxError(Diagnostic{file_name, line, lex_error.column, lex_error.message});
     if (block.percent) {

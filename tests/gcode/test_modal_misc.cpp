@@ -17,6 +17,11 @@ TEST_CASE("codes without effect on the path are accepted; stops and dwells move 
   REQUIRE(r.moves.size() == 2);
   CHECK(r.warnings.empty());
   CHECK(near(r.moves[1].end, Vec3(1, 0, 5)));
+  // Look-ahead and smoothing modes of Fanuc and Haas posts; a UTF-8 byte order mark.
+  r = run_program("\xEF\xBB\xBFG5.1 Q1 R5\nG8 P1\nG187 P3 E0.01\nG0 X0 Y0 Z5\nG5.1 Q0\nM30\n");
+  CHECK(r.moves.size() == 1);
+  CHECK(r.warnings.empty());
+  CHECK(error_of("G5.1 Q1 G8 P1\n").message.find("conflicts") != std::string::npos);
   // Text after the closing '%' is never read; a program without any still ends at M30.
   r = run_program("G0 X0 Y0 Z5\nM30\nG0 X1\n", at_origin());
   CHECK(r.moves.size() == 1);
@@ -84,4 +89,24 @@ TEST_CASE("a whole program grouped: each group's moves seen in its frame move al
       Vec3 a = g.frame.to_local(m.start), b = g.frame.to_local(m.end);
       if (m.line == 3 || m.line == 10) CHECK(std::abs(a.x - b.x) + std::abs(a.y - b.y) < 1e-9);
     }
+}
+
+TEST_CASE("M98 jumps across a file much larger than the line buffer") {
+  std::string padding;
+  for (int i = 0; i < 20000; ++i) padding += "(padding line " + std::to_string(i) + ")\n";
+  std::string program = "O1\nG0 X0 Y0 Z1\nM98 P9 L2\nG0 X5\n" + padding + "M30\n" + padding +
+                        "O9\nG91 G0 X1\nG90 M99\n";
+  Result r = run_program(program);
+  REQUIRE(r.moves.size() == 4);
+  CHECK(near(r.moves[1].end, Vec3(1, 0, 1)));
+  CHECK(near(r.moves[2].end, Vec3(2, 0, 1)));
+  CHECK(near(r.moves[3].end, Vec3(5, 0, 1)));
+  CHECK(r.moves[1].line == 4 + 2 * 20000 + 3);  // line numbers survive the jumps
+  CHECK(r.moves[3].line == 4);
+}
+
+TEST_CASE("G20 applies to the G68.2 origin but not to its angles") {
+  Result r = run_program("G20 G90\nG68.2 X1 Y0 Z0 I0 J90 K0\nG53.1\nG0 X0 Y0 Z1\nM30\n");
+  REQUIRE(r.moves.size() == 1);
+  CHECK(near(r.moves[0].end, Vec3(25.4, -25.4, 0), 1e-9));
 }

@@ -5,7 +5,8 @@
 // M3/M4/M5, M0/M1/M2/M30, G28/G30/G53, canned cycles G73 G81 G82 G83 G85 G86 G89 with G98/G99 and
 // repeats (L or K), M98 P L / M99 with O numbers, G4; tilted planes Fanuc G68.2 (Euler Z-X-Z),
 // G53.1, G53.6, G69 and Haas G268 (Q123), G253, G269. Accepted without effect on the tool path:
-// G15 G40 G49 G61 G64 G80 G94 G97, M7 M8 M9. Anything else is an error naming file, line, column
+// G15 G40 G49 G61 G64 (P Q) G80 G94 G97, look-ahead/smoothing G5.1 (Q R), G8 (P), G187 (P E),
+// M7 M8 M9. Anything else is an error naming file, line, column
 // and word (a warning in lenient mode, which then skips the word).
 //
 // Conventions (../shared/DESIGN.md): the programmed point is the tool tip after work offsets;
