@@ -340,11 +340,14 @@ int run_simulate(const SimulateOptions& options) {
 
   if (!options.quiet) {
     for (const std::string& w : warnings) std::cerr << "warning: " << w << '\n';
-    std::printf("%s: %lld segments in %zu directions, %d x %d x %d dexels; %.1f mm^3 removed, "
-                "%.1f mm^3 left, %zu triangles%s; %.2f s\n",
+    std::string written;
+    for (const std::string& path : {options.output, options.png, options.report})
+      if (!path.empty()) written += (written.empty() ? " -> " : ", ") + path;
+    std::printf("%s: %lld segments in %zu directions, %d x %d x %d dexels; %.1f mm^3 left, %.1f mm^3 "
+                "removed, %zu triangles, %s%s; %.2f s\n",
                 input.program.filename().string().c_str(), segments, groups.size(), lattice.n.x,
-                lattice.n.y, lattice.n.z, stock.volume - volume, volume, mesh.triangles.size(),
-                check.closed() ? ", watertight" : ", NOT watertight", total_s);
+                lattice.n.y, lattice.n.z, volume, stock.volume - volume, mesh.triangles.size(),
+                check.closed() ? "watertight" : "NOT watertight", written.c_str(), total_s);
   }
   return kSuccess;
 }
