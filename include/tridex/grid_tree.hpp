@@ -156,6 +156,7 @@ class GridTree {
     }
 
     void visit(std::uint32_t index, const Range& r, double ta, double tb) {
+      if (!(ta < tb)) return;  // the ray only touches this node's border: no length inside
       const Node& node = tree.nodes_[index];
       double za = o.z + ta * d.z, zb = o.z + tb * d.z;
       if (std::min(za, zb) > node.hi) return;  // wholly above the top: outside
