@@ -139,8 +139,14 @@ class Extractor {
     auto worker = [&] {
       try {
         Scratch scratch(*this);
-        for (int s; (s = next.fetch_add(1)) < slabs;)
-          process_slab(s * slab, std::min(layers, (s + 1) * slab), scratch, parts[static_cast<std::size_t>(s)]);
+        for (int s; (s = next.fetch_add(1)) < slabs;) {
+          SlabMesh& part = parts[static_cast<std::size_t>(s)];
+          process_slab(s * slab, std::min(layers, (s + 1) * slab), scratch, part);
+          // Normals were only needed inside the slab; the rest waits for the join, at its size.
+          std::vector<glm::vec3>().swap(part.normals);
+          part.positions.shrink_to_fit();
+          part.triangles.shrink_to_fit();
+        }
       } catch (...) {
         std::lock_guard<std::mutex> lock(error_mutex);
         if (!error) error = std::current_exception();
