@@ -163,18 +163,34 @@ class Extractor {
   }
 
  private:
+  // Vertex ids of one lattice column (i, j): on its x edge, y edge and node in the node layers
+  // of each parity (layer m uses index m & 1), and on its z edge of the current cell layer. One
+  // record per column keeps a cell's lookups in a few cache lines.
+  struct ColumnSlots {
+    std::array<std::uint32_t, 2> xe{kNone, kNone}, ye{kNone, kNone}, node{kNone, kNone};
+    std::uint32_t ze = kNone;
+  };
   struct Scratch {
-    std::vector<std::uint64_t> s0, s1;                        // node states, layers k and k+1
-    std::array<std::vector<std::uint32_t>, 2> xe, ye, nodes;  // vertex ids on node layers k, k+1
-    std::vector<std::uint32_t> ze;                             // vertex ids on z edges k → k+1
-    std::array<std::vector<std::uint32_t>, 2> xe_used, ye_used, nodes_used;
+    std::vector<std::uint64_t> s0, s1;  // node states, layers k and k+1
+    std::vector<ColumnSlots> slots;
+    std::array<std::vector<std::uint32_t>, 2> xe_used, ye_used, node_used;  // columns set, by parity
     std::vector<std::uint32_t> ze_used;
     explicit Scratch(const Extractor& e) {
-      std::size_t layer = static_cast<std::size_t>(e.nx_) * static_cast<std::size_t>(e.ny_);
       s0.assign(static_cast<std::size_t>(e.ny_) * static_cast<std::size_t>(e.words_), 0);
       s1 = s0;
-      for (int l = 0; l < 2; ++l) xe[l].assign(layer, kNone), ye[l].assign(layer, kNone), nodes[l].assign(layer, kNone);
-      ze.assign(layer, kNone);
+      slots.resize(static_cast<std::size_t>(e.nx_) * static_cast<std::size_t>(e.ny_));
+    }
+    // Forgets the vertices of node layers of parity p.
+    void clear_layer(int p) {
+      std::size_t q = static_cast<std::size_t>(p);
+      for (std::uint32_t c : xe_used[q]) slots[c].xe[q] = kNone;
+      for (std::uint32_t c : ye_used[q]) slots[c].ye[q] = kNone;
+      for (std::uint32_t c : node_used[q]) slots[c].node[q] = kNone;
+      xe_used[q].clear(), ye_used[q].clear(), node_used[q].clear();
+    }
+    void clear_z() {
+      for (std::uint32_t c : ze_used) slots[c].ze = kNone;
+      ze_used.clear();
     }
   };
 
@@ -274,12 +290,13 @@ class Extractor {
     std::size_t slot = column(node.x, node.y);
     std::uint32_t* id;
     std::vector<std::uint32_t>* used;
+    ColumnSlots& c = st.s.slots[slot];
     if (a == 2) {
-      id = &st.s.ze[slot], used = &st.s.ze_used;
+      id = &c.ze, used = &st.s.ze_used;
     } else {
-      int l = node.z - st.k;
-      id = a == 0 ? &st.s.xe[static_cast<std::size_t>(l)][slot] : &st.s.ye[static_cast<std::size_t>(l)][slot];
-      used = a == 0 ? &st.s.xe_used[static_cast<std::size_t>(l)] : &st.s.ye_used[static_cast<std::size_t>(l)];
+      std::size_t p = static_cast<std::size_t>(node.z & 1);
+      id = a == 0 ? &c.xe[p] : &c.ye[p];
+      used = a == 0 ? &st.s.xe_used[p] : &st.s.ye_used[p];
     }
     if (*id != kNone) return *id;
     const int u = TripleDexel::u_axis(a), v = TripleDexel::v_axis(a);
@@ -347,12 +364,11 @@ class Extractor {
   }
 
   std::uint32_t node_vertex(SlabState& st, glm::ivec3 node) const {
-    int l = node.z - st.k;
-    std::size_t slot = column(node.x, node.y);
-    std::uint32_t& id = st.s.nodes[static_cast<std::size_t>(l)][slot];
+    std::size_t p = static_cast<std::size_t>(node.z & 1), slot = column(node.x, node.y);
+    std::uint32_t& id = st.s.slots[slot].node[p];
     if (id == kNone) {
       id = add_vertex(st.out, Vec3(coord(0, node.x), coord(1, node.y), coord(2, node.z)), glm::vec3(0.0f));
-      st.s.nodes_used[static_cast<std::size_t>(l)].push_back(static_cast<std::uint32_t>(slot));
+      st.s.node_used[p].push_back(static_cast<std::uint32_t>(slot));
     }
     return id;
   }
@@ -515,22 +531,17 @@ class Extractor {
     return (row[w] >> 1) | (w + 1 < words ? row[w + 1] << 63 : 0);
   }
 
-  void record_keys(const Scratch& s, int l, std::vector<std::pair<std::uint64_t, std::uint32_t>>& keys) const {
+  void record_keys(const Scratch& s, int node_layer, std::vector<std::pair<std::uint64_t, std::uint32_t>>& keys) const {
     const std::uint64_t layer = static_cast<std::uint64_t>(nx_) * static_cast<std::uint64_t>(ny_);
-    const std::vector<std::uint32_t>* used[3] = {&s.xe_used[static_cast<std::size_t>(l)], &s.ye_used[static_cast<std::size_t>(l)], &s.nodes_used[static_cast<std::size_t>(l)]};
-    const std::vector<std::uint32_t>* ids[3] = {&s.xe[static_cast<std::size_t>(l)], &s.ye[static_cast<std::size_t>(l)], &s.nodes[static_cast<std::size_t>(l)]};
-    for (int type = 0; type < 3; ++type)
-      for (std::uint32_t slot : *used[type]) keys.emplace_back(type * layer + slot, (*ids[type])[slot]);
+    const std::size_t p = static_cast<std::size_t>(node_layer & 1);
+    for (std::uint32_t c : s.xe_used[p]) keys.emplace_back(c, s.slots[c].xe[p]);
+    for (std::uint32_t c : s.ye_used[p]) keys.emplace_back(layer + c, s.slots[c].ye[p]);
+    for (std::uint32_t c : s.node_used[p]) keys.emplace_back(2 * layer + c, s.slots[c].node[p]);
     std::sort(keys.begin(), keys.end());
   }
 
   void process_slab(int k0, int k1, Scratch& s, SlabMesh& out) const {
-    for (int l = 0; l < 2; ++l) {
-      for (std::uint32_t slot : s.xe_used[static_cast<std::size_t>(l)]) s.xe[static_cast<std::size_t>(l)][slot] = kNone;
-      for (std::uint32_t slot : s.ye_used[static_cast<std::size_t>(l)]) s.ye[static_cast<std::size_t>(l)][slot] = kNone;
-      for (std::uint32_t slot : s.nodes_used[static_cast<std::size_t>(l)]) s.nodes[static_cast<std::size_t>(l)][slot] = kNone;
-      s.xe_used[static_cast<std::size_t>(l)].clear(), s.ye_used[static_cast<std::size_t>(l)].clear(), s.nodes_used[static_cast<std::size_t>(l)].clear();
-    }
+    s.clear_layer(0), s.clear_layer(1), s.clear_z();
     init_layer(s.s0, k0);
     const std::size_t row_words = static_cast<std::size_t>(words_);
     for (int k = k0; k < k1; ++k) {
@@ -585,18 +596,12 @@ class Extractor {
       if (k == nz_ - 2)
         for (int j = 0; j + 1 < ny_; ++j)
           for_cells(upper, 1, true, j, [&](int i) { emit_cap(st, i, j, cell_mask(s, i, j), 5); });
-      if (k == k0 && k0 > 0) record_keys(s, 0, out.bottom);
-      if (k == k1 - 1 && k1 < nz_ - 1) record_keys(s, 1, out.top);
+      if (k == k0 && k0 > 0) record_keys(s, k, out.bottom);
+      if (k == k1 - 1 && k1 < nz_ - 1) record_keys(s, k + 1, out.top);
       // Roll: node layer k+1 becomes the lower layer.
       std::swap(s.s0, s.s1);
-      for (std::uint32_t slot : s.ze_used) s.ze[slot] = kNone;
-      s.ze_used.clear();
-      for (std::uint32_t slot : s.xe_used[0]) s.xe[0][slot] = kNone;
-      for (std::uint32_t slot : s.ye_used[0]) s.ye[0][slot] = kNone;
-      for (std::uint32_t slot : s.nodes_used[0]) s.nodes[0][slot] = kNone;
-      s.xe_used[0].clear(), s.ye_used[0].clear(), s.nodes_used[0].clear();
-      std::swap(s.xe[0], s.xe[1]), std::swap(s.ye[0], s.ye[1]), std::swap(s.nodes[0], s.nodes[1]);
-      std::swap(s.xe_used[0], s.xe_used[1]), std::swap(s.ye_used[0], s.ye_used[1]), std::swap(s.nodes_used[0], s.nodes_used[1]);
+      s.clear_z();
+      s.clear_layer(k & 1);  // node layer k is done; its parity is reused by layer k + 2
     }
   }
 
