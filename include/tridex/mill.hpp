@@ -21,6 +21,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstddef>
@@ -102,15 +103,26 @@ struct MoveGeometry {
         double t = w > 0 ? lo : hi;
         return {az + t * w, t};
       }
-      case CutterShape::ball: {
-        double t = std::clamp(t_foot - w * k * ball_factor, lo, hi);
-        double s = t - t_foot;
-        double d2 = e2 + s * s * vv;
-        return {az + t * w + radius - std::sqrt(std::max(0.0, radius2 - d2)), t};
-      }
+      case CutterShape::ball:
+        return ball_lowest(ux, uy);
       default:
         return convex_minimum(e2, t_foot, lo, hi);
     }
+  }
+
+  // The ball end's closed form for a non-vertical move, at offset (ux, uy) from the move's start:
+  // the hot path of milling, kept short.
+  Lowest ball_lowest(double ux, double uy) const {
+    double dot = ux * vx + uy * vy;
+    double t_foot = dot * inv_vv;
+    double e2 = ux * ux + uy * uy - t_foot * dot;
+    if (e2 > radius2) return {kInf, 0};
+    double k = std::sqrt(std::max(0.0, radius2 - e2));
+    double lo = std::max(0.0, t_foot - k * inv_len), hi = std::min(1.0, t_foot + k * inv_len);
+    if (lo > hi) return {kInf, 0};
+    double t = std::min(std::max(t_foot - w * k * ball_factor, lo), hi);
+    double dx = ux - t * vx, dy = uy - t * vy;
+    return {az + t * w + radius - std::sqrt(std::max(0.0, radius2 - (dx * dx + dy * dy))), t};
   }
 
   double lowest_above(double x, double y) const { return lowest(x, y).z; }
@@ -136,6 +148,20 @@ struct MoveGeometry {
     }
     double d = std::sqrt(d2);
     gradient = d > 0 ? (cutter->lower_slope(d) / d) * Vec2(dx, dy) : Vec2(0);
+    return true;
+  }
+
+  // lowest() and supporting_plane() at once; for the ball end, sharing the square root.
+  bool lowest_with_plane(double x, double y, Lowest& p, Vec2& gradient) const {
+    if (cutter->shape() != CutterShape::ball || vertical) {
+      p = lowest(x, y);
+      return p.z < kInf && supporting_plane(x, y, p, gradient);
+    }
+    p = ball_lowest(x - ax, y - ay);
+    if (!(p.z < kInf)) return false;
+    double root = az + p.t * w + radius - p.z;  // √(R² − d²) at the minimiser
+    if (root * root <= radius2 * 1e-7) return false;
+    gradient = Vec2(x - ax - p.t * vx, y - ay - p.t * vy) / root;
     return true;
   }
 
@@ -297,23 +323,47 @@ class Miller {
       }
   }
 
+  // A plane P through the tile's centre at height z with slope `gradient`, that approximates the
+  // tile's surface once a smooth move has cut it.
+  struct TilePlane {
+    bool valid = false;
+    double z = 0;
+    Vec2 gradient{0};
+  };
+
+  // What a tile holds, row by row: the highest point and the largest height above P.
+  struct TileState {
+    std::array<double, kTile> row_top, row_excess;
+    double top = -kInf, excess = -kInf;
+    void summarise(int rows) {
+      top = *std::max_element(row_top.begin(), row_top.begin() + rows);
+      excess = *std::max_element(row_excess.begin(), row_excess.begin() + rows);
+    }
+  };
+
   // Mills one tile with every move of its block that reaches it, lowest first, skipping the
-  // moves that provably cannot lower any point of it:
+  // moves (and, within a move, the rows) that provably cannot lower any point:
   //   * each move's swept surface S has a lower bound over the tile: the lowest tip plus h at the
-  //     tile's distance, tightened by S's supporting plane at the tile's centre;
+  //     tile's distance, or better, S's supporting plane at the tile's centre;
   //   * moves are taken in order of that bound, so once a bound reaches the tile's highest point
   //     every later move is skipped;
   //   * once a smooth move has cut the tile, its supporting plane P approximates the tile's
-  //     surface, and a move is skipped when min(S − P) over the tile ≥ max(height − P): this
-  //     keeps skipping effective on sloped surfaces, where the tile's highest point is far above
-  //     most of it.
+  //     surface, and a move (or one row of it) is skipped when min(S − P) ≥ max(height − P)
+  //     there: this keeps skipping effective on sloped surfaces, where the highest point of a
+  //     tile is far above most of it.
   void mill_tile_with_candidates(const IndexBox& tile, BlockScratch& scratch) {
     const double x_lo = g_.x(tile.i0), x_hi = g_.x(tile.i1), y_lo = g_.y(tile.j0), y_hi = g_.y(tile.j1);
     const double xc = 0.5 * (x_lo + x_hi), yc = 0.5 * (y_lo + y_hi);
     const double hx = 0.5 * (x_hi - x_lo), hy = 0.5 * (y_hi - y_lo);
-    const float empty = map_.empty_height;
     TilePlane plane;
-    TileState state = scan_tile(tile, xc, yc, plane);
+    TileState state;
+    for (int j = tile.j0; j <= tile.j1; ++j) {
+      const float* row = &map_.heights[g_.index(0, j)];
+      state.row_top[static_cast<std::size_t>(j - tile.j0)] = *std::max_element(row + tile.i0, row + tile.i1 + 1);
+      state.row_excess[static_cast<std::size_t>(j - tile.j0)] = -kInf;
+    }
+    state.summarise(tile.j1 - tile.j0 + 1);
+
     std::vector<Candidate>& candidates = scratch.candidates;
     candidates.clear();
     for (std::size_t k = 0; k < scratch.moves.size(); ++k) {
@@ -322,9 +372,8 @@ class Miller {
       const MoveGeometry& m = scratch.moves[k];
       if (m.lowest_tip() >= state.top) continue;
       Candidate c{&m, kInf, kInf, Vec2(0), false};
-      MoveGeometry::Lowest centre = m.lowest(xc, yc);
-      if (centre.z < kInf && m.supporting_plane(xc, yc, centre, c.gradient)) {
-        // The supporting plane at the centre bounds S over the whole tile.
+      MoveGeometry::Lowest centre;
+      if (m.lowest_with_plane(xc, yc, centre, c.gradient)) {
         c.centre_z = centre.z;
         c.has_plane = true;
         c.bound = centre.z - std::abs(c.gradient.x) * hx - std::abs(c.gradient.y) * hy;
@@ -342,18 +391,31 @@ class Miller {
     std::iter_swap(candidates.begin(),
                    std::min_element(candidates.begin(), candidates.end(),
                                     [](const Candidate& a, const Candidate& b) { return a.bound < b.bound; }));
+    // min(S − P) over the tile (or over a row, with half_height = 0 and dy its offset).
+    auto above_plane = [&](const Candidate& c, double dy, double half_height) {
+      if (!c.has_plane)
+        return c.bound - (plane.z + plane.gradient.y * dy + std::abs(plane.gradient.x) * hx +
+                          std::abs(plane.gradient.y) * half_height);
+      return (c.centre_z - plane.z) + (c.gradient.y - plane.gradient.y) * dy -
+             std::abs(c.gradient.x - plane.gradient.x) * hx -
+             std::abs(c.gradient.y - plane.gradient.y) * half_height;
+    };
     auto can_cut = [&](const Candidate& c) {
-      if (c.bound >= state.top) return false;
-      if (!plane.valid) return true;
-      double lower = c.has_plane ? (c.centre_z - plane.z) - std::abs(c.gradient.x - plane.gradient.x) * hx -
-                                       std::abs(c.gradient.y - plane.gradient.y) * hy
-                                 : c.bound - (plane.z + std::abs(plane.gradient.x) * hx +
-                                              std::abs(plane.gradient.y) * hy);
-      return lower < state.excess;
+      return c.bound < state.top && (!plane.valid || above_plane(c, 0, hy) < state.excess);
     };
     auto cut = [&](const Candidate& c) {
-      if (!plane.valid && c.has_plane) plane = {true, c.centre_z, c.gradient};
-      state = mill_tile(c, tile, xc, yc, plane, empty);
+      if (!plane.valid && c.has_plane) {
+        plane = {true, c.centre_z, c.gradient};
+        mill_tile(c, tile, xc, yc, plane, state, [](int) { return true; });
+        return;
+      }
+      mill_tile(c, tile, xc, yc, plane, state, [&](int j) {
+        std::size_t r = static_cast<std::size_t>(j - tile.j0);
+        double dy = g_.y(j) - yc;
+        double row_bound = c.has_plane ? c.centre_z + c.gradient.y * dy - std::abs(c.gradient.x) * hx : c.bound;
+        if (row_bound >= state.row_top[r]) return false;
+        return !plane.valid || above_plane(c, dy, 0) < state.row_excess[r];
+      });
     };
     cut(candidates.front());
     // Then the others that can still cut, lowest bound first.
@@ -367,56 +429,48 @@ class Miller {
     }
   }
 
-  // A plane P through (centre, z) with slope `gradient` that approximates a tile's surface.
-  struct TilePlane {
-    bool valid = false;
-    double z = 0;
-    Vec2 gradient{0};
-  };
-  struct TileState {
-    double top;     // the highest point of the tile
-    double excess;  // max(height − P) over the tile, if the plane is valid
-  };
-
-  TileState scan_tile(const IndexBox& t, double xc, double yc, const TilePlane& plane) const {
-    float top = -std::numeric_limits<float>::infinity();
-    double excess = -kInf;
-    for (int j = t.j0; j <= t.j1; ++j) {
-      const float* row = &map_.heights[g_.index(0, j)];
-      double row_plane = plane.z + plane.gradient.y * (g_.y(j) - yc);
-      for (int i = t.i0; i <= t.i1; ++i) {
-        top = std::max(top, row[i]);
-        if (plane.valid) excess = std::max(excess, row[i] - (row_plane + plane.gradient.x * (g_.x(i) - xc)));
-      }
-    }
-    return {top, excess};
+  // Lowers the rows of one tile that `row_may_cut` admits to one move's swept surface, and
+  // updates those rows' state (measured against `plane`) in the same pass. Where the move has a
+  // supporting plane, a point already below that plane is not evaluated.
+  template <class RowTest>
+  void mill_tile(const Candidate& c, const IndexBox& t, double xc, double yc, const TilePlane& plane,
+                 TileState& state, RowTest&& row_may_cut) {
+    const MoveGeometry& m = *c.move;
+    if (m.cutter->shape() == CutterShape::ball && !m.vertical)
+      mill_rows(c, t, xc, yc, plane, state, row_may_cut,
+                [&m](double x, double y) { return m.ball_lowest(x - m.ax, y - m.ay).z; });
+    else
+      mill_rows(c, t, xc, yc, plane, state, row_may_cut,
+                [&m](double x, double y) { return m.lowest_above(x, y); });
   }
 
-  // Lowers the points of one tile to one move's swept surface, and returns the tile's state
-  // after it (measured against `plane`) from the same pass. Where the move has a supporting
-  // plane, a point already below that plane is not evaluated.
-  TileState mill_tile(const Candidate& c, const IndexBox& t, double xc, double yc,
-                      const TilePlane& plane, float empty) {
-    const MoveGeometry& m = *c.move;
+  template <class RowTest, class Lowest>
+  void mill_rows(const Candidate& c, const IndexBox& t, double xc, double yc, const TilePlane& plane,
+                 TileState& state, RowTest& row_may_cut, Lowest&& lowest_above) {
+    const float empty = map_.empty_height;
     const double move_plane_z = c.has_plane ? c.centre_z : -kInf;
-    float top = -std::numeric_limits<float>::infinity();
-    double excess = -kInf;
     for (int j = t.j0; j <= t.j1; ++j) {
+      if (!row_may_cut(j)) continue;
       const double y = g_.y(j);
       const double move_row = move_plane_z + c.gradient.y * (y - yc);
       const double tile_row = plane.z + plane.gradient.y * (y - yc);
       float* row = &map_.heights[g_.index(0, j)];
+      float top = -std::numeric_limits<float>::infinity();
+      double excess = -kInf;
       for (int i = t.i0; i <= t.i1; ++i) {
         const double x = g_.x(i);
         if (move_row + c.gradient.x * (x - xc) < row[i]) {
-          float lowered = std::max(static_cast<float>(m.lowest_above(x, y)), empty);
+          float lowered = std::max(static_cast<float>(lowest_above(x, y)), empty);
           row[i] = std::min(row[i], lowered);
         }
         top = std::max(top, row[i]);
         excess = std::max(excess, row[i] - (tile_row + plane.gradient.x * (x - xc)));
       }
+      std::size_t r = static_cast<std::size_t>(j - t.j0);
+      state.row_top[r] = top;
+      state.row_excess[r] = plane.valid ? excess : -kInf;
     }
-    return {top, plane.valid ? excess : -kInf};
+    state.summarise(t.j1 - t.j0 + 1);
   }
 
   ZMap& map_;
