@@ -154,11 +154,15 @@ class ZMapScanner {
  private:
   std::int64_t ceil_units(std::int64_t x) const { return -((-x) >> bits_); }
 
+  // Rounding to the nearest fixed-point unit (ties away from zero), inline: llround is a libm
+  // call and was a seventh of the scan. |x| < 2^62 here.
+  static std::int64_t round_fixed(double x) { return static_cast<std::int64_t>(x + (x >= 0 ? 0.5 : -0.5)); }
+
   double world_t(int i, int j, double h) const { return t0_ + i * tx_ + j * ty_ + h * tz_; }
 
   ScanVertex vertex(int i, int j, double h) const {
-    return {q0_[0] + i * qx_[0] + j * qy_[0] + std::llround(h * qz_[0]),
-            q0_[1] + i * qx_[1] + j * qy_[1] + std::llround(h * qz_[1]), world_t(i, j, h)};
+    return {q0_[0] + i * qx_[0] + j * qy_[0] + round_fixed(h * qz_[0]),
+            q0_[1] + i * qx_[1] + j * qy_[1] + round_fixed(h * qz_[1]), world_t(i, j, h)};
   }
 
   void fill_row(int j, std::vector<ScanVertex>& row, std::vector<double>& h) const {
@@ -169,8 +173,8 @@ class ZMapScanner {
       const auto ii = static_cast<std::size_t>(i);
       double z = std::max(double(heights[i]), empty);
       h[ii] = z;
-      row[ii].u = bu + i * qx_[0] + std::llround(z * qz_[0]);
-      row[ii].v = bv + i * qx_[1] + std::llround(z * qz_[1]);
+      row[ii].u = bu + i * qx_[0] + round_fixed(z * qz_[0]);
+      row[ii].v = bv + i * qx_[1] + round_fixed(z * qz_[1]);
     }
   }
 
@@ -183,10 +187,33 @@ class ZMapScanner {
     std::int64_t iu1 = std::min<std::int64_t>(nu_ - 1, ceil_units(std::max({a.u, b.u, c.u})) - 1);
     std::int64_t iv0 = std::max<std::int64_t>(0, ceil_units(std::min({a.v, b.v, c.v})));
     std::int64_t iv1 = std::min<std::int64_t>(nv_ - 1, ceil_units(std::max({a.v, b.v, c.v})) - 1);
+    if (iu0 > iu1 || iv0 > iv1) return;
     const double lo_t = std::min({a.t, b.t, c.t}), hi_t = std::max({a.t, b.t, c.t});
     const double inverse_area = 1.0 / double(area);
-    for (std::int64_t iv = iv0; iv <= iv1; ++iv)
-      for (std::int64_t iu = iu0; iu <= iu1; ++iu) {
+    // A long thin triangle seen at a slant (a wall of a tilted map) has a bounding box of many
+    // rays and covers few: for each row of rays, only the columns within one ray spacing of its
+    // u-extent on that row are tested (the exact tests below still decide).
+    const bool scanline = (iu1 - iu0) > 2 && (iv1 - iv0) > 2;
+    const double one = std::ldexp(1.0, bits_);
+    const ScanVertex* corners[3] = {&a, &b, &c};
+    for (std::int64_t iv = iv0; iv <= iv1; ++iv) {
+      std::int64_t row_u0 = iu0, row_u1 = iu1;
+      if (scanline) {
+        const double pv = double(iv) * one;
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        for (int e = 0; e < 3; ++e) {
+          const ScanVertex &p = *corners[e], &q = *corners[(e + 1) % 3];
+          double p_u = double(p.u), p_v = double(p.v), q_u = double(q.u), q_v = double(q.v);
+          if (pv < std::min(p_v, q_v) - one || pv > std::max(p_v, q_v) + one) continue;
+          double u_at = p_v == q_v ? p_u : p_u + (std::clamp(pv, std::min(p_v, q_v), std::max(p_v, q_v)) - p_v) * (q_u - p_u) / (q_v - p_v);
+          if (p_v == q_v) lo = std::min({lo, p_u, q_u}), hi = std::max({hi, p_u, q_u});
+          else lo = std::min(lo, u_at), hi = std::max(hi, u_at);
+        }
+        if (!(lo <= hi)) continue;
+        row_u0 = std::max(iu0, static_cast<std::int64_t>(std::floor(lo / one)) - 1);
+        row_u1 = std::min(iu1, static_cast<std::int64_t>(std::ceil(hi / one)) + 1);
+      }
+      for (std::int64_t iu = row_u0; iu <= row_u1; ++iu) {
         auto ray = static_cast<std::uint32_t>(iu + std::int64_t{nu_} * iv);
         if (mask_ && mask_->offsets[ray] == mask_->offsets[ray + 1]) continue;  // nothing left to cut
         const std::int64_t pu = iu << bits_, pv = iv << bits_;
@@ -201,6 +228,7 @@ class ZMapScanner {
         // Normal along +axis (counter-clockwise in (u, v)) means the ray leaves there.
         hits.push_back({ray, static_cast<float>(t), -orientation});
       }
+    }
   }
 
   static int perturbed_sign_wide(ScanWide value, std::int64_t du, std::int64_t dv) {
