@@ -10,8 +10,9 @@
 //    than SurfaceOptions::feature_angle, the cell's loop is fanned around the point that
 //    minimises Σ (n_i·(x − p_i))² (a quadric error function solved with a truncated
 //    pseudo-inverse), and edges between two such fans are flipped so that the fans' apexes join
-//    along the feature. Normals come from the neighbouring rays' end points (one-sided or central
-//    differences of the end-point heights, whichever side is smoother), not from any field.
+//    along the feature. Normals come from the neighbouring rays' end points: central
+//    differences of the end-point heights, or, across an edge, the one-sided difference whose
+//    continuation is straighter (as in ENO schemes), not from any field.
 //
 // Consistency. Node inside/outside comes from ONE rule: the z ray through the node, with
 // half-open intervals [enter, exit) — the convention of dexel_ops.hpp's `contains` and of
@@ -328,29 +329,49 @@ class Extractor {
   // f_v e_v). Zero when no neighbour has a matching end point within two spacings.
   glm::vec3 crossing_normal(int a, int iu, int iv, double x, bool enter) const {
     const DexelGrid& g = d_.grids[a];
+    // The end point of the same kind nearest to `near` on ray (ju, jv), if within two spacings.
+    auto end_point_near = [&](int ju, int jv, double near, double& out) {
+      if (ju < 0 || jv < 0 || ju >= g.nu || jv >= g.nv) return false;
+      std::span<const DexelInterval> ray = g.ray(ju, jv);
+      auto end_point = [&](const DexelInterval& s) { return double(enter ? s.enter : s.exit); };
+      auto it = std::lower_bound(ray.begin(), ray.end(), near,
+                                 [&](const DexelInterval& s, double value) { return end_point(s) < value; });
+      double best = std::numeric_limits<double>::infinity();
+      if (it != ray.end()) best = end_point(*it);
+      if (it != ray.begin() && std::abs(end_point(*(it - 1)) - near) < std::abs(best - near)) best = end_point(*(it - 1));
+      if (!(std::abs(best - near) <= 2 * h_)) return false;
+      out = best;
+      return true;
+    };
+    // f_u by finite differences: central where both sides agree; otherwise (an edge or a ridge
+    // between the rays) the one-sided difference whose continuation one more ray out is the
+    // straighter (ENO), so a crossing's normal is that of its own face.
     auto slope = [&](int du, int dv, double& out) {
-      double best[2];
+      double x1[2], d1[2];
       bool have[2] = {false, false};
       for (int side = 0; side < 2; ++side) {
         int su = side ? 1 : -1;
-        int ju = iu + su * du, jv = iv + su * dv;
-        if (ju < 0 || jv < 0 || ju >= g.nu || jv >= g.nv) continue;
-        std::span<const DexelInterval> ray = g.ray(ju, jv);
-        auto end_point = [&](const DexelInterval& s) { return double(enter ? s.enter : s.exit); };
-        auto it = std::lower_bound(ray.begin(), ray.end(), x,
-                                   [&](const DexelInterval& s, double value) { return end_point(s) < value; });
-        double nearest = std::numeric_limits<double>::infinity();
-        if (it != ray.end()) nearest = end_point(*it) - x;
-        if (it != ray.begin() && std::abs(end_point(*(it - 1)) - x) < std::abs(nearest)) nearest = end_point(*(it - 1)) - x;
-        if (std::abs(nearest) <= 2 * h_) have[side] = true, best[side] = su * nearest / h_;
+        if (end_point_near(iu + su * du, iv + su * dv, x, x1[side])) have[side] = true, d1[side] = su * (x1[side] - x) / h_;
       }
       if (have[0] && have[1]) {
-        out = std::abs(best[0] - best[1]) <= 0.5 ? 0.5 * (best[0] + best[1])
-              : std::abs(best[0]) < std::abs(best[1]) ? best[0] : best[1];
+        if (std::abs(d1[0] - d1[1]) <= 0.1) {
+          out = 0.5 * (d1[0] + d1[1]);
+          return true;
+        }
+        double bend[2];
+        for (int side = 0; side < 2; ++side) {
+          int su = side ? 1 : -1;
+          double x2;
+          bend[side] = end_point_near(iu + 2 * su * du, iv + 2 * su * dv, x1[side], x2)
+                           ? std::abs(su * (x2 - x1[side]) / h_ - d1[side])
+                           : std::numeric_limits<double>::infinity();
+        }
+        int pick = bend[0] < bend[1] ? 0 : bend[1] < bend[0] ? 1 : std::abs(d1[0]) <= std::abs(d1[1]) ? 0 : 1;
+        out = d1[pick];
         return true;
       }
       if (have[0] || have[1]) {
-        out = have[0] ? best[0] : best[1];
+        out = have[0] ? d1[0] : d1[1];
         return true;
       }
       return false;
