@@ -711,11 +711,13 @@ class Extractor {
 }  // namespace detail::surface
 
 // The boundary of the solid sampled by `dexel` (clipped to the lattice box) as a closed,
-// 2-manifold, outward-oriented triangle mesh without degenerate triangles. Vertices are dexel
-// end points (kept a tiny fraction of the spacing off the nodes), lattice nodes where the solid
-// reaches the lattice boundary, and per-cell feature or centre points. Features thinner than
-// one spacing between nodes may be lost (as in any marching-cubes method). Throws tridex::Error
-// for a malformed triple dexel or options.
+// outward-oriented triangle mesh — every edge shared by exactly two triangles in opposite
+// directions (check_mesh(...).closed()) — without degenerate triangles. Vertices are dexel end
+// points (kept at least 1e-4 of a spacing off the nodes), lattice nodes where the solid reaches
+// the lattice boundary, and per-cell feature or centre points. Node states follow the z rays
+// (half-open [enter, exit)); parts thinner than the spacing between nodes may be lost (as in
+// any marching-cubes method). Throws tridex::Error for a malformed triple dexel (see validate) or
+// a feature_angle outside (0, 180) degrees.
 inline Mesh extract_surface(const TripleDexel& dexel, SurfaceOptions options = {}) {
   validate(dexel);
   if (!(options.feature_angle > 0 && options.feature_angle < 180))
