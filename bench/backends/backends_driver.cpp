@@ -4,11 +4,12 @@
 //
 // The program is parsed once (the G-code front end), its moves grouped by spindle direction
 // and kept as tool-tip segments in each direction's frame. Each backend configuration then runs
-// in a forked child process, so that its peak resident memory (getrusage) is its own: the
-// child mills one Z-map per direction (Step 1), dexelizes each map on the stock's lattice
-// (Step 2) and intersects the results with the stock (Step 3), both as the paper splits them,
-// and once more fused through machine_with (what `tridex simulate` runs: each ray cut by every
-// map in turn, rays already empty skipped), then extracts the surface. Figures are medians
+// in forked processes, so that its peak resident memory (getrusage) is its own: a child per
+// Z-map backend mills one Z-map per direction (Step 1, once), then a grandchild per dexel
+// backend dexelizes each map on the stock's lattice (Step 2) and intersects the results with
+// the stock (Step 3), as the paper splits them, and once more fused through machine_with (what
+// `tridex simulate` runs: each ray cut by every map in turn, rays already empty skipped), then
+// extracts the surface. Figures are medians
 // over --runs runs; the backends of one run share the machine's state, so compare them as
 // ratios within one table.
 //
@@ -125,24 +126,29 @@ TripleDexel dexelize_with(be::DexelBackend backend, const ZMap& map, const Dexel
   throw std::logic_error("invalid dexel backend");
 }
 
-Result run_config(const Options& o, be::ZMapBackend zb, be::DexelBackend db, const std::vector<Group>& groups,
-                  const std::vector<Cutter>& cutters) {
-  Result r;
+// Step 1 with one Z-map backend: one milled map per direction.
+std::vector<ZMap> mill_all(const Options& o, be::ZMapBackend zb, const std::vector<Group>& groups,
+                           const std::vector<Cutter>& cutters) {
   const Aabb stock = bench::workload_stock();
   const Vec3 size = stock.size();
   const double cell = std::max({size.x, size.y, size.z}) / (o.zmap - 1);
-  auto t = std::chrono::steady_clock::now();
   std::vector<ZMap> maps;
   for (const Group& g : groups) {
     maps.push_back(ZMap::from_box(g.frame, stock, cell));
     if (zb == be::ZMapBackend::gl) be::gl_mill(maps.back(), cutters, g.moves, {.tolerance = o.gl_tolerance});
     else be::mill_with(zb, maps.back(), cutters, g.moves, o.threads);
   }
-  r.step1 = seconds_since(t);
+  return maps;
+}
+
+// Steps 2, 3 (split as the paper does, and fused through machine_with) and the surface.
+Result run_dexel(const Options& o, be::DexelBackend db, std::vector<ZMap>& maps) {
+  Result r;
+  const Aabb stock = bench::workload_stock();
   const DexelLattice lattice = DexelLattice::covering_resolution(stock, o.dexel);
   TripleDexel result = TripleDexel::box(lattice, stock);
   for (const ZMap& map : maps) {
-    t = std::chrono::steady_clock::now();
+    auto t = std::chrono::steady_clock::now();
     TripleDexel m = dexelize_with(db, map, lattice, o.threads);
     r.step2 += seconds_since(t);
     t = std::chrono::steady_clock::now();
@@ -152,14 +158,14 @@ Result run_config(const Options& o, be::ZMapBackend zb, be::DexelBackend db, con
   r.volume = volume(result);
   if (o.fused) {
     TripleDexel w0 = TripleDexel::box(lattice, stock);
-    t = std::chrono::steady_clock::now();
+    auto t = std::chrono::steady_clock::now();
     TripleDexel fused = be::machine_with(db, w0, maps, o.threads);
     r.fused = seconds_since(t);
     r.fused_volume = volume(fused);
   }
   maps.clear();
   maps.shrink_to_fit();
-  t = std::chrono::steady_clock::now();
+  auto t = std::chrono::steady_clock::now();
   Mesh mesh = extract_surface(result, {.threads = o.threads});
   r.surface = seconds_since(t);
   r.triangles = static_cast<long long>(mesh.triangles.size());
@@ -170,9 +176,9 @@ Result run_config(const Options& o, be::ZMapBackend zb, be::DexelBackend db, con
   return r;
 }
 
-// Runs one configuration in a child process and returns what it reports.
-Result forked(const Options& o, be::ZMapBackend zb, be::DexelBackend db, const std::vector<Group>& groups,
-              const std::vector<Cutter>& cutters) {
+// Runs `work` in a child process and returns the Results it writes back; `count` of them.
+template <class Work>
+std::vector<Result> in_child(std::size_t count, Work&& work) {
   int pipe_fd[2];
   if (pipe(pipe_fd) != 0) throw std::runtime_error("pipe failed");
   std::fflush(stdout), std::fflush(stderr);
@@ -180,28 +186,53 @@ Result forked(const Options& o, be::ZMapBackend zb, be::DexelBackend db, const s
   if (child < 0) throw std::runtime_error("fork failed");
   if (child == 0) {
     close(pipe_fd[0]);
-    Result r;
+    std::vector<Result> out(count);
     try {
-      r = run_config(o, zb, db, groups, cutters);
+      out = work();
     } catch (const std::exception& e) {
-      std::snprintf(r.error, sizeof r.error, "%s", e.what());
+      for (Result& r : out) std::snprintf(r.error, sizeof r.error, "%s", e.what());
     }
-    ssize_t written = write(pipe_fd[1], &r, sizeof r);
-    _exit(written == static_cast<ssize_t>(sizeof r) ? 0 : 1);
+    out.resize(count);
+    ssize_t bytes = static_cast<ssize_t>(count * sizeof(Result));
+    ssize_t written = write(pipe_fd[1], out.data(), static_cast<std::size_t>(bytes));
+    _exit(written == bytes ? 0 : 1);
   }
   close(pipe_fd[1]);
-  Result r;
-  std::size_t got = 0;
-  while (got < sizeof r) {
-    ssize_t n = read(pipe_fd[0], reinterpret_cast<char*>(&r) + got, sizeof r - got);
+  std::vector<Result> results(count);
+  std::size_t got = 0, want = count * sizeof(Result);
+  while (got < want) {
+    ssize_t n = read(pipe_fd[0], reinterpret_cast<char*>(results.data()) + got, want - got);
     if (n <= 0) break;
     got += static_cast<std::size_t>(n);
   }
   close(pipe_fd[0]);
   int status = 0;
   waitpid(child, &status, 0);
-  if (got != sizeof r) std::snprintf(r.error, sizeof r.error, "child died (status %d)", status);
-  return r;
+  if (got != want)
+    for (Result& r : results) r = Result{}, std::snprintf(r.error, sizeof r.error, "child died (status %d)", status);
+  return results;
+}
+
+// One Z-map backend in a child (Step 1 once), each dexel backend in a grandchild of its own,
+// so that each reports its own peak memory (the milled maps included).
+std::vector<Result> run_zmap_backend(const Options& o, be::ZMapBackend zb, const std::vector<be::DexelBackend>& dbs,
+                                     const std::vector<Group>& groups, const std::vector<Cutter>& cutters) {
+  return in_child(dbs.size(), [&] {
+    auto t = std::chrono::steady_clock::now();
+    std::vector<ZMap> maps = mill_all(o, zb, groups, cutters);
+    double step1 = seconds_since(t);
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    const double step1_peak = double(usage.ru_maxrss) / 1024.0;  // the gl context's buffers included
+    std::vector<Result> out;
+    for (be::DexelBackend db : dbs) {
+      Result r = in_child(1, [&] { return std::vector<Result>{run_dexel(o, db, maps)}; })[0];
+      r.step1 = step1;
+      r.peak_mib = std::max(r.peak_mib, step1_peak);
+      out.push_back(r);
+    }
+    return out;
+  });
 }
 
 double median(std::vector<double> v) {
@@ -260,14 +291,22 @@ int main(int argc, char** argv) {
 
   std::vector<std::vector<Result>> results(o.configs.size());
   for (int run = 0; run < o.runs; ++run)
-    for (std::size_t c = 0; c < o.configs.size(); ++c) {
-      Result r = forked(o, o.configs[c].first, o.configs[c].second, groups, cutters);
-      if (!r.ok) {
-        std::fprintf(stderr, "%s+%s failed: %s\n", be::to_string(o.configs[c].first), be::to_string(o.configs[c].second),
-                     r.error);
-        return 1;
+    for (be::ZMapBackend zb : {be::ZMapBackend::cpu, be::ZMapBackend::gl}) {
+      std::vector<std::size_t> which;
+      std::vector<be::DexelBackend> dbs;
+      for (std::size_t c = 0; c < o.configs.size(); ++c)
+        if (o.configs[c].first == zb) which.push_back(c), dbs.push_back(o.configs[c].second);
+      if (dbs.empty()) continue;
+      std::vector<Result> got = run_zmap_backend(o, zb, dbs, groups, cutters);
+      for (std::size_t k = 0; k < which.size(); ++k) {
+        const std::size_t c = which[k];
+        if (!got[k].ok) {
+          std::fprintf(stderr, "%s+%s failed: %s\n", be::to_string(o.configs[c].first), be::to_string(o.configs[c].second),
+                       got[k].error);
+          return 1;
+        }
+        results[c].push_back(got[k]);
       }
-      results[c].push_back(r);
     }
   std::printf("| backend (zmap+dexel) | Step 1 (s) | Step 2 (s) | Step 3 (s) | Steps 2+3 fused (s) | surface (s) | total (s) | peak memory (MiB) | volume (mm³) | triangles |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
