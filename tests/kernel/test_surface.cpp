@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -246,7 +247,37 @@ Solid random_solid(int kind, std::mt19937& rng) {
   }
 }
 
+// Vertices whose link (the opposite edges of their triangles) is not one cycle: where two
+// sheets of surface touch in a single vertex. check_mesh only looks at edges.
+std::size_t non_manifold_vertices(const Mesh& m) {
+  std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> link(m.positions.size());
+  for (const glm::uvec3& t : m.triangles) {
+    link[t.x].emplace_back(t.y, t.z);
+    link[t.y].emplace_back(t.z, t.x);
+    link[t.z].emplace_back(t.x, t.y);
+  }
+  std::size_t bad = 0;
+  for (auto& l : link) {
+    if (l.empty()) continue;
+    std::sort(l.begin(), l.end());
+    auto next = [&](std::uint32_t a) {
+      auto it = std::lower_bound(l.begin(), l.end(), std::make_pair(a, std::uint32_t(0)));
+      return it != l.end() && it->first == a ? std::optional<std::uint32_t>(it->second) : std::nullopt;
+    };
+    std::uint32_t start = l[0].first, at = start;
+    std::size_t steps = 0;
+    do {
+      std::optional<std::uint32_t> b = next(at);
+      if (!b) break;
+      at = *b, ++steps;
+    } while (at != start && steps <= l.size());
+    if (at != start || steps != l.size()) ++bad;
+  }
+  return bad;
+}
+
 void check_closed(const Mesh& m) {
+  CHECK(non_manifold_vertices(m) == 0);
   MeshCheck check = check_mesh(m);
   CHECK(check.boundary_edges == 0);
   CHECK(check.non_manifold_edges == 0);
