@@ -24,7 +24,8 @@
 // the ray disagrees about. Crossings are kept a small fraction of the spacing away from nodes so
 // that no two vertices coincide and no triangle degenerates (three points interior to distinct
 // cube edges are never collinear); triangles around feature or centre points, and flipped ones,
-// are checked in float before they are kept. The solid is clipped to the lattice box: where it reaches the
+// are checked in float before they are kept. Positions are float, so this holds while
+// coordinates stay within about 10^5 spacings of the world origin. The solid is clipped to the lattice box: where it reaches the
 // outer nodes, caps on the box faces close it.
 //
 // Cost. Node states of one lattice layer are kept as bit rows updated by the z rays' state

@@ -479,6 +479,30 @@ TEST_CASE("extract_surface: a solid cut by the lattice boundary is closed by cap
   }
 }
 
+TEST_CASE("extract_surface: far from the origin, float positions stay distinct") {
+  // 3·10^4 spacings out (a 3 m machine table at 0.1 mm): crossings near nodes must not round
+  // onto the nodes or onto each other.
+  std::mt19937 rng(23);
+  for (int trial = 0; trial < 3; ++trial) {
+    double h = 0.1;
+    std::uniform_real_distribution<double> far(-3000, 3000);
+    Solid s = trial == 0 ? sphere(Vec3(far(rng), far(rng), far(rng)), 0.9) : random_solid(trial, rng);
+    if (trial > 0) {  // move the solid far away
+      Vec3 shift(far(rng), far(rng), far(rng));
+      auto inner = s.sdf;
+      s.sdf = [inner, shift](const Vec3& p) { return inner(p - shift); };
+      s.bounds = Aabb{s.bounds.min + shift, s.bounds.max + shift};
+      h = 0.3;
+    }
+    TripleDexel d = dexelize_solid(s, DexelLattice::covering(s.bounds, h));
+    for (bool sharp : {false, true}) {
+      Mesh m = extract_surface(d, {.sharp_features = sharp});
+      check_closed(m);
+      CHECK(std::abs(m.signed_volume() - s.volume) <= 0.05 * s.area * h);
+    }
+  }
+}
+
 TEST_CASE("extract_surface: the output does not depend on the thread count") {
   std::mt19937 rng(99);
   for (int kind = 0; kind < 6; ++kind) {
