@@ -31,6 +31,10 @@
 #include <thread>
 #include <vector>
 
+#if defined(__SSE2__) || defined(__AVX__)
+#include <immintrin.h>
+#endif
+
 #include "tridex/cutter.hpp"
 #include "tridex/error.hpp"
 #include "tridex/geometry.hpp"
@@ -53,6 +57,27 @@ namespace detail {
 constexpr int kTile = 16;        // points along each side of a tile
 constexpr int kBinTiles = 8;     // tiles along each side of a work block
 constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Doubles processed as one value (GCC/Clang vector extension): four with AVX, two with the
+// SSE2 of every x86-64, two in plain scalar code elsewhere. Used by the ball end's row loop.
+#if defined(__AVX__)
+using DoubleN = double __attribute__((vector_size(32)));
+#else
+using DoubleN = double __attribute__((vector_size(16)));
+#endif
+constexpr int kLanes = static_cast<int>(sizeof(DoubleN) / sizeof(double));
+inline DoubleN splat(double v) { return DoubleN{} + v; }
+inline DoubleN min_n(DoubleN a, DoubleN b) { return a < b ? a : b; }
+inline DoubleN max_n(DoubleN a, DoubleN b) { return a > b ? a : b; }
+inline DoubleN sqrt_n(DoubleN a) {
+#if defined(__AVX__)
+  return reinterpret_cast<DoubleN>(_mm256_sqrt_pd(reinterpret_cast<__m256d>(a)));
+#elif defined(__SSE2__)
+  return reinterpret_cast<DoubleN>(_mm_sqrt_pd(reinterpret_cast<__m128d>(a)));
+#else
+  return DoubleN{std::sqrt(a[0]), std::sqrt(a[1])};
+#endif
+}
 
 // The geometry of one move, in coordinates relative to its start point.
 struct MoveGeometry {
@@ -123,6 +148,28 @@ struct MoveGeometry {
     double t = std::min(std::max(t_foot - w * k * ball_factor, lo), hi);
     double dx = ux - t * vx, dy = uy - t * vy;
     return {az + t * w + radius - std::sqrt(std::max(0.0, radius2 - (dx * dx + dy * dy))), t};
+  }
+
+  // ball_lowest(...).z at the `count` points x_first + k·step, k = 0..count−1, of the row y,
+  // kLanes at a time; +infinity where the cutter does not pass. `out` holds a multiple of kLanes.
+  void ball_row(double x_first, double step, double y, int count, double* out) const {
+    const double uy = y - ay, uy_vy = uy * vy, uy2 = uy * uy;
+    DoubleN lane{};
+    for (int l = 0; l < kLanes; ++l) lane[l] = l;
+    for (int k = 0; k < count; k += kLanes) {
+      DoubleN ux = (x_first - ax) + (lane + k) * step;
+      DoubleN dot = ux * vx + uy_vy;
+      DoubleN t_foot = dot * inv_vv;
+      DoubleN e2 = ux * ux + uy2 - t_foot * dot;
+      DoubleN root_e = sqrt_n(max_n(radius2 - e2, splat(0)));
+      DoubleN lo = max_n(t_foot - root_e * inv_len, splat(0));
+      DoubleN hi = min_n(t_foot + root_e * inv_len, splat(1));
+      DoubleN t = min_n(max_n(t_foot - w * ball_factor * root_e, lo), hi);
+      DoubleN dx = ux - t * vx, dy = uy - t * vy;
+      DoubleN z = az + t * w + radius - sqrt_n(max_n(radius2 - (dx * dx + dy * dy), splat(0)));
+      z = (e2 > radius2) | (lo > hi) ? splat(kInf) : z;
+      __builtin_memcpy(out + k, &z, sizeof z);
+    }
   }
 
   double lowest_above(double x, double y) const { return lowest(x, y).z; }
@@ -436,32 +483,26 @@ class Miller {
   void mill_tile(const Candidate& c, const IndexBox& t, double xc, double yc, const TilePlane& plane,
                  TileState& state, RowTest&& row_may_cut) {
     const MoveGeometry& m = *c.move;
-    if (m.cutter->shape() == CutterShape::ball && !m.vertical)
-      mill_rows(c, t, xc, yc, plane, state, row_may_cut,
-                [&m](double x, double y) { return m.ball_lowest(x - m.ax, y - m.ay).z; });
-    else
-      mill_rows(c, t, xc, yc, plane, state, row_may_cut,
-                [&m](double x, double y) { return m.lowest_above(x, y); });
-  }
-
-  template <class RowTest, class Lowest>
-  void mill_rows(const Candidate& c, const IndexBox& t, double xc, double yc, const TilePlane& plane,
-                 TileState& state, RowTest& row_may_cut, Lowest&& lowest_above) {
     const float empty = map_.empty_height;
+    const bool ball = m.cutter->shape() == CutterShape::ball && !m.vertical;
     const double move_plane_z = c.has_plane ? c.centre_z : -kInf;
+    alignas(32) double lowest[kTile];
     for (int j = t.j0; j <= t.j1; ++j) {
       if (!row_may_cut(j)) continue;
       const double y = g_.y(j);
       const double move_row = move_plane_z + c.gradient.y * (y - yc);
       const double tile_row = plane.z + plane.gradient.y * (y - yc);
       float* row = &map_.heights[g_.index(0, j)];
+      // The ball end evaluates the whole row at once, four points at a time; other cutters only
+      // the points above the move's supporting plane.
+      if (ball) m.ball_row(g_.x(t.i0), g_.cell, y, t.i1 - t.i0 + 1, lowest);
       float top = -std::numeric_limits<float>::infinity();
       double excess = -kInf;
       for (int i = t.i0; i <= t.i1; ++i) {
         const double x = g_.x(i);
         if (move_row + c.gradient.x * (x - xc) < row[i]) {
-          float lowered = std::max(static_cast<float>(lowest_above(x, y)), empty);
-          row[i] = std::min(row[i], lowered);
+          double z = ball ? lowest[i - t.i0] : m.lowest_above(x, y);
+          row[i] = std::min(row[i], std::max(static_cast<float>(z), empty));
         }
         top = std::max(top, row[i]);
         excess = std::max(excess, row[i] - (tile_row + plane.gradient.x * (x - xc)));
