@@ -395,6 +395,55 @@ TEST_CASE("extract_surface: vertices on lattice edges are the rays' end points")
   }
 }
 
+TEST_CASE("extract_surface: one vertex per sign-changing lattice edge and per inside boundary node") {
+  // Brute force over every node and edge of the lattice, independent of the sparse traversal:
+  // node states from the z rays (half-open), a crossing vertex on every edge whose two nodes
+  // differ, a node vertex on every inside node of the lattice boundary.
+  std::mt19937 rng(41);
+  for (int trial = 0; trial < 8; ++trial) {
+    Solid s = random_solid(trial % 6, rng);
+    double h = std::uniform_real_distribution<double>(0.25, 0.4)(rng);
+    DexelLattice lattice = DexelLattice::covering(s.bounds, h);
+    if (trial % 2) {  // cut the solid with the lattice box so that caps appear
+      Vec3 size = s.bounds.size();
+      lattice.origin = s.bounds.min + 0.2 * size;
+      lattice.n = glm::ivec3(glm::floor(0.7 * size / h)) + 1;
+    }
+    TripleDexel d = dexelize_solid(s, lattice);
+    const glm::ivec3 n = lattice.n;
+    auto inside = [&](int i, int j, int k) {
+      double z = lattice.origin.z + lattice.spacing * k;
+      for (DexelInterval x : d.grids[2].ray(i, j))
+        if (double(x.enter) <= z && z < double(x.exit)) return true;
+      return false;
+    };
+    std::size_t changing_edges = 0, boundary_inside = 0;
+    for (int k = 0; k < n.z; ++k)
+      for (int j = 0; j < n.y; ++j)
+        for (int i = 0; i < n.x; ++i) {
+          bool in = inside(i, j, k);
+          if (i + 1 < n.x && in != inside(i + 1, j, k)) ++changing_edges;
+          if (j + 1 < n.y && in != inside(i, j + 1, k)) ++changing_edges;
+          if (k + 1 < n.z && in != inside(i, j, k + 1)) ++changing_edges;
+          bool boundary = i == 0 || j == 0 || k == 0 || i == n.x - 1 || j == n.y - 1 || k == n.z - 1;
+          if (boundary && in) ++boundary_inside;
+        }
+    Mesh m = extract_surface(d, {.sharp_features = false});
+    std::size_t on_nodes = 0, on_edges = 0;
+    for (const glm::vec3& p : m.positions) {
+      Vec3 g = (Vec3(p) - lattice.origin) / lattice.spacing;
+      int off = 0;
+      for (int a = 0; a < 3; ++a) off += std::abs(g[a] - std::round(g[a])) > 5e-5;
+      on_nodes += off == 0, on_edges += off == 1;
+    }
+    CAPTURE(std::string(s.name));
+    CHECK(on_edges == changing_edges);
+    CHECK(on_nodes == boundary_inside);
+    CHECK((trial % 2 ? boundary_inside : changing_edges) > 0);
+    check_closed(m);
+  }
+}
+
 TEST_CASE("extract_surface: sharp features keep a box's edges and corners") {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> c(-2, 2), e(1.5, 4);
