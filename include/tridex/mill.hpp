@@ -130,6 +130,8 @@ struct MoveGeometry {
       }
       case CutterShape::ball:
         return ball_lowest(ux, uy);
+      case CutterShape::bull_nose:
+        return bull_nose_lowest(e2, t_foot, lo, hi);
       default:
         return convex_minimum(e2, t_foot, lo, hi);
     }
@@ -148,6 +150,35 @@ struct MoveGeometry {
     double t = std::min(std::max(t_foot - w * k * ball_factor, lo), hi);
     double dx = ux - t * vx, dy = uy - t * vy;
     return {az + t * w + radius - std::sqrt(std::max(0.0, radius2 - (dx * dx + dy * dy))), t};
+  }
+
+  // The bull nose: its lower surface is flat out to R0 = R − r, where f' = w has one sign, so the
+  // minimum lies on the side of that stretch where the move is lower; there f is smooth (the
+  // corner torus) and the root of f' is found by regula falsi on the reduced bracket.
+  Lowest bull_nose_lowest(double e2, double t_foot, double lo, double hi) const {
+    const double corner = cutter->corner_radius(), flat = radius - corner;
+    if (e2 < flat * flat) {
+      double half = std::sqrt(flat * flat - e2) * inv_len;
+      double flat_lo = t_foot - half, flat_hi = t_foot + half;
+      if (flat_lo <= hi && flat_hi >= lo) {  // the flat bottom passes over q
+        if (w == 0) return {az, std::clamp(t_foot, lo, hi)};
+        if (w > 0) hi = std::max(lo, flat_lo);
+        else lo = std::min(hi, flat_hi);
+      }
+    }
+    auto height = [&](double t) {
+      double s = t - t_foot;
+      double reach = std::max(0.0, std::sqrt(e2 + s * s * vv) - flat);
+      return az + t * w + corner - std::sqrt(std::max(0.0, corner * corner - reach * reach));
+    };
+    auto slope = [&](double t) {
+      double s = t - t_foot;
+      double d = std::sqrt(e2 + s * s * vv), reach = d - flat;
+      if (reach <= 0 || d == 0) return w;
+      double root = std::sqrt(std::max(0.0, corner * corner - reach * reach));
+      return root > 0 ? w + reach / root * (s * vv / d) : (s > 0 ? kInf : -kInf);
+    };
+    return convex_root(height, slope, lo, hi);
   }
 
   // ball_lowest(...).z at the `count` points x_first + k·step, k = 0..count−1, of the row y,
@@ -181,10 +212,7 @@ struct MoveGeometry {
   // where that does not hold: at the rim (d = R) and at kinks of the profile.
   bool supporting_plane(double x, double y, const Lowest& p, Vec2& gradient) const {
     CutterShape shape = cutter->shape();
-    if (shape == CutterShape::flat) {
-      gradient = Vec2(0);
-      return w == 0;  // level: S is constant where the end face covers
-    }
+    if (shape == CutterShape::flat) return flat_supporting_plane(x, y, gradient);
     if (shape != CutterShape::ball && shape != CutterShape::bull_nose) return false;
     double dx = x - (ax + p.t * vx), dy = y - (ay + p.t * vy);
     double d2 = dx * dx + dy * dy;
@@ -195,6 +223,26 @@ struct MoveGeometry {
     }
     double d = std::sqrt(d2);
     gradient = d > 0 ? (cutter->lower_slope(d) / d) * Vec2(dx, dy) : Vec2(0);
+    return true;
+  }
+
+  // The flat end's S is az + w·t_edge, t_edge the parameter where the end disc first (w > 0) or
+  // last (w < 0) covers q: t⊥ ∓ k/|v|, clamped to [0, 1]. Its gradient, w·∇t_edge with
+  // ∇t⊥ = v/|v|², ∇k = −(u − t⊥·v)/k, is a limit of gradients of the convex S, hence a supporting
+  // slope. Zero where t_edge is clamped or the move is vertical or level.
+  bool flat_supporting_plane(double x, double y, Vec2& gradient) const {
+    gradient = Vec2(0);
+    if (vertical || w == 0) return true;
+    double ux = x - ax, uy = y - ay;
+    double t_foot = (ux * vx + uy * vy) * inv_vv;
+    double e2 = std::max(0.0, ux * ux + uy * uy - t_foot * t_foot * vv);
+    double k = std::sqrt(std::max(0.0, radius2 - e2));
+    if (k <= radius * 1e-6) return false;  // at the side of the footprint: S is vertical there
+    double sign = w > 0 ? -1.0 : 1.0;      // entering edge when rising, leaving edge when falling
+    double t_edge = t_foot + sign * k * inv_len;
+    if (t_edge <= 0 || t_edge >= 1) return true;
+    Vec2 across(ux - t_foot * vx, uy - t_foot * vy);
+    gradient = w * (Vec2(vx, vy) * inv_vv - sign * across * (inv_len / k));
     return true;
   }
 
@@ -212,8 +260,7 @@ struct MoveGeometry {
     return true;
   }
 
-  // min over t ∈ [lo, hi] of f(t) = az + t·w + h(√(e² + (t − t⊥)²·|v|²)) by bisection on the
-  // sign of f', which is non-decreasing because f is convex.
+  // min over t ∈ [lo, hi] of f(t) = az + t·w + h(√(e² + (t − t⊥)²·|v|²)), for any cutter.
   Lowest convex_minimum(double e2, double t_foot, double lo, double hi) const {
     auto f = [&](double t) {
       double s = t - t_foot;
@@ -227,11 +274,33 @@ struct MoveGeometry {
       double dh = cutter->lower_slope(std::min(d, radius));
       return w + (ds == 0 ? 0 : dh * ds);
     };
-    if (slope(lo) >= 0) return {f(lo), lo};
-    if (slope(hi) <= 0) return {f(hi), hi};
-    for (int iteration = 0; iteration < 64 && hi - lo > 1e-15; ++iteration) {
-      double mid = 0.5 * (lo + hi);
-      (slope(mid) > 0 ? hi : lo) = mid;
+    return convex_root(f, slope, lo, hi);
+  }
+
+  // The minimum of a convex f on [lo, hi] from its non-decreasing derivative: an end where f'
+  // does not change sign, else the root of f' by the Illinois variant of regula falsi
+  // (superlinear where f' is smooth), with bisection where the secant leaves the bracket.
+  template <class F, class Slope>
+  static Lowest convex_root(F&& f, Slope&& slope, double lo, double hi) {
+    double slope_lo = slope(lo), slope_hi = slope(hi);
+    if (slope_lo >= 0) return {f(lo), lo};
+    if (slope_hi <= 0) return {f(hi), hi};
+    int kept = 0;  // which end survived the last step: −1 low, +1 high
+    for (int iteration = 0; iteration < 100 && hi - lo > 1e-13; ++iteration) {
+      double t = (lo * slope_hi - hi * slope_lo) / (slope_hi - slope_lo);
+      if (!(t > lo && t < hi)) t = 0.5 * (lo + hi);
+      double g = slope(t);
+      if (g > 0) {
+        hi = t, slope_hi = g;
+        if (kept == -1) slope_lo *= 0.5;
+        kept = -1;
+      } else if (g < 0) {
+        lo = t, slope_lo = g;
+        if (kept == 1) slope_hi *= 0.5;
+        kept = 1;
+      } else {
+        lo = hi = t;
+      }
     }
     double f_lo = f(lo), f_hi = f(hi);
     return f_lo <= f_hi ? Lowest{f_lo, lo} : Lowest{f_hi, hi};
