@@ -4,15 +4,18 @@
 // The tree is built on the grid itself: the root covers all cells; a node is halved alternately
 // along x and y (along the other axis once one side is down to 4 cells) until it has at most
 // 4 × 4 cells. A node stores only the lowest and highest top height over its points; its x-y
-// extent follows from the split rule, so a node costs 12 bytes.
+// extent follows from the split rule. It also stores the plane through three of its corners and
+// a bound on how far the top strays from that plane (bottom-up: a child's bound plus the largest
+// gap between the two planes at the child's corners), 28 bytes in all.
 //
 // Query. Instead of collecting triangle hits and pairing them (which can lose or double a hit
 // where a ray grazes a shared edge or vertex), the ray's solid part is found as a 1-D sign
 // analysis: inside the grid's rectangle and above the bottom, the ray is in the solid where
 // g(t) = z(t) − H(x(t), y(t)) ≤ 0, H the piecewise-linear top. The traversal cuts the ray's
 // parameter range at the same split lines as the tree (each cut computed once, by the parent),
-// so the pieces tile the range exactly; a node whose height range lies wholly above or below
-// the ray's z over its piece is settled without descending (the paper's pruning), and a leaf
+// so the pieces tile the range exactly; a node whose height range (or plane band) lies wholly
+// above or below the ray over its piece is settled without descending (the paper's pruning,
+// tightened for flat regions), and a leaf
 // walks its cells, cutting at grid lines and cell diagonals, where g is linear. The result is a
 // sorted list of disjoint intervals — boundary crossings come out paired by construction.
 #pragma once
@@ -48,6 +51,9 @@ class GridTree {
   struct Node {
     float lo, hi;        // lowest and highest top height over the node's points
     std::uint32_t left;  // first child (the second is left + 1); 0 for a leaf
+    // A plane through the node's corners (i0, j0), (i1, j0), (i0, j1):
+    // P(x, y) = c + a·(x − x(i0)) + b·(y − y(j0)), and a bound on |H − P| over the node.
+    float a, b, c, deviation;
   };
 
   explicit GridTree(const ZMap& map) : map_(&map) {
@@ -61,6 +67,31 @@ class GridTree {
   }
 
   const ZMap& map() const { return *map_; }
+
+  // The cells [i0, i1) × [j0, j1) of each node, by node index (for inspection and tests).
+  struct NodeCells {
+    int i0, j0, i1, j1;
+  };
+  std::vector<NodeCells> node_cells() const {
+    std::vector<NodeCells> cells(nodes_.size());
+    std::vector<std::pair<std::uint32_t, Range>> stack{{0, Range{0, 0, map_->grid.nx - 1, map_->grid.ny - 1, 0}}};
+    while (!stack.empty()) {
+      auto [index, r] = stack.back();
+      stack.pop_back();
+      cells[index] = {r.i0, r.j0, r.i1, r.j1};
+      if (nodes_[index].left == 0) continue;
+      int at;
+      int axis = r.split(at);
+      stack.push_back({nodes_[index].left, r.child(axis, at, false)});
+      stack.push_back({nodes_[index].left + 1, r.child(axis, at, true)});
+    }
+    return cells;
+  }
+
+  // Node `index`'s plane P at frame-local (x, y); `c` its cells from node_cells().
+  double plane_at(std::uint32_t index, const NodeCells& c, double x, double y) const {
+    return plane_at(nodes_[index], Range{c.i0, c.j0, c.i1, c.j1, 0}, x, y);
+  }
   const std::vector<Node>& nodes() const { return nodes_; }
   double bottom() const { return bottom_; }
 
@@ -120,24 +151,70 @@ class GridTree {
     }
   };
 
+  double top(int i, int j) const { return detail::zmap_top(*map_, map_->grid.index(i, j)); }
+
+  // The corner plane of range r, with coefficients rounded to float as stored.
+  void set_plane(Node& node, const Range& r) const {
+    const ZMapGrid& g = map_->grid;
+    double h00 = top(r.i0, r.j0);
+    node.c = static_cast<float>(h00);
+    node.a = static_cast<float>((top(r.i1, r.j0) - h00) / (g.x(r.i1) - g.x(r.i0)));
+    node.b = static_cast<float>((top(r.i0, r.j1) - h00) / (g.y(r.j1) - g.y(r.j0)));
+  }
+
+  double plane_at(const Node& node, const Range& r, double x, double y) const {
+    const ZMapGrid& g = map_->grid;
+    return double(node.c) + double(node.a) * (x - g.x(r.i0)) + double(node.b) * (y - g.y(r.j0));
+  }
+
+  // A float at least as large as `bound`, with headroom for the double rounding of the tests.
+  static float round_up(double bound) {
+    auto f = static_cast<float>(bound * (1 + 1e-6) + 1e-9);
+    return std::nextafter(f, std::numeric_limits<float>::infinity());
+  }
+
   void build(std::uint32_t index, const Range& r) {
+    const ZMapGrid& g = map_->grid;
     if (r.leaf()) {
+      Node node{};
+      set_plane(node, r);
       float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+      double deviation = 0;
       for (int j = r.j0; j <= r.j1; ++j)
         for (int i = r.i0; i <= r.i1; ++i) {
-          float h = static_cast<float>(detail::zmap_top(*map_, map_->grid.index(i, j)));
-          lo = std::min(lo, h), hi = std::max(hi, h);
+          double h = top(i, j);
+          lo = std::min(lo, static_cast<float>(h)), hi = std::max(hi, static_cast<float>(h));
+          deviation = std::max(deviation, std::abs(h - plane_at(node, r, g.x(i), g.y(j))));
         }
-      nodes_[index] = {lo, hi, 0};
+      node.lo = lo, node.hi = hi, node.left = 0, node.deviation = round_up(deviation);
+      nodes_[index] = node;
       return;
     }
     int at;
     int axis = r.split(at);
     auto left = static_cast<std::uint32_t>(nodes_.size());
     nodes_.push_back({}), nodes_.push_back({});
-    build(left, r.child(axis, at, false));
-    build(left + 1, r.child(axis, at, true));
-    nodes_[index] = {std::min(nodes_[left].lo, nodes_[left + 1].lo), std::max(nodes_[left].hi, nodes_[left + 1].hi), left};
+    Range children[2] = {r.child(axis, at, false), r.child(axis, at, true)};
+    build(left, children[0]);
+    build(left + 1, children[1]);
+    Node node{};
+    set_plane(node, r);
+    node.lo = std::min(nodes_[left].lo, nodes_[left + 1].lo);
+    node.hi = std::max(nodes_[left].hi, nodes_[left + 1].hi);
+    node.left = left;
+    // |H − P| ≤ |H − P_child| + |P_child − P|, and the last, being linear, peaks at a corner.
+    double deviation = 0;
+    for (int k = 0; k < 2; ++k) {
+      const Node& child = nodes_[left + static_cast<std::uint32_t>(k)];
+      const Range& c = children[k];
+      double worst = 0;
+      for (double x : {g.x(c.i0), g.x(c.i1)})
+        for (double y : {g.y(c.j0), g.y(c.j1)})
+          worst = std::max(worst, std::abs(plane_at(child, c, x, y) - plane_at(node, r, x, y)));
+      deviation = std::max(deviation, double(child.deviation) + worst);
+    }
+    node.deviation = round_up(deviation);
+    nodes_[index] = node;
   }
 
   struct Walker {
@@ -161,6 +238,15 @@ class GridTree {
       double za = o.z + ta * d.z, zb = o.z + tb * d.z;
       if (std::min(za, zb) > node.hi) return;  // wholly above the top: outside
       if (std::max(za, zb) < node.lo) {         // wholly below the top: inside
+        emit(ta, tb);
+        return;
+      }
+      // Against the node's plane: a ray running close and parallel to a flat region (an uncut
+      // stock face seen at a tilt) is settled here instead of in every leaf along it.
+      double ga = za - tree.plane_at(node, r, o.x + ta * d.x, o.y + ta * d.y);
+      double gb = zb - tree.plane_at(node, r, o.x + tb * d.x, o.y + tb * d.y);
+      if (std::min(ga, gb) > node.deviation) return;
+      if (std::max(ga, gb) < -double(node.deviation)) {
         emit(ta, tb);
         return;
       }

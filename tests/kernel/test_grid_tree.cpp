@@ -48,6 +48,45 @@ TEST_CASE("grid tree: node bounds enclose their heights, leaves have at most 4 x
   CHECK(nodes.size() == 2 * leaves - 1);
 }
 
+TEST_CASE("grid tree: every node's height range and plane bound hold at all its points") {
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> angle(-60, 60);
+  for (int trial = 0; trial < 6; ++trial) {
+    Frame frame = Frame::from_rotation(rotation_z(angle(rng)) * rotation_x(angle(rng)));
+    ZMap map = trial % 2 ? random_map(rng, 41, 29, frame) : ZMap::from_box(frame, Aabb{Vec3(0), Vec3(7, 5, 3)}, 0.13);
+    GridTree tree(map);
+    const auto& nodes = tree.nodes();
+    std::vector<GridTree::NodeCells> cells = tree.node_cells();
+    for (std::uint32_t k = 0; k < nodes.size(); ++k) {
+      const GridTree::NodeCells& c = cells[k];
+      CHECK(c.i1 > c.i0);
+      CHECK(c.j1 > c.j0);
+      if (nodes[k].left == 0) {
+        CHECK(c.i1 - c.i0 <= 4);
+        CHECK(c.j1 - c.j0 <= 4);
+      } else {  // the children tile the node
+        const GridTree::NodeCells &a = cells[nodes[k].left], &b = cells[nodes[k].left + 1];
+        CHECK((a.i1 - a.i0) * (a.j1 - a.j0) + (b.i1 - b.i0) * (b.j1 - b.j0) == (c.i1 - c.i0) * (c.j1 - c.j0));
+      }
+      float lo = 1e30f, hi = -1e30f;
+      for (int j = c.j0; j <= c.j1; ++j)
+        for (int i = c.i0; i <= c.i1; ++i) {
+          double h = std::max(map.height(i, j), map.empty_height);
+          lo = std::min(lo, static_cast<float>(h)), hi = std::max(hi, static_cast<float>(h));
+          CHECK(std::abs(h - tree.plane_at(k, c, map.grid.x(i), map.grid.y(j))) <= nodes[k].deviation);
+        }
+      CHECK(nodes[k].lo == lo);
+      CHECK(nodes[k].hi == hi);
+    }
+    // An uncut tilted box is flat almost everywhere: most nodes' planes fit to float noise.
+    if (trial % 2 == 0) {
+      std::size_t flat = 0;
+      for (const auto& n : nodes) flat += n.deviation < 1e-4f;
+      CHECK(flat * 2 > nodes.size());
+    }
+  }
+}
+
 TEST_CASE("grid tree: hits equal brute-force hits on the polyhedron for random rays") {
   std::mt19937 rng(8);
   std::uniform_real_distribution<double> unit(0, 1), angle(-70, 70);
