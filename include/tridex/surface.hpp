@@ -116,6 +116,13 @@ struct SlabMesh {
   std::vector<std::pair<std::uint64_t, std::uint32_t>> bottom, top;
 };
 
+// Feature points are accepted only when they lie within this many spacings of every crossing's
+// tangent plane, and of the box around the cell's crossings (measured on a randomly rotated box
+// and on machined stock: looser bounds let blurred normals put apexes up to half a spacing off
+// the surface; tighter ones only lose oblique features, which then stay as plain chamfers).
+constexpr double kFeatureResidual = 0.1;
+constexpr double kFeatureOvershoot = 0.05;
+
 class Extractor {
  public:
   Extractor(const TripleDexel& d, const SurfaceOptions& options)
@@ -485,7 +492,9 @@ class Extractor {
       glm::vec3 normal = st.out.normals[id[q]];
       if (normal != glm::vec3(0.0f)) n[count++] = Vec3(normal);
     }
-    if (count < 2) return false;
+    // A crossing without a normal (no neighbouring ray ends near it: a thin ridge or spike)
+    // leaves the point free along some direction; no feature then.
+    if (count < p.size()) return false;
     double min_dot = 1;
     for (std::size_t a = 0; a < count; ++a)
       for (std::size_t b = a + 1; b < count; ++b) min_dot = std::min(min_dot, glm::dot(n[a], n[b]));
@@ -507,10 +516,20 @@ class Extractor {
     for (int e = 0; e < 3; ++e)
       if (values[e] > 0.02 * largest) x += vectors[e] * (glm::dot(vectors[e], atb) / values[e]);
     out = centroid + x;
-    Vec3 lo(coord(0, i), coord(1, j), coord(2, st.k)), hi(coord(0, i + 1), coord(1, j + 1), coord(2, st.k + 1));
-    double tol = 1e-9 * h_;
-    return out.x >= lo.x - tol && out.y >= lo.y - tol && out.z >= lo.z - tol && out.x <= hi.x + tol &&
-           out.y <= hi.y + tol && out.z <= hi.z + tol;
+    // Normals that do not agree with their points (noisy, or blurred across an edge) leave the
+    // point off some tangent planes: no feature then, rather than an apex standing off the surface.
+    for (std::size_t q = 0, c = 0; q < p.size(); ++q) {
+      if (st.out.normals[id[q]] == glm::vec3(0.0f)) continue;
+      if (std::abs(glm::dot(n[c++], out - p[q])) > kFeatureResidual * h_) return false;
+    }
+    // Three crossings always meet in a point, right or wrong, so the residual cannot catch normals
+    // blurred across a neighbouring edge. The apex may stand out of the box of its loop by a
+    // little (a ridge between rays), not by much; and it stays in its cell.
+    Aabb loop;
+    for (const Vec3& q : p) loop.extend(q);
+    loop = loop.inflated(kFeatureOvershoot * h_);
+    Aabb cell{Vec3(coord(0, i), coord(1, j), coord(2, st.k)), Vec3(coord(0, i + 1), coord(1, j + 1), coord(2, st.k + 1))};
+    return loop.contains(out) && cell.inflated(1e-9 * h_).contains(out);
   }
 
   void emit_cell(SlabState& st, int i, int j, unsigned mask) const {
