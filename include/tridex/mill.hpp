@@ -502,11 +502,14 @@ class Miller {
     }
     if (candidates.empty()) return;
 
-    // The lowest-bound move first: it usually cuts the tile close to its final shape, and its
-    // supporting plane then follows the tile's surface.
-    std::iter_swap(candidates.begin(),
-                   std::min_element(candidates.begin(), candidates.end(),
-                                    [](const Candidate& a, const Candidate& b) { return a.bound < b.bound; }));
+    // First the move whose surface is lowest at the tile's centre (the lowest bound if none has
+    // a plane): it usually cuts the tile close to its final shape, and its supporting plane then
+    // follows the tile's surface.
+    auto first_key = [](const Candidate& c) { return c.has_plane ? c.centre_z : kInf; };
+    auto first = std::min_element(candidates.begin(), candidates.end(), [&](const Candidate& a, const Candidate& b) {
+      return first_key(a) < first_key(b) || (first_key(a) == first_key(b) && a.bound < b.bound);
+    });
+    std::iter_swap(candidates.begin(), first);
     // min(S − P) over the tile (or over a row, with half_height = 0 and dy its offset).
     auto above_plane = [&](const Candidate& c, double dy, double half_height) {
       if (!c.has_plane)
