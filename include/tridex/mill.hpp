@@ -307,35 +307,6 @@ struct MoveGeometry {
   }
 };
 
-inline double distance_to_rect(double px, double py, double x0, double y0, double x1, double y1) {
-  double dx = std::max({x0 - px, 0.0, px - x1}), dy = std::max({y0 - py, 0.0, py - y1});
-  return std::sqrt(dx * dx + dy * dy);
-}
-
-// Distance between the horizontal projection of a move and a rectangle.
-inline double distance_move_rect(const MoveGeometry& m, double x0, double y0, double x1,
-                                 double y1) {
-  double bx = m.ax + m.vx, by = m.ay + m.vy;
-  // Does the segment cross the rectangle? Clip it (Liang–Barsky).
-  double t0 = 0, t1 = 1;
-  auto clip = [&](double p, double q) {
-    if (p == 0) return q >= 0;
-    double r = q / p;
-    if (p < 0) t0 = std::max(t0, r);
-    else t1 = std::min(t1, r);
-    return t0 <= t1;
-  };
-  if (clip(-m.vx, m.ax - x0) && clip(m.vx, x1 - m.ax) && clip(-m.vy, m.ay - y0) &&
-      clip(m.vy, y1 - m.ay))
-    return 0;
-  double best = std::min(distance_to_rect(m.ax, m.ay, x0, y0, x1, y1),
-                         distance_to_rect(bx, by, x0, y0, x1, y1));
-  Vec2 a(m.ax, m.ay), b(bx, by);
-  for (Vec2 corner : {Vec2(x0, y0), Vec2(x1, y0), Vec2(x0, y1), Vec2(x1, y1)})
-    best = std::min(best, std::sqrt(distance2_point_segment(corner, a, b)));
-  return best;
-}
-
 // The milling of one Z-map: moves are binned to work blocks; each block is milled by one thread,
 // tile by tile, each tile with every move that reaches it (see `mill_tile_with_candidates`).
 class Miller {
@@ -470,7 +441,7 @@ class Miller {
   void mill_tile_with_candidates(const IndexBox& tile, BlockScratch& scratch) {
     const double x_lo = g_.x(tile.i0), x_hi = g_.x(tile.i1), y_lo = g_.y(tile.j0), y_hi = g_.y(tile.j1);
     const double xc = 0.5 * (x_lo + x_hi), yc = 0.5 * (y_lo + y_hi);
-    const double hx = 0.5 * (x_hi - x_lo), hy = 0.5 * (y_hi - y_lo);
+    const double hx = 0.5 * (x_hi - x_lo), hy = 0.5 * (y_hi - y_lo), half_diagonal = std::hypot(hx, hy);
     TilePlane plane;
     TileState state;
     for (int j = tile.j0; j <= tile.j1; ++j) {
@@ -494,7 +465,10 @@ class Miller {
         c.has_plane = true;
         c.bound = centre.z - std::abs(c.gradient.x) * hx - std::abs(c.gradient.y) * hy;
       } else {
-        double distance = distance_move_rect(m, x_lo, y_lo, x_hi, y_hi);
+        // No plane: bound h by the move's distance from the tile's centre less its half-diagonal.
+        double distance = std::max(0.0, std::sqrt(distance2_point_segment(
+                                            Vec2(xc, yc), Vec2(m.ax, m.ay), Vec2(m.ax + m.vx, m.ay + m.vy))) -
+                                            half_diagonal);
         if (distance > m.radius) continue;
         c.bound = m.lowest_tip() + m.cutter->lower_height(distance);
       }
