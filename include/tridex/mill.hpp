@@ -282,8 +282,9 @@ struct MoveGeometry {
   // (superlinear where f' is smooth), with bisection where the secant leaves the bracket.
   template <class F, class Slope>
   static Lowest convex_root(F&& f, Slope&& slope, double lo, double hi) {
-    double slope_lo = slope(lo), slope_hi = slope(hi);
+    double slope_lo = slope(lo);
     if (slope_lo >= 0) return {f(lo), lo};
+    double slope_hi = slope(hi);
     if (slope_hi <= 0) return {f(hi), hi};
     int kept = 0;  // which end survived the last step: −1 low, +1 high
     for (int iteration = 0; iteration < 100 && hi - lo > 1e-13; ++iteration) {
