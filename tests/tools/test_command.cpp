@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <random>
 
 #include <nlohmann/json.hpp>
@@ -137,7 +138,10 @@ struct Reference {
     }
     return false;
   }
-  bool kept(const Vec3& p) const { return box.contains(p) && !removed(p); }
+  // The stock: the box itself unless a test gives another solid inside it.
+  std::function<bool(const Vec3&)> solid;
+  bool in_stock(const Vec3& p) const { return box.contains(p) && (!solid || solid(p)); }
+  bool kept(const Vec3& p) const { return in_stock(p) && !removed(p); }
 };
 
 // Point membership in a closed mesh by the parity of crossings of a ray along +z, with the
@@ -229,20 +233,34 @@ void check_against_reference(const Simulated& s, const Reference& ref, std::uint
   auto at = [&](int i, int j, int k) -> char& { return kept[static_cast<std::size_t>(i + n.x * (j + n.y * k))]; };
   for (int k = 0; k < n.z; ++k)
     for (int j = 0; j < n.y; ++j)
-      for (int i = 0; i < n.x; ++i) at(i, j, k) = !ref.removed(box.min + jitter + g * Vec3(i, j, k));
-  std::size_t kept_count = 0, differing = 0;
+      for (int i = 0; i < n.x; ++i) at(i, j, k) = ref.kept(box.min + jitter + g * Vec3(i, j, k));
+  std::vector<char> in_stock(kept.size());
+  auto stock_at = [&](int i, int j, int k) -> char& { return in_stock[static_cast<std::size_t>(i + n.x * (j + n.y * k))]; };
+  for (int k = 0; k < n.z; ++k)
+    for (int j = 0; j < n.y; ++j)
+      for (int i = 0; i < n.x; ++i) stock_at(i, j, k) = ref.in_stock(box.min + jitter + g * Vec3(i, j, k));
+  // Pairs of neighbouring samples that differ: on any surface of the result, and on the surfaces
+  // the program cut (both samples in the stock).
+  std::size_t kept_count = 0, stock_count = 0, differing = 0, differing_cut = 0;
+  auto pair = [&](int i, int j, int k, int i2, int j2, int k2) {
+    if (at(i, j, k) == at(i2, j2, k2)) return;
+    ++differing;
+    if (stock_at(i, j, k) && stock_at(i2, j2, k2)) ++differing_cut;
+  };
   for (int k = 0; k < n.z; ++k)
     for (int j = 0; j < n.y; ++j)
       for (int i = 0; i < n.x; ++i) {
         kept_count += at(i, j, k) ? 1 : 0;
-        if (i + 1 < n.x && at(i, j, k) != at(i + 1, j, k)) ++differing;
-        if (j + 1 < n.y && at(i, j, k) != at(i, j + 1, k)) ++differing;
-        if (k + 1 < n.z && at(i, j, k) != at(i, j, k + 1)) ++differing;
+        stock_count += stock_at(i, j, k) ? 1 : 0;
+        if (i + 1 < n.x) pair(i, j, k, i + 1, j, k);
+        if (j + 1 < n.y) pair(i, j, k, i, j + 1, k);
+        if (k + 1 < n.z) pair(i, j, k, i, j, k + 1);
       }
   Vec3 size = box.size();
   double stock_volume = size.x * size.y * size.z;
   // Samples cover n·g along each side; scale the kept fraction to the whole box.
   double reference_volume = stock_volume * static_cast<double>(kept_count) / static_cast<double>(kept.size());
+  double reference_stock = stock_volume * static_cast<double>(stock_count) / static_cast<double>(kept.size());
   // The surface lies within h of the true one (exact dexel crossings), so the volume is within
   // h/2 · area on average; the sampled reference adds about g³·√(samples on the surface)/2.
   double cut_area = static_cast<double>(differing) * g * g;
@@ -251,7 +269,10 @@ void check_against_reference(const Simulated& s, const Reference& ref, std::uint
   INFO("reference volume " << reference_volume << ", result " << volume << ", tolerance " << tolerance
                            << " (cut area about " << cut_area << " mm^2, h " << h << ")");
   CHECK(std::abs(volume - reference_volume) <= tolerance);
-  CHECK(stock_volume - reference_volume > 3 * tolerance);  // the test cuts something real
+  // The program cuts something well above what the cut surfaces alone would let pass.
+  double cut_tolerance = 0.5 * h * static_cast<double>(differing_cut) * g * g +
+                         2 * g * g * g * std::sqrt(static_cast<double>(differing_cut));
+  CHECK(reference_stock - reference_volume > 3 * cut_tolerance);
 
   // Point membership wherever the reference classification does not change within h.
   MeshInside inside(s.mesh, 1.0);
@@ -592,6 +613,77 @@ TEST_CASE("simulate: all five directions together, and the report's schema") {
   cli::ToolTable table = cli::ToolTable::read(tools);
   Reference ref(gcode::read_moves(program.string()), table, Aabb{Vec3(0, 0, 0), Vec3(40, 30, 20)});
   check_against_reference(s, ref, 7);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("simulate: an STL stock (a hexagonal prism) and the automatic stock") {
+  fs::path dir = scratch("stl-stock");
+  fs::path tools = dir / "tools.json", program = dir / "two.nc", prism = dir / "prism.stl";
+  write_text(tools, kTools);
+  write_text(program, program_of({&kDirections[0], &kDirections[4]}));
+  // A hexagonal prism around the box's centre axis (x, y within 15 mm of (20, 15)), z 0..20,
+  // as ASCII STL, outward facing.
+  const Vec3 centre(20, 15, 0);
+  const double radius = 15;
+  std::vector<Vec3> ring;
+  for (int k = 0; k < 6; ++k) {
+    double a = M_PI / 3 * k;
+    ring.push_back(centre + Vec3(radius * std::cos(a), radius * std::sin(a), 0));
+  }
+  std::ostringstream stl;
+  stl.precision(17);
+  auto facet = [&](Vec3 a, Vec3 b, Vec3 c) {
+    stl << "facet normal 0 0 0\n outer loop\n";
+    for (const Vec3& p : {a, b, c}) stl << "  vertex " << p.x << ' ' << p.y << ' ' << p.z << '\n';
+    stl << " endloop\nendfacet\n";
+  };
+  stl << "solid prism\n";
+  const Vec3 up(0, 0, 20);
+  for (int k = 0; k < 6; ++k) {
+    Vec3 a = ring[static_cast<std::size_t>(k)], b = ring[static_cast<std::size_t>((k + 1) % 6)];
+    facet(a, b, b + up);
+    facet(a, b + up, a + up);
+    facet(centre, b, a);
+    facet(centre + up, a + up, b + up);
+  }
+  stl << "endsolid prism\n";
+  write_text(prism, stl.str());
+  Simulated s = simulate(dir, program, tools, prism.string(), 128, 0.08);
+  cli::ToolTable table = cli::ToolTable::read(tools);
+  Reference ref(gcode::read_moves(program.string()), table, Aabb{Vec3(5, 15 - radius * std::sqrt(3) / 2, 0), Vec3(35, 15 + radius * std::sqrt(3) / 2, 20)});
+  ref.solid = [&](const Vec3& p) {
+    Vec2 q(p.x - centre.x, p.y - centre.y);
+    // Inside all six half-planes of the hexagon's sides (apothem r·√3/2).
+    for (int k = 0; k < 6; ++k) {
+      double a = M_PI / 3 * k + M_PI / 6;
+      if (q.x * std::cos(a) + q.y * std::sin(a) > radius * std::sqrt(3) / 2) return false;
+    }
+    return true;
+  };
+  check_against_reference(s, ref, 23);
+  double prism_volume = 1.5 * std::sqrt(3) * radius * radius * 20;
+  CHECK(s.report["result"]["removed_mm3"].get<double>() + s.report["result"]["volume_mm3"].get<double>() ==
+        doctest::Approx(prism_volume).epsilon(1e-6));
+  CHECK(s.report["stock"]["kind"] == "stl");
+
+  // auto:1: the box around the tool tips of the cutting moves (approaches from far excluded),
+  // one millimetre larger on every side.
+  fs::path report = dir / "auto.json";
+  CommandResult r = run_tridex({"simulate", program.string(), "--tools", tools.string(), "--stock", "auto:1",
+                                "--dexel-res", "48", "--report", report.string(), "--quiet"},
+                               dir);
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  Aabb cuts;
+  for (const gcode::Move& m : gcode::read_moves(program.string()))
+    if (m.kind != gcode::MoveKind::rapid) {
+      if (glm::length(m.start) < 1000) cuts.extend(m.start);
+      cuts.extend(m.end);
+    }
+  json stock = json::parse(slurp(report))["stock"];
+  CHECK(stock["kind"] == "auto");
+  CHECK(glm::length(vec(stock["min"]) - (cuts.min - Vec3(1))) < 1e-9);
+  CHECK(glm::length(vec(stock["max"]) - (cuts.max + Vec3(1))) < 1e-9);
   fs::remove_all(dir);
 }
 
