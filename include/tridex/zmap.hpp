@@ -67,6 +67,14 @@ class ZMap {
   static ZMap from_mesh(const Frame& frame, const Mesh& stock, double cell,
                         ZMapLimits limits = {});
 
+  // A Z-map for the intersection W0 ∩ M1 ∩ … ∩ MN (Step 3): it covers the projection of the
+  // stock's bounds `stock` (world) with a margin and starts ABOVE the whole stock. The stock's
+  // shape is carried exactly by W0, so M_i needs only the cuts: an M_i built from the stock's
+  // own top (from_box) would be a linear interpolation of that top, which lies below the real
+  // one in every cell that straddles a ridge or the silhouette of a tilted stock, and shaves W0
+  // there even where nothing is cut. The continuum result is the same: W0 ⊆ {z ≤ top}.
+  static ZMap over_stock(const Frame& frame, const Aabb& stock, double cell, ZMapLimits limits = {});
+
   static void validate(const ZMapGrid& g, ZMapLimits limits) {
     detail::require_positive(g.cell, "Z-map cell size");
     detail::require_finite(g.x0, "Z-map origin x");
@@ -143,6 +151,15 @@ inline ZMap ZMap::from_box(const Frame& frame, const Aabb& stock, double cell, Z
         map.heights[g.index(i, j)] = static_cast<float>(s1);
     }
   return map;
+}
+
+inline ZMap ZMap::over_stock(const Frame& frame, const Aabb& stock, double cell, ZMapLimits limits) {
+  detail::require_positive(cell, "Z-map cell size");
+  const double margin = detail::empty_margin(cell);
+  Aabb local = local_bounds(frame, stock);
+  ZMapGrid g = ZMapGrid::covering(frame, local.inflated(margin), cell);
+  return ZMap(g, static_cast<float>(local.max.z + margin), static_cast<float>(local.min.z - margin),
+              limits);
 }
 
 inline ZMap ZMap::from_mesh(const Frame& frame, const Mesh& stock, double cell,

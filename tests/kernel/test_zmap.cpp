@@ -2,6 +2,7 @@
 
 #include <random>
 
+#include "tridex/machine.hpp"
 #include "tridex/zmap.hpp"
 
 using namespace tridex;
@@ -124,4 +125,24 @@ TEST_CASE("bad Z-map parameters are rejected") {
   g.nx = 0, g.ny = 5;
   CHECK_THROWS_WITH_AS(ZMap(g, 0, -1), doctest::Contains("empty"), Error);
   CHECK_THROWS_AS(ZMap::from_mesh(Frame{}, Mesh{}, 0.1), Error);
+}
+
+TEST_CASE("a Z-map over the stock starts above it, so an uncut direction keeps the whole stock") {
+  const Aabb stock{Vec3(0, 0, 0), Vec3(10, 8, 5)};
+  const DexelLattice lattice = DexelLattice::covering_resolution(stock, 40);
+  const double stock_volume = volume(TripleDexel::box(lattice, stock));
+  for (Vec3 axis : {Vec3(0, 0, 1), Vec3(1, 0, 0.364), Vec3(-1, 0.2, 0.3), Vec3(0.3, -1, 0.1)}) {
+    Frame f = Frame::from_axis(axis);
+    ZMap over = ZMap::over_stock(f, stock, 0.2);
+    Aabb local = local_bounds(f, stock);
+    CHECK(*std::min_element(over.heights.begin(), over.heights.end()) > local.max.z);
+    CHECK(over.empty_height < local.min.z);
+    std::vector<ZMap> maps{over};
+    CHECK(volume(machine(stock, lattice, maps)) == doctest::Approx(stock_volume).epsilon(1e-9));
+    // The stock's own top, interpolated cell by cell, shaves a tilted stock where nothing is cut.
+    if (axis.z != 1) {
+      std::vector<ZMap> tops{ZMap::from_box(f, stock, 0.2)};
+      CHECK(volume(machine(stock, lattice, tops)) < stock_volume * (1 - 1e-4));
+    }
+  }
 }
