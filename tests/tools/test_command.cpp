@@ -709,3 +709,39 @@ TEST_CASE("simulate: the bundled example, from its CAMotics project, matches the
   check_against_reference(s, ref, 11);
   fs::remove_all(dir);
 }
+
+TEST_CASE("progress goes to stderr only when asked (stderr is not a terminal here), and projects with several files") {
+  fs::path dir = scratch("progress");
+  fs::path tools = dir / "tools.json", first = dir / "first.nc", second = dir / "second.nc", project = dir / "job.camotics";
+  write_text(tools, kTools);
+  write_text(first, program_of({&kDirections[0]}));
+  write_text(second, program_of({&kDirections[3]}));
+  write_text(project, R"({"files": ["first.nc", "second.nc"], "tools": )" + kTools +
+                          R"(, "workpiece": {"automatic": false, "bounds": {"min": [0, 0, 0], "max": [40, 30, 20]}}})");
+  std::vector<std::string> args{"simulate", project.string(), "--dexel-res", "40", "--zmap-cell", "0.2"};
+  CommandResult plain = run_tridex(args, dir);
+  REQUIRE(plain.status == 0);
+  CHECK(plain.out.find("job.camotics: ") == 0);
+  CHECK(plain.err.find("milling direction") == std::string::npos);
+  args.push_back("--progress");
+  CommandResult progress = run_tridex(args, dir);
+  REQUIRE(progress.status == 0);
+  CHECK(progress.err.find("milling direction 2/2") != std::string::npos);
+  CHECK(progress.err.find("extracting the surface") != std::string::npos);
+  CHECK(progress.out == plain.out.substr(0, plain.out.rfind(';')) + progress.out.substr(progress.out.rfind(';')));
+
+  // `moves` on the project: both files, in order, each record naming its file.
+  CommandResult moves = run_tridex({"moves", project.string()}, dir);
+  REQUIRE(moves.status == 0);
+  std::istringstream lines(moves.out);
+  std::string line, last_file;
+  std::vector<std::string> files;
+  while (std::getline(lines, line)) {
+    std::string file = json::parse(line)["file"].get<std::string>();
+    if (file != last_file) files.push_back(file), last_file = file;
+  }
+  REQUIRE(files.size() == 2);
+  CHECK(fs::path(files[0]).filename() == "first.nc");
+  CHECK(fs::path(files[1]).filename() == "second.nc");
+  fs::remove_all(dir);
+}
