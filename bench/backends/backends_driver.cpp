@@ -55,6 +55,7 @@ struct Options {
   unsigned threads = 0;
   double gl_tolerance = 0;  // 0: a quarter of the Z-map cell
   bool fused = true;
+  std::string maps;  // cache of the cpu backend's milled maps: saved after Step 1, loaded if present
   std::vector<std::pair<be::ZMapBackend, be::DexelBackend>> configs;
 };
 
@@ -79,7 +80,7 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 [[noreturn]] void usage(const char* message) {
   std::fprintf(stderr,
                "%s\nusage: bench_backends_driver [--segments N | --program FILE] [--write FILE] [--zmap N] [--dexel N]\n"
-               "       [--runs R] [--threads T] [--gl-tolerance E] [--no-fused] [--configs cpu+scan,cpu+tree,...]\n",
+               "       [--runs R] [--threads T] [--gl-tolerance E] [--no-fused] [--maps DIR] [--configs cpu+scan,cpu+tree,...]\n",
                message);
   std::exit(2);
 }
@@ -102,6 +103,7 @@ Options parse(int argc, char** argv) {
     else if (a == "--threads") o.threads = static_cast<unsigned>(std::stoul(value()));
     else if (a == "--gl-tolerance") o.gl_tolerance = std::stod(value());
     else if (a == "--no-fused") o.fused = false;
+    else if (a == "--maps") o.maps = value();
     else if (a == "--configs") configs = value();
     else usage(("unknown option " + a).c_str());
   }
@@ -124,6 +126,36 @@ TripleDexel dexelize_with(be::DexelBackend backend, const ZMap& map, const Dexel
     case be::DexelBackend::scan: return scan_dexelize(map, lattice, threads);
   }
   throw std::logic_error("invalid dexel backend");
+}
+
+// The milled maps as raw files (grid, then heights), so that Steps 2-3 can be rerun at full size
+// without Step 1.
+std::string map_path(const std::string& dir, std::size_t k) { return dir + "/map_" + std::to_string(k) + ".bin"; }
+
+void save_maps(const std::string& dir, const std::vector<ZMap>& maps) {
+  for (std::size_t k = 0; k < maps.size(); ++k) {
+    std::ofstream out(map_path(dir, k), std::ios::binary);
+    const ZMap& m = maps[k];
+    out.write(reinterpret_cast<const char*>(&m.grid), sizeof m.grid);
+    out.write(reinterpret_cast<const char*>(&m.empty_height), sizeof m.empty_height);
+    out.write(reinterpret_cast<const char*>(m.heights.data()), static_cast<std::streamsize>(m.heights.size() * sizeof(float)));
+    if (!out) throw std::runtime_error("cannot write " + map_path(dir, k));
+  }
+}
+
+bool load_maps(const std::string& dir, std::size_t count, std::vector<ZMap>& maps) {
+  for (std::size_t k = 0; k < count; ++k) {
+    std::ifstream in(map_path(dir, k), std::ios::binary);
+    if (!in) return false;
+    ZMap m;
+    in.read(reinterpret_cast<char*>(&m.grid), sizeof m.grid);
+    in.read(reinterpret_cast<char*>(&m.empty_height), sizeof m.empty_height);
+    m.heights.resize(m.grid.size());
+    in.read(reinterpret_cast<char*>(m.heights.data()), static_cast<std::streamsize>(m.heights.size() * sizeof(float)));
+    if (!in) return false;
+    maps.push_back(std::move(m));
+  }
+  return true;
 }
 
 // Step 1 with one Z-map backend: one milled map per direction.
@@ -219,8 +251,13 @@ std::vector<Result> run_zmap_backend(const Options& o, be::ZMapBackend zb, const
                                      const std::vector<Group>& groups, const std::vector<Cutter>& cutters) {
   return in_child(dbs.size(), [&] {
     auto t = std::chrono::steady_clock::now();
-    std::vector<ZMap> maps = mill_all(o, zb, groups, cutters);
-    double step1 = seconds_since(t);
+    std::vector<ZMap> maps;
+    double step1 = -1;  // loaded, not measured
+    if (o.maps.empty() || zb != be::ZMapBackend::cpu || !load_maps(o.maps, groups.size(), maps)) {
+      maps = mill_all(o, zb, groups, cutters);
+      step1 = seconds_since(t);
+      if (!o.maps.empty() && zb == be::ZMapBackend::cpu) save_maps(o.maps, maps);
+    }
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
     const double step1_peak = double(usage.ru_maxrss) / 1024.0;  // the gl context's buffers included
@@ -319,15 +356,18 @@ int main(int argc, char** argv) {
     double s1 = pick([](const Result& r) { return r.step1; }), s2 = pick([](const Result& r) { return r.step2; });
     double s3 = pick([](const Result& r) { return r.step3; }), fu = pick([](const Result& r) { return r.fused; });
     double su = pick([](const Result& r) { return r.surface; });
-    double total = pick([](const Result& r) { return r.step1 + r.step2 + r.step3 + r.surface; });
+    double total = pick([](const Result& r) { return std::max(0.0, r.step1) + r.step2 + r.step3 + r.surface; });
+    char step1_text[32] = "loaded";
+    if (s1 >= 0) std::snprintf(step1_text, sizeof step1_text, "%.2f", s1);
     char fused_text[32] = "-";
     if (o.fused) std::snprintf(fused_text, sizeof fused_text, "%.2f", fu);
-    std::printf("| %s+%s | %.2f | %.2f | %.3f | %s | %.2f | %.2f | %.0f | %.1f | %lld |\n", be::to_string(o.configs[c].first),
-                be::to_string(o.configs[c].second), s1, s2, s3, fused_text, su,
+    std::printf("| %s+%s | %s | %.2f | %.3f | %s | %.2f | %.2f | %.0f | %.1f | %lld |\n", be::to_string(o.configs[c].first),
+                be::to_string(o.configs[c].second), step1_text, s2, s3, fused_text, su,
                 total, pick([](const Result& r) { return r.peak_mib; }), results[c][0].volume, results[c][0].triangles);
     if (o.fused && std::abs(results[c][0].fused_volume - results[c][0].volume) > 1e-6 * results[c][0].volume)
       std::printf("  (!) fused volume %.3f differs from the split one\n", results[c][0].fused_volume);
   }
-  std::printf("\ntotal = Step 1 + Step 2 + Step 3 + surface (the paper's split); medians of %d run(s)\n", o.runs);
+  std::printf("\ntotal = Step 1 + Step 2 + Step 3 + surface (the paper's split; Step 1 left out where the maps were\n"
+              "loaded from --maps); medians of %d run(s)\n", o.runs);
   return 0;
 }
