@@ -171,14 +171,42 @@ struct MoveGeometry {
       double reach = std::max(0.0, std::sqrt(e2 + s * s * vv) - flat);
       return az + t * w + corner - std::sqrt(std::max(0.0, corner * corner - reach * reach));
     };
-    auto slope = [&](double t) {
+    // f' and f'' on the corner: with ρ = d − R0, h' = ρ/√(r² − ρ²), h'' = r²/(r² − ρ²)^(3/2),
+    // d' = s·|v|²/d and d'' = |v|²·e²/d³.
+    auto slopes = [&](double t, double& curvature) {
       double s = t - t_foot;
       double d = std::sqrt(e2 + s * s * vv), reach = d - flat;
+      curvature = 0;
       if (reach <= 0 || d == 0) return w;
-      double root = std::sqrt(std::max(0.0, corner * corner - reach * reach));
-      return root > 0 ? w + reach / root * (s * vv / d) : (s > 0 ? kInf : -kInf);
+      double root2 = corner * corner - reach * reach;
+      if (root2 <= 0) return s > 0 ? kInf : -kInf;
+      double root = std::sqrt(root2), dd = s * vv / d;
+      curvature = corner * corner / (root2 * root) * dd * dd + reach / root * vv * e2 / (d * d * d);
+      return w + reach / root * dd;
     };
-    return convex_root(height, slope, lo, hi);
+    auto slope = [&](double t) {
+      double curvature;
+      return slopes(t, curvature);
+    };
+    double slope_lo = slope(lo);
+    if (slope_lo >= 0) return {height(lo), lo};
+    double slope_hi = slope(hi);
+    if (slope_hi <= 0) return {height(hi), hi};
+    // Newton's method on f', kept inside the bracket (bisection where a step would leave it).
+    double t = 0.5 * (lo + hi);
+    for (int iteration = 0; iteration < 60 && hi - lo > 1e-13; ++iteration) {
+      double curvature, g = slopes(t, curvature);
+      if (g == 0) break;
+      (g > 0 ? hi : lo) = t;
+      double next = curvature > 0 ? t - g / curvature : kInf;
+      if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+      if (std::abs(next - t) < 1e-14) {
+        t = next;
+        break;
+      }
+      t = next;
+    }
+    return {height(t), t};
   }
 
   // ball_lowest(...).z at the `count` points x_first + k·step, k = 0..count−1, of the row y,
