@@ -2,7 +2,7 @@
 //
 // Each linear move of the tool tip lowers every grid point to the lowest point of the swept
 // cutter above it. For a move C(t) = a + t·(b − a), t ∈ [0, 1], and a grid point q, that is
-//     min_t f(t),   f(t) = C_z(t) + h(|q − C_xy(t)|)
+//     S(q) = min_t f(t),   f(t) = C_z(t) + h(|q − C_xy(t)|)
 // with h the cutter's lower surface (cutter.hpp). f is convex in t (a convex function of an
 // affine map plus a linear term), so its minimum is exact:
 //   * flat end: f is linear where the disc covers q, so the minimum is at an end of that interval;
@@ -10,14 +10,19 @@
 //     v the move's horizontal vector, w its rise, t⊥ the foot of q on the move and k² = R² − e²
 //     (e the distance from q to the move's line), clamped to the covering interval (the lowest
 //     hit of a vertical line with a capsule);
-//   * other cutters: bisection on the sign of f'(t), to the precision of double.
+//   * bull nose: f' has one sign under the flat bottom, so the minimum lies on one side of it,
+//     where Newton's method (kept in a bracket) finds the root of f' on the corner torus;
+//   * other cutters: regula falsi (Illinois) on the non-decreasing f', to double precision.
 //
-// Speed comes from touching only what a move can still lower. The grid is cut into 16×16-point
-// tiles, each with the maximum height it holds; a move skips a tile when the lowest its cutter
-// can reach there (the move's lowest tip plus h at the tile's distance from the move) is not
-// below that maximum. Moves are binned to 128×128-point blocks, and the blocks are milled on all
-// threads. Every point ends at the minimum over moves of a value computed the same way whatever
-// the order, so the result is identical for any thread count and any move order.
+// Speed comes from touching only what a move can still lower (Miller below). S is convex too (the
+// lower surface of a convex swept solid), so its tangent plane at any point bounds it from below
+// everywhere. The grid is cut into 16×16-point tiles; each tile gathers the moves that reach it,
+// bounds each one's S over the tile by that tangent plane, cuts first with the move lowest at
+// its centre, and then skips every move (and every row) whose bound is not below what the tile
+// still holds, measured against the first move's plane so that sloped surfaces skip as well as
+// flat ones. Moves are binned to 128×128-point blocks, and the blocks are milled on all threads.
+// Every point ends at the minimum over moves of a value computed the same way whatever the order,
+// so the result is identical for any thread count and any move order.
 #pragma once
 
 #include <algorithm>
