@@ -624,3 +624,39 @@ inline void mill(ZMap& map, std::span<const Cutter> cutters, std::span<const Cut
 }
 
 }  // namespace tridex
+
+namespace tridex {
+
+// How deep one move would cut into what `map` holds now: the largest height − S(q) over the grid
+// points under its footprint (S the move's swept lower surface, zero or less when it cuts
+// nothing), and the grid point where that happens. For checks such as "does this rapid meet
+// stock?": call it before milling the move. Evaluates every point of the footprint (no skipping):
+// meant for the few moves that need checking, not for milling.
+struct CutDepth {
+  double depth = -std::numeric_limits<double>::infinity();  // mm along the frame's z
+  int i = -1, j = -1;                                        // where (−1 when off the grid)
+};
+
+inline CutDepth cut_depth(const ZMap& map, const Cutter& cutter, const Segment& tip) {
+  if (!is_finite(tip.a) || !is_finite(tip.b)) detail::fail("cut_depth: move is not finite");
+  const ZMapGrid& g = map.grid;
+  const double r = cutter.radius();
+  double i0 = std::ceil((std::min(tip.a.x, tip.b.x) - r - g.x0) / g.cell);
+  double i1 = std::floor((std::max(tip.a.x, tip.b.x) + r - g.x0) / g.cell);
+  double j0 = std::ceil((std::min(tip.a.y, tip.b.y) - r - g.y0) / g.cell);
+  double j1 = std::floor((std::max(tip.a.y, tip.b.y) + r - g.y0) / g.cell);
+  i0 = std::max(i0, 0.0), j0 = std::max(j0, 0.0);
+  i1 = std::min(i1, g.nx - 1.0), j1 = std::min(j1, g.ny - 1.0);
+  CutDepth deepest;
+  if (i0 > i1 || j0 > j1) return deepest;
+  detail::MoveGeometry m(cutter, tip);
+  for (int j = static_cast<int>(j0); j <= static_cast<int>(j1); ++j)
+    for (int i = static_cast<int>(i0); i <= static_cast<int>(i1); ++i) {
+      if (map.is_empty(i, j)) continue;
+      double depth = map.height(i, j) - m.lowest_above(g.x(i), g.y(j));
+      if (depth > deepest.depth) deepest = {depth, i, j};
+    }
+  return deepest;
+}
+
+}  // namespace tridex

@@ -207,3 +207,36 @@ TEST_CASE("tile skipping never skips a point a move lowers (dense raster, every 
     CHECK(mismatches == 0);
   }
 }
+
+TEST_CASE("cut_depth: how deep a move would cut, equal to what milling it removes") {
+  std::mt19937 rng(17);
+  int cutting = 0;
+  for (int trial = 0; trial < 24; ++trial) {
+    Cutter cutter = random_cutter(trial, rng).cutter;
+    ZMapGrid g;
+    g.cell = 0.1, g.nx = 120, g.ny = 100;
+    ZMap map(g, 3, -1);
+    std::vector<Cutter> cutters{cutter};
+    std::vector<Segment> segments = random_segments(rng, 2);
+    std::vector<CutMove> first{{segments[0], 0}};
+    mill(map, cutters, first);
+    CutDepth predicted = cut_depth(map, cutter, segments[1]);
+    ZMap after = map;
+    std::vector<CutMove> second{{segments[1], 0}};
+    mill(after, cutters, second);
+    double removed = 0;
+    for (std::size_t p = 0; p < map.heights.size(); ++p)
+      if (!map.is_empty(static_cast<int>(p % 120), static_cast<int>(p / 120)))
+        removed = std::max(removed, double(map.heights[p] - after.heights[p]));
+    CAPTURE(trial);
+    if (predicted.depth > 1e-4 && after.height(predicted.i, predicted.j) > after.empty_height) {
+      CHECK(removed == doctest::Approx(predicted.depth).epsilon(1e-4));
+      ++cutting;
+    } else {
+      CHECK(removed <= std::max(0.0, predicted.depth) + 1e-4);
+    }
+  }
+  CHECK(cutting >= 6);
+  CHECK(cut_depth(ZMap(ZMapGrid{Frame{}, 0, 0, 1, 4, 4}, 0, -1), Cutter::ball(1),
+                  Segment{Vec3(100, 100, 0), Vec3(101, 100, 0)}).i == -1);
+}
