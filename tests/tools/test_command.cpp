@@ -602,6 +602,7 @@ TEST_CASE("simulate: all five directions together, and the report's schema") {
         doctest::Approx(40 * 30 * 20));
   CHECK(report["result"]["triangles"].get<std::size_t>() == s.mesh.triangles.size());
   CHECK(report["groups"].size() == 5);
+  CHECK(report["rapid_cuts"].empty());  // every rapid of the program stays clear of the stock
   long long moves = 0;
   for (const json& g : report["groups"]) {
     moves += g["moves"].get<long long>();
@@ -743,5 +744,31 @@ TEST_CASE("progress goes to stderr only when asked (stderr is not a terminal her
   REQUIRE(files.size() == 2);
   CHECK(fs::path(files[0]).filename() == "first.nc");
   CHECK(fs::path(files[1]).filename() == "second.nc");
+  fs::remove_all(dir);
+}
+
+TEST_CASE("rapids that cut material no feed move removes are reported with their line and depth") {
+  fs::path dir = scratch("rapids");
+  fs::path tools = dir / "tools.json", program = dir / "crash.nc", report = dir / "report.json";
+  write_text(tools, kTools);
+  // Line 6 plunges at rapid 5 mm into the 20 mm high stock where no feed move goes, and line 7
+  // retracts through the same material; line 11 rapids back over the path a feed move (line 10)
+  // cut 2 mm deeper, so it meets nothing the feeds leave; lines 12-13 are clear.
+  write_text(program,
+             "G21 G90\nT1 M6\nS1000 M3\nG0 X10 Y10\nG43 Z30 H1\nG0 Z15\nG0 Z30\nG0 X30 Y20\nG1 Z16 F100\n"
+             "G1 X34 Y8\nG0 X30 Y20 Z18\nG0 Z30\nG0 X5 Y25\nM30\n");
+  CommandResult r = run_tridex({"simulate", program.string(), "--tools", tools.string(), "--stock", kStock,
+                                "--dexel-res", "40", "--report", report.string()},
+                               dir);
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  CHECK(r.err.find("2 rapid move(s) cut material that no feed move removes (lines 6, 7;") != std::string::npos);
+  json found = json::parse(slurp(report))["rapid_cuts"];
+  REQUIRE(found.size() == 2);
+  for (std::size_t k = 0; k < 2; ++k) {
+    CHECK(found[k]["line"] == 6 + static_cast<int>(k));
+    CHECK(found[k]["tool"] == 1);
+    CHECK(found[k]["depth_mm"].get<double>() == doctest::Approx(5).epsilon(1e-4));
+  }
   fs::remove_all(dir);
 }

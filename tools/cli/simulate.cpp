@@ -18,6 +18,7 @@
 #include "memory.hpp"
 #include "output.hpp"
 #include "program_input.hpp"
+#include "rapid_check.hpp"
 #include "progress.hpp"
 #include "render.hpp"
 #include "tridex/dexel_ops.hpp"
@@ -37,6 +38,10 @@ namespace fs = std::filesystem;
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// A rapid deeper than this below the feed-only surface is reported (mm): well above the
+// rounding of float heights, well below any real collision.
+constexpr double kRapidTolerance = 0.005;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -236,19 +241,42 @@ int run_simulate(const SimulateOptions& options) {
   ZMapLimits limits;
   limits.max_points = std::numeric_limits<std::size_t>::max();  // the memory check above rules
   long long segments = 0;
+  Json rapid_findings = Json::array();
   for (std::size_t g = 0; g < groups.size(); ++g) {
     const gcode::MoveGroup& group = groups[g];
     progress.stage("milling direction " + std::to_string(g + 1) + "/" + std::to_string(groups.size()) +
                    " (" + axis_label(group.axis) + ", " + std::to_string(group.moves.size()) + " moves)");
     maps.push_back(stock.mesh ? ZMap::from_mesh(group.frame, *stock.mesh, zmap_cell, limits)
                               : ZMap::from_box(group.frame, stock.box, zmap_cell, limits));
-    std::vector<CutMove> cut;
-    cut.reserve(group.moves.size());
-    for (const gcode::Move& m : group.moves)
-      cut.push_back(CutMove{Segment{group.frame.to_local(m.start), group.frame.to_local(m.end)},
-                            cutter_of_tool.at(m.tool)});
-    segments += static_cast<long long>(cut.size());
-    mill(maps.back(), cutters, cut, MillOptions{options.threads});
+    // Feed moves first; the rapids are checked against what the feeds leave, then milled too.
+    std::vector<CutMove> feeds, rapids;
+    std::vector<const gcode::Move*> rapid_moves;
+    feeds.reserve(group.moves.size());
+    for (const gcode::Move& m : group.moves) {
+      CutMove cut{Segment{group.frame.to_local(m.start), group.frame.to_local(m.end)}, cutter_of_tool.at(m.tool)};
+      if (m.kind == gcode::MoveKind::rapid) {
+        rapids.push_back(cut);
+        rapid_moves.push_back(&m);
+      } else {
+        feeds.push_back(cut);
+      }
+    }
+    segments += static_cast<long long>(group.moves.size());
+    mill(maps.back(), cutters, feeds, MillOptions{options.threads});
+    for (const RapidCut& found : rapid_cuts(maps.back(), cutters, rapids, kRapidTolerance)) {
+      const gcode::Move& m = *rapid_moves[found.index];
+      rapid_findings.push_back({{"line", m.line}, {"tool", m.tool}, {"axis", to_json(group.axis)},
+                                {"depth_mm", found.depth_mm}});
+    }
+    mill(maps.back(), cutters, rapids, MillOptions{options.threads});
+  }
+  if (!rapid_findings.empty()) {
+    std::string lines;
+    for (std::size_t k = 0; k < rapid_findings.size() && k < 10; ++k)
+      lines += (k ? ", " : "") + std::to_string(rapid_findings[k]["line"].get<int>());
+    warnings.push_back(std::to_string(rapid_findings.size()) +
+                       " rapid move(s) cut material that no feed move removes (lines " + lines +
+                       (rapid_findings.size() > 10 ? ", …" : "") + "; see \"rapid_cuts\" in the report)");
   }
   const double zmap_s = seconds_since(t);
 
@@ -331,6 +359,7 @@ int run_simulate(const SimulateOptions& options) {
                       {"dexel_volume_mm3", tridex::volume(result)},
                       {"triangles", mesh.triangles.size()},
                       {"watertight", check.closed()}};
+  report["rapid_cuts"] = rapid_findings;
   report["warnings"] = warnings;
   if (!options.report.empty()) {
     progress.stage("writing " + options.report);
