@@ -59,11 +59,10 @@ class GridTree {
   explicit GridTree(const ZMap& map) : map_(&map) {
     detail::require_solid_zmap(map, "grid tree");
     bottom_ = detail::zmap_bottom(map);
-    // The node count is below twice the leaf count; reserve for it.
-    std::size_t cells = static_cast<std::size_t>(map.grid.nx - 1) * static_cast<std::size_t>(map.grid.ny - 1);
-    nodes_.reserve(2 * (cells / (kLeafCells * kLeafCells) + 1) + 64);
+    const Range root{0, 0, map.grid.nx - 1, map.grid.ny - 1, 0};
+    nodes_.reserve(root.count());  // exactly: no regrowth of a vector of millions of nodes
     nodes_.push_back({});
-    build(0, Range{0, 0, map.grid.nx - 1, map.grid.ny - 1, 0});
+    build(0, root);
   }
 
   const ZMap& map() const { return *map_; }
@@ -136,11 +135,21 @@ class GridTree {
     int i0, j0, i1, j1, depth;
     bool leaf() const { return i1 - i0 <= kLeafCells && j1 - j0 <= kLeafCells; }
     // Split along x at even depths, along y at odd ones, along the other axis once one side is
-    // down to a leaf's width. Returns the axis (0 = x, 1 = y) and the split grid line.
+    // down to a leaf's width; at the block of 4 cells nearest the middle, so that leaves are
+    // full 4 × 4 blocks (plain halving of 4999 cells ends in leaves of 2 or 3). Returns the axis
+    // (0 = x, 1 = y) and the split grid line.
     int split(int& at) const {
       bool x = (depth % 2 == 0) ? (i1 - i0 > kLeafCells) : !(j1 - j0 > kLeafCells);
-      at = x ? (i0 + i1) / 2 : (j0 + j1) / 2;
+      int lo = x ? i0 : j0, hi = x ? i1 : j1;
+      int blocks = (hi - lo + kLeafCells - 1) / kLeafCells;
+      at = lo + kLeafCells * (blocks / 2);
       return x ? 0 : 1;
+    }
+    std::size_t count() const {  // nodes in the subtree
+      if (leaf()) return 1;
+      int at;
+      int axis = split(at);
+      return 1 + child(axis, at, false).count() + child(axis, at, true).count();
     }
     Range child(int axis, int at, bool upper) const {
       Range r = *this;
