@@ -6,8 +6,9 @@
 // towards ±X and ±Y, and 45° towards +X+Y), each with a Z-map of 5000 points across its longer
 // side, "milled" by an analytic mold-like surface (a deep round pocket, a ridge and waves) so that
 // every map has cut and uncut regions. Maps are built once, outside the timed region.
-// Peak memory is the process's ru_maxrss (cumulative: run one benchmark per process, with
-// --benchmark_filter, for a per-step figure).
+// Counters: peak_rss_MiB is the process's ru_maxrss (cumulative: run one benchmark per process,
+// with --benchmark_filter, for a per-step figure, which then includes its inputs: a Z-map of
+// 25 M points is 100 MB); cpu_s is processor time per iteration over all threads.
 #include <benchmark/benchmark.h>
 
 #include <sys/resource.h>
@@ -65,6 +66,14 @@ ZMap mold_map(int i) {
   return map;
 }
 
+// Each direction's map is built on first use, so that a benchmark's peak memory counts only the
+// maps it needs.
+const ZMap& map_of(int i) {
+  static std::unique_ptr<ZMap> built[6];
+  if (!built[i]) built[i] = std::make_unique<ZMap>(mold_map(i));
+  return *built[i];
+}
+
 const std::vector<ZMap>& maps() {
   static const std::vector<ZMap> all = [] {
     std::vector<ZMap> m;
@@ -74,12 +83,22 @@ const std::vector<ZMap>& maps() {
   return all;
 }
 
+// Processor time of the whole process (all threads), in seconds: on a shared machine this is
+// steadier than wall time.
+double process_cpu_s() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+}
+
 const DexelLattice& lattice() {
   static const DexelLattice l = DexelLattice::covering_resolution(kStock, 1021);
   return l;
 }
 
-void report(benchmark::State& state, const TripleDexel& d) {
+void report(benchmark::State& state, const TripleDexel& d, double cpu_start) {
+  state.counters["cpu_s"] = (process_cpu_s() - cpu_start) / static_cast<double>(state.iterations());
   state.counters["peak_rss_MiB"] = peak_rss_mib();
   state.counters["intervals"] = static_cast<double>(interval_count(d));
   state.counters["nodes"] = static_cast<double>(d.n.x) * d.n.y * d.n.z;
@@ -88,14 +107,15 @@ void report(benchmark::State& state, const TripleDexel& d) {
 // Step 2: one 5000-point Z-map → triple dexel. Arguments: direction (0 = +Z, 5 = 45° tilt),
 // threads (0 = all).
 void step2_dexelize_zmap(benchmark::State& state) {
-  const ZMap& map = maps()[static_cast<std::size_t>(state.range(0))];
+  const ZMap& map = map_of(static_cast<int>(state.range(0)));
   TripleDexel d;
+  double cpu_start = process_cpu_s();
   for (auto _ : state) {
     d = dexelize(map, lattice(), {.threads = static_cast<unsigned>(state.range(1))});
     benchmark::DoNotOptimize(d.grids[0].intervals.data());
   }
   state.counters["zmap_points"] = static_cast<double>(map.grid.size());
-  report(state, d);
+  report(state, d, cpu_start);
 }
 
 // Step 3: the stock ∩ six dexelized models, on the 1024 × 1024 × 684 lattice (the models are
@@ -108,12 +128,13 @@ void step3_intersect_six(benchmark::State& state) {
   }();
   const TripleDexel stock = TripleDexel::box(lattice(), kStock);
   TripleDexel result;
+  double cpu_start = process_cpu_s();
   for (auto _ : state) {
     result = stock;
     for (const TripleDexel& m : models) result = intersect(result, m, static_cast<unsigned>(state.range(0)));
     benchmark::DoNotOptimize(result.grids[0].intervals.data());
   }
-  report(state, result);
+  report(state, result, cpu_start);
   state.counters["volume_mm3"] = volume(result);
 }
 
@@ -121,11 +142,12 @@ void step3_intersect_six(benchmark::State& state) {
 void machine_six(benchmark::State& state) {
   const std::vector<ZMap>& all = maps();
   TripleDexel result;
+  double cpu_start = process_cpu_s();
   for (auto _ : state) {
     result = machine(kStock, lattice(), all, static_cast<unsigned>(state.range(0)));
     benchmark::DoNotOptimize(result.grids[0].intervals.data());
   }
-  report(state, result);
+  report(state, result, cpu_start);
   state.counters["volume_mm3"] = volume(result);
 }
 
@@ -156,12 +178,13 @@ void dexelize_mesh_sphere(benchmark::State& state) {
   }
   DexelLattice l = DexelLattice::covering_resolution(m.bounds(), 509);
   TripleDexel d;
+  double cpu_start = process_cpu_s();
   for (auto _ : state) {
     d = dexelize(m, l, {.threads = static_cast<unsigned>(state.range(0))});
     benchmark::DoNotOptimize(d.grids[0].intervals.data());
   }
   state.counters["triangles"] = static_cast<double>(m.triangles.size());
-  report(state, d);
+  report(state, d, cpu_start);
 }
 
 }  // namespace
