@@ -67,13 +67,6 @@ class ZMap {
   static ZMap from_mesh(const Frame& frame, const Mesh& stock, double cell,
                         ZMapLimits limits = {});
 
-  // A Z-map for the intersection W0 ∩ M1 ∩ … ∩ MN (Step 3): it covers the projection of the
-  // stock's bounds `stock` (world) with a margin and starts ABOVE the whole stock. The stock's
-  // shape is carried exactly by W0, so M_i needs only the cuts: an M_i built from the stock's
-  // own top (from_box) would be a linear interpolation of that top, which lies below the real
-  // one in every cell that straddles a ridge or the silhouette of a tilted stock, and shaves W0
-  // there even where nothing is cut. The continuum result is the same: W0 ⊆ {z ≤ top}.
-  static ZMap over_stock(const Frame& frame, const Aabb& stock, double cell, ZMapLimits limits = {});
 
   static void validate(const ZMapGrid& g, ZMapLimits limits) {
     detail::require_positive(g.cell, "Z-map cell size");
@@ -87,6 +80,15 @@ class ZMap {
                    limits.max_points, " points");
   }
 };
+
+// Prepares a milled map for the intersection W0 ∩ M1 ∩ … ∩ MN (Step 3): every point that still
+// holds its height in `initial` (the same map before milling) is raised above the stock. W0
+// carries the stock's shape exactly, so M_i needs only the cuts; left at the stock's own top,
+// M_i's polyhedron would interpolate that top linearly, which lies below it in every cell that
+// straddles a ridge or the silhouette of a tilted stock (and ramps down to the empty points
+// around it), and so would shave W0 where direction i cut nothing. A point cut below the stock
+// (to the empty height) stays low. Throws if the grids differ.
+void raise_uncut(ZMap& milled, const ZMap& initial);
 
 // ---------------------------------------------------------------------------------------------
 
@@ -153,15 +155,6 @@ inline ZMap ZMap::from_box(const Frame& frame, const Aabb& stock, double cell, Z
   return map;
 }
 
-inline ZMap ZMap::over_stock(const Frame& frame, const Aabb& stock, double cell, ZMapLimits limits) {
-  detail::require_positive(cell, "Z-map cell size");
-  const double margin = detail::empty_margin(cell);
-  Aabb local = local_bounds(frame, stock);
-  ZMapGrid g = ZMapGrid::covering(frame, local.inflated(margin), cell);
-  return ZMap(g, static_cast<float>(local.max.z + margin), static_cast<float>(local.min.z - margin),
-              limits);
-}
-
 inline ZMap ZMap::from_mesh(const Frame& frame, const Mesh& stock, double cell,
                             ZMapLimits limits) {
   if (stock.triangles.empty()) detail::fail("Z-map: stock mesh has no triangles");
@@ -204,6 +197,18 @@ inline ZMap ZMap::from_mesh(const Frame& frame, const Mesh& stock, double cell,
       }
   }
   return map;
+}
+
+inline void raise_uncut(ZMap& milled, const ZMap& initial) {
+  const ZMapGrid &a = milled.grid, &b = initial.grid;
+  if (a.nx != b.nx || a.ny != b.ny || a.x0 != b.x0 || a.y0 != b.y0 || a.cell != b.cell ||
+      milled.heights.size() != initial.heights.size())
+    detail::fail("raise_uncut: the milled and initial Z-maps have different grids");
+  float top = milled.empty_height;
+  for (float h : initial.heights) top = std::max(top, h);
+  const float above = static_cast<float>(top + detail::empty_margin(a.cell));
+  for (std::size_t p = 0; p < milled.heights.size(); ++p)
+    if (milled.heights[p] == initial.heights[p]) milled.heights[p] = above;
 }
 
 }  // namespace tridex

@@ -3,6 +3,7 @@
 #include <random>
 
 #include "tridex/machine.hpp"
+#include "tridex/mill.hpp"
 #include "tridex/zmap.hpp"
 
 using namespace tridex;
@@ -127,22 +128,36 @@ TEST_CASE("bad Z-map parameters are rejected") {
   CHECK_THROWS_AS(ZMap::from_mesh(Frame{}, Mesh{}, 0.1), Error);
 }
 
-TEST_CASE("a Z-map over the stock starts above it, so an uncut direction keeps the whole stock") {
+TEST_CASE("raise_uncut: an uncut direction keeps the whole stock; cuts stay cut") {
   const Aabb stock{Vec3(0, 0, 0), Vec3(10, 8, 5)};
   const DexelLattice lattice = DexelLattice::covering_resolution(stock, 40);
   const double stock_volume = volume(TripleDexel::box(lattice, stock));
   for (Vec3 axis : {Vec3(0, 0, 1), Vec3(1, 0, 0.364), Vec3(-1, 0.2, 0.3), Vec3(0.3, -1, 0.1)}) {
     Frame f = Frame::from_axis(axis);
-    ZMap over = ZMap::over_stock(f, stock, 0.2);
-    Aabb local = local_bounds(f, stock);
-    CHECK(*std::min_element(over.heights.begin(), over.heights.end()) > local.max.z);
-    CHECK(over.empty_height < local.min.z);
-    std::vector<ZMap> maps{over};
+    const ZMap initial = ZMap::from_box(f, stock, 0.2);
+    // The stock's own top, interpolated cell by cell, shaves a tilted stock where nothing is cut...
+    std::vector<ZMap> maps{initial};
+    double shaved = volume(machine(stock, lattice, maps));
+    if (axis.z != 1) CHECK(shaved < stock_volume * (1 - 1e-4));
+    // ...raised, it keeps it all.
+    raise_uncut(maps[0], initial);
     CHECK(volume(machine(stock, lattice, maps)) == doctest::Approx(stock_volume).epsilon(1e-9));
-    // The stock's own top, interpolated cell by cell, shaves a tilted stock where nothing is cut.
-    if (axis.z != 1) {
-      std::vector<ZMap> tops{ZMap::from_box(f, stock, 0.2)};
-      CHECK(volume(machine(stock, lattice, tops)) < stock_volume * (1 - 1e-4));
-    }
+    // A plunge through the middle stays: cut points keep their heights, cut-through stays low.
+    ZMap milled = initial;
+    Vec3 centre = f.to_local(stock.center());
+    std::vector<Cutter> cutters{Cutter::flat(1.5)};
+    std::vector<CutMove> plunge{{Segment{centre + Vec3(0, 0, 20), centre - Vec3(0, 0, 20)}, 0}};
+    mill(milled, cutters, plunge);
+    ZMap raised = milled;
+    raise_uncut(raised, initial);
+    int kept = 0;
+    for (std::size_t p = 0; p < milled.heights.size(); ++p)
+      if (milled.heights[p] != initial.heights[p]) kept += raised.heights[p] == milled.heights[p];
+    CHECK(kept > 100);
+    std::vector<ZMap> cut{raised};
+    CHECK(volume(machine(stock, lattice, cut)) < stock_volume - 0.5 * 3.14 * 1.5 * 1.5 * 5);
   }
+  ZMap other = ZMap::from_box(Frame{}, stock, 0.5);
+  ZMap mismatched = ZMap::from_box(Frame{}, stock, 0.25);
+  CHECK_THROWS_AS(raise_uncut(other, mismatched), Error);
 }

@@ -294,6 +294,11 @@ int run_simulate(const SimulateOptions& options) {
   // machine() fuses the two steps ray by ray (each ray of the stock clipped by each Z-map's
   // polyhedron in turn, never storing M_i), so "intersect" times them together.
   t = Clock::now();
+  // The intersection needs only the cuts: what a direction left uncut is raised above the stock,
+  // so that the stock's faces and silhouette come from W0 exactly (see raise_uncut).
+  for (std::size_t g = 0; g < maps.size(); ++g)
+    raise_uncut(maps[g], stock.mesh ? ZMap::from_mesh(groups[g].frame, *stock.mesh, zmap_cell, limits)
+                                    : ZMap::from_box(groups[g].frame, stock.box, zmap_cell, limits));
   progress.stage("dexelizing the stock");
   TripleDexel stock_dexel = stock.mesh ? dexelize(*stock.mesh, lattice, DexelizeOptions{options.threads})
                                        : TripleDexel::box(lattice, stock.box);
