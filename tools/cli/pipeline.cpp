@@ -1,0 +1,324 @@
+#include "pipeline.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <limits>
+
+#include "errors.hpp"
+#include "output.hpp"
+#include "rapid_check.hpp"
+#include "render.hpp"
+#include "tridex/dexel_ops.hpp"
+#include "tridex/dexelize.hpp"
+#include "tridex/machine.hpp"
+#include "tridex/mill.hpp"
+#include "tridex/polyhedron.hpp"
+#include "tridex/stl.hpp"
+#include "tridex/surface.hpp"
+
+namespace tridex::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+Stock load_stock(const StockSpec& spec, const Aabb& cutting_bounds) {
+  Stock stock;
+  switch (spec.kind) {
+    case StockSpec::Kind::box:
+    case StockSpec::Kind::automatic: {
+      stock.box = spec.kind == StockSpec::Kind::box ? spec.box : automatic_stock(cutting_bounds, spec);
+      Vec3 size = stock.box.size();
+      stock.volume = size.x * size.y * size.z;
+      stock.description = {{"kind", spec.kind == StockSpec::Kind::box ? "box" : "auto"},
+                           {"min", to_json(stock.box.min)}, {"max", to_json(stock.box.max)}};
+      break;
+    }
+    case StockSpec::Kind::mesh: {
+      try {
+        stock.mesh = read_stl(spec.mesh_path.string(), StlOptions{.require_closed = true});
+      } catch (const tridex::Error& e) {
+        input_error("--stock ", spec.mesh_path.string(), ": ", e.what());
+      }
+      stock.box = stock.mesh->bounds();
+      stock.volume = stock.mesh->signed_volume();
+      if (!(stock.volume > 0))
+        input_error("--stock ", spec.mesh_path.string(), ": the mesh encloses no volume (",
+                    stock.volume, " mm^3); are its triangles inside out?");
+      stock.description = {{"kind", "stl"}, {"file", spec.mesh_path.string()},
+                           {"min", to_json(stock.box.min)}, {"max", to_json(stock.box.max)}};
+      break;
+    }
+  }
+  return stock;
+}
+
+void write_png_file(const fs::path& path, const render::Image& image) {
+  write_file_atomically(path, render::encode_png(image));
+}
+
+// Mills one group's moves into `map` in program order, checking each rapid with cut_depth against
+// what the map holds when the rapid runs (RapidCheck::in_program_order).
+void mill_in_program_order(ZMap& map, const gcode::MoveGroup& group, std::size_t g,
+                           std::span<const Cutter> cutters,
+                           const std::map<int, std::uint32_t>& cutter_of_tool, unsigned threads,
+                           std::vector<RapidFinding>& found) {
+  // Heights only fall, so a rapid entirely above the initial top cuts nothing and needs no flush.
+  float top = -std::numeric_limits<float>::infinity();
+  for (float h : map.heights) top = std::max(top, h);
+  std::vector<CutMove> batch;
+  for (const gcode::Move& m : group.moves) {
+    CutMove cut{Segment{group.frame.to_local(m.start), group.frame.to_local(m.end)}, cutter_of_tool.at(m.tool)};
+    if (m.kind == gcode::MoveKind::rapid &&
+        std::min(cut.tip.a.z, cut.tip.b.z) < double(top) - kRapidTolerance) {
+      mill(map, cutters, batch, MillOptions{threads});
+      batch.clear();
+      CutDepth deepest = cut_depth(map, cutters[cut.cutter], cut.tip);
+      if (deepest.depth > kRapidTolerance) {
+        Vec3 local(map.grid.x(deepest.i), map.grid.y(deepest.j), map.height(deepest.i, deepest.j));
+        found.push_back(RapidFinding{m.line, m.tool, group.axis, deepest.depth, group.frame.to_world(local), g});
+      }
+    }
+    batch.push_back(cut);
+  }
+  mill(map, cutters, batch, MillOptions{threads});
+}
+
+}  // namespace
+
+std::string axis_label(const Vec3& axis) {
+  static const char* names[] = {"x", "y", "z"};
+  for (int a = 0; a < 3; ++a) {
+    Vec3 e(0);
+    e[a] = 1;
+    if (glm::dot(axis, e) > 1 - 1e-9) return std::string("+") + names[a];
+    if (glm::dot(axis, e) < -(1 - 1e-9)) return std::string("-") + names[a];
+  }
+  char text[64];
+  std::snprintf(text, sizeof text, "%.3f_%.3f_%.3f", clean(axis.x), clean(axis.y), clean(axis.z));
+  return text;
+}
+
+void write_stl_file(const fs::path& path, const Mesh& mesh) {
+  AtomicOutput out(path);
+  write_stl(out.stream(), mesh);
+  out.commit();
+}
+
+SimulationResult simulate_program(const SimulateOptions& options, Progress& progress,
+                                  const PipelineRequest& request) {
+  SimulationResult r;
+  // ---- inputs and outputs, checked before any work ---------------------------------------
+  r.input = resolve_program(options.program);
+  const ProgramInput& input = r.input;
+  std::optional<ToolTable> table;
+  if (!options.tools.empty()) table = ToolTable::read(options.tools);
+  else if (r.input.tools) table = std::move(r.input.tools);
+  StockSpec stock_spec;
+  if (!options.stock.empty()) stock_spec = parse_stock(options.stock);
+  else if (input.stock) stock_spec = *input.stock;
+  std::uint64_t max_memory = options.max_memory.empty()
+                                 ? physical_memory_bytes() / 10 * 8
+                                 : parse_memory(options.max_memory);
+
+  std::vector<fs::path> inputs(input.files.begin(), input.files.end());
+  inputs.push_back(input.program);
+  if (!options.tools.empty()) inputs.push_back(options.tools);
+  if (stock_spec.kind == StockSpec::Kind::mesh) inputs.push_back(stock_spec.mesh_path);
+  inputs.insert(inputs.end(), request.extra_inputs.begin(), request.extra_inputs.end());
+  for (const auto& [option, path] : request.outputs)
+    if (!path.empty()) check_output_path(option, path, inputs);
+  if (!options.dump_zmaps.empty()) {
+    std::error_code error;
+    fs::create_directories(options.dump_zmaps, error);
+    if (!fs::is_directory(options.dump_zmaps, error))
+      input_error("--dump-zmaps ", options.dump_zmaps, ": cannot create the directory");
+  }
+
+  // ---- parse, grouped by spindle direction ------------------------------------------------
+  progress.stage("parsing " + input.program.string());
+  Clock::time_point t = Clock::now();
+  gcode::InterpreterOptions interpreter_options;
+  interpreter_options.arc_tolerance = options.arc_tolerance;
+  interpreter_options.lenient = options.lenient;
+  gcode::DirectionGrouper grouper;
+  Aabb cutting_bounds;
+  const double far = 0.5 * gcode::MachineConfig::kDefaultFar;
+  InterpretResult parsed = interpret(input, interpreter_options, [&](const gcode::Move& m, std::size_t) {
+    grouper.add(m);
+    if (m.kind != gcode::MoveKind::rapid) {
+      // An approach from "far along the tool axis" is not where the work is.
+      if (glm::length(m.start) < far) cutting_bounds.extend(m.start);
+      cutting_bounds.extend(m.end);
+    }
+  });
+  r.groups = grouper.take();
+  std::vector<gcode::MoveGroup>& groups = r.groups;
+  r.warnings = parsed.warnings;
+  r.timings.parse = seconds_since(t);
+
+  // ---- cutters: every tool used must be in the table --------------------------------------
+  std::vector<Cutter>& cutters = r.cutters;
+  std::map<int, std::uint32_t>& cutter_of_tool = r.cutter_of_tool;
+  long long toolless_rapids = 0;
+  for (const gcode::MoveGroup& group : groups)
+    for (int tool : group.tools) {
+      if (cutter_of_tool.count(tool)) continue;
+      const ToolSpec* spec = table ? table->find(tool) : nullptr;
+      if (spec) {
+        cutter_of_tool[tool] = static_cast<std::uint32_t>(cutters.size());
+        cutters.push_back(spec->cutter);
+        continue;
+      }
+      if (tool == 0) continue;  // moves before the first tool change; checked below
+      auto where = parsed.tool_first_line.find(tool);
+      std::string location = where == parsed.tool_first_line.end()
+                                 ? input.program.string()
+                                 : where->second.file + ":" + std::to_string(where->second.line);
+      if (!table)
+        input_error(location, ": tool ", tool, " is used but there is no tool table (give --tools FILE)");
+      input_error(location, ": tool ", tool, " is used but missing from the tool table ",
+                  options.tools.empty() ? input.program.string() : options.tools);
+    }
+  // Without a tool in the spindle nothing cuts; rapids before the first tool change are only
+  // positioning and are skipped, but a feed move then is an error.
+  if (!cutter_of_tool.count(0))
+    for (gcode::MoveGroup& group : groups) {
+      std::vector<gcode::Move> kept;
+      kept.reserve(group.moves.size());
+      for (const gcode::Move& m : group.moves) {
+        if (m.tool != 0) kept.push_back(m);
+        else if (m.kind == gcode::MoveKind::rapid) ++toolless_rapids;
+        else
+          input_error(input.files.size() == 1 ? input.files[0].string() : input.program.string(), ":",
+                      m.line, ": a ", gcode::to_string(m.kind), " move with no tool loaded (T… M6)");
+      }
+      group.moves = std::move(kept);
+    }
+  if (toolless_rapids > 0)
+    r.warnings.push_back(std::to_string(toolless_rapids) +
+                         " rapid move(s) before the first tool change were not simulated (no tool)");
+
+  // ---- stock, resolutions, and the memory they need ---------------------------------------
+  r.stock = load_stock(stock_spec, cutting_bounds);
+  const Stock& stock = r.stock;
+  const double diagonal = glm::length(stock.box.size());
+  const double zmap_cell = options.zmap_cell > 0 ? options.zmap_cell : diagonal * kDefaultZmapCellFraction;
+  r.zmap_cell = zmap_cell;
+  try {
+    r.lattice = options.dexel_cell > 0
+                    ? DexelLattice::covering(stock.box, options.dexel_cell)
+                    : DexelLattice::covering_resolution(stock.box, options.dexel_res > 0 ? options.dexel_res : kDefaultDexelRes);
+  } catch (const tridex::Error& e) {
+    input_error("dexel resolution: ", e.what());
+  }
+  const DexelLattice& lattice = r.lattice;
+  double zmap_points = 0;
+  for (const gcode::MoveGroup& group : groups) {
+    try {
+      r.grids.push_back(ZMapGrid::covering(group.frame, local_bounds(group.frame, stock.box), zmap_cell));
+    } catch (const tridex::Error& e) {
+      input_error("--zmap-cell ", zmap_cell, ": ", e.what());
+    }
+    zmap_points += static_cast<double>(r.grids.back().nx) * r.grids.back().ny;
+  }
+  r.memory = estimate_memory(zmap_points, lattice.n.x, lattice.n.y, lattice.n.z);
+  const MemoryEstimate& need = r.memory;
+  if (need.total() > static_cast<double>(max_memory))
+    input_error("the resolution needs an estimated ", format_mib(need.total()), " (Z-maps ",
+                format_mib(need.zmaps), ", dexels ", format_mib(need.dexels), ", mesh ",
+                format_mib(need.mesh), "), more than --max-memory ",
+                format_mib(static_cast<double>(max_memory)),
+                "; use a larger --zmap-cell or --dexel-cell, or a smaller --dexel-res");
+
+  // ---- Step 1: one milled Z-map per direction ---------------------------------------------
+  t = Clock::now();
+  std::vector<ZMap>& maps = r.maps;
+  maps.reserve(groups.size());
+  ZMapLimits limits;
+  limits.max_points = std::numeric_limits<std::size_t>::max();  // the memory check above rules
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const gcode::MoveGroup& group = groups[g];
+    progress.stage("milling direction " + std::to_string(g + 1) + "/" + std::to_string(groups.size()) +
+                   " (" + axis_label(group.axis) + ", " + std::to_string(group.moves.size()) + " moves)");
+    maps.push_back(stock.mesh ? ZMap::from_mesh(group.frame, *stock.mesh, zmap_cell, limits)
+                              : ZMap::from_box(group.frame, stock.box, zmap_cell, limits));
+    r.segments += static_cast<long long>(group.moves.size());
+    if (request.rapid_check == RapidCheck::in_program_order) {
+      mill_in_program_order(maps.back(), group, g, cutters, cutter_of_tool, options.threads, r.rapid_cuts);
+      continue;
+    }
+    // Feed moves first; the rapids are checked against what the feeds leave, then milled too.
+    std::vector<CutMove> feeds, rapids;
+    std::vector<const gcode::Move*> rapid_moves;
+    feeds.reserve(group.moves.size());
+    for (const gcode::Move& m : group.moves) {
+      CutMove cut{Segment{group.frame.to_local(m.start), group.frame.to_local(m.end)}, cutter_of_tool.at(m.tool)};
+      if (m.kind == gcode::MoveKind::rapid) {
+        rapids.push_back(cut);
+        rapid_moves.push_back(&m);
+      } else {
+        feeds.push_back(cut);
+      }
+    }
+    mill(maps.back(), cutters, feeds, MillOptions{options.threads});
+    for (const RapidCut& found : rapid_cuts(maps.back(), cutters, rapids, kRapidTolerance)) {
+      const gcode::Move& m = *rapid_moves[found.index];
+      r.rapid_cuts.push_back(RapidFinding{m.line, m.tool, group.axis, found.depth_mm, m.end, g});
+    }
+    mill(maps.back(), cutters, rapids, MillOptions{options.threads});
+  }
+  r.timings.zmap = seconds_since(t);
+
+  if (!options.dump_zmaps.empty()) {
+    for (std::size_t g = 0; g < maps.size(); ++g) {
+      progress.stage("writing Z-map " + std::to_string(g + 1) + " to " + options.dump_zmaps);
+      fs::path base = fs::path(options.dump_zmaps) /
+                      ("zmap-" + std::to_string(g + 1) + "-" + axis_label(groups[g].axis));
+      write_stl_file(base.string() + ".stl", polyhedrize(maps[g]));
+      write_png_file(base.string() + ".png", render::render_heights(maps[g]));
+    }
+  }
+
+  // ---- Steps 2 and 3: the stock as a triple dexel, cut by every direction's Z-map ---------
+  // machine() fuses the two steps ray by ray (each ray of the stock clipped by each Z-map's
+  // polyhedron in turn, never storing M_i), so "intersect" times them together.
+  t = Clock::now();
+  // The intersection needs only the cuts: what a direction left uncut is raised above the stock,
+  // so that the stock's faces and silhouette come from W0 exactly (see raise_uncut). A kept map
+  // stays as milled; the raised copy is the one intersected.
+  std::vector<ZMap> kept_maps;
+  if (request.keep_maps) kept_maps = maps;
+  for (std::size_t g = 0; g < maps.size(); ++g)
+    raise_uncut(maps[g], stock.mesh ? ZMap::from_mesh(groups[g].frame, *stock.mesh, zmap_cell, limits)
+                                    : ZMap::from_box(groups[g].frame, stock.box, zmap_cell, limits));
+  progress.stage("dexelizing the stock");
+  TripleDexel stock_dexel = stock.mesh ? dexelize(*stock.mesh, lattice, DexelizeOptions{options.threads})
+                                       : TripleDexel::box(lattice, stock.box);
+  r.timings.dexelize = seconds_since(t);
+  progress.stage("dexelizing and intersecting " + std::to_string(maps.size()) + " Z-maps");
+  t = Clock::now();
+  r.result = machine(stock_dexel, maps, options.threads);
+  r.timings.intersect = seconds_since(t);
+  stock_dexel = TripleDexel{};
+  maps = std::move(kept_maps);
+  maps.shrink_to_fit();
+
+  // ---- surface ------------------------------------------------------------------------------
+  progress.stage("extracting the surface");
+  t = Clock::now();
+  r.mesh = extract_surface(r.result);
+  r.mesh_check = check_mesh(r.mesh);
+  r.timings.mesh = seconds_since(t);
+  r.volume = r.mesh.signed_volume();
+  return r;
+}
+
+}  // namespace tridex::cli

@@ -1,0 +1,105 @@
+// tridex command — the simulation pipeline shared by `simulate` and `check` (Inui, Chen and Umezu,
+// "Visualization of 3+2 Axis Machining Result by Combining Multiple Z-map Models", CAD&A 19(4)
+// 2022, §3): parse -> group moves by spindle direction -> one Z-map per direction, milled with the
+// direction's moves (Step 1) -> stock ∩ M_1 ∩ … ∩ M_N on one triple-dexel lattice (Steps 2-3)
+// -> surface. The callers write the outputs; the pipeline only checks their paths up front.
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "commands.hpp"
+#include "json_text.hpp"
+#include "memory.hpp"
+#include "program_input.hpp"
+#include "progress.hpp"
+#include "tridex/cutter.hpp"
+#include "tridex/dexel.hpp"
+#include "tridex/gcode/grouping.hpp"
+#include "tridex/mesh.hpp"
+#include "tridex/mesh_check.hpp"
+#include "tridex/zmap.hpp"
+
+namespace tridex::cli {
+
+// The stock as the pipeline needs it: a box, or a closed mesh and its bounds.
+struct Stock {
+  Aabb box;                  // bounds (the box itself for a box stock)
+  std::optional<Mesh> mesh;  // a mesh stock
+  double volume = 0;
+  Json description;
+};
+
+// How rapids are checked for cutting material (DESIGN.md: a rapid that touches stock is a
+// finding).
+enum class RapidCheck {
+  // Against the direction's Z-map milled by its feed moves alone: rapids through material that no
+  // feed move of the direction removes (what `simulate` reports).
+  against_feeds,
+  // In program order: the direction's moves are milled in batches between rapids (mill() does not
+  // depend on order within a batch) and each rapid is checked with cut_depth before it is milled.
+  // Exact for a program with one spindle direction. With several, material that another direction
+  // removed earlier still counts, so a rapid may be reported that a machine runs safely, but none
+  // that meets material is missed — in particular every rapid that meets the final solid.
+  in_program_order,
+};
+
+struct PipelineRequest {
+  std::vector<std::pair<std::string, std::filesystem::path>> outputs;  // (option, path), checked first
+  std::vector<std::filesystem::path> extra_inputs;                     // never overwritten either
+  RapidCheck rapid_check = RapidCheck::against_feeds;
+  bool keep_maps = false;  // keep the milled Z-maps (otherwise released after Step 3)
+};
+
+// A rapid that cuts: `depth_mm` below the material along the spindle at `where` (work frame).
+struct RapidFinding {
+  int line = 0;
+  int tool = 0;
+  Vec3 axis{0, 0, 1};
+  double depth_mm = 0;
+  Vec3 where{0};
+  std::size_t group = 0;
+};
+
+struct PipelineTimings {
+  double parse = 0, zmap = 0, dexelize = 0, intersect = 0, mesh = 0;
+};
+
+struct SimulationResult {
+  ProgramInput input;
+  std::vector<gcode::MoveGroup> groups;  // moves in program order within each group
+  std::vector<Cutter> cutters;
+  std::map<int, std::uint32_t> cutter_of_tool;  // tool number -> index into cutters
+  Stock stock;
+  double zmap_cell = 0;
+  std::vector<ZMapGrid> grids;  // one per group
+  std::vector<ZMap> maps;       // milled, one per group (empty unless keep_maps)
+  DexelLattice lattice;
+  MemoryEstimate memory;
+  TripleDexel result;
+  Mesh mesh;
+  MeshCheck mesh_check;
+  double volume = 0;
+  long long segments = 0;
+  std::vector<RapidFinding> rapid_cuts;
+  std::vector<std::string> warnings;
+  PipelineTimings timings;
+};
+
+// A rapid deeper than this below the material is reported (mm): well above the rounding of float
+// heights, well below any real collision.
+constexpr double kRapidTolerance = 0.005;
+
+// Runs the pipeline. Throws InputError (exit status 2) for bad input, including an output path of
+// `request` that cannot be written or names an input; writes --dump-zmaps if asked.
+SimulationResult simulate_program(const SimulateOptions& options, Progress& progress,
+                                  const PipelineRequest& request = {});
+
+std::string axis_label(const Vec3& axis);
+void write_stl_file(const std::filesystem::path& path, const Mesh& mesh);
+
+}  // namespace tridex::cli
