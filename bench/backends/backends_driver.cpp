@@ -353,10 +353,14 @@ int main(int argc, char** argv) {
       for (const Result& r : results[c]) v.push_back(field(r));
       return median(v);
     };
-    double s1 = pick([](const Result& r) { return r.step1; }), s2 = pick([](const Result& r) { return r.step2; });
+    // Step 1: the median of the runs that milled (with --maps, only the first does).
+    std::vector<double> milled_runs;
+    for (const Result& r : results[c])
+      if (r.step1 >= 0) milled_runs.push_back(r.step1);
+    double s1 = milled_runs.empty() ? -1 : median(milled_runs), s2 = pick([](const Result& r) { return r.step2; });
     double s3 = pick([](const Result& r) { return r.step3; }), fu = pick([](const Result& r) { return r.fused; });
     double su = pick([](const Result& r) { return r.surface; });
-    double total = pick([](const Result& r) { return std::max(0.0, r.step1) + r.step2 + r.step3 + r.surface; });
+    double total = std::max(0.0, s1) + pick([](const Result& r) { return r.step2 + r.step3 + r.surface; });
     char step1_text[32] = "loaded";
     if (s1 >= 0) std::snprintf(step1_text, sizeof step1_text, "%.2f", s1);
     char fused_text[32] = "-";
@@ -367,7 +371,7 @@ int main(int argc, char** argv) {
     if (o.fused && std::abs(results[c][0].fused_volume - results[c][0].volume) > 1e-6 * results[c][0].volume)
       std::printf("  (!) fused volume %.3f differs from the split one\n", results[c][0].fused_volume);
   }
-  std::printf("\ntotal = Step 1 + Step 2 + Step 3 + surface (the paper's split; Step 1 left out where the maps were\n"
-              "loaded from --maps); medians of %d run(s)\n", o.runs);
+  std::printf("\ntotal = Step 1 + Step 2 + Step 3 + surface (the paper's split); medians of %d run(s), Step 1 over\n"
+              "the runs that milled (with --maps only the first does; \"loaded\": none did)\n", o.runs);
   return 0;
 }
