@@ -56,6 +56,8 @@ class GridTree {
     float a, b, c, deviation;
   };
 
+  // The tree refers to `map` (it stores no heights of its own): keep the map alive and unchanged
+  // while the tree is used. Throws tridex::Error for a map with fewer than 2 × 2 points.
   explicit GridTree(const ZMap& map) : map_(&map) {
     detail::require_solid_zmap(map, "grid tree");
     bottom_ = detail::zmap_bottom(map);
