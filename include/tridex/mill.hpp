@@ -128,6 +128,12 @@ struct MoveGeometry {
     double k = std::sqrt(radius2 - e2);
     double lo = std::max(0.0, t_foot - k * inv_len), hi = std::min(1.0, t_foot + k * inv_len);
     if (lo > hi) return {kInf, 0};
+    if (w == 0 && cutter->shape() != CutterShape::ball) {
+      // A level move (the roughing passes of most programs): the cutter is lowest above q where
+      // it comes closest to q, for any cutter.
+      double t = std::clamp(t_foot, lo, hi), s = t - t_foot;
+      return {az + cutter->lower_height(std::sqrt(e2 + s * s * vv)), t};
+    }
     switch (cutter->shape()) {
       case CutterShape::flat: {
         double t = w > 0 ? lo : hi;
