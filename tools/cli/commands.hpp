@@ -29,11 +29,23 @@ struct SimulateOptions : CommonOptions {
   std::string max_memory;       // empty: 80 % of RAM
 };
 
+// `check`: simulate's options (--report and --png are the check's own report and picture; -o still
+// writes the machined solid) and the design to compare with.
+struct CheckOptions : SimulateOptions {
+  std::string design;     // --design PART.stl (closed)
+  double tolerance = 0;   // --tolerance: both tolerances; 0: one dexel spacing
+  double gouge_tol = 0;   // --gouge-tol (overrides --tolerance)
+  double excess_tol = 0;  // --excess-tol (overrides --tolerance)
+  std::string ply;        // --ply OUT.ply: the machined mesh coloured by deviation
+  std::string envelope;   // --envelope box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX
+};
+
 constexpr int kDefaultDexelRes = 320;
 constexpr double kDefaultZmapCellFraction = 1.0 / 1000;  // of the stock's diagonal
 
 int run_moves(const ListOptions& options);
 int run_groups(const ListOptions& options);
 int run_simulate(const SimulateOptions& options);
+int run_check(const CheckOptions& options);
 
 }  // namespace tridex::cli

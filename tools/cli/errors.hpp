@@ -12,7 +12,8 @@
 
 namespace tridex::cli {
 
-enum ExitStatus : int { kSuccess = 0, kFailure = 1, kBadInput = 2 };
+// `check` adds 3: the program gouges, leaves excess, crashes a rapid or leaves the envelope.
+enum ExitStatus : int { kSuccess = 0, kFailure = 1, kBadInput = 2, kFindings = 3 };
 
 class InputError : public tridex::Error {
  public:

@@ -1,4 +1,4 @@
-// tridex — the command: `simulate`, `moves`, `groups` (see README.md for the full story).
+// tridex — the command: `simulate`, `check`, `moves`, `groups` (see README.md for the full story).
 //
 // Exit status: 0 on success, 2 for bad input (program, tool table, stock, options), 1 for
 // anything else. Program errors are printed as file:line:col: message.
@@ -34,6 +34,32 @@ void add_common(CLI::App& command, CommonOptions& options) {
   command.add_flag("-q,--quiet", options.quiet, "print nothing but errors")->excludes("--progress");
 }
 
+// simulate's options, shared by check.
+void add_simulate(CLI::App& command, SimulateOptions& options) {
+  add_common(command, options);
+  command.add_option("--tools", options.tools,
+                  "tool table, JSON in the CAMotics schema (overrides a project's tools)");
+  command.add_option("--stock", options.stock,
+                  "box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX | FILE.stl | auto[:MARGIN] (default auto: the box around\n"
+                  "the cutting moves plus MARGIN mm, or 5 % of each side without one)");
+  command.add_option("--zmap-cell", options.zmap_cell,
+                  "Z-map grid spacing, mm (default: stock diagonal / 1000)")
+      ->check(CLI::PositiveNumber);
+  auto* dexel_cell = command.add_option("--dexel-cell", options.dexel_cell, "triple-dexel spacing, mm")
+                         ->check(CLI::PositiveNumber);
+  command.add_option("--dexel-res", options.dexel_res,
+                  "triple-dexel cells along the stock's longest side (default " +
+                      std::to_string(kDefaultDexelRes) + ": the bundled example in seconds on 2 cores)")
+      ->check(CLI::Range(1, 1 << 20))
+      ->excludes(dexel_cell);
+  command.add_option("--dump-zmaps", options.dump_zmaps,
+                  "write each direction's milled Z-map to DIR as STL and as a height picture");
+  command.add_option("--threads", options.threads, "worker threads (default: every hardware thread)")
+      ->check(CLI::Range(0u, 4096u));
+  command.add_option("--max-memory", options.max_memory,
+                  "refuse resolutions whose estimated memory exceeds this (e.g. 4G; default 80 % of RAM)");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -42,36 +68,38 @@ int main(int argc, char** argv) {
                "tridex"};
   app.set_version_flag("--version", "tridex " TRIDEX_VERSION);
   app.require_subcommand(1);
-  app.footer("Exit status: 0 success, 2 bad input (program, tool table, stock, options), 1 other failure.\n"
+  app.footer("Exit status: 0 success, 2 bad input (program, tool table, stock, options), 1 other failure;\n"
+             "`check` exits 3 when it finds a gouge, excess, a rapid into material or a move outside the envelope.\n"
              "Run `tridex COMMAND --help` for a command's options.");
 
   SimulateOptions simulate;
   CLI::App* sim = app.add_subcommand("simulate", "mill the program into its stock and write the machined solid");
-  add_common(*sim, simulate);
-  sim->add_option("--tools", simulate.tools,
-                  "tool table, JSON in the CAMotics schema (overrides a project's tools)");
-  sim->add_option("--stock", simulate.stock,
-                  "box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX | FILE.stl | auto[:MARGIN] (default auto: the box around\n"
-                  "the cutting moves plus MARGIN mm, or 5 % of each side without one)");
-  sim->add_option("--zmap-cell", simulate.zmap_cell,
-                  "Z-map grid spacing, mm (default: stock diagonal / 1000)")
-      ->check(CLI::PositiveNumber);
-  auto* dexel_cell = sim->add_option("--dexel-cell", simulate.dexel_cell, "triple-dexel spacing, mm")
-                         ->check(CLI::PositiveNumber);
-  sim->add_option("--dexel-res", simulate.dexel_res,
-                  "triple-dexel cells along the stock's longest side (default " +
-                      std::to_string(kDefaultDexelRes) + ": the bundled example in seconds on 2 cores)")
-      ->check(CLI::Range(1, 1 << 20))
-      ->excludes(dexel_cell);
+  add_simulate(*sim, simulate);
   sim->add_option("-o,--output", simulate.output, "write the result as binary STL");
   sim->add_option("--png", simulate.png, "write a shaded picture of the result (off-screen OSMesa)");
   sim->add_option("--report", simulate.report, "write the JSON report");
-  sim->add_option("--dump-zmaps", simulate.dump_zmaps,
-                  "write each direction's milled Z-map to DIR as STL and as a height picture");
-  sim->add_option("--threads", simulate.threads, "worker threads (default: every hardware thread)")
-      ->check(CLI::Range(0u, 4096u));
-  sim->add_option("--max-memory", simulate.max_memory,
-                  "refuse resolutions whose estimated memory exceeds this (e.g. 4G; default 80 % of RAM)");
+
+  CheckOptions check;
+  CLI::App* chk = app.add_subcommand(
+      "check", "compare the machined result with a design: gouges, excess, rapids into stock, envelope;\n"
+               "exit status 3 when anything is found");
+  add_simulate(*chk, check);
+  chk->add_option("--design", check.design, "the designed part, a closed STL")->required();
+  auto* tolerance = chk->add_option("--tolerance", check.tolerance,
+                                    "gouge and excess tolerance, mm (default: one dexel spacing)")
+                        ->check(CLI::PositiveNumber);
+  chk->add_option("--gouge-tol", check.gouge_tol, "material removed inside the design beyond this is a gouge, mm")
+      ->check(CLI::PositiveNumber)
+      ->excludes(tolerance);
+  chk->add_option("--excess-tol", check.excess_tol, "material left outside the design beyond this is excess, mm")
+      ->check(CLI::PositiveNumber)
+      ->excludes(tolerance);
+  chk->add_option("--envelope", check.envelope,
+                  "box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX: every move whose tool tip ends outside is a finding");
+  chk->add_option("-o,--output", check.output, "write the machined result as binary STL");
+  chk->add_option("--report", check.report, "write the JSON report of the check");
+  chk->add_option("--png", check.png, "write a picture coloured by deviation, with a legend");
+  chk->add_option("--ply", check.ply, "write the machined mesh as PLY with per-vertex colour by deviation");
 
   ListOptions moves;
   CLI::App* mov = app.add_subcommand("moves", "print the interpreted moves as JSON Lines, one object per move");
@@ -93,6 +121,7 @@ int main(int argc, char** argv) {
 
   try {
     if (sim->parsed()) return run_simulate(simulate);
+    if (chk->parsed()) return run_check(check);
     if (mov->parsed()) return run_moves(moves);
     if (grp->parsed()) return run_groups(groups);
   } catch (const tridex::gcode::GcodeError& e) {

@@ -6,6 +6,7 @@
 #include <png.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <memory>
@@ -91,11 +92,21 @@ void draw_view(const Mesh& mesh, const MeshView& view, const MeshRenderOptions& 
   std::vector<glm::vec3> positions, normals;
   positions.reserve(3 * std::min(kChunk, mesh.triangles.size()));
   normals.reserve(positions.capacity());
+  const bool coloured = !options.vertex_colours.empty();
+  std::vector<glm::vec3> colours;
+  if (coloured) {
+    // The material follows the vertex colours (ambient and diffuse) instead of options.colour.
+    glColorMaterial(GL_FRONT_AND_BACK, GL_AMBIENT_AND_DIFFUSE);
+    glEnable(GL_COLOR_MATERIAL);
+    glEnableClientState(GL_COLOR_ARRAY);
+    colours.reserve(positions.capacity());
+  }
   glEnableClientState(GL_VERTEX_ARRAY);
   glEnableClientState(GL_NORMAL_ARRAY);
   for (std::size_t first = 0; first < mesh.triangles.size(); first += kChunk) {
     positions.clear();
     normals.clear();
+    colours.clear();
     std::size_t last = std::min(mesh.triangles.size(), first + kChunk);
     for (std::size_t t = first; t < last; ++t) {
       const glm::uvec3& tri = mesh.triangles[t];
@@ -103,13 +114,21 @@ void draw_view(const Mesh& mesh, const MeshView& view, const MeshRenderOptions& 
       glm::vec3 n = glm::cross(b - a, c - a);
       positions.insert(positions.end(), {a, b, c});
       normals.insert(normals.end(), {n, n, n});
+      if (coloured)
+        colours.insert(colours.end(), {options.vertex_colours[tri.x], options.vertex_colours[tri.y],
+                                       options.vertex_colours[tri.z]});
     }
+    if (coloured) glColorPointer(3, GL_FLOAT, 0, colours.data());
     glVertexPointer(3, GL_FLOAT, 0, positions.data());
     glNormalPointer(GL_FLOAT, 0, normals.data());
     glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(positions.size()));
   }
   glDisableClientState(GL_VERTEX_ARRAY);
   glDisableClientState(GL_NORMAL_ARRAY);
+  if (coloured) {
+    glDisableClientState(GL_COLOR_ARRAY);
+    glDisable(GL_COLOR_MATERIAL);
+  }
   glFinish();
 }
 
@@ -118,6 +137,9 @@ void draw_view(const Mesh& mesh, const MeshView& view, const MeshRenderOptions& 
 Image render_mesh(const Mesh& mesh, const MeshRenderOptions& options) {
   if (mesh.triangles.empty()) detail::fail("render: the mesh has no triangles");
   if (options.views.empty()) detail::fail("render: no view to draw");
+  if (!options.vertex_colours.empty() && options.vertex_colours.size() != mesh.positions.size())
+    detail::fail("render: ", options.vertex_colours.size(), " vertex colours for ", mesh.positions.size(),
+                 " vertices");
   if (options.panel_width < 1 || options.panel_height < 1 || options.panel_width > 8192 ||
       options.panel_height > 8192)
     detail::fail("render: panel size ", options.panel_width, " x ", options.panel_height,
@@ -204,6 +226,67 @@ Image render_heights(const ZMap& map, int max_side) {
             static_cast<std::uint8_t>(std::lround(255 * std::clamp(colour[c], 0.0f, 1.0f)));
     }
   return image;
+}
+
+namespace {
+
+// The classic 5x7 LCD font, ASCII 32 (' ') to 90 ('Z'): five columns per glyph, bit r of a
+// column set when row r (from the top) is ink.
+constexpr std::uint8_t kFont[59][5] = {
+    {0x00, 0x00, 0x00, 0x00, 0x00}, {0x00, 0x00, 0x5F, 0x00, 0x00}, {0x00, 0x07, 0x00, 0x07, 0x00},
+    {0x14, 0x7F, 0x14, 0x7F, 0x14}, {0x24, 0x2A, 0x7F, 0x2A, 0x12}, {0x23, 0x13, 0x08, 0x64, 0x62},
+    {0x36, 0x49, 0x56, 0x20, 0x50}, {0x00, 0x08, 0x07, 0x03, 0x00}, {0x00, 0x1C, 0x22, 0x41, 0x00},
+    {0x00, 0x41, 0x22, 0x1C, 0x00}, {0x2A, 0x1C, 0x7F, 0x1C, 0x2A}, {0x08, 0x08, 0x3E, 0x08, 0x08},
+    {0x00, 0x80, 0x70, 0x30, 0x00}, {0x08, 0x08, 0x08, 0x08, 0x08}, {0x00, 0x00, 0x60, 0x60, 0x00},
+    {0x20, 0x10, 0x08, 0x04, 0x02}, {0x3E, 0x51, 0x49, 0x45, 0x3E}, {0x00, 0x42, 0x7F, 0x40, 0x00},
+    {0x72, 0x49, 0x49, 0x49, 0x46}, {0x21, 0x41, 0x49, 0x4D, 0x33}, {0x18, 0x14, 0x12, 0x7F, 0x10},
+    {0x27, 0x45, 0x45, 0x45, 0x39}, {0x3C, 0x4A, 0x49, 0x49, 0x31}, {0x41, 0x21, 0x11, 0x09, 0x07},
+    {0x36, 0x49, 0x49, 0x49, 0x36}, {0x46, 0x49, 0x49, 0x29, 0x1E}, {0x00, 0x00, 0x14, 0x00, 0x00},
+    {0x00, 0x40, 0x34, 0x00, 0x00}, {0x00, 0x08, 0x14, 0x22, 0x41}, {0x14, 0x14, 0x14, 0x14, 0x14},
+    {0x00, 0x41, 0x22, 0x14, 0x08}, {0x02, 0x01, 0x59, 0x09, 0x06}, {0x3E, 0x41, 0x5D, 0x59, 0x4E},
+    {0x7C, 0x12, 0x11, 0x12, 0x7C}, {0x7F, 0x49, 0x49, 0x49, 0x36}, {0x3E, 0x41, 0x41, 0x41, 0x22},
+    {0x7F, 0x41, 0x41, 0x41, 0x3E}, {0x7F, 0x49, 0x49, 0x49, 0x41}, {0x7F, 0x09, 0x09, 0x09, 0x01},
+    {0x3E, 0x41, 0x41, 0x51, 0x73}, {0x7F, 0x08, 0x08, 0x08, 0x7F}, {0x00, 0x41, 0x7F, 0x41, 0x00},
+    {0x20, 0x40, 0x41, 0x3F, 0x01}, {0x7F, 0x08, 0x14, 0x22, 0x41}, {0x7F, 0x40, 0x40, 0x40, 0x40},
+    {0x7F, 0x02, 0x1C, 0x02, 0x7F}, {0x7F, 0x04, 0x08, 0x10, 0x7F}, {0x3E, 0x41, 0x41, 0x41, 0x3E},
+    {0x7F, 0x09, 0x09, 0x09, 0x06}, {0x3E, 0x41, 0x51, 0x21, 0x5E}, {0x7F, 0x09, 0x19, 0x29, 0x46},
+    {0x26, 0x49, 0x49, 0x49, 0x32}, {0x03, 0x01, 0x7F, 0x01, 0x03}, {0x3F, 0x40, 0x40, 0x40, 0x3F},
+    {0x1F, 0x20, 0x40, 0x20, 0x1F}, {0x3F, 0x40, 0x38, 0x40, 0x3F}, {0x63, 0x14, 0x08, 0x14, 0x63},
+    {0x03, 0x04, 0x78, 0x04, 0x03}, {0x61, 0x59, 0x49, 0x4D, 0x43}};
+
+void fill_rect(Image& image, int x0, int y0, int w, int h, glm::vec3 colour) {
+  for (int y = std::max(0, y0); y < std::min(image.height, y0 + h); ++y)
+    for (int x = std::max(0, x0); x < std::min(image.width, x0 + w); ++x)
+      for (int c = 0; c < 3; ++c)
+        image.rgb[3 * (static_cast<std::size_t>(x) + static_cast<std::size_t>(image.width) * static_cast<std::size_t>(y)) +
+                  static_cast<std::size_t>(c)] =
+            static_cast<std::uint8_t>(std::clamp(colour[c], 0.0f, 1.0f) * 255.0f + 0.5f);
+}
+
+}  // namespace
+
+void draw_legend(Image& image, const std::vector<LegendEntry>& entries, int scale) {
+  if (scale < 1 || scale > 16) detail::fail("render: legend scale ", scale, " must lie in 1..16");
+  const int line = 10 * scale, pad = 4 * scale, swatch = 7 * scale;
+  std::size_t longest = 0;
+  for (const LegendEntry& e : entries) longest = std::max(longest, e.label.size());
+  const int width = pad * 3 + swatch + static_cast<int>(longest) * 6 * scale;
+  const int height = pad * 2 + static_cast<int>(entries.size()) * line;
+  fill_rect(image, 0, 0, width, height, glm::vec3(1));
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    const int top = pad + static_cast<int>(k) * line;
+    fill_rect(image, pad, top, swatch, swatch, glm::vec3(0.1f));
+    fill_rect(image, pad + 1, top + 1, swatch - 2, swatch - 2, entries[k].colour);
+    int x = pad * 2 + swatch;
+    for (char ch : entries[k].label) {
+      int code = std::toupper(static_cast<unsigned char>(ch));
+      const std::uint8_t* glyph = kFont[code >= 32 && code <= 90 ? code - 32 : 0];
+      for (int col = 0; col < 5; ++col)
+        for (int row = 0; row < 7; ++row)
+          if (glyph[col] & (1 << row)) fill_rect(image, x + col * scale, top + row * scale, scale, scale, glm::vec3(0.1f));
+      x += 6 * scale;
+    }
+  }
 }
 
 std::vector<std::uint8_t> encode_png(const Image& image) {

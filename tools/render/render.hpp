@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "tridex/geometry.hpp"
@@ -32,7 +33,18 @@ struct MeshRenderOptions {
   std::vector<MeshView> views{MeshView{{1, -1, 0.8}, {0, 0, 1}}, MeshView{{-1, 1, 0.8}, {0, 0, 1}}};
   glm::vec3 colour{0.62f, 0.70f, 0.80f};
   glm::vec3 background{0.96f, 0.96f, 0.97f};
+  // One colour per mesh vertex (each triangle takes its last vertex's colour, flat shaded);
+  // empty: `colour` everywhere.
+  std::vector<glm::vec3> vertex_colours;
 };
+
+// A key drawn in the picture's top-left corner: a swatch and a label per entry. Labels use a
+// built-in 5x7 pixel font: letters (drawn upper case), digits, space and . , : - + < > / % ( ).
+struct LegendEntry {
+  glm::vec3 colour;
+  std::string label;
+};
+void draw_legend(Image& image, const std::vector<LegendEntry>& entries, int scale = 2);
 
 // Throws tridex::Error if OSMesa cannot make a context or the mesh is empty.
 Image render_mesh(const Mesh& mesh, const MeshRenderOptions& options = {});

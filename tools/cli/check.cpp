@@ -1,0 +1,405 @@
+// tridex check — the machined result against the design, rapids that cut, moves outside an
+// envelope (issue 7). The result comes from simulate's pipeline (pipeline.hpp, Inui, Chen and
+// Umezu, CAD&A 19(4) 2022), with rapids checked in program order.
+//
+// Deviation: for every vertex of the machined mesh, the distance to the design surface, negative
+// when the vertex lies inside the design (material removed that the part needs: a gouge) and
+// positive outside (material left: excess); see deviation.hpp for the distance and its sign.
+// Out-of-tolerance vertices joined by mesh edges form regions. A gouge region's moves are those
+// whose swept cutter reaches its deepest vertices: in a group's frame, p is reached by a move when
+// p.z ≥ S(p.x, p.y) − one dexel spacing (S the move's swept lower surface, MoveGeometry), the
+// spacing absorbing the surface's resolution.
+//
+// The design side: a part feature cut away entirely (a thin rib) can leave a machined surface
+// that lies on the design everywhere, so the design's own vertices and triangle centroids are
+// measured against the machined surface too (signed by the result's triple dexel): a design
+// sample outside the machined solid beyond --gouge-tol is material missing, one inside beyond
+// --excess-tol is material left. These are counted and bounded, not split into regions.
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <set>
+#include <thread>
+
+#include "commands.hpp"
+#include "deviation.hpp"
+#include "errors.hpp"
+#include "numbers.hpp"
+#include "output.hpp"
+#include "pipeline.hpp"
+#include "render.hpp"
+#include "tridex/dexel_ops.hpp"
+#include "tridex/dexelize.hpp"
+#include "tridex/mill.hpp"
+#include "tridex/stl.hpp"
+
+namespace tridex::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr glm::vec3 kGougeColour{0.86f, 0.16f, 0.14f};
+constexpr glm::vec3 kOkColour{0.70f, 0.76f, 0.70f};
+constexpr glm::vec3 kExcessColour{0.18f, 0.40f, 0.90f};
+constexpr std::size_t kRegionsListed = 100;   // per kind, deepest first
+constexpr std::size_t kRegionsWithLines = 20;
+constexpr std::size_t kProbesPerRegion = 16;  // deepest vertices tested against the moves
+constexpr int kHistogramBins = 20;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+Aabb parse_envelope(const std::string& text) {
+  if (text.rfind("box:", 0) != 0)
+    input_error("--envelope ", text, ": expected box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX");
+  std::vector<double> v = parse_number_list(text.substr(4), "--envelope");
+  if (v.size() != 6) input_error("--envelope box: expected 6 numbers, got ", v.size());
+  Aabb box{Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5])};
+  static const char* names[] = {"X", "Y", "Z"};
+  for (int a = 0; a < 3; ++a)
+    if (!(box.min[a] < box.max[a]))
+      input_error("--envelope box: ", names[a], "MIN ", box.min[a], " must be less than ", names[a], "MAX ",
+                  box.max[a]);
+  return box;
+}
+
+// Runs body(k) for k in [0, n) on `threads` threads (0: every hardware thread), in blocks.
+template <class Body>
+void parallel_for(std::size_t n, unsigned threads, const Body& body) {
+  unsigned t = threads ? threads : std::max(1u, std::thread::hardware_concurrency());
+  t = static_cast<unsigned>(std::min<std::size_t>(t, std::max<std::size_t>(1, n / 4096)));
+  if (t <= 1) {
+    for (std::size_t k = 0; k < n; ++k) body(k);
+    return;
+  }
+  std::vector<std::thread> workers;
+  for (unsigned w = 0; w < t; ++w)
+    workers.emplace_back([&, w] {
+      for (std::size_t k = n * w / t; k < n * (w + 1) / t; ++k) body(k);
+    });
+  for (std::thread& worker : workers) worker.join();
+}
+
+Json statistics(std::vector<double> values) {
+  Json s;
+  s["samples"] = values.size();
+  if (values.empty()) return s;
+  std::sort(values.begin(), values.end());
+  double sum = 0, sum2 = 0;
+  for (double v : values) sum += v, sum2 += v * v;
+  const double n = static_cast<double>(values.size());
+  auto percentile = [&](double q) {
+    return values[static_cast<std::size_t>(std::round(q / 100 * (n - 1)))];
+  };
+  s["min_mm"] = values.front();
+  s["max_mm"] = values.back();
+  s["mean_mm"] = sum / n;
+  s["rms_mm"] = std::sqrt(sum2 / n);
+  s["percentiles_mm"] = {{"p1", percentile(1)}, {"p5", percentile(5)}, {"p25", percentile(25)},
+                         {"p50", percentile(50)}, {"p75", percentile(75)}, {"p95", percentile(95)},
+                         {"p99", percentile(99)}};
+  // Equal bins over [min, max]; the last bin includes max.
+  const double lo = values.front(), hi = values.back(), width = (hi - lo) / kHistogramBins;
+  std::vector<long long> counts(kHistogramBins, 0);
+  for (double v : values) {
+    int bin = width > 0 ? static_cast<int>((v - lo) / width) : 0;
+    ++counts[static_cast<std::size_t>(std::clamp(bin, 0, kHistogramBins - 1))];
+  }
+  Json edges = Json::array();
+  for (int b = 0; b <= kHistogramBins; ++b) edges.push_back(lo + b * width);
+  s["histogram"] = {{"edges_mm", edges}, {"counts", counts}};
+  return s;
+}
+
+// Source lines of the moves whose swept cutter reaches the region's deepest vertices.
+std::vector<int> gouging_lines(const DeviationRegion& region, const Mesh& mesh, const std::vector<double>& deviation,
+                               const SimulationResult& r, double slack) {
+  std::vector<std::uint32_t> probes = region.vertices;
+  std::size_t keep = std::min(kProbesPerRegion, probes.size());
+  std::partial_sort(probes.begin(), probes.begin() + static_cast<std::ptrdiff_t>(keep), probes.end(),
+                    [&](std::uint32_t a, std::uint32_t b) { return deviation[a] < deviation[b]; });
+  probes.resize(keep);
+  std::set<int> lines;
+  for (const gcode::MoveGroup& group : r.groups) {
+    std::vector<Vec3> local;
+    for (std::uint32_t v : probes) local.push_back(group.frame.to_local(Vec3(mesh.positions[v])));
+    const gcode::Move* previous = nullptr;
+    for (const gcode::Move& m : group.moves) {
+      // A move that reaches p only at its start, where the move before it left the cutter, cut
+      // nothing there (a retract from the bottom of a plunge).
+      const bool continues = previous && glm::length(previous->end - m.start) < 1e-9;
+      previous = &m;
+      const Cutter& cutter = r.cutters[r.cutter_of_tool.at(m.tool)];
+      Segment tip{group.frame.to_local(m.start), group.frame.to_local(m.end)};
+      const double radius = cutter.radius();
+      for (const Vec3& p : local) {
+        if (p.x < std::min(tip.a.x, tip.b.x) - radius || p.x > std::max(tip.a.x, tip.b.x) + radius ||
+            p.y < std::min(tip.a.y, tip.b.y) - radius || p.y > std::max(tip.a.y, tip.b.y) + radius ||
+            p.z + slack < std::min(tip.a.z, tip.b.z))
+          continue;
+        detail::MoveGeometry::Lowest lowest = detail::MoveGeometry(cutter, tip).lowest(p.x, p.y);
+        if (p.z + slack >= lowest.z && !(continues && lowest.t <= 1e-9)) {
+          lines.insert(m.line);
+          break;
+        }
+      }
+    }
+  }
+  return {lines.begin(), lines.end()};
+}
+
+Json region_json(const DeviationRegion& region, const Mesh& mesh, const std::vector<double>& deviation) {
+  return {{"depth_mm", region.depth},
+          {"deepest_point", to_json(Vec3(mesh.positions[region.deepest]))},
+          {"deviation_mm", deviation[region.deepest]},
+          {"centroid", to_json(region.centroid)},
+          {"bbox", {{"min", to_json(region.box.min)}, {"max", to_json(region.box.max)}}},
+          {"area_mm2", region.area},
+          {"vertices", region.vertices.size()}};
+}
+
+// Binary little-endian PLY: float x y z and uchar red green blue per vertex, uchar-counted int
+// index lists per face.
+void write_ply(const fs::path& path, const Mesh& mesh, const std::vector<glm::vec3>& colours) {
+  AtomicOutput out(path);
+  std::ostream& s = out.stream();
+  s << "ply\nformat binary_little_endian 1.0\ncomment tridex check: red gouge, grey within tolerance, blue excess\n"
+    << "element vertex " << mesh.positions.size()
+    << "\nproperty float x\nproperty float y\nproperty float z\n"
+    << "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+    << "element face " << mesh.triangles.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
+  std::string bytes;
+  bytes.reserve(mesh.positions.size() * 15 + mesh.triangles.size() * 13);
+  auto put = [&](const void* data, std::size_t size) { bytes.append(static_cast<const char*>(data), size); };
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+    put(&mesh.positions[v], 12);
+    for (int c = 0; c < 3; ++c) {
+      auto byte = static_cast<std::uint8_t>(std::clamp(colours[v][c], 0.0f, 1.0f) * 255.0f + 0.5f);
+      put(&byte, 1);
+    }
+  }
+  for (const glm::uvec3& t : mesh.triangles) {
+    std::uint8_t three = 3;
+    put(&three, 1);
+    for (int k = 0; k < 3; ++k) {
+      auto index = static_cast<std::int32_t>(t[k]);
+      put(&index, 4);
+    }
+  }
+  s.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  out.commit();
+}
+
+}  // namespace
+
+int run_check(const CheckOptions& options) {
+  const Clock::time_point start = Clock::now();
+  Progress progress(!options.quiet && (options.progress || stderr_is_terminal()));
+
+  // ---- inputs that the pipeline does not know, checked before any work --------------------
+  std::optional<Aabb> envelope;
+  if (!options.envelope.empty()) envelope = parse_envelope(options.envelope);
+  progress.stage("reading the design " + options.design);
+  Mesh design;
+  try {
+    design = read_stl(options.design, StlOptions{.require_closed = true});
+  } catch (const tridex::Error& e) {
+    input_error("--design: ", e.what(), " (the design must be a closed solid)");
+  }
+  if (!(design.signed_volume() > 0))
+    input_error("--design ", options.design, ": the mesh encloses no volume (", design.signed_volume(),
+                " mm^3); are its triangles inside out?");
+
+  PipelineRequest request;
+  request.outputs = {{"-o", options.output}, {"--report", options.report}, {"--png", options.png},
+                     {"--ply", options.ply}};
+  request.extra_inputs = {options.design};
+  request.rapid_check = RapidCheck::in_program_order;
+  SimulationResult r = simulate_program(options, progress, request);
+  const Mesh& mesh = r.mesh;
+  const double spacing = r.lattice.spacing;
+  const double gouge_tol = options.gouge_tol > 0 ? options.gouge_tol : options.tolerance > 0 ? options.tolerance : spacing;
+  const double excess_tol = options.excess_tol > 0 ? options.excess_tol : options.tolerance > 0 ? options.tolerance : spacing;
+
+  // ---- deviation of the machined surface from the design -----------------------------------
+  Clock::time_point t = Clock::now();
+  progress.stage("dexelizing the design");
+  TripleDexel design_dexel = dexelize(design, r.lattice, DexelizeOptions{options.threads});
+  progress.stage("measuring " + std::to_string(mesh.positions.size()) + " vertices against the design");
+  DistanceTree design_tree(design);
+  std::vector<double> deviation(mesh.positions.size());
+  parallel_for(mesh.positions.size(), options.threads, [&](std::size_t v) {
+    deviation[v] = design_tree.signed_distance(Vec3(mesh.positions[v]),
+                                               [&](const Vec3& p) { return contains(design_dexel, p); });
+  });
+  std::vector<char> gouge(deviation.size()), excess(deviation.size());
+  std::vector<glm::vec3> colours(deviation.size(), kOkColour);
+  for (std::size_t v = 0; v < deviation.size(); ++v) {
+    gouge[v] = deviation[v] < -gouge_tol;
+    excess[v] = deviation[v] > excess_tol;
+    if (gouge[v]) colours[v] = kGougeColour;
+    if (excess[v]) colours[v] = kExcessColour;
+  }
+  std::vector<DeviationRegion> gouges = deviation_regions(mesh, deviation, gouge);
+  std::vector<DeviationRegion> excesses = deviation_regions(mesh, deviation, excess);
+
+  // ---- the design side ------------------------------------------------------------------------
+  std::vector<Vec3> samples;
+  samples.reserve(design.positions.size() + design.triangles.size());
+  for (const glm::vec3& p : design.positions) samples.emplace_back(p);
+  for (const glm::uvec3& tri : design.triangles)
+    samples.push_back((Vec3(design.positions[tri.x]) + Vec3(design.positions[tri.y]) + Vec3(design.positions[tri.z])) / 3.0);
+  std::vector<double> design_deviation;
+  if (!mesh.triangles.empty()) {
+    progress.stage("measuring the design against the machined surface");
+    DistanceTree result_tree(mesh);
+    design_deviation.resize(samples.size());
+    // Positive where the machined solid holds the design sample (material left outside the
+    // design there), negative where it does not (material missing).
+    parallel_for(samples.size(), options.threads, [&](std::size_t k) {
+      design_deviation[k] = 0.0 - result_tree.signed_distance(samples[k], [&](const Vec3& p) { return contains(r.result, p); });
+    });
+  }
+  Json design_side;
+  {
+    Aabb missing_box, left_box;
+    long long missing = 0, left = 0;
+    double missing_depth = 0, left_depth = 0;
+    for (std::size_t k = 0; k < design_deviation.size(); ++k) {
+      if (design_deviation[k] < -gouge_tol) ++missing, missing_box.extend(samples[k]), missing_depth = std::max(missing_depth, -design_deviation[k]);
+      if (design_deviation[k] > excess_tol) ++left, left_box.extend(samples[k]), left_depth = std::max(left_depth, design_deviation[k]);
+    }
+    if (mesh.triangles.empty()) missing = static_cast<long long>(samples.size()), missing_box = design.bounds();
+    design_side["deviation"] = statistics(design_deviation);
+    design_side["missing"] = {{"samples", missing}, {"depth_mm", missing_depth}};
+    if (missing) design_side["missing"]["bbox"] = {{"min", to_json(missing_box.min)}, {"max", to_json(missing_box.max)}};
+    design_side["left"] = {{"samples", left}, {"depth_mm", left_depth}};
+    if (left) design_side["left"]["bbox"] = {{"min", to_json(left_box.min)}, {"max", to_json(left_box.max)}};
+  }
+  const bool design_side_finding = design_side["missing"]["samples"].get<long long>() > 0 ||
+                                   design_side["left"]["samples"].get<long long>() > 0;
+
+  // ---- which moves made the gouges ----------------------------------------------------------
+  progress.stage("finding the moves that cut " + std::to_string(gouges.size()) + " gouge region(s)");
+  Json gouge_list = Json::array(), excess_list = Json::array();
+  for (std::size_t k = 0; k < gouges.size() && k < kRegionsListed; ++k) {
+    Json g = region_json(gouges[k], mesh, deviation);
+    if (k < kRegionsWithLines) g["lines"] = gouging_lines(gouges[k], mesh, deviation, r, spacing);
+    gouge_list.push_back(g);
+  }
+  for (std::size_t k = 0; k < excesses.size() && k < kRegionsListed; ++k)
+    excess_list.push_back(region_json(excesses[k], mesh, deviation));
+  const double deviation_s = seconds_since(t);
+
+  // ---- rapids and envelope ------------------------------------------------------------------
+  Json rapid_list = Json::array();
+  for (const RapidFinding& f : r.rapid_cuts)
+    rapid_list.push_back({{"line", f.line}, {"tool", f.tool}, {"axis", to_json(f.axis)},
+                          {"depth_mm", f.depth_mm}, {"where", to_json(f.where)}});
+  Json envelope_list = Json::array();
+  if (envelope) {
+    // Positions "far along the tool axis" (home returns, reorientations) are tridex's stand-in for
+    // where the machine takes the tool, not programmed points.
+    const double far = 0.5 * gcode::MachineConfig::kDefaultFar;
+    std::vector<std::pair<int, Vec3>> outside;
+    for (const gcode::MoveGroup& group : r.groups)
+      for (const gcode::Move& m : group.moves)
+        if (glm::length(m.end) < far && !envelope->contains(m.end)) outside.emplace_back(m.line, m.end);
+    std::sort(outside.begin(), outside.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (const auto& [line, point] : outside) envelope_list.push_back({{"line", line}, {"tip", to_json(point)}});
+  }
+
+  // ---- outputs ------------------------------------------------------------------------------
+  if (!options.output.empty()) {
+    progress.stage("writing " + options.output);
+    write_stl_file(options.output, mesh);
+  }
+  if (!options.ply.empty()) {
+    progress.stage("writing " + options.ply);
+    write_ply(options.ply, mesh, colours);
+  }
+  if (!options.png.empty()) {
+    progress.stage("rendering " + options.png);
+    if (mesh.triangles.empty()) {
+      r.warnings.push_back("no material is left: " + options.png + " was not written");
+    } else {
+      render::MeshRenderOptions view;
+      view.vertex_colours = colours;
+      render::Image image = render::render_mesh(mesh, view);
+      char gouge_label[64], excess_label[64], ok_label[64];
+      std::snprintf(gouge_label, sizeof gouge_label, "gouge < -%.3g mm", gouge_tol);
+      std::snprintf(ok_label, sizeof ok_label, "within tolerance");
+      std::snprintf(excess_label, sizeof excess_label, "excess > +%.3g mm", excess_tol);
+      render::draw_legend(image, {{kGougeColour, gouge_label}, {kOkColour, ok_label}, {kExcessColour, excess_label}});
+      write_file_atomically(options.png, render::encode_png(image));
+    }
+  }
+  if (!r.mesh_check.closed())
+    r.warnings.push_back("the result mesh is not watertight (" + std::to_string(r.mesh_check.boundary_edges) +
+                         " boundary, " + std::to_string(r.mesh_check.non_manifold_edges) + " non-manifold edges)");
+
+  const bool failed = !gouges.empty() || !excesses.empty() || design_side_finding || !rapid_list.empty() ||
+                      !envelope_list.empty();
+  const double total_s = seconds_since(start);
+  Json report;
+  report["program"] = r.input.program.string();
+  report["design"] = options.design;
+  report["verdict"] = failed ? "fail" : "pass";
+  report["tolerances_mm"] = {{"gouge", gouge_tol}, {"excess", excess_tol}};
+  report["stock"] = r.stock.description;
+  report["segments"] = r.segments;
+  report["dexel"] = {{"cell_mm", spacing}, {"res", {r.lattice.n.x, r.lattice.n.y, r.lattice.n.z}}};
+  report["deviation"] = statistics(deviation);
+  report["gouges"] = gouge_list;
+  report["excess"] = excess_list;
+  report["design_side"] = design_side;
+  report["rapid_cuts"] = rapid_list;
+  if (envelope)
+    report["envelope"] = {{"box", {{"min", to_json(envelope->min)}, {"max", to_json(envelope->max)}}},
+                          {"violations", envelope_list}};
+  report["result"] = {{"volume_mm3", r.volume}, {"triangles", mesh.triangles.size()},
+                      {"watertight", r.mesh_check.closed()}};
+  report["timings_s"] = {{"parse", r.timings.parse}, {"zmap", r.timings.zmap}, {"dexelize", r.timings.dexelize},
+                         {"intersect", r.timings.intersect}, {"mesh", r.timings.mesh},
+                         {"deviation", deviation_s}, {"total", total_s}};
+  report["warnings"] = r.warnings;
+  if (!options.report.empty()) {
+    progress.stage("writing " + options.report);
+    write_file_atomically(options.report, report.dump(2) + "\n");
+  }
+  progress.finish();
+
+  if (!options.quiet) {
+    for (const std::string& w : r.warnings) std::cerr << "warning: " << w << '\n';
+    const Json& d = report["deviation"];
+    std::printf("%s vs %s: deviation %s; %zu gouge and %zu excess region(s) beyond -%g/+%g mm, "
+                "%zu rapid(s) cutting material, %zu move(s) outside the envelope: %s; %.2f s\n",
+                r.input.program.filename().string().c_str(), fs::path(options.design).filename().string().c_str(),
+                d.contains("min_mm") ? (std::to_string(d["min_mm"].get<double>()) + " .. " +
+                                        std::to_string(d["max_mm"].get<double>()) + " mm").c_str()
+                                     : "not measured (no material left)",
+                gouges.size(), excesses.size(), gouge_tol, excess_tol, rapid_list.size(), envelope_list.size(),
+                failed ? "FAIL" : "pass", total_s);
+    for (const Json& g : gouge_list)
+      if (g.contains("lines")) {
+        std::string lines;
+        for (int line : g["lines"]) lines += (lines.empty() ? "" : ", ") + std::to_string(line);
+        std::printf("  gouge %.3f mm at %s, lines %s\n", g["depth_mm"].get<double>(), g["centroid"].dump().c_str(),
+                    lines.empty() ? "?" : lines.c_str());
+      }
+    for (const Json& f : rapid_list)
+      std::printf("  rapid at line %d cuts %.3f mm of material\n", f["line"].get<int>(), f["depth_mm"].get<double>());
+    for (const Json& f : envelope_list)
+      std::printf("  line %d: tool tip %s outside the envelope\n", f["line"].get<int>(), f["tip"].dump().c_str());
+  }
+  return failed ? kFindings : kSuccess;
+}
+
+}  // namespace tridex::cli
