@@ -97,6 +97,9 @@ struct MoveGeometry {
   MoveGeometry(const Cutter& c, const Segment& s) : cutter(&c) {
     ax = s.a.x, ay = s.a.y, az = s.a.z;
     vx = s.b.x - s.a.x, vy = s.b.y - s.a.y, w = s.b.z - s.a.z;
+    // A level move that went through a tilted frame rises by rounding noise; taken as level (an
+    // error far below float heights) it gets the level moves' closed form.
+    if (std::abs(w) <= 1e-9) w = 0;
     vv = vx * vx + vy * vy;
     radius = c.radius(), radius2 = radius * radius;
     // Below this the move is treated as vertical: the horizontal drift is far below float
