@@ -211,7 +211,7 @@ int run_check(const CheckOptions& options) {
   try {
     design = read_stl(options.design, StlOptions{.require_closed = true});
   } catch (const tridex::Error& e) {
-    input_error("--design: ", e.what(), " (the design must be a closed solid)");
+    input_error("--design: ", e.what());
   }
   if (!(design.signed_volume() > 0))
     input_error("--design ", options.design, ": the mesh encloses no volume (", design.signed_volume(),
