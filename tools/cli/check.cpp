@@ -49,6 +49,8 @@ constexpr glm::vec3 kOkColour{0.70f, 0.76f, 0.70f};
 constexpr glm::vec3 kExcessColour{0.18f, 0.40f, 0.90f};
 constexpr std::size_t kRegionsListed = 100;   // per kind, deepest first
 constexpr std::size_t kRegionsWithLines = 20;
+constexpr std::size_t kFindingsListed = 1000;  // envelope violations in the report, in line order
+constexpr std::size_t kFindingsPrinted = 20;   // of each kind on stdout
 constexpr std::size_t kProbesPerRegion = 16;  // deepest vertices tested against the moves
 constexpr int kHistogramBins = 20;
 
@@ -304,6 +306,7 @@ int run_check(const CheckOptions& options) {
     rapid_list.push_back({{"line", f.line}, {"tool", f.tool}, {"axis", to_json(f.axis)},
                           {"depth_mm", f.depth_mm}, {"where", to_json(f.where)}});
   Json envelope_list = Json::array();
+  std::size_t envelope_outside = 0;
   if (envelope) {
     // Positions "far along the tool axis" (home returns, reorientations) are tridex's stand-in for
     // where the machine takes the tool, not programmed points.
@@ -313,7 +316,9 @@ int run_check(const CheckOptions& options) {
       for (const gcode::Move& m : group.moves)
         if (glm::length(m.end) < far && !envelope->contains(m.end)) outside.emplace_back(m.line, m.end);
     std::sort(outside.begin(), outside.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    for (const auto& [line, point] : outside) envelope_list.push_back({{"line", line}, {"tip", to_json(point)}});
+    envelope_outside = outside.size();
+    for (std::size_t k = 0; k < outside.size() && k < kFindingsListed; ++k)
+      envelope_list.push_back({{"line", outside[k].first}, {"tip", to_json(outside[k].second)}});
   }
 
   // ---- outputs ------------------------------------------------------------------------------
@@ -346,7 +351,7 @@ int run_check(const CheckOptions& options) {
                          " boundary, " + std::to_string(r.mesh_check.non_manifold_edges) + " non-manifold edges)");
 
   const bool failed = !gouges.empty() || !excesses.empty() || design_side_finding || !rapid_list.empty() ||
-                      !envelope_list.empty();
+                      envelope_outside > 0;
   const double total_s = seconds_since(start);
   Json report;
   report["program"] = r.input.program.string();
@@ -363,7 +368,7 @@ int run_check(const CheckOptions& options) {
   report["rapid_cuts"] = rapid_list;
   if (envelope)
     report["envelope"] = {{"box", {{"min", to_json(envelope->min)}, {"max", to_json(envelope->max)}}},
-                          {"violations", envelope_list}};
+                          {"outside", envelope_outside}, {"violations", envelope_list}};
   report["result"] = {{"volume_mm3", r.volume}, {"triangles", mesh.triangles.size()},
                       {"watertight", r.mesh_check.closed()}};
   report["timings_s"] = {{"parse", r.timings.parse}, {"zmap", r.timings.zmap}, {"dexelize", r.timings.dexelize},
@@ -379,25 +384,34 @@ int run_check(const CheckOptions& options) {
   if (!options.quiet) {
     for (const std::string& w : r.warnings) std::cerr << "warning: " << w << '\n';
     const Json& d = report["deviation"];
+    char range[96] = "not measured (no material left)";
+    if (d.contains("min_mm"))
+      std::snprintf(range, sizeof range, "%.4g .. %.4g mm", d["min_mm"].get<double>(), d["max_mm"].get<double>());
     std::printf("%s vs %s: deviation %s; %zu gouge and %zu excess region(s) beyond -%g/+%g mm, "
                 "%zu rapid(s) cutting material, %zu move(s) outside the envelope: %s; %.2f s\n",
                 r.input.program.filename().string().c_str(), fs::path(options.design).filename().string().c_str(),
-                d.contains("min_mm") ? (std::to_string(d["min_mm"].get<double>()) + " .. " +
-                                        std::to_string(d["max_mm"].get<double>()) + " mm").c_str()
-                                     : "not measured (no material left)",
-                gouges.size(), excesses.size(), gouge_tol, excess_tol, rapid_list.size(), envelope_list.size(),
+                range, gouges.size(), excesses.size(), gouge_tol, excess_tol, rapid_list.size(), envelope_outside,
                 failed ? "FAIL" : "pass", total_s);
+    std::size_t printed = 0;
     for (const Json& g : gouge_list)
-      if (g.contains("lines")) {
+      if (g.contains("lines") && printed++ < kFindingsPrinted) {
         std::string lines;
-        for (int line : g["lines"]) lines += (lines.empty() ? "" : ", ") + std::to_string(line);
-        std::printf("  gouge %.3f mm at %s, lines %s\n", g["depth_mm"].get<double>(), g["centroid"].dump().c_str(),
-                    lines.empty() ? "?" : lines.c_str());
+        std::size_t count = 0;
+        for (int line : g["lines"])
+          if (count++ < 10) lines += (lines.empty() ? "" : ", ") + std::to_string(line);
+        if (count > 10) lines += ", … (" + std::to_string(count) + " in all)";
+        const Json& c = g["centroid"];
+        std::printf("  gouge %.3f mm around (%.3f, %.3f, %.3f), lines %s\n", g["depth_mm"].get<double>(),
+                    c[0].get<double>(), c[1].get<double>(), c[2].get<double>(), lines.empty() ? "?" : lines.c_str());
       }
-    for (const Json& f : rapid_list)
-      std::printf("  rapid at line %d cuts %.3f mm of material\n", f["line"].get<int>(), f["depth_mm"].get<double>());
-    for (const Json& f : envelope_list)
-      std::printf("  line %d: tool tip %s outside the envelope\n", f["line"].get<int>(), f["tip"].dump().c_str());
+    for (std::size_t k = 0; k < rapid_list.size() && k < kFindingsPrinted; ++k)
+      std::printf("  rapid at line %d cuts %.3f mm of material\n", rapid_list[k]["line"].get<int>(),
+                  rapid_list[k]["depth_mm"].get<double>());
+    for (std::size_t k = 0; k < envelope_list.size() && k < kFindingsPrinted; ++k)
+      std::printf("  line %d: tool tip %s outside the envelope\n", envelope_list[k]["line"].get<int>(),
+                  envelope_list[k]["tip"].dump().c_str());
+    if (rapid_list.size() > kFindingsPrinted || envelope_outside > kFindingsPrinted)
+      std::printf("  (more in the report)\n");
   }
   return failed ? kFindings : kSuccess;
 }
