@@ -96,7 +96,9 @@ namespace detail {
 
 // Empty points sit this far below the stock: far enough that the polyhedron built on them
 // (Step 2) has a slab of non-zero thickness under the stock, and a few cells so that it is not
-// confused with a cut.
+// confused with a cut. The grid reaches as far beyond the stock's projection, so that the
+// polyhedron's side walls never lie in the plane of a stock face (a tie that loses a layer of
+// rays in the intersection).
 inline double empty_margin(double cell) { return 2.0 * cell; }
 
 // The interval of s where the line p + s·d lies inside the box (slab method); false if none.
@@ -141,7 +143,7 @@ inline ZMapGrid ZMapGrid::covering(const Frame& frame, const Aabb& local_box, do
 
 inline ZMap ZMap::from_box(const Frame& frame, const Aabb& stock, double cell, ZMapLimits limits) {
   Aabb local = local_bounds(frame, stock);
-  ZMapGrid g = ZMapGrid::covering(frame, local, cell);
+  ZMapGrid g = ZMapGrid::covering(frame, local.inflated(detail::empty_margin(cell)), cell);
   float empty = static_cast<float>(local.min.z - detail::empty_margin(cell));
   ZMap map(g, empty, empty, limits);
   const Vec3 up = frame.axis();
@@ -165,7 +167,7 @@ inline ZMap ZMap::from_mesh(const Frame& frame, const Mesh& stock, double cell,
     if (!is_finite(local[v])) detail::fail("Z-map: stock mesh vertex ", v, " is not finite");
     box.extend(local[v]);
   }
-  ZMapGrid g = ZMapGrid::covering(frame, box, cell);
+  ZMapGrid g = ZMapGrid::covering(frame, box.inflated(detail::empty_margin(cell)), cell);
   float empty = static_cast<float>(box.min.z - detail::empty_margin(cell));
   ZMap map(g, empty, empty, limits);
   // Rasterise each triangle's projection; the top surface above a point is the highest hit.

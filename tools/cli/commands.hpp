@@ -27,6 +27,8 @@ struct SimulateOptions : CommonOptions {
   std::string output, png, report, dump_zmaps;
   unsigned threads = 0;         // 0: every hardware thread
   std::string max_memory;       // empty: 80 % of RAM
+  std::string zmap_backend = "cpu";   // --zmap-backend: cpu | gl (tools/backends)
+  std::string dexel_backend = "scan";  // --dexel-backend: scan | tree | embree
 };
 
 // `check`: simulate's options (--report and --png are the check's own report and picture; -o still

@@ -56,6 +56,14 @@ void add_simulate(CLI::App& command, SimulateOptions& options) {
                   "write each direction's milled Z-map to DIR as STL and as a height picture");
   command.add_option("--threads", options.threads, "worker threads (default: every hardware thread)")
       ->check(CLI::Range(0u, 4096u));
+  command.add_option("--zmap-backend", options.zmap_backend,
+                     "Step 1: cpu (the kernel's exact milling, default) or gl (the swept cutters drawn into an\n"
+                     "OSMesa float depth buffer)")
+      ->check(CLI::IsMember({"cpu", "gl"}));
+  command.add_option("--dexel-backend", options.dexel_backend,
+                     "Steps 2-3: scan (scan conversion onto the ray grids, default), tree (the paper's grid\n"
+                     "AABB tree) or embree (Embree 3 ray casting)")
+      ->check(CLI::IsMember({"scan", "tree", "embree"}));
   command.add_option("--max-memory", options.max_memory,
                   "refuse resolutions whose estimated memory exceeds this (e.g. 4G; default 80 % of RAM)");
 }

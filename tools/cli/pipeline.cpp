@@ -9,6 +9,7 @@
 #include "output.hpp"
 #include "rapid_check.hpp"
 #include "render.hpp"
+#include "tridex/backends/backends.hpp"
 #include "tridex/dexel_ops.hpp"
 #include "tridex/dexelize.hpp"
 #include "tridex/machine.hpp"
@@ -68,7 +69,8 @@ void write_png_file(const fs::path& path, const render::Image& image) {
 // what the map holds when the rapid runs (RapidCheck::in_program_order).
 void mill_in_program_order(ZMap& map, const gcode::MoveGroup& group, std::size_t g,
                            std::span<const Cutter> cutters,
-                           const std::map<int, std::uint32_t>& cutter_of_tool, unsigned threads,
+                           const std::map<int, std::uint32_t>& cutter_of_tool,
+                           backends::ZMapBackend backend, unsigned threads,
                            std::vector<RapidFinding>& found) {
   // Heights only fall, so a rapid entirely above the initial top cuts nothing and needs no flush.
   float top = -std::numeric_limits<float>::infinity();
@@ -78,7 +80,7 @@ void mill_in_program_order(ZMap& map, const gcode::MoveGroup& group, std::size_t
     CutMove cut{Segment{group.frame.to_local(m.start), group.frame.to_local(m.end)}, cutter_of_tool.at(m.tool)};
     if (m.kind == gcode::MoveKind::rapid &&
         std::min(cut.tip.a.z, cut.tip.b.z) < double(top) - kRapidTolerance) {
-      mill(map, cutters, batch, MillOptions{threads});
+      backends::mill_with(backend, map, cutters, batch, threads);
       batch.clear();
       CutDepth deepest = cut_depth(map, cutters[cut.cutter], cut.tip);
       if (deepest.depth > kRapidTolerance) {
@@ -88,7 +90,7 @@ void mill_in_program_order(ZMap& map, const gcode::MoveGroup& group, std::size_t
     }
     batch.push_back(cut);
   }
-  mill(map, cutters, batch, MillOptions{threads});
+  backends::mill_with(backend, map, cutters, batch, threads);
 }
 
 }  // namespace
@@ -242,6 +244,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   t = Clock::now();
   std::vector<ZMap>& maps = r.maps;
   maps.reserve(groups.size());
+  const backends::ZMapBackend zmap_backend = backends::parse_zmap_backend(options.zmap_backend);
   ZMapLimits limits;
   limits.max_points = std::numeric_limits<std::size_t>::max();  // the memory check above rules
   for (std::size_t g = 0; g < groups.size(); ++g) {
@@ -252,7 +255,8 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
                               : ZMap::from_box(group.frame, stock.box, zmap_cell, limits));
     r.segments += static_cast<long long>(group.moves.size());
     if (request.rapid_check == RapidCheck::in_program_order) {
-      mill_in_program_order(maps.back(), group, g, cutters, cutter_of_tool, options.threads, r.rapid_cuts);
+      mill_in_program_order(maps.back(), group, g, cutters, cutter_of_tool, zmap_backend, options.threads,
+                            r.rapid_cuts);
       continue;
     }
     // Feed moves first; the rapids are checked against what the feeds leave, then milled too.
@@ -268,12 +272,12 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
         feeds.push_back(cut);
       }
     }
-    mill(maps.back(), cutters, feeds, MillOptions{options.threads});
+    backends::mill_with(zmap_backend, maps.back(), cutters, feeds, options.threads);
     for (const RapidCut& found : rapid_cuts(maps.back(), cutters, rapids, kRapidTolerance)) {
       const gcode::Move& m = *rapid_moves[found.index];
       r.rapid_cuts.push_back(RapidFinding{m.line, m.tool, group.axis, found.depth_mm, m.end, g});
     }
-    mill(maps.back(), cutters, rapids, MillOptions{options.threads});
+    backends::mill_with(zmap_backend, maps.back(), cutters, rapids, options.threads);
   }
   r.timings.zmap = seconds_since(t);
 
@@ -305,7 +309,8 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   r.timings.dexelize = seconds_since(t);
   progress.stage("dexelizing and intersecting " + std::to_string(maps.size()) + " Z-maps");
   t = Clock::now();
-  r.result = machine(stock_dexel, maps, options.threads);
+  r.result = backends::machine_with(backends::parse_dexel_backend(options.dexel_backend), stock_dexel, maps,
+                                    options.threads);
   r.timings.intersect = seconds_since(t);
   stock_dexel = TripleDexel{};
   maps = std::move(kept_maps);
