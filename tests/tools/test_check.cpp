@@ -310,6 +310,34 @@ TEST_CASE("check: a plunge 0.3 mm too deep in a tilted direction is a gouge of 0
   CHECK(reddish_pixels(png) > 1000);
 }
 
+TEST_CASE("check: a hole left out is excess, from the machined side and from the design's") {
+  Fixture f("check-excess");
+  CommandResult r = f.check(program(5));  // the "plunge" stays above the stock
+  INFO(r.err);
+  INFO(r.out);
+  CHECK(r.status == 3);
+  json report = f.report();
+  CHECK(report["gouges"].empty());
+  CHECK(report["rapid_cuts"].empty());
+  REQUIRE(!report["excess"].empty());
+  // Over the hole's floor (feature z = -2, radius 3 around (0, 4)) the material left is the
+  // groove's floor (z = -1, where y ≤ 3) or else the top face (z = -y·tan 20°, below -1.09 for
+  // y > 3): at most 1 mm above the floor, from the groove. Within a dexel cell (0.1 mm).
+  double deepest = 0;
+  for (double y = 1; y <= 7; y += 0.001)
+    deepest = std::max(deepest, (y <= 3 ? -1.0 : -y * std::tan(glm::radians(kTilt))) + 2);
+  const json& excess = report["excess"][0];
+  CHECK(excess["depth_mm"].get<double>() == doctest::Approx(deepest).epsilon(0.1 / deepest));
+  CHECK(!excess.contains("lines"));
+  Vec3 centroid(excess["centroid"][0].get<double>(), excess["centroid"][1].get<double>(),
+                excess["centroid"][2].get<double>());
+  CHECK(glm::length(centroid - to_work(Vec3(0, 4, -1))) < 2.5);
+  // The hole's floor and wall, seen from the design, lie inside the machined solid.
+  CHECK(report["design_side"]["left"]["samples"].get<long long>() > 0);
+  CHECK(report["design_side"]["left"]["depth_mm"].get<double>() == doctest::Approx(deepest).epsilon(0.1 / deepest));
+  CHECK(report["design_side"]["missing"]["samples"] == 0);
+}
+
 TEST_CASE("check: rapids through material are reported with their line, in program order") {
   Fixture f("check-rapid");
   // Line 8 rapids 0.5 mm into the stock where the groove (lines 12-13) cuts later: no gouge, but a

@@ -11,8 +11,8 @@
 // spacing absorbing the surface's resolution.
 //
 // The design side: a part feature cut away entirely (a thin rib) can leave a machined surface
-// that lies on the design everywhere, so the design's own vertices and triangle centroids are
-// measured against the machined surface too (signed by the result's triple dexel): a design
+// that lies on the design everywhere, so points on the design's surface (its vertices and samples
+// about two dexel spacings apart, at most 4 million) are measured against the machined surface too (signed by the result's triple dexel): a design
 // sample outside the machined solid beyond --gouge-tol is material missing, one inside beyond
 // --excess-tol is material left. These are counted and bounded, not split into regions.
 #include <algorithm>
@@ -53,6 +53,7 @@ constexpr std::size_t kFindingsListed = 1000;  // envelope violations in the rep
 constexpr std::size_t kFindingsPrinted = 20;   // of each kind on stdout
 constexpr std::size_t kProbesPerRegion = 16;  // deepest vertices tested against the moves
 constexpr int kHistogramBins = 20;
+constexpr double kMaxDesignSamples = 4e6;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -118,6 +119,34 @@ Json statistics(std::vector<double> values) {
   for (int b = 0; b <= kHistogramBins; ++b) edges.push_back(lo + b * width);
   s["histogram"] = {{"edges_mm", edges}, {"counts", counts}};
   return s;
+}
+
+// Points on the design's surface about `step` apart: its vertices, and in each triangle split into
+// n² similar ones (n = ⌈longest edge / step⌉) their centroids; the step grows until at most
+// kMaxDesignSamples remain.
+std::vector<Vec3> design_samples(const Mesh& design, double step) {
+  auto splits = [&](const glm::uvec3& t, double s) {
+    Vec3 a(design.positions[t.x]), b(design.positions[t.y]), c(design.positions[t.z]);
+    double longest = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
+    return std::max(1.0, std::ceil(longest / s));
+  };
+  for (;;) {
+    double total = static_cast<double>(design.positions.size());
+    for (const glm::uvec3& t : design.triangles) total += splits(t, step) * splits(t, step);
+    if (total <= kMaxDesignSamples) break;
+    step *= std::sqrt(total / kMaxDesignSamples) * 1.01;
+  }
+  std::vector<Vec3> samples(design.positions.begin(), design.positions.end());
+  for (const glm::uvec3& t : design.triangles) {
+    Vec3 a(design.positions[t.x]), ab = Vec3(design.positions[t.y]) - a, ac = Vec3(design.positions[t.z]) - a;
+    const auto n = static_cast<int>(splits(t, step));
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; i + j < n; ++j) {
+        samples.push_back(a + ((i + 1.0 / 3) / n) * ab + ((j + 1.0 / 3) / n) * ac);
+        if (i + j + 1 < n) samples.push_back(a + ((i + 2.0 / 3) / n) * ab + ((j + 2.0 / 3) / n) * ac);
+      }
+  }
+  return samples;
 }
 
 // Source lines of the moves whose swept cutter reaches the region's deepest vertices.
@@ -253,11 +282,7 @@ int run_check(const CheckOptions& options) {
   std::vector<DeviationRegion> excesses = deviation_regions(mesh, deviation, excess);
 
   // ---- the design side ------------------------------------------------------------------------
-  std::vector<Vec3> samples;
-  samples.reserve(design.positions.size() + design.triangles.size());
-  for (const glm::vec3& p : design.positions) samples.emplace_back(p);
-  for (const glm::uvec3& tri : design.triangles)
-    samples.push_back((Vec3(design.positions[tri.x]) + Vec3(design.positions[tri.y]) + Vec3(design.positions[tri.z])) / 3.0);
+  std::vector<Vec3> samples = design_samples(design, 2 * spacing);
   std::vector<double> design_deviation;
   if (!mesh.triangles.empty()) {
     progress.stage("measuring the design against the machined surface");
