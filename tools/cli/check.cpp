@@ -386,6 +386,7 @@ int run_check(const CheckOptions& options) {
   report["stock"] = r.stock.description;
   report["segments"] = r.segments;
   report["dexel"] = {{"cell_mm", spacing}, {"res", {r.lattice.n.x, r.lattice.n.y, r.lattice.n.z}}};
+  report["backends"] = {{"zmap", options.zmap_backend}, {"dexel", options.dexel_backend}};
   report["deviation"] = statistics(deviation);
   report["gouges"] = gouge_list;
   report["excess"] = excess_list;
