@@ -66,6 +66,49 @@ inline int perturbed_sign(std::int64_t value, std::int64_t du, std::int64_t dv) 
   return du > 0 ? 1 : (du < 0 ? -1 : 0);
 }
 
+// One ray family from its crossings (found in any order, by any number of threads): a counting
+// sort by ray, then per ray a sort by position and spans by winding number, so that overlapping
+// shells unite. `unbalanced(ray, t)` is called (and must throw) where a ray's crossings do not
+// balance: an open or inside-out solid.
+template <class Unbalanced>
+DexelGrid grid_from_hits(const DexelLattice& lattice, int axis, unsigned threads,
+                         std::vector<std::vector<MeshHit>>& found, Unbalanced&& unbalanced) {
+  const std::size_t rays = static_cast<std::size_t>(lattice.n[TripleDexel::u_axis(axis)]) *
+                           static_cast<std::size_t>(lattice.n[TripleDexel::v_axis(axis)]);
+  std::vector<std::size_t> start(rays + 1, 0);
+  for (const auto& list : found)
+    for (const MeshHit& h : list) ++start[h.ray + 1];
+  for (std::size_t r = 0; r < rays; ++r) start[r + 1] += start[r];
+  std::vector<MeshHit> sorted(start[rays]);
+  {
+    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+    for (auto& list : found) {
+      for (const MeshHit& h : list) sorted[fill[h.ray]++] = h;
+      std::vector<MeshHit>().swap(list);
+    }
+  }
+  return build_grid(lattice, axis, threads, [&](std::size_t r, std::vector<DexelInterval>& out) {
+    auto first = sorted.begin() + static_cast<std::ptrdiff_t>(start[r]);
+    auto last = sorted.begin() + static_cast<std::ptrdiff_t>(start[r + 1]);
+    if (last - first == 2) {  // the usual case: one span
+      if (first[1].t < first[0].t) std::swap(first[0], first[1]);
+    } else {
+      std::sort(first, last, [](const MeshHit& p, const MeshHit& q) { return p.t < q.t; });
+    }
+    std::size_t ray_start = out.size();
+    int winding = 0;
+    double enter = 0;
+    for (auto it = first; it != last;) {
+      float t = it->t;
+      int before = winding;
+      for (; it != last && it->t == t; ++it) winding += it->direction;
+      if (winding < 0 || (it == last && winding != 0)) unbalanced(r, t);
+      if (before == 0 && winding > 0) enter = t;
+      if (before > 0 && winding == 0) push_span(out, ray_start, enter, t);
+    }
+  });
+}
+
 }  // namespace detail
 
 // (b): any closed, outward-oriented mesh. Throws tridex::Error for an invalid lattice, a vertex
@@ -150,37 +193,9 @@ inline TripleDexel dexelize(const Mesh& mesh, const DexelLattice& lattice, Dexel
       worker(0);
       for (std::thread& th : pool) th.join();
     }
-    // Counting sort by ray.
-    const std::size_t rays = static_cast<std::size_t>(nu) * static_cast<std::size_t>(nv);
-    std::vector<std::size_t> start(rays + 1, 0);
-    for (const auto& list : found)
-      for (const detail::MeshHit& h : list) ++start[h.ray + 1];
-    for (std::size_t r = 0; r < rays; ++r) start[r + 1] += start[r];
-    std::vector<detail::MeshHit> sorted(start[rays]);
-    {
-      std::vector<std::size_t> fill(start.begin(), start.end() - 1);
-      for (auto& list : found) {
-        for (const detail::MeshHit& h : list) sorted[fill[h.ray]++] = h;
-        std::vector<detail::MeshHit>().swap(list);
-      }
-    }
-    result.grids[axis] = detail::build_grid(lattice, axis, threads, [&](std::size_t r, std::vector<DexelInterval>& out) {
-      auto first = sorted.begin() + static_cast<std::ptrdiff_t>(start[r]);
-      auto last = sorted.begin() + static_cast<std::ptrdiff_t>(start[r + 1]);
-      std::sort(first, last, [](const detail::MeshHit& p, const detail::MeshHit& q) { return p.t < q.t; });
-      std::size_t ray_start = out.size();
-      int winding = 0;
-      double enter = 0;
-      for (auto it = first; it != last;) {
-        float t = it->t;
-        int before = winding;
-        for (; it != last && it->t == t; ++it) winding += it->direction;
-        if (winding < 0 || (it == last && winding != 0))
-          detail::fail("dexelize: mesh is not closed or not outward-oriented: ray ", r % static_cast<std::size_t>(nu), ", ",
-                       r / static_cast<std::size_t>(nu), " along axis ", "xyz"[axis], " has unbalanced crossings at ", t);
-        if (before == 0 && winding > 0) enter = t;
-        if (before > 0 && winding == 0) detail::push_span(out, ray_start, enter, t);
-      }
+    result.grids[axis] = detail::grid_from_hits(lattice, axis, threads, found, [&](std::size_t r, float t) {
+      detail::fail("dexelize: mesh is not closed or not outward-oriented: ray ", r % static_cast<std::size_t>(nu), ", ",
+                   r / static_cast<std::size_t>(nu), " along axis ", "xyz"[axis], " has unbalanced crossings at ", t);
     });
   }
   return result;

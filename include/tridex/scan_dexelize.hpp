@@ -270,42 +270,10 @@ inline DexelGrid scan_family(const ZMap& map, const DexelLattice& lattice, int a
     worker(0);
     for (std::thread& th : pool) th.join();
   }
-  const int u = TripleDexel::u_axis(axis), v = TripleDexel::v_axis(axis);
-  const std::size_t nu = static_cast<std::size_t>(lattice.n[u]);
-  const std::size_t rays = nu * static_cast<std::size_t>(lattice.n[v]);
-  std::vector<std::size_t> start(rays + 1, 0);
-  for (const auto& list : found)
-    for (const MeshHit& h : list) ++start[h.ray + 1];
-  for (std::size_t r = 0; r < rays; ++r) start[r + 1] += start[r];
-  std::vector<MeshHit> sorted(start[rays]);
-  {
-    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
-    for (auto& list : found) {
-      for (const MeshHit& h : list) sorted[fill[h.ray]++] = h;
-      std::vector<MeshHit>().swap(list);
-    }
-  }
-  return build_grid(lattice, axis, threads, [&](std::size_t r, std::vector<DexelInterval>& out) {
-    auto first = sorted.begin() + static_cast<std::ptrdiff_t>(start[r]);
-    auto last = sorted.begin() + static_cast<std::ptrdiff_t>(start[r + 1]);
-    if (last - first == 2) {  // the usual case: one span
-      if (first[1].t < first[0].t) std::swap(first[0], first[1]);
-    } else {
-      std::sort(first, last, [](const MeshHit& p, const MeshHit& q) { return p.t < q.t; });
-    }
-    std::size_t ray_start = out.size();
-    int winding = 0;
-    double enter = 0;
-    for (auto it = first; it != last;) {
-      float t = it->t;
-      int before = winding;
-      for (; it != last && it->t == t; ++it) winding += it->direction;
-      if (winding < 0 || (it == last && winding != 0))
-        fail("scan dexelize: unbalanced crossings on ray ", r % nu, ", ", r / nu, " along axis ", "xyz"[axis],
-             " at ", t, " (an internal error: please report the Z-map and lattice)");
-      if (before == 0 && winding > 0) enter = t;
-      if (before > 0 && winding == 0) push_span(out, ray_start, enter, t);
-    }
+  const std::size_t nu = static_cast<std::size_t>(lattice.n[TripleDexel::u_axis(axis)]);
+  return grid_from_hits(lattice, axis, threads, found, [&](std::size_t r, float t) {
+    fail("scan dexelize: unbalanced crossings on ray ", r % nu, ", ", r / nu, " along axis ", "xyz"[axis], " at ", t,
+         " (an internal error: please report the Z-map and lattice)");
   });
 }
 
