@@ -413,11 +413,13 @@ int run_check(const CheckOptions& options) {
     char range[96] = "not measured (no material left)";
     if (d.contains("min_mm"))
       std::snprintf(range, sizeof range, "%.4g .. %.4g mm", d["min_mm"].get<double>(), d["max_mm"].get<double>());
-    std::printf("%s vs %s: deviation %s; %zu gouge and %zu excess region(s) beyond -%g/+%g mm, "
-                "%zu rapid(s) cutting material, %zu move(s) outside the envelope: %s; %.2f s\n",
+    std::printf("%s vs %s: deviation %s; %zu gouge and %zu excess region(s) beyond -%g/+%g mm, design "
+                "samples %lld missing and %lld left, %zu rapid(s) cutting material, %zu move(s) outside the "
+                "envelope: %s; %.2f s\n",
                 r.input.program.filename().string().c_str(), fs::path(options.design).filename().string().c_str(),
-                range, gouges.size(), excesses.size(), gouge_tol, excess_tol, rapid_list.size(), envelope_outside,
-                failed ? "FAIL" : "pass", total_s);
+                range, gouges.size(), excesses.size(), gouge_tol, excess_tol,
+                design_side["missing"]["samples"].get<long long>(), design_side["left"]["samples"].get<long long>(),
+                rapid_list.size(), envelope_outside, failed ? "FAIL" : "pass", total_s);
     std::size_t printed = 0;
     for (const Json& g : gouge_list)
       if (g.contains("lines") && printed++ < kFindingsPrinted) {
