@@ -235,6 +235,12 @@ int run_check(const CheckOptions& options) {
   Progress progress(!options.quiet && (options.progress || stderr_is_terminal()));
 
   // ---- inputs that the pipeline does not know, checked before any work --------------------
+  // The rapid check reads each direction's Z-map between batches with the kernel's cut_depth; the
+  // GL backend's maps do not agree with it (simulate --zmap-backend gl lists retracts through cut
+  // space as rapid cuts), so check keeps to the exact kernel milling.
+  if (options.zmap_backend != "cpu")
+    input_error("--zmap-backend ", options.zmap_backend,
+                ": check needs the kernel's exact milling (cpu) for its rapid check");
   std::optional<Aabb> envelope;
   if (!options.envelope.empty()) envelope = parse_envelope(options.envelope);
   progress.stage("reading the design " + options.design);
