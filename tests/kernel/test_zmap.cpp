@@ -2,6 +2,7 @@
 
 #include <random>
 
+#include "test_dexel_shapes.hpp"
 #include "tridex/machine.hpp"
 #include "tridex/mill.hpp"
 #include "tridex/zmap.hpp"
@@ -9,19 +10,6 @@
 using namespace tridex;
 
 namespace {
-
-Mesh box_mesh(const Aabb& b) {
-  Mesh m;
-  for (const Vec3& c : b.corners()) m.positions.emplace_back(c);
-  // Corner index bits: 1 = +x, 2 = +y, 4 = +z. Faces counter-clockwise from outside.
-  const unsigned quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                                {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& q : quads) {
-    m.triangles.emplace_back(q[0], q[1], q[2]);
-    m.triangles.emplace_back(q[0], q[2], q[3]);
-  }
-  return m;
-}
 
 // Top of the box above a frame-local point, by marching along the frame's axis.
 double brute_top(const Frame& f, const Aabb& box, double x, double y, double lo, double hi) {
@@ -99,7 +87,7 @@ TEST_CASE("Z-map from a closed mesh equals the Z-map from the same box") {
   const Aabb box{Vec3(0, 0, 0), Vec3(10, 6, 3)};
   for (Vec3 axis : {Vec3(0, 0, 1), Vec3(1, 2, 3), Vec3(-1, 0.3, 0.2)}) {
     Frame f = Frame::from_axis(axis);
-    ZMap a = ZMap::from_box(f, box, 0.25), b = ZMap::from_mesh(f, box_mesh(box), 0.25);
+    ZMap a = ZMap::from_box(f, box, 0.25), b = ZMap::from_mesh(f, tridex_test::box_mesh(box.min, box.max), 0.25);
     REQUIRE(a.grid.nx == b.grid.nx);
     REQUIRE(a.grid.ny == b.grid.ny);
     int differ = 0;
