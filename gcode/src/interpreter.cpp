@@ -627,6 +627,16 @@ struct Interpreter::State {
     if (bottom > r_level)
       error(motion_column, "hole bottom " + format_number(bottom) + " is above the R plane " +
                                format_number(r_level));
+    if (code == 730 || code == 830) {
+      // A real control pecks a hole a few hundred times at most; a tiny Q against a deep hole
+      // (or a far R plane) would emit moves without end, and below one ulp would never finish.
+      constexpr double kMaxPecks = 100000;
+      double pecks = (r_level - bottom) / cycle_q;
+      if (!(pecks <= kMaxPecks))
+        error(motion_column, code_name('G', code) + " would peck " + format_number(pecks) +
+                                 " times (R " + format_number(r_level) + " to " + format_number(bottom) +
+                                 " by Q " + format_number(cycle_q) + "); at most 100000 per hole");
+    }
     bool clear_far = !retract_to_r && cycle_initial_far;
     double clear = retract_to_r ? r_level : std::max(cycle_initial, r_level);
     if (clear_far) clear = r_level;

@@ -106,3 +106,15 @@ TEST_CASE("max_blocks bounds endless subprogram loops") {
   std::string loop = "O1\nM98 P2 L9999\nM30\nO2\nM98 P3 L9999\nM99\nO3\nG4 P0\nM99\n";
   CHECK_THROWS_AS(run_program(loop, options), GcodeError);
 }
+
+TEST_CASE("fuzz: G73 with an R plane 780 km up and Q3 — too many pecks is an error, not a hang") {
+  InterpreterOptions lenient;  // as the fuzzer runs it: the unsupported G221 is skipped
+  lenient.lenient = true;
+  Diagnostic d = error_of(file_text("fuzz/timeout-far-r-plane-pecks.nc"), lenient);
+  CAPTURE(d.message);
+  CHECK(d.line == 6);
+  CHECK(d.message.find("would peck") != std::string::npos);
+  survives(file_text("fuzz/timeout-far-r-plane-pecks.nc"));
+  // A sensible deep hole still pecks.
+  CHECK_NOTHROW(run_program("G21 G90 G17 F100\nG0 X0 Y0 Z5\nG83 X1 Y1 Z-30 R2 Q0.5\nG80\nM2\n"));
+}
