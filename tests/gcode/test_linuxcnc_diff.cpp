@@ -207,6 +207,35 @@ std::string random_program(std::mt19937_64& rng) {
   return text + "M2\n";
 }
 
+// Runs rs274 and tridex on `program` and checks that every move end point agrees within rs274's
+// printed precision, reporting at most `max_reports` disagreements; returns how many were compared
+// and whether all agreed.
+struct Comparison {
+  std::size_t compared = 0;
+  bool agreed = true;
+};
+
+Comparison compare_with_rs274(const fs::path& program, int max_reports) {
+  std::string log;
+  std::vector<Point> theirs = run_rs274(program, log);
+  std::vector<Point> ours = run_tridex(program);
+  INFO("rs274 log: " << log.substr(0, 600));
+  CHECK(ours.size() == theirs.size());
+  std::size_t n = std::min(ours.size(), theirs.size());
+  int reported = 0;
+  for (std::size_t i = 0; i < n && reported < max_reports; ++i) {
+    Vec3 d = glm::abs(ours[i].p - theirs[i].p);
+    if (std::max(d.x, std::max(d.y, d.z)) > theirs[i].tolerance) {
+      ++reported;
+      FAIL_CHECK("move " << i << ": tridex (line " << ours[i].record << ") " << ours[i].p.x << " "
+                         << ours[i].p.y << " " << ours[i].p.z << " vs rs274 (record "
+                         << theirs[i].record << ") " << theirs[i].p.x << " " << theirs[i].p.y
+                         << " " << theirs[i].p.z);
+    }
+  }
+  return {n, reported == 0 && ours.size() == theirs.size()};
+}
+
 }  // namespace
 
 TEST_CASE("differential: random programs agree with rs274") {
@@ -225,24 +254,9 @@ TEST_CASE("differential: random programs agree with rs274") {
       out << random_program(rng);
     }
     CAPTURE(trial);
-    std::string log;
-    std::vector<Point> theirs = run_rs274(program, log);
-    std::vector<Point> ours = run_tridex(program);
-    INFO("rs274 log: " << log.substr(0, 600));
-    CHECK(ours.size() == theirs.size());
-    std::size_t n = std::min(ours.size(), theirs.size());
-    int reported = 0;
-    for (std::size_t i = 0; i < n && reported < 3; ++i) {
-      Vec3 d = glm::abs(ours[i].p - theirs[i].p);
-      if (std::max(d.x, std::max(d.y, d.z)) > theirs[i].tolerance) {
-        ++reported;
-        FAIL_CHECK("move " << i << ": tridex (line " << ours[i].record << ") " << ours[i].p.x << " "
-                           << ours[i].p.y << " " << ours[i].p.z << " vs rs274 " << theirs[i].p.x
-                           << " " << theirs[i].p.y << " " << theirs[i].p.z);
-      }
-    }
-    compared += n;
-    if (reported == 0 && ours.size() == theirs.size()) fs::remove(program);
+    Comparison c = compare_with_rs274(program, 3);
+    compared += c.compared;
+    if (c.agreed) fs::remove(program);
   }
   MESSAGE("random programs: " << compared << " end points compared");
 }
@@ -256,24 +270,7 @@ TEST_CASE("differential: LinuxCNC rs274 and tridex agree on every move end point
   for (const fs::path& program : corpus()) {
     CAPTURE(program.string());
     REQUIRE_MESSAGE(fs::exists(program), "corpus file missing");
-    std::string log;
-    std::vector<Point> theirs = run_rs274(program, log);
-    std::vector<Point> ours = run_tridex(program);
-    INFO("rs274 log: " << log.substr(0, 600));
-    CHECK(ours.size() == theirs.size());
-    std::size_t n = std::min(ours.size(), theirs.size());
-    int reported = 0;
-    for (std::size_t i = 0; i < n && reported < 5; ++i) {
-      Vec3 d = glm::abs(ours[i].p - theirs[i].p);
-      double worst = std::max(d.x, std::max(d.y, d.z));
-      if (worst > theirs[i].tolerance) {
-        ++reported;
-        FAIL_CHECK("move " << i << ": tridex (line " << ours[i].record << ") " << ours[i].p.x << " "
-                           << ours[i].p.y << " " << ours[i].p.z << " vs rs274 (record "
-                           << theirs[i].record << ") " << theirs[i].p.x << " " << theirs[i].p.y
-                           << " " << theirs[i].p.z);
-      }
-    }
+    std::size_t n = compare_with_rs274(program, 5).compared;
     MESSAGE(program.filename().string() << ": " << n << " end points compared");
   }
 }
