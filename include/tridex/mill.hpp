@@ -64,16 +64,28 @@ constexpr int kBinTiles = 8;     // tiles along each side of a work block
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Doubles processed as one value (GCC/Clang vector extension): four with AVX, two with the
-// SSE2 of every x86-64, two in plain scalar code elsewhere. Used by the ball end's row loop.
+// SSE2 of every x86-64, two in plain scalar code elsewhere. Comparisons give a MaskN of
+// all-ones/all-zeros lanes.
 #if defined(__AVX__)
 using DoubleN = double __attribute__((vector_size(32)));
+using MaskN = long long __attribute__((vector_size(32)));
+using FloatN = float __attribute__((vector_size(16)));
 #else
 using DoubleN = double __attribute__((vector_size(16)));
+using MaskN = long long __attribute__((vector_size(16)));
+using FloatN = float __attribute__((vector_size(8)));
 #endif
 constexpr int kLanes = static_cast<int>(sizeof(DoubleN) / sizeof(double));
 inline DoubleN splat(double v) { return DoubleN{} + v; }
+inline DoubleN load_n(const double* p) {
+  DoubleN v;
+  __builtin_memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void store_n(double* p, DoubleN v) { __builtin_memcpy(p, &v, sizeof v); }
 inline DoubleN min_n(DoubleN a, DoubleN b) { return a < b ? a : b; }
 inline DoubleN max_n(DoubleN a, DoubleN b) { return a > b ? a : b; }
+inline DoubleN abs_n(DoubleN a) { return a < 0 ? -a : a; }
 inline DoubleN sqrt_n(DoubleN a) {
 #if defined(__AVX__)
   return reinterpret_cast<DoubleN>(_mm256_sqrt_pd(reinterpret_cast<__m256d>(a)));
@@ -82,6 +94,20 @@ inline DoubleN sqrt_n(DoubleN a) {
 #else
   return DoubleN{std::sqrt(a[0]), std::sqrt(a[1])};
 #endif
+}
+inline bool any_n(MaskN m) {
+#if defined(__AVX__)
+  return _mm256_movemask_pd(reinterpret_cast<__m256d>(m)) != 0;
+#elif defined(__SSE2__)
+  return _mm_movemask_pd(reinterpret_cast<__m128d>(m)) != 0;
+#else
+  return (m[0] | m[1]) != 0;
+#endif
+}
+inline DoubleN lane_index() {
+  DoubleN lane{};
+  for (int l = 0; l < kLanes; ++l) lane[l] = l;
+  return lane;
 }
 
 // The geometry of one move, in coordinates relative to its start point.
@@ -223,28 +249,6 @@ struct MoveGeometry {
     return {height(t), t};
   }
 
-  // ball_lowest(...).z at the `count` points x_first + k·step, k = 0..count−1, of the row y,
-  // kLanes at a time; +infinity where the cutter does not pass. `out` holds a multiple of kLanes.
-  void ball_row(double x_first, double step, double y, int count, double* out) const {
-    const double uy = y - ay, uy_vy = uy * vy, uy2 = uy * uy;
-    DoubleN lane{};
-    for (int l = 0; l < kLanes; ++l) lane[l] = l;
-    for (int k = 0; k < count; k += kLanes) {
-      DoubleN ux = (x_first - ax) + (lane + k) * step;
-      DoubleN dot = ux * vx + uy_vy;
-      DoubleN t_foot = dot * inv_vv;
-      DoubleN e2 = ux * ux + uy2 - t_foot * dot;
-      DoubleN root_e = sqrt_n(max_n(radius2 - e2, splat(0)));
-      DoubleN lo = max_n(t_foot - root_e * inv_len, splat(0));
-      DoubleN hi = min_n(t_foot + root_e * inv_len, splat(1));
-      DoubleN t = min_n(max_n(t_foot - w * ball_factor * root_e, lo), hi);
-      DoubleN dx = ux - t * vx, dy = uy - t * vy;
-      DoubleN z = az + t * w + radius - sqrt_n(max_n(radius2 - (dx * dx + dy * dy), splat(0)));
-      z = (e2 > radius2) | (lo > hi) ? splat(kInf) : z;
-      __builtin_memcpy(out + k, &z, sizeof z);
-    }
-  }
-
   double lowest_above(double x, double y) const { return lowest(x, y).z; }
 
   // A supporting plane of the swept lower surface S at (x, y), where S(x, y) = p.z is finite:
@@ -350,6 +354,87 @@ struct MoveGeometry {
   }
 };
 
+// The ball end's swept surface S for one non-vertical move, kLanes points at a time: the hot
+// path of milling. It is MoveGeometry::ball_lowest rewritten with one square root per point:
+// with the move stored rising (w ≥ 0; a falling move is the same swept solid run backwards), the
+// minimiser t* = t⊥ − c·k (c = w / (|v|·√(|v|² + w²)), k = √(R² − e²)) lies
+//   * before the start exactly when t⊥ < 0 or t⊥² < c²k², and S is the start sphere's
+//     az + R − √(R² − |u|²);
+//   * past the end exactly when t⊥ > 1 and (t⊥ − 1)² > c²k², and S is the end sphere's;
+//   * otherwise on the swept cylinder, whose lowest point above q is
+//     az + R + t⊥·w − √(k²·(1 + w²/|v|²))  (a vertical line meeting a tilted cylinder),
+// and in each case q is covered exactly when the square root's argument is not negative.
+// The cylinder's gradient is w·v/|v|² + (1 + w²/|v|²)·(u − t⊥·v)/√(…) and a sphere's (u − t·v)/√(…),
+// the supporting plane of MoveGeometry::supporting_plane in other terms.
+struct BallLanes {
+  double ax = 0, ay = 0, top = 0;  // start of the (rising) move; top = its tip + R, the ball's centre
+  double vx = 0, vy = 0, w = 0, vv = 0, inv_vv = 0, stretch = 1, c2 = 0, r2 = 0, rim = 0;
+  double slope_x = 0, slope_y = 0;  // w·v/|v|²
+
+  BallLanes() = default;
+
+  explicit BallLanes(const MoveGeometry& m) {
+    const bool falling = m.w < 0;
+    ax = falling ? m.ax + m.vx : m.ax, ay = falling ? m.ay + m.vy : m.ay;
+    vx = falling ? -m.vx : m.vx, vy = falling ? -m.vy : m.vy, w = std::abs(m.w);
+    top = m.lowest_tip() + m.radius;
+    vv = m.vv, inv_vv = m.inv_vv, r2 = m.radius2;
+    stretch = 1 + w * w * inv_vv;
+    c2 = w * w * inv_vv / (vv + w * w);
+    rim = r2 * 1e-7;  // as MoveGeometry::lowest_with_plane: no plane this close to the rim
+    slope_x = w * vx * inv_vv, slope_y = w * vy * inv_vv;
+  }
+
+  double lowest_tip() const { return top - std::sqrt(r2); }
+
+  struct Cases {
+    MaskN before, after;   // t* < 0, t* > 1
+    DoubleN t_foot, root2;  // t⊥ and the square root's argument (< 0: q not covered)
+  };
+
+  // At offsets (ux, uy) from the start.
+  Cases cases(DoubleN ux, DoubleN uy) const {
+    DoubleN dot = ux * vx + uy * vy, t = dot * inv_vv, uu = ux * ux + uy * uy;
+    DoubleN k2 = r2 - (uu - t * dot), ck2 = c2 * k2, t1 = t - 1;
+    MaskN before = (t < 0) | (t * t < ck2);
+    MaskN after = (t1 > 0) & (t1 * t1 > ck2);
+    DoubleN root2 = before ? r2 - uu : after ? r2 - (uu - 2 * dot + vv) : k2 * stretch;
+    return {before, after, t, root2};
+  }
+
+  DoubleN base(const Cases& c) const { return c.before ? splat(top) : c.after ? splat(top + w) : top + c.t_foot * w; }
+
+  // S at the points; +infinity where the cutter does not pass.
+  DoubleN at(DoubleN ux, DoubleN uy) const {
+    Cases c = cases(ux, uy);
+    DoubleN z = base(c) - sqrt_n(max_n(c.root2, splat(0)));
+    return c.root2 >= 0 ? z : splat(kInf);
+  }
+
+  // S, its supporting plane's slope (where `has_plane`), and the squared distance from the
+  // points to the move's path (for a bound where there is no plane).
+  struct Plane {
+    DoubleN z, gx, gy, distance2;
+    MaskN has_plane;
+  };
+  Plane plane_at(DoubleN ux, DoubleN uy) const {
+    Cases c = cases(ux, uy);
+    MaskN sphere = c.before | c.after;
+    DoubleN root = sqrt_n(max_n(c.root2, splat(0)));
+    Plane p;
+    p.z = base(c) - root;
+    p.has_plane = c.root2 > (sphere ? splat(rim) : rim * stretch * stretch);
+    root = p.has_plane ? root : splat(1);
+    DoubleN t = c.before ? splat(0) : c.after ? splat(1) : c.t_foot;
+    DoubleN scale = (sphere ? splat(1) : splat(stretch)) / root;
+    p.gx = (sphere ? splat(0) : splat(slope_x)) + scale * (ux - t * vx);
+    p.gy = (sphere ? splat(0) : splat(slope_y)) + scale * (uy - t * vy);
+    DoubleN along = min_n(max_n(c.t_foot, splat(0)), splat(1)), dx = ux - along * vx, dy = uy - along * vy;
+    p.distance2 = dx * dx + dy * dy;
+    return p;
+  }
+};
+
 // The milling of one Z-map: moves are binned to work blocks; each block is milled by one thread,
 // tile by tile, each tile with every move that reaches it (see `mill_tile_with_candidates`).
 class Miller {
@@ -384,17 +469,40 @@ class Miller {
 
   // A move that reaches a tile, with lower bounds of its swept surface over the tile.
   struct Candidate {
-    const MoveGeometry* move;
+    std::uint32_t move;  // index into the block's moves
+    bool has_plane;
     double bound;        // lower bound of the swept surface over the tile
     double centre_z;     // the swept surface at the tile's centre (+inf if not covered)
     Vec2 gradient;       // its supporting plane's slope there, if `has_plane`
-    bool has_plane;
   };
+
+  // What a tile holds, row by row: the highest point and the largest height above P.
+  struct TileState {
+    std::array<double, kTile> row_top, row_excess;
+    double top = -kInf, excess = -kInf;
+    void summarise(int rows) {
+      top = *std::max_element(row_top.begin(), row_top.begin() + rows);
+      excess = *std::max_element(row_excess.begin(), row_excess.begin() + rows);
+    }
+  };
+
+  // The tiles of one row of a work block, with the moves that may cut each one.
+  struct TileRow {
+    int first_tx = 0, count = 0;
+    std::array<IndexBox, kBinTiles> tiles;
+    alignas(32) std::array<double, kBinTiles> xc, hx;  // centres and half widths
+    double yc = 0, hy = 0;
+    std::array<TileState, kBinTiles> state;
+    std::array<std::vector<Candidate>, kBinTiles> candidates;
+  };
+  static_assert(kBinTiles % kLanes == 0);
 
   struct BlockScratch {
     std::vector<MoveGeometry> moves;
+    std::vector<BallLanes> balls;  // parallel to `moves`; used where `is_ball`
+    std::vector<unsigned char> is_ball;
     std::vector<IndexBox> boxes;
-    std::vector<Candidate> candidates;
+    TileRow row;
   };
 
   // Grid-index box of a move's footprint, clipped to the grid; false if it misses the grid.
@@ -435,22 +543,112 @@ class Miller {
   void mill_bin(std::size_t bin, BlockScratch& scratch) {
     if (bin_start_[bin] == bin_start_[bin + 1]) return;
     scratch.moves.clear();
+    scratch.balls.clear();
+    scratch.is_ball.clear();
     scratch.boxes.clear();
     for (std::size_t k = bin_start_[bin]; k < bin_start_[bin + 1]; ++k) {
       const CutMove& move = moves_[bin_moves_[k]];
-      scratch.moves.emplace_back(cutters_[move.cutter], move.tip);
+      const MoveGeometry& m = scratch.moves.emplace_back(cutters_[move.cutter], move.tip);
+      const bool ball = m.cutter->shape() == CutterShape::ball && !m.vertical;
+      scratch.is_ball.push_back(ball);
+      scratch.balls.push_back(ball ? BallLanes(m) : BallLanes{});
       scratch.boxes.emplace_back();
       footprint_box(move, scratch.boxes.back());
     }
     int bx = static_cast<int>(bin % static_cast<std::size_t>(bins_x_));
     int by = static_cast<int>(bin / static_cast<std::size_t>(bins_x_));
     int tx1 = std::min(tiles_x_, (bx + 1) * kBinTiles), ty1 = std::min(tiles_y_, (by + 1) * kBinTiles);
-    for (int ty = by * kBinTiles; ty < ty1; ++ty)
-      for (int tx = bx * kBinTiles; tx < tx1; ++tx) {
-        IndexBox tile{tx * kTile, ty * kTile, std::min(g_.nx, (tx + 1) * kTile) - 1,
-                      std::min(g_.ny, (ty + 1) * kTile) - 1};
-        mill_tile_with_candidates(tile, scratch);
+    TileRow& row = scratch.row;
+    for (int ty = by * kBinTiles; ty < ty1; ++ty) {
+      start_row(row, bx * kBinTiles, tx1 - bx * kBinTiles, ty);
+      gather_candidates(row, scratch);
+      for (int col = 0; col < row.count; ++col) mill_tile_with_candidates(row, col, scratch);
+    }
+  }
+
+  // Sets up the tiles of one row of a block: their extents and what they hold now.
+  void start_row(TileRow& row, int first_tx, int count, int ty) {
+    row.first_tx = first_tx, row.count = count;
+    const int j0 = ty * kTile, j1 = std::min(g_.ny, (ty + 1) * kTile) - 1;
+    row.yc = 0.5 * (g_.y(j0) + g_.y(j1)), row.hy = 0.5 * (g_.y(j1) - g_.y(j0));
+    for (int col = 0; col < kBinTiles; ++col) {
+      // Columns past the grid's edge repeat the last tile (their lanes are computed, not used).
+      const int tx = first_tx + std::min(col, count - 1);
+      const int i0 = tx * kTile, i1 = std::min(g_.nx, (tx + 1) * kTile) - 1;
+      row.tiles[col] = {i0, j0, i1, j1};
+      row.xc[col] = 0.5 * (g_.x(i0) + g_.x(i1)), row.hx[col] = 0.5 * (g_.x(i1) - g_.x(i0));
+      row.candidates[col].clear();
+      TileState& state = row.state[col];
+      for (int j = j0; j <= j1; ++j) {
+        const float* heights = &map_.heights[g_.index(0, j)];
+        state.row_top[static_cast<std::size_t>(j - j0)] = *std::max_element(heights + i0, heights + i1 + 1);
+        state.row_excess[static_cast<std::size_t>(j - j0)] = -kInf;
       }
+      state.summarise(j1 - j0 + 1);
+    }
+  }
+
+  // Every move of the block that reaches a tile of the row and may lower it, bounded over that
+  // tile: by the supporting plane of its swept surface at the tile's centre where there is one,
+  // else by its lowest tip plus the cutter's lower surface at the tile's distance from the path.
+  // A ball end move is bounded at all the row's tile centres at once (kLanes at a time).
+  void gather_candidates(TileRow& row, BlockScratch& scratch) {
+    const IndexBox& any = row.tiles[0];
+    for (std::size_t k = 0; k < scratch.moves.size(); ++k) {
+      const IndexBox& b = scratch.boxes[k];
+      if (b.j1 < any.j0 || b.j0 > any.j1) continue;
+      const int col0 = std::max(0, b.i0 / kTile - row.first_tx);
+      const int col1 = std::min(row.count - 1, b.i1 / kTile - row.first_tx);
+      if (col0 > col1) continue;
+      const MoveGeometry& m = scratch.moves[k];
+      auto keep = [&](int col, const Candidate& c) {
+        if (c.bound < row.state[col].top) row.candidates[col].push_back(c);
+      };
+      if (!scratch.is_ball[k]) {
+        for (int col = col0; col <= col1; ++col)
+          if (m.lowest_tip() < row.state[col].top) keep(col, bound_at_centre(m, row, col, static_cast<std::uint32_t>(k)));
+        continue;
+      }
+      const BallLanes& ball = scratch.balls[k];
+      const DoubleN uy = splat(row.yc - ball.ay), half_diagonal_y2 = splat(row.hy * row.hy);
+      for (int lane0 = col0 / kLanes * kLanes; lane0 <= col1; lane0 += kLanes) {
+        const DoubleN hx = load_n(&row.hx[static_cast<std::size_t>(lane0)]);
+        BallLanes::Plane p = ball.plane_at(load_n(&row.xc[static_cast<std::size_t>(lane0)]) - ball.ax, uy);
+        DoubleN bound = p.z - abs_n(p.gx) * hx - abs_n(p.gy) * row.hy;
+        // Without a plane: the lowest tip plus the ball's height at the tile's distance.
+        DoubleN gap = max_n(sqrt_n(p.distance2) - sqrt_n(hx * hx + half_diagonal_y2), splat(0));
+        DoubleN far = ball.lowest_tip() + (std::sqrt(ball.r2) - sqrt_n(max_n(ball.r2 - gap * gap, splat(0))));
+        far = gap * gap > ball.r2 ? splat(kInf) : far;
+        for (int l = 0; l < kLanes; ++l) {
+          const int col = lane0 + l;
+          if (col < col0 || col > col1) continue;
+          if (p.has_plane[l])
+            keep(col, {static_cast<std::uint32_t>(k), true, bound[l], p.z[l], Vec2(p.gx[l], p.gy[l])});
+          else
+            keep(col, {static_cast<std::uint32_t>(k), false, far[l], kInf, Vec2(0)});
+        }
+      }
+    }
+  }
+
+  // The same bounds for one move and one tile, for any cutter.
+  Candidate bound_at_centre(const MoveGeometry& m, const TileRow& row, int col, std::uint32_t index) const {
+    const double xc = row.xc[static_cast<std::size_t>(col)], yc = row.yc;
+    const double hx = row.hx[static_cast<std::size_t>(col)], hy = row.hy;
+    Candidate c{index, false, kInf, kInf, Vec2(0)};
+    MoveGeometry::Lowest centre;
+    if (m.lowest_with_plane(xc, yc, centre, c.gradient)) {
+      c.centre_z = centre.z;
+      c.has_plane = true;
+      c.bound = centre.z - std::abs(c.gradient.x) * hx - std::abs(c.gradient.y) * hy;
+      return c;
+    }
+    c.gradient = Vec2(0);
+    double distance = std::max(0.0, std::sqrt(distance2_point_segment(Vec2(xc, yc), Vec2(m.ax, m.ay),
+                                                                       Vec2(m.ax + m.vx, m.ay + m.vy))) -
+                                        std::hypot(hx, hy));
+    if (distance <= m.radius) c.bound = m.lowest_tip() + m.cutter->lower_height(distance);
+    return c;
   }
 
   // A plane P through the tile's centre at height z with slope `gradient`, that approximates the
@@ -459,16 +657,6 @@ class Miller {
     bool valid = false;
     double z = 0;
     Vec2 gradient{0};
-  };
-
-  // What a tile holds, row by row: the highest point and the largest height above P.
-  struct TileState {
-    std::array<double, kTile> row_top, row_excess;
-    double top = -kInf, excess = -kInf;
-    void summarise(int rows) {
-      top = *std::max_element(row_top.begin(), row_top.begin() + rows);
-      excess = *std::max_element(row_excess.begin(), row_excess.begin() + rows);
-    }
   };
 
   // Mills one tile with every move of its block that reaches it, lowest first, skipping the
@@ -481,43 +669,14 @@ class Miller {
   //     surface, and a move (or one row of it) is skipped when min(S − P) ≥ max(height − P)
   //     there: this keeps skipping effective on sloped surfaces, where the highest point of a
   //     tile is far above most of it.
-  void mill_tile_with_candidates(const IndexBox& tile, BlockScratch& scratch) {
-    const double x_lo = g_.x(tile.i0), x_hi = g_.x(tile.i1), y_lo = g_.y(tile.j0), y_hi = g_.y(tile.j1);
-    const double xc = 0.5 * (x_lo + x_hi), yc = 0.5 * (y_lo + y_hi);
-    const double hx = 0.5 * (x_hi - x_lo), hy = 0.5 * (y_hi - y_lo), half_diagonal = std::hypot(hx, hy);
-    TilePlane plane;
-    TileState state;
-    for (int j = tile.j0; j <= tile.j1; ++j) {
-      const float* row = &map_.heights[g_.index(0, j)];
-      state.row_top[static_cast<std::size_t>(j - tile.j0)] = *std::max_element(row + tile.i0, row + tile.i1 + 1);
-      state.row_excess[static_cast<std::size_t>(j - tile.j0)] = -kInf;
-    }
-    state.summarise(tile.j1 - tile.j0 + 1);
-
-    std::vector<Candidate>& candidates = scratch.candidates;
-    candidates.clear();
-    for (std::size_t k = 0; k < scratch.moves.size(); ++k) {
-      const IndexBox& b = scratch.boxes[k];
-      if (b.i1 < tile.i0 || b.i0 > tile.i1 || b.j1 < tile.j0 || b.j0 > tile.j1) continue;
-      const MoveGeometry& m = scratch.moves[k];
-      if (m.lowest_tip() >= state.top) continue;
-      Candidate c{&m, kInf, kInf, Vec2(0), false};
-      MoveGeometry::Lowest centre;
-      if (m.lowest_with_plane(xc, yc, centre, c.gradient)) {
-        c.centre_z = centre.z;
-        c.has_plane = true;
-        c.bound = centre.z - std::abs(c.gradient.x) * hx - std::abs(c.gradient.y) * hy;
-      } else {
-        // No plane: bound h by the move's distance from the tile's centre less its half-diagonal.
-        double distance = std::max(0.0, std::sqrt(distance2_point_segment(
-                                            Vec2(xc, yc), Vec2(m.ax, m.ay), Vec2(m.ax + m.vx, m.ay + m.vy))) -
-                                            half_diagonal);
-        if (distance > m.radius) continue;
-        c.bound = m.lowest_tip() + m.cutter->lower_height(distance);
-      }
-      if (c.bound < state.top) candidates.push_back(c);
-    }
+  void mill_tile_with_candidates(TileRow& row, int col, BlockScratch& scratch) {
+    std::vector<Candidate>& candidates = row.candidates[static_cast<std::size_t>(col)];
     if (candidates.empty()) return;
+    const IndexBox& tile = row.tiles[static_cast<std::size_t>(col)];
+    const double xc = row.xc[static_cast<std::size_t>(col)], yc = row.yc;
+    const double hx = row.hx[static_cast<std::size_t>(col)], hy = row.hy;
+    TileState& state = row.state[static_cast<std::size_t>(col)];
+    TilePlane plane;
 
     // First the move whose surface is lowest at the tile's centre (the lowest bound if none has
     // a plane): it usually cuts the tile close to its final shape, and its supporting plane then
@@ -540,12 +699,14 @@ class Miller {
       return c.bound < state.top && (!plane.valid || above_plane(c, 0, hy) < state.excess);
     };
     auto cut = [&](const Candidate& c) {
+      const std::size_t k = c.move;
+      const BallLanes* ball = scratch.is_ball[k] ? &scratch.balls[k] : nullptr;
       if (!plane.valid && c.has_plane) {
         plane = {true, c.centre_z, c.gradient};
-        mill_tile(c, tile, xc, yc, plane, state, [](int) { return true; });
+        mill_tile(c, scratch.moves[k], ball, tile, xc, yc, plane, state, [](int) { return true; });
         return;
       }
-      mill_tile(c, tile, xc, yc, plane, state, [&](int j) {
+      mill_tile(c, scratch.moves[k], ball, tile, xc, yc, plane, state, [&](int j) {
         std::size_t r = static_cast<std::size_t>(j - tile.j0);
         double dy = g_.y(j) - yc;
         double row_bound = c.has_plane ? c.centre_z + c.gradient.y * dy - std::abs(c.gradient.x) * hx : c.bound;
@@ -567,38 +728,52 @@ class Miller {
 
   // Lowers the rows of one tile that `row_may_cut` admits to one move's swept surface, and
   // updates those rows' state (measured against `plane`) in the same pass. Where the move has a
-  // supporting plane, a point already below that plane is not evaluated.
+  // supporting plane, a point already below that plane is not evaluated (for the ball end, a
+  // group of kLanes points all below it).
   template <class RowTest>
-  void mill_tile(const Candidate& c, const IndexBox& t, double xc, double yc, const TilePlane& plane,
-                 TileState& state, RowTest&& row_may_cut) {
-    const MoveGeometry& m = *c.move;
-    const float empty = map_.empty_height;
-    const bool ball = m.cutter->shape() == CutterShape::ball && !m.vertical;
+  void mill_tile(const Candidate& c, const MoveGeometry& m, const BallLanes* ball, const IndexBox& t, double xc,
+                 double yc, const TilePlane& plane, TileState& state, RowTest&& row_may_cut) {
+    const double empty = map_.empty_height;
     const double move_plane_z = c.has_plane ? c.centre_z : -kInf;
-    alignas(32) double lowest[kTile];
+    const int count = t.i1 - t.i0 + 1;
+    alignas(32) double heights[kTile];
     for (int j = t.j0; j <= t.j1; ++j) {
       if (!row_may_cut(j)) continue;
       const double y = g_.y(j);
       const double move_row = move_plane_z + c.gradient.y * (y - yc);
       const double tile_row = plane.z + plane.gradient.y * (y - yc);
-      float* row = &map_.heights[g_.index(0, j)];
-      // The ball end evaluates the whole row at once, four points at a time; other cutters only
-      // the points above the move's supporting plane.
-      if (ball) m.ball_row(g_.x(t.i0), g_.cell, y, t.i1 - t.i0 + 1, lowest);
-      float top = -std::numeric_limits<float>::infinity();
-      double excess = -kInf;
-      for (int i = t.i0; i <= t.i1; ++i) {
-        const double x = g_.x(i);
-        if (move_row + c.gradient.x * (x - xc) < row[i]) {
-          double z = ball ? lowest[i - t.i0] : m.lowest_above(x, y);
-          row[i] = std::min(row[i], std::max(static_cast<float>(z), empty));
+      float* row = &map_.heights[g_.index(t.i0, j)];
+      // Points past the grid's edge are -inf: never lowered, never the top.
+      for (int i = 0; i < kTile; ++i) heights[i] = i < count ? row[i] : -kInf;
+      DoubleN top = splat(-kInf), excess = splat(-kInf);
+      for (int i = 0; i < kTile; i += kLanes) {
+        // x computed as ZMapGrid::x does, so that points on a footprint's rim go the same way.
+        const DoubleN x = g_.x0 + (lane_index() + (t.i0 + i)) * g_.cell, dx = x - xc;
+        DoubleN h = load_n(heights + i);
+        if (ball) {
+          if (any_n(move_row + c.gradient.x * dx < h)) {
+            DoubleN z = ball->at(x - ball->ax, splat(y - ball->ay));
+            // Rounded to the map's float first, as the scalar path stores it.
+            z = __builtin_convertvector(__builtin_convertvector(z, FloatN), DoubleN);
+            h = min_n(h, max_n(z, splat(empty)));
+          }
+        } else {
+          for (int l = 0; l < kLanes; ++l)
+            if (move_row + c.gradient.x * dx[l] < h[l]) {
+              double z = m.lowest_above(x[l], y);
+              h[l] = std::min(h[l], std::max(static_cast<double>(static_cast<float>(z)), empty));
+            }
         }
-        top = std::max(top, row[i]);
-        excess = std::max(excess, row[i] - (tile_row + plane.gradient.x * (x - xc)));
+        store_n(heights + i, h);
+        top = max_n(top, h);
+        excess = max_n(excess, h - (tile_row + plane.gradient.x * dx));
       }
+      for (int i = 0; i < count; ++i) row[i] = static_cast<float>(heights[i]);
       std::size_t r = static_cast<std::size_t>(j - t.j0);
-      state.row_top[r] = top;
-      state.row_excess[r] = plane.valid ? excess : -kInf;
+      state.row_top[r] = top[0], state.row_excess[r] = excess[0];
+      for (int l = 1; l < kLanes; ++l)
+        state.row_top[r] = std::max(state.row_top[r], top[l]), state.row_excess[r] = std::max(state.row_excess[r], excess[l]);
+      if (!plane.valid) state.row_excess[r] = -kInf;
     }
     state.summarise(t.j1 - t.j0 + 1);
   }
