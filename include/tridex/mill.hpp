@@ -368,7 +368,7 @@ struct MoveGeometry {
 // the supporting plane of MoveGeometry::supporting_plane in other terms.
 struct BallLanes {
   double ax = 0, ay = 0, top = 0;  // start of the (rising) move; top = its tip + R, the ball's centre
-  double vx = 0, vy = 0, w = 0, vv = 0, inv_vv = 0, stretch = 1, c2 = 0, r2 = 0, rim = 0;
+  double vx = 0, vy = 0, w = 0, vv = 0, inv_vv = 0, stretch = 1, c2 = 0, radius = 0, r2 = 0, inv_diameter = 0, rim = 0;
   double slope_x = 0, slope_y = 0;  // w·v/|v|²
 
   BallLanes() = default;
@@ -378,14 +378,14 @@ struct BallLanes {
     ax = falling ? m.ax + m.vx : m.ax, ay = falling ? m.ay + m.vy : m.ay;
     vx = falling ? -m.vx : m.vx, vy = falling ? -m.vy : m.vy, w = std::abs(m.w);
     top = m.lowest_tip() + m.radius;
-    vv = m.vv, inv_vv = m.inv_vv, r2 = m.radius2;
+    vv = m.vv, inv_vv = m.inv_vv, radius = m.radius, r2 = m.radius2, inv_diameter = 0.5 / m.radius;
     stretch = 1 + w * w * inv_vv;
     c2 = w * w * inv_vv / (vv + w * w);
     rim = r2 * 1e-7;  // as MoveGeometry::lowest_with_plane: no plane this close to the rim
     slope_x = w * vx * inv_vv, slope_y = w * vy * inv_vv;
   }
 
-  double lowest_tip() const { return top - std::sqrt(r2); }
+  double lowest_tip() const { return top - radius; }
 
   struct Cases {
     MaskN before, after;   // t* < 0, t* > 1
@@ -469,11 +469,11 @@ class Miller {
 
   // A move that reaches a tile, with lower bounds of its swept surface over the tile.
   struct Candidate {
-    std::uint32_t move;  // index into the block's moves
-    bool has_plane;
-    double bound;        // lower bound of the swept surface over the tile
-    double centre_z;     // the swept surface at the tile's centre (+inf if not covered)
-    Vec2 gradient;       // its supporting plane's slope there, if `has_plane`
+    std::uint32_t move = 0;  // index into the block's moves
+    bool has_plane = false;
+    double bound = kInf;     // lower bound of the swept surface over the tile
+    double centre_z = kInf;  // the swept surface at the tile's centre (+inf if not covered)
+    Vec2 gradient{0};        // its supporting plane's slope there, if `has_plane`
   };
 
   // What a tile holds, row by row: the highest point and the largest height above P.
@@ -486,18 +486,49 @@ class Miller {
     }
   };
 
-  // The tiles of one row of a work block, with the moves that may cut each one.
+  // A plane P through the tile's centre at height z with slope `gradient`, that approximates the
+  // tile's surface once a smooth move has cut it.
+  struct TilePlane {
+    bool valid = false;
+    double z = 0;
+    Vec2 gradient{0};
+  };
+
+  struct Tile {
+    IndexBox box;
+    double xc, yc, hx, hy;  // centre and half extents
+    TileState state;
+    TilePlane plane;
+    std::vector<Candidate> candidates;
+  };
+
+  // The tiles of one row of a work block. The arrays hold, tile by tile, what the ball end's
+  // vector code reads kLanes tiles at a time.
   struct TileRow {
     int first_tx = 0, count = 0;
-    std::array<IndexBox, kBinTiles> tiles;
-    alignas(32) std::array<double, kBinTiles> xc, hx;  // centres and half widths
-    double yc = 0, hy = 0;
-    std::array<TileState, kBinTiles> state;
-    std::array<std::vector<Candidate>, kBinTiles> candidates;
+    std::array<Tile, kBinTiles> tiles;
+    struct Lanes {
+      alignas(32) double xc[kBinTiles], hx[kBinTiles], half_diagonal[kBinTiles], top[kBinTiles];
+      // The move to cut first: its index (as a double), centre height, plane slope and bound.
+      alignas(32) double first[kBinTiles], first_z[kBinTiles], first_gx[kBinTiles], first_gy[kBinTiles],
+          first_bound[kBinTiles];
+      // The tile's plane P and its largest height above P (P valid where plane_valid ≠ 0).
+      alignas(32) double plane_valid[kBinTiles], plane_z[kBinTiles], plane_gx[kBinTiles], plane_gy[kBinTiles],
+          excess[kBinTiles];
+    } lanes;
   };
   static_assert(kBinTiles % kLanes == 0);
 
+  // A ball end move's bounds over kLanes tiles of a row, from pass 1 for pass 2.
+  struct BallBounds {
+    DoubleN z, gx, gy, bound;  // the plane at each tile's centre (where `has_plane`), the bound
+    MaskN has_plane, in_range;  // in_range: the move reaches that tile
+    std::uint32_t move;
+    int lane0;
+  };
+
   struct BlockScratch {
+    std::vector<BallBounds> ball_bounds;  // of the current row
     std::vector<MoveGeometry> moves;
     std::vector<BallLanes> balls;  // parallel to `moves`; used where `is_ball`
     std::vector<unsigned char> is_ball;
@@ -540,6 +571,18 @@ class Miller {
       for_each_bin(moves_[m], [&](std::size_t b) { bin_moves_[fill[b]++] = static_cast<std::uint32_t>(m); });
   }
 
+  // Mills one work block, one row of tiles at a time, each tile with every move that reaches it,
+  // skipping the moves (and, within a move, the rows and points) that provably cannot lower it:
+  //   * each move's swept surface S has a lower bound over a tile: S's supporting plane at the
+  //     tile's centre, or the lowest tip plus h at the tile's distance from the path;
+  //   * the move lowest at the tile's centre cuts it first: it usually leaves the tile close to
+  //     its final shape, and its supporting plane P then follows the tile's surface;
+  //   * after that a move (or one row of it) is skipped when its bound is not below the highest
+  //     point, or when min(S − P) ≥ max(height − P) there: this keeps skipping effective on
+  //     sloped surfaces, where the highest point of a tile is far above most of it;
+  //   * the moves left cut in order of their bound, each checked again before it cuts.
+  // Ball end moves are bounded kLanes tiles at a time, twice (to find the first cut, then against
+  // what it left) rather than stored; other moves are bounded once, one tile at a time, and kept.
   void mill_bin(std::size_t bin, BlockScratch& scratch) {
     if (bin_start_[bin] == bin_start_[bin + 1]) return;
     scratch.moves.clear();
@@ -561,8 +604,10 @@ class Miller {
     TileRow& row = scratch.row;
     for (int ty = by * kBinTiles; ty < ty1; ++ty) {
       start_row(row, bx * kBinTiles, tx1 - bx * kBinTiles, ty);
-      gather_candidates(row, scratch);
-      for (int col = 0; col < row.count; ++col) mill_tile_with_candidates(row, col, scratch);
+      find_first_cuts(row, scratch);
+      for (int col = 0; col < row.count; ++col) cut_first(row, col, scratch);
+      find_other_cuts(row, scratch);
+      for (int col = 0; col < row.count; ++col) cut_others(row.tiles[static_cast<std::size_t>(col)], scratch);
     }
   }
 
@@ -570,186 +615,255 @@ class Miller {
   void start_row(TileRow& row, int first_tx, int count, int ty) {
     row.first_tx = first_tx, row.count = count;
     const int j0 = ty * kTile, j1 = std::min(g_.ny, (ty + 1) * kTile) - 1;
-    row.yc = 0.5 * (g_.y(j0) + g_.y(j1)), row.hy = 0.5 * (g_.y(j1) - g_.y(j0));
+    TileRow::Lanes& lanes = row.lanes;
     for (int col = 0; col < kBinTiles; ++col) {
       // Columns past the grid's edge repeat the last tile (their lanes are computed, not used).
       const int tx = first_tx + std::min(col, count - 1);
       const int i0 = tx * kTile, i1 = std::min(g_.nx, (tx + 1) * kTile) - 1;
-      row.tiles[col] = {i0, j0, i1, j1};
-      row.xc[col] = 0.5 * (g_.x(i0) + g_.x(i1)), row.hx[col] = 0.5 * (g_.x(i1) - g_.x(i0));
-      row.candidates[col].clear();
-      TileState& state = row.state[col];
+      Tile& tile = row.tiles[static_cast<std::size_t>(col)];
+      tile.box = {i0, j0, i1, j1};
+      tile.xc = 0.5 * (g_.x(i0) + g_.x(i1)), tile.yc = 0.5 * (g_.y(j0) + g_.y(j1));
+      tile.hx = 0.5 * (g_.x(i1) - g_.x(i0)), tile.hy = 0.5 * (g_.y(j1) - g_.y(j0));
+      tile.plane = {};
+      tile.candidates.clear();
       for (int j = j0; j <= j1; ++j) {
         const float* heights = &map_.heights[g_.index(0, j)];
-        state.row_top[static_cast<std::size_t>(j - j0)] = *std::max_element(heights + i0, heights + i1 + 1);
-        state.row_excess[static_cast<std::size_t>(j - j0)] = -kInf;
+        tile.state.row_top[static_cast<std::size_t>(j - j0)] = *std::max_element(heights + i0, heights + i1 + 1);
+        tile.state.row_excess[static_cast<std::size_t>(j - j0)] = -kInf;
       }
-      state.summarise(j1 - j0 + 1);
+      tile.state.summarise(j1 - j0 + 1);
+      lanes.xc[col] = tile.xc, lanes.hx[col] = tile.hx, lanes.top[col] = tile.state.top;
+      lanes.half_diagonal[col] = std::hypot(tile.hx, tile.hy);
+      lanes.first[col] = -1, lanes.first_z[col] = kInf, lanes.first_bound[col] = kInf;
+      lanes.first_gx[col] = lanes.first_gy[col] = 0;
     }
   }
 
-  // Every move of the block that reaches a tile of the row and may lower it, bounded over that
-  // tile: by the supporting plane of its swept surface at the tile's centre where there is one,
-  // else by its lowest tip plus the cutter's lower surface at the tile's distance from the path.
-  // A ball end move is bounded at all the row's tile centres at once (kLanes at a time).
-  void gather_candidates(TileRow& row, BlockScratch& scratch) {
-    const IndexBox& any = row.tiles[0];
+  // Calls visit(k, col0, col1) for each move k of the block that reaches the row's tiles col0..col1.
+  template <class Visit>
+  void for_each_move(const TileRow& row, const BlockScratch& scratch, Visit&& visit) const {
+    const IndexBox& any = row.tiles[0].box;
     for (std::size_t k = 0; k < scratch.moves.size(); ++k) {
       const IndexBox& b = scratch.boxes[k];
       if (b.j1 < any.j0 || b.j0 > any.j1) continue;
       const int col0 = std::max(0, b.i0 / kTile - row.first_tx);
       const int col1 = std::min(row.count - 1, b.i1 / kTile - row.first_tx);
-      if (col0 > col1) continue;
+      if (col0 <= col1) visit(k, col0, col1);
+    }
+  }
+
+  // A ball end move's bounds over the row's tiles lane0 .. lane0 + kLanes − 1 (those in
+  // col0..col1 are in range).
+  BallBounds ball_bounds(const BallLanes& ball, const TileRow& row, std::uint32_t move, int lane0, int col0,
+                         int col1) const {
+    const Tile& tile = row.tiles[0];
+    const DoubleN hx = load_n(&row.lanes.hx[lane0]);
+    BallLanes::Plane p = ball.plane_at(load_n(&row.lanes.xc[lane0]) - ball.ax, splat(tile.yc - ball.ay));
+    // Without a plane: the lowest tip plus the ball's height at the tile's distance s from the
+    // path, bounded below by s²/2R (h(s) = R − √(R² − s²) = s² / (R + √(R² − s²))).
+    DoubleN gap = max_n(sqrt_n(p.distance2) - load_n(&row.lanes.half_diagonal[lane0]), splat(0));
+    DoubleN far = gap * gap > ball.r2 ? splat(kInf) : ball.lowest_tip() + gap * gap * ball.inv_diameter;
+    DoubleN on_plane = p.z - abs_n(p.gx) * hx - abs_n(p.gy) * tile.hy;
+    const DoubleN col = lane_index() + lane0;
+    return {p.z, p.gx, p.gy, p.has_plane ? on_plane : far, p.has_plane, (col >= col0) & (col <= col1), move, lane0};
+  }
+
+  // Pass 1: for each tile, the move whose swept surface is lowest at its centre among those with
+  // a supporting plane there (ties: the lower bound). Moves other than ball ends are kept.
+  void find_first_cuts(TileRow& row, BlockScratch& scratch) {
+    TileRow::Lanes& lanes = row.lanes;
+    scratch.ball_bounds.clear();
+    for_each_move(row, scratch, [&](std::size_t k, int col0, int col1) {
       const MoveGeometry& m = scratch.moves[k];
-      auto keep = [&](int col, const Candidate& c) {
-        if (c.bound < row.state[col].top) row.candidates[col].push_back(c);
-      };
       if (!scratch.is_ball[k]) {
-        for (int col = col0; col <= col1; ++col)
-          if (m.lowest_tip() < row.state[col].top) keep(col, bound_at_centre(m, row, col, static_cast<std::uint32_t>(k)));
-        continue;
+        for (int col = col0; col <= col1; ++col) {
+          Tile& tile = row.tiles[static_cast<std::size_t>(col)];
+          if (m.lowest_tip() >= tile.state.top) continue;
+          Candidate c = bound_at_centre(m, tile, static_cast<std::uint32_t>(k));
+          if (c.bound >= tile.state.top) continue;
+          tile.candidates.push_back(c);
+          if (c.has_plane && (c.centre_z < lanes.first_z[col] ||
+                              (c.centre_z == lanes.first_z[col] && c.bound < lanes.first_bound[col]))) {
+            lanes.first[col] = static_cast<double>(k), lanes.first_z[col] = c.centre_z;
+            lanes.first_gx[col] = c.gradient.x, lanes.first_gy[col] = c.gradient.y;
+            lanes.first_bound[col] = c.bound;
+          }
+        }
+        return;
       }
       const BallLanes& ball = scratch.balls[k];
-      const DoubleN uy = splat(row.yc - ball.ay), half_diagonal_y2 = splat(row.hy * row.hy);
       for (int lane0 = col0 / kLanes * kLanes; lane0 <= col1; lane0 += kLanes) {
-        const DoubleN hx = load_n(&row.hx[static_cast<std::size_t>(lane0)]);
-        BallLanes::Plane p = ball.plane_at(load_n(&row.xc[static_cast<std::size_t>(lane0)]) - ball.ax, uy);
-        DoubleN bound = p.z - abs_n(p.gx) * hx - abs_n(p.gy) * row.hy;
-        // Without a plane: the lowest tip plus the ball's height at the tile's distance.
-        DoubleN gap = max_n(sqrt_n(p.distance2) - sqrt_n(hx * hx + half_diagonal_y2), splat(0));
-        DoubleN far = ball.lowest_tip() + (std::sqrt(ball.r2) - sqrt_n(max_n(ball.r2 - gap * gap, splat(0))));
-        far = gap * gap > ball.r2 ? splat(kInf) : far;
-        for (int l = 0; l < kLanes; ++l) {
-          const int col = lane0 + l;
-          if (col < col0 || col > col1) continue;
-          if (p.has_plane[l])
-            keep(col, {static_cast<std::uint32_t>(k), true, bound[l], p.z[l], Vec2(p.gx[l], p.gy[l])});
-          else
-            keep(col, {static_cast<std::uint32_t>(k), false, far[l], kInf, Vec2(0)});
-        }
+        const BallBounds& b =
+            scratch.ball_bounds.emplace_back(ball_bounds(ball, row, static_cast<std::uint32_t>(k), lane0, col0, col1));
+        const DoubleN first_z = load_n(&lanes.first_z[lane0]), first_bound = load_n(&lanes.first_bound[lane0]);
+        const MaskN better = b.in_range & b.has_plane & (b.bound < load_n(&lanes.top[lane0])) &
+                             ((b.z < first_z) | ((b.z == first_z) & (b.bound < first_bound)));
+        if (!any_n(better)) continue;
+        store_n(&lanes.first[lane0], better ? splat(static_cast<double>(k)) : load_n(&lanes.first[lane0]));
+        store_n(&lanes.first_z[lane0], better ? b.z : first_z);
+        store_n(&lanes.first_gx[lane0], better ? b.gx : load_n(&lanes.first_gx[lane0]));
+        store_n(&lanes.first_gy[lane0], better ? b.gy : load_n(&lanes.first_gy[lane0]));
+        store_n(&lanes.first_bound[lane0], better ? b.bound : first_bound);
+      }
+    });
+  }
+
+  // Cuts a tile with its first move (if it has one), and records the plane and state that the
+  // other moves are then measured against.
+  void cut_first(TileRow& row, int col, const BlockScratch& scratch) {
+    Tile& tile = row.tiles[static_cast<std::size_t>(col)];
+    TileRow::Lanes& lanes = row.lanes;
+    if (lanes.first[col] >= 0) {
+      Candidate first{static_cast<std::uint32_t>(lanes.first[col]), true, lanes.first_bound[col], lanes.first_z[col],
+                      Vec2(lanes.first_gx[col], lanes.first_gy[col])};
+      tile.plane = {true, first.centre_z, first.gradient};
+      cut(tile, first, scratch, true);
+    }
+    lanes.top[col] = tile.state.top, lanes.excess[col] = tile.state.excess;
+    lanes.plane_valid[col] = tile.plane.valid, lanes.plane_z[col] = tile.plane.z;
+    lanes.plane_gx[col] = tile.plane.gradient.x, lanes.plane_gy[col] = tile.plane.gradient.y;
+  }
+
+  // min(S − P) over a tile (or over one of its rows, with half_height = 0 and dy its offset).
+  static double above_plane(const Candidate& c, const Tile& tile, double dy, double half_height) {
+    const TilePlane& p = tile.plane;
+    if (!c.has_plane)
+      return c.bound - (p.z + p.gradient.y * dy + std::abs(p.gradient.x) * tile.hx +
+                        std::abs(p.gradient.y) * half_height);
+    return (c.centre_z - p.z) + (c.gradient.y - p.gradient.y) * dy - std::abs(c.gradient.x - p.gradient.x) * tile.hx -
+           std::abs(c.gradient.y - p.gradient.y) * half_height;
+  }
+
+  static bool can_cut(const Candidate& c, const Tile& tile) {
+    return c.bound < tile.state.top && (!tile.plane.valid || above_plane(c, tile, 0, tile.hy) < tile.state.excess);
+  }
+
+  // Pass 2: the moves that can still cut each tile after its first cut (the same test as
+  // `can_cut`, kLanes tiles at a time for the ball end).
+  void find_other_cuts(TileRow& row, const BlockScratch& scratch) {
+    const TileRow::Lanes& lanes = row.lanes;
+    for (int col = 0; col < row.count; ++col) {
+      Tile& tile = row.tiles[static_cast<std::size_t>(col)];
+      const auto first = static_cast<std::uint32_t>(std::max(0.0, lanes.first[col]));
+      const bool has_first = lanes.first[col] >= 0;
+      std::erase_if(tile.candidates,
+                    [&](const Candidate& c) { return (has_first && c.move == first) || !can_cut(c, tile); });
+    }
+    const double hy = row.tiles[0].hy;
+    for (const BallBounds& b : scratch.ball_bounds) {
+      const int lane0 = b.lane0;
+      const DoubleN hx = load_n(&lanes.hx[lane0]);
+      const DoubleN pz = load_n(&lanes.plane_z[lane0]), pgx = load_n(&lanes.plane_gx[lane0]),
+                    pgy = load_n(&lanes.plane_gy[lane0]);
+      DoubleN with_plane = (b.z - pz) - abs_n(b.gx - pgx) * hx - abs_n(b.gy - pgy) * hy;
+      DoubleN without_plane = b.bound - (pz + abs_n(pgx) * hx + abs_n(pgy) * hy);
+      DoubleN above = b.has_plane ? with_plane : without_plane;
+      MaskN cuts = b.in_range & (b.bound < load_n(&lanes.top[lane0])) &
+                   ((load_n(&lanes.plane_valid[lane0]) == 0) | (above < load_n(&lanes.excess[lane0]))) &
+                   (load_n(&lanes.first[lane0]) != static_cast<double>(b.move));
+      if (!any_n(cuts)) continue;
+      for (int l = 0; l < kLanes; ++l) {
+        if (!cuts[l]) continue;
+        Candidate c{b.move, b.has_plane[l] != 0, b.bound[l], kInf, Vec2(0)};
+        if (c.has_plane) c.centre_z = b.z[l], c.gradient = Vec2(b.gx[l], b.gy[l]);
+        row.tiles[static_cast<std::size_t>(lane0 + l)].candidates.push_back(c);
       }
     }
   }
 
-  // The same bounds for one move and one tile, for any cutter.
-  Candidate bound_at_centre(const MoveGeometry& m, const TileRow& row, int col, std::uint32_t index) const {
-    const double xc = row.xc[static_cast<std::size_t>(col)], yc = row.yc;
-    const double hx = row.hx[static_cast<std::size_t>(col)], hy = row.hy;
+  // Cuts a tile with the moves left, lowest bound first, each checked again against what the
+  // tile holds by then.
+  void cut_others(Tile& tile, const BlockScratch& scratch) {
+    std::vector<Candidate>& candidates = tile.candidates;
+    std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+      return a.bound < b.bound || (a.bound == b.bound && a.move < b.move);
+    });
+    for (const Candidate& c : candidates) {
+      if (c.bound >= tile.state.top) break;
+      if (can_cut(c, tile)) cut(tile, c, scratch, false);
+    }
+  }
+
+  // The bounds of one move over one tile, for any cutter.
+  static Candidate bound_at_centre(const MoveGeometry& m, const Tile& tile, std::uint32_t index) {
     Candidate c{index, false, kInf, kInf, Vec2(0)};
     MoveGeometry::Lowest centre;
-    if (m.lowest_with_plane(xc, yc, centre, c.gradient)) {
+    if (m.lowest_with_plane(tile.xc, tile.yc, centre, c.gradient)) {
       c.centre_z = centre.z;
       c.has_plane = true;
-      c.bound = centre.z - std::abs(c.gradient.x) * hx - std::abs(c.gradient.y) * hy;
+      c.bound = centre.z - std::abs(c.gradient.x) * tile.hx - std::abs(c.gradient.y) * tile.hy;
       return c;
     }
     c.gradient = Vec2(0);
-    double distance = std::max(0.0, std::sqrt(distance2_point_segment(Vec2(xc, yc), Vec2(m.ax, m.ay),
+    double distance = std::max(0.0, std::sqrt(distance2_point_segment(Vec2(tile.xc, tile.yc), Vec2(m.ax, m.ay),
                                                                        Vec2(m.ax + m.vx, m.ay + m.vy))) -
-                                        std::hypot(hx, hy));
+                                        std::hypot(tile.hx, tile.hy));
     if (distance <= m.radius) c.bound = m.lowest_tip() + m.cutter->lower_height(distance);
     return c;
   }
 
-  // A plane P through the tile's centre at height z with slope `gradient`, that approximates the
-  // tile's surface once a smooth move has cut it.
-  struct TilePlane {
-    bool valid = false;
-    double z = 0;
-    Vec2 gradient{0};
-  };
-
-  // Mills one tile with every move of its block that reaches it, lowest first, skipping the
-  // moves (and, within a move, the rows) that provably cannot lower any point:
-  //   * each move's swept surface S has a lower bound over the tile: the lowest tip plus h at the
-  //     tile's distance, or better, S's supporting plane at the tile's centre;
-  //   * moves are taken in order of that bound, so once a bound reaches the tile's highest point
-  //     every later move is skipped;
-  //   * once a smooth move has cut the tile, its supporting plane P approximates the tile's
-  //     surface, and a move (or one row of it) is skipped when min(S − P) ≥ max(height − P)
-  //     there: this keeps skipping effective on sloped surfaces, where the highest point of a
-  //     tile is far above most of it.
-  void mill_tile_with_candidates(TileRow& row, int col, BlockScratch& scratch) {
-    std::vector<Candidate>& candidates = row.candidates[static_cast<std::size_t>(col)];
-    if (candidates.empty()) return;
-    const IndexBox& tile = row.tiles[static_cast<std::size_t>(col)];
-    const double xc = row.xc[static_cast<std::size_t>(col)], yc = row.yc;
-    const double hx = row.hx[static_cast<std::size_t>(col)], hy = row.hy;
-    TileState& state = row.state[static_cast<std::size_t>(col)];
-    TilePlane plane;
-
-    // First the move whose surface is lowest at the tile's centre (the lowest bound if none has
-    // a plane): it usually cuts the tile close to its final shape, and its supporting plane then
-    // follows the tile's surface.
-    auto first_key = [](const Candidate& c) { return c.has_plane ? c.centre_z : kInf; };
-    auto first = std::min_element(candidates.begin(), candidates.end(), [&](const Candidate& a, const Candidate& b) {
-      return first_key(a) < first_key(b) || (first_key(a) == first_key(b) && a.bound < b.bound);
-    });
-    std::iter_swap(candidates.begin(), first);
-    // min(S − P) over the tile (or over a row, with half_height = 0 and dy its offset).
-    auto above_plane = [&](const Candidate& c, double dy, double half_height) {
-      if (!c.has_plane)
-        return c.bound - (plane.z + plane.gradient.y * dy + std::abs(plane.gradient.x) * hx +
-                          std::abs(plane.gradient.y) * half_height);
-      return (c.centre_z - plane.z) + (c.gradient.y - plane.gradient.y) * dy -
-             std::abs(c.gradient.x - plane.gradient.x) * hx -
-             std::abs(c.gradient.y - plane.gradient.y) * half_height;
-    };
-    auto can_cut = [&](const Candidate& c) {
-      return c.bound < state.top && (!plane.valid || above_plane(c, 0, hy) < state.excess);
-    };
-    auto cut = [&](const Candidate& c) {
-      const std::size_t k = c.move;
-      const BallLanes* ball = scratch.is_ball[k] ? &scratch.balls[k] : nullptr;
-      if (!plane.valid && c.has_plane) {
-        plane = {true, c.centre_z, c.gradient};
-        mill_tile(c, scratch.moves[k], ball, tile, xc, yc, plane, state, [](int) { return true; });
-        return;
-      }
-      mill_tile(c, scratch.moves[k], ball, tile, xc, yc, plane, state, [&](int j) {
-        std::size_t r = static_cast<std::size_t>(j - tile.j0);
-        double dy = g_.y(j) - yc;
-        double row_bound = c.has_plane ? c.centre_z + c.gradient.y * dy - std::abs(c.gradient.x) * hx : c.bound;
-        if (row_bound >= state.row_top[r]) return false;
-        return !plane.valid || above_plane(c, dy, 0) < state.row_excess[r];
-      });
-    };
-    cut(candidates.front());
-    // Then the others that can still cut, lowest bound first.
-    auto rest = std::remove_if(candidates.begin() + 1, candidates.end(),
-                               [&](const Candidate& c) { return !can_cut(c); });
-    std::sort(candidates.begin() + 1, rest,
-              [](const Candidate& a, const Candidate& b) { return a.bound < b.bound; });
-    for (auto c = candidates.begin() + 1; c != rest; ++c) {
-      if (c->bound >= state.top) break;
-      if (can_cut(*c)) cut(*c);
+  // Cuts a tile with one move: every row (the first cut) or the rows whose bounds admit it.
+  void cut(Tile& tile, const Candidate& c, const BlockScratch& scratch, bool every_row) {
+    const MoveGeometry& m = scratch.moves[c.move];
+    const BallLanes* ball = scratch.is_ball[c.move] ? &scratch.balls[c.move] : nullptr;
+    if (every_row) {
+      mill_tile(c, m, ball, tile, [](int) { return true; });
+      return;
     }
+    mill_tile(c, m, ball, tile, [&](int j) {
+      std::size_t r = static_cast<std::size_t>(j - tile.box.j0);
+      double dy = g_.y(j) - tile.yc;
+      double row_bound = c.has_plane ? c.centre_z + c.gradient.y * dy - std::abs(c.gradient.x) * tile.hx : c.bound;
+      if (row_bound >= tile.state.row_top[r]) return false;
+      return !tile.plane.valid || above_plane(c, tile, dy, 0) < tile.state.row_excess[r];
+    });
+  }
+
+  // kLanes heights of a map row as doubles; of the last `available` < kLanes of a row, the rest
+  // -inf (never lowered, never the top).
+  static DoubleN load_heights(const float* p, int available) {
+    if (available >= kLanes) {
+      FloatN f;
+      __builtin_memcpy(&f, p, sizeof f);
+      return __builtin_convertvector(f, DoubleN);
+    }
+    DoubleN h = splat(-kInf);
+    for (int l = 0; l < available; ++l) h[l] = p[l];
+    return h;
+  }
+  static void store_heights(float* p, DoubleN h, int available) {
+    if (available >= kLanes) {
+      FloatN f = __builtin_convertvector(h, FloatN);
+      __builtin_memcpy(p, &f, sizeof f);
+      return;
+    }
+    for (int l = 0; l < available; ++l) p[l] = static_cast<float>(h[l]);
   }
 
   // Lowers the rows of one tile that `row_may_cut` admits to one move's swept surface, and
-  // updates those rows' state (measured against `plane`) in the same pass. Where the move has a
-  // supporting plane, a point already below that plane is not evaluated (for the ball end, a
-  // group of kLanes points all below it).
+  // updates those rows' state (measured against the tile's plane) in the same pass. Where the
+  // move has a supporting plane, a point already below that plane is not evaluated (for the
+  // ball end, a group of kLanes points all below it).
   template <class RowTest>
-  void mill_tile(const Candidate& c, const MoveGeometry& m, const BallLanes* ball, const IndexBox& t, double xc,
-                 double yc, const TilePlane& plane, TileState& state, RowTest&& row_may_cut) {
+  void mill_tile(const Candidate& c, const MoveGeometry& m, const BallLanes* ball, Tile& tile, RowTest&& row_may_cut) {
+    const IndexBox& t = tile.box;
+    const TilePlane& plane = tile.plane;
+    TileState& state = tile.state;
     const double empty = map_.empty_height;
     const double move_plane_z = c.has_plane ? c.centre_z : -kInf;
     const int count = t.i1 - t.i0 + 1;
-    alignas(32) double heights[kTile];
+    const DoubleN first_index = lane_index() + t.i0;
     for (int j = t.j0; j <= t.j1; ++j) {
       if (!row_may_cut(j)) continue;
       const double y = g_.y(j);
-      const double move_row = move_plane_z + c.gradient.y * (y - yc);
-      const double tile_row = plane.z + plane.gradient.y * (y - yc);
+      const double move_row = move_plane_z + c.gradient.y * (y - tile.yc);
+      const double tile_row = plane.z + plane.gradient.y * (y - tile.yc);
       float* row = &map_.heights[g_.index(t.i0, j)];
-      // Points past the grid's edge are -inf: never lowered, never the top.
-      for (int i = 0; i < kTile; ++i) heights[i] = i < count ? row[i] : -kInf;
       DoubleN top = splat(-kInf), excess = splat(-kInf);
       for (int i = 0; i < kTile; i += kLanes) {
         // x computed as ZMapGrid::x does, so that points on a footprint's rim go the same way.
-        const DoubleN x = g_.x0 + (lane_index() + (t.i0 + i)) * g_.cell, dx = x - xc;
-        DoubleN h = load_n(heights + i);
+        const DoubleN x = g_.x0 + (first_index + i) * g_.cell, dx = x - tile.xc;
+        DoubleN h = load_heights(row + i, count - i);
         if (ball) {
           if (any_n(move_row + c.gradient.x * dx < h)) {
             DoubleN z = ball->at(x - ball->ax, splat(y - ball->ay));
@@ -764,11 +878,10 @@ class Miller {
               h[l] = std::min(h[l], std::max(static_cast<double>(static_cast<float>(z)), empty));
             }
         }
-        store_n(heights + i, h);
+        store_heights(row + i, h, count - i);
         top = max_n(top, h);
         excess = max_n(excess, h - (tile_row + plane.gradient.x * dx));
       }
-      for (int i = 0; i < count; ++i) row[i] = static_cast<float>(heights[i]);
       std::size_t r = static_cast<std::size_t>(j - t.j0);
       state.row_top[r] = top[0], state.row_excess[r] = excess[0];
       for (int l = 1; l < kLanes; ++l)
