@@ -104,6 +104,20 @@ inline bool any_n(MaskN m) {
   return (m[0] | m[1]) != 0;
 #endif
 }
+inline bool all_n(MaskN m) {
+#if defined(__AVX__)
+  return _mm256_movemask_pd(reinterpret_cast<__m256d>(m)) == (1 << kLanes) - 1;
+#elif defined(__SSE2__)
+  return _mm_movemask_pd(reinterpret_cast<__m128d>(m)) == (1 << kLanes) - 1;
+#else
+  return (m[0] & m[1]) != 0;
+#endif
+}
+inline double max_lane(DoubleN a) {
+  double m = a[0];
+  for (int l = 1; l < kLanes; ++l) m = std::max(m, a[l]);
+  return m;
+}
 inline DoubleN lane_index() {
   DoubleN lane{};
   for (int l = 0; l < kLanes; ++l) lane[l] = l;
@@ -366,10 +380,18 @@ struct MoveGeometry {
 // and in each case q is covered exactly when the square root's argument is not negative.
 // The cylinder's gradient is w·v/|v|² + (1 + w²/|v|²)·(u − t⊥·v)/√(…) and a sphere's (u − t·v)/√(…),
 // the supporting plane of MoveGeometry::supporting_plane in other terms.
+//
+// Across the move S also rises at least quadratically from that plane: with n the move's unit
+// horizontal normal,  S(q) ≥ S(c) + ∇S(c)·(q − c) + ((q − c)·n)² / 2R  ("across"). Proof: the
+// ball's lower surface h(|p|) has curvature ≥ 1/R in every direction, so h(|p|) − (p·n + κ)²/2R
+// is convex in p; p = q − C(t) is affine in (q, t), and p·n differs from (q − c)·n by a constant
+// along a straight move; so S(q) − ((q − c)·n)²/2R, a minimum over t of a function jointly convex
+// in (q, t), is convex, and lies above its tangent plane at c.
 struct BallLanes {
   double ax = 0, ay = 0, top = 0;  // start of the (rising) move; top = its tip + R, the ball's centre
   double vx = 0, vy = 0, w = 0, vv = 0, inv_vv = 0, stretch = 1, c2 = 0, radius = 0, r2 = 0, inv_diameter = 0, rim = 0;
   double slope_x = 0, slope_y = 0;  // w·v/|v|²
+  double nx = 0, ny = 0;            // unit horizontal normal of the move
 
   BallLanes() = default;
 
@@ -383,6 +405,7 @@ struct BallLanes {
     c2 = w * w * inv_vv / (vv + w * w);
     rim = r2 * 1e-7;  // as MoveGeometry::lowest_with_plane: no plane this close to the rim
     slope_x = w * vx * inv_vv, slope_y = w * vy * inv_vv;
+    nx = -vy * m.inv_len, ny = vx * m.inv_len;
   }
 
   double lowest_tip() const { return top - radius; }
@@ -627,8 +650,10 @@ class Miller {
       tile.plane = {};
       tile.candidates.clear();
       for (int j = j0; j <= j1; ++j) {
-        const float* heights = &map_.heights[g_.index(0, j)];
-        tile.state.row_top[static_cast<std::size_t>(j - j0)] = *std::max_element(heights + i0, heights + i1 + 1);
+        const float* heights = &map_.heights[g_.index(i0, j)];
+        DoubleN top = load_heights(heights, i1 - i0 + 1);
+        for (int i = kLanes; i < kTile; i += kLanes) top = max_n(top, load_heights(heights + i, i1 - i0 + 1 - i));
+        tile.state.row_top[static_cast<std::size_t>(j - j0)] = max_lane(top);
         tile.state.row_excess[static_cast<std::size_t>(j - j0)] = -kInf;
       }
       tile.state.summarise(j1 - j0 + 1);
@@ -661,11 +686,14 @@ class Miller {
     BallLanes::Plane p = ball.plane_at(load_n(&row.lanes.xc[lane0]) - ball.ax, splat(tile.yc - ball.ay));
     // Without a plane: the lowest tip plus the ball's height at the tile's distance s from the
     // path, bounded below by s²/2R (h(s) = R − √(R² − s²) = s² / (R + √(R² − s²))).
-    DoubleN gap = max_n(sqrt_n(p.distance2) - load_n(&row.lanes.half_diagonal[lane0]), splat(0));
-    DoubleN far = gap * gap > ball.r2 ? splat(kInf) : ball.lowest_tip() + gap * gap * ball.inv_diameter;
-    DoubleN on_plane = p.z - abs_n(p.gx) * hx - abs_n(p.gy) * tile.hy;
+    DoubleN bound = p.z - abs_n(p.gx) * hx - abs_n(p.gy) * tile.hy;
+    if (!all_n(p.has_plane)) {
+      DoubleN gap = max_n(sqrt_n(p.distance2) - load_n(&row.lanes.half_diagonal[lane0]), splat(0));
+      DoubleN far = gap * gap > ball.r2 ? splat(kInf) : ball.lowest_tip() + gap * gap * ball.inv_diameter;
+      bound = p.has_plane ? bound : far;
+    }
     const DoubleN col = lane_index() + lane0;
-    return {p.z, p.gx, p.gy, p.has_plane ? on_plane : far, p.has_plane, (col >= col0) & (col <= col1), move, lane0};
+    return {p.z, p.gx, p.gy, bound, p.has_plane, (col >= col0) & (col <= col1), move, lane0};
   }
 
   // Pass 1: for each tile, the move whose swept surface is lowest at its centre among those with
@@ -717,7 +745,7 @@ class Miller {
       Candidate first{static_cast<std::uint32_t>(lanes.first[col]), true, lanes.first_bound[col], lanes.first_z[col],
                       Vec2(lanes.first_gx[col], lanes.first_gy[col])};
       tile.plane = {true, first.centre_z, first.gradient};
-      cut(tile, first, scratch, true);
+      mill_tile(std::span<const Candidate>(&first, 1), tile, scratch, true);
     }
     lanes.top[col] = tile.state.top, lanes.excess[col] = tile.state.excess;
     lanes.plane_valid[col] = tile.plane.valid, lanes.plane_z[col] = tile.plane.z;
@@ -771,17 +799,15 @@ class Miller {
     }
   }
 
-  // Cuts a tile with the moves left, lowest bound first, each checked again against what the
-  // tile holds by then.
+  // Cuts a tile with the moves left, lowest bound first, those whose bounds still admit them
+  // against what the first cut left.
   void cut_others(Tile& tile, const BlockScratch& scratch) {
     std::vector<Candidate>& candidates = tile.candidates;
+    if (candidates.empty()) return;
     std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
       return a.bound < b.bound || (a.bound == b.bound && a.move < b.move);
     });
-    for (const Candidate& c : candidates) {
-      if (c.bound >= tile.state.top) break;
-      if (can_cut(c, tile)) cut(tile, c, scratch, false);
-    }
+    mill_tile(candidates, tile, scratch, false);
   }
 
   // The bounds of one move over one tile, for any cutter.
@@ -802,21 +828,19 @@ class Miller {
     return c;
   }
 
-  // Cuts a tile with one move: every row (the first cut) or the rows whose bounds admit it.
-  void cut(Tile& tile, const Candidate& c, const BlockScratch& scratch, bool every_row) {
-    const MoveGeometry& m = scratch.moves[c.move];
-    const BallLanes* ball = scratch.is_ball[c.move] ? &scratch.balls[c.move] : nullptr;
-    if (every_row) {
-      mill_tile(c, m, ball, tile, [](int) { return true; });
-      return;
+  // Whether move c may lower row j of a tile (from its bounds and the row's state).
+  bool row_may_cut(const Candidate& c, const BallLanes* ball, const Tile& tile, int j) const {
+    std::size_t r = static_cast<std::size_t>(j - tile.box.j0);
+    double dy = g_.y(j) - tile.yc;
+    // The ball end's rise across the move (BallLanes::across), at its least on this row.
+    double across = 0;
+    if (ball && c.has_plane) {
+      double a = std::max(0.0, std::abs(dy * ball->ny) - tile.hx * std::abs(ball->nx));
+      across = a * a * ball->inv_diameter;
     }
-    mill_tile(c, m, ball, tile, [&](int j) {
-      std::size_t r = static_cast<std::size_t>(j - tile.box.j0);
-      double dy = g_.y(j) - tile.yc;
-      double row_bound = c.has_plane ? c.centre_z + c.gradient.y * dy - std::abs(c.gradient.x) * tile.hx : c.bound;
-      if (row_bound >= tile.state.row_top[r]) return false;
-      return !tile.plane.valid || above_plane(c, tile, dy, 0) < tile.state.row_excess[r];
-    });
+    double row_bound = c.has_plane ? c.centre_z + c.gradient.y * dy - std::abs(c.gradient.x) * tile.hx + across : c.bound;
+    if (row_bound >= tile.state.row_top[r]) return false;
+    return !tile.plane.valid || above_plane(c, tile, dy, 0) + across < tile.state.row_excess[r];
   }
 
   // kLanes heights of a map row as doubles; of the last `available` < kLanes of a row, the rest
@@ -840,55 +864,71 @@ class Miller {
     for (int l = 0; l < available; ++l) p[l] = static_cast<float>(h[l]);
   }
 
-  // Lowers the rows of one tile that `row_may_cut` admits to one move's swept surface, and
-  // updates those rows' state (measured against the tile's plane) in the same pass. Where the
-  // move has a supporting plane, a point already below that plane is not evaluated (for the
-  // ball end, a group of kLanes points all below it).
-  template <class RowTest>
-  void mill_tile(const Candidate& c, const MoveGeometry& m, const BallLanes* ball, Tile& tile, RowTest&& row_may_cut) {
+  // Lowers a tile to the swept surfaces of `cuts`, row by row: each row is read once, lowered by
+  // every move whose bounds admit it (all of them on every row if `every_row`), and its state
+  // (measured against the tile's plane) updated once. Other cutters than the ball end skip the
+  // points already below the move's supporting plane.
+  void mill_tile(std::span<const Candidate> cuts, Tile& tile, const BlockScratch& scratch, bool every_row) {
     const IndexBox& t = tile.box;
     const TilePlane& plane = tile.plane;
     TileState& state = tile.state;
     const double empty = map_.empty_height;
-    const double move_plane_z = c.has_plane ? c.centre_z : -kInf;
     const int count = t.i1 - t.i0 + 1;
-    const DoubleN first_index = lane_index() + t.i0;
+    constexpr int kGroups = kTile / kLanes;
+    DoubleN dx[kGroups], x[kGroups];
+    for (int g = 0; g < kGroups; ++g) {
+      // x computed as ZMapGrid::x does, so that points on a footprint's rim go the same way.
+      x[g] = g_.x0 + (lane_index() + (t.i0 + g * kLanes)) * g_.cell;
+      dx[g] = x[g] - tile.xc;
+    }
+    bool changed = false;
     for (int j = t.j0; j <= t.j1; ++j) {
-      if (!row_may_cut(j)) continue;
-      const double y = g_.y(j);
-      const double move_row = move_plane_z + c.gradient.y * (y - tile.yc);
-      const double tile_row = plane.z + plane.gradient.y * (y - tile.yc);
+      const double y = g_.y(j), dy = y - tile.yc;
       float* row = &map_.heights[g_.index(t.i0, j)];
-      DoubleN top = splat(-kInf), excess = splat(-kInf);
-      for (int i = 0; i < kTile; i += kLanes) {
-        // x computed as ZMapGrid::x does, so that points on a footprint's rim go the same way.
-        const DoubleN x = g_.x0 + (first_index + i) * g_.cell, dx = x - tile.xc;
-        DoubleN h = load_heights(row + i, count - i);
+      DoubleN h[kGroups];
+      bool loaded = false;
+      for (const Candidate& c : cuts) {
+        const MoveGeometry& m = scratch.moves[c.move];
+        const BallLanes* ball = scratch.is_ball[c.move] ? &scratch.balls[c.move] : nullptr;
+        if (!every_row && !row_may_cut(c, ball, tile, j)) continue;
+        if (!loaded) {
+          for (int g = 0; g < kGroups; ++g) h[g] = load_heights(row + g * kLanes, count - g * kLanes);
+          loaded = true;
+        }
         if (ball) {
-          if (any_n(move_row + c.gradient.x * dx < h)) {
-            DoubleN z = ball->at(x - ball->ax, splat(y - ball->ay));
-            // Rounded to the map's float first, as the scalar path stores it.
-            z = __builtin_convertvector(__builtin_convertvector(z, FloatN), DoubleN);
-            h = min_n(h, max_n(z, splat(empty)));
+          // Every point of the row: a test per group costs more in mispredicted branches and
+          // in the chain through h than the evaluations it saves (measured).
+          const double uy = y - ball->ay;
+          for (int g = 0; g < kGroups; ++g) {
+            // Rounded to float and raised to the empty height once per row, below: heights are
+            // floats and never below it, so min(h, round(max(z, empty))) = round(max(min(h, z), empty)).
+            h[g] = min_n(h[g], ball->at(x[g] - ball->ax, splat(uy)));
           }
         } else {
-          for (int l = 0; l < kLanes; ++l)
-            if (move_row + c.gradient.x * dx[l] < h[l]) {
-              double z = m.lowest_above(x[l], y);
-              h[l] = std::min(h[l], std::max(static_cast<double>(static_cast<float>(z)), empty));
-            }
+          const double move_row = (c.has_plane ? c.centre_z : -kInf) + c.gradient.y * dy;
+          for (int g = 0; g < kGroups; ++g)
+            for (int l = 0; l < kLanes; ++l)
+              if (move_row + c.gradient.x * dx[g][l] < h[g][l]) {
+                double z = m.lowest_above(x[g][l], y);
+                h[g][l] = std::min(h[g][l], std::max(static_cast<double>(static_cast<float>(z)), empty));
+              }
         }
-        store_heights(row + i, h, count - i);
-        top = max_n(top, h);
-        excess = max_n(excess, h - (tile_row + plane.gradient.x * dx));
+      }
+      if (!loaded) continue;
+      changed = true;
+      const double tile_row = plane.z + plane.gradient.y * dy;
+      DoubleN top = splat(-kInf), excess = splat(-kInf);
+      for (int g = 0; g < kGroups; ++g) {
+        h[g] = max_n(__builtin_convertvector(__builtin_convertvector(h[g], FloatN), DoubleN), splat(empty));
+        store_heights(row + g * kLanes, h[g], count - g * kLanes);
+        top = max_n(top, h[g]);
+        excess = max_n(excess, h[g] - (tile_row + plane.gradient.x * dx[g]));
       }
       std::size_t r = static_cast<std::size_t>(j - t.j0);
-      state.row_top[r] = top[0], state.row_excess[r] = excess[0];
-      for (int l = 1; l < kLanes; ++l)
-        state.row_top[r] = std::max(state.row_top[r], top[l]), state.row_excess[r] = std::max(state.row_excess[r], excess[l]);
-      if (!plane.valid) state.row_excess[r] = -kInf;
+      state.row_top[r] = max_lane(top);
+      state.row_excess[r] = plane.valid ? max_lane(excess) : -kInf;
     }
-    state.summarise(t.j1 - t.j0 + 1);
+    if (changed) state.summarise(t.j1 - t.j0 + 1);
   }
 
   ZMap& map_;
