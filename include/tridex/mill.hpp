@@ -16,13 +16,19 @@
 //
 // Speed comes from touching only what a move can still lower (Miller below). S is convex too (the
 // lower surface of a convex swept solid), so its tangent plane at any point bounds it from below
-// everywhere. The grid is cut into 16×16-point tiles; each tile gathers the moves that reach it,
-// bounds each one's S over the tile by that tangent plane, cuts first with the move lowest at
-// its centre, and then skips every move (and every row) whose bound is not below what the tile
-// still holds, measured against the first move's plane so that sloped surfaces skip as well as
-// flat ones. Moves are binned to 128×128-point blocks, and the blocks are milled on all threads.
-// Every point ends at the minimum over moves of a value computed the same way whatever the order,
-// so the result is identical for any thread count and any move order.
+// everywhere; for the ball end S also rises at least quadratically across the move (BallLanes).
+// The grid is cut into 16×16-point tiles and the tiles into 8×8-tile work blocks, milled on all
+// threads. A block is milled one row of tiles at a time, in two passes over its moves:
+//   1. every move is bounded over every tile of the row it reaches, by S's tangent plane at the
+//      tile's centre, and each tile is cut first by the move lowest at its centre: that leaves
+//      it close to its final shape, and that move's plane P then follows its surface;
+//   2. the moves whose bound is still below the tile's highest point, and below max(height − P)
+//      when measured from P (so that sloped surfaces skip as well as flat ones), cut the tile
+//      row by row, each row read once and lowered by every move admitted there.
+// Ball end moves are bounded kLanes tiles at a time and evaluated kLanes points at a time, with
+// one square root per point (BallLanes). Every point ends at the minimum over moves of a value
+// computed the same way whatever the order, so the result is identical for any thread count and
+// any move order (for one build: the vector width and FMA contraction change the last bits).
 #pragma once
 
 #include <algorithm>
@@ -36,7 +42,7 @@
 #include <thread>
 #include <vector>
 
-#if defined(__SSE2__) || defined(__AVX__)
+#if defined(__SSE2__) || defined(__AVX__) || defined(__AVX512F__)
 #include <immintrin.h>
 #endif
 
@@ -63,10 +69,15 @@ constexpr int kTile = 16;        // points along each side of a tile
 constexpr int kBinTiles = 8;     // tiles along each side of a work block
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// Doubles processed as one value (GCC/Clang vector extension): four with AVX, two with the
-// SSE2 of every x86-64, two in plain scalar code elsewhere. Comparisons give a MaskN of
-// all-ones/all-zeros lanes.
-#if defined(__AVX__)
+// Doubles processed as one value (GCC/Clang vector extension): eight with AVX-512, four with
+// AVX, two with the SSE2 of every x86-64, two in plain scalar code elsewhere; the compiler's
+// target decides (the project's build picks the building machine's, see TRIDEX_SIMD in
+// CMakeLists.txt). Comparisons give a MaskN of all-ones/all-zeros lanes.
+#if defined(__AVX512F__)
+using DoubleN = double __attribute__((vector_size(64)));
+using MaskN = long long __attribute__((vector_size(64)));
+using FloatN = float __attribute__((vector_size(32)));
+#elif defined(__AVX__)
 using DoubleN = double __attribute__((vector_size(32)));
 using MaskN = long long __attribute__((vector_size(32)));
 using FloatN = float __attribute__((vector_size(16)));
@@ -87,7 +98,11 @@ inline DoubleN min_n(DoubleN a, DoubleN b) { return a < b ? a : b; }
 inline DoubleN max_n(DoubleN a, DoubleN b) { return a > b ? a : b; }
 inline DoubleN abs_n(DoubleN a) { return a < 0 ? -a : a; }
 inline DoubleN sqrt_n(DoubleN a) {
-#if defined(__AVX__)
+#if defined(__AVX512F__)
+  // The masked form: GCC 12 warns of an uninitialised operand in _mm512_sqrt_pd.
+  const __m512d v = reinterpret_cast<__m512d>(a);
+  return reinterpret_cast<DoubleN>(_mm512_mask_sqrt_pd(v, static_cast<__mmask8>(0xff), v));
+#elif defined(__AVX__)
   return reinterpret_cast<DoubleN>(_mm256_sqrt_pd(reinterpret_cast<__m256d>(a)));
 #elif defined(__SSE2__)
   return reinterpret_cast<DoubleN>(_mm_sqrt_pd(reinterpret_cast<__m128d>(a)));
@@ -96,7 +111,9 @@ inline DoubleN sqrt_n(DoubleN a) {
 #endif
 }
 inline bool any_n(MaskN m) {
-#if defined(__AVX__)
+#if defined(__AVX512F__)
+  return _mm512_test_epi64_mask(reinterpret_cast<__m512i>(m), reinterpret_cast<__m512i>(m)) != 0;
+#elif defined(__AVX__)
   return _mm256_movemask_pd(reinterpret_cast<__m256d>(m)) != 0;
 #elif defined(__SSE2__)
   return _mm_movemask_pd(reinterpret_cast<__m128d>(m)) != 0;
@@ -105,7 +122,9 @@ inline bool any_n(MaskN m) {
 #endif
 }
 inline bool all_n(MaskN m) {
-#if defined(__AVX__)
+#if defined(__AVX512F__)
+  return _mm512_test_epi64_mask(reinterpret_cast<__m512i>(m), reinterpret_cast<__m512i>(m)) == 0xff;
+#elif defined(__AVX__)
   return _mm256_movemask_pd(reinterpret_cast<__m256d>(m)) == (1 << kLanes) - 1;
 #elif defined(__SSE2__)
   return _mm_movemask_pd(reinterpret_cast<__m128d>(m)) == (1 << kLanes) - 1;
@@ -799,15 +818,27 @@ class Miller {
     }
   }
 
-  // Cuts a tile with the moves left, lowest bound first, those whose bounds still admit them
-  // against what the first cut left.
+  // Cuts a tile with the moves left, lowest bound first: the ball end moves together, row by row
+  // (admitted by what the first cut left: their rows are cheap, a fresher test costs more than it
+  // saves), then each other move, checked again against what the tile holds by then (its points
+  // cost far more).
   void cut_others(Tile& tile, const BlockScratch& scratch) {
     std::vector<Candidate>& candidates = tile.candidates;
     if (candidates.empty()) return;
-    std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+    auto others = std::stable_partition(candidates.begin(), candidates.end(),
+                                        [&](const Candidate& c) { return scratch.is_ball[c.move] != 0; });
+    auto by_bound = [](const Candidate& a, const Candidate& b) {
       return a.bound < b.bound || (a.bound == b.bound && a.move < b.move);
-    });
-    mill_tile(candidates, tile, scratch, false);
+    };
+    std::sort(candidates.begin(), others, by_bound);
+    std::sort(others, candidates.end(), by_bound);
+    if (others != candidates.begin())
+      mill_tile(std::span<const Candidate>(&*candidates.begin(), static_cast<std::size_t>(others - candidates.begin())),
+                tile, scratch, false);
+    for (auto c = others; c != candidates.end(); ++c) {
+      if (c->bound >= tile.state.top) break;
+      if (can_cut(*c, tile)) mill_tile(std::span<const Candidate>(&*c, 1), tile, scratch, false);
+    }
   }
 
   // The bounds of one move over one tile, for any cutter.

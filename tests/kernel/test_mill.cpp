@@ -170,10 +170,9 @@ TEST_CASE("bad moves are rejected before anything is milled") {
   CHECK(map.height(4, 4) == -1);
 }
 
-TEST_CASE("tile skipping never skips a point a move lowers (dense raster, every cutter kind)") {
-  // A raster over a wavy surface makes many moves reach every tile, so most are skipped by the
-  // tile, row and plane bounds; compare with evaluating every move at every point.
-  std::mt19937 rng(5);
+// A raster over a wavy surface, and a plunge: many moves reach every tile, so most are skipped
+// by the tile, row and plane bounds.
+std::vector<Segment> dense_raster() {
   auto wavy = [](double x, double y) { return 2 + 0.8 * std::sin(x / 1.3) * std::cos(y / 1.7) + 0.05 * x; };
   std::vector<Segment> path;
   for (int line = 0; line <= 24; ++line) {
@@ -183,7 +182,14 @@ TEST_CASE("tile skipping never skips a point a move lowers (dense raster, every 
       path.push_back({Vec3(x0, y, wavy(x0, y)), Vec3(x1, y, wavy(x1, y))});
     }
   }
-  path.push_back({Vec3(3, 3, 6), Vec3(3, 3, 1.2)});  // a plunge
+  path.push_back({Vec3(3, 3, 6), Vec3(3, 3, 1.2)});
+  return path;
+}
+
+TEST_CASE("tile skipping never skips a point a move lowers (dense raster, every cutter kind)") {
+  // Compared with evaluating every move at every point.
+  std::mt19937 rng(5);
+  const std::vector<Segment> path = dense_raster();
   for (int kind = 0; kind < 6; ++kind) {
     Cutter cutter = random_cutter(kind, rng).cutter;
     CAPTURE(cutter.name());
@@ -206,6 +212,31 @@ TEST_CASE("tile skipping never skips a point a move lowers (dense raster, every 
       }
     CHECK(mismatches == 0);
   }
+}
+
+TEST_CASE("moves of several cutters in one call: each point at the lowest of them all") {
+  // The ball end's vector path and the scalar path of the others share tiles and bounds.
+  const std::vector<Segment> path = dense_raster();
+  std::vector<Cutter> cutters{Cutter::ball(0.8), Cutter::bull_nose(1.1, 0.3), Cutter::flat(0.6), Cutter::ball(1.7)};
+  ZMapGrid g;
+  g.x0 = -0.5, g.y0 = -0.5, g.cell = 0.02, g.nx = 350, g.ny = 350;
+  ZMap map(g, 4, -1);
+  std::vector<CutMove> moves;
+  for (std::size_t k = 0; k < path.size(); ++k) {
+    const Vec3 lift(0, 0, 0.1 * static_cast<double>(k % 3));  // so that every cutter shows somewhere
+    moves.push_back({Segment{path[k].a + lift, path[k].b + lift}, static_cast<std::uint32_t>(k % cutters.size())});
+  }
+  mill(map, cutters, moves);
+  int mismatches = 0;
+  for (int j = 0; j < g.ny; j += 2)
+    for (int i = 0; i < g.nx; i += 2) {
+      double expected = 4;
+      for (const CutMove& m : moves)
+        expected = std::min(expected, detail::MoveGeometry(cutters[m.cutter], m.tip).lowest_above(g.x(i), g.y(j)));
+      expected = std::max(expected, -1.0);
+      if (std::abs(map.height(i, j) - expected) > 1e-5) ++mismatches;
+    }
+  CHECK(mismatches == 0);
 }
 
 TEST_CASE("cut_depth: how deep a move would cut, equal to what milling it removes") {
