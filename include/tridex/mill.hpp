@@ -453,10 +453,9 @@ struct BallLanes {
     return c.root2 >= 0 ? z : splat(kInf);
   }
 
-  // S, its supporting plane's slope (where `has_plane`), and the squared distance from the
-  // points to the move's path (for a bound where there is no plane).
+  // S and its supporting plane's slope (where `has_plane`).
   struct Plane {
-    DoubleN z, gx, gy, distance2;
+    DoubleN z, gx, gy;
     MaskN has_plane;
   };
   Plane plane_at(DoubleN ux, DoubleN uy) const {
@@ -471,9 +470,14 @@ struct BallLanes {
     DoubleN scale = (sphere ? splat(1) : splat(stretch)) / root;
     p.gx = (sphere ? splat(0) : splat(slope_x)) + scale * (ux - t * vx);
     p.gy = (sphere ? splat(0) : splat(slope_y)) + scale * (uy - t * vy);
-    DoubleN along = min_n(max_n(c.t_foot, splat(0)), splat(1)), dx = ux - along * vx, dy = uy - along * vy;
-    p.distance2 = dx * dx + dy * dy;
     return p;
+  }
+
+  // The squared distance from the points to the move's path.
+  DoubleN distance2(DoubleN ux, DoubleN uy) const {
+    DoubleN along = min_n(max_n((ux * vx + uy * vy) * inv_vv, splat(0)), splat(1));
+    DoubleN dx = ux - along * vx, dy = uy - along * vy;
+    return dx * dx + dy * dy;
   }
 };
 
@@ -569,8 +573,16 @@ class Miller {
     int lane0;
   };
 
+  // A ball end move left out of pass 1, and its distance from the row's tiles.
+  struct FarMove {
+    std::uint32_t move;
+    int col0, col1;
+    double distance;
+  };
+
   struct BlockScratch {
     std::vector<BallBounds> ball_bounds;  // of the current row
+    std::vector<FarMove> far_moves;       // of the current row
     std::vector<MoveGeometry> moves;
     std::vector<BallLanes> balls;  // parallel to `moves`; used where `is_ball`
     std::vector<unsigned char> is_ball;
@@ -702,12 +714,13 @@ class Miller {
                          int col1) const {
     const Tile& tile = row.tiles[0];
     const DoubleN hx = load_n(&row.lanes.hx[lane0]);
-    BallLanes::Plane p = ball.plane_at(load_n(&row.lanes.xc[lane0]) - ball.ax, splat(tile.yc - ball.ay));
+    const DoubleN ux = load_n(&row.lanes.xc[lane0]) - ball.ax, uy = splat(tile.yc - ball.ay);
+    BallLanes::Plane p = ball.plane_at(ux, uy);
     // Without a plane: the lowest tip plus the ball's height at the tile's distance s from the
     // path, bounded below by s²/2R (h(s) = R − √(R² − s²) = s² / (R + √(R² − s²))).
     DoubleN bound = p.z - abs_n(p.gx) * hx - abs_n(p.gy) * tile.hy;
     if (!all_n(p.has_plane)) {
-      DoubleN gap = max_n(sqrt_n(p.distance2) - load_n(&row.lanes.half_diagonal[lane0]), splat(0));
+      DoubleN gap = max_n(sqrt_n(ball.distance2(ux, uy)) - load_n(&row.lanes.half_diagonal[lane0]), splat(0));
       DoubleN far = gap * gap > ball.r2 ? splat(kInf) : ball.lowest_tip() + gap * gap * ball.inv_diameter;
       bound = p.has_plane ? bound : far;
     }
@@ -717,9 +730,19 @@ class Miller {
 
   // Pass 1: for each tile, the move whose swept surface is lowest at its centre among those with
   // a supporting plane there (ties: the lower bound). Moves other than ball ends are kept.
+  //
+  // A ball end move whose path stays farther than R/2 from the row's tiles is left for pass 2,
+  // where most such moves fall to a scalar test: the lowest point of the ball within a distance d
+  // of its path is at least d²/2R above the tip, and a tile's surface comes within d of the move
+  // only if the move passes within d of it. The first cut is only a choice (any move gives a
+  // correct result); in a raster it is the nearby move a little downhill, well within R/2.
   void find_first_cuts(TileRow& row, BlockScratch& scratch) {
     TileRow::Lanes& lanes = row.lanes;
     scratch.ball_bounds.clear();
+    scratch.far_moves.clear();
+    const Tile& last = row.tiles[static_cast<std::size_t>(row.count - 1)];
+    const double row_x0 = g_.x(row.tiles[0].box.i0), row_x1 = g_.x(last.box.i1);
+    const double row_y0 = g_.y(last.box.j0), row_y1 = g_.y(last.box.j1);
     for_each_move(row, scratch, [&](std::size_t k, int col0, int col1) {
       const MoveGeometry& m = scratch.moves[k];
       if (!scratch.is_ball[k]) {
@@ -739,6 +762,14 @@ class Miller {
         return;
       }
       const BallLanes& ball = scratch.balls[k];
+      // Distance between the path's bounding box and the row's rectangle.
+      const double dx = std::max({0.0, std::min(m.ax, m.ax + m.vx) - row_x1, row_x0 - std::max(m.ax, m.ax + m.vx)});
+      const double dy = std::max({0.0, std::min(m.ay, m.ay + m.vy) - row_y1, row_y0 - std::max(m.ay, m.ay + m.vy)});
+      const double distance = std::hypot(dx, dy);
+      if (distance > 0.5 * m.radius) {
+        scratch.far_moves.push_back({static_cast<std::uint32_t>(k), col0, col1, distance});
+        return;
+      }
       for (int lane0 = col0 / kLanes * kLanes; lane0 <= col1; lane0 += kLanes) {
         const BallBounds& b =
             scratch.ball_bounds.emplace_back(ball_bounds(ball, row, static_cast<std::uint32_t>(k), lane0, col0, col1));
@@ -796,25 +827,37 @@ class Miller {
       std::erase_if(tile.candidates,
                     [&](const Candidate& c) { return (has_first && c.move == first) || !can_cut(c, tile); });
     }
+    for (const BallBounds& b : scratch.ball_bounds) keep_other_cuts(row, b);
+    double row_top = -kInf;
+    for (int col = 0; col < row.count; ++col) row_top = std::max(row_top, lanes.top[col]);
+    for (const FarMove& far : scratch.far_moves) {
+      const BallLanes& ball = scratch.balls[far.move];
+      if (ball.lowest_tip() + far.distance * far.distance * ball.inv_diameter >= row_top) continue;
+      for (int lane0 = far.col0 / kLanes * kLanes; lane0 <= far.col1; lane0 += kLanes)
+        keep_other_cuts(row, ball_bounds(ball, row, far.move, lane0, far.col0, far.col1));
+    }
+  }
+
+  // The tiles of b's lanes where its move can still cut (see `can_cut`) get it as a candidate.
+  void keep_other_cuts(TileRow& row, const BallBounds& b) const {
+    const TileRow::Lanes& lanes = row.lanes;
     const double hy = row.tiles[0].hy;
-    for (const BallBounds& b : scratch.ball_bounds) {
-      const int lane0 = b.lane0;
-      const DoubleN hx = load_n(&lanes.hx[lane0]);
-      const DoubleN pz = load_n(&lanes.plane_z[lane0]), pgx = load_n(&lanes.plane_gx[lane0]),
-                    pgy = load_n(&lanes.plane_gy[lane0]);
-      DoubleN with_plane = (b.z - pz) - abs_n(b.gx - pgx) * hx - abs_n(b.gy - pgy) * hy;
-      DoubleN without_plane = b.bound - (pz + abs_n(pgx) * hx + abs_n(pgy) * hy);
-      DoubleN above = b.has_plane ? with_plane : without_plane;
-      MaskN cuts = b.in_range & (b.bound < load_n(&lanes.top[lane0])) &
-                   ((load_n(&lanes.plane_valid[lane0]) == 0) | (above < load_n(&lanes.excess[lane0]))) &
-                   (load_n(&lanes.first[lane0]) != static_cast<double>(b.move));
-      if (!any_n(cuts)) continue;
-      for (int l = 0; l < kLanes; ++l) {
-        if (!cuts[l]) continue;
-        Candidate c{b.move, b.has_plane[l] != 0, b.bound[l], kInf, Vec2(0)};
-        if (c.has_plane) c.centre_z = b.z[l], c.gradient = Vec2(b.gx[l], b.gy[l]);
-        row.tiles[static_cast<std::size_t>(lane0 + l)].candidates.push_back(c);
-      }
+    const int lane0 = b.lane0;
+    const DoubleN hx = load_n(&lanes.hx[lane0]);
+    const DoubleN pz = load_n(&lanes.plane_z[lane0]), pgx = load_n(&lanes.plane_gx[lane0]),
+                  pgy = load_n(&lanes.plane_gy[lane0]);
+    DoubleN with_plane = (b.z - pz) - abs_n(b.gx - pgx) * hx - abs_n(b.gy - pgy) * hy;
+    DoubleN without_plane = b.bound - (pz + abs_n(pgx) * hx + abs_n(pgy) * hy);
+    DoubleN above = b.has_plane ? with_plane : without_plane;
+    MaskN cuts = b.in_range & (b.bound < load_n(&lanes.top[lane0])) &
+                 ((load_n(&lanes.plane_valid[lane0]) == 0) | (above < load_n(&lanes.excess[lane0]))) &
+                 (load_n(&lanes.first[lane0]) != static_cast<double>(b.move));
+    if (!any_n(cuts)) return;
+    for (int l = 0; l < kLanes; ++l) {
+      if (!cuts[l]) continue;
+      Candidate c{b.move, b.has_plane[l] != 0, b.bound[l], kInf, Vec2(0)};
+      if (c.has_plane) c.centre_z = b.z[l], c.gradient = Vec2(b.gx[l], b.gy[l]);
+      row.tiles[static_cast<std::size_t>(lane0 + l)].candidates.push_back(c);
     }
   }
 
@@ -825,8 +868,8 @@ class Miller {
   void cut_others(Tile& tile, const BlockScratch& scratch) {
     std::vector<Candidate>& candidates = tile.candidates;
     if (candidates.empty()) return;
-    auto others = std::stable_partition(candidates.begin(), candidates.end(),
-                                        [&](const Candidate& c) { return scratch.is_ball[c.move] != 0; });
+    auto others = std::partition(candidates.begin(), candidates.end(),
+                                 [&](const Candidate& c) { return scratch.is_ball[c.move] != 0; });
     auto by_bound = [](const Candidate& a, const Candidate& b) {
       return a.bound < b.bound || (a.bound == b.bound && a.move < b.move);
     };
