@@ -542,7 +542,8 @@ class Miller {
 
   struct Tile {
     IndexBox box;
-    double xc, yc, hx, hy;  // centre and half extents
+    double xc, yc, hx, hy;   // centre and half extents
+    double half_diagonal;    // √(hx² + hy²)
     TileState state;
     TilePlane plane;
     std::vector<Candidate> candidates;
@@ -580,9 +581,18 @@ class Miller {
     double distance;
   };
 
+  // A move of another cutter left out of pass 1 over one tile (its lowest tip is not below the
+  // lowest centre height found there so far).
+  struct DeferredMove {
+    std::uint32_t move;
+    int col;
+  };
+
   struct BlockScratch {
     std::vector<BallBounds> ball_bounds;  // of the current row
     std::vector<FarMove> far_moves;       // of the current row
+    std::vector<DeferredMove> deferred;   // of the current row
+    std::vector<std::uint32_t> by_tip;    // the other cutters' moves, lowest tip first
     std::vector<MoveGeometry> moves;
     std::vector<BallLanes> balls;  // parallel to `moves`; used where `is_ball`
     std::vector<unsigned char> is_ball;
@@ -625,18 +635,10 @@ class Miller {
       for_each_bin(moves_[m], [&](std::size_t b) { bin_moves_[fill[b]++] = static_cast<std::uint32_t>(m); });
   }
 
-  // Mills one work block, one row of tiles at a time, each tile with every move that reaches it,
-  // skipping the moves (and, within a move, the rows and points) that provably cannot lower it:
-  //   * each move's swept surface S has a lower bound over a tile: S's supporting plane at the
-  //     tile's centre, or the lowest tip plus h at the tile's distance from the path;
-  //   * the move lowest at the tile's centre cuts it first: it usually leaves the tile close to
-  //     its final shape, and its supporting plane P then follows the tile's surface;
-  //   * after that a move (or one row of it) is skipped when its bound is not below the highest
-  //     point, or when min(S − P) ≥ max(height − P) there: this keeps skipping effective on
-  //     sloped surfaces, where the highest point of a tile is far above most of it;
-  //   * the moves left cut in order of their bound, each checked again before it cuts.
-  // Ball end moves are bounded kLanes tiles at a time, twice (to find the first cut, then against
-  // what it left) rather than stored; other moves are bounded once, one tile at a time, and kept.
+  // Mills one work block, one row of tiles at a time, in the two passes of the header comment:
+  // find_first_cuts and cut_first (pass 1), find_other_cuts and cut_others (pass 2). A move is
+  // skipped over a tile (or one of its rows) when its bound is not below the highest point there,
+  // or when min(S − P) ≥ max(height − P), P the first cut's plane.
   void mill_bin(std::size_t bin, BlockScratch& scratch) {
     if (bin_start_[bin] == bin_start_[bin + 1]) return;
     scratch.moves.clear();
@@ -652,6 +654,13 @@ class Miller {
       scratch.boxes.emplace_back();
       footprint_box(move, scratch.boxes.back());
     }
+    scratch.by_tip.clear();
+    for (std::size_t k = 0; k < scratch.moves.size(); ++k)
+      if (!scratch.is_ball[k]) scratch.by_tip.push_back(static_cast<std::uint32_t>(k));
+    std::sort(scratch.by_tip.begin(), scratch.by_tip.end(), [&](std::uint32_t a, std::uint32_t b) {
+      const double ta = scratch.moves[a].lowest_tip(), tb = scratch.moves[b].lowest_tip();
+      return ta < tb || (ta == tb && a < b);
+    });
     int bx = static_cast<int>(bin % static_cast<std::size_t>(bins_x_));
     int by = static_cast<int>(bin / static_cast<std::size_t>(bins_x_));
     int tx1 = std::min(tiles_x_, (bx + 1) * kBinTiles), ty1 = std::min(tiles_y_, (by + 1) * kBinTiles);
@@ -678,6 +687,7 @@ class Miller {
       tile.box = {i0, j0, i1, j1};
       tile.xc = 0.5 * (g_.x(i0) + g_.x(i1)), tile.yc = 0.5 * (g_.y(j0) + g_.y(j1));
       tile.hx = 0.5 * (g_.x(i1) - g_.x(i0)), tile.hy = 0.5 * (g_.y(j1) - g_.y(j0));
+      tile.half_diagonal = std::sqrt(tile.hx * tile.hx + tile.hy * tile.hy);
       tile.plane = {};
       tile.candidates.clear();
       for (int j = j0; j <= j1; ++j) {
@@ -689,7 +699,7 @@ class Miller {
       }
       tile.state.summarise(j1 - j0 + 1);
       lanes.xc[col] = tile.xc, lanes.hx[col] = tile.hx, lanes.top[col] = tile.state.top;
-      lanes.half_diagonal[col] = std::hypot(tile.hx, tile.hy);
+      lanes.half_diagonal[col] = tile.half_diagonal;
       lanes.first[col] = -1, lanes.first_z[col] = kInf, lanes.first_bound[col] = kInf;
       lanes.first_gx[col] = lanes.first_gy[col] = 0;
     }
@@ -698,14 +708,19 @@ class Miller {
   // Calls visit(k, col0, col1) for each move k of the block that reaches the row's tiles col0..col1.
   template <class Visit>
   void for_each_move(const TileRow& row, const BlockScratch& scratch, Visit&& visit) const {
-    const IndexBox& any = row.tiles[0].box;
     for (std::size_t k = 0; k < scratch.moves.size(); ++k) {
-      const IndexBox& b = scratch.boxes[k];
-      if (b.j1 < any.j0 || b.j0 > any.j1) continue;
-      const int col0 = std::max(0, b.i0 / kTile - row.first_tx);
-      const int col1 = std::min(row.count - 1, b.i1 / kTile - row.first_tx);
-      if (col0 <= col1) visit(k, col0, col1);
+      int col0, col1;
+      if (columns(row, scratch.boxes[k], col0, col1)) visit(k, col0, col1);
     }
+  }
+
+  // The row's tiles col0..col1 that a footprint box reaches; false if none.
+  static bool columns(const TileRow& row, const IndexBox& b, int& col0, int& col1) {
+    const IndexBox& any = row.tiles[0].box;
+    if (b.j1 < any.j0 || b.j0 > any.j1) return false;
+    col0 = std::max(0, b.i0 / kTile - row.first_tx);
+    col1 = std::min(row.count - 1, b.i1 / kTile - row.first_tx);
+    return col0 <= col1;
   }
 
   // A ball end move's bounds over the row's tiles lane0 .. lane0 + kLanes − 1 (those in
@@ -745,27 +760,12 @@ class Miller {
     const double row_y0 = g_.y(last.box.j0), row_y1 = g_.y(last.box.j1);
     for_each_move(row, scratch, [&](std::size_t k, int col0, int col1) {
       const MoveGeometry& m = scratch.moves[k];
-      if (!scratch.is_ball[k]) {
-        for (int col = col0; col <= col1; ++col) {
-          Tile& tile = row.tiles[static_cast<std::size_t>(col)];
-          if (m.lowest_tip() >= tile.state.top) continue;
-          Candidate c = bound_at_centre(m, tile, static_cast<std::uint32_t>(k));
-          if (c.bound >= tile.state.top) continue;
-          tile.candidates.push_back(c);
-          if (c.has_plane && (c.centre_z < lanes.first_z[col] ||
-                              (c.centre_z == lanes.first_z[col] && c.bound < lanes.first_bound[col]))) {
-            lanes.first[col] = static_cast<double>(k), lanes.first_z[col] = c.centre_z;
-            lanes.first_gx[col] = c.gradient.x, lanes.first_gy[col] = c.gradient.y;
-            lanes.first_bound[col] = c.bound;
-          }
-        }
-        return;
-      }
+      if (!scratch.is_ball[k]) return;
       const BallLanes& ball = scratch.balls[k];
       // Distance between the path's bounding box and the row's rectangle.
       const double dx = std::max({0.0, std::min(m.ax, m.ax + m.vx) - row_x1, row_x0 - std::max(m.ax, m.ax + m.vx)});
       const double dy = std::max({0.0, std::min(m.ay, m.ay + m.vy) - row_y1, row_y0 - std::max(m.ay, m.ay + m.vy)});
-      const double distance = std::hypot(dx, dy);
+      const double distance = std::sqrt(dx * dx + dy * dy);
       if (distance > 0.5 * m.radius) {
         scratch.far_moves.push_back({static_cast<std::uint32_t>(k), col0, col1, distance});
         return;
@@ -784,6 +784,33 @@ class Miller {
         store_n(&lanes.first_bound[lane0], better ? b.bound : first_bound);
       }
     });
+    // The other cutters' moves, lowest tip first; one whose tip is not below the lowest centre
+    // height found for a tile cannot be its first cut, and waits for pass 2 (where, after the
+    // first cut, most such moves fall to the same cheap test against the tile's top: the upper
+    // levels of a Z-level roughing, for instance).
+    scratch.deferred.clear();
+    for (std::uint32_t k : scratch.by_tip) {
+      int col0, col1;
+      if (!columns(row, scratch.boxes[k], col0, col1)) continue;
+      const MoveGeometry& m = scratch.moves[k];
+      for (int col = col0; col <= col1; ++col) {
+        Tile& tile = row.tiles[static_cast<std::size_t>(col)];
+        if (m.lowest_tip() >= tile.state.top) continue;
+        if (m.lowest_tip() >= lanes.first_z[col]) {
+          scratch.deferred.push_back({k, col});
+          continue;
+        }
+        Candidate c = bound_at_centre(m, tile, k);
+        if (c.bound >= tile.state.top) continue;
+        tile.candidates.push_back(c);
+        if (c.has_plane && (c.centre_z < lanes.first_z[col] ||
+                            (c.centre_z == lanes.first_z[col] && c.bound < lanes.first_bound[col]))) {
+          lanes.first[col] = static_cast<double>(k), lanes.first_z[col] = c.centre_z;
+          lanes.first_gx[col] = c.gradient.x, lanes.first_gy[col] = c.gradient.y;
+          lanes.first_bound[col] = c.bound;
+        }
+      }
+    }
   }
 
   // Cuts a tile with its first move (if it has one), and records the plane and state that the
@@ -826,6 +853,13 @@ class Miller {
       const bool has_first = lanes.first[col] >= 0;
       std::erase_if(tile.candidates,
                     [&](const Candidate& c) { return (has_first && c.move == first) || !can_cut(c, tile); });
+    }
+    for (const DeferredMove& d : scratch.deferred) {
+      Tile& tile = row.tiles[static_cast<std::size_t>(d.col)];
+      const MoveGeometry& m = scratch.moves[d.move];
+      if (m.lowest_tip() >= tile.state.top || static_cast<double>(d.move) == lanes.first[d.col]) continue;
+      Candidate c = bound_at_centre(m, tile, d.move);
+      if (can_cut(c, tile)) tile.candidates.push_back(c);
     }
     for (const BallBounds& b : scratch.ball_bounds) keep_other_cuts(row, b);
     double row_top = -kInf;
@@ -897,7 +931,7 @@ class Miller {
     c.gradient = Vec2(0);
     double distance = std::max(0.0, std::sqrt(distance2_point_segment(Vec2(tile.xc, tile.yc), Vec2(m.ax, m.ay),
                                                                        Vec2(m.ax + m.vx, m.ay + m.vy))) -
-                                        std::hypot(tile.hx, tile.hy));
+                                        tile.half_diagonal);
     if (distance <= m.radius) c.bound = m.lowest_tip() + m.cutter->lower_height(distance);
     return c;
   }

@@ -63,6 +63,54 @@ std::vector<Segment> random_segments(std::mt19937& rng, int count) {
 
 }  // namespace
 
+TEST_CASE("the ball end's vector form agrees with the scalar one, and its plane and across bound hold") {
+  // BallLanes (one square root, kLanes points) against MoveGeometry (the closed form for t*):
+  // heights, coverage, the supporting plane, and the quadratic rise across the move.
+  std::mt19937 rng(41);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const double r = 1.7;
+  const Cutter ball = Cutter::ball(r);
+  int covered = 0, planes = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    Segment s{Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng))};
+    if (trial % 4 == 0) s.b.z = s.a.z;  // level
+    if (trial % 7 == 0) s.b = s.a + Vec3(0.01 * u(rng), 0.01 * u(rng), 2 * u(rng));  // steep
+    detail::MoveGeometry m(ball, s);
+    if (m.vertical) continue;
+    detail::BallLanes lanes(m);
+    detail::DoubleN x{}, y{};
+    for (int l = 0; l < detail::kLanes; ++l) x[l] = 3 * u(rng), y[l] = 3 * u(rng);
+    detail::DoubleN z = lanes.at(x - lanes.ax, y - lanes.ay);
+    detail::BallLanes::Plane p = lanes.plane_at(x - lanes.ax, y - lanes.ay);
+    for (int l = 0; l < detail::kLanes; ++l) {
+      const double expected = m.lowest_above(x[l], y[l]);
+      CAPTURE(trial);
+      if (!(expected < 1e300)) {
+        // Not covered, or only within rounding of the rim.
+        CHECK((z[l] > 1e300 || std::abs(m.lowest(x[l], y[l]).z) > 1e300));
+        continue;
+      }
+      ++covered;
+      REQUIRE(z[l] == doctest::Approx(expected).epsilon(0).scale(1).epsilon(1e-9));
+      REQUIRE(p.z[l] == doctest::Approx(expected).epsilon(0).scale(1).epsilon(1e-9));
+      if (!p.has_plane[l]) continue;
+      ++planes;
+      // S(q) >= S(c) + g·(q − c) + ((q − c)·n)² / 2R around c.
+      for (int k = 0; k < 20; ++k) {
+        const double qx = x[l] + 0.5 * u(rng), qy = y[l] + 0.5 * u(rng);
+        const double s_q = m.lowest_above(qx, qy);
+        if (!(s_q < 1e300)) continue;
+        const double across = (qx - x[l]) * lanes.nx + (qy - y[l]) * lanes.ny;
+        const double bound =
+            p.z[l] + p.gx[l] * (qx - x[l]) + p.gy[l] * (qy - y[l]) + across * across * lanes.inv_diameter;
+        REQUIRE(s_q >= bound - 1e-9);
+      }
+    }
+  }
+  CHECK(covered > 1000);
+  CHECK(planes > 1000);
+}
+
 TEST_CASE("milled heights are the exact lowest point of the swept cutter (every cutter kind)") {
   std::mt19937 rng(2026);
   for (int trial = 0; trial < 12; ++trial) {
