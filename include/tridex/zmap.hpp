@@ -87,7 +87,12 @@ class ZMap {
 // M_i's polyhedron would interpolate that top linearly, which lies below it in every cell that
 // straddles a ridge or the silhouette of a tilted stock (and ramps down to the empty points
 // around it), and so would shave W0 where direction i cut nothing. A point cut below the stock
-// (to the empty height) stays low. Throws if the grids differ.
+// (to the empty height) stays low.
+// A grid point just outside the stock's footprint, next to points that were cut, takes the cut
+// surface extrapolated from them (the largest such value): between it and its neighbour the
+// polyhedron spans the strip of stock up to the footprint's edge, and a raised point there
+// would leave a fin of uncut stock in that strip, as thin as a cell and as tall as the cut
+// (seen by the dexel rays across the edge only). Throws if the grids differ.
 void raise_uncut(ZMap& milled, const ZMap& initial);
 
 // ---------------------------------------------------------------------------------------------
@@ -209,8 +214,28 @@ inline void raise_uncut(ZMap& milled, const ZMap& initial) {
   float top = milled.empty_height;
   for (float h : initial.heights) top = std::max(top, h);
   const float above = static_cast<float>(top + detail::empty_margin(a.cell));
+  // Points outside the footprint next to cut ones: the cut surface continued linearly from the
+  // two points inward along each of the 8 directions (constant where only one was cut).
+  auto inside = [&](int i, int j) { return i >= 0 && j >= 0 && i < a.nx && j < a.ny && initial.height(i, j) > initial.empty_height; };
+  auto cut = [&](int i, int j) { return inside(i, j) && milled.height(i, j) != initial.height(i, j); };
+  std::vector<std::pair<std::size_t, float>> continued;
+  for (int j = 0; j < a.ny; ++j)
+    for (int i = 0; i < a.nx; ++i) {
+      if (initial.height(i, j) > initial.empty_height) continue;
+      float best = -std::numeric_limits<float>::infinity();
+      for (int dj = -1; dj <= 1; ++dj)
+        for (int di = -1; di <= 1; ++di) {
+          if ((di == 0 && dj == 0) || !cut(i + di, j + dj)) continue;
+          const float near = milled.height(i + di, j + dj);
+          const float far = cut(i + 2 * di, j + 2 * dj) ? milled.height(i + 2 * di, j + 2 * dj) : near;
+          best = std::max(best, 2 * near - far);
+        }
+      if (best > -std::numeric_limits<float>::infinity())
+        continued.emplace_back(a.index(i, j), std::clamp(best, milled.empty_height, above));
+    }
   for (std::size_t p = 0; p < milled.heights.size(); ++p)
     if (milled.heights[p] == initial.heights[p]) milled.heights[p] = above;
+  for (const auto& [p, h] : continued) milled.heights[p] = h;
 }
 
 }  // namespace tridex

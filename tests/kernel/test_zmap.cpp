@@ -116,6 +116,36 @@ TEST_CASE("bad Z-map parameters are rejected") {
   CHECK_THROWS_AS(ZMap::from_mesh(Frame{}, Mesh{}, 0.1), Error);
 }
 
+TEST_CASE("raise_uncut: no fin of stock left between the last grid row and a face that falls between rows") {
+  // A facing cut over the whole top, 1 mm down. Cell 0.3 puts the faces x = 10 and y = 8 between
+  // grid rows: the strip beyond the last row inside interpolates towards the first row outside.
+  // Raised above the stock, that row left a fin of uncut stock up to the old top in the strip.
+  const Aabb stock{Vec3(0, 0, 0), Vec3(10, 8, 5)};
+  const DexelLattice lattice = DexelLattice::covering_resolution(stock, 50);
+  const ZMap initial = ZMap::from_box(Frame{}, stock, 0.3);
+  ZMap milled = initial;
+  std::vector<Cutter> cutters{Cutter::flat(2)};
+  std::vector<CutMove> facing;
+  for (double y = -2; y <= 10; y += 1.5) facing.push_back({Segment{Vec3(-3, y, 4), Vec3(13, y, 4)}, 0});
+  mill(milled, cutters, facing);
+  raise_uncut(milled, initial);
+  std::vector<ZMap> maps{milled};
+  const TripleDexel result = machine(stock, lattice, maps);
+  int checked = 0, above_cut = 0;
+  for (int a = 0; a < 2; ++a) {  // the rays along x and along y: those that cross the faces
+    const DexelGrid& g = result.grids[a];
+    for (int iv = 0; iv < g.nv; ++iv)
+      for (int iu = 0; iu < g.nu; ++iu) {
+        const double z = a == 0 ? lattice.node(0, iu, iv).z : lattice.node(iv, 0, iu).z;
+        if (z <= 4 + 1e-6 || z >= 5) continue;
+        ++checked;
+        above_cut += !g.ray(iu, iv).empty();
+      }
+  }
+  CHECK(checked > 100);
+  CHECK(above_cut == 0);
+}
+
 TEST_CASE("raise_uncut: an uncut direction keeps the whole stock; cuts stay cut") {
   const Aabb stock{Vec3(0, 0, 0), Vec3(10, 8, 5)};
   const DexelLattice lattice = DexelLattice::covering_resolution(stock, 40);
