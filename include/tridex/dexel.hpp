@@ -39,8 +39,7 @@ struct DexelLattice {
 
   // Nodes covering `box` with the given spacing, centred on it, with the outermost nodes more
   // than spacing/2 outside it on every side, so that a solid inside `box` never touches the
-  // lattice's outer rays or nodes (surface extraction needs outside nodes all around), and with
-  // the box's faces off the rows of rays.
+  // lattice's outer rays or nodes (surface extraction needs outside nodes all around).
   static DexelLattice covering(const Aabb& box, double spacing);
   // The same with `cells_on_longest_side` spacings across the box's longest side.
   static DexelLattice covering_resolution(const Aabb& box, int cells_on_longest_side);
@@ -113,18 +112,17 @@ inline DexelLattice DexelLattice::covering(const Aabb& box, double spacing) {
   if (box.empty() || !is_finite(box.min) || !is_finite(box.max))
     detail::fail("dexel lattice: box is empty or not finite");
   DexelLattice l;
-  l.spacing = spacing;
+  // A hair less than asked (1e-7 relative, far below float resolution of the rays' intervals):
+  // a box a whole number of spacings wide would otherwise have its faces exactly on rows of
+  // rays, where the half-open intervals keep the rows on the min faces and drop those on the
+  // max faces, and with them the crossings the surface needs to rebuild the edges there (the
+  // top edge came out bevelled by up to a spacing along the max faces). Slightly closer, the
+  // rows fall just inside both faces.
+  l.spacing = spacing * (1 - 1e-7);
   Vec3 size = box.size();
   for (int a = 0; a < 3; ++a) {
-    // A box a whole number of spacings wide would have its faces on rows of rays; one node more
-    // puts them half-way between rows instead. On a row, a face is on no side of the half-open
-    // ray intervals: the rays along a max face are left out, and with them the crossings that
-    // the surface needs to rebuild the edges there (the top edge came out bevelled by up to a
-    // spacing along the stock's max faces).
-    const double cells = size[a] / spacing;
-    const bool faces_on_rows = std::abs(cells - std::round(cells)) < 1e-6;
-    l.n[a] = detail::lattice_count(size[a], spacing) + (faces_on_rows ? 1 : 0);
-    l.origin[a] = box.center()[a] - 0.5 * spacing * (l.n[a] - 1);
+    l.n[a] = detail::lattice_count(size[a], spacing);
+    l.origin[a] = box.center()[a] - 0.5 * l.spacing * (l.n[a] - 1);
   }
   return l;
 }

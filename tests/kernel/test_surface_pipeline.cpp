@@ -4,6 +4,8 @@
 // rounding of three independently cast ray families.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <limits>
 #include <random>
 
 #include "tridex/dexel_ops.hpp"
@@ -61,4 +63,52 @@ TEST_CASE("extract_surface on a machined stock: closed, inside the stock, the st
       CHECK(std::abs(m.signed_volume() - volume(solid)) <= 0.5 * area * h);
     }
   }
+}
+
+TEST_CASE("a machined box keeps its top edges on every side, when it is a whole number of spacings wide") {
+  // 10 × 8 × 5 at spacing 0.25: every face would lie on a row of rays, where the half-open
+  // intervals keep the rows on the min faces and drop those on the max faces, and the top edge
+  // along the max faces came out up to 1.3 spacings low. The lattice puts the rows nearest the
+  // faces just inside them.
+  const Aabb stock{Vec3(0, 0, 0), Vec3(10, 8, 5)};
+  const DexelLattice lattice = DexelLattice::covering(stock, 0.25);
+  for (int a = 0; a < 3; ++a) {
+    const double first = std::ceil((stock.min[a] - lattice.origin[a]) / lattice.spacing);
+    const double last = std::floor((stock.max[a] - lattice.origin[a]) / lattice.spacing);
+    CHECK(lattice.origin[a] + first * lattice.spacing > stock.min[a]);
+    CHECK(lattice.origin[a] + last * lattice.spacing < stock.max[a]);
+    CHECK(last - first == doctest::Approx((stock.max[a] - stock.min[a]) / 0.25));
+  }
+  // A flat end on moves rising along x and y leaves the plane z = 3.6 + 0.1·x + 0.07·y.
+  auto plane = [](double x, double y) { return 3.6 + 0.1 * x + 0.07 * y; };
+  ZMap map = ZMap::from_box(Frame{}, stock, 0.1);
+  const ZMap initial = map;
+  const std::vector<Cutter> cutters{Cutter::flat(2)};
+  std::vector<CutMove> moves;
+  for (double y = -2; y <= 10; y += 1.5)
+    moves.push_back({Segment{Vec3(-3, y, plane(-1, y)), Vec3(13, y, plane(15, y))}, 0});
+  mill(map, cutters, moves);
+  raise_uncut(map, initial);
+  std::vector<ZMap> maps{map};
+  const Mesh mesh = extract_surface(machine(stock, lattice, maps));
+  // Every vertex on a side face is below the top, and the top edge is there: within each
+  // stretch of a spacing along the face, the highest vertex is within 3/4 of a spacing of the
+  // top (measured: 0.17 on the min faces, 0.57 on the max faces; 1.3 before).
+  for (int axis = 0; axis < 2; ++axis)
+    for (double face : {stock.min[axis], stock.max[axis]}) {
+      const int along = 1 - axis;
+      std::vector<double> worst(static_cast<std::size_t>(stock.max[along] / lattice.spacing), std::numeric_limits<double>::infinity());
+      for (const auto& p : mesh.positions) {
+        if (std::abs(p[axis] - face) > 1e-4) continue;
+        const double below = plane(p.x, p.y) - p.z;
+        CHECK(below > -1e-3);
+        double& w = worst[static_cast<std::size_t>(std::clamp(p[along] / lattice.spacing, 0.0, double(worst.size() - 1)))];
+        w = std::min(w, below);
+      }
+      double dip = 0;
+      for (double w : worst) dip = std::max(dip, w);
+      CAPTURE(axis);
+      CAPTURE(face);
+      CHECK(dip < 0.75 * lattice.spacing);
+    }
 }
