@@ -112,12 +112,12 @@ inline DexelLattice DexelLattice::covering(const Aabb& box, double spacing) {
   if (box.empty() || !is_finite(box.min) || !is_finite(box.max))
     detail::fail("dexel lattice: box is empty or not finite");
   DexelLattice l;
-  // A hair less than asked (1e-7 relative, far below float resolution of the rays' intervals):
-  // a box a whole number of spacings wide would otherwise have its faces exactly on rows of
-  // rays, where the half-open intervals keep the rows on the min faces and drop those on the
-  // max faces, and with them the crossings the surface needs to rebuild the edges there (the
-  // top edge came out bevelled by up to a spacing along the max faces). Slightly closer, the
-  // rows fall just inside both faces.
+  // A hair less than asked (1e-7 relative): a box a whole number of spacings wide would
+  // otherwise have its faces exactly on rows of rays, where the half-open intervals keep the
+  // rows on the min faces and drop those on the max faces, and with them the crossings the
+  // surface needs to rebuild the edges there (the top edge came out bevelled by up to a spacing
+  // along the max faces). With the nodes drawn together about the box's centre, the rows
+  // nearest the faces fall just inside both (by about 1e-7 of the box's size).
   l.spacing = spacing * (1 - 1e-7);
   Vec3 size = box.size();
   for (int a = 0; a < 3; ++a) {
