@@ -482,7 +482,7 @@ struct BallLanes {
 };
 
 // The milling of one Z-map: moves are binned to work blocks; each block is milled by one thread,
-// tile by tile, each tile with every move that reaches it (see `mill_tile_with_candidates`).
+// one row of tiles at a time (see `mill_bin`).
 class Miller {
  public:
   Miller(ZMap& map, std::span<const Cutter> cutters, std::span<const CutMove> moves)
