@@ -221,7 +221,7 @@ inline void raise_uncut(ZMap& milled, const ZMap& initial) {
   std::vector<std::pair<std::size_t, float>> continued;
   for (int j = 0; j < a.ny; ++j)
     for (int i = 0; i < a.nx; ++i) {
-      if (initial.height(i, j) > initial.empty_height) continue;
+      if (inside(i, j)) continue;
       float best = -std::numeric_limits<float>::infinity();
       for (int dj = -1; dj <= 1; ++dj)
         for (int di = -1; di <= 1; ++di) {
