@@ -108,13 +108,11 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log) {
 
 std::vector<Point> run_tridex(const fs::path& program) {
   InterpreterOptions options;
-  options.start_position = Vec3(0.0);   // rs274 starts at the origin
-  options.tool_change_retracts = false; // and does not move on M6
-  options.block_delete = false;         // its block-delete switch is off by default
+  options.block_delete = false;  // rs274's block-delete switch is off by default
   std::vector<Point> points;
   std::ifstream in(program, std::ios::binary);
   REQUIRE(in);
-  Interpreter interpreter(options);
+  Interpreter interpreter(options, *MachineConfig::bundled("linuxcnc"));
   Move last_arc;
   bool in_arc = false;
   auto flush = [&] {
