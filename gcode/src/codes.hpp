@@ -81,7 +81,7 @@ enum MGroup { kStop, kToolChange, kSpindle, kCoolant, kMGroupCount };
 inline int m_group(int code) {
   switch (code) {
     case 0: case 1: case 2: case 30: case 98: case 99: return kStop;
-    case 6: return kToolChange;
+    case 6: case 61: return kToolChange;
     case 3: case 4: case 5: return kSpindle;
     case 7: case 8: case 9: return kCoolant;
     default: return -1;

@@ -69,13 +69,18 @@ Flow Interpreter::State::execute(const Block& block) {
       }
     }
   }
+  if (int column = w.find_m(61)) {  // LinuxCNC: the tool in the spindle is Q (nothing moves)
+    if (!w.has('Q')) error(column, "M61 needs Q (the tool number)");
+    tool = tool_selected = static_cast<int>(integer('Q', "M61 tool number", 0, 99'999'999));
+  }
   if (w.find_m(3)) spindle_direction = 1;
   if (w.find_m(4)) spindle_direction = -1;
   if (w.find_m(5)) spindle_direction = 0;
 
   if (nonmodal == 40) {  // dwell: P (seconds or ms) or, on Fanuc, X
-    if (w.has('P') && w.has('X')) error(w.col('X'), "G4 with both P and X");
-    char c = w.has('P') ? 'P' : w.has('X') ? 'X' : 0;
+    // Fanuc's `G4 X2.` dwells; beside P, or with a motion code in the block, X is a coordinate.
+    bool x_dwell = !w.has('P') && w.has('X') && motion_code < 0;
+    char c = w.has('P') ? 'P' : x_dwell ? 'X' : 0;
     if (!c) error(w.find_g(40), "G4 needs a dwell time P");
     if (w.take(c) < 0) error(w.col(c), "dwell time must not be negative");
     if (c == 'X') w.present &= ~(1u << letter_index('X'));  // a time here, not a coordinate

@@ -136,7 +136,7 @@ void Interpreter::State::assign(const Assignment& a) {
     }
     return;
   }
-  if ((n >= 4001 && n <= 4400) || (n >= 5001 && n <= 5110) || (n >= 5400 && n <= 5428))
+  if ((n >= 4001 && n <= 4400) || (n >= 5001 && n <= 5043) || (n >= 5420 && n <= 5428))
     error(a.column, "#" + std::to_string(n) + " is a read-only system variable");
   globals[n] = a.value;
 }
