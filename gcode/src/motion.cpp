@@ -40,7 +40,7 @@ void Interpreter::State::move_to(Vec3 target, const std::array<bool, 3>& set_abs
           "the tool is retracted far along its axis and this move sets only some of the "
           "coordinates along the tool axis; set all of X, Y and Z to bring it back");
   Vec3 end = to_frame_machine(target);
-  emit(kind, end + machine.far_distance * axis, end, move_feed);
+  emit(kind, end + machine.far_distance * axis, end, move_feed, true);
   pos = end;
   far = false;
 }
@@ -65,9 +65,24 @@ void Interpreter::State::require_feed() {
 
 // ---- arcs ----
 void Interpreter::State::arc(bool ccw) {
-  if (far)
-    error(motion_column,
-          "arc from a retracted position: the tool is far along its axis; position it first");
+  if (far) {
+    // The far rule: a move that leaves the coordinates along the tool axis unset stays far and
+    // only changes the lateral position (a 2D program's arcs before any Z cut nothing).
+    Vec3 along = glm::transpose(rotation) * axis;
+    Vec3 target = to_program(pos);
+    for (int i = 0; i < 3; ++i) {
+      char c = kAxisLetter[i];
+      if (!w.has(c)) continue;
+      if (std::abs(along[i]) > kAxisEps)
+        error(w.col(c), "arc from a retracted position that also moves along the tool axis: the "
+                        "tool is far along its axis and its start is unknown; position it first");
+      target[i] = incremental ? target[i] + length(c) : length(c);
+    }
+    for (char c : {'I', 'J', 'K', 'R'})
+      if (w.has(c)) w.take(c);
+    pos = to_machine(target);
+    return;
+  }
   require_feed();
   const std::array<int, 3> axes = plane_axes(plane);
   const int u = axes[0], v = axes[1], n = axes[2];
@@ -254,7 +269,7 @@ void Interpreter::State::cycle(int code) {
     if (far) {
       // Come back from far straight down the axis onto the R plane of the hole.
       Vec3 r_point = at(hole_u, hole_v, r_level);
-      emit(MoveKind::cycle, r_point + machine.far_distance * axis, r_point, 0.0);
+      emit(MoveKind::cycle, r_point + machine.far_distance * axis, r_point, 0.0, true);
       pos = r_point;
       far = false;
     } else {

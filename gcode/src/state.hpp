@@ -221,7 +221,7 @@ struct Interpreter::State : ParameterReader {
   }
 
   // ---- emitting ----
-  void emit(MoveKind kind, const Vec3& a, const Vec3& b, double move_feed) {
+  void emit(MoveKind kind, const Vec3& a, const Vec3& b, double move_feed, bool from_far = false) {
     if (ambiguous) {
       std::string message = "spindle direction is ambiguous: the plane tilted at line " +
                             std::to_string(tilt_line) +
@@ -238,6 +238,7 @@ struct Interpreter::State : ParameterReader {
     move.end = b - world_origin;
     move.axis = axis;
     move.feed = move_feed;
+    move.from_far = from_far;
     move.spindle = speed * spindle_direction;
     if (tools_used.insert(tool).second) tool_first_line.emplace(tool, line);
     (*sink)(move);

@@ -169,6 +169,12 @@ TEST_CASE("arcs: bad arcs are errors with their position") {
   CHECK(d.message.find("both") != std::string::npos);
   d = error_of("G17 G90\nG0 X10 Y0 Z0\nG2 X0 Y0 I-5\n");
   CHECK(d.message.find("feed") != std::string::npos);
-  d = error_of("G17 G90 F100\nG0 X10 Y0\nG2 X0 Y0 I-5\n");  // Z never set: still far
+  // Z never set: the tool is still far along +Z, so the arc only moves it laterally (the far
+  // rule) and the approach comes down at the arc's end; a helix from there has no known start.
+  Result r = run_program("G17 G90 F100\nG0 X10 Y0\nG2 X0 Y0 I-5\nG1 Z-1\nM30\n");
+  REQUIRE(r.moves.size() == 1);
+  CHECK(r.moves[0].from_far);
+  CHECK(near(r.moves[0].end, Vec3(0, 0, -1)));
+  d = error_of("G17 G90 F100\nG0 X10 Y0\nG2 X0 Y0 Z-1 I-5\n");
   CHECK(d.message.find("retracted") != std::string::npos);
 }

@@ -78,6 +78,7 @@ int run_moves(const ListOptions& options) {
       append_number(record, m.feed);
       record += ",\"spindle\":";
       append_number(record, m.spindle);
+      if (m.from_far) record += ",\"from_far\":true";
       record += "}\n";
       out << record;
     });
@@ -105,7 +106,7 @@ int run_groups(const ListOptions& options) {
     e.last_line = m.line;
     if (m.kind != gcode::MoveKind::rapid) {
       const Frame& frame = grouper.groups()[g].frame;
-      e.local.extend(frame.to_local(m.start));
+      if (!m.from_far) e.local.extend(frame.to_local(m.start));
       e.local.extend(frame.to_local(m.end));
     }
   });

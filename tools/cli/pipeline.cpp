@@ -152,12 +152,11 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   interpreter_options.lenient = options.lenient;
   gcode::DirectionGrouper grouper;
   Aabb cutting_bounds;
-  const double far = 0.5 * gcode::MachineConfig::kDefaultFar;
   InterpretResult parsed = interpret(input, interpreter_options, [&](const gcode::Move& m, std::size_t) {
     grouper.add(m);
     if (m.kind != gcode::MoveKind::rapid) {
       // An approach from "far along the tool axis" is not where the work is.
-      if (glm::length(m.start) < far) cutting_bounds.extend(m.start);
+      if (!m.from_far) cutting_bounds.extend(m.start);
       cutting_bounds.extend(m.end);
     }
   });

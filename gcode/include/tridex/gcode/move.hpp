@@ -28,6 +28,9 @@ struct Move {
   Vec3 axis{0.0, 0.0, 1.0};      // unit spindle direction (tip towards holder), work frame
   double feed = 0;               // mm/min; 0 for rapids and the rapid pieces of cycles
   double spindle = 0;            // rpm, signed: + for M3, − for M4, 0 while stopped (M5)
+  bool from_far = false;         // the approach from "far along the tool axis": `start` is a
+                                 //   stand-in for where the machine put the tool, not a point
+                                 //   of the program (docs/design.md, the far rule)
 };
 
 }  // namespace tridex::gcode
