@@ -149,7 +149,8 @@ std::vector<fs::path> corpus() {
     files.assign(1, fs::path(only));
     return files;
   }
-  for (const char* name : {"3dtest.ngc", "arcspiral.ngc", "cds.ngc", "tort.ngc"})
+  for (const char* name : {"3D_Chips.ngc", "3dtest.ngc", "arcspiral.ngc", "cds.ngc", "flowsnake.ngc",
+                           "lathe_pawn.ngc", "plasmatest.ngc", "tort.ngc"})
     files.push_back(fs::path("/usr/share/linuxcnc/ncfiles") / name);
   return files;
 }
@@ -228,6 +229,17 @@ Comparison compare_with_rs274(const fs::path& program, int max_reports) {
   std::vector<Point> theirs = run_rs274(program, log);
   std::vector<Point> ours = run_tridex(program);
   INFO("rs274 log: " << log.substr(0, 600));
+  // rs274 reports an interpreter error as "<line>: <message>" and stops: a corpus program must
+  // run to its end there, or the comparison would only cover a prefix.
+  bool rs274_error = false;
+  for (std::size_t at = 0; at < log.size();) {
+    std::size_t end = log.find('\n', at);
+    std::string row = log.substr(at, end == std::string::npos ? std::string::npos : end - at);
+    std::size_t digits = row.find_first_not_of("0123456789");
+    if (digits > 0 && digits != std::string::npos && row.compare(digits, 2, ": ") == 0) rs274_error = true;
+    at = end == std::string::npos ? log.size() : end + 1;
+  }
+  CHECK_MESSAGE(!rs274_error, "rs274 stopped on an error");
   CHECK(ours.size() == theirs.size());
   std::size_t n = std::min(ours.size(), theirs.size());
   int reported = 0;
