@@ -53,6 +53,29 @@ std::string finishing_program(long long blocks, bool arcs) {
   return text;
 }
 
+// The same kind of program computed by macros: a Fanuc Macro B raster whose every coordinate is an
+// expression (five blocks a pass: WHILE, two settings, G1, END), and the finishing program with
+// each coordinate written as an expression over parameters.
+std::string macro_raster(long long passes) {
+  return "%\nO1000\nG21 G90 G17\nT1 M6\nG0 X0 Y0 Z5.\nF1200\n#1 = 0\n#10 = " +
+         std::to_string(passes) +
+         "\nWHILE [#1 LT #10] DO1\n#2 = [#1 * 0.4]\nG1 X[#2 MOD 100] Y[FIX[#2 / 100] * 0.5] "
+         "Z[-1 - SIN[#1] * 0.5]\n#1 = #1 + 1\nEND1\nM30\n%\n";
+}
+
+std::string expression_program(long long blocks) {
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> coord(-100, 100), depth(-20, 0);
+  std::string text = "%\nO1000\nG21 G90 G17\nT1 M6\nG0 X0 Y0 Z5.\nF1200\n#1 = 0.5\n#2 = 2.\n#<z> = -1\n";
+  char line[200];
+  for (long long i = 0; i < blocks; ++i) {
+    std::snprintf(line, sizeof line, "N%lld G1 X[%.3f + #1] Y[%.3f * #2] Z[#<z> + %.3f]\n", i,
+                  coord(rng), coord(rng) / 2, depth(rng));
+    text += line;
+  }
+  return text + "M30\n%\n";
+}
+
 void run_program(benchmark::State& state, std::string& text, long long blocks) {
   InterpreterOptions options;
   Interpreter interpreter(options);
@@ -68,6 +91,18 @@ void run_program(benchmark::State& state, std::string& text, long long blocks) {
   state.counters["MB/s"] = benchmark::Counter(static_cast<double>(text.size()) / 1e6,
                                               benchmark::Counter::kIsIterationInvariantRate);
 }
+
+void BM_interpret_macro_loop(benchmark::State& state) {
+  static std::string text = macro_raster(200'000);
+  run_program(state, text, 200'000 * 5);
+}
+BENCHMARK(BM_interpret_macro_loop)->Unit(benchmark::kMillisecond);
+
+void BM_interpret_expressions(benchmark::State& state) {
+  static std::string text = expression_program(1'000'000);
+  run_program(state, text, 1'000'000);
+}
+BENCHMARK(BM_interpret_expressions)->Unit(benchmark::kMillisecond);
 
 void BM_interpret_linear(benchmark::State& state) {
   static std::string text = finishing_program(1'000'000, false);

@@ -5,6 +5,7 @@
 #include "tridex/gcode/lexer.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -313,16 +314,19 @@ class Parser {
     return Value{v, false};
   }
 
-  // Operator-precedence parsing of `primary (op primary)*`.
+  // Operator-precedence parsing of `primary (op primary)*`, on fixed stacks (no allocation per
+  // expression: left-associative operators reduce at once, so only a chain of ** or of rising
+  // precedence deepens them).
   Value expression(std::size_t context) {
-    std::vector<Value> values{primary(context)};
-    std::vector<std::pair<Op, std::size_t>> ops;
+    constexpr std::size_t kStack = 32;
+    std::array<Value, kStack + 1> values;
+    std::array<std::pair<Op, std::size_t>, kStack> ops;
+    std::size_t nv = 0, no = 0;
+    values[nv++] = primary(context);
     auto reduce = [&] {
-      auto [op, at] = ops.back();
-      ops.pop_back();
-      Value b = values.back();
-      values.pop_back();
-      values.back() = apply(op, values.back(), b, at);
+      auto [op, at] = ops[--no];
+      Value b = values[--nv];
+      values[nv - 1] = apply(op, values[nv - 1], b, at);
     };
     for (;;) {
       std::size_t save = i_;
@@ -334,14 +338,15 @@ class Parser {
         break;
       }
       // ** is right-associative; the others associate to the left.
-      while (!ops.empty() && (precedence(ops.back().first) > precedence(op) ||
-                              (precedence(ops.back().first) == precedence(op) && op != Op::power)))
+      while (no > 0 && (precedence(ops[no - 1].first) > precedence(op) ||
+                        (precedence(ops[no - 1].first) == precedence(op) && op != Op::power)))
         reduce();
-      ops.emplace_back(op, at);
-      values.push_back(primary(at));
+      if (no == kStack) fail(at, "expression too deeply chained");
+      ops[no++] = {op, at};
+      values[nv++] = primary(at);
     }
-    while (!ops.empty()) reduce();
-    return values.front();
+    while (no > 0) reduce();
+    return values[0];
   }
 
   std::string_view text_;

@@ -59,6 +59,11 @@ class LineReader {
   bool seekable() const { return seekable_; }
 
   bool seek(std::uint64_t offset) {
+    // A jump back into what the buffer holds (a loop's body) needs no I/O.
+    if (offset >= base_ && offset <= base_ + end_) {
+      pos_ = static_cast<std::size_t>(offset - base_);
+      return true;
+    }
     if (!seekable_) return false;
     in_.clear();
     in_.seekg(static_cast<std::streamoff>(offset));
