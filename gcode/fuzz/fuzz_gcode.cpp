@@ -39,7 +39,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     options.lenient = lenient;
     options.arc_tolerance = 0.01;  // keeps huge arcs cheap
     options.max_blocks = 20000;    // keeps M98 L loops bounded
-    Interpreter interpreter(options);
+    MachineConfig machine;  // no subprogram folders: calls stay inside the input
+    machine.dialect = lenient ? Dialect::linuxcnc : Dialect::fanuc;
+    Interpreter interpreter(options, machine);
     DirectionGrouper grouper;
     std::istringstream in(text);
     long long moves = 0;

@@ -199,6 +199,7 @@ std::optional<Source::Label> ProgramFlow::find_program(int number) {
 std::optional<std::pair<std::size_t, Source::Label>> ProgramFlow::find_external(
     const std::string& label, bool o_word) {
   std::vector<std::string> names;
+  if (label.find_first_of("/\\") != std::string::npos) return std::nullopt;  // a name, not a path
   if (o_word) {
     names = {label + ".ngc", label + ".NGC", label + ".nc"};
   } else {
