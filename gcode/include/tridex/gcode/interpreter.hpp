@@ -1,13 +1,15 @@
 // tridex::gcode — the modal interpreter: a milling program in, a stream of tool-tip moves out.
 //
-// Codes (the list): G0 G1 G2 G3 (I/J/K and R, full circles, helices) in G17/G18/G19,
-// G20/G21, G90/G91, G90.1/G91.1, G54–G59 and G54.1 Pn, G10 L2/L20, G43/G44/G49 H, T, M6, F, S,
-// M3/M4/M5, M0/M1/M2/M30, G28/G30/G53, canned cycles G73 G81 G82 G83 G85 G86 G89 with G98/G99 and
-// repeats (L or K), M98 P L / M99 with O numbers, G4; tilted planes Fanuc G68.2 (Euler Z-X-Z),
-// G53.1, G53.6, G69 and Haas G268 (Q123), G253, G269. Accepted without effect on the tool path:
-// G15 G40 G49 G61 G64 (P Q) G80 G94 G97, look-ahead/smoothing G5.1 (Q R), G8 (P), G187 (P E),
-// M7 M8 M9. Anything else is an error naming file, line, column
-// and word (a warning in lenient mode, which then skips the word).
+// Codes: G0 G1 G2 G3 (I/J/K and R, full circles, helices) in G17/G18/G19, G20/G21, G90/G91,
+// G90.1/G91.1, G54–G59 and G54.1 Pn, G10 L2/L20 (P0 the active system), G52, G92/G92.1/G92.2/
+// G92.3, G43/G44/G49 H, T, M6, M61 Q, F, S, M3/M4/M5, M0/M1/M2/M30, G28/G30/G53, canned cycles
+// G73 G81 G82 G83 G85 G86 G89 with G98/G99 and repeats (L or K), M98 P L / M99 with O (or ':')
+// numbers, G65 macro calls, G4; tilted planes Fanuc G68.2 (Euler Z-X-Z), G53.1, G53.6, G69 and
+// Haas G268 (Q123), G253, G269; Fanuc Macro B and LinuxCNC parameters, expressions and o-word
+// control flow (lexer.hpp). Accepted without effect on the tool path: G15 G40 G49 G61 G64 (P Q)
+// G80 G94 G97, look-ahead/smoothing G5.1 (Q R), G8 (P), G187 (P E), M7 M8 M9 and any other
+// M-code (one warning per code unless the MachineConfig declares it). Anything else is an error
+// naming file, line, column and word (a warning in lenient mode, which then skips the word).
 //
 // Conventions (docs/design.md): the programmed point is the tool tip after work offsets;
 // G20 values are converted to mm; G68.2 R = Rz(I)·Rx(J)·Rz(K) and the tool axis is R·(0,0,1)
