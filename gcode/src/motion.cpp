@@ -361,6 +361,21 @@ void Interpreter::State::home_return(bool second) {
     machine_move(target, mask, MoveKind::rapid, 0.0);
     return;
   }
+  // A machine file that sets the position makes the return a known rapid (tool along +Z: the
+  // machine's axes are the work's).
+  if (!is_default && !rotary && glm::dot(axis, Vec3(0, 0, 1)) >= 1 - kSameDirection) {
+    Vec3 end = pos;
+    for (int i = 0; i < 3; ++i)
+      if ((mask >> i) & 1u) end[i] = target[i];
+    if (!far) {
+      emit(MoveKind::rapid, pos, end, 0.0);
+      pos = end;
+      return;
+    }
+    pos = end;
+    if (mask & 4u) far = false;  // the height is now known
+    return;
+  }
   for (int i = 0; i < 3; ++i)
     if ((mask >> i) & 1u) pos[i] = target[i];
   far = true;

@@ -1,0 +1,154 @@
+// --machine and --subprograms: the bundled machines, a machine file's every key changing what a
+// program means, and bad machine files refused with the file and the key (exit 2).
+#include <doctest/doctest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "command_harness.hpp"
+#include "errors.hpp"
+#include "machine_file.hpp"
+
+using namespace tridex;
+using namespace tridex::test;
+
+namespace {
+
+std::vector<nlohmann::json> moves_of(const CommandResult& r) {
+  std::vector<nlohmann::json> moves;
+  std::istringstream in(r.out);
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) moves.push_back(nlohmann::json::parse(line));
+  return moves;
+}
+
+std::string load_error(const fs::path& file) {
+  try {
+    cli::load_machine(file.string());
+  } catch (const cli::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("machine files: each key changes what the program means") {
+  fs::path dir = scratch("machine");
+  write_text(dir / "p.nc", "G21 G90\nG0 X1 Y2 Z3\nT2 M6\nG0 X5 Y5 Z5\nG28\nM10\nM30\n");
+
+  // The default machine: far along the tool axis, a warning for G28's default position and one
+  // for the undeclared M10.
+  CommandResult r = run_tridex({"moves", (dir / "p.nc").string()}, dir);
+  REQUIRE(r.status == 0);
+  std::vector<nlohmann::json> m = moves_of(r);
+  REQUIRE(m.size() == 2);
+  CHECK(m[0]["from_far"] == true);
+  CHECK(r.err.find("G28") != std::string::npos);
+  CHECK(r.err.find("M10") != std::string::npos);
+
+  // linuxcnc: starts at the origin, M6 in place, G28 to the origin.
+  r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", "linuxcnc"}, dir);
+  REQUIRE(r.status == 0);
+  m = moves_of(r);
+  REQUIRE(m.size() == 3);
+  CHECK(m[0]["start"] == nlohmann::json::array({0, 0, 0}));
+  CHECK(m[2]["end"] == nlohmann::json::array({0, 0, 0}));
+  CHECK(r.err.find("G28") == std::string::npos);
+
+  // A machine file: a start, a tool-change position, a home, an offset, inch, declared M10.
+  write_text(dir / "vf2.json", R"({
+    "name": "test mill", "units": "inch", "start": [0, 0, 100],
+    "tool_change": [0, 0, 200], "home": [0, 0, 300],
+    "work_offsets": {"G54": [10, 0, 0]}, "m_codes": [10]})");
+  write_text(dir / "q.nc", "G0 X1 Y0 Z0\nT2 M6\nG0 X0\nG28\nM10\nM30\n");
+  r = run_tridex({"moves", (dir / "q.nc").string(), "--machine", (dir / "vf2.json").string()}, dir);
+  REQUIRE(r.status == 0);
+  m = moves_of(r);
+  // Work frame = machine − G54: the start (0,0,100) is at (−10,0,100); X1 inch is 25.4 mm.
+  REQUIRE(m.size() == 4);
+  CHECK(m[0]["start"] == nlohmann::json::array({-10, 0, 100}));
+  CHECK(m[0]["end"] == nlohmann::json::array({25.4, 0, 0}));
+  CHECK(m[1]["end"] == nlohmann::json::array({-10, 0, 200}));  // the tool change
+  CHECK(m[2]["end"] == nlohmann::json::array({0, 0, 200}));    // X0 at the tool-change height
+  CHECK(r.err.empty());  // G28 is set and M10 declared: nothing to warn about
+
+  // Forbidden M-codes are errors with the line.
+  write_text(dir / "strict.json", R"({"base": "linuxcnc", "forbidden_m_codes": [10]})");
+  r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "strict.json").string()}, dir);
+  CHECK(r.status == 2);
+  CHECK(r.err.find("p.nc:6:1") != std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("machine files: T alone loads the tool where the control does so") {
+  fs::path dir = scratch("machine-t");
+  write_text(dir / "p.nc", "T3\nG0 X0 Y0 Z5\nG1 Z0 F100\nM30\n");
+  write_text(dir / "t.json", R"({"base": "linuxcnc", "tool_loads_on_t": true})");
+  CommandResult r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "t.json").string()}, dir);
+  REQUIRE(r.status == 0);
+  CHECK(moves_of(r).back()["tool"] == 3);
+  r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", "linuxcnc"}, dir);
+  CHECK(moves_of(r).back()["tool"] == 0);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("machine files: --subprograms finds called programs") {
+  fs::path dir = scratch("machine-subs");
+  fs::create_directories(dir / "macros");
+  write_text(dir / "macros" / "O9810.nc", "O9810\nG0 X#24 Y#25 Z1\nM99\n");
+  write_text(dir / "p.nc", "G65 P9810 X4 Y5\nM30\n");
+  CommandResult r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", "linuxcnc"}, dir);
+  CHECK(r.status == 2);
+  CHECK(r.err.find("O9810") != std::string::npos);
+  r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", "linuxcnc", "--subprograms",
+                  (dir / "macros").string()}, dir);
+  REQUIRE(r.status == 0);
+  CHECK(moves_of(r)[0]["end"] == nlohmann::json::array({4, 5, 1}));
+  // The machine file's own folders, relative to the file.
+  write_text(dir / "m.json", R"({"base": "linuxcnc", "subprograms": ["macros"]})");
+  r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "m.json").string()}, dir);
+  CHECK(r.status == 0);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("machine files: bad files name the file, the key and the value") {
+  fs::path dir = scratch("machine-bad");
+  struct Case {
+    const char* text;
+    const char* expected;
+  } cases[] = {
+      {"[1, 2]", "JSON object"},
+      {"{\"dialect\": \"heidenhain\"}", "\"dialect\""},
+      {"{\"start\": [0, 0]}", "\"start\""},
+      {"{\"start\": [0, 0, \"a\"]}", "\"start\""},
+      {"{\"tool_change\": 5}", "\"tool_change\""},
+      {"{\"work_offsets\": {\"G60\": [0, 0, 0]}}", "G60"},
+      {"{\"work_offsets\": {\"G54.1 P301\": [0, 0, 0]}}", "G54.1 P301"},
+      {"{\"m_codes\": [1.5]}", "\"m_codes\""},
+      {"{\"m_codes\": [10], \"forbidden_m_codes\": [10]}", "M10"},
+      {"{\"far_distance\": -1}", "\"far_distance\""},
+      {"{\"units\": \"cm\"}", "\"units\""},
+      {"{\"base\": \"haas\"}", "\"base\""},
+      {"{\"kinematic\": {}}", "unknown key"},
+      {"{\"start\": [0, 0, 1e999]}", "JSON"},
+      {"{", "JSON"},
+  };
+  for (const Case& c : cases) {
+    fs::path file = dir / "m.json";
+    write_text(file, c.text);
+    std::string message = load_error(file);
+    INFO(c.text << " -> " << message);
+    CHECK(message.find(file.string()) != std::string::npos);
+    CHECK(message.find(c.expected) != std::string::npos);
+  }
+  CHECK(load_error(dir / "missing.json").find("neither a bundled machine") != std::string::npos);
+  CHECK(load_error(dir).find("neither a bundled machine") != std::string::npos);  // a folder
+  // Through the command: exit 2, no output written.
+  write_text(dir / "p.nc", "G0 X0 Y0 Z0\nM30\n");
+  write_text(dir / "m.json", "{\"dialect\": 3}");
+  CommandResult r = run_tridex({"moves", (dir / "p.nc").string(), "--machine",
+                                (dir / "m.json").string(), "-o", (dir / "out.jsonl").string()}, dir);
+  CHECK(r.status == 2);
+  CHECK(!fs::exists(dir / "out.jsonl"));
+  fs::remove_all(dir);
+}
