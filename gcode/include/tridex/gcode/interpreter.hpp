@@ -9,7 +9,7 @@
 // M7 M8 M9. Anything else is an error naming file, line, column
 // and word (a warning in lenient mode, which then skips the word).
 //
-// Conventions (../shared/DESIGN.md): the programmed point is the tool tip after work offsets;
+// Conventions (docs/design.md): the programmed point is the tool tip after work offsets;
 // G20 values are converted to mm; G68.2 R = Rz(I)·Rx(J)·Rz(K) and the tool axis is R·(0,0,1)
 // once G53.1/G53.6 orient the tool; G268 R = Rz(K)·Ry(J)·Rx(I), oriented by G253. A home return
 // (G28, G30 — but X/Y alone with the tool along +Z is a rapid at the current height — and G53

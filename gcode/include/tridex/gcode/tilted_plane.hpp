@@ -19,7 +19,7 @@
 //   David Mueller, 2023-2025): calc_euler_rot_matrix, g682, g684, and remap_funcs_twp.py's
 //   kins_calc_twp_origin_rot_matrix. Its reading differs from Fanuc's in the places named below.
 // - Haas G268 as Autodesk's Haas posts emit it (`G268 X Y Z I J K Q123`): rotations about the
-//   fixed X, then Y, then Z axes, the same as Fanuc P1 Q123 (../shared/DESIGN.md).
+//   fixed X, then Y, then Z axes, the same as Fanuc P1 Q123 (interpreter.hpp's G268).
 //
 // Errors (degenerate points, parallel or zero vectors, an unknown rotation order) are
 // tridex::Error whose message names the words; the interpreter adds file:line:column.

@@ -1,0 +1,253 @@
+// tridex::gcode — the modal machine: one block's codes applied in RS274/NGC's order of execution
+// (NIST IR 6556 §3.8): units, feed, speed, tool, dwell, plane, distance modes, offsets, tilted
+// planes, motion, program flow.
+#include <cmath>
+
+#include "state.hpp"
+
+namespace tridex::gcode {
+
+Flow Interpreter::State::execute(const Block& block) {
+  gather(block);
+  motion_column = 0;
+  int motion_code = -1, nonmodal = -1, tilt = -1, orient = -1;
+  for (int i = 0; i < w.g_count; ++i) {
+    const Code& g = w.g[static_cast<std::size_t>(i)];
+    int group = g_group(g.code);
+    if (group == kMotion) {
+      motion_code = g.code;
+      motion_column = g.column;
+    } else if (group == kNonModal) {
+      nonmodal = g.code;
+      if (g.code != 40) motion_column = g.column;
+    } else if (group == kTilt) {
+      tilt = g.code;
+    } else if (group == kOrient) {
+      orient = g.code;
+    }
+  }
+  if (motion_column == 0) {
+    motion_column = 1;
+    for (char c : {'X', 'Y', 'Z'})
+      if (w.has(c)) {
+        motion_column = w.col(c);
+        break;
+      }
+  }
+
+  // Units first, so that every length in this block is read in them.
+  if (w.find_g(200)) unit = 25.4;
+  if (w.find_g(210)) unit = 1.0;
+
+  if (w.has('F')) {
+    double f = length('F');
+    if (f < 0) error(w.col('F'), "feed rate F must not be negative");
+    feed = f;
+  }
+  if (w.has('S')) {
+    double s = w.take('S');
+    if (s < 0) error(w.col('S'), "spindle speed S must not be negative");
+    speed = s;
+  }
+  if (w.has('T')) tool_selected = static_cast<int>(integer('T', "tool number", 0, 99'999'999));
+
+  if (w.find_m(6)) {
+    tool = tool_selected;
+    tool_first_line.emplace(tool, line);
+    if (options.tool_change_retracts) go_far();
+  }
+  if (w.find_m(3)) spindle_direction = 1;
+  if (w.find_m(4)) spindle_direction = -1;
+  if (w.find_m(5)) spindle_direction = 0;
+
+  if (nonmodal == 40) {  // dwell: P (seconds or ms) or, on Fanuc, X
+    if (w.has('P') && w.has('X')) error(w.col('X'), "G4 with both P and X");
+    char c = w.has('P') ? 'P' : w.has('X') ? 'X' : 0;
+    if (!c) error(w.find_g(40), "G4 needs a dwell time P");
+    if (w.take(c) < 0) error(w.col(c), "dwell time must not be negative");
+    if (c == 'X') w.present &= ~(1u << letter_index('X'));  // a time here, not a coordinate
+  }
+
+  for (int code : {170, 180, 190})
+    if (w.find_g(code)) plane = code;
+  if (w.find_g(900)) incremental = false;
+  if (w.find_g(910)) incremental = true;
+  if (w.find_g(901)) arc_absolute = true;
+  if (w.find_g(911)) arc_absolute = false;
+  if (w.find_g(430) || w.find_g(440)) {
+    if (w.has('H')) integer('H', "tool length offset number", 0, 99'999'999);
+  }
+  // Look-ahead and smoothing modes change how the control follows the path, not the path.
+  if (w.find_g(51)) {
+    for (char c : {'Q', 'R'})
+      if (w.has(c)) w.take(c);
+  }
+  if (w.find_g(80) && w.has('P')) w.take('P');
+  if (w.find_g(1870)) {
+    for (char c : {'P', 'E'})
+      if (w.has(c)) w.take(c);
+  }
+  if (w.find_g(640)) {  // path blending tolerances (LinuxCNC G64 P Q): no effect on the path
+    if (w.has('P')) w.take('P');
+    if (w.has('Q')) w.take('Q');
+  }
+  if (w.find_g(980)) retract_to_r = false;
+  if (w.find_g(990)) retract_to_r = true;
+
+  // Work coordinate system.
+  for (int code : {540, 550, 560, 570, 580, 590, 541}) {
+    int column = w.find_g(code);
+    if (!column) continue;
+    int key = code == 541 ? 0 : (code - 540) / 10 + 1;
+    if (code == 541) {
+      if (!w.has('P')) error(column, "G54.1 needs P (1-300)");
+      key = MachineConfig::g54_1_key(static_cast<int>(integer('P', "G54.1 number", 1, 300)));
+    }
+    if (tilted && key != work_key)
+      error(column, "work coordinates change while a tilted plane is active (cancel it first)");
+    work_key = key;
+    auto it = offsets.find(key);
+    work_offset = it == offsets.end() ? Vec3(0.0) : it->second;
+    update_frame();
+  }
+
+  bool axis_consumer = false;  // a code other than motion that takes X/Y/Z
+  if (nonmodal == 100) {
+    axis_consumer = true;
+    int column = w.find_g(100);
+    if (!w.has('L')) error(column, "G10 needs L2 or L20");
+    long long l = integer('L', "G10 L", 0, 99);
+    if (l != 2 && l != 20) {
+      unsupported(column, "G10 L" + std::to_string(l) + " is not supported (only L2 and L20)");
+    } else {
+      if (!w.has('P')) error(column, "G10 L" + std::to_string(l) + " needs P");
+      int key = l == 2 ? static_cast<int>(integer('P', "G10 L2 P", 1, 6))
+                       : MachineConfig::g54_1_key(static_cast<int>(integer('P', "G10 L20 P", 1, 300)));
+      if (incremental)
+        error(column, "G10 under G91 is read differently by different controls; use G90");
+      Vec3 value = offsets.count(key) ? offsets[key] : Vec3(0.0);
+      for (int i = 0; i < 3; ++i)
+        if (w.has(kAxisLetter[i])) value[i] = length(kAxisLetter[i]);
+      offsets[key] = value;
+      if (key == work_key) {
+        if (tilted) error(column, "G10 changes the active work offset under a tilted plane");
+        work_offset = value;
+        update_frame();
+      }
+    }
+  }
+
+  // Tilted working plane.
+  if (tilt == 690 || tilt == 2690) {
+    tilted = false;
+    update_frame();
+  } else if (tilt == 682 || tilt == 2680) {
+    axis_consumer = true;
+    int column = w.find_g(tilt);
+    if (incremental) error(column, code_name('G', tilt) + " under G91 is not supported; use G90");
+    if (tilt == 682 && w.has('P') && integer('P', "G68.2 P", 0, 3) != 0)
+      unsupported(w.col('P'), "G68.2 P1/P2/P3 (other angle conventions) are not supported");
+    if (tilt == 2680 && w.has('Q') && integer('Q', "G268 Q", 0, 999) != 123)
+      unsupported(w.col('Q'), "G268 rotation order other than Q123 is not supported");
+    Vec3 o(0.0);
+    for (int i = 0; i < 3; ++i)
+      if (w.has(kAxisLetter[i])) o[i] = length(kAxisLetter[i]);
+    double a = w.has('I') ? w.take('I') : 0.0;
+    double b = w.has('J') ? w.take('J') : 0.0;
+    double c = w.has('K') ? w.take('K') : 0.0;
+    // The feature frame sits on the active work coordinate system.
+    tilt_rotation = tilt == 682 ? rotation_z(a) * rotation_x(b) * rotation_z(c)
+                                : rotation_z(c) * rotation_y(b) * rotation_x(a);
+    tilt_origin = work_offset + o;
+    tilted = true;
+    tilt_line = line;
+    update_frame();
+  }
+  if (orient >= 0) {
+    int column = w.find_g(orient);
+    if (!tilted)
+      error(column, code_name('G', orient) + " without an active G68.2/G268 tilted plane");
+    Vec3 direction = glm::normalize(tilt_rotation[2]);
+    if (glm::dot(direction, axis) < 1 - kSameDirection) {
+      axis = direction;
+      go_far();  // the machine turns the tool: where the tip ends is the kinematics' business
+    }
+    update_frame();
+  }
+
+  // Motion.
+  if (motion_code >= 0) {
+    if (axis_consumer && motion_code != 800)
+      error(motion_column, code_name('G', motion_code) +
+                               " in a block whose X/Y/Z belong to another code");
+    if (motion_code == 800 || !is_cycle(motion_code)) cycle_active = false;
+    if (is_cycle(motion_code) && motion != motion_code) cycle_active = false;
+    motion = motion_code;
+  }
+  if (nonmodal == 280 || nonmodal == 300) {
+    if (motion_code >= 0 && motion_code != 800)
+      error(motion_column, "G28/G30 with a motion code in the same block");
+    home_return(nonmodal == 300);
+  } else if (nonmodal == 530) {
+    if (motion != 0 && motion != 10)
+      error(motion_column, "G53 needs G0 or G1 modal");
+    if (motion == 10) require_feed();
+    Vec3 target(0.0);
+    unsigned mask = 0;
+    for (int i = 0; i < 3; ++i)
+      if (w.has(kAxisLetter[i])) {
+        target[i] = length(kAxisLetter[i]);
+        mask |= 1u << i;
+      }
+    if (mask)
+      machine_move(target, mask, motion == 0 ? MoveKind::rapid : MoveKind::feed,
+                   motion == 0 ? 0.0 : feed);
+  } else if (!axis_consumer) {
+    bool axes = has_axis_words();
+    if (motion == 0 || motion == 10) {
+      if (axes) {
+        if (motion == 10) require_feed();
+        linear(motion == 0 ? MoveKind::rapid : MoveKind::feed, motion == 0 ? 0.0 : feed);
+      }
+    } else if (motion == 20 || motion == 30) {
+      char cu = kCenterLetter[plane_axes(plane)[0]], cv = kCenterLetter[plane_axes(plane)[1]];
+      if (axes || motion_code >= 0 || w.has(cu) || w.has(cv) || w.has('R')) arc(motion == 30);
+    } else if (is_cycle(motion)) {
+      if (axes || motion_code >= 0 || w.has('R')) cycle(motion);
+    } else if (axes) {
+      error(motion_column, "X/Y/Z without an active motion mode (G0, G1, G2, G3 or a cycle)");
+    }
+  }
+
+  // Program flow last.
+  Flow flow = Flow::next;
+  if (w.find_m(2) || w.find_m(30)) flow = Flow::end;
+  if (int column = w.find_m(98)) {
+    if (!w.has('P')) error(column, "M98 needs P (the O number to call)");
+    call_label = static_cast<int>(integer('P', "M98 P", 0, 999'999'999));
+    if (w.has('L') && w.has('K')) error(w.col('K'), "repeat count given twice (L and K)");
+    call_repeats = 1;
+    if (w.has('L')) call_repeats = integer('L', "M98 repeat count", 0, 9999);
+    if (w.has('K')) call_repeats = integer('K', "M98 repeat count", 0, 9999);
+    flow = Flow::call;
+  }
+  if (w.find_m(99)) flow = Flow::ret;
+
+  // Every word must have been used by some code of the block: never a silent misreading.
+  std::uint32_t free_words = w.present & ~w.used;
+  for (char c : {'F', 'S', 'T', 'O'}) free_words &= ~(1u << letter_index(c));
+  if (free_words) {
+    for (int i = 0; i < 26; ++i) {
+      if (!((free_words >> i) & 1u)) continue;
+      char c = static_cast<char>('A' + i);
+      std::size_t k = static_cast<std::size_t>(i);
+      bool axis_letter = c == 'X' || c == 'Y' || c == 'Z';
+      if (axis_letter) continue;  // axis words are consumed by construction or rejected above
+      unsupported(w.column[k], std::string("word ") + c + format_number(w.value[k]) +
+                                   " is not used by any code in this block");
+    }
+  }
+  return flow;
+}
+
+}  // namespace tridex::gcode

@@ -1,0 +1,362 @@
+// tridex::gcode — motion: straight moves and the "far along the tool axis" rule, arcs linearised
+// to a chord tolerance, canned cycles expanded into pieces, home returns and machine-coordinate
+// moves. Geometry follows RS274/NGC (NIST IR 6556) as LinuxCNC implements it.
+#include <algorithm>
+#include <cmath>
+
+#include "state.hpp"
+
+namespace tridex::gcode {
+
+// Moves the tip to program point `target` of the frame (rot, org); coordinate i was set
+// absolutely when set_absolute[i]. Handles the far state (see interpreter.hpp).
+void Interpreter::State::move_to(Vec3 target, const std::array<bool, 3>& set_absolute, const Mat3& rot,
+             const Vec3& org, MoveKind kind, double move_feed) {
+  auto to_frame_machine = [&](const Vec3& p) { return org + rot * p; };
+  if (!far) {
+    Vec3 end = to_frame_machine(target);
+    emit(kind, pos, end, move_feed);
+    pos = end;
+    return;
+  }
+  Vec3 current = glm::transpose(rot) * (pos - org);
+  Vec3 along = glm::transpose(rot) * axis;
+  bool any = false, all = true;
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(along[i]) <= kAxisEps) continue;
+    if (set_absolute[static_cast<std::size_t>(i)]) {
+      any = true;
+    } else {
+      all = false;
+      target[i] = current[i];
+    }
+  }
+  if (!any) {  // still far: only the lateral position changes
+    pos = to_frame_machine(target);
+    return;
+  }
+  if (!all)
+    error(motion_column,
+          "the tool is retracted far along its axis and this move sets only some of the "
+          "coordinates along the tool axis; set all of X, Y and Z to bring it back");
+  Vec3 end = to_frame_machine(target);
+  emit(kind, end + machine.far_distance * axis, end, move_feed);
+  pos = end;
+  far = false;
+}
+
+void Interpreter::State::linear(MoveKind kind, double move_feed) {
+  Vec3 current = to_program(pos);
+  Vec3 target = current;
+  std::array<bool, 3> set{};
+  for (int i = 0; i < 3; ++i) {
+    char c = kAxisLetter[i];
+    if (!w.has(c)) continue;
+    double v = length(c);
+    target[i] = incremental ? current[i] + v : v;
+    set[static_cast<std::size_t>(i)] = !incremental;
+  }
+  move_to(target, set, rotation, origin, kind, move_feed);
+}
+
+void Interpreter::State::require_feed() {
+  if (!(feed > 0)) error(motion_column, "feed move with no feed rate (F) set");
+}
+
+// ---- arcs ----
+void Interpreter::State::arc(bool ccw) {
+  if (far)
+    error(motion_column,
+          "arc from a retracted position: the tool is far along its axis; position it first");
+  require_feed();
+  const std::array<int, 3> axes = plane_axes(plane);
+  const int u = axes[0], v = axes[1], n = axes[2];
+  Vec3 start = to_program(pos);
+  Vec3 end = start;
+  for (int i = 0; i < 3; ++i) {
+    char c = kAxisLetter[i];
+    if (w.has(c)) end[i] = incremental ? start[i] + length(c) : length(c);
+  }
+  char cu = kCenterLetter[u], cv = kCenterLetter[v];
+  bool has_center = w.has(cu) || w.has(cv);
+  bool has_radius = w.has('R');
+  if (has_center && has_radius)
+    error(w.col('R'), "arc with both R and " + std::string(1, cu) + "/" + cv + " words");
+  if (!has_center && !has_radius)
+    error(motion_column, std::string("arc needs ") + cu + "/" + cv + " (in " +
+                             code_name('G', plane) + ") or R");
+  Vec2 s(start[u], start[v]), e(end[u], end[v]), c;
+  double r0, r1;
+  if (has_center) {
+    if (arc_absolute) {
+      if (!w.has(cu) || !w.has(cv))
+        error(motion_column, std::string("arc centre under G90.1 needs both ") + cu + " and " + cv);
+      c = Vec2(length(cu), length(cv));
+    } else {
+      c = s + Vec2(w.has(cu) ? length(cu) : 0.0, w.has(cv) ? length(cv) : 0.0);
+    }
+    r0 = glm::length(s - c);
+    r1 = glm::length(e - c);
+    if (!(r0 > 1e-9)) error(motion_column, "zero-radius arc: the centre is the start point");
+    if (!(r1 > 1e-9)) error(motion_column, "zero-radius arc: the centre is the end point");
+    if (std::abs(r1 - r0) > options.arc_radius_tolerance)
+      error(motion_column, "arc end radius " + format_number(r1) + " differs from start radius " +
+                               format_number(r0) + " by more than " +
+                               format_number(options.arc_radius_tolerance) + " mm");
+  } else {
+    double r = length('R');
+    double d = glm::length(e - s);
+    if (!(std::abs(r) > 1e-9)) error(w.col('R'), "zero-radius arc (R0)");
+    if (!(d > 1e-9))
+      error(w.col('R'), "R-form arc with the same start and end point (a full circle needs I/J/K)");
+    if (d > 2 * std::abs(r) + options.arc_radius_tolerance)
+      error(w.col('R'), "arc radius " + format_number(std::abs(r)) +
+                            " is too small for its chord of " + format_number(d));
+    double h = std::sqrt(std::max(0.0, r * r - d * d / 4));
+    Vec2 dir = (e - s) / d;
+    Vec2 left(-dir.y, dir.x);
+    // The shorter arc (R > 0) turns around a centre on its inner side: left of the chord for
+    // counter-clockwise motion.
+    bool centre_left = ccw == (r > 0);
+    c = 0.5 * (s + e) + (centre_left ? h : -h) * left;
+    r0 = glm::length(s - c);
+    r1 = glm::length(e - c);
+  }
+  double a0 = std::atan2(s.y - c.y, s.x - c.x);
+  double a1 = std::atan2(e.y - c.y, e.x - c.x);
+  double sweep = ccw ? a1 - a0 : a0 - a1;
+  if (glm::length(e - s) <= 1e-9) {
+    sweep = 2 * kPi;  // start == end: a full circle
+  } else {
+    while (sweep <= 0) sweep += 2 * kPi;
+    while (sweep > 2 * kPi) sweep -= 2 * kPi;
+  }
+  double r = std::max(r0, r1);
+  long long pieces = 1;
+  if (r > options.arc_tolerance) {
+    double step = 2 * std::acos(1 - options.arc_tolerance / r);
+    double count = std::ceil(sweep / step);
+    if (!(count <= static_cast<double>(kMaxArcPieces)))
+      error(motion_column, "arc of radius " + format_number(r) + " needs more than " +
+                               std::to_string(kMaxArcPieces) + " pieces at this tolerance");
+    pieces = std::max(1LL, static_cast<long long>(count));
+  }
+  double sign = ccw ? 1.0 : -1.0;
+  Vec3 previous = pos;
+  for (long long k = 1; k <= pieces; ++k) {
+    Vec3 p = end;
+    if (k < pieces) {
+      double t = static_cast<double>(k) / static_cast<double>(pieces);
+      double angle = a0 + sign * sweep * t;
+      double radius = r0 + (r1 - r0) * t;
+      p[u] = c.x + radius * std::cos(angle);
+      p[v] = c.y + radius * std::sin(angle);
+      p[n] = start[n] + (end[n] - start[n]) * t;
+    }
+    Vec3 m = to_machine(p);
+    emit(MoveKind::arc, previous, m, feed);
+    previous = m;
+  }
+  pos = to_machine(end);
+}
+
+// ---- canned cycles ----
+void Interpreter::State::cycle(int code) {
+  const std::array<int, 3> axes = plane_axes(plane);
+  const int u = axes[0], v = axes[1], n = axes[2];
+  Vec3 drill = rotation[n];  // cycle axis in machine coordinates
+  if (glm::dot(drill, axis) < 1 - 1e-9)
+    error(motion_column, code_name('G', code) + " drills along the " + code_name('G', plane) +
+                             " plane normal, which is not the spindle direction");
+  char depth_letter = kAxisLetter[n];
+  if (w.has('R')) {
+    cycle_r = length('R');
+    has_cycle_r = true;
+  }
+  if (w.has(depth_letter)) {
+    cycle_z = length(depth_letter);
+    has_cycle_z = true;
+  }
+  if (code == 730 || code == 830) {
+    if (w.has('Q')) {
+      cycle_q = length('Q');
+      has_cycle_q = true;
+    }
+    if (!has_cycle_q || !(cycle_q > 0))
+      error(motion_column, code_name('G', code) + " needs a positive peck depth Q");
+  }
+  if ((code == 820 || code == 860 || code == 890) && w.has('P')) {
+    if (w.take('P') < 0) error(w.col('P'), "dwell P must not be negative");
+  }
+  if (!has_cycle_r) error(motion_column, code_name('G', code) + " needs R (retract plane)");
+  if (!has_cycle_z)
+    error(motion_column, code_name('G', code) + " needs " + depth_letter + " (hole bottom)");
+  require_feed();
+  if (w.has('L') && w.has('K')) error(w.col('K'), "repeat count given twice (L and K)");
+  long long repeats = 1;
+  if (w.has('L')) repeats = integer('L', "repeat count", 0, 9999);
+  if (w.has('K')) repeats = integer('K', "repeat count", 0, 9999);
+
+  Vec3 current = to_program(pos);
+  if (!cycle_active) {
+    cycle_active = true;
+    cycle_initial_far = far;
+    cycle_initial = current[n];
+  }
+  if (far && incremental)
+    error(motion_column, "incremental canned cycle from a retracted (far) position");
+  double r_level = incremental ? current[n] + cycle_r : cycle_r;
+  double bottom = incremental ? r_level + cycle_z : cycle_z;
+  if (bottom > r_level)
+    error(motion_column, "hole bottom " + format_number(bottom) + " is above the R plane " +
+                             format_number(r_level));
+  if (code == 730 || code == 830) {
+    // A real control pecks a hole a few hundred times at most; a tiny Q against a deep hole
+    // (or a far R plane) would emit moves without end, and below one ulp would never finish.
+    constexpr double kMaxPecks = 100000;
+    double pecks = (r_level - bottom) / cycle_q;
+    if (!(pecks <= kMaxPecks))
+      error(motion_column, code_name('G', code) + " would peck " + format_number(pecks) +
+                               " times (R " + format_number(r_level) + " to " + format_number(bottom) +
+                               " by Q " + format_number(cycle_q) + "); at most 100000 per hole");
+  }
+  bool clear_far = !retract_to_r && cycle_initial_far;
+  double clear = retract_to_r ? r_level : std::max(cycle_initial, r_level);
+  if (clear_far) clear = r_level;
+
+  // Lateral target of the first hole; increments repeat under G91.
+  double du = w.has(kAxisLetter[u]) ? length(kAxisLetter[u]) : 0.0;
+  double dv = w.has(kAxisLetter[v]) ? length(kAxisLetter[v]) : 0.0;
+  double hole_u = incremental ? current[u] : (w.has(kAxisLetter[u]) ? du : current[u]);
+  double hole_v = incremental ? current[v] : (w.has(kAxisLetter[v]) ? dv : current[v]);
+
+  auto at = [&](double uu, double vv, double depth) {
+    Vec3 p;
+    p[u] = uu;
+    p[v] = vv;
+    p[n] = depth;
+    return to_machine(p);
+  };
+  auto rapid = [&](const Vec3& to) {
+    emit(MoveKind::cycle, pos, to, 0.0);
+    pos = to;
+  };
+  auto cut = [&](const Vec3& to) {
+    emit(MoveKind::cycle, pos, to, feed);
+    pos = to;
+  };
+  if (!far && current[n] < r_level - 1e-9) rapid(at(current[u], current[v], r_level));
+  for (long long k = 0; k < repeats; ++k) {
+    if (incremental) {
+      hole_u += du;
+      hole_v += dv;
+    }
+    if (far) {
+      // Come back from far straight down the axis onto the R plane of the hole.
+      Vec3 r_point = at(hole_u, hole_v, r_level);
+      emit(MoveKind::cycle, r_point + machine.far_distance * axis, r_point, 0.0);
+      pos = r_point;
+      far = false;
+    } else {
+      Vec3 level = to_program(pos);
+      rapid(at(hole_u, hole_v, level[n]));
+      rapid(at(hole_u, hole_v, r_level));
+    }
+    double d = options.peck_clearance;
+    switch (code) {
+      case 730:
+        for (double depth = r_level - cycle_q; depth > bottom; depth -= cycle_q) {
+          cut(at(hole_u, hole_v, depth));
+          rapid(at(hole_u, hole_v, depth + d));
+        }
+        cut(at(hole_u, hole_v, bottom));
+        break;
+      case 830:
+        for (double depth = r_level - cycle_q; depth > bottom; depth -= cycle_q) {
+          cut(at(hole_u, hole_v, depth));
+          rapid(at(hole_u, hole_v, r_level));
+          rapid(at(hole_u, hole_v, depth + d));
+        }
+        cut(at(hole_u, hole_v, bottom));
+        break;
+      case 850:  // out at feed to R (then rapid to the clear level)
+        cut(at(hole_u, hole_v, bottom));
+        cut(at(hole_u, hole_v, r_level));
+        break;
+      case 890:  // out at feed all the way to the clear level, as LinuxCNC does
+        cut(at(hole_u, hole_v, bottom));
+        cut(at(hole_u, hole_v, clear_far ? r_level : clear));
+        break;
+      default:  // 810, 820, 860: down at feed, out at rapid
+        cut(at(hole_u, hole_v, bottom));
+        break;
+    }
+    Vec3 out = at(hole_u, hole_v, clear);
+    if (out != pos) rapid(out);
+    if (clear_far) far = true;
+  }
+}
+
+// ---- returns and machine-coordinate moves ----
+// The machine's Z is the spindle's own axis (on a table-tilting machine it stays along the tool
+// in the work frame; on a head-tilting one it retracts the head), so a machine-coordinate move
+// of Z is a retract: the tip goes far along the tool axis. X/Y alone move the tip in machine
+// coordinates, which is only unambiguous with the tool along +Z.
+void Interpreter::State::machine_move(const Vec3& target, unsigned mask, MoveKind kind, double move_feed) {
+  Vec3 end = pos;
+  for (int i = 0; i < 3; ++i)
+    if ((mask >> i) & 1u) end[i] = target[i];
+  if ((mask & 4u) || far) {
+    pos = end;
+    far = true;
+    return;
+  }
+  if (glm::dot(axis, Vec3(0, 0, 1)) < 1 - kSameDirection)
+    error(motion_column, "G53 X/Y with a tilted tool depends on the machine's kinematics; "
+                         "retract with G53 Z (or G28) first");
+  emit(kind, pos, end, move_feed);
+  pos = end;
+}
+
+void Interpreter::State::home_return(bool second) {
+  int column = w.find_g(second ? 300 : 280);
+  if (second && w.has('P')) {
+    if (integer('P', "G30 reference number", 2, 2) != 2) error(w.col('P'), "only G30 P2");
+  }
+  unsigned mask = 0;
+  for (int i = 0; i < 3; ++i)
+    if (w.has(kAxisLetter[i])) mask |= 1u << i;
+  bool rotary = w.has('A') || w.has('B') || w.has('C');
+  if (mask) linear(MoveKind::rapid, 0.0);  // the intermediate point
+  if (!mask && !rotary) mask = 7;
+  const Vec3& target = second ? machine.reference2 : machine.home;
+  bool is_default = second ? machine.reference2_is_default : machine.home_is_default;
+  bool& warned = second ? warned_reference2 : warned_home;
+  if (is_default && !warned) {
+    warn(column, std::string(second ? "G30" : "G28") +
+                     " uses the default reference position (far above the work along +Z); "
+                     "set it in the machine configuration if the machine differs");
+    warned = true;
+  }
+  // With the tool along +Z, returning X/Y only is a plain rapid at the current height (on any
+  // machine). Anything else is a retract: the tip goes far along the tool axis, the homed
+  // axes' coordinates kept for the lateral position.
+  if (mask && !(mask & 4u) && !rotary && !far &&
+      glm::dot(axis, Vec3(0, 0, 1)) >= 1 - kSameDirection) {
+    machine_move(target, mask, MoveKind::rapid, 0.0);
+    return;
+  }
+  for (int i = 0; i < 3; ++i)
+    if ((mask >> i) & 1u) pos[i] = target[i];
+  far = true;
+  if (rotary) {
+    // Rotary axes home: the spindle returns to the machine's +Z, and the tip goes far.
+    for (char c : {'A', 'B', 'C'})
+      if (w.has(c)) w.take(c);
+    axis = Vec3(0, 0, 1);
+    far = true;
+    update_frame();
+  }
+}
+
+}  // namespace tridex::gcode

@@ -1,0 +1,237 @@
+// tridex::gcode — the interpreter's state: the modal machine, the tool and the program context,
+// shared by the stage files (modal.cpp: one block's codes; motion.cpp: lines, arcs, cycles,
+// returns; interpreter.cpp: reading and program flow).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <numbers>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "codes.hpp"
+#include "tridex/gcode/interpreter.hpp"
+#include "tridex/gcode/lexer.hpp"
+
+namespace tridex::gcode {
+
+inline constexpr double kPi = std::numbers::pi;
+inline constexpr double kAxisEps = 1e-9;        // a frame axis "has a component" along the tool axis
+inline constexpr double kSameDirection = 1e-12;  // 1 − cos of the angle below which axes are equal
+inline constexpr long long kMaxArcPieces = 10'000'000;
+
+// ---- the interpreter's state ----------------------------------------------------------------
+struct Interpreter::State {
+  InterpreterOptions options;
+  MachineConfig machine;
+
+  std::vector<Diagnostic> warnings;
+  std::set<int> tools_used;
+  std::map<int, int> tool_first_line;
+  long long blocks = 0;
+
+  // Context of the block being executed.
+  const std::string* file = nullptr;
+  const std::function<void(const Move&)>* sink = nullptr;
+  int line = 0;
+  int motion_column = 1;
+
+  // Modal state.
+  double unit = 1.0;  // mm per program unit
+  bool incremental = false;
+  bool arc_absolute = false;
+  int plane = 170;
+  int motion = -1;  // -1: none yet
+  bool retract_to_r = false;
+  int work_key = 1;
+  Vec3 work_offset{0.0};
+  std::map<int, Vec3> offsets;
+  double feed = 0;
+  double speed = 0;
+  int spindle_direction = 0;
+  int tool_selected = 0;
+  int tool = 0;
+
+  // Tilted working plane and the active program frame (program point p -> machine
+  // origin + rotation·p).
+  bool tilted = false;
+  Mat3 tilt_rotation{1.0};
+  Vec3 tilt_origin{0.0};
+  int tilt_line = 0;
+  Mat3 rotation{1.0};
+  Vec3 origin{0.0};
+
+  // Tool: spindle direction, tip position (machine coordinates) and the far flag.
+  Vec3 axis{0.0, 0.0, 1.0};
+  Vec3 pos{0.0};
+  bool far = true;
+  bool ambiguous = false;
+  bool warned_ambiguous = false;
+  bool warned_home = false;
+  bool warned_reference2 = false;
+  Vec3 world_origin{0.0};
+
+  // Canned cycle state (sticky values, program units converted to mm, as written).
+  bool cycle_active = false;
+  bool cycle_initial_far = false;
+  double cycle_initial = 0;
+  double cycle_r = 0, cycle_z = 0, cycle_q = 0;
+  bool has_cycle_r = false, has_cycle_z = false, has_cycle_q = false;
+
+  // Subprograms.
+  struct Label {
+    std::uint64_t body = 0;  // offset of the line after the label
+    int line = 0;            // line number of the label
+  };
+  struct Call {
+    int label = 0;
+    std::uint64_t return_offset = 0;
+    int return_line = 0;
+    long long remaining = 0;
+    Label body;
+  };
+  std::map<int, Label> labels;
+  std::vector<Call> calls;
+  std::uint64_t scanned_to = 0;
+  int scanned_line = 0;
+  int call_label = 0;
+  long long call_repeats = 0;
+
+  Words w;
+
+  // ---- diagnostics ----
+  [[noreturn]] void error(int column, std::string message) const {
+    throw GcodeError(Diagnostic{*file, line, column, std::move(message)});
+  }
+  void warn(int column, std::string message) {
+    // Bounded: a warning per block of a long program would grow memory with its length.
+    if (warnings.size() < 1000) warnings.push_back(Diagnostic{*file, line, column, std::move(message)});
+  }
+  void unsupported(int column, const std::string& message) {
+    if (!options.lenient) error(column, message);
+    warn(column, message + " (skipped: lenient mode)");
+  }
+
+  // ---- words ----
+  void gather(const Block& block) {
+    w.present = w.used = 0;
+    w.g_count = w.m_count = 0;
+    std::array<int, kGroupCount> g_seen{};
+    std::array<int, kMGroupCount> m_seen{};
+    for (const Word& word : block.words) {
+      if (word.letter == 'G' || word.letter == 'M') {
+        // Codes are small; anything else is unsupported before it reaches an int (fuzz finding).
+        double scaled = word.value * 10;
+        double rounded = std::round(scaled);
+        bool integral = std::abs(scaled - rounded) < 1e-6 && word.value >= 0 && word.value < 10000;
+        int code = integral ? static_cast<int>(rounded) : -1;
+        if (word.letter == 'M' && code % 10) integral = false;
+        int group = !integral ? -1 : word.letter == 'G' ? g_group(code) : m_group(code / 10);
+        if (group < 0) {
+          unsupported(word.column, std::string("unsupported code ") + word.letter +
+                                       format_number(word.value));
+          continue;
+        }
+        if (word.letter == 'G') {
+          int& seen = g_seen[static_cast<std::size_t>(group)];
+          if (seen)
+            error(word.column, code_name('G', code) + " conflicts with " +
+                                   code_name('G', w.g[static_cast<std::size_t>(seen - 1)].code) +
+                                   " in the same block (same modal group)");
+          if (w.g_count == static_cast<int>(w.g.size())) error(word.column, "too many G codes");
+          w.g[static_cast<std::size_t>(w.g_count++)] = Code{code, word.column};
+          seen = w.g_count;
+        } else {
+          int& seen = m_seen[static_cast<std::size_t>(group)];
+          if (seen)
+            error(word.column, code_name('M', code) + " conflicts with " +
+                                   code_name('M', w.m[static_cast<std::size_t>(seen - 1)].code) +
+                                   " in the same block (same modal group)");
+          w.m[static_cast<std::size_t>(w.m_count++)] = Code{code / 10, word.column};
+          seen = w.m_count;
+        }
+        continue;
+      }
+      if (word.letter == 'N') continue;  // sequence numbers carry no meaning here
+      std::size_t i = static_cast<std::size_t>(letter_index(word.letter));
+      if (w.has(word.letter))
+        error(word.column, std::string("repeated word ") + word.letter + " (first at column " +
+                               std::to_string(w.column[i]) + ")");
+      w.present |= 1u << i;
+      w.value[i] = word.value;
+      w.column[i] = word.column;
+    }
+  }
+
+  double length(char c) { return w.take(c) * unit; }
+
+  long long integer(char c, const char* what, long long low, long long high) {
+    double v = w.take(c);
+    if (std::abs(v - std::round(v)) > 1e-9 || v < static_cast<double>(low) ||
+        v > static_cast<double>(high))
+      error(w.col(c), std::string(what) + ": " + c + format_number(v) + " must be an integer in [" +
+                          std::to_string(low) + ", " + std::to_string(high) + "]");
+    return static_cast<long long>(std::llround(v));
+  }
+
+  bool has_axis_words() const { return w.has('X') || w.has('Y') || w.has('Z'); }
+
+  // ---- frames ----
+  Vec3 to_machine(const Vec3& p) const { return origin + rotation * p; }
+  Vec3 to_program(const Vec3& m) const { return glm::transpose(rotation) * (m - origin); }
+
+  void update_frame() {
+    if (tilted) {
+      rotation = tilt_rotation;
+      origin = tilt_origin;
+    } else {
+      rotation = Mat3(1.0);
+      origin = work_offset;
+    }
+    ambiguous = tilted && glm::dot(tilt_rotation[2], axis) < 1 - kSameDirection;
+  }
+
+  // ---- emitting ----
+  void emit(MoveKind kind, const Vec3& a, const Vec3& b, double move_feed) {
+    if (ambiguous) {
+      std::string message = "spindle direction is ambiguous: the plane tilted at line " +
+                            std::to_string(tilt_line) +
+                            " is not normal to the tool and no G53.1/G53.6/G253 has oriented it";
+      if (!options.lenient) error(motion_column, message);
+      if (!warned_ambiguous) warn(motion_column, message + "; keeping the current direction");
+      warned_ambiguous = true;
+    }
+    Move move;
+    move.line = line;
+    move.kind = kind;
+    move.tool = tool;
+    move.start = a - world_origin;
+    move.end = b - world_origin;
+    move.axis = axis;
+    move.feed = move_feed;
+    move.spindle = speed * spindle_direction;
+    if (tools_used.insert(tool).second) tool_first_line.emplace(tool, line);
+    (*sink)(move);
+  }
+
+  // ---- motion (motion.cpp) ----
+  void move_to(Vec3 target, const std::array<bool, 3>& set_absolute, const Mat3& rot,
+               const Vec3& org, MoveKind kind, double move_feed);
+  void linear(MoveKind kind, double move_feed);
+  void require_feed();
+  void arc(bool ccw);
+  void cycle(int code);
+  void machine_move(const Vec3& target, unsigned mask, MoveKind kind, double move_feed);
+  void home_return(bool second);
+  void go_far() { far = true; }
+
+  // ---- one block ----
+  Flow execute(const Block& block);
+};
+
+}  // namespace tridex::gcode
