@@ -230,6 +230,11 @@ struct Interpreter::State {
   void home_return(bool second);
   void go_far() { far = true; }
 
+  // ---- tilted planes (tilt.cpp) ----
+  Frame plane_words(int code);
+  void tilted_plane(int code);
+  void orient_to_plane(int code);
+
   // ---- one block ----
   Flow execute(const Block& block);
 };
