@@ -10,8 +10,9 @@ build=${2:-build-fuzz}
 mkdir -p "$build/fuzz_corpus"
 clang++ -std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
   -Iinclude -Igcode/include gcode/fuzz/fuzz_gcode.cpp gcode/src/lexer.cpp \
-  gcode/src/interpreter.cpp gcode/src/modal.cpp gcode/src/motion.cpp gcode/src/tilt.cpp gcode/src/grouping.cpp \
-  gcode/src/tilted_plane.cpp gcode/src/kinematics.cpp -o "$build/fuzz_gcode"
+  gcode/src/interpreter.cpp gcode/src/flow.cpp gcode/src/modal.cpp gcode/src/motion.cpp \
+  gcode/src/parameters.cpp gcode/src/tilt.cpp gcode/src/grouping.cpp gcode/src/tilted_plane.cpp \
+  gcode/src/kinematics.cpp -o "$build/fuzz_gcode"
 # A fixed seed (FUZZ_SEED, default 1) makes CI explore the same inputs in the same order.
 exec "$build/fuzz_gcode" -seed="${FUZZ_SEED:-1}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=4096 \
   -dict=gcode/fuzz/gcode.dict -artifact_prefix="$build/" -print_final_stats=1 \

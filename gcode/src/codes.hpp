@@ -53,7 +53,8 @@ enum Group {
 
 inline int g_group(int code) {
   switch (code) {
-    case 40: case 100: case 280: case 300: case 530: return kNonModal;
+    case 40: case 100: case 280: case 300: case 530: case 520: case 650: case 920: case 921:
+    case 922: case 923: return kNonModal;
     case 0: case 10: case 20: case 30: case 730: case 800: case 810: case 820: case 830:
     case 850: case 860: case 890: return kMotion;
     case 170: case 180: case 190: return kPlane;
@@ -80,7 +81,7 @@ enum MGroup { kStop, kToolChange, kSpindle, kCoolant, kMGroupCount };
 inline int m_group(int code) {
   switch (code) {
     case 0: case 1: case 2: case 30: case 98: case 99: return kStop;
-    case 6: return kToolChange;
+    case 6: case 61: return kToolChange;
     case 3: case 4: case 5: return kSpindle;
     case 7: case 8: case 9: return kCoolant;
     default: return -1;
@@ -117,6 +118,8 @@ inline std::array<int, 3> plane_axes(int plane) {
 inline constexpr char kAxisLetter[3] = {'X', 'Y', 'Z'};
 inline constexpr char kCenterLetter[3] = {'I', 'J', 'K'};
 
-enum class Flow { next, end, call, ret };
+// What a block asks of the program flow: go on, end, call a subprogram (M98: same locals),
+// call a macro (G65: new locals from its arguments) or return (M99).
+enum class Flow { next, end, call, macro, ret };
 
 }  // namespace tridex::gcode

@@ -9,6 +9,7 @@ namespace tridex::gcode {
 
 Flow Interpreter::State::execute(const Block& block) {
   gather(block);
+  if (int column = w.find_g(650)) return macro_call(column);
   motion_column = 0;
   int motion_code = -1, nonmodal = -1, tilt = -1, orient = -1;
   for (int i = 0; i < w.g_count; ++i) {
@@ -51,18 +52,35 @@ Flow Interpreter::State::execute(const Block& block) {
   }
   if (w.has('T')) tool_selected = static_cast<int>(integer('T', "tool number", 0, 99'999'999));
 
-  if (w.find_m(6)) {
+  if (w.find_m(6) || (w.has('T') && machine.tool_loads_on_t)) {
     tool = tool_selected;
     tool_first_line.emplace(tool, line);
-    if (options.tool_change_retracts) go_far();
+    if (machine.tool_change == ToolChange::retract_far) go_far();
+    if (machine.tool_change == ToolChange::to_position) {
+      if (glm::dot(axis, Vec3(0, 0, 1)) < 1 - kSameDirection)
+        error(w.find_m(6) ? w.find_m(6) : w.col('T'),
+              "a tool change to the machine's tool-change position with a tilted tool depends on "
+              "the kinematics; retract (G28 or G53 Z) and cancel the tilt first");
+      if (far) {
+        pos = machine.tool_change_position;
+      } else {
+        emit(MoveKind::rapid, pos, machine.tool_change_position, 0.0);
+        pos = machine.tool_change_position;
+      }
+    }
+  }
+  if (int column = w.find_m(61)) {  // LinuxCNC: the tool in the spindle is Q (nothing moves)
+    if (!w.has('Q')) error(column, "M61 needs Q (the tool number)");
+    tool = tool_selected = static_cast<int>(integer('Q', "M61 tool number", 0, 99'999'999));
   }
   if (w.find_m(3)) spindle_direction = 1;
   if (w.find_m(4)) spindle_direction = -1;
   if (w.find_m(5)) spindle_direction = 0;
 
   if (nonmodal == 40) {  // dwell: P (seconds or ms) or, on Fanuc, X
-    if (w.has('P') && w.has('X')) error(w.col('X'), "G4 with both P and X");
-    char c = w.has('P') ? 'P' : w.has('X') ? 'X' : 0;
+    // Fanuc's `G4 X2.` dwells; beside P, or with a motion code in the block, X is a coordinate.
+    bool x_dwell = !w.has('P') && w.has('X') && motion_code < 0;
+    char c = w.has('P') ? 'P' : x_dwell ? 'X' : 0;
     if (!c) error(w.find_g(40), "G4 needs a dwell time P");
     if (w.take(c) < 0) error(w.col(c), "dwell time must not be negative");
     if (c == 'X') w.present &= ~(1u << letter_index('X'));  // a time here, not a coordinate
@@ -112,6 +130,10 @@ Flow Interpreter::State::execute(const Block& block) {
   }
 
   bool axis_consumer = false;  // a code other than motion that takes X/Y/Z
+  if (nonmodal == 520 || (nonmodal >= 920 && nonmodal <= 923)) {
+    axis_consumer = true;
+    local_offsets(nonmodal, w.find_g(nonmodal));
+  }
   if (nonmodal == 100) {
     axis_consumer = true;
     int column = w.find_g(100);
@@ -121,13 +143,28 @@ Flow Interpreter::State::execute(const Block& block) {
       unsupported(column, "G10 L" + std::to_string(l) + " is not supported (only L2 and L20)");
     } else {
       if (!w.has('P')) error(column, "G10 L" + std::to_string(l) + " needs P");
-      int key = l == 2 ? static_cast<int>(integer('P', "G10 L2 P", 1, 6))
-                       : MachineConfig::g54_1_key(static_cast<int>(integer('P', "G10 L20 P", 1, 300)));
+      // Fanuc: L2 P1-6 sets G54-G59, L20 Pn sets G54.1 Pn. LinuxCNC: P1-6 are G54-G59 for both,
+      // and L20 sets the offset that makes the current position read X Y Z. P0: the active one.
+      bool linuxcnc = machine.dialect == Dialect::linuxcnc;
+      int key = 0;
+      if (l == 2 || linuxcnc) {
+        if (w.has('R')) unsupported(w.col('R'), "G10 L" + std::to_string(l) + " R (a rotated coordinate system) is not supported");
+        key = static_cast<int>(integer('P', linuxcnc ? "G10 P" : "G10 L2 P", 0, 6));
+      } else {
+        key = MachineConfig::g54_1_key(static_cast<int>(integer('P', "G10 L20 P", 0, 300)));
+        if (key == MachineConfig::g54_1_key(0)) key = 0;
+      }
+      if (key == 0) key = work_key;
       if (incremental)
         error(column, "G10 under G91 is read differently by different controls; use G90");
       Vec3 value = offsets.count(key) ? offsets[key] : Vec3(0.0);
+      bool relative_to_position = linuxcnc && l == 20;
+      if (relative_to_position && far)
+        error(column, "G10 L20 with the tool retracted far along its axis: its position is unknown");
       for (int i = 0; i < 3; ++i)
-        if (w.has(kAxisLetter[i])) value[i] = length(kAxisLetter[i]);
+        if (w.has(kAxisLetter[i]))
+          value[i] = relative_to_position ? pos[i] - local_offset[i] - length(kAxisLetter[i])
+                                          : length(kAxisLetter[i]);
       offsets[key] = value;
       if (key == work_key) {
         if (tilted) error(column, "G10 changes the active work offset under a tilted plane");
@@ -217,6 +254,67 @@ Flow Interpreter::State::execute(const Block& block) {
     }
   }
   return flow;
+}
+
+}  // namespace tridex::gcode
+
+namespace tridex::gcode {
+
+// G65 P<program> L<repeats> <arguments>: a macro call. Argument words become the callee's locals
+// by Fanuc's argument specification I: A B C I J K D E F H M Q R S T U V W X Y Z are #1 #2 #3 #4
+// #5 #6 #7 #8 #9 #11 #13 #17 #18 #19 #20 #21 #22 #23 #24 #25 #26 (G, L, N, O, P are not arguments).
+Flow Interpreter::State::macro_call(int column) {
+  if (w.g_count > 1 || w.m_count > 0)
+    error(column, "G65 must be the only G or M code of its block");
+  if (!w.has('P')) error(column, "G65 needs P (the O number of the macro)");
+  call_label = static_cast<int>(integer('P', "G65 P", 0, 999'999'999));
+  call_repeats = w.has('L') ? integer('L', "G65 repeat count", 0, 9999) : 1;
+  static constexpr int kArgument[26] = {1,  2,  3,  7,  8,  9,  0,  11, 4,  5,  6,  0,  13,
+                                        0,  0,  0,  17, 18, 19, 20, 21, 22, 23, 24, 25, 26};
+  call_arguments.fill(Value{0, true});
+  for (int i = 0; i < 26; ++i) {
+    char c = static_cast<char>('A' + i);
+    if (!w.has(c) || c == 'L' || c == 'P') continue;
+    if (kArgument[i] == 0)
+      error(w.col(c), std::string("G65: ") + c + " is not an argument word");
+    call_arguments[static_cast<std::size_t>(kArgument[i])] = Value{w.take(c), false};
+  }
+  w.used = w.present;
+  return Flow::macro;
+}
+
+// G52 X Y Z sets the local offset (from the work zero); G92 X Y Z sets it so that the current
+// position reads X Y Z; G92.1 clears it, G92.2 suspends it, G92.3 restores it. LinuxCNC keeps G52
+// and G92 in one register; Fanuc's G52 and G92 change the same program origin.
+void Interpreter::State::local_offsets(int code, int column) {
+  if (tilted) error(column, code_name('G', code) + " under a tilted plane (cancel it first)");
+  if (code == 921 || code == 922) {
+    saved_local_offset = code == 922 ? local_offset : Vec3(0.0);
+    local_offset = Vec3(0.0);
+  } else if (code == 923) {
+    local_offset = saved_local_offset;
+  } else {
+    bool any = false;
+    for (int i = 0; i < 3; ++i) {
+      char c = kAxisLetter[i];
+      if (!w.has(c)) continue;
+      any = true;
+      double v = length(c);
+      if (code == 520) {
+        local_offset[i] = v;
+      } else {
+        bool along_axis = std::abs(axis[i]) > kAxisEps;
+        if (far && along_axis)
+          error(w.col(c), std::string("G92 ") += c + std::string(
+                              " with the tool retracted far along its axis: its position is "
+                              "unknown (a machine file can set the start position)"));
+        local_offset[i] = pos[i] - work_offset[i] - v;
+      }
+    }
+    if (!any) error(column, code_name('G', code) + " needs X, Y or Z");
+    saved_local_offset = local_offset;
+  }
+  update_frame();
 }
 
 }  // namespace tridex::gcode

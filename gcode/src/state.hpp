@@ -11,6 +11,7 @@
 #include <map>
 #include <numbers>
 #include <set>
+#include <unordered_map>
 #include <string>
 #include <vector>
 
@@ -26,7 +27,7 @@ inline constexpr double kSameDirection = 1e-12;  // 1 − cos of the angle below
 inline constexpr long long kMaxArcPieces = 10'000'000;
 
 // ---- the interpreter's state ----------------------------------------------------------------
-struct Interpreter::State {
+struct Interpreter::State : ParameterReader {
   InterpreterOptions options;
   MachineConfig machine;
 
@@ -74,6 +75,9 @@ struct Interpreter::State {
   bool warned_ambiguous = false;
   bool warned_home = false;
   bool warned_reference2 = false;
+  std::set<int> warned_m_codes;
+  Vec3 local_offset{0.0};  // G52 / G92 (one register, as LinuxCNC keeps it), machine axes
+  Vec3 saved_local_offset{0.0};  // G92.2 suspends, G92.3 restores
   Vec3 world_origin{0.0};
 
   // Canned cycle state (sticky values, program units converted to mm, as written).
@@ -83,24 +87,26 @@ struct Interpreter::State {
   double cycle_r = 0, cycle_z = 0, cycle_q = 0;
   bool has_cycle_r = false, has_cycle_z = false, has_cycle_q = false;
 
-  // Subprograms.
-  struct Label {
-    std::uint64_t body = 0;  // offset of the line after the label
-    int line = 0;            // line number of the label
-  };
-  struct Call {
-    int label = 0;
-    std::uint64_t return_offset = 0;
-    int return_line = 0;
-    long long remaining = 0;
-    Label body;
-  };
-  std::map<int, Label> labels;
-  std::vector<Call> calls;
-  std::uint64_t scanned_to = 0;
-  int scanned_line = 0;
+  // Subprogram calls requested by the block just executed (flow.cpp carries them out).
   int call_label = 0;
   long long call_repeats = 0;
+  std::array<Value, 34> call_arguments{};  // G65: #1..#33 from the argument words
+
+  // Parameters (parameters.cpp): #1..#33 of each call level (Fanuc locals; LinuxCNC's #1..#30),
+  // named locals of each o-word call, and the globals. Fanuc's vacant is the default.
+  struct Scope {
+    std::array<Value, 34> locals;
+    std::unordered_map<std::string, Value> named;
+    Scope() { locals.fill(Value{0, true}); }
+  };
+  std::vector<Scope> scopes = std::vector<Scope>(1);
+  std::unordered_map<int, Value> globals;
+  std::unordered_map<std::string, Value> named_globals;
+
+  Value numbered(int n) override;
+  std::optional<Value> named(std::string_view name) override;
+  bool vacant_words_omitted() const override { return machine.dialect != Dialect::linuxcnc; }
+  void assign(const Assignment& a);  // #n = v or #<name> = v, system variables included
 
   Words w;
 
@@ -132,6 +138,18 @@ struct Interpreter::State {
         int code = integral ? static_cast<int>(rounded) : -1;
         if (word.letter == 'M' && code % 10) integral = false;
         int group = !integral ? -1 : word.letter == 'G' ? g_group(code) : m_group(code / 10);
+        if (group < 0 && integral && word.letter == 'M') {
+          // An M-code moves no axis: accepted (once a warning per code unless the machine
+          // declares it), an error where the machine forbids it.
+          int m = code / 10;
+          if (machine.forbidden_m_codes.count(m))
+            error(word.column, code_name('M', code) + " is not allowed on this machine (machine file)");
+          if (!machine.m_codes.count(m) && warned_m_codes.insert(m).second)
+            warn(word.column, code_name('M', code) +
+                                  " has no effect on the tool path here (accepted; declare it in the "
+                                  "machine file's m_codes to silence this)");
+          continue;
+        }
         if (group < 0) {
           unsupported(word.column, std::string("unsupported code ") + word.letter +
                                        format_number(word.value));
@@ -139,6 +157,12 @@ struct Interpreter::State {
         }
         if (word.letter == 'G') {
           int& seen = g_seen[static_cast<std::size_t>(group)];
+          if (seen && group == kMotion && (code == 800 || w.g[static_cast<std::size_t>(seen - 1)].code == 800)) {
+            // G80 beside another motion code (the safe-start line `G0 G17 G40 G49 G80 G90`):
+            // rs274, Fanuc and Haas read it as the other code, which ends any cycle anyway.
+            if (code != 800) w.g[static_cast<std::size_t>(seen - 1)] = Code{code, word.column};
+            continue;
+          }
           if (seen)
             error(word.column, code_name('G', code) + " conflicts with " +
                                    code_name('G', w.g[static_cast<std::size_t>(seen - 1)].code) +
@@ -191,7 +215,7 @@ struct Interpreter::State {
       origin = tilt_origin;
     } else {
       rotation = Mat3(1.0);
-      origin = work_offset;
+      origin = work_offset + local_offset;
     }
     ambiguous = tilted && glm::dot(tilt_rotation[2], axis) < 1 - kSameDirection;
   }
@@ -229,6 +253,8 @@ struct Interpreter::State {
   void machine_move(const Vec3& target, unsigned mask, MoveKind kind, double move_feed);
   void home_return(bool second);
   void go_far() { far = true; }
+  Flow macro_call(int column);          // G65 (modal.cpp)
+  void local_offsets(int code, int column);  // G52, G92, G92.1, G92.2, G92.3 (modal.cpp)
 
   // ---- tilted planes (tilt.cpp) ----
   Frame plane_words(int code);
@@ -238,5 +264,8 @@ struct Interpreter::State {
   // ---- one block ----
   Flow execute(const Block& block);
 };
+
+// Runs a whole program through `state` (flow.cpp).
+void run_program(Interpreter::State& state, std::istream& program, const std::string& file_name);
 
 }  // namespace tridex::gcode

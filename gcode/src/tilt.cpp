@@ -19,7 +19,9 @@ Vec3 word_vector(Words& w, char a, char b, char c) {
 //   G68.2 [P0] X Y Z A B C        Mazak: the same angles in A B C
 //   G68.2 X Y Z I J K U V W       Hurco: IJK the feature X direction, UVW its Y direction
 //   G68.2 [P0] Q X Y Z I J K [R]  LinuxCNC: Q the Euler order (121 … 323), R about the work Z
-//   G68.2 P1 [Q] X Y Z I J K      Fanuc/Mazak: angles about the fixed X, Y, Z in the order Q
+//   G68.2 P1 [Q] X Y Z I J K      Fanuc/Mazak: angles about the fixed X, Y, Z in the order Q;
+//                                 LinuxCNC's dialect (machine file): I J K the first to third
+//                                 angle of the intrinsic order Q, and R about the work Z
 //   G268 X Y Z I J K [Q]          Haas: as P1 (Q123 when Q is absent)
 Frame Interpreter::State::plane_words(int code) {
   int column = w.find_g(code);
@@ -58,6 +60,10 @@ Frame Interpreter::State::plane_words(int code) {
       return hurco_vector_frame(o, x, y);
     }
     Vec3 angles = abc ? word_vector(w, 'A', 'B', 'C') : word_vector(w, 'I', 'J', 'K');
+    bool linuxcnc = machine.dialect == Dialect::linuxcnc && code != 2680;
+    if (p == 1 && linuxcnc)  // LinuxCNC's P1: I J K the first to third angle of the order Q
+      return linuxcnc_angles_frame(1, q, o, angles.x, angles.y, angles.z,
+                                   w.has('R') ? w.take('R') : 0.0);
     if (code == 2680 || p == 1) return fixed_axis_angles(o, angles.x, angles.y, angles.z, q);
     if (w.has('Q'))  // LinuxCNC's P0: Q names the Euler order; R turns about the work Z
       return linuxcnc_angles_frame(0, q, o, angles.x, angles.y, angles.z,
@@ -88,7 +94,7 @@ void Interpreter::State::tilted_plane(int code) {
     Vec3 o(0.0);
     if (given == 3) {
       for (int i = 0; i < 3; ++i) o[i] = length(kAxisLetter[i]);
-      o += work_offset;
+      o += work_offset + local_offset;
     } else {
       if (far)
         error(column, "G68.3 without X Y Z takes the tool tip as the origin, but the tool is "
@@ -106,7 +112,7 @@ void Interpreter::State::tilted_plane(int code) {
     feature = compose(Frame{tilt_rotation, tilt_origin}, plane_words(684));
   } else {
     feature = plane_words(code);
-    feature.origin += work_offset;  // the feature frame sits on the active work coordinate system
+    feature.origin += work_offset + local_offset;  // on the active work coordinate system
   }
   tilt_rotation = feature.rotation;
   tilt_origin = feature.origin;

@@ -43,11 +43,11 @@ inline Diagnostic error_of(const std::string& text, InterpreterOptions options =
   return {};
 }
 
-inline InterpreterOptions at_origin() {
-  InterpreterOptions o;
-  o.start_position = Vec3(0.0);
-  o.tool_change_retracts = false;
-  return o;
+// A machine that starts at the origin and changes tools in place (as rs274 standalone does).
+inline MachineConfig at_origin(MachineConfig machine = {}) {
+  machine.start_position = Vec3(0.0);
+  machine.tool_change = ToolChange::in_place;
+  return machine;
 }
 
 inline bool near(const Vec3& a, const Vec3& b, double eps = 1e-9) {

@@ -77,8 +77,8 @@ TEST_CASE("arcs (I/J/K): on the circle, within the chord tolerance, turning the 
                           fmt(end.y) + " Z" + fmt(end.z) + " " + letters[u] + fmt(offset.x) +
                           " " + letters[v] + fmt(offset.y) + "\nM30\n";
     Vec2 centre = Vec2(start[u], start[v]) + Vec2(std::stod(fmt(offset.x)), std::stod(fmt(offset.y)));
-    InterpreterOptions options = at_origin();
-    Result r = run_program(program, options);
+    InterpreterOptions options;
+    Result r = run_program(program, options, at_origin());
     REQUIRE(r.moves.size() >= 2);
     CHECK(near(r.moves.back().end, end, 1e-12));
     double turned = 0, r0 = glm::length(Vec2(start[u], start[v]) - centre);
@@ -121,16 +121,16 @@ TEST_CASE("arcs: the R form gives the same path as the I/J/K form") {
     std::snprintf(ijk, sizeof ijk, "%c%.12f %c%.12f\nM30\n", letters[u], offset.x, letters[v],
                   offset.y);
     std::snprintf(r, sizeof r, "R%.12f\nM30\n", c.sweep > std::numbers::pi ? -c.radius : c.radius);
-    Result a = run_program(base + ijk, at_origin());
-    Result b = run_program(base + r, at_origin());
+    Result a = run_program(base + ijk, {}, at_origin());
+    Result b = run_program(base + r, {}, at_origin());
     REQUIRE(a.moves.size() == b.moves.size());
     for (std::size_t k = 0; k < a.moves.size(); ++k) CHECK(near(a.moves[k].end, b.moves[k].end, 1e-6));
   }
 }
 
 TEST_CASE("arcs: full circles, G90.1 centres, G20, and the chord tolerance option") {
-  InterpreterOptions options = at_origin();
-  Result r = run_program("G17 G90 F100\nG0 X10 Y0 Z0\nG2 I-10 J0\nM30\n", options);
+  InterpreterOptions options;
+  Result r = run_program("G17 G90 F100\nG0 X10 Y0 Z0\nG2 I-10 J0\nM30\n", options, at_origin());
   CHECK(near(r.moves.back().end, Vec3(10, 0, 0)));
   double turned = 0;
   for (std::size_t k = 1; k < r.moves.size(); ++k) {
@@ -140,10 +140,10 @@ TEST_CASE("arcs: full circles, G90.1 centres, G20, and the chord tolerance optio
   CHECK(turned == doctest::Approx(-2 * std::numbers::pi));
   std::size_t fine = r.moves.size();
   options.arc_tolerance = 0.1;
-  r = run_program("G17 G90 F100\nG0 X10 Y0 Z0\nG2 I-10 J0\nM30\n", options);
+  r = run_program("G17 G90 F100\nG0 X10 Y0 Z0\nG2 I-10 J0\nM30\n", options, at_origin());
   CHECK(r.moves.size() < fine / 5);
   // Absolute centre (G90.1) and inches.
-  r = run_program("G20 G17 G90 G90.1 F10\nG0 X1 Y0 Z0\nG3 X0 Y1 I0 J0\nM30\n", at_origin());
+  r = run_program("G20 G17 G90 G90.1 F10\nG0 X1 Y0 Z0\nG3 X0 Y1 I0 J0\nM30\n", {}, at_origin());
   CHECK(near(r.moves.back().end, Vec3(0, 25.4, 0)));
   for (const Move& m : r.moves) CHECK(glm::length(Vec2(m.end)) == doctest::Approx(25.4));
 }

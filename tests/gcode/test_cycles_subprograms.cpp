@@ -17,7 +17,7 @@ std::vector<Vec3> ends(const Result& r, MoveKind kind) {
 
 TEST_CASE("G81 with G98 and G99: retract levels") {
   Result r = run_program("G90 F100\nG0 X0 Y0 Z10\nG99 G81 X1 Y1 Z-2 R1\nG98 X2\nG80\nM30\n",
-                         at_origin());
+                         {}, at_origin());
   std::vector<Vec3> want = {Vec3(1, 1, 10), Vec3(1, 1, 1), Vec3(1, 1, -2), Vec3(1, 1, 1),
                             Vec3(2, 1, 1),  Vec3(2, 1, 1), Vec3(2, 1, -2), Vec3(2, 1, 10)};
   std::vector<Vec3> got = ends(r, MoveKind::cycle);
@@ -36,7 +36,7 @@ TEST_CASE("G83/G73 pecks: each step at most Q deeper, the last at the bottom, ra
     bool g83 = rng() % 2;
     std::string program = cat("G90 F100\nG0 X0 Y0 Z10\n", g83 ? "G83" : "G73", " X3 Y4 Z",
                               fmt(bottom), " R", fmt(r_level), " Q", fmt(q), "\nG80\nM30\n");
-    Result r = run_program(program, at_origin());
+    Result r = run_program(program, {}, at_origin());
     double deepest = r_level;
     int feeds = 0;
     for (const Move& m : r.moves) {
@@ -63,7 +63,7 @@ TEST_CASE("G83/G73 pecks: each step at most Q deeper, the last at the bottom, ra
 TEST_CASE("G85/G89 feed out, G86 rapids out; L repeats step under G91") {
   Result r = run_program("G90 F100\nG0 X0 Y0 Z5\nG85 X1 Y0 Z-3 R1\nG80\n"
                          "G91 G99 G81 X2 Y1 Z-4 R-3 L3\nG90 G80\nM30\n",
-                         at_origin());
+                         {}, at_origin());
   std::vector<Move> cycle;
   for (const Move& m : r.moves)
     if (m.kind == MoveKind::cycle) cycle.push_back(m);
@@ -79,7 +79,7 @@ TEST_CASE("G85/G89 feed out, G86 rapids out; L repeats step under G91") {
   REQUIRE(bottoms.size() == 3);
   for (int k = 0; k < 3; ++k) CHECK(near(bottoms[static_cast<std::size_t>(k)], Vec3(3 + 2 * k, 1 + k, -2)));
   // K is the Fanuc spelling of the repeat count.
-  Result k = run_program("G90 F100\nG0 X0 Y0 Z5\nG91 G81 X1 Z-1 R-1 K2\nG90 G80\nM30\n", at_origin());
+  Result k = run_program("G90 F100\nG0 X0 Y0 Z5\nG91 G81 X1 Z-1 R-1 K2\nG90 G80\nM30\n", {}, at_origin());
   CHECK(near(k.moves.back().end, Vec3(2, 0, 5)));
 }
 

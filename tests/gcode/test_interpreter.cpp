@@ -30,7 +30,7 @@ TEST_CASE("G0/G1 random walk, absolute and incremental, matches an accumulated r
       if (!words.empty()) expected.push_back(p);
     }
     program += "M30\n";
-    Result r = run_program(program, at_origin());
+    Result r = run_program(program, {}, at_origin());
     REQUIRE(r.moves.size() == expected.size());
     for (std::size_t k = 0; k < expected.size(); ++k) {
       CHECK(near(r.moves[k].end, expected[k], 1e-9));
@@ -43,7 +43,7 @@ TEST_CASE("G0/G1 random walk, absolute and incremental, matches an accumulated r
 TEST_CASE("units, feed, spindle and tool travel on every move") {
   Result r = run_program(
       "G20 G90\nT3 M6\nS1000 M3\nG1 X1 Y2 Z-0.5 F10\nM4 S500\nG0 X2\nM5\nT7\nG1 X3\nM6\nG1 X4\nM30\n",
-      at_origin());
+      {}, at_origin());
   REQUIRE(r.moves.size() == 4);
   CHECK(near(r.moves[0].end, Vec3(25.4, 50.8, -12.7)));
   CHECK(r.moves[0].feed == doctest::Approx(254));
@@ -70,7 +70,7 @@ TEST_CASE("work offsets: table, G54.1 P, G10 L2/L20; output in the G54 frame") {
   Result r = run_program(
       "G90 G54 G0 X1 Y1 Z1\nG55 X1 Y1 Z1\nG54.1 P7 X1 Y1 Z1\nG10 L2 P3 X5 Y6 Z7\nG56 X0 Y0 Z0\n"
       "G10 L20 P7 Z-60\nG54.1 P7 X0 Y0 Z0\nM30\n",
-      at_origin(), machine);
+      {}, at_origin(machine));
   REQUIRE(r.moves.size() == 5);
   CHECK(near(r.moves[0].end, Vec3(1, 1, 1)));
   CHECK(near(r.moves[1].end, Vec3(101, 11, 1)));        // G55 point, seen from G54
@@ -153,16 +153,16 @@ TEST_CASE("rejected blocks name line, column and word") {
 }
 
 TEST_CASE("lenient mode turns unsupported words into warnings and skips them") {
-  InterpreterOptions options = at_origin();
+  InterpreterOptions options;
   options.lenient = true;
-  Result r = run_program("G0 X1 Y1 Z1\nG41 D1\nG1 X2 F100 E4\nM30\n", options);
+  Result r = run_program("G0 X1 Y1 Z1\nG41 D1\nG1 X2 F100 E4\nM30\n", options, at_origin());
   CHECK(r.moves.size() == 2);
   CHECK(r.warnings.size() == 3);
   CHECK(r.warnings[0].line == 2);
 }
 
 TEST_CASE("truncated programs warn; a stream is read with constant memory") {
-  Result r = run_program("G0 X1 Y1 Z1\nG1 X2 F1", at_origin());
+  Result r = run_program("G0 X1 Y1 Z1\nG1 X2 F1", {}, at_origin());
   CHECK(r.moves.size() == 2);
   REQUIRE(r.warnings.size() == 1);
   CHECK(r.warnings[0].message.find("truncated") != std::string::npos);
@@ -181,7 +181,7 @@ TEST_CASE("truncated programs warn; a stream is read with constant memory") {
     }
   } generator(200000);
   std::istream in(&generator);
-  Interpreter interpreter(at_origin());
+  Interpreter interpreter({}, at_origin());
   long long count = 0;
   interpreter.run(in, "gen", [&](const Move&) { ++count; });
   CHECK(count == 200000);

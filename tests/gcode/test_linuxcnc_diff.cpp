@@ -65,7 +65,8 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log) {
   std::ifstream in(out);
   std::vector<Point> points;
   double scale = 1;
-  Vec3 offset(0.0);  // mm
+  Vec3 offset(0.0);  // mm, G5x
+  Vec3 local(0.0);   // mm, G92 / G52
   char plane = 'Z';  // XY: Z, XZ: Y, YZ: X (the arc's axis)
   std::string line;
   int record = 0;
@@ -81,6 +82,11 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log) {
       auto v = arguments(line, line.find('(', at));
       REQUIRE(v.size() >= 4);
       offset = Vec3(v[1], v[2], v[3]) * scale;
+    }
+    if ((at = line.find("SET_G92_OFFSET(")) != std::string::npos) {
+      auto v = arguments(line, line.find('(', at));
+      REQUIRE(v.size() >= 3);
+      local = Vec3(v[0], v[1], v[2]) * scale;
     }
     Vec3 p;
     if ((at = line.find("STRAIGHT_TRAVERSE(")) != std::string::npos ||
@@ -99,7 +105,7 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log) {
     } else {
       continue;
     }
-    push(points, Point{p * scale + offset, 0.5e-4 * scale + 1e-6, record});
+    push(points, Point{p * scale + offset + local, 0.5e-4 * scale + 1e-6, record});
   }
   fs::remove(out);
   fs::remove(out.string() + ".log");
@@ -108,13 +114,11 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log) {
 
 std::vector<Point> run_tridex(const fs::path& program) {
   InterpreterOptions options;
-  options.start_position = Vec3(0.0);   // rs274 starts at the origin
-  options.tool_change_retracts = false; // and does not move on M6
-  options.block_delete = false;         // its block-delete switch is off by default
+  options.block_delete = false;  // rs274's block-delete switch is off by default
   std::vector<Point> points;
   std::ifstream in(program, std::ios::binary);
   REQUIRE(in);
-  Interpreter interpreter(options);
+  Interpreter interpreter(options, *MachineConfig::bundled("linuxcnc"));
   Move last_arc;
   bool in_arc = false;
   auto flush = [&] {
@@ -141,6 +145,10 @@ std::vector<fs::path> corpus() {
     if (entry.path().extension() == ".ngc") files.push_back(entry.path());
   std::sort(files.begin(), files.end());
   // LinuxCNC's own sample programs that use only codes both interpreters support.
+  if (const char* only = std::getenv("TRIDEX_DIFF_ONLY")) {  // ad-hoc: one program
+    files.assign(1, fs::path(only));
+    return files;
+  }
   for (const char* name : {"3dtest.ngc", "arcspiral.ngc", "cds.ngc", "tort.ngc"})
     files.push_back(fs::path("/usr/share/linuxcnc/ncfiles") / name);
   return files;

@@ -13,7 +13,7 @@ TEST_CASE("codes without effect on the path are accepted; stops and dwells move 
   Result r = run_program(
       "%\nO42 (name)\nN1 G15 G40 G49 G61 G80 G94 G97 G91.1\nG64 P0.01 Q0.01\nG0 X0 Y0 Z5\nM0\nM1\nM8\nM7\n"
       "M9\nG4 P1.5\nG4 X2\nG44 H3\nG43 H1\nG49\nG1 X1 F10\nM30\n%\nG0 X99\n",
-      at_origin());
+      {}, at_origin());
   REQUIRE(r.moves.size() == 2);
   CHECK(r.warnings.empty());
   CHECK(near(r.moves[1].end, Vec3(1, 0, 5)));
@@ -23,16 +23,16 @@ TEST_CASE("codes without effect on the path are accepted; stops and dwells move 
   CHECK(r.warnings.empty());
   CHECK(error_of("G5.1 Q1 G8 P1\n").message.find("conflicts") != std::string::npos);
   // Text after the closing '%' is never read; a program without any still ends at M30.
-  r = run_program("G0 X0 Y0 Z5\nM30\nG0 X1\n", at_origin());
+  r = run_program("G0 X0 Y0 Z5\nM30\nG0 X1\n", {}, at_origin());
   CHECK(r.moves.size() == 1);
   CHECK(r.warnings.empty());
 }
 
 TEST_CASE("block delete: skipped by default, executed when the switch is off") {
-  InterpreterOptions options = at_origin();
-  CHECK(run_program("G0 X1 Y1 Z1\n/G0 X2\nM30\n", options).moves.size() == 1);
+  InterpreterOptions options;
+  CHECK(run_program("G0 X1 Y1 Z1\n/G0 X2\nM30\n", options, at_origin()).moves.size() == 1);
   options.block_delete = false;
-  CHECK(run_program("G0 X1 Y1 Z1\n/G0 X2\nM30\n", options).moves.size() == 2);
+  CHECK(run_program("G0 X1 Y1 Z1\n/G0 X2\nM30\n", options, at_origin()).moves.size() == 2);
 }
 
 TEST_CASE("G53.6 orients like G53.1; G269 cancels G268; G69 cancels G68.2") {

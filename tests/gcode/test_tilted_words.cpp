@@ -18,10 +18,11 @@ namespace {
 
 // The tool direction and the moves of a program that defines a plane, orients the tool and cuts
 // a small square in the plane.
-Result square_in(const std::string& plane, const std::string& orient = "G53.1") {
+Result square_in(const std::string& plane, const std::string& orient = "G53.1",
+                 MachineConfig machine = at_origin()) {
   return run_program(cat("G21 G90 G54 T1 M6 S1000 M3\n", plane, "\n", orient, "\n",
                          "G0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X10\nG1 Y10\nG1 X0\nG1 Y0\nG0 Z5\nM30\n"),
-                     at_origin());
+                     {}, machine);
 }
 
 Vec3 tool_of(const Result& r) {
@@ -72,6 +73,20 @@ TEST_CASE("LinuxCNC G68.2 Q121: the issue's plane") {
   CHECK(near(tool_of(r), linuxcnc_angles_frame(0, 121, Vec3(0), 30, 15, 0, 90).rotation[2], 1e-12));
 }
 
+TEST_CASE("G68.2 P1 in LinuxCNC's dialect: I J K the first to third angle, intrinsic") {
+  MachineConfig linuxcnc = at_origin();
+  linuxcnc.dialect = Dialect::linuxcnc;
+  Vec3 t = tool_of(square_in("G68.2 P1 Q123 I30 J20 K0", "G53.1", linuxcnc));
+  CHECK(near(t, linuxcnc_angles_frame(1, 123, Vec3(0), 30, 20, 0).rotation[2], 1e-12));
+  CHECK(near(t, rotation_x(30) * rotation_y(20) * Vec3(0, 0, 1), 1e-12));
+  // Fanuc's reading of the same words differs: about the fixed X, then the fixed Y.
+  CHECK(near(tool_of(square_in("G68.2 P1 Q123 I30 J20 K0")),
+             rotation_y(20) * rotation_x(30) * Vec3(0, 0, 1), 1e-12));
+  // G268 stays Haas's in either dialect.
+  CHECK(near(tool_of(square_in("G268 I30 J20 Q123", "G253", linuxcnc)),
+             rotation_y(20) * rotation_x(30) * Vec3(0, 0, 1), 1e-12));
+}
+
 TEST_CASE("G68.4 composes with the active plane; G68.3 takes the tool axis") {
   CHECK(same_moves(square_in("G68.2 X10 I0 J30 K0\nG68.4 Z2 J15"),
                    square_in(cat("G68.2 X10 Y", fmt(-2 * std::sin(glm::radians(30.0))), " Z",
@@ -89,7 +104,8 @@ TEST_CASE("G68.4 composes with the active plane; G68.3 takes the tool axis") {
 }
 
 TEST_CASE("LinuxCNC G53.3 orients and rapids to I J K in the plane") {
-  Result r = run_program("G21 G90 T1 M6\nG68.2 X5 I0 J30 K0 Q313\nG53.3 P1 I1 J2 K3\nM30\n", at_origin());
+  Result r = run_program("G21 G90 T1 M6\nG68.2 X5 I0 J30 K0 Q313\nG53.3 P1 I1 J2 K3\nM30\n", {},
+                         at_origin());
   REQUIRE(r.moves.size() == 1);
   Frame f = fanuc_euler(Vec3(5, 0, 0), 0, 30, 0);
   CHECK(near(r.moves[0].end, f.to_world(Vec3(1, 2, 3)), 1e-9));

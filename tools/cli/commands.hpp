@@ -3,6 +3,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace tridex::cli {
 
@@ -10,6 +11,8 @@ struct CommonOptions {
   std::string program;          // G-code file or CAMotics project
   double arc_tolerance = 0.001;  // mm
   bool lenient = false;
+  std::string machine;                    // --machine FILE|NAME (empty: the default machine)
+  std::vector<std::string> subprograms;   // --subprograms DIR (repeatable)
   bool progress = false;
   bool quiet = false;
 };

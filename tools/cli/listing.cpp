@@ -50,7 +50,7 @@ void print_warnings(const std::vector<std::string>& warnings, bool quiet) {
 }  // namespace
 
 int run_moves(const ListOptions& options) {
-  ProgramInput input = resolve_program(options.program);
+  ProgramInput input = resolve_program(options);
   check_output(options.output, input);
   InterpretResult result;
   write_output(options.output, [&](std::ostream& out) {
@@ -87,7 +87,7 @@ int run_moves(const ListOptions& options) {
 }
 
 int run_groups(const ListOptions& options) {
-  ProgramInput input = resolve_program(options.program);
+  ProgramInput input = resolve_program(options);
   check_output(options.output, input);
   gcode::DirectionGrouper grouper;
   struct Extra {

@@ -29,6 +29,11 @@ void add_common(CLI::App& command, CommonOptions& options) {
       ->check(CLI::PositiveNumber);
   command.add_flag("--lenient", options.lenient,
                    "unsupported G-code words become warnings and are skipped");
+  command.add_option("--machine", options.machine,
+                     "machine file (JSON) or bundled machine: default, linuxcnc (README: Machine files)");
+  command.add_option("--subprograms", options.subprograms,
+                     "folder of subprogram files (O9810.nc, name.ngc) that M98/G65/o-call may "
+                     "call (repeatable)");
   command.add_flag("--progress", options.progress,
                    "show progress on stderr even when it is not a terminal");
   command.add_flag("-q,--quiet", options.quiet, "print nothing but errors")->excludes("--progress");

@@ -118,7 +118,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
                                   const PipelineRequest& request) {
   SimulationResult r;
   // ---- inputs and outputs, checked before any work ---------------------------------------
-  r.input = resolve_program(options.program);
+  r.input = resolve_program(options);
   const ProgramInput& input = r.input;
   std::optional<ToolTable> table;
   if (!options.tools.empty()) table = ToolTable::read(options.tools);

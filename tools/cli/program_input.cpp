@@ -3,14 +3,17 @@
 #include <fstream>
 
 #include "errors.hpp"
+#include "machine_file.hpp"
 #include "project.hpp"
 
 namespace tridex::cli {
 
 namespace fs = std::filesystem;
 
-ProgramInput resolve_program(const std::string& program) {
+ProgramInput resolve_program(const CommonOptions& options) {
+  const std::string& program = options.program;
   ProgramInput input;
+  input.machine = load_machine(options.machine, options.subprograms);
   input.program = program;
   std::error_code error;
   if (!fs::is_regular_file(input.program, error))
@@ -29,7 +32,7 @@ ProgramInput resolve_program(const std::string& program) {
 InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOptions& options,
                           const std::function<void(const gcode::Move&, std::size_t file)>& sink) {
   InterpretResult result;
-  gcode::Interpreter interpreter(options);
+  gcode::Interpreter interpreter(options, input.machine);
   for (std::size_t f = 0; f < input.files.size(); ++f) {
     const fs::path& path = input.files[f];
     std::ifstream in(path, std::ios::binary);

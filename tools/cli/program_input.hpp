@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "commands.hpp"
 #include "stock.hpp"
 #include "tool_table.hpp"
 #include "tridex/gcode/interpreter.hpp"
@@ -19,10 +20,11 @@ struct ProgramInput {
   std::vector<std::filesystem::path> files;   // the G-code file(s), in order
   std::optional<ToolTable> tools;             // from a project
   std::optional<StockSpec> stock;             // from a project
+  gcode::MachineConfig machine;               // --machine, --subprograms
 };
 
-// Throws InputError if the file is missing or the project is malformed.
-ProgramInput resolve_program(const std::string& program);
+// Throws InputError if the file is missing, the project is malformed or the machine unknown.
+ProgramInput resolve_program(const CommonOptions& options);
 
 // Where each tool was first selected, for messages: "file:line".
 struct ToolSelection {

@@ -36,8 +36,25 @@
 
 namespace tridex::gcode {
 
+// The controller dialect: where Fanuc (and Haas, Mazak, most Fanuc-like controls) and LinuxCNC
+// read the same program differently. Fanuc: a word whose value is vacant (#0, an unset local) is
+// left out, FIX/FUP round toward/away from zero. LinuxCNC: unset numbered parameters read 0, FIX
+// and FUP are floor and ceiling.
+enum class Dialect { fanuc, linuxcnc };
+
+// What M6 does with the tool tip.
+enum class ToolChange {
+  retract_far,  // leaves it far along the tool axis (the default: where it goes is the machine's)
+  in_place,     // leaves it where it is (LinuxCNC's rs274 standalone)
+  to_position,  // moves it (a rapid, machine coordinates) to tool_change_position
+};
+
+// What the interpreter needs to know of the machine (tridex's machine file, tools/cli/machine.*,
+// fills it; the defaults are the "far along the tool axis" rule of docs/design.md).
 struct MachineConfig {
   static constexpr double kDefaultFar = 1e4;  // mm
+
+  Dialect dialect = Dialect::fanuc;
 
   // G28 and G30 P2 positions in machine coordinates. The defaults lie far above the work along
   // +Z, so that the usual `G28 G91 Z0` retract cuts nothing; using them raises a warning.
@@ -54,6 +71,23 @@ struct MachineConfig {
   // back from a retract. Must exceed the size of the work.
   double far_distance = kDefaultFar;
 
+  // Tip at program start, machine coordinates; unset: far along +Z.
+  std::optional<Vec3> start_position;
+  ToolChange tool_change = ToolChange::retract_far;
+  Vec3 tool_change_position{0.0};  // machine coordinates, for ToolChange::to_position
+  bool tool_loads_on_t = false;    // the control loads a tool on T alone (no M6 needed)
+  bool inch_at_start = false;      // units before any G20/G21: inch (true) or mm
+
+  // M-codes beyond the ones the interpreter acts on (M0-M9, M30, M98, M99): declared ones are
+  // accepted quietly, forbidden ones are errors, any other is accepted with one warning per code
+  // (an M-code moves no axis; the machine file says which ones exist).
+  std::set<int> m_codes;
+  std::set<int> forbidden_m_codes;
+
+  // Where M98 / G65 / o<name> call look for programs the file does not contain: O1234.nc-style
+  // files (and name.ngc for LinuxCNC) in these folders, in order.
+  std::vector<std::string> subprogram_dirs;
+
   void set_home(const Vec3& p) {
     home = p;
     home_is_default = false;
@@ -64,6 +98,10 @@ struct MachineConfig {
   }
   static int g54_key(int n) { return n; }          // n = 1..6 for G54..G59
   static int g54_1_key(int p) { return 100 + p; }  // G54.1 Pp
+
+  // The bundled machines: "default" (the far rule) and "linuxcnc" (rs274 run standalone: start
+  // at the origin, M6 in place, G28/G30 at the origin, LinuxCNC's dialect); nullopt otherwise.
+  static std::optional<MachineConfig> bundled(const std::string& name);
 };
 
 struct InterpreterOptions {
@@ -71,11 +109,10 @@ struct InterpreterOptions {
   double arc_radius_tolerance = 0.002;  // mm, allowed |end radius − start radius| of I/J/K arcs
   bool lenient = false;        // unsupported words become warnings and are skipped
   bool block_delete = true;    // skip blocks that start with '/' (the switch on)
-  bool tool_change_retracts = true;  // M6 leaves the tip far along the tool axis
-  std::optional<Vec3> start_position;  // tip at program start, work frame; default: far along +Z
-  int max_call_depth = 16;     // nested M98 calls
+  int max_call_depth = 16;     // nested M98 / G65 / o-word calls
   double peck_clearance = 0.254;  // mm, G73 back-off and G83 re-entry gap (LinuxCNC's 0.010 in)
-  long long max_blocks = 0;    // > 0: error once this many blocks ran (bounds M98 L loops)
+  // Error once this many blocks ran: bounds endless loops (M98 L, WHILE, GOTO); 0 = no bound.
+  long long max_blocks = 100'000'000;
 };
 
 class Interpreter {
@@ -97,8 +134,9 @@ class Interpreter {
                                                         // (its first move's line if none)
   long long blocks() const;                             // blocks executed by the last run
 
+  struct State;  // the implementation (gcode/src/state.hpp)
+
  private:
-  struct State;
   std::unique_ptr<State> state_;
 };
 

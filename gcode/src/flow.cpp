@@ -1,0 +1,673 @@
+// tridex::gcode — program flow: reading lines from the program and the subprogram files it calls,
+// and carrying out calls (M98, G65, LinuxCNC o-word call), returns (M99, endsub, return), loops
+// (Fanuc WHILE/DO/END, LinuxCNC while/do/repeat with break and continue), branches (Fanuc IF
+// GOTO and GOTO, LinuxCNC if/elseif/else/endif) and subroutine definitions.
+//
+// Memory stays flat for long programs: control flow jumps by byte offset within a file, and what
+// is remembered is bounded by the program's structure, not its length — the O labels, o-word
+// subroutines and GOTO targets met, and a stack of calls, loops and branches. A GOTO or a call to
+// a label not seen yet reads ahead (without executing) noting labels on the way, as M98 always
+// did; a WHILE whose condition is false skips to its END the same way.
+#include <filesystem>
+#include <fstream>
+
+#include "line_reader.hpp"
+#include "state.hpp"
+
+namespace tridex::gcode {
+namespace {
+
+constexpr std::size_t kMaxControlDepth = 1000;  // open loops and branches
+
+// One program file: the main program or a subprogram file found by name.
+struct Source {
+  std::string name;
+  std::unique_ptr<std::ifstream> owned;  // null for the main program's stream
+  LineReader reader;
+  struct Label {
+    std::uint64_t body = 0;  // offset of the line after the label
+    int line = 0;            // line number of the label
+  };
+  std::map<int, Label> programs;              // O numbers
+  std::map<std::string, Label> subroutines;   // o<name> sub / o100 sub
+  std::map<long long, Label> sequences;       // N numbers that GOTO looked for (at the N line)
+  std::uint64_t scanned_to = 0;
+  int scanned_line = 0;
+  std::uint64_t start = 0;
+
+  Source(std::string n, std::istream& in) : name(std::move(n)), reader(in) {
+    start = scanned_to = reader.offset();
+  }
+};
+
+struct Position {
+  std::size_t source = 0;
+  std::uint64_t offset = 0;
+  int line = 0;  // the line number of the line before `offset`
+};
+
+enum class CallKind { m98, g65, o_call };
+
+struct Call {
+  CallKind kind;
+  std::string label;  // for messages and for matching endsub/return
+  Position back;      // where the caller goes on
+  Position body;
+  long long remaining = 1;
+  std::size_t loops = 0, branches = 0;  // depths of the control stacks at the call
+  bool scope = false;                   // pushed a parameter scope
+  std::array<Value, 34> arguments{};    // G65: the locals each repeat starts from
+};
+
+enum class LoopKind { fanuc, o_while, o_do, o_repeat };
+
+struct Loop {
+  LoopKind kind;
+  long long id = 0;   // fanuc: DO m
+  std::string label;  // o-words
+  Position start;     // the loop's first line (WHILE / o-while: the condition line itself)
+  long long remaining = 0;
+};
+
+struct Branch {
+  std::string label;
+  bool taken = false;
+};
+
+}  // namespace
+
+class ProgramFlow {
+ public:
+  ProgramFlow(Interpreter::State& state, std::istream& program, const std::string& file_name)
+      : s_(state) {
+    sources_.push_back(std::make_unique<Source>(file_name, program));
+    s_.file = &sources_[0]->name;
+  }
+
+  void run();
+
+ private:
+  Source& source() { return *sources_[current_]; }
+
+  bool read(std::string_view& out);
+  void jump(const Position& to);
+  Position here() { return Position{current_, source().reader.offset(), line_}; }
+  [[noreturn]] void error(int column, const std::string& message) { s_.error(column, message); }
+  void count_block();
+
+  void note_label(std::string_view text, const Position& after);
+  bool scan_for(const std::function<bool()>& found);
+  std::optional<Source::Label> find_program(int number);
+  std::optional<std::pair<std::size_t, Source::Label>> find_external(const std::string& label,
+                                                                     bool o_word);
+
+  void skip_until(const std::function<bool(const Skim&)>& stop, const std::string& what, int column);
+  void call(CallKind kind, const std::string& label, long long repeats, int column);
+  void give_back(int column);
+  void o_word(const Control& control);
+  void loop_control(const Control& control);
+  void jump_to_sequence(long long number, int column);
+  std::vector<Value> arguments(const Control& control);
+  bool condition(const Control& control);
+
+  Interpreter::State& s_;
+  std::vector<std::unique_ptr<Source>> sources_;
+  std::size_t current_ = 0;
+  int line_ = 0;
+  std::vector<Call> calls_;
+  std::vector<Loop> loops_;
+  std::vector<Branch> branches_;
+  Block block_;
+  LexError lex_error_;
+  bool started_ = false, percent_seen_ = false, ended_ = false;
+  std::uint64_t statement_offset_ = 0;  // where the line being executed starts
+  std::string_view skipped_;            // the line skip_until stopped at (until the next read)
+  std::vector<Value> o_arguments_;      // an o-word call's arguments
+};
+
+bool ProgramFlow::read(std::string_view& out) {
+  Source& src = source();
+  std::uint64_t at = src.reader.offset();
+  bool too_long = false;
+  if (!src.reader.next(out, too_long)) return false;
+  ++line_;
+  s_.line = line_;
+  if (too_long) error(0, "line longer than 65535 characters");
+  if (line_ == 1 && out.substr(0, 3) == "\xEF\xBB\xBF") out.remove_prefix(3);  // UTF-8 BOM
+  if (at >= src.scanned_to) {  // first visit: note labels
+    note_label(out, here());
+    src.scanned_to = src.reader.offset();
+    src.scanned_line = line_;
+  }
+  return true;
+}
+
+void ProgramFlow::note_label(std::string_view text, const Position& after) {
+  Source& src = source();
+  int number;
+  if (parse_label(text, number)) {
+    src.programs.emplace(number, Source::Label{after.offset, after.line});
+    return;
+  }
+  std::size_t i = text.find_first_not_of(" \t");
+  if (i == std::string_view::npos || (text[i] != 'o' && text[i] != 'O')) return;
+  Skim skim;
+  skim_line(text, skim);
+  if (skim.kind == ControlKind::o_word && skim.keyword == OKeyword::sub)
+    src.subroutines.emplace(skim.label, Source::Label{after.offset, after.line});
+}
+
+void ProgramFlow::jump(const Position& to) {
+  current_ = to.source;
+  s_.file = &source().name;
+  if (!source().reader.seek(to.offset))
+    error(0, "calls, loops and jumps need a seekable input stream");
+  line_ = to.line;
+}
+
+void ProgramFlow::count_block() {
+  if (++s_.blocks > s_.options.max_blocks && s_.options.max_blocks > 0)
+    error(0, "more than " + std::to_string(s_.options.max_blocks) +
+                 " blocks executed (the block limit; an endless loop?)");
+}
+
+// Reads ahead from the furthest line seen, noting labels, until `found` or the end of the file;
+// then comes back. Returns whether `found` became true.
+bool ProgramFlow::scan_for(const std::function<bool()>& found) {
+  if (found()) return true;
+  Position back = here();
+  int line = s_.line;
+  Source& src = source();
+  jump(Position{current_, src.scanned_to, src.scanned_line});
+  std::string_view skipped;
+  bool ok = false;
+  while (!(ok = found()) && read(skipped)) {
+  }
+  jump(back);
+  s_.line = line;
+  return ok;
+}
+
+std::optional<Source::Label> ProgramFlow::find_program(int number) {
+  Source& src = source();
+  if (!scan_for([&] { return src.programs.count(number) > 0; })) return std::nullopt;
+  return src.programs.at(number);
+}
+
+// A subprogram file: `O1234.nc`-style names for an O number, `name.ngc` for a LinuxCNC o-word,
+// in the machine's subprogram folders and the program's own folder.
+std::optional<std::pair<std::size_t, Source::Label>> ProgramFlow::find_external(
+    const std::string& label, bool o_word) {
+  std::vector<std::string> names;
+  if (o_word) {
+    names = {label + ".ngc", label + ".NGC", label + ".nc"};
+  } else {
+    std::string padded = label;
+    while (padded.size() < 4) padded = "0" + padded;
+    for (const std::string& stem : {"O" + padded, "O" + label, "o" + padded, "o" + label, label})
+      for (const char* ext : {".nc", ".NC", ".ngc", ".NGC", ".tap", ".txt", ""})
+        names.push_back(stem + ext);
+  }
+  std::vector<std::filesystem::path> dirs;
+  for (const std::string& d : s_.machine.subprogram_dirs) dirs.emplace_back(d);
+  dirs.push_back(std::filesystem::path(sources_[0]->name).parent_path());
+  for (std::size_t k = 0; k < sources_.size(); ++k)
+    if (sources_[k]->name == label) return std::pair{k, Source::Label{sources_[k]->start, 0}};
+  for (const auto& dir : dirs) {
+    for (const std::string& name : names) {
+      std::filesystem::path path = dir / name;
+      std::error_code ec;
+      if (!std::filesystem::is_regular_file(path, ec)) continue;
+      std::string shown = path.string();
+      for (std::size_t k = 0; k < sources_.size(); ++k)
+        if (sources_[k]->name == shown) return std::pair{k, Source::Label{sources_[k]->start, 0}};
+      auto file = std::make_unique<std::ifstream>(path, std::ios::binary);
+      if (!*file) continue;
+      auto src = std::make_unique<Source>(shown, *file);
+      src->owned = std::move(file);
+      sources_.push_back(std::move(src));
+      return std::pair{sources_.size() - 1, Source::Label{sources_.back()->start, 0}};
+    }
+  }
+  return std::nullopt;
+}
+
+void ProgramFlow::skip_until(const std::function<bool(const Skim&)>& stop, const std::string& what,
+                             int column) {
+  int from = line_;
+  std::string_view text;
+  Skim skim;
+  while (read(text)) {
+    skim_line(text, skim);
+    if (stop(skim)) {
+      skipped_ = text;
+      return;
+    }
+  }
+  s_.line = from;
+  error(column, "no " + what + " after this line");
+}
+
+void ProgramFlow::call(CallKind kind, const std::string& label, long long repeats, int column) {
+  if (repeats <= 0) return;
+  if (static_cast<int>(calls_.size()) >= s_.options.max_call_depth)
+    error(column, "subprogram calls nested deeper than " + std::to_string(s_.options.max_call_depth));
+  Call c{kind, label, here(), {}, repeats, loops_.size(), branches_.size(), false};
+  const char* how = kind == CallKind::m98 ? "M98 P" : kind == CallKind::g65 ? "G65 P" : "o";
+  if (kind == CallKind::o_call) {
+    Source& src = source();
+    std::optional<Source::Label> body;
+    if (scan_for([&] { return src.subroutines.count(label) > 0; })) body = src.subroutines.at(label);
+    if (body) {
+      c.body = Position{current_, body->body, body->line};
+    } else if (auto external = find_external(label, true)) {
+      // A subroutine file holds `o<name> sub` … `o<name> endsub`: run from its sub line on.
+      std::size_t k = external->first;
+      Position back = here();
+      jump(Position{k, external->second.body, 0});
+      bool found = scan_for([&] { return sources_[k]->subroutines.count(label) > 0; });
+      if (!found) error(column, "o<" + label + "> call: " + sources_[k]->name + " has no o<" + label + "> sub");
+      Source::Label l = sources_[k]->subroutines.at(label);
+      jump(back);
+      c.body = Position{k, l.body, l.line};
+    } else {
+      error(column, "o<" + label + "> call: no such subroutine in the program, and no " + label +
+                        ".ngc in the subprogram folders");
+    }
+  } else {
+    int number = std::stoi(label);
+    std::optional<Source::Label> body = find_program(number);
+    if (body) {
+      c.body = Position{current_, body->body, body->line};
+    } else if (auto external = find_external(label, false)) {
+      std::size_t k = external->first;
+      Position back = here();
+      jump(Position{k, external->second.body, 0});
+      std::optional<Source::Label> inner;
+      if (scan_for([&] { return sources_[k]->programs.count(number) > 0; }))
+        inner = sources_[k]->programs.at(number);
+      jump(back);
+      c.body = inner ? Position{k, inner->body, inner->line} : Position{k, sources_[k]->start, 0};
+    } else {
+      std::string message = std::string(how) + label + ": no O" + label +
+                            " in the program nor in the subprogram folders (--subprograms)";
+      if (!s_.options.lenient) error(column, message);
+      s_.warn(column, message + "; the call is skipped (lenient mode)");
+      return;
+    }
+  }
+  if (kind != CallKind::m98) {
+    s_.scopes.emplace_back();
+    c.scope = true;
+    auto& locals = s_.scopes.back().locals;
+    if (kind == CallKind::g65) {
+      locals = c.arguments = s_.call_arguments;
+    } else {
+      for (std::size_t k = 0; k < o_arguments_.size() && k + 1 < locals.size(); ++k)
+        locals[k + 1] = o_arguments_[k];
+    }
+  }
+  calls_.push_back(std::move(c));
+  jump(calls_.back().body);
+}
+
+// M99, endsub, return: the next repeat of the call, or back to the caller.
+void ProgramFlow::give_back(int column) {
+  Call& c = calls_.back();
+  loops_.resize(std::min(loops_.size(), c.loops));
+  branches_.resize(std::min(branches_.size(), c.branches));
+  (void)column;
+  if (--c.remaining > 0) {
+    if (c.kind == CallKind::g65) s_.scopes.back().locals = c.arguments;  // G65 L: afresh
+    jump(c.body);
+    return;
+  }
+  Position back = c.back;
+  if (c.scope) s_.scopes.pop_back();
+  calls_.pop_back();
+  jump(back);
+}
+
+std::vector<Value> ProgramFlow::arguments(const Control& control) {
+  std::vector<Value> values;
+  if (!evaluate_arguments(control.arguments, control.arguments_column, s_, values, lex_error_))
+    throw SyntaxError(Diagnostic{source().name, line_, lex_error_.column, lex_error_.message});
+  return values;
+}
+
+bool ProgramFlow::condition(const Control& control) {
+  std::vector<Value> values = arguments(control);
+  if (values.size() != 1)
+    error(control.arguments_column, std::string("o-word ") + to_string(control.keyword) +
+                                        " needs one condition in [ ]");
+  return values[0].number != 0;
+}
+
+void ProgramFlow::jump_to_sequence(long long number, int column) {
+  Source& src = source();
+  auto it = src.sequences.find(number);
+  if (it == src.sequences.end()) {
+    // Fanuc searches forward from here, then from the start of the program.
+    int from = line_;
+    Position back = here();
+    std::string_view text;
+    Skim skim;
+    std::optional<Position> found;
+    for (int pass = 0; pass < 2 && !found; ++pass) {
+      if (pass == 1) jump(Position{current_, src.start, 0});
+      for (;;) {
+        Position at = here();
+        if (!read(text)) break;
+        skim_line(text, skim);
+        if (skim.sequence == number) {
+          found = at;
+          break;
+        }
+        if (pass == 1 && here().offset > back.offset) break;
+      }
+    }
+    if (!found) {
+      jump(back);
+      s_.line = from;
+      error(column, "GOTO " + std::to_string(number) + ": no block N" + std::to_string(number));
+    }
+    it = src.sequences.emplace(number, Source::Label{found->offset, found->line}).first;
+  }
+  jump(Position{current_, it->second.body, it->second.line});
+}
+
+void ProgramFlow::loop_control(const Control& control) {
+  Position start{current_, 0, line_ - 1};
+  // The statement's own line: its offset is where the reader was before reading it.
+  start.offset = statement_offset_;
+  if (control.kind == ControlKind::while_loop) {
+    auto same = std::find_if(loops_.begin(), loops_.end(), [&](const Loop& l) {
+      return l.kind == LoopKind::fanuc && l.start.source == start.source && l.start.offset == start.offset;
+    });
+    if (control.condition) {
+      if (same != loops_.end()) {
+        loops_.erase(same + 1, loops_.end());
+      } else {
+        if (loops_.size() >= kMaxControlDepth) error(control.column, "loops nested too deeply");
+        loops_.push_back(Loop{LoopKind::fanuc, control.number, {}, start, 0});
+      }
+      return;
+    }
+    if (same != loops_.end()) loops_.erase(same, loops_.end());
+    long long id = control.number;
+    int depth = 0;
+    skip_until(
+        [&](const Skim& k) {
+          if (k.kind == ControlKind::while_loop && k.number == id) ++depth;
+          if (k.kind == ControlKind::end_loop && k.number == id) return depth-- == 0;
+          return false;
+        },
+        "END " + std::to_string(id), control.column);
+    return;
+  }
+  // END m: back to the loop's WHILE (evaluated again) or DO.
+  auto it = std::find_if(loops_.rbegin(), loops_.rend(), [&](const Loop& l) {
+    return l.kind == LoopKind::fanuc && l.id == control.number;
+  });
+  if (it == loops_.rend())
+    error(control.column, "END " + std::to_string(control.number) + " without a running DO " +
+                              std::to_string(control.number));
+  loops_.erase(it.base(), loops_.end());
+  jump(it->start);
+}
+
+void ProgramFlow::o_word(const Control& control) {
+  const std::string& label = control.label;
+  auto find_loop = [&]() {
+    return std::find_if(loops_.rbegin(), loops_.rend(), [&](const Loop& l) {
+      return l.kind != LoopKind::fanuc && l.label == label;
+    });
+  };
+  auto skip_to = [&](std::initializer_list<OKeyword> keywords, const std::string& what) {
+    OKeyword hit = OKeyword::sub;
+    skip_until(
+        [&](const Skim& k) {
+          if (k.kind != ControlKind::o_word || k.label != label) return false;
+          for (OKeyword kw : keywords)
+            if (k.keyword == kw) {
+              hit = kw;
+              return true;
+            }
+          return false;
+        },
+        what, control.column);
+    return hit;
+  };
+  Position start{current_, statement_offset_, line_ - 1};
+  switch (control.keyword) {
+    case OKeyword::sub:  // a definition met in the flow of the program: note it, skip it
+      source().subroutines.emplace(label, Source::Label{here().offset, line_});
+      skip_to({OKeyword::endsub}, "o" + label + " endsub");
+      return;
+    case OKeyword::endsub:
+    case OKeyword::return_: {
+      if (calls_.empty() || calls_.back().kind != CallKind::o_call)
+        error(control.column, "o" + label + " " + to_string(control.keyword) + " outside a call");
+      std::vector<Value> values = arguments(control);
+      if (!values.empty()) {
+        s_.named_globals["_value"] = values[0];
+        s_.named_globals["_value_returned"] = Value{1, false};
+      } else {
+        s_.named_globals["_value_returned"] = Value{0, false};
+      }
+      give_back(control.column);
+      return;
+    }
+    case OKeyword::call:
+      o_arguments_ = arguments(control);
+      call(CallKind::o_call, label, 1, control.column);
+      return;
+    case OKeyword::if_: {
+      bool taken = condition(control);
+      if (branches_.size() >= kMaxControlDepth) error(control.column, "if nested too deeply");
+      branches_.push_back(Branch{label, taken});
+      while (!branches_.back().taken) {
+        OKeyword hit = skip_to({OKeyword::elseif, OKeyword::else_, OKeyword::endif}, "o" + label + " endif");
+        if (hit == OKeyword::endif) {
+          branches_.pop_back();
+          return;
+        }
+        if (hit == OKeyword::else_) {
+          branches_.back().taken = true;
+        } else {  // elseif: skimmed, so its condition is evaluated now
+          Block b;
+          if (!lex_line(skipped_, b, lex_error_, &s_))
+            throw SyntaxError(Diagnostic{source().name, line_, lex_error_.column, lex_error_.message});
+          branches_.back().taken = condition(b.control);
+        }
+      }
+      return;
+    }
+    case OKeyword::elseif:
+    case OKeyword::else_:
+      if (branches_.empty() || branches_.back().label != label)
+        error(control.column, "o" + label + " " + to_string(control.keyword) + " without o" + label + " if");
+      skip_to({OKeyword::endif}, "o" + label + " endif");
+      branches_.pop_back();
+      return;
+    case OKeyword::endif:
+      if (branches_.empty() || branches_.back().label != label)
+        error(control.column, "o" + label + " endif without o" + label + " if");
+      branches_.pop_back();
+      return;
+    case OKeyword::while_: {
+      auto loop = find_loop();
+      if (loop != loops_.rend() && loop->kind == LoopKind::o_do) {  // the end of a do … while
+        if (condition(control)) {
+          jump(loop->start);
+        } else {
+          loops_.erase(std::prev(loop.base()), loops_.end());
+        }
+        return;
+      }
+      bool running = loop != loops_.rend() && loop->start.offset == start.offset;
+      if (condition(control)) {
+        if (!running) {
+          if (loops_.size() >= kMaxControlDepth) error(control.column, "loops nested too deeply");
+          loops_.push_back(Loop{LoopKind::o_while, 0, label, start, 0});
+        }
+        return;
+      }
+      if (running) loops_.erase(std::prev(loop.base()), loops_.end());
+      skip_to({OKeyword::endwhile}, "o" + label + " endwhile");
+      return;
+    }
+    case OKeyword::do_:
+      if (loops_.size() >= kMaxControlDepth) error(control.column, "loops nested too deeply");
+      loops_.push_back(Loop{LoopKind::o_do, 0, label, here(), 0});
+      return;
+    case OKeyword::repeat: {
+      std::vector<Value> values = arguments(control);
+      if (values.size() != 1) error(control.arguments_column, "o" + label + " repeat needs a count in [ ]");
+      long long count = std::llround(values[0].number);
+      if (count <= 0) {
+        skip_to({OKeyword::endrepeat}, "o" + label + " endrepeat");
+        return;
+      }
+      if (loops_.size() >= kMaxControlDepth) error(control.column, "loops nested too deeply");
+      loops_.push_back(Loop{LoopKind::o_repeat, 0, label, here(), count});
+      return;
+    }
+    case OKeyword::endwhile:
+    case OKeyword::endrepeat:
+    case OKeyword::continue_: {
+      auto loop = find_loop();
+      if (loop == loops_.rend())
+        error(control.column, "o" + label + " " + to_string(control.keyword) + " outside its loop");
+      loops_.erase(loop.base(), loops_.end());  // loops opened inside it end here
+      if (loop->kind == LoopKind::o_repeat) {
+        if (--loop->remaining > 0) {
+          jump(loop->start);
+        } else {
+          bool at_end = control.keyword == OKeyword::endrepeat;
+          loops_.pop_back();
+          if (!at_end) skip_to({OKeyword::endrepeat}, "o" + label + " endrepeat");
+        }
+        return;
+      }
+      jump(loop->start);  // while: its condition again; do: its first line
+      return;
+    }
+    case OKeyword::break_: {
+      auto loop = find_loop();
+      if (loop == loops_.rend()) error(control.column, "o" + label + " break outside its loop");
+      LoopKind kind = loop->kind;
+      loops_.erase(std::prev(loop.base()), loops_.end());
+      if (kind == LoopKind::o_repeat)
+        skip_to({OKeyword::endrepeat}, "o" + label + " endrepeat");
+      else if (kind == LoopKind::o_do)
+        skip_to({OKeyword::while_}, "o" + label + " while");
+      else
+        skip_to({OKeyword::endwhile}, "o" + label + " endwhile");
+      return;
+    }
+  }
+}
+
+void ProgramFlow::run() {
+  std::string_view text;
+  for (;;) {
+    statement_offset_ = source().reader.offset();
+    if (!read(text)) {
+      if (current_ != 0 && !calls_.empty() && calls_.back().body.source == current_ &&
+          calls_.back().kind != CallKind::o_call) {
+        give_back(0);  // a subprogram file that ends without M99
+        continue;
+      }
+      break;
+    }
+    if (!lex_line(text, block_, lex_error_, &s_))
+      throw SyntaxError(Diagnostic{source().name, line_, lex_error_.column, lex_error_.message});
+    if (block_.percent) {
+      if (current_ != 0) continue;  // a subprogram file's own tape marks
+      if (!started_ && !percent_seen_) {
+        percent_seen_ = true;
+        continue;
+      }
+      if (!calls_.empty())
+        error(1, "'%' (end of tape) inside subprogram " + calls_.back().label);
+      ended_ = true;
+      break;
+    }
+    if (block_.block_delete && s_.options.block_delete) continue;
+    const Control& control = block_.control;
+    if (control.kind != ControlKind::none) {
+      count_block();
+      started_ = true;
+      for (const Assignment& a : block_.assignments) s_.assign(a);
+      if (control.kind == ControlKind::o_word) {
+        o_word(control);
+      } else if (control.kind == ControlKind::jump) {
+        jump_to_sequence(control.number, control.column);
+      } else {
+        loop_control(control);
+      }
+      continue;
+    }
+    if (block_.words.empty() && block_.assignments.empty()) continue;
+    if (!block_.words.empty() && block_.words.front().letter == 'O') {
+      const Word& label = block_.words.front();
+      if (block_.words.size() > 1)
+        error(block_.words[1].column, "an O number must be alone on its line");
+      if (label.value < 0 || label.value != std::floor(label.value))
+        error(label.column, "O number must be a non-negative integer");
+      if (!calls_.empty() && calls_.back().body.source == current_ && current_ != 0 &&
+          calls_.back().body.offset == sources_[current_]->start)
+        continue;  // a subprogram file's own O number, run from its top
+      if (!calls_.empty())
+        error(label.column, "subprogram " + calls_.back().label + " runs into O" +
+                                format_number(label.value) + " without M99");
+      if (!started_) {
+        started_ = true;
+        continue;
+      }
+      std::string message = "the main program runs into O" + format_number(label.value) +
+                            " without M2/M30";
+      if (!s_.options.lenient) error(label.column, message);
+      s_.warn(label.column, message + "; treated as the end of the program");
+      ended_ = true;
+      break;
+    }
+    started_ = true;
+    count_block();
+    for (const Assignment& a : block_.assignments) s_.assign(a);
+    if (block_.words.empty()) continue;
+    Flow flow = s_.execute(block_);
+    if (flow == Flow::end) {
+      ended_ = true;
+      break;
+    }
+    if (flow == Flow::call || flow == Flow::macro) {
+      int column = flow == Flow::call ? s_.w.find_m(98) : s_.w.find_g(650);
+      call(flow == Flow::call ? CallKind::m98 : CallKind::g65, std::to_string(s_.call_label),
+           s_.call_repeats, column);
+      continue;
+    }
+    if (flow == Flow::ret) {
+      if (calls_.empty()) {
+        s_.warn(s_.w.find_m(99), "M99 in the main program: treated as the end of the program");
+        ended_ = true;
+        break;
+      }
+      if (calls_.back().kind == CallKind::o_call)
+        error(s_.w.find_m(99), "M99 inside o" + calls_.back().label + " sub (use endsub or return)");
+      give_back(s_.w.find_m(99));
+    }
+  }
+  if (!ended_) {
+    if (!calls_.empty())
+      error(0, "end of file inside subprogram " + calls_.back().label + " (missing M99/endsub)");
+    s_.warn(0, "the program ends without M2, M30 or '%' (truncated?)");
+  }
+}
+
+void run_program(Interpreter::State& state, std::istream& program, const std::string& file_name) {
+  ProgramFlow(state, program, file_name).run();
+}
+
+}  // namespace tridex::gcode

@@ -1,0 +1,144 @@
+// tridex::gcode — parameters: Fanuc Macro B variables (locals #1–#33 per macro call, commons
+// #100–#199 and #500–#999, #0 vacant) and LinuxCNC's (#1–#30 per o-word call, #31–#5000
+// global, #<name> local to a call, #<_name> global), with the system variables that posts and
+// probing macros read: modal state (Fanuc #4001–#4120), positions (Fanuc #5001–#5043, LinuxCNC
+// #5420–#5428, #<_x> …) and work offsets (#5221 + 20·(n−1) for G54…G59 in both dialects,
+// Fanuc #7001 + 20·(p−1) for G54.1 Pp). Sources: Fanuc 0i-MF operator's manual, "Custom
+// macro: system variables"; LinuxCNC's "Numbered parameters" and "Predefined named parameters".
+#include <cmath>
+
+#include "state.hpp"
+
+namespace tridex::gcode {
+namespace {
+
+// Work-offset key (MachineConfig numbering) and axis of a work-offset system variable, or -1.
+int offset_variable(int n, int& axis) {
+  if (n >= 5221 && n < 5221 + 6 * 20) {
+    int k = (n - 5221) / 20, a = (n - 5221) % 20;
+    if (a < 3) {
+      axis = a;
+      return k + 1;
+    }
+  }
+  if (n >= 7001 && n < 7001 + 300 * 20) {
+    int k = (n - 7001) / 20, a = (n - 7001) % 20;
+    if (a < 3) {
+      axis = a;
+      return MachineConfig::g54_1_key(k + 1);
+    }
+  }
+  return -1;
+}
+
+Value number(double v) { return Value{v, false}; }
+
+}  // namespace
+
+Value Interpreter::State::numbered(int n) {
+  if (n == 0) return Value{0, true};
+  if (n <= 33) return scopes.back().locals[static_cast<std::size_t>(n)];
+  Vec3 program = to_program(pos);  // the end of the last block: the tip is there
+  switch (n) {
+    // Fanuc modal information of the block before (#4001 + group − 1).
+    case 4001: return number(motion < 0 ? 0 : motion / 10.0);
+    case 4002: return number(plane / 10.0);
+    case 4003: return number(incremental ? 91 : 90);
+    case 4005: return number(94);
+    case 4006: return number(unit == 1.0 ? 21 : 20);
+    case 4007: return number(40);
+    case 4008: return number(49);
+    case 4009: return number(is_cycle(motion) ? motion / 10.0 : 80);
+    case 4010: return number(retract_to_r ? 99 : 98);
+    case 4014: return number(work_key >= 100 ? 54.1 : 53 + work_key);
+    case 4109: return number(feed / unit);
+    case 4119: return number(speed);
+    case 4120: return number(tool);
+    case 5001: case 5002: case 5003: return number(program[n - 5001] / unit);
+    case 5041: case 5042: case 5043: return number(program[n - 5041] / unit);
+    case 5021: case 5022: case 5023: return number(pos[n - 5021] / unit);
+    // LinuxCNC: the active coordinate system (1 = G54), the tool, the current position.
+    case 5220: return number(work_key >= 100 ? 0 : work_key);
+    case 5400: return number(tool);
+    case 5420: case 5421: case 5422: return number(program[n - 5420] / unit);
+    case 5423: case 5424: case 5425: case 5426: case 5427: case 5428: return number(0);
+    default: break;
+  }
+  int component = 0;
+  if (int key = offset_variable(n, component); key >= 0) {
+    auto it = offsets.find(key);
+    return number(it == offsets.end() ? 0.0 : it->second[component] / unit);
+  }
+  auto it = globals.find(n);
+  if (it != globals.end()) return it->second;
+  // Unset: Fanuc's vacant; LinuxCNC's parameters start at 0 (the word rule tells them apart).
+  return Value{0, true};
+}
+
+std::optional<Value> Interpreter::State::named(std::string_view name) {
+  std::string key(name);
+  if (!key.empty() && key[0] == '_') {
+    Vec3 program = to_program(pos);
+    if (key == "_x" || key == "_y" || key == "_z") return number(program[key[1] - 'x'] / unit);
+    if (key == "_current_tool") return number(tool);
+    if (key == "_selected_tool") return number(tool_selected);
+    if (key == "_metric") return number(unit == 1.0 ? 1 : 0);
+    if (key == "_imperial") return number(unit == 1.0 ? 0 : 1);
+    if (key == "_absolute") return number(incremental ? 0 : 1);
+    if (key == "_incremental") return number(incremental ? 1 : 0);
+    if (key == "_feed") return number(feed / unit);
+    if (key == "_rpm") return number(speed);
+    if (key == "_motion_mode") return number(motion < 0 ? 0 : motion);
+    if (key == "_plane") return number(plane);
+    if (key == "_coord_system") return number(work_key >= 100 ? 0 : 530 + 10 * work_key);
+    if (key == "_call_level") return number(static_cast<double>(scopes.size() - 1));
+    if (key == "_line") return number(line);
+    auto it = named_globals.find(key);
+    if (it == named_globals.end()) return std::nullopt;
+    return it->second;
+  }
+  auto& locals = scopes.back().named;
+  auto it = locals.find(key);
+  if (it == locals.end()) return std::nullopt;
+  return it->second;
+}
+
+void Interpreter::State::assign(const Assignment& a) {
+  if (a.number < 0) {
+    if (!a.name.empty() && a.name[0] == '_')
+      named_globals[a.name] = a.value;
+    else
+      scopes.back().named[a.name] = a.value;
+    return;
+  }
+  int n = a.number;
+  if (n == 0) error(a.column, "#0 is the vacant value and cannot be set");
+  if (n <= 33) {
+    scopes.back().locals[static_cast<std::size_t>(n)] = a.value;
+    return;
+  }
+  if (n == 3000)  // Fanuc's alarm: the program stops with this number
+    error(a.column, "the program raises alarm #3000 = " + format_number(a.value.number));
+  if (n == 3006) {  // a stop with a message for the operator
+    warn(a.column, "#3006 = " + format_number(a.value.number) + ": the program stops for the operator here");
+    return;
+  }
+  int component = 0;
+  if (int key = offset_variable(n, component); key >= 0) {  // probing macros set work offsets this way
+    if (tilted && key == work_key)
+      error(a.column, "the active work offset changes under a tilted plane");
+    Vec3 value = offsets.count(key) ? offsets[key] : Vec3(0.0);
+    value[component] = (a.value.vacant ? 0.0 : a.value.number) * unit;
+    offsets[key] = value;
+    if (key == work_key) {
+      work_offset = value;
+      update_frame();
+    }
+    return;
+  }
+  if ((n >= 4001 && n <= 4400) || (n >= 5001 && n <= 5043) || (n >= 5420 && n <= 5428))
+    error(a.column, "#" + std::to_string(n) + " is a read-only system variable");
+  globals[n] = a.value;
+}
+
+}  // namespace tridex::gcode

@@ -1,0 +1,181 @@
+#include "machine_file.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "errors.hpp"
+
+namespace tridex::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// Concatenation through a stream (GCC 12 warns falsely on "literal" + std::string chains).
+template <class... Parts>
+std::string cat(const Parts&... parts) {
+  std::ostringstream out;
+  (out << ... << parts);
+  return out.str();
+}
+
+Vec3 point(const json& value, const std::string& where) {
+  if (!value.is_array() || value.size() != 3)
+    input_error(where, ": must be [x, y, z] in mm, got ", value.dump());
+  Vec3 p;
+  for (int i = 0; i < 3; ++i) {
+    const json& c = value[static_cast<std::size_t>(i)];
+    if (!c.is_number() || !std::isfinite(c.get<double>()))
+      input_error(where, ": must be [x, y, z] of finite numbers, got ", value.dump());
+    p[i] = c.get<double>();
+  }
+  return p;
+}
+
+std::set<int> m_code_list(const json& value, const std::string& where) {
+  if (!value.is_array()) input_error(where, ": must be a list of M-code numbers, got ", value.dump());
+  std::set<int> codes;
+  for (const json& c : value) {
+    if (!c.is_number_integer() || c.get<long long>() < 0 || c.get<long long>() > 9999)
+      input_error(where, ": M-code numbers are integers in [0, 9999], got ", c.dump());
+    codes.insert(static_cast<int>(c.get<long long>()));
+  }
+  return codes;
+}
+
+const json& string_value(const json& value, const std::string& where) {
+  if (!value.is_string()) input_error(where, ": must be a string, got ", value.dump());
+  return value;
+}
+
+// "G54".."G59" -> 1..6; "G54.1 P<n>" -> 100 + n.
+int work_offset_key(const std::string& name, const std::string& where) {
+  for (int n = 1; n <= 6; ++n)
+    if (name == cat("G", 53 + n)) return gcode::MachineConfig::g54_key(n);
+  if (name.rfind("G54.1 P", 0) == 0) {
+    std::string number = name.substr(7);
+    if (!number.empty() && number.size() <= 3 &&
+        number.find_first_not_of("0123456789") == std::string::npos) {
+      int p = std::stoi(number);
+      if (p >= 1 && p <= 300) return gcode::MachineConfig::g54_1_key(p);
+    }
+  }
+  input_error(where, ": unknown work offset \"", name, "\" (G54..G59 or \"G54.1 P1\"..\"G54.1 P300\")");
+}
+
+gcode::MachineConfig parse(const json& doc, const std::string& file) {
+  if (!doc.is_object()) input_error(file, ": a machine file is a JSON object");
+  gcode::MachineConfig m;
+  if (auto base = doc.find("base"); base != doc.end()) {
+    std::string name = string_value(*base, cat(file, ": \"base\"")).get<std::string>();
+    auto bundled = gcode::MachineConfig::bundled(name);
+    if (!bundled) input_error(file, ": \"base\": no bundled machine \"", name, "\" (", kBundledMachines, ")");
+    m = *bundled;
+  }
+  for (const auto& [key, value] : doc.items()) {
+    std::string where = cat(file, ": \"", key, "\"");
+    if (key == "name" || key == "description" || key == "base") {
+      string_value(value, where);
+    } else if (key == "dialect") {
+      std::string d = string_value(value, where).get<std::string>();
+      if (d == "fanuc") m.dialect = gcode::Dialect::fanuc;
+      else if (d == "linuxcnc") m.dialect = gcode::Dialect::linuxcnc;
+      else input_error(where, ": \"fanuc\" or \"linuxcnc\", got \"", d, "\"");
+    } else if (key == "units") {
+      std::string u = string_value(value, where).get<std::string>();
+      if (u != "mm" && u != "inch") input_error(where, ": \"mm\" or \"inch\", got \"", u, "\"");
+      m.inch_at_start = u == "inch";
+    } else if (key == "start") {
+      if (value.is_string() && value.get<std::string>() == "far")
+        m.start_position.reset();
+      else
+        m.start_position = point(value, where);
+    } else if (key == "tool_change") {
+      if (value.is_string() && value.get<std::string>() == "far") {
+        m.tool_change = gcode::ToolChange::retract_far;
+      } else if (value.is_string() && value.get<std::string>() == "in_place") {
+        m.tool_change = gcode::ToolChange::in_place;
+      } else if (value.is_array()) {
+        m.tool_change = gcode::ToolChange::to_position;
+        m.tool_change_position = point(value, where);
+      } else {
+        input_error(where, ": \"far\", \"in_place\" or [x, y, z], got ", value.dump());
+      }
+    } else if (key == "tool_loads_on_t") {
+      if (!value.is_boolean()) input_error(where, ": must be true or false, got ", value.dump());
+      m.tool_loads_on_t = value.get<bool>();
+    } else if (key == "home") {
+      m.set_home(point(value, where));
+    } else if (key == "reference2") {
+      m.set_reference2(point(value, where));
+    } else if (key == "work_offsets") {
+      if (!value.is_object()) input_error(where, ": must be an object such as {\"G54\": [x, y, z]}");
+      for (const auto& [name, offset] : value.items())
+        m.work_offsets[work_offset_key(name, where)] = point(offset, cat(where, ": \"", name, "\""));
+    } else if (key == "m_codes") {
+      m.m_codes = m_code_list(value, where);
+    } else if (key == "forbidden_m_codes") {
+      m.forbidden_m_codes = m_code_list(value, where);
+    } else if (key == "far_distance") {
+      if (!value.is_number() || !(value.get<double>() > 0) || !std::isfinite(value.get<double>()))
+        input_error(where, ": must be a positive number of mm, got ", value.dump());
+      m.far_distance = value.get<double>();
+    } else if (key == "subprograms") {
+      if (!value.is_array()) input_error(where, ": must be a list of folders");
+      fs::path base = fs::path(file).parent_path();
+      for (const json& dir : value)
+        m.subprogram_dirs.push_back((base / string_value(dir, where).get<std::string>()).string());
+    } else {
+      input_error(where, ": unknown key (known: name, description, base, dialect, units, start, "
+                         "tool_change, tool_loads_on_t, home, reference2, work_offsets, m_codes, "
+                         "forbidden_m_codes, far_distance, subprograms)");
+    }
+  }
+  for (int code : m.m_codes)
+    if (m.forbidden_m_codes.count(code))
+      input_error(file, ": M", code, " is both in \"m_codes\" and in \"forbidden_m_codes\"");
+  return m;
+}
+
+}  // namespace
+
+gcode::MachineConfig load_machine(const std::string& name_or_file,
+                                  const std::vector<std::string>& subprogram_dirs) {
+  gcode::MachineConfig machine;
+  if (name_or_file.empty()) {
+    machine = *gcode::MachineConfig::bundled("default");
+  } else if (auto bundled = gcode::MachineConfig::bundled(name_or_file)) {
+    machine = *bundled;
+  } else {
+    std::error_code error;
+    if (!fs::is_regular_file(name_or_file, error))
+      input_error("--machine ", name_or_file, ": neither a bundled machine (", kBundledMachines,
+                  ") nor a machine file");
+    std::ifstream in(name_or_file, std::ios::binary);
+    if (!in) input_error(name_or_file, ": cannot open the machine file");
+    json doc;
+    try {
+      doc = json::parse(in);
+    } catch (const json::exception& e) {
+      input_error(name_or_file, ": not valid JSON (byte ", in.tellg(), "): ", e.what());
+    }
+    try {
+      machine = parse(doc, name_or_file);
+    } catch (const json::exception& e) {
+      input_error(name_or_file, ": ", e.what());
+    }
+  }
+  for (const std::string& dir : subprogram_dirs) {
+    std::error_code error;
+    if (!fs::is_directory(dir, error)) input_error("--subprograms ", dir, ": not a folder");
+    machine.subprogram_dirs.insert(machine.subprogram_dirs.begin(), dir);
+  }
+  return machine;
+}
+
+}  // namespace tridex::cli

@@ -1,0 +1,19 @@
+// tridex command — `--machine FILE|NAME`: what the interpreter needs to know of the machine, from
+// a bundled profile or a JSON machine file (README "Machine files" documents the keys).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "tridex/gcode/interpreter.hpp"
+
+namespace tridex::cli {
+
+inline constexpr const char* kBundledMachines = "default, linuxcnc";
+
+// An empty name is the default machine. `subprogram_dirs` (--subprograms) are searched before
+// the machine file's own. Throws InputError naming the file, the key and the value.
+gcode::MachineConfig load_machine(const std::string& name_or_file,
+                                  const std::vector<std::string>& subprogram_dirs = {});
+
+}  // namespace tridex::cli
