@@ -174,43 +174,12 @@ Flow Interpreter::State::execute(const Block& block) {
     }
   }
 
-  // Tilted working plane.
-  if (tilt == 690 || tilt == 2690) {
-    tilted = false;
-    update_frame();
-  } else if (tilt == 682 || tilt == 2680) {
-    axis_consumer = true;
-    int column = w.find_g(tilt);
-    if (incremental) error(column, code_name('G', tilt) + " under G91 is not supported; use G90");
-    if (tilt == 682 && w.has('P') && integer('P', "G68.2 P", 0, 3) != 0)
-      unsupported(w.col('P'), "G68.2 P1/P2/P3 (other angle conventions) are not supported");
-    if (tilt == 2680 && w.has('Q') && integer('Q', "G268 Q", 0, 999) != 123)
-      unsupported(w.col('Q'), "G268 rotation order other than Q123 is not supported");
-    Vec3 o(0.0);
-    for (int i = 0; i < 3; ++i)
-      if (w.has(kAxisLetter[i])) o[i] = length(kAxisLetter[i]);
-    double a = w.has('I') ? w.take('I') : 0.0;
-    double b = w.has('J') ? w.take('J') : 0.0;
-    double c = w.has('K') ? w.take('K') : 0.0;
-    // The feature frame sits on the active work coordinate system.
-    tilt_rotation = tilt == 682 ? rotation_z(a) * rotation_x(b) * rotation_z(c)
-                                : rotation_z(c) * rotation_y(b) * rotation_x(a);
-    tilt_origin = work_offset + local_offset + o;
-    tilted = true;
-    tilt_line = line;
-    update_frame();
+  // Tilted working plane (tilt.cpp).
+  if (tilt >= 0) {
+    if (tilt != 690 && tilt != 2690) axis_consumer = true;
+    tilted_plane(tilt);
   }
-  if (orient >= 0) {
-    int column = w.find_g(orient);
-    if (!tilted)
-      error(column, code_name('G', orient) + " without an active G68.2/G268 tilted plane");
-    Vec3 direction = glm::normalize(tilt_rotation[2]);
-    if (glm::dot(direction, axis) < 1 - kSameDirection) {
-      axis = direction;
-      go_far();  // the machine turns the tool: where the tip ends is the kinematics' business
-    }
-    update_frame();
-  }
+  if (orient >= 0) orient_to_plane(orient);
 
   // Motion.
   if (motion_code >= 0) {

@@ -257,6 +257,11 @@ struct Interpreter::State : ParameterReader {
   Flow macro_call(int column);          // G65 (modal.cpp)
   void local_offsets(int code, int column);  // G52, G92, G92.1, G92.2, G92.3 (modal.cpp)
 
+  // ---- tilted planes (tilt.cpp) ----
+  Frame plane_words(int code);
+  void tilted_plane(int code);
+  void orient_to_plane(int code);
+
   // ---- one block ----
   Flow execute(const Block& block);
 };

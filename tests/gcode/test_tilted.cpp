@@ -137,7 +137,7 @@ TEST_CASE("G68.2 without G53.1: ambiguous direction is an error, unless the tool
   two.work_offsets[2] = Vec3(1, 2, 3);
   d = error_of(g682(Vec3(0.0), 0, 30, 0) + "G55\n", InterpreterOptions{}, two);
   CHECK(d.message.find("tilted") != std::string::npos);
-  CHECK(error_of("G68.2 P1 X0 Y0 Z0 I0 J0 K0\n").column == 7);
+  CHECK(error_of("G68.2 P2 X0 Y0 Z0 I0 J0 K0\n").column == 7);  // several-block form, not read
 }
 
 TEST_CASE("Haas G268 Q123 / G253 / G269: R = Rz(K)·Ry(J)·Rx(I)") {
@@ -155,7 +155,7 @@ TEST_CASE("Haas G268 Q123 / G253 / G269: R = Rz(K)·Ry(J)·Rx(I)") {
     CHECK(near(r.moves[0].axis, R * Vec3(0, 0, 1), 1e-12));
     CHECK(near(r.moves[0].end, o + R * Vec3(1, 2, 3), 1e-9));
   }
-  CHECK(error_of("G268 X0 Y0 Z0 I0 J0 K0 Q321\n").message.find("Q123") != std::string::npos);
+  CHECK(error_of("G268 X0 Y0 Z0 I0 J0 K0 Q121\n").message.find("Q121") != std::string::npos);
 }
 
 TEST_CASE("after G69 the tool stays tilted; a tilted retract needs all coordinates to return") {

@@ -1,0 +1,453 @@
+// tridex::gcode — rotary kinematics: forward maps, the two-axis inverse (Paden–Kahan subproblems
+// 1 and 2, Murray, Li and Sastry 1994, §3.2.2), bundled profiles and the machine file's
+// "kinematics" object. See kinematics.hpp for the model.
+#include "tridex/gcode/kinematics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "tridex/error.hpp"
+#include "tridex/gcode/tilted_plane.hpp"
+
+namespace tridex::gcode {
+namespace {
+
+constexpr double kTurn = 360.0;
+constexpr double kLimitSlack = 1e-9;     // degrees: a solution this close to a limit is inside
+constexpr double kSameDirection = 1e-9;  // 1 − cos of the angle below which directions agree
+constexpr double kFreeAxis = 1e-9;       // |component normal to an axis| below which it is along it
+constexpr double kParallelAxes = 1e-6;   // |a × b| below which two rotary axes are parallel
+
+// Rotation by `degrees` about the unit axis `k`, right-handed (Rodrigues).
+Mat3 rotation_about(const Vec3& k, double degrees) {
+  double t = glm::radians(degrees), c = std::cos(t), s = std::sin(t);
+  Mat3 m;
+  for (int col = 0; col < 3; ++col) {
+    Vec3 e(0.0);
+    e[col] = 1;
+    m[col] = e * c + glm::cross(k, e) * s + k * glm::dot(k, e) * (1 - c);
+  }
+  return m;
+}
+
+// The rigid turn of an axis's carriage: p ↦ pivot + R·(p − pivot).
+Frame axis_turn(const RotaryAxis& axis, double degrees) {
+  Mat3 r = rotation_about(axis.direction, degrees);
+  return Frame{r, axis.pivot - r * axis.pivot};
+}
+
+// One side's chain, from the machine outward: T1 ∘ T2 ∘ ….
+Frame chain(const Kinematics& kin, const RotaryPositions& rotary, bool head) {
+  Frame result;
+  for (const RotaryAxis& axis : kin.axes)
+    if (axis.on_head == head)
+      result = compose(result, axis_turn(axis, rotary[std::size_t(rotary_index(axis.letter))]));
+  return result;
+}
+
+std::string vector_text(const Vec3& v) {
+  std::ostringstream out;
+  out << '(' << v.x << ", " << v.y << ", " << v.z << ')';
+  return out.str();
+}
+
+// Subproblem 1: the angle α with Rot(a, α)·x = y, for unit a and x, y at the same angle to a;
+// nullopt when x lies along a (any α will do).
+std::optional<double> turn_onto(const Vec3& a, const Vec3& x, const Vec3& y) {
+  Vec3 xp = x - glm::dot(a, x) * a, yp = y - glm::dot(a, y) * a;
+  if (glm::length(xp) < kFreeAxis) return std::nullopt;
+  return glm::degrees(std::atan2(glm::dot(a, glm::cross(xp, yp)), glm::dot(xp, yp)));
+}
+
+// A solution of the inverse: an angle per axis of the kinematics, or free (nullopt).
+struct Candidate {
+  std::optional<double> first, second;
+};
+
+// Subproblem 2: the vectors z with a·z = a·x, b·z = b·y, |z| = 1 (a, b unit, not parallel; x, y
+// unit): z = c1·a + c2·b + c3·(a × b). Zero, one or two of them.
+std::vector<Vec3> common_vectors(const Vec3& a, const Vec3& x, const Vec3& b, const Vec3& y) {
+  double g = glm::dot(a, b), ax = glm::dot(a, x), by = glm::dot(b, y);
+  double d = 1 - g * g;
+  double c1 = (ax - g * by) / d, c2 = (by - g * ax) / d;
+  Vec3 n = glm::cross(a, b);
+  double in_plane2 = c1 * c1 + c2 * c2 + 2 * c1 * c2 * g;
+  double c3sq = (1 - in_plane2) / glm::dot(n, n);
+  if (c3sq < -1e-12) return {};
+  double c3 = std::sqrt(std::max(c3sq, 0.0));
+  Vec3 base = c1 * a + c2 * b;
+  if (c3 < 1e-12) return {base};
+  return {base + c3 * n, base - c3 * n};
+}
+
+// The angle on the turn nearest `current` within the axis's limits; nullopt when no turn of it
+// lies within them.
+std::optional<double> nearest_turn(const RotaryAxis& axis, double angle, double current) {
+  double k = std::round((current - angle) / kTurn);
+  if (axis.limits) {
+    auto [lo, hi] = *axis.limits;
+    double k_lo = std::ceil((lo - kLimitSlack - angle) / kTurn);
+    double k_hi = std::floor((hi + kLimitSlack - angle) / kTurn);
+    if (k_lo > k_hi) return std::nullopt;
+    k = std::clamp(k, k_lo, k_hi);
+  }
+  return angle + k * kTurn;
+}
+
+double clamp_to_limits(const RotaryAxis& axis, double angle) {
+  return axis.limits ? std::clamp(angle, (*axis.limits)[0], (*axis.limits)[1]) : angle;
+}
+
+// ---- JSON -------------------------------------------------------------------------------------
+
+[[noreturn]] void json_fail(const std::string& path, const std::string& what,
+                            const nlohmann::json& value) {
+  detail::fail(path, ": ", what, ", got ", value.dump());
+}
+
+double json_number(const nlohmann::json& j, const std::string& path) {
+  if (!j.is_number()) json_fail(path, "must be a number", j);
+  double v = j.get<double>();
+  if (!std::isfinite(v)) json_fail(path, "must be finite", j);
+  return v;
+}
+
+Vec3 json_vec3(const nlohmann::json& j, const std::string& path) {
+  if (!j.is_array() || j.size() != 3) json_fail(path, "must be an array of 3 numbers", j);
+  Vec3 v;
+  for (int i = 0; i < 3; ++i) v[i] = json_number(j[std::size_t(i)], path + "[" + std::to_string(i) + "]");
+  return v;
+}
+
+const nlohmann::json& json_key(const nlohmann::json& object, const char* key,
+                               const std::string& path) {
+  auto it = object.find(key);
+  if (it == object.end()) detail::fail(path, ": the key \"", key, "\" is missing");
+  return *it;
+}
+
+void json_known_keys(const nlohmann::json& object, std::initializer_list<const char*> keys,
+                     const std::string& path) {
+  for (auto it = object.begin(); it != object.end(); ++it)
+    if (std::none_of(keys.begin(), keys.end(), [&](const char* k) { return it.key() == k; }))
+      detail::fail(path, ".", it.key(), ": unknown key (known: ", [&] {
+        std::string list;
+        for (const char* k : keys) list += (list.empty() ? "" : ", ") + std::string(k);
+        return list;
+      }(), ")");
+}
+
+RotaryAxis axis_from_json(const nlohmann::json& j, const std::string& path) {
+  if (!j.is_object()) json_fail(path, "must be an object", j);
+  json_known_keys(j, {"letter", "on", "direction", "sense", "pivot", "limits"}, path);
+  RotaryAxis axis;
+  const nlohmann::json& letter = json_key(j, "letter", path);
+  if (!letter.is_string() || letter.get<std::string>().size() != 1 ||
+      rotary_index(letter.get<std::string>()[0]) < 0)
+    json_fail(path + ".letter", "must be \"A\", \"B\" or \"C\"", letter);
+  axis.letter = char(std::toupper(static_cast<unsigned char>(letter.get<std::string>()[0])));
+  const nlohmann::json& on = json_key(j, "on", path);
+  if (on != "table" && on != "head") json_fail(path + ".on", "must be \"table\" or \"head\"", on);
+  axis.on_head = on == "head";
+  Vec3 direction = json_vec3(json_key(j, "direction", path), path + ".direction");
+  if (!(glm::length(direction) > 1e-12))
+    json_fail(path + ".direction", "must not be the zero vector", j["direction"]);
+  double sense = 1;
+  if (j.contains("sense")) {
+    sense = json_number(j["sense"], path + ".sense");
+    if (sense != 1 && sense != -1) json_fail(path + ".sense", "must be 1 or -1", j["sense"]);
+  }
+  axis.direction = sense * glm::normalize(direction);
+  axis.pivot = json_vec3(json_key(j, "pivot", path), path + ".pivot");
+  if (j.contains("limits")) {
+    const nlohmann::json& limits = j["limits"];
+    if (!limits.is_array() || limits.size() != 2)
+      json_fail(path + ".limits", "must be [min, max] in degrees", limits);
+    double lo = json_number(limits[0], path + ".limits[0]");
+    double hi = json_number(limits[1], path + ".limits[1]");
+    if (!(lo < hi)) json_fail(path + ".limits", "min must be less than max", limits);
+    axis.limits = std::array<double, 2>{lo, hi};
+  }
+  return axis;
+}
+
+RotaryAxis make_axis(char letter, bool on_head, Vec3 direction, Vec3 pivot,
+                     std::optional<std::array<double, 2>> limits) {
+  RotaryAxis axis;
+  axis.letter = letter;
+  axis.on_head = on_head;
+  axis.direction = direction;
+  axis.pivot = pivot;
+  axis.limits = limits;
+  return axis;
+}
+
+}  // namespace
+
+int rotary_index(char letter) {
+  switch (letter) {
+    case 'A': case 'a': return 0;
+    case 'B': case 'b': return 1;
+    case 'C': case 'c': return 2;
+    default: return -1;
+  }
+}
+
+const RotaryAxis* Kinematics::find(char letter) const {
+  int index = rotary_index(letter);
+  for (const RotaryAxis& axis : axes)
+    if (rotary_index(axis.letter) == index) return &axis;
+  return nullptr;
+}
+
+void Kinematics::validate() const {
+  if (axes.empty() || axes.size() > 2)
+    detail::fail("kinematics: a machine here has one or two rotary axes, got ", axes.size());
+  int heads = 0;
+  for (std::size_t i = 0; i < axes.size(); ++i) {
+    const RotaryAxis& axis = axes[i];
+    if (rotary_index(axis.letter) < 0)
+      detail::fail("kinematics: axis letter must be A, B or C, got '", axis.letter, "'");
+    for (std::size_t k = 0; k < i; ++k)
+      if (rotary_index(axes[k].letter) == rotary_index(axis.letter))
+        detail::fail("kinematics: axis ", axis.letter, " appears twice");
+    if (!is_finite(axis.direction) || std::abs(glm::length(axis.direction) - 1) > 1e-9)
+      detail::fail("kinematics: axis ", axis.letter, " direction must be a unit vector, got ",
+                   vector_text(axis.direction));
+    if (!is_finite(axis.pivot))
+      detail::fail("kinematics: axis ", axis.letter, " pivot must be finite");
+    if (axis.limits && !((*axis.limits)[0] < (*axis.limits)[1]))
+      detail::fail("kinematics: axis ", axis.letter, " limits must be min < max, got [",
+                   (*axis.limits)[0], ", ", (*axis.limits)[1], "]");
+    heads += axis.on_head ? 1 : 0;
+  }
+  int tables = int(axes.size()) - heads;
+  switch (type) {
+    case MachineType::table_table:
+      if (heads != 0) detail::fail("kinematics: a table-table machine has no axis on the head");
+      break;
+    case MachineType::head_head:
+      if (tables != 0) detail::fail("kinematics: a head-head machine has no axis on the table");
+      break;
+    case MachineType::head_table:
+      if (heads != 1 || tables != 1)
+        detail::fail("kinematics: a head-table machine has one axis on the head and one on the "
+                     "table");
+      break;
+  }
+  if (axes.size() == 2 && glm::length(glm::cross(axes[0].direction, axes[1].direction)) < kParallelAxes)
+    detail::fail("kinematics: axes ", axes[0].letter, " and ", axes[1].letter,
+                 " are parallel, so they cannot turn the tool to an arbitrary direction");
+}
+
+Frame part_to_machine(const Kinematics& kin, const RotaryPositions& rotary) {
+  return chain(kin, rotary, false);
+}
+
+Frame head_offset(const Kinematics& kin, const RotaryPositions& rotary) {
+  return chain(kin, rotary, true);
+}
+
+Vec3 tool_direction(const Kinematics& kin, const RotaryPositions& rotary) {
+  return glm::transpose(part_to_machine(kin, rotary).rotation) *
+         head_offset(kin, rotary).rotation * Vec3(0, 0, 1);
+}
+
+Vec3 tip_in_part(const Kinematics& kin, const Vec3& machine_xyz, const RotaryPositions& rotary) {
+  return part_to_machine(kin, rotary).to_local(machine_xyz + head_offset(kin, rotary).origin);
+}
+
+Vec3 machine_from_part(const Kinematics& kin, const Vec3& part_tip, const RotaryPositions& rotary) {
+  return part_to_machine(kin, rotary).to_world(part_tip) - head_offset(kin, rotary).origin;
+}
+
+Frame machine_to_part(const Kinematics& kin, const RotaryPositions& rotary) {
+  Frame part = part_to_machine(kin, rotary);
+  Mat3 rt = glm::transpose(part.rotation);
+  return Frame{rt, rt * (head_offset(kin, rotary).origin - part.origin)};
+}
+
+void check_limits(const Kinematics& kin, const RotaryPositions& rotary) {
+  for (const RotaryAxis& axis : kin.axes) {
+    double v = rotary[std::size_t(rotary_index(axis.letter))];
+    if (!std::isfinite(v)) detail::fail(axis.letter, " must be finite, got ", v);
+    if (axis.limits &&
+        (v < (*axis.limits)[0] - kLimitSlack || v > (*axis.limits)[1] + kLimitSlack))
+      detail::fail(axis.letter, v, " is outside the axis limits ", (*axis.limits)[0], " to ",
+                   (*axis.limits)[1]);
+  }
+}
+
+RotaryPositions orient_tool(const Kinematics& kin, const Vec3& part_direction,
+                            const RotaryPositions& current) {
+  kin.validate();
+  if (!is_finite(part_direction) || !(glm::length(part_direction) > 1e-12))
+    detail::fail("tool direction ", vector_text(part_direction), " is not a direction");
+  const Vec3 v = glm::normalize(part_direction), ez(0, 0, 1);
+  const RotaryAxis& first = kin.axes[0];
+  const RotaryAxis* second = kin.axes.size() > 1 ? &kin.axes[1] : nullptr;
+
+  // Each case writes the tool direction v(θ) as Rot(a, α)·x = Rot(b, β)·y and names which angle
+  // is which (the chain equations are in kinematics.hpp).
+  std::vector<Candidate> candidates;
+  if (!second) {
+    // One axis: table v = Rot(u, −θ)·ez ⇔ Rot(u, θ)·v = ez; head v = Rot(u, θ)·ez.
+    const Vec3& u = first.direction;
+    Vec3 x = first.on_head ? ez : v, y = first.on_head ? v : ez;
+    if (std::abs(glm::dot(u, x) - glm::dot(u, y)) < 1e-9) candidates.push_back({turn_onto(u, x, y), {}});
+  } else {
+    // a, x, α = sa·θ(ia); b, y, β = sb·θ(ib).
+    const RotaryAxis *axis_a, *axis_b;
+    Vec3 x, y;
+    double sa, sb;
+    if (kin.type == MachineType::table_table) {
+      // v = R2ᵀ·R1ᵀ·ez ⇔ Rot(u2, θ2)·v = Rot(u1, −θ1)·ez
+      axis_a = second, x = v, sa = 1, axis_b = &first, y = ez, sb = -1;
+    } else if (kin.type == MachineType::head_head) {
+      // v = R1·R2·ez ⇔ Rot(u1, −θ1)·v = Rot(u2, θ2)·ez
+      axis_a = &first, x = v, sa = -1, axis_b = second, y = ez, sb = 1;
+    } else {
+      // v = Rtᵀ·Rh·ez ⇔ Rot(ut, θt)·v = Rot(uh, θh)·ez
+      const RotaryAxis* table = first.on_head ? second : &first;
+      const RotaryAxis* head = first.on_head ? &first : second;
+      axis_a = table, x = v, sa = 1, axis_b = head, y = ez, sb = 1;
+    }
+    for (const Vec3& z : common_vectors(axis_a->direction, x, axis_b->direction, y)) {
+      std::optional<double> alpha = turn_onto(axis_a->direction, x, z);
+      std::optional<double> beta = turn_onto(axis_b->direction, y, z);
+      Candidate c;
+      std::optional<double> theta_a = alpha ? std::optional<double>(sa * *alpha) : std::nullopt;
+      std::optional<double> theta_b = beta ? std::optional<double>(sb * *beta) : std::nullopt;
+      bool a_is_first = axis_a == &first;
+      c.first = a_is_first ? theta_a : theta_b;
+      c.second = a_is_first ? theta_b : theta_a;
+      candidates.push_back(c);
+    }
+  }
+  if (candidates.empty())
+    detail::fail("tool direction ", vector_text(v), " is not reachable: the machine's rotary axes "
+                 "cannot turn the tool there");
+
+  // Each candidate on the turns nearest the current positions, within the limits; the nearest.
+  std::optional<RotaryPositions> best;
+  double best_distance = std::numeric_limits<double>::infinity();
+  std::ostringstream excluded;
+  for (const Candidate& c : candidates) {
+    RotaryPositions p = current;
+    bool inside = true;
+    for (std::size_t n = 0; n < kin.axes.size(); ++n) {
+      const RotaryAxis& axis = kin.axes[n];
+      auto index = std::size_t(rotary_index(axis.letter));
+      const std::optional<double>& angle = n == 0 ? c.first : c.second;
+      if (!angle) {
+        p[index] = clamp_to_limits(axis, current[index]);
+        continue;
+      }
+      std::optional<double> turn = nearest_turn(axis, *angle, current[index]);
+      if (!turn) {
+        inside = false;
+        excluded << (excluded.tellp() > 0 ? "; " : "") << axis.letter << *angle << " (limits "
+                 << (*axis.limits)[0] << " to " << (*axis.limits)[1] << ")";
+        break;
+      }
+      p[index] = *turn;
+    }
+    if (!inside) continue;
+    // Numerical guard: the pose must give the direction asked for.
+    if (glm::dot(tool_direction(kin, p), v) < 1 - kSameDirection) continue;
+    double distance = 0;
+    for (int i = 0; i < 3; ++i) distance += std::abs(p[std::size_t(i)] - current[std::size_t(i)]);
+    if (distance < best_distance) best = p, best_distance = distance;
+  }
+  if (!best) {
+    if (excluded.tellp() > 0)
+      detail::fail("tool direction ", vector_text(v), " is outside the rotary limits: it needs ",
+                   excluded.str());
+    detail::fail("tool direction ", vector_text(v), " is not reachable: the machine's rotary axes "
+                 "cannot turn the tool there");
+  }
+  return *best;
+}
+
+// Bundled profiles. Machine coordinates are tool-tip coordinates with every rotary at 0; the
+// pivots put the table-face centre (or the tip, for head axes) at the origin, as a machine file
+// written against a machine's own zero would after subtracting it.
+//   ac-trunnion   table-table, A tilts the trunnion about X through (0, 0, −75) (the C face
+//                 75 mm above the tilt axis), −120°…120°; C turns the platter on it about Z
+//                 through the origin, endless. LinuxCNC's xyzac-trt kinematics with its default
+//                 directions (part_to_machine = Rx(A)·Rz(C) about the pivots).
+//   bc-trunnion   table-table, Haas UMC-style: B tilts about Y through (0, 0, −50), −35°…110°
+//                 (a UMC-750's published tilt range); C turns about Z through the origin,
+//                 endless.
+//   b-head-c-table head-table: B turns the head about Y through (0, 0, 150) (pivot 150 mm above
+//                 the tip), −110°…110°; C turns the table about Z through the origin, endless.
+//   head-head     head-head: C turns the head about Z through the spindle line, −360°…360°;
+//                 A, carried by C, tilts the spindle about X through (0, 0, 150), −100°…100°.
+std::optional<Kinematics> kinematics_profile(std::string_view name) {
+  using Limits = std::optional<std::array<double, 2>>;
+  const Limits endless;
+  Kinematics kin;
+  if (name == "ac-trunnion") {
+    kin.type = MachineType::table_table;
+    kin.axes = {make_axis('A', false, {1, 0, 0}, {0, 0, -75}, std::array<double, 2>{-120, 120}),
+                make_axis('C', false, {0, 0, 1}, {0, 0, 0}, endless)};
+  } else if (name == "bc-trunnion") {
+    kin.type = MachineType::table_table;
+    kin.axes = {make_axis('B', false, {0, 1, 0}, {0, 0, -50}, std::array<double, 2>{-35, 110}),
+                make_axis('C', false, {0, 0, 1}, {0, 0, 0}, endless)};
+  } else if (name == "b-head-c-table") {
+    kin.type = MachineType::head_table;
+    kin.axes = {make_axis('B', true, {0, 1, 0}, {0, 0, 150}, std::array<double, 2>{-110, 110}),
+                make_axis('C', false, {0, 0, 1}, {0, 0, 0}, endless)};
+  } else if (name == "head-head") {
+    kin.type = MachineType::head_head;
+    kin.axes = {make_axis('C', true, {0, 0, 1}, {0, 0, 0}, std::array<double, 2>{-360, 360}),
+                make_axis('A', true, {1, 0, 0}, {0, 0, 150}, std::array<double, 2>{-100, 100})};
+  } else {
+    return std::nullopt;
+  }
+  return kin;
+}
+
+std::vector<std::string> kinematics_profile_names() {
+  return {"ac-trunnion", "bc-trunnion", "b-head-c-table", "head-head"};
+}
+
+Kinematics kinematics_from_json(const nlohmann::json& value, const std::string& path) {
+  if (value.is_string()) {
+    std::optional<Kinematics> profile = kinematics_profile(value.get<std::string>());
+    if (!profile) {
+      std::string names;
+      for (const std::string& n : kinematics_profile_names()) names += (names.empty() ? "" : ", ") + n;
+      json_fail(path, "is not a bundled profile (" + names + ")", value);
+    }
+    return *profile;
+  }
+  if (!value.is_object()) json_fail(path, "must be a profile name or an object", value);
+  json_known_keys(value, {"type", "axes"}, path);
+  Kinematics kin;
+  const nlohmann::json& type = json_key(value, "type", path);
+  if (type == "table-table") kin.type = MachineType::table_table;
+  else if (type == "head-table") kin.type = MachineType::head_table;
+  else if (type == "head-head") kin.type = MachineType::head_head;
+  else json_fail(path + ".type", "must be \"table-table\", \"head-table\" or \"head-head\"", type);
+  const nlohmann::json& axes = json_key(value, "axes", path);
+  if (!axes.is_array() || axes.empty() || axes.size() > 2)
+    json_fail(path + ".axes", "must be an array of one or two axes", axes);
+  for (std::size_t i = 0; i < axes.size(); ++i)
+    kin.axes.push_back(axis_from_json(axes[i], path + ".axes[" + std::to_string(i) + "]"));
+  try {
+    kin.validate();
+  } catch (const Error& e) {
+    // validate() speaks of "kinematics"; name the machine file's path and the axes instead.
+    std::string message = e.what();
+    if (message.rfind("kinematics: ", 0) == 0) message = message.substr(12);
+    detail::fail(path, ": ", message, " (", value.dump(), ")");
+  }
+  return kin;
+}
+
+}  // namespace tridex::gcode

@@ -1,0 +1,129 @@
+// The tilted-plane words as the interpreter reads them (tilt.cpp): each control's G68.2 form,
+// G68.3, G68.4, G268's Q orders and LinuxCNC's G53.3, run as programs and compared with the frames
+// of tilted_plane.hpp (tested against the manuals' definitions in test_tilted_forms.cpp) and with
+// each other.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <string>
+
+#include "helpers.hpp"
+#include "tridex/gcode/tilted_plane.hpp"
+
+using namespace tridex;
+using namespace tridex::gcode;
+using namespace tridex::gcode::test;
+
+namespace {
+
+// The tool direction and the moves of a program that defines a plane, orients the tool and cuts
+// a small square in the plane.
+Result square_in(const std::string& plane, const std::string& orient = "G53.1",
+                 MachineConfig machine = at_origin()) {
+  return run_program(cat("G21 G90 G54 T1 M6 S1000 M3\n", plane, "\n", orient, "\n",
+                         "G0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X10\nG1 Y10\nG1 X0\nG1 Y0\nG0 Z5\nM30\n"),
+                     {}, machine);
+}
+
+Vec3 tool_of(const Result& r) {
+  REQUIRE(!r.moves.empty());
+  return r.moves.back().axis;
+}
+
+bool same_moves(const Result& a, const Result& b, double eps = 1e-9) {
+  if (a.moves.size() != b.moves.size()) return false;
+  for (std::size_t i = 0; i < a.moves.size(); ++i)
+    if (!near(a.moves[i].start, b.moves[i].start, eps) || !near(a.moves[i].end, b.moves[i].end, eps) ||
+        !near(a.moves[i].axis, b.moves[i].axis, eps))
+      return false;
+  return true;
+}
+
+}  // namespace
+
+TEST_CASE("G68.2 forms: one plane written five ways gives the same moves") {
+  // A 90-degree turn about Y with the origin at (3, -3, -6), as in Hurco's example.
+  Result hurco = square_in("G68.2 X3 Y-3 Z-6 I0 J0 K-1 U0 V1 W0");
+  CHECK(near(tool_of(hurco), Vec3(1, 0, 0), 1e-12));
+  Frame f = hurco_vector_frame(Vec3(3, -3, -6), Vec3(0, 0, -1), Vec3(0, 1, 0));
+  CHECK(near(hurco.moves.back().end, f.to_world(Vec3(0, 0, 5)), 1e-9));
+  CHECK(same_moves(hurco, square_in("G68.2 X3 Y-3 Z-6 I90 J90 K-90")));        // Fanuc P0
+  CHECK(same_moves(hurco, square_in("G68.2 X3 Y-3 Z-6 A90 B90 C-90")));        // Mazak A B C
+  CHECK(same_moves(hurco, square_in("G68.2 P1 Q123 X3 Y-3 Z-6 J90")));         // Fanuc P1
+  CHECK(same_moves(hurco, square_in("G268 X3 Y-3 Z-6 J90 Q123", "G253")));     // Haas
+  CHECK(same_moves(hurco, square_in("G68.2 P0 Q313 X3 Y-3 Z-6 I90 J90 K-90"))); // LinuxCNC P0
+}
+
+TEST_CASE("G68.2 P1 and G268: the Q order decides") {
+  CHECK(near(tool_of(square_in("G68.2 P1 I90 K90")), Vec3(1, 0, 0), 1e-12));       // Q123 default
+  CHECK(near(tool_of(square_in("G68.2 P1 Q321 I90 K90")), Vec3(0, -1, 0), 1e-12));
+  CHECK(near(tool_of(square_in("G268 I90 K90 Q321", "G253")), Vec3(0, -1, 0), 1e-12));
+  CHECK(near(tool_of(square_in("G268 I90 J90 Q213", "G253")), Vec3(1, 0, 0), 1e-12));
+  Diagnostic d = error_of("G68.2 P1 Q121 I10\n");
+  CHECK(d.column == 10);
+  CHECK_MESSAGE(d.message.find("Q121") != std::string::npos, d.message);
+}
+
+TEST_CASE("LinuxCNC G68.2 Q121: the issue's plane") {
+  Vec3 t = tool_of(square_in("G68.2 X0 Y0 Z0 I30 J15 K0 Q121"));
+  CHECK(near(t, Vec3(0.259, -0.483, 0.837), 1e-3));
+  CHECK(near(t, linuxcnc_angles_frame(0, 121, Vec3(0), 30, 15, 0).rotation[2], 1e-12));
+  // R turns about the work Z.
+  Result r = square_in("G68.2 X0 Y0 Z0 I30 J15 K0 Q121 R90");
+  CHECK(near(tool_of(r), linuxcnc_angles_frame(0, 121, Vec3(0), 30, 15, 0, 90).rotation[2], 1e-12));
+}
+
+TEST_CASE("G68.2 P1 in LinuxCNC's dialect: I J K the first to third angle, intrinsic") {
+  MachineConfig linuxcnc = at_origin();
+  linuxcnc.dialect = Dialect::linuxcnc;
+  Vec3 t = tool_of(square_in("G68.2 P1 Q123 I30 J20 K0", "G53.1", linuxcnc));
+  CHECK(near(t, linuxcnc_angles_frame(1, 123, Vec3(0), 30, 20, 0).rotation[2], 1e-12));
+  CHECK(near(t, rotation_x(30) * rotation_y(20) * Vec3(0, 0, 1), 1e-12));
+  // Fanuc's reading of the same words differs: about the fixed X, then the fixed Y.
+  CHECK(near(tool_of(square_in("G68.2 P1 Q123 I30 J20 K0")),
+             rotation_y(20) * rotation_x(30) * Vec3(0, 0, 1), 1e-12));
+  // G268 stays Haas's in either dialect.
+  CHECK(near(tool_of(square_in("G268 I30 J20 Q123", "G253", linuxcnc)),
+             rotation_y(20) * rotation_x(30) * Vec3(0, 0, 1), 1e-12));
+}
+
+TEST_CASE("G68.4 composes with the active plane; G68.3 takes the tool axis") {
+  CHECK(same_moves(square_in("G68.2 X10 I0 J30 K0\nG68.4 Z2 J15"),
+                   square_in(cat("G68.2 X10 Y", fmt(-2 * std::sin(glm::radians(30.0))), " Z",
+                                 fmt(2 * std::cos(glm::radians(30.0))), " J45")),
+                   1e-4));
+  CHECK(error_of("G68.4 J15\n").message.find("without an active tilted plane") != std::string::npos);
+  // G68.3 after orienting to a plane, with the plane cancelled: Z along that tool axis (+X).
+  Result r = square_in("G68.2 I90 J90 K0\nG53.1\nG69\nG68.3 X1 Y2 Z3 R30");
+  Frame g = tool_axis_frame(Vec3(1, 2, 3), Vec3(1, 0, 0), 30);
+  CHECK(near(tool_of(r), Vec3(1, 0, 0), 1e-12));
+  CHECK(near(r.moves.back().end, g.to_world(Vec3(0, 0, 5)), 1e-9));
+  CHECK(near(r.moves[r.moves.size() - 3].end, g.to_world(Vec3(0, 10, -1)), 1e-9));
+  CHECK(error_of("G68.3 X1 Y2\n").message.find("all of X, Y and Z") != std::string::npos);
+  CHECK(error_of("G68.3\n").message.find("retracted") != std::string::npos);
+}
+
+TEST_CASE("LinuxCNC G53.3 orients and rapids to I J K in the plane") {
+  Result r = run_program("G21 G90 T1 M6\nG68.2 X5 I0 J30 K0 Q313\nG53.3 P1 I1 J2 K3\nM30\n", {},
+                         at_origin());
+  REQUIRE(r.moves.size() == 1);
+  Frame f = fanuc_euler(Vec3(5, 0, 0), 0, 30, 0);
+  CHECK(near(r.moves[0].end, f.to_world(Vec3(1, 2, 3)), 1e-9));
+  CHECK(r.moves[0].kind == MoveKind::rapid);
+  CHECK(near(r.moves[0].axis, f.rotation[2], 1e-12));
+  CHECK(error_of("G68.2 J30\nG53.3 I1 J2\n").message.find("needs I, J and K") != std::string::npos);
+}
+
+TEST_CASE("tilted-plane words: bad combinations are errors with their column") {
+  Diagnostic d = error_of("G68.2 X0 I10 A20\n");
+  CHECK(d.line == 1);
+  CHECK(d.column == 14);
+  d = error_of("G68.2 X0 I1 J0 K0 U1 V0 W0\n");  // Hurco vectors not normal
+  CHECK_MESSAGE(d.message.find("not normal") != std::string::npos, d.message);
+  d = error_of("G68.2 P2 Q1 X0 Y0 Z0\n");
+  CHECK_MESSAGE(d.message.find("P2") != std::string::npos, d.message);
+  d = error_of("G68.2 P0 Q123 I10\n");  // LinuxCNC P0 takes proper Euler orders only
+  CHECK_MESSAGE(d.message.find("Q123") != std::string::npos, d.message);
+  d = error_of("G68.2 I10 R5\n");  // Fanuc P0 has no R
+  CHECK_MESSAGE(d.message.find("R5") != std::string::npos, d.message);
+}
