@@ -76,6 +76,15 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
     s.far = true;
   }
   run_program(s, program, file_name);
+  // One line per kind of word lenient mode skipped, however many: never a silent skip.
+  for (const auto& [cause, skipped] : s.skipped) {
+    std::string lines;
+    for (int l : skipped.lines) lines += (lines.empty() ? "" : ", ") + std::to_string(l);
+    if (skipped.count > static_cast<long long>(skipped.lines.size())) lines += ", …";
+    s.warnings.push_back(Diagnostic{file_name, 0, 0,
+                                    "lenient mode skipped " + std::to_string(skipped.count) + " × " +
+                                        cause + " (lines " + lines + ")"});
+  }
 }
 
 std::optional<MachineConfig> MachineConfig::bundled(const std::string& name) {

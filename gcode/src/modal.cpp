@@ -140,7 +140,7 @@ Flow Interpreter::State::execute(const Block& block) {
     if (!w.has('L')) error(column, "G10 needs L2 or L20");
     long long l = integer('L', "G10 L", 0, 99);
     if (l != 2 && l != 20) {
-      unsupported(column, "G10 L" + std::to_string(l) + " is not supported (only L2 and L20)");
+      unsupported(column, "G10 L" + std::to_string(l) + " is not supported (only L2 and L20)", "G10 L");
     } else {
       if (!w.has('P')) error(column, "G10 L" + std::to_string(l) + " needs P");
       // Fanuc: L2 P1-6 sets G54-G59, L20 Pn sets G54.1 Pn. LinuxCNC: P1-6 are G54-G59 for both,
@@ -148,7 +148,9 @@ Flow Interpreter::State::execute(const Block& block) {
       bool linuxcnc = machine.dialect == Dialect::linuxcnc;
       int key = 0;
       if (l == 2 || linuxcnc) {
-        if (w.has('R')) unsupported(w.col('R'), "G10 L" + std::to_string(l) + " R (a rotated coordinate system) is not supported");
+        if (w.has('R'))
+          unsupported(w.col('R'), "G10 L" + std::to_string(l) + " R (a rotated coordinate system) is not supported",
+                      "G10 R", false);
         key = static_cast<int>(integer('P', linuxcnc ? "G10 P" : "G10 L2 P", 0, 6));
       } else {
         key = MachineConfig::g54_1_key(static_cast<int>(integer('P', "G10 L20 P", 0, 300)));
@@ -249,8 +251,12 @@ Flow Interpreter::State::execute(const Block& block) {
       std::size_t k = static_cast<std::size_t>(i);
       bool axis_letter = c == 'X' || c == 'Y' || c == 'Z';
       if (axis_letter) continue;  // axis words are consumed by construction or rejected above
+      // Only words that never carry geometry may be dropped: E (an extruder), D and H (offset
+      // numbers, which tridex does not apply).
+      bool skippable = c == 'E' || c == 'D' || c == 'H';
       unsupported(w.column[k], std::string("word ") + c + format_number(w.value[k]) +
-                                   " is not used by any code in this block");
+                                   " is not used by any code in this block",
+                  std::string("unused word ") + c, skippable);
     }
   }
   return flow;

@@ -118,10 +118,22 @@ struct Interpreter::State : ParameterReader {
     // Bounded: a warning per block of a long program would grow memory with its length.
     if (warnings.size() < 1000) warnings.push_back(Diagnostic{*file, line, column, std::move(message)});
   }
-  void unsupported(int column, const std::string& message) {
+  // Lenient mode may skip a word only where skipping cannot change the tool path; `cause` names
+  // the kind of word (counted for the run's summary, however many there are).
+  void unsupported(int column, const std::string& message, const std::string& cause,
+                   bool skippable = true) {
     if (!options.lenient) error(column, message);
+    if (!skippable)
+      error(column, message + " (cannot be skipped in lenient mode: it changes the tool path)");
     warn(column, message + " (skipped: lenient mode)");
+    Skipped& s = skipped[cause];
+    if (s.count++ < 5) s.lines.push_back(line);
   }
+  struct Skipped {
+    long long count = 0;
+    std::vector<int> lines;  // the first few
+  };
+  std::map<std::string, Skipped> skipped;
 
   // ---- words ----
   void gather(const Block& block) {
@@ -151,8 +163,18 @@ struct Interpreter::State : ParameterReader {
           continue;
         }
         if (group < 0) {
-          unsupported(word.column, std::string("unsupported code ") + word.letter +
-                                       format_number(word.value));
+          // Codes known to leave the path alone (feed and speed modes, exact stop, cancels of
+          // modes tridex never enters) may be skipped in a block without coordinates; any other
+          // unknown code could move the tool or change how later coordinates read.
+          static constexpr int kHarmless[] = {50, 90, 131, 500, 501, 611, 620, 630, 670, 930, 950, 960};
+          bool harmless = word.letter == 'G' && integral &&
+                          std::find(std::begin(kHarmless), std::end(kHarmless), code) != std::end(kHarmless);
+          bool coordinates = false;
+          for (const Word& other : block.words)
+            coordinates |= other.letter == 'X' || other.letter == 'Y' || other.letter == 'Z';
+          std::string name = integral ? code_name(word.letter, code)
+                                      : std::string(1, word.letter) + format_number(word.value);
+          unsupported(word.column, "unsupported code " + name, "code " + name, harmless && !coordinates);
           continue;
         }
         if (word.letter == 'G') {

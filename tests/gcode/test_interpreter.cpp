@@ -155,10 +155,19 @@ TEST_CASE("rejected blocks name line, column and word") {
 TEST_CASE("lenient mode turns unsupported words into warnings and skips them") {
   InterpreterOptions options;
   options.lenient = true;
-  Result r = run_program("G0 X1 Y1 Z1\nG41 D1\nG1 X2 F100 E4\nM30\n", options, at_origin());
-  CHECK(r.moves.size() == 2);
-  CHECK(r.warnings.size() == 3);
+  Result r = run_program("G0 X1 Y1 Z1\nG61.1\nG1 X2 F100 E4\nG1 X3 E5\nM30\n", options, at_origin());
+  CHECK(r.moves.size() == 3);
+  REQUIRE(r.warnings.size() == 5);  // three skips, then one summary line per kind of word
   CHECK(r.warnings[0].line == 2);
+  CHECK(r.warnings[3].message.find("skipped 1 × code G61.1 (lines 2)") != std::string::npos);
+  CHECK(r.warnings[4].message.find("skipped 2 × unused word E (lines 3, 4)") != std::string::npos);
+  // What would change the path is never skipped: cutter compensation, an unknown code beside
+  // coordinates, a rotary word, a rotated coordinate system.
+  for (const char* text : {"G0 X1 Y1 Z1\nG41 D1\nM30\n", "G0 X1 Y1 Z1\nG16 X2\nM30\n",
+                           "G0 X1 Y1 Z1\nG0 X2 B90\nM30\n", "G10 L2 P1 X0 R30\nM30\n"}) {
+    Diagnostic d = error_of(text, options, at_origin());
+    CHECK(d.message.find("cannot be skipped") != std::string::npos);
+  }
 }
 
 TEST_CASE("truncated programs warn; a stream is read with constant memory") {
