@@ -27,10 +27,12 @@
 #include "commands.hpp"
 #include "deviation.hpp"
 #include "errors.hpp"
+#include "memory.hpp"
 #include "numbers.hpp"
 #include "output.hpp"
 #include "pipeline.hpp"
 #include "render.hpp"
+#include "stock.hpp"
 #include "tridex/dexel_ops.hpp"
 #include "tridex/dexelize.hpp"
 #include "tridex/mill.hpp"
@@ -57,20 +59,6 @@ constexpr double kMaxDesignSamples = 4e6;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-Aabb parse_envelope(const std::string& text) {
-  if (text.rfind("box:", 0) != 0)
-    input_error("--envelope ", text, ": expected box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX");
-  std::vector<double> v = parse_number_list(text.substr(4), "--envelope");
-  if (v.size() != 6) input_error("--envelope box: expected 6 numbers, got ", v.size());
-  Aabb box{Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5])};
-  static const char* names[] = {"X", "Y", "Z"};
-  for (int a = 0; a < 3; ++a)
-    if (!(box.min[a] < box.max[a]))
-      input_error("--envelope box: ", names[a], "MIN ", box.min[a], " must be less than ", names[a], "MAX ",
-                  box.max[a]);
-  return box;
 }
 
 // Runs body(k) for k in [0, n) on `threads` threads (0: every hardware thread), in blocks.
@@ -123,13 +111,27 @@ Json statistics(std::vector<double> values) {
 
 // Points on the design's surface about `step` apart: its vertices, and in each triangle split into
 // n² similar ones (n = ⌈longest edge / step⌉) their centroids; the step grows until at most
-// kMaxDesignSamples remain.
+// kMaxDesignSamples remain. A design whose vertices and triangles alone exceed that (n = 1 gives
+// each triangle one sample) is sampled by stride instead: every k-th vertex and every k-th
+// triangle's centroid, k = ⌈(vertices + triangles) / kMaxDesignSamples⌉.
 std::vector<Vec3> design_samples(const Mesh& design, double step) {
   auto splits = [&](const glm::uvec3& t, double s) {
     Vec3 a(design.positions[t.x]), b(design.positions[t.y]), c(design.positions[t.z]);
     double longest = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
     return std::max(1.0, std::ceil(longest / s));
   };
+  const std::size_t least = design.positions.size() + design.triangles.size();
+  if (static_cast<double>(least) > kMaxDesignSamples) {
+    const auto stride = static_cast<std::size_t>(std::ceil(static_cast<double>(least) / kMaxDesignSamples));
+    std::vector<Vec3> samples;
+    samples.reserve(least / stride + 2);
+    for (std::size_t v = 0; v < design.positions.size(); v += stride) samples.emplace_back(design.positions[v]);
+    for (std::size_t k = 0; k < design.triangles.size(); k += stride) {
+      const glm::uvec3& t = design.triangles[k];
+      samples.push_back((Vec3(design.positions[t.x]) + Vec3(design.positions[t.y]) + Vec3(design.positions[t.z])) / 3.0);
+    }
+    return samples;
+  }
   for (;;) {
     double total = static_cast<double>(design.positions.size());
     for (const glm::uvec3& t : design.triangles) total += splits(t, step) * splits(t, step);
@@ -246,7 +248,9 @@ int run_check(const CheckOptions& options) {
   progress.stage("reading the design " + options.design);
   Mesh design;
   try {
-    design = read_stl(options.design, StlOptions{.require_closed = true});
+    design = read_stl(options.design, StlOptions{.require_closed = true,
+                                                 .max_bytes = max_memory_bytes(options.max_memory),
+                                                 .limit_name = "--max-memory"});
   } catch (const tridex::Error& e) {
     input_error("--design: ", e.what());
   }
@@ -258,6 +262,7 @@ int run_check(const CheckOptions& options) {
   request.outputs = {{"-o", options.output}, {"--report", options.report}, {"--png", options.png},
                      {"--ply", options.ply}};
   request.extra_inputs = {options.design};
+  request.extra_bounds = {{"--design " + options.design, design.bounds()}};
   request.rapid_check = RapidCheck::in_program_order;
   SimulationResult r = simulate_program(options, progress, request);
   const Mesh& mesh = r.mesh;

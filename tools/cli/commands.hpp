@@ -6,12 +6,18 @@
 
 namespace tridex::cli {
 
+// Far above the blocks of a real program, low enough that a few bytes of nested M98 ... L9999
+// stop with a message instead of running for hours.
+constexpr long long kDefaultMaxBlocks = 100'000'000;
+
 struct CommonOptions {
   std::string program;          // G-code file or CAMotics project
   double arc_tolerance = 0.001;  // mm
   bool lenient = false;
   bool progress = false;
   bool quiet = false;
+  long long max_blocks = kDefaultMaxBlocks;  // --max-blocks: executed blocks before exit status 2
+  std::string max_memory;      // --max-memory (simulate, check, groups); empty: 80 % of RAM
 };
 
 struct ListOptions : CommonOptions {
@@ -26,7 +32,6 @@ struct SimulateOptions : CommonOptions {
   int dexel_res = 0;            // 0: the default
   std::string output, png, report, dump_zmaps;
   unsigned threads = 0;         // 0: every hardware thread
-  std::string max_memory;       // empty: 80 % of RAM
   std::string zmap_backend = "cpu";   // --zmap-backend: cpu | gl (tools/backends)
   std::string dexel_backend = "scan";  // --dexel-backend: scan | tree | embree
 };
