@@ -6,9 +6,10 @@
 
 namespace tridex::cli {
 
-// Far above the blocks of a real program, low enough that a few bytes of nested M98 ... L9999
-// stop with a message instead of running for hours.
-constexpr long long kDefaultMaxBlocks = 100'000'000;
+// Above the blocks of all but the largest real programs (a 20-million-line file is hundreds of MB
+// of G-code), low enough that a few bytes of nested M98 ... L9999 (10^8 blocks and more) stop
+// with a message instead of running on without bound.
+constexpr long long kDefaultMaxBlocks = 20'000'000;
 
 struct CommonOptions {
   std::string program;          // G-code file or CAMotics project

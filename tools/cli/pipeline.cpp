@@ -45,7 +45,8 @@ Stock load_stock(const StockSpec& spec, const Aabb& cutting_bounds, std::uint64_
     }
     case StockSpec::Kind::mesh: {
       try {
-        stock.mesh = read_stl(spec.mesh_path.string(), StlOptions{.require_closed = true, .max_bytes = max_memory});
+        stock.mesh = read_stl(spec.mesh_path.string(), StlOptions{.require_closed = true, .max_bytes = max_memory,
+                                                           .limit_name = "--max-memory"});
       } catch (const tridex::Error& e) {
         input_error("--stock ", spec.mesh_path.string(), ": ", e.what());
       }
@@ -92,6 +93,13 @@ void mill_in_program_order(ZMap& map, const gcode::MoveGroup& group, std::size_t
     batch.push_back(cut);
   }
   backends::mill_with(backend, map, cutters, batch, threads);
+}
+
+std::string describe_box(const Aabb& box) {
+  char text[160];
+  std::snprintf(text, sizeof text, "%g,%g,%g to %g,%g,%g", box.min.x, box.min.y, box.min.z, box.max.x,
+                box.max.y, box.max.z);
+  return text;
 }
 
 // The kernel's meshes hold float positions, and the surface's vertices stay exact while they lie
@@ -365,6 +373,12 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   r.result = backends::machine_with(backends::parse_dexel_backend(options.dexel_backend), stock_dexel, maps,
                                     options.threads);
   r.timings.intersect = seconds_since(t);
+  // The result is the stock less the cuts: the same volume means no move reached the stock (a
+  // stock given far from where the program works, say). Not an error, but surely not meant.
+  const double stock_dexel_volume = tridex::volume(stock_dexel);
+  if (tridex::volume(r.result) >= stock_dexel_volume * (1 - 1e-12))
+    r.warnings.push_back("nothing was cut: no move reaches the stock (" + describe_box(stock.box) +
+                         "); the result is the whole stock");
   stock_dexel = TripleDexel{};
   maps = std::move(kept_maps);
   maps.shrink_to_fit();

@@ -42,7 +42,7 @@ void MoveBudget::keep(const gcode::Move& move, const std::string& file) {
     input_error(file, ":", move.line, ": the program expands into more than ", kept_ - 1, " moves (",
                 format_mib(bytes()), " to keep them), more than --max-memory ",
                 format_mib(static_cast<double>(max_bytes_)),
-                "; a larger --arc-tolerance gives fewer arc segments");
+                "; raise --max-memory, or give a larger --arc-tolerance if fine arcs make the moves");
 }
 
 InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOptions& options,
