@@ -55,7 +55,7 @@ constexpr std::size_t kFindingsListed = 1000;  // envelope violations in the rep
 constexpr std::size_t kFindingsPrinted = 20;   // of each kind on stdout
 constexpr std::size_t kProbesPerRegion = 16;  // deepest vertices tested against the moves
 constexpr int kHistogramBins = 20;
-constexpr double kMaxDesignSamples = 4e6;
+constexpr std::size_t kMaxDesignSamples = 4'000'000;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -107,48 +107,6 @@ Json statistics(std::vector<double> values) {
   for (int b = 0; b <= kHistogramBins; ++b) edges.push_back(lo + b * width);
   s["histogram"] = {{"edges_mm", edges}, {"counts", counts}};
   return s;
-}
-
-// Points on the design's surface about `step` apart: its vertices, and in each triangle split into
-// n² similar ones (n = ⌈longest edge / step⌉) their centroids; the step grows until at most
-// kMaxDesignSamples remain. A design whose vertices and triangles alone exceed that (n = 1 gives
-// each triangle one sample) is sampled by stride instead: every k-th vertex and every k-th
-// triangle's centroid, k = ⌈(vertices + triangles) / kMaxDesignSamples⌉.
-std::vector<Vec3> design_samples(const Mesh& design, double step) {
-  auto splits = [&](const glm::uvec3& t, double s) {
-    Vec3 a(design.positions[t.x]), b(design.positions[t.y]), c(design.positions[t.z]);
-    double longest = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
-    return std::max(1.0, std::ceil(longest / s));
-  };
-  const std::size_t least = design.positions.size() + design.triangles.size();
-  if (static_cast<double>(least) > kMaxDesignSamples) {
-    const auto stride = static_cast<std::size_t>(std::ceil(static_cast<double>(least) / kMaxDesignSamples));
-    std::vector<Vec3> samples;
-    samples.reserve(least / stride + 2);
-    for (std::size_t v = 0; v < design.positions.size(); v += stride) samples.emplace_back(design.positions[v]);
-    for (std::size_t k = 0; k < design.triangles.size(); k += stride) {
-      const glm::uvec3& t = design.triangles[k];
-      samples.push_back((Vec3(design.positions[t.x]) + Vec3(design.positions[t.y]) + Vec3(design.positions[t.z])) / 3.0);
-    }
-    return samples;
-  }
-  for (;;) {
-    double total = static_cast<double>(design.positions.size());
-    for (const glm::uvec3& t : design.triangles) total += splits(t, step) * splits(t, step);
-    if (total <= kMaxDesignSamples) break;
-    step *= std::sqrt(total / kMaxDesignSamples) * 1.01;
-  }
-  std::vector<Vec3> samples(design.positions.begin(), design.positions.end());
-  for (const glm::uvec3& t : design.triangles) {
-    Vec3 a(design.positions[t.x]), ab = Vec3(design.positions[t.y]) - a, ac = Vec3(design.positions[t.z]) - a;
-    const auto n = static_cast<int>(splits(t, step));
-    for (int i = 0; i < n; ++i)
-      for (int j = 0; i + j < n; ++j) {
-        samples.push_back(a + ((i + 1.0 / 3) / n) * ab + ((j + 1.0 / 3) / n) * ac);
-        if (i + j + 1 < n) samples.push_back(a + ((i + 2.0 / 3) / n) * ab + ((j + 2.0 / 3) / n) * ac);
-      }
-  }
-  return samples;
 }
 
 // Source lines of the moves whose swept cutter reaches the region's deepest vertices.
@@ -293,7 +251,7 @@ int run_check(const CheckOptions& options) {
   std::vector<DeviationRegion> excesses = deviation_regions(mesh, deviation, excess);
 
   // ---- the design side ------------------------------------------------------------------------
-  std::vector<Vec3> samples = design_samples(design, 2 * spacing);
+  std::vector<Vec3> samples = design_samples(design, 2 * spacing, kMaxDesignSamples);
   std::vector<double> design_deviation;
   if (!mesh.triangles.empty()) {
     progress.stage("measuring the design against the machined surface");
