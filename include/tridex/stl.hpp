@@ -80,7 +80,7 @@ inline Mesh read_stl_binary(std::istream& in, const std::string& path, std::uint
   soup.positions.reserve(3 * static_cast<std::size_t>(count));
   soup.triangles.reserve(count);
   const std::size_t batch = 1 << 16;
-  std::vector<unsigned char> buffer(50 * batch);
+  std::vector<unsigned char> buffer(50 * std::min<std::size_t>(batch, count));
   for (std::size_t done = 0; done < count;) {
     std::size_t n = std::min<std::size_t>(batch, count - done);
     in.read(reinterpret_cast<char*>(buffer.data()), static_cast<std::streamsize>(50 * n));

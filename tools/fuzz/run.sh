@@ -8,7 +8,7 @@
 #   options     --stock, --envelope and --max-memory (tools/cli/stock.cpp, memory.cpp)
 # Exit status 0: no crash in that time. A crash leaves its input as BUILD_DIR/<harness>-crash-*
 # and stops the script with a non-zero status; turn it into a named case in
-# tests/tools/test_fuzz_findings.cpp with the input under tests/data/fuzz/.
+# tests/tools/test_bad_input.cpp with the input under tests/data/.
 # (The G-code front end has its own harness: gcode/fuzz/run.sh.)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
