@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
-#include <limits>
 #include <new>
 
 #include "commands.hpp"
@@ -35,8 +34,7 @@ const CLI::Validator kFinitePositive(
 
 // An option given with an empty value (`--stock ''`, `-o ""`) is a mistake, not the default.
 const CLI::Validator kNotEmpty(
-    [](std::string& text) -> std::string { return text.empty() ? "must not be empty" : std::string(); },
-    "TEXT");
+    [](std::string& text) -> std::string { return text.empty() ? "must not be empty" : std::string(); }, "");
 
 void add_common(CLI::App& command, CommonOptions& options) {
   command.add_option("PROGRAM", options.program,
@@ -48,7 +46,7 @@ void add_common(CLI::App& command, CommonOptions& options) {
   command.add_option("--max-blocks", options.max_blocks,
                      "stop with exit status 2 after this many executed blocks (bounds M98 ... L loops; default " +
                          std::to_string(kDefaultMaxBlocks) + ")")
-      ->check(CLI::Range(1LL, std::numeric_limits<long long>::max()));
+      ->check(CLI::PositiveNumber);
   command.add_flag("--lenient", options.lenient,
                    "unsupported G-code words become warnings and are skipped");
   command.add_flag("--progress", options.progress,
