@@ -44,6 +44,8 @@ ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 LSAN_OPTIONS=suppre
 
 echo "== fuzzing the G-code front end (bounded)"
 bash gcode/fuzz/run.sh 60 build-fuzz
+echo "== fuzzing the command's input formats: STL, tool table, project, options (bounded)"
+bash tools/fuzz/run.sh 60 build-fuzz
 
 # One closing line for both suites (ctest's own summaries are further up).
 total=$(( $(cat build/ctest.log build-asan/ctest.log | sed -n 's/.*tests failed out of \([0-9]*\).*/\1/p' | paste -sd+) ))

@@ -15,10 +15,12 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <istream>
+#include <limits>
 #include <ostream>
 #include <string>
 #include <string_view>
@@ -43,7 +45,15 @@ namespace tridex {
 
 struct StlOptions {
   bool require_closed = false;  // throw unless the welded mesh is closed (check_mesh)
+  // Refuse, before allocating, a file whose triangles would need more than this many bytes to
+  // read and weld (kStlBytesPerTriangle each; an ASCII file's text besides). 0: no limit.
+  std::uint64_t max_bytes = 0;
+  const char* limit_name = "the memory limit";  // for the message, e.g. "--max-memory"
 };
+
+// Memory that reading one triangle takes at its peak: the soup's three corners and indices (48
+// bytes), the weld's remap and hash index, and the welded mesh (weld_vertices).
+inline constexpr std::uint64_t kStlBytesPerTriangle = 128;
 
 namespace detail {
 
@@ -70,7 +80,7 @@ inline Mesh read_stl_binary(std::istream& in, const std::string& path, std::uint
   soup.positions.reserve(3 * static_cast<std::size_t>(count));
   soup.triangles.reserve(count);
   const std::size_t batch = 1 << 16;
-  std::vector<unsigned char> buffer(50 * batch);
+  std::vector<unsigned char> buffer(50 * std::min<std::size_t>(batch, count));
   for (std::size_t done = 0; done < count;) {
     std::size_t n = std::min<std::size_t>(batch, count - done);
     in.read(reinterpret_cast<char*>(buffer.data()), static_cast<std::streamsize>(50 * n));
@@ -121,9 +131,17 @@ class StlText {
     const char* first = w.data();
     if (!w.empty() && *first == '+') ++first;  // from_chars does not take a leading '+'
     auto [end, error] = std::from_chars(first, w.data() + w.size(), value);
-    if (w.empty() || error != std::errc() || end != w.data() + w.size() || !std::isfinite(value))
+    if (w.empty() || (error != std::errc() && error != std::errc::result_out_of_range) ||
+        end != w.data() + w.size() || std::isnan(value) || (error == std::errc() && std::isinf(value)))
       fail("STL ", path_, ": line ", word_line_, ": expected a finite number but found '",
            w.empty() ? std::string_view("end of file") : w, "'");
+    // from_chars leaves the value alone when out of range; strtod gives ±HUGE_VAL for an overflow
+    // and 0 or a subnormal for an underflow, which is harmless.
+    if (error == std::errc::result_out_of_range) value = std::strtod(std::string(w).c_str(), nullptr);
+    // Positions are float: a value beyond its range would become infinite.
+    if (std::abs(value) > double(std::numeric_limits<float>::max()))
+      fail("STL ", path_, ": line ", word_line_, ": ", w, " is beyond the range of an STL coordinate (float, ±",
+           std::numeric_limits<float>::max(), ")");
     return static_cast<float>(value);
   }
 
@@ -147,7 +165,8 @@ class StlText {
   std::size_t pos_ = 0, line_ = 1, word_line_ = 1;
 };
 
-inline Mesh read_stl_ascii(std::string text, const std::string& path) {
+inline Mesh read_stl_ascii(std::string text, const std::string& path, const StlOptions& options) {
+  const std::uint64_t text_bytes = text.size();
   StlText in(std::move(text), path);
   Mesh soup;
   in.expect("solid");
@@ -178,6 +197,9 @@ inline Mesh read_stl_ascii(std::string text, const std::string& path) {
     in.expect("endfacet");
     soup.triangles.emplace_back(base, base + 1, base + 2);
     if (soup.positions.size() > 0xFFFFFFF0u) fail("STL ", path, ": too many triangles");
+    if (options.max_bytes && text_bytes + kStlBytesPerTriangle * soup.triangles.size() > options.max_bytes)
+      fail("STL ", path, ": line ", line, ": ", soup.triangles.size(), " triangles and ", text_bytes,
+           " bytes of text need more than ", options.limit_name, " (", options.max_bytes, " bytes)");
   }
   return soup;
 }
@@ -189,6 +211,13 @@ inline Mesh read_stl_ascii(std::string text, const std::string& path) {
 // coordinate that is not finite, and — with options.require_closed — a mesh that is not closed
 // (with the edge counts of check_mesh).
 inline Mesh read_stl(const std::string& path, StlOptions options = {}) {
+  {
+    namespace fs = std::filesystem;
+    std::error_code error;
+    fs::file_status status = fs::status(path, error);
+    if (fs::is_directory(status)) detail::fail("STL ", path, ": is a directory");
+    if (fs::exists(status) && !fs::is_regular_file(status)) detail::fail("STL ", path, ": is not a regular file");
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) detail::fail("STL ", path, ": cannot open the file");
   in.seekg(0, std::ios::end);
@@ -200,6 +229,10 @@ inline Mesh read_stl(const std::string& path, StlOptions options = {}) {
   std::uint64_t binary_count = in.gcount() == 84 ? detail::load_u32_le(header + 80) : 0;
   if (in.gcount() == 84 && size == 84 + 50 * binary_count) {
     if (binary_count > 0x55555550u) detail::fail("STL ", path, ": too many triangles (", binary_count, ")");
+    if (options.max_bytes && kStlBytesPerTriangle * binary_count > options.max_bytes)
+      detail::fail("STL ", path, ": the header declares ", binary_count, " triangles, about ",
+                   kStlBytesPerTriangle * binary_count / (1 << 20), " MiB to read, more than ", options.limit_name,
+                   " (", options.max_bytes / (1 << 20), " MiB)");
     soup = detail::read_stl_binary(in, path, static_cast<std::uint32_t>(binary_count));
   } else {
     std::string_view start(reinterpret_cast<const char*>(header), static_cast<std::size_t>(in.gcount()));
@@ -209,6 +242,9 @@ inline Mesh read_stl(const std::string& path, StlOptions options = {}) {
       detail::fail("STL ", path, ": binary header announces ", binary_count, " triangles (", 84 + 50 * binary_count,
                    " bytes) but the file has ", size, " bytes: truncated or not an STL file");
     }
+    if (options.max_bytes && size > options.max_bytes)
+      detail::fail("STL ", path, ": ", size, " bytes of text are more than ", options.limit_name, " (",
+                   options.max_bytes, " bytes)");
     std::string text(static_cast<std::size_t>(size), '\0');
     in.seekg(0, std::ios::beg);
     in.read(text.data(), static_cast<std::streamsize>(size));
@@ -217,7 +253,7 @@ inline Mesh read_stl(const std::string& path, StlOptions options = {}) {
     if (text.find('\0') != std::string::npos)
       detail::fail("STL ", path, ": binary header announces ", binary_count, " triangles (", 84 + 50 * binary_count,
                    " bytes) but the file has ", size, " bytes: truncated");
-    soup = detail::read_stl_ascii(std::move(text), path);
+    soup = detail::read_stl_ascii(std::move(text), path, options);
   }
   Mesh mesh = weld_vertices(soup);
   if (options.require_closed) {

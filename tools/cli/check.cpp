@@ -27,10 +27,12 @@
 #include "commands.hpp"
 #include "deviation.hpp"
 #include "errors.hpp"
+#include "memory.hpp"
 #include "numbers.hpp"
 #include "output.hpp"
 #include "pipeline.hpp"
 #include "render.hpp"
+#include "stock.hpp"
 #include "tridex/dexel_ops.hpp"
 #include "tridex/dexelize.hpp"
 #include "tridex/mill.hpp"
@@ -53,24 +55,10 @@ constexpr std::size_t kFindingsListed = 1000;  // envelope violations in the rep
 constexpr std::size_t kFindingsPrinted = 20;   // of each kind on stdout
 constexpr std::size_t kProbesPerRegion = 16;  // deepest vertices tested against the moves
 constexpr int kHistogramBins = 20;
-constexpr double kMaxDesignSamples = 4e6;
+constexpr std::size_t kMaxDesignSamples = 4'000'000;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-Aabb parse_envelope(const std::string& text) {
-  if (text.rfind("box:", 0) != 0)
-    input_error("--envelope ", text, ": expected box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX");
-  std::vector<double> v = parse_number_list(text.substr(4), "--envelope");
-  if (v.size() != 6) input_error("--envelope box: expected 6 numbers, got ", v.size());
-  Aabb box{Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5])};
-  static const char* names[] = {"X", "Y", "Z"};
-  for (int a = 0; a < 3; ++a)
-    if (!(box.min[a] < box.max[a]))
-      input_error("--envelope box: ", names[a], "MIN ", box.min[a], " must be less than ", names[a], "MAX ",
-                  box.max[a]);
-  return box;
 }
 
 // Runs body(k) for k in [0, n) on `threads` threads (0: every hardware thread), in blocks.
@@ -119,34 +107,6 @@ Json statistics(std::vector<double> values) {
   for (int b = 0; b <= kHistogramBins; ++b) edges.push_back(lo + b * width);
   s["histogram"] = {{"edges_mm", edges}, {"counts", counts}};
   return s;
-}
-
-// Points on the design's surface about `step` apart: its vertices, and in each triangle split into
-// n² similar ones (n = ⌈longest edge / step⌉) their centroids; the step grows until at most
-// kMaxDesignSamples remain.
-std::vector<Vec3> design_samples(const Mesh& design, double step) {
-  auto splits = [&](const glm::uvec3& t, double s) {
-    Vec3 a(design.positions[t.x]), b(design.positions[t.y]), c(design.positions[t.z]);
-    double longest = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
-    return std::max(1.0, std::ceil(longest / s));
-  };
-  for (;;) {
-    double total = static_cast<double>(design.positions.size());
-    for (const glm::uvec3& t : design.triangles) total += splits(t, step) * splits(t, step);
-    if (total <= kMaxDesignSamples) break;
-    step *= std::sqrt(total / kMaxDesignSamples) * 1.01;
-  }
-  std::vector<Vec3> samples(design.positions.begin(), design.positions.end());
-  for (const glm::uvec3& t : design.triangles) {
-    Vec3 a(design.positions[t.x]), ab = Vec3(design.positions[t.y]) - a, ac = Vec3(design.positions[t.z]) - a;
-    const auto n = static_cast<int>(splits(t, step));
-    for (int i = 0; i < n; ++i)
-      for (int j = 0; i + j < n; ++j) {
-        samples.push_back(a + ((i + 1.0 / 3) / n) * ab + ((j + 1.0 / 3) / n) * ac);
-        if (i + j + 1 < n) samples.push_back(a + ((i + 2.0 / 3) / n) * ab + ((j + 2.0 / 3) / n) * ac);
-      }
-  }
-  return samples;
 }
 
 // Source lines of the moves whose swept cutter reaches the region's deepest vertices.
@@ -246,7 +206,9 @@ int run_check(const CheckOptions& options) {
   progress.stage("reading the design " + options.design);
   Mesh design;
   try {
-    design = read_stl(options.design, StlOptions{.require_closed = true});
+    design = read_stl(options.design, StlOptions{.require_closed = true,
+                                                 .max_bytes = max_memory_bytes(options.max_memory),
+                                                 .limit_name = "--max-memory"});
   } catch (const tridex::Error& e) {
     input_error("--design: ", e.what());
   }
@@ -258,6 +220,7 @@ int run_check(const CheckOptions& options) {
   request.outputs = {{"-o", options.output}, {"--report", options.report}, {"--png", options.png},
                      {"--ply", options.ply}};
   request.extra_inputs = {options.design};
+  request.extra_bounds = {{"--design " + options.design, design.bounds()}};
   request.rapid_check = RapidCheck::in_program_order;
   SimulationResult r = simulate_program(options, progress, request);
   const Mesh& mesh = r.mesh;
@@ -288,7 +251,7 @@ int run_check(const CheckOptions& options) {
   std::vector<DeviationRegion> excesses = deviation_regions(mesh, deviation, excess);
 
   // ---- the design side ------------------------------------------------------------------------
-  std::vector<Vec3> samples = design_samples(design, 2 * spacing);
+  std::vector<Vec3> samples = design_samples(design, 2 * spacing, kMaxDesignSamples);
   std::vector<double> design_deviation;
   if (!mesh.triangles.empty()) {
     progress.stage("measuring the design against the machined surface");

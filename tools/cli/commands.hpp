@@ -7,6 +7,11 @@
 
 namespace tridex::cli {
 
+// Above the blocks of all but the largest real programs (a 20-million-line file is hundreds of MB
+// of G-code), low enough that a few bytes of nested M98 ... L9999 (10^8 blocks and more) stop
+// with a message instead of running on without bound.
+constexpr long long kDefaultMaxBlocks = 20'000'000;
+
 struct CommonOptions {
   std::string program;          // G-code file or CAMotics project
   double arc_tolerance = 0.001;  // mm
@@ -15,6 +20,8 @@ struct CommonOptions {
   std::vector<std::string> subprograms;   // --subprograms DIR (repeatable)
   bool progress = false;
   bool quiet = false;
+  long long max_blocks = kDefaultMaxBlocks;  // --max-blocks: executed blocks before exit status 2
+  std::string max_memory;      // --max-memory (simulate, check, groups); empty: 80 % of RAM
 };
 
 struct ListOptions : CommonOptions {
@@ -29,7 +36,6 @@ struct SimulateOptions : CommonOptions {
   int dexel_res = 0;            // 0: the default
   std::string output, png, report, dump_zmaps;
   unsigned threads = 0;         // 0: every hardware thread
-  std::string max_memory;       // empty: 80 % of RAM
   std::string zmap_backend = "cpu";   // --zmap-backend: cpu | gl (tools/backends)
   std::string dexel_backend = "scan";  // --dexel-backend: scan | tree | embree
 };

@@ -172,4 +172,48 @@ std::vector<DeviationRegion> deviation_regions(const Mesh& mesh, const std::vect
   return regions;
 }
 
+std::vector<Vec3> design_samples(const Mesh& design, double step, std::size_t max_samples) {
+  const auto limit = static_cast<double>(max_samples);
+  auto splits = [&](const glm::uvec3& t, double s) {
+    Vec3 a(design.positions[t.x]), b(design.positions[t.y]), c(design.positions[t.z]);
+    double longest = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
+    return std::max(1.0, std::ceil(longest / s));
+  };
+  const std::size_t least = design.positions.size() + design.triangles.size();
+  if (static_cast<double>(least) > limit) {
+    const auto stride = static_cast<std::size_t>(std::ceil(static_cast<double>(least) / limit));
+    // Vertices then triangles as one sequence, every stride-th taken: ⌈least / stride⌉ samples.
+    std::vector<Vec3> samples;
+    samples.reserve(least / stride + 1);
+    const std::size_t vertices = design.positions.size();
+    for (std::size_t k = 0; k < least; k += stride) {
+      if (k < vertices) {
+        samples.emplace_back(design.positions[k]);
+        continue;
+      }
+      const glm::uvec3& t = design.triangles[k - vertices];
+      samples.push_back((Vec3(design.positions[t.x]) + Vec3(design.positions[t.y]) + Vec3(design.positions[t.z])) / 3.0);
+    }
+    return samples;
+  }
+  for (;;) {
+    double total = static_cast<double>(design.positions.size());
+    for (const glm::uvec3& t : design.triangles) total += splits(t, step) * splits(t, step);
+    if (total <= limit) break;
+    step *= std::sqrt(total / limit) * 1.01;
+  }
+  std::vector<Vec3> samples(design.positions.begin(), design.positions.end());
+  for (const glm::uvec3& t : design.triangles) {
+    Vec3 a(design.positions[t.x]), ab = Vec3(design.positions[t.y]) - a, ac = Vec3(design.positions[t.z]) - a;
+    const auto n = static_cast<int>(splits(t, step));
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; i + j < n; ++j) {
+        samples.push_back(a + ((i + 1.0 / 3) / n) * ab + ((j + 1.0 / 3) / n) * ac);
+        if (i + j + 1 < n) samples.push_back(a + ((i + 2.0 / 3) / n) * ab + ((j + 2.0 / 3) / n) * ac);
+      }
+  }
+  return samples;
+}
+
+
 }  // namespace tridex::cli

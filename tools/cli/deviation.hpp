@@ -64,4 +64,12 @@ struct DeviationRegion {
 std::vector<DeviationRegion> deviation_regions(const Mesh& mesh, const std::vector<double>& deviation,
                                                const std::vector<char>& selected);
 
+// Points on the design's surface about `step` apart: its vertices, and in each triangle split into
+// n² similar ones (n = ⌈longest edge / step⌉) their centroids; the step grows until at most
+// `max_samples` remain. A design whose vertices and triangles alone exceed that (n = 1 gives
+// each triangle one sample) is sampled by stride instead: every k-th of its vertices and then
+// triangle centroids, k = ⌈(vertices + triangles) / `max_samples`⌉. Either way at most
+// `max_samples` points, at a cost linear in the design's size.
+std::vector<Vec3> design_samples(const Mesh& design, double step, std::size_t max_samples);
+
 }  // namespace tridex::cli

@@ -7,6 +7,7 @@
 #include "commands.hpp"
 #include "errors.hpp"
 #include "json_text.hpp"
+#include "memory.hpp"
 #include "output.hpp"
 #include "program_input.hpp"
 #include "tridex/gcode/grouping.hpp"
@@ -14,13 +15,6 @@
 namespace tridex::cli {
 
 namespace {
-
-gcode::InterpreterOptions interpreter_options(const CommonOptions& options) {
-  gcode::InterpreterOptions o;
-  o.arc_tolerance = options.arc_tolerance;
-  o.lenient = options.lenient;
-  return o;
-}
 
 // Writes through an atomic file, or to stdout for "-".
 template <class Write>
@@ -90,6 +84,8 @@ int run_moves(const ListOptions& options) {
 int run_groups(const ListOptions& options) {
   ProgramInput input = resolve_program(options);
   check_output(options.output, input);
+  // The groups hold every move (a vector's capacity can be twice its size).
+  MoveBudget budget(max_memory_bytes(options.max_memory), 2.0 * sizeof(gcode::Move));
   gcode::DirectionGrouper grouper;
   struct Extra {
     long long kinds[4] = {0, 0, 0, 0};
@@ -97,7 +93,8 @@ int run_groups(const ListOptions& options) {
     Aabb local;  // tool-tip box of the cutting moves in the group's frame
   };
   std::vector<Extra> extras;
-  InterpretResult result = interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t) {
+  InterpretResult result = interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t file) {
+    budget.keep(m, input.files[file].string());
     std::size_t g = grouper.add(m);
     if (g >= extras.size()) extras.resize(g + 1);
     Extra& e = extras[g];

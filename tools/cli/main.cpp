@@ -4,12 +4,14 @@
 // anything else. Program errors are printed as file:line:col: message.
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <new>
 
 #include "commands.hpp"
 #include "errors.hpp"
+#include "output.hpp"
 #include "tridex/gcode/diagnostic.hpp"
 
 #ifndef TRIDEX_VERSION
@@ -20,12 +22,30 @@ namespace {
 
 using namespace tridex::cli;
 
+// CLI11's PositiveNumber lets "nan" and "inf" through; every length here must be finite.
+const CLI::Validator kFinitePositive(
+    [](std::string& text) -> std::string {
+      double value = 0;
+      if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0))
+        return "must be a finite positive number, got \"" + text + "\"";
+      return {};
+    },
+    "POSITIVE");
+
+// An option given with an empty value (`--stock ''`, `-o ""`) is a mistake, not the default.
+const CLI::Validator kNotEmpty(
+    [](std::string& text) -> std::string { return text.empty() ? "must not be empty" : std::string(); }, "");
+
 void add_common(CLI::App& command, CommonOptions& options) {
   command.add_option("PROGRAM", options.program,
                      "G-code file (.nc, .ngc, .tap, .gcode, any name) or CAMotics project (.camotics)")
       ->required();
   command.add_option("--arc-tolerance", options.arc_tolerance,
                      "largest chord error of linearised arcs, mm (default 0.001)")
+      ->check(kFinitePositive);
+  command.add_option("--max-blocks", options.max_blocks,
+                     "stop with exit status 2 after this many executed blocks (bounds M98 ... L loops; default " +
+                         std::to_string(kDefaultMaxBlocks) + ")")
       ->check(CLI::PositiveNumber);
   command.add_flag("--lenient", options.lenient,
                    "unsupported G-code words become warnings and are skipped");
@@ -39,26 +59,36 @@ void add_common(CLI::App& command, CommonOptions& options) {
   command.add_flag("-q,--quiet", options.quiet, "print nothing but errors")->excludes("--progress");
 }
 
+void add_max_memory(CLI::App& command, std::string& max_memory) {
+  command.add_option("--max-memory", max_memory,
+                     "refuse a run whose estimated memory (the moves it keeps, the Z-maps, dexels and mesh)\n"
+                     "exceeds this (e.g. 4G; default 80 % of RAM)")
+      ->check(kNotEmpty);
+}
+
 // simulate's options, shared by check.
 void add_simulate(CLI::App& command, SimulateOptions& options) {
   add_common(command, options);
   command.add_option("--tools", options.tools,
-                  "tool table, JSON in the CAMotics schema (overrides a project's tools)");
+                  "tool table, JSON in the CAMotics schema (overrides a project's tools)")
+      ->check(kNotEmpty);
   command.add_option("--stock", options.stock,
                   "box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX | FILE.stl | auto[:MARGIN] (default auto: the box around\n"
-                  "the cutting moves plus MARGIN mm, or 5 % of each side without one)");
+                  "the cutting moves plus MARGIN mm, or 5 % of each side without one)")
+      ->check(kNotEmpty);
   command.add_option("--zmap-cell", options.zmap_cell,
                   "Z-map grid spacing, mm (default: stock diagonal / 1000)")
-      ->check(CLI::PositiveNumber);
+      ->check(kFinitePositive);
   auto* dexel_cell = command.add_option("--dexel-cell", options.dexel_cell, "triple-dexel spacing, mm")
-                         ->check(CLI::PositiveNumber);
+                         ->check(kFinitePositive);
   command.add_option("--dexel-res", options.dexel_res,
                   "triple-dexel cells along the stock's longest side (default " +
                       std::to_string(kDefaultDexelRes) + ": the bundled example in seconds on 2 cores)")
       ->check(CLI::Range(1, 1 << 20))
       ->excludes(dexel_cell);
   command.add_option("--dump-zmaps", options.dump_zmaps,
-                  "write each direction's milled Z-map to DIR as STL and as a height picture");
+                  "write each direction's milled Z-map to DIR as STL and as a height picture")
+      ->check(kNotEmpty);
   command.add_option("--threads", options.threads, "worker threads (default: every hardware thread)")
       ->check(CLI::Range(0u, 4096u));
   command.add_option("--zmap-backend", options.zmap_backend,
@@ -69,13 +99,13 @@ void add_simulate(CLI::App& command, SimulateOptions& options) {
                      "Steps 2-3: scan (scan conversion onto the ray grids, default), tree (the paper's grid\n"
                      "AABB tree) or embree (Embree 3 ray casting)")
       ->check(CLI::IsMember({"scan", "tree", "embree"}));
-  command.add_option("--max-memory", options.max_memory,
-                  "refuse resolutions whose estimated memory exceeds this (e.g. 4G; default 80 % of RAM)");
+  add_max_memory(command, options.max_memory);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  remove_temporaries_on_signals();
   CLI::App app{"tridex: simulate 3+2-axis milling (G68.2 tilted planes) from a G-code program to a\n"
                "watertight STL, a picture and a report. Method: Inui, Chen and Umezu, CAD&A 19(4) 2022.",
                "tridex"};
@@ -88,41 +118,43 @@ int main(int argc, char** argv) {
   SimulateOptions simulate;
   CLI::App* sim = app.add_subcommand("simulate", "mill the program into its stock and write the machined solid");
   add_simulate(*sim, simulate);
-  sim->add_option("-o,--output", simulate.output, "write the result as binary STL");
-  sim->add_option("--png", simulate.png, "write a shaded picture of the result (off-screen OSMesa)");
-  sim->add_option("--report", simulate.report, "write the JSON report");
+  sim->add_option("-o,--output", simulate.output, "write the result as binary STL")->check(kNotEmpty);
+  sim->add_option("--png", simulate.png, "write a shaded picture of the result (off-screen OSMesa)")->check(kNotEmpty);
+  sim->add_option("--report", simulate.report, "write the JSON report")->check(kNotEmpty);
 
   CheckOptions check;
   CLI::App* chk = app.add_subcommand(
       "check", "compare the machined result with a design: gouges, excess, rapids into stock, envelope;\n"
                "exit status 3 when anything is found");
   add_simulate(*chk, check);
-  chk->add_option("--design", check.design, "the designed part, a closed STL")->required();
+  chk->add_option("--design", check.design, "the designed part, a closed STL")->required()->check(kNotEmpty);
   auto* tolerance = chk->add_option("--tolerance", check.tolerance,
                                     "gouge and excess tolerance, mm (default: one dexel spacing)")
-                        ->check(CLI::PositiveNumber);
+                        ->check(kFinitePositive);
   chk->add_option("--gouge-tol", check.gouge_tol, "material removed inside the design beyond this is a gouge, mm")
-      ->check(CLI::PositiveNumber)
+      ->check(kFinitePositive)
       ->excludes(tolerance);
   chk->add_option("--excess-tol", check.excess_tol, "material left outside the design beyond this is excess, mm")
-      ->check(CLI::PositiveNumber)
+      ->check(kFinitePositive)
       ->excludes(tolerance);
   chk->add_option("--envelope", check.envelope,
-                  "box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX: every move whose tool tip ends outside is a finding");
-  chk->add_option("-o,--output", check.output, "write the machined result as binary STL");
-  chk->add_option("--report", check.report, "write the JSON report of the check");
-  chk->add_option("--png", check.png, "write a picture coloured by deviation, with a legend");
-  chk->add_option("--ply", check.ply, "write the machined mesh as PLY with per-vertex colour by deviation");
+                  "box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX: every move whose tool tip ends outside is a finding")
+      ->check(kNotEmpty);
+  chk->add_option("-o,--output", check.output, "write the machined result as binary STL")->check(kNotEmpty);
+  chk->add_option("--report", check.report, "write the JSON report of the check")->check(kNotEmpty);
+  chk->add_option("--png", check.png, "write a picture coloured by deviation, with a legend")->check(kNotEmpty);
+  chk->add_option("--ply", check.ply, "write the machined mesh as PLY with per-vertex colour by deviation")->check(kNotEmpty);
 
   ListOptions moves;
   CLI::App* mov = app.add_subcommand("moves", "print the interpreted moves as JSON Lines, one object per move");
   add_common(*mov, moves);
-  mov->add_option("-o,--output", moves.output, "write to a file instead of stdout");
+  mov->add_option("-o,--output", moves.output, "write to a file instead of stdout")->check(kNotEmpty);
 
   ListOptions groups;
   CLI::App* grp = app.add_subcommand("groups", "print the spindle-direction groups as JSON");
   add_common(*grp, groups);
-  grp->add_option("-o,--output", groups.output, "write to a file instead of stdout");
+  add_max_memory(*grp, groups.max_memory);
+  grp->add_option("-o,--output", groups.output, "write to a file instead of stdout")->check(kNotEmpty);
 
   try {
     app.parse(argc, argv);

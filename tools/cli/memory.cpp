@@ -41,6 +41,10 @@ std::uint64_t parse_memory(const std::string& text) {
   return static_cast<std::uint64_t>(bytes);
 }
 
+std::uint64_t max_memory_bytes(const std::string& option) {
+  return option.empty() ? physical_memory_bytes() / 10 * 8 : parse_memory(option);
+}
+
 MemoryEstimate estimate_memory(double zmap_points, double nx, double ny, double nz) {
   MemoryEstimate e;
   e.zmaps = 4.0 * zmap_points * 1.02;  // float heights plus tile maxima

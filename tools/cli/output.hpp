@@ -2,7 +2,10 @@
 //
 // Every output goes to a temporary file next to its destination and is renamed over it only once
 // complete, so a failed or interrupted run leaves no partial or empty file and an existing file
-// is replaced atomically (rename(2) within one directory).
+// is replaced atomically (rename(2) within one directory). SIGINT, SIGTERM and SIGHUP remove the
+// temporary files before the process dies (remove_temporaries_on_signals). An existing special
+// file (a device node such as /dev/null, a FIFO) is written in place instead: renaming over it
+// would replace the node with a regular file.
 #pragma once
 
 #include <cstdint>
@@ -10,6 +13,7 @@
 #include <fstream>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace tridex::cli {
@@ -33,6 +37,8 @@ class AtomicOutput {
   std::filesystem::path temporary_;
   std::ofstream stream_;
   bool committed_ = false;
+  bool in_place_ = false;  // a special file, written directly
+  int slot_ = -1;          // in the signal handler's list of temporaries
 };
 
 // Writes `bytes` to `path` through an AtomicOutput.
@@ -44,5 +50,13 @@ void write_file_atomically(const std::filesystem::path& path, const std::string&
 // Throws InputError naming `option` and the path.
 void check_output_path(const std::string& option, const std::filesystem::path& path,
                        std::span<const std::filesystem::path> inputs);
+
+// Throws InputError when two of (option, path) name the same file (special files excepted:
+// they are written in place, and /dev/null may take several outputs).
+void check_distinct_outputs(std::span<const std::pair<std::string, std::filesystem::path>> outputs);
+
+// Installs handlers for SIGINT, SIGTERM and SIGHUP that remove the temporary files of every
+// AtomicOutput alive, then end the process by the same signal. Called once by main().
+void remove_temporaries_on_signals();
 
 }  // namespace tridex::cli

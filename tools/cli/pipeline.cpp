@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 
@@ -30,7 +31,7 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-Stock load_stock(const StockSpec& spec, const Aabb& cutting_bounds) {
+Stock load_stock(const StockSpec& spec, const Aabb& cutting_bounds, std::uint64_t max_memory) {
   Stock stock;
   switch (spec.kind) {
     case StockSpec::Kind::box:
@@ -44,7 +45,8 @@ Stock load_stock(const StockSpec& spec, const Aabb& cutting_bounds) {
     }
     case StockSpec::Kind::mesh: {
       try {
-        stock.mesh = read_stl(spec.mesh_path.string(), StlOptions{.require_closed = true});
+        stock.mesh = read_stl(spec.mesh_path.string(), StlOptions{.require_closed = true, .max_bytes = max_memory,
+                                                           .limit_name = "--max-memory"});
       } catch (const tridex::Error& e) {
         input_error("--stock ", spec.mesh_path.string(), ": ", e.what());
       }
@@ -93,6 +95,53 @@ void mill_in_program_order(ZMap& map, const gcode::MoveGroup& group, std::size_t
   backends::mill_with(backend, map, cutters, batch, threads);
 }
 
+std::string describe_box(const Aabb& box) {
+  char text[160];
+  std::snprintf(text, sizeof text, "%g,%g,%g to %g,%g,%g", box.min.x, box.min.y, box.min.z, box.max.x,
+                box.max.y, box.max.z);
+  return text;
+}
+
+// The kernel's meshes hold float positions, and the surface's vertices stay exact while they lie
+// within about 1e5 lattice spacings of the world origin (surface.hpp); beyond that the dexel and
+// Z-map arithmetic fails in ways that say nothing to the user.
+constexpr double kMaxReachSpacings = 1e5;
+
+void check_reach(const std::string& what, const Aabb& box, double spacing) {
+  double reach = 0;
+  for (int a = 0; a < 3; ++a) reach = std::max({reach, std::abs(box.min[a]), std::abs(box.max[a])});
+  if (!(reach <= kMaxReachSpacings * spacing))
+    input_error(what, " reaches ", reach, " mm from the origin, beyond the coordinates tridex represents exactly at a ",
+                "dexel spacing of ", spacing, " mm (", kMaxReachSpacings * spacing, " mm, ", kMaxReachSpacings,
+                " spacings); move it nearer the origin or use a larger --dexel-cell");
+}
+
+// The files --dump-zmaps writes for the groups: DIR/zmap-<k>-<axis>.stl and .png.
+std::vector<fs::path> dump_names(const std::string& directory, const std::vector<gcode::MoveGroup>& groups) {
+  std::vector<fs::path> names;
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    fs::path base = fs::path(directory) / ("zmap-" + std::to_string(g + 1) + "-" + axis_label(groups[g].axis));
+    names.push_back(base.string() + ".stl");
+    names.push_back(base.string() + ".png");
+  }
+  return names;
+}
+
+// The dump files are named by the directions, known once the program is read: checked then,
+// before any milling, against every input and every other output.
+void check_dump_names(const std::string& directory, const std::vector<gcode::MoveGroup>& groups,
+                      const std::vector<std::pair<std::string, fs::path>>& outputs,
+                      const std::vector<fs::path>& inputs) {
+  std::vector<std::pair<std::string, fs::path>> all;
+  for (const auto& [option, path] : outputs)
+    if (!path.empty()) all.emplace_back(option, path);
+  for (const fs::path& name : dump_names(directory, groups)) {
+    check_output_path("--dump-zmaps", name, inputs);
+    all.emplace_back("--dump-zmaps", name);
+  }
+  check_distinct_outputs(all);
+}
+
 }  // namespace
 
 std::string axis_label(const Vec3& axis) {
@@ -126,9 +175,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   StockSpec stock_spec;
   if (!options.stock.empty()) stock_spec = parse_stock(options.stock);
   else if (input.stock) stock_spec = *input.stock;
-  std::uint64_t max_memory = options.max_memory.empty()
-                                 ? physical_memory_bytes() / 10 * 8
-                                 : parse_memory(options.max_memory);
+  const std::uint64_t max_memory = max_memory_bytes(options.max_memory);
 
   std::vector<fs::path> inputs(input.files.begin(), input.files.end());
   inputs.push_back(input.program);
@@ -137,6 +184,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   inputs.insert(inputs.end(), request.extra_inputs.begin(), request.extra_inputs.end());
   for (const auto& [option, path] : request.outputs)
     if (!path.empty()) check_output_path(option, path, inputs);
+  check_distinct_outputs(request.outputs);
   if (!options.dump_zmaps.empty()) {
     std::error_code error;
     fs::create_directories(options.dump_zmaps, error);
@@ -147,12 +195,13 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   // ---- parse, grouped by spindle direction ------------------------------------------------
   progress.stage("parsing " + input.program.string());
   Clock::time_point t = Clock::now();
-  gcode::InterpreterOptions interpreter_options;
-  interpreter_options.arc_tolerance = options.arc_tolerance;
-  interpreter_options.lenient = options.lenient;
   gcode::DirectionGrouper grouper;
+  // simulate must hold every move: grouped by direction (a vector's capacity can be twice its
+  // size), then as one direction's cutter sweeps while it is milled.
+  MoveBudget budget(max_memory, 2.0 * sizeof(gcode::Move) + sizeof(CutMove) + sizeof(void*));
   Aabb cutting_bounds;
-  InterpretResult parsed = interpret(input, interpreter_options, [&](const gcode::Move& m, std::size_t) {
+  InterpretResult parsed = interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t file) {
+    budget.keep(m, input.files[file].string());
     grouper.add(m);
     if (m.kind != gcode::MoveKind::rapid) {
       // An approach from "far along the tool axis" is not where the work is.
@@ -164,6 +213,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   std::vector<gcode::MoveGroup>& groups = r.groups;
   r.warnings = parsed.warnings;
   r.timings.parse = seconds_since(t);
+  if (!options.dump_zmaps.empty()) check_dump_names(options.dump_zmaps, groups, request.outputs, inputs);
 
   // ---- cutters: every tool used must be in the table --------------------------------------
   std::vector<Cutter>& cutters = r.cutters;
@@ -208,7 +258,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
                          " rapid move(s) before the first tool change were not simulated (no tool)");
 
   // ---- stock, resolutions, and the memory they need ---------------------------------------
-  r.stock = load_stock(stock_spec, cutting_bounds);
+  r.stock = load_stock(stock_spec, cutting_bounds, max_memory);
   const Stock& stock = r.stock;
   const double diagonal = glm::length(stock.box.size());
   const double zmap_cell = options.zmap_cell > 0 ? options.zmap_cell : diagonal * kDefaultZmapCellFraction;
@@ -221,6 +271,9 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
     input_error("dexel resolution: ", e.what());
   }
   const DexelLattice& lattice = r.lattice;
+  check_reach(stock_spec.kind == StockSpec::Kind::mesh ? "--stock " + stock_spec.mesh_path.string() : "the stock",
+              stock.box, lattice.spacing);
+  for (const auto& [what, bounds] : request.extra_bounds) check_reach(what, bounds, lattice.spacing);
   double zmap_points = 0;
   for (const gcode::MoveGroup& group : groups) {
     try {
@@ -231,9 +284,11 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
     zmap_points += static_cast<double>(r.grids.back().nx) * r.grids.back().ny;
   }
   r.memory = estimate_memory(zmap_points, lattice.n.x, lattice.n.y, lattice.n.z);
+  r.memory.moves = budget.bytes();
   const MemoryEstimate& need = r.memory;
   if (need.total() > static_cast<double>(max_memory))
-    input_error("the resolution needs an estimated ", format_mib(need.total()), " (Z-maps ",
+    input_error("the resolution needs an estimated ", format_mib(need.total()), " (", budget.kept(), " moves ",
+                format_mib(need.moves), ", Z-maps ",
                 format_mib(need.zmaps), ", dexels ", format_mib(need.dexels), ", mesh ",
                 format_mib(need.mesh), "), more than --max-memory ",
                 format_mib(static_cast<double>(max_memory)),
@@ -288,12 +343,11 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   r.timings.zmap = seconds_since(t);
 
   if (!options.dump_zmaps.empty()) {
+    const std::vector<fs::path> names = dump_names(options.dump_zmaps, groups);
     for (std::size_t g = 0; g < maps.size(); ++g) {
       progress.stage("writing Z-map " + std::to_string(g + 1) + " to " + options.dump_zmaps);
-      fs::path base = fs::path(options.dump_zmaps) /
-                      ("zmap-" + std::to_string(g + 1) + "-" + axis_label(groups[g].axis));
-      write_stl_file(base.string() + ".stl", polyhedrize(maps[g]));
-      write_png_file(base.string() + ".png", render::render_heights(maps[g]));
+      write_stl_file(names[2 * g], polyhedrize(maps[g]));
+      write_png_file(names[2 * g + 1], render::render_heights(maps[g]));
     }
   }
 
@@ -318,6 +372,12 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   r.result = backends::machine_with(backends::parse_dexel_backend(options.dexel_backend), stock_dexel, maps,
                                     options.threads);
   r.timings.intersect = seconds_since(t);
+  // The result is the stock less the cuts: the same volume means no move reached the stock (a
+  // stock given far from where the program works, say). Not an error, but surely not meant.
+  const double stock_dexel_volume = tridex::volume(stock_dexel);
+  if (tridex::volume(r.result) >= stock_dexel_volume * (1 - 1e-12))
+    r.warnings.push_back("nothing was cut: no move reaches the stock (" + describe_box(stock.box) +
+                         "); the result is the whole stock");
   stock_dexel = TripleDexel{};
   maps = std::move(kept_maps);
   maps.shrink_to_fit();

@@ -51,6 +51,9 @@ enum class RapidCheck {
 struct PipelineRequest {
   std::vector<std::pair<std::string, std::filesystem::path>> outputs;  // (option, path), checked first
   std::vector<std::filesystem::path> extra_inputs;                     // never overwritten either
+  // Other geometry that must lie within the exact range on the lattice (check's design), with
+  // its name for the message.
+  std::vector<std::pair<std::string, Aabb>> extra_bounds;
   RapidCheck rapid_check = RapidCheck::against_feeds;
   bool keep_maps = false;  // keep the milled Z-maps (otherwise released after Step 3)
 };

@@ -4,6 +4,7 @@
 
 #include "errors.hpp"
 #include "machine_file.hpp"
+#include "memory.hpp"
 #include "project.hpp"
 
 namespace tridex::cli {
@@ -16,6 +17,7 @@ ProgramInput resolve_program(const CommonOptions& options) {
   input.machine = load_machine(options.machine, options.subprograms);
   input.program = program;
   std::error_code error;
+  if (fs::is_directory(input.program, error)) input_error(program, ": is a directory, not a program file");
   if (!fs::is_regular_file(input.program, error))
     input_error(program, ": no such program file");
   if (is_project_file(input.program)) {
@@ -29,6 +31,23 @@ ProgramInput resolve_program(const CommonOptions& options) {
   return input;
 }
 
+gcode::InterpreterOptions interpreter_options(const CommonOptions& options) {
+  gcode::InterpreterOptions o;
+  o.arc_tolerance = options.arc_tolerance;
+  o.lenient = options.lenient;
+  o.max_blocks = options.max_blocks;
+  return o;
+}
+
+void MoveBudget::keep(const gcode::Move& move, const std::string& file) {
+  ++kept_;
+  if (bytes() > static_cast<double>(max_bytes_))
+    input_error(file, ":", move.line, ": the program expands into more than ", kept_ - 1, " moves (",
+                format_mib(bytes()), " to keep them), more than --max-memory ",
+                format_mib(static_cast<double>(max_bytes_)),
+                "; raise --max-memory, or give a larger --arc-tolerance if fine arcs make the moves");
+}
+
 InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOptions& options,
                           const std::function<void(const gcode::Move&, std::size_t file)>& sink) {
   InterpretResult result;
@@ -37,10 +56,17 @@ InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOpt
     const fs::path& path = input.files[f];
     std::ifstream in(path, std::ios::binary);
     if (!in) input_error(path.string(), ": cannot open the program file");
-    interpreter.run(in, path.string(), [&](const gcode::Move& move) {
-      ++result.moves;
-      sink(move, f);
-    });
+    try {
+      interpreter.run(in, path.string(), [&](const gcode::Move& move) {
+        ++result.moves;
+        sink(move, f);
+      });
+    } catch (const gcode::GcodeError& e) {
+      if (options.max_blocks <= 0 || interpreter.blocks() <= options.max_blocks) throw;
+      input_error(e.where.file, ":", e.where.line, ":", e.where.column, ": more than ", options.max_blocks,
+                  " blocks executed (--max-blocks ", options.max_blocks,
+                  "; nested M98 ... L repeats?); raise --max-blocks if the program needs more");
+    }
     for (const gcode::Diagnostic& d : interpreter.warnings()) result.warnings.push_back(d.to_string());
     for (const auto& [tool, line] : interpreter.tool_first_line())
       result.tool_first_line.try_emplace(tool, ToolSelection{path.string(), line});

@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
@@ -38,8 +39,29 @@ struct InterpretResult {
   long long moves = 0;
 };
 
+// The interpreter's options from the command's: arc tolerance, --lenient and --max-blocks.
+gcode::InterpreterOptions interpreter_options(const CommonOptions& options);
+
+// Counts the moves a command keeps in memory against its --max-memory, so that a program that
+// expands into too many moves (nested M98 ... L loops, arcs at a tiny --arc-tolerance) stops with
+// exit status 2 and the count instead of running out of memory.
+class MoveBudget {
+ public:
+  MoveBudget(std::uint64_t max_bytes, double bytes_per_move) : max_bytes_(max_bytes), per_move_(bytes_per_move) {}
+  // Throws InputError, naming the file and line of the move that crosses the limit.
+  void keep(const gcode::Move& move, const std::string& file);
+  long long kept() const { return kept_; }
+  double bytes() const { return static_cast<double>(kept_) * per_move_; }
+
+ private:
+  std::uint64_t max_bytes_;
+  double per_move_;
+  long long kept_ = 0;
+};
+
 // Runs every file of the program through the interpreter, streaming moves to `sink` with the
-// index of the file they came from. GcodeError propagates (exit status 2).
+// index of the file they came from. GcodeError propagates (exit status 2); running past
+// options.max_blocks is an InputError that names --max-blocks.
 InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOptions& options,
                           const std::function<void(const gcode::Move&, std::size_t file)>& sink);
 

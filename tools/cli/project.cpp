@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "errors.hpp"
+#include "json_input.hpp"
 
 namespace tridex::cli {
 
@@ -37,14 +38,10 @@ Vec3 read_point(const nlohmann::json& value, const std::string& where) {
 }  // namespace
 
 Project read_project(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) input_error(path.string(), ": cannot open the project file");
-  nlohmann::json json;
-  try {
-    json = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    input_error(path.string(), ": not a valid CAMotics project (", e.what(), ")");
-  }
+  return project_from_json(read_json_file(path), path);
+}
+
+Project project_from_json(const nlohmann::json& json, const fs::path& path) {
   if (!json.is_object()) input_error(path.string(), ": a CAMotics project must be a JSON object");
   const std::string source = path.string();
   Project project;
@@ -57,7 +54,9 @@ Project read_project(const fs::path& path) {
     std::string name;
     if (f.is_string()) name = f.get<std::string>();
     else if (f.is_object() && f.contains("path") && f["path"].is_string()) name = f["path"].get<std::string>();
-    else input_error(source, ": \"files\" entries must be file names");
+    else input_error(source, ": \"files\" entries must be file names, got ", json_type_name(f));
+    if (name.empty() || name.find('\0') != std::string::npos)
+      input_error(source, ": \"files\" holds an empty or invalid file name");
     fs::path file = name;
     if (file.is_relative()) file = folder / file;
     std::error_code error;
@@ -70,10 +69,17 @@ Project read_project(const fs::path& path) {
   if (auto work = json.find("workpiece"); work != json.end()) {
     if (!work->is_object()) input_error(source, ": \"workpiece\" must be an object");
     StockSpec stock;
-    bool automatic = work->value("automatic", true);
+    bool automatic = true;
+    if (auto flag = work->find("automatic"); flag != work->end()) {
+      if (!flag->is_boolean())
+        input_error(source, ": workpiece \"automatic\" must be true or false, got ", json_type_name(*flag),
+                    flag->is_string() ? " " + flag->dump() : std::string());
+      automatic = flag->get<bool>();
+    }
     if (auto margin = work->find("margin"); margin != work->end()) {
-      if (!margin->is_number() || margin->get<double>() < 0)
-        input_error(source, ": workpiece \"margin\" must be a non-negative number (percent)");
+      if (!margin->is_number() || !(margin->get<double>() >= 0))
+        input_error(source, ": workpiece \"margin\" must be a non-negative number (percent), got ",
+                    margin->is_number() ? margin->dump() : json_type_name(*margin));
       stock.margin_percent = margin->get<double>();
     }
     auto bounds = work->find("bounds");
@@ -81,8 +87,12 @@ Project read_project(const fs::path& path) {
       if (bounds == work->end() || !bounds->is_object())
         input_error(source, ": a workpiece that is not automatic needs \"bounds\"");
       stock.kind = StockSpec::Kind::box;
-      stock.box = Aabb{read_point(bounds->value("min", nlohmann::json()), source + ": workpiece bounds min"),
-                       read_point(bounds->value("max", nlohmann::json()), source + ": workpiece bounds max")};
+      auto corner = [&](const char* key) {
+        auto found = bounds->find(key);
+        return read_point(found == bounds->end() ? nlohmann::json() : *found,
+                          source + ": workpiece bounds " + key);
+      };
+      stock.box = Aabb{corner("min"), corner("max")};
       for (int a = 0; a < 3; ++a)
         if (!(stock.box.min[a] < stock.box.max[a]))
           input_error(source, ": workpiece bounds min must be below max on every axis");

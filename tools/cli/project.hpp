@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "stock.hpp"
 #include "tool_table.hpp"
 
@@ -24,6 +26,9 @@ struct Project {
 
 // True if `path` looks like a CAMotics project (its extension, or a leading '{').
 bool is_project_file(const std::filesystem::path& path);
+// Throws InputError naming the file and the key for any fault (json_input.hpp).
 Project read_project(const std::filesystem::path& path);
+// The same from parsed JSON; `path` names the project and its folder holds the program files.
+Project project_from_json(const nlohmann::json& json, const std::filesystem::path& path);
 
 }  // namespace tridex::cli

@@ -9,19 +9,30 @@
 
 namespace tridex::cli {
 
+Aabb parse_box(const std::string& numbers, const std::string& option) {
+  std::vector<double> v = parse_number_list(numbers, option + " box");
+  if (v.size() != 6)
+    input_error(option, " box: expected XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX (6 numbers), got ", v.size());
+  Aabb box{Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5])};
+  const char* names = "XYZ";
+  for (int a = 0; a < 3; ++a)
+    if (!(box.min[a] < box.max[a]))
+      input_error(option, " box: ", names[a], "MIN ", box.min[a], " must be less than ", names[a], "MAX ",
+                  box.max[a]);
+  return box;
+}
+
+Aabb parse_envelope(const std::string& text) {
+  if (text.rfind("box:", 0) != 0)
+    input_error("--envelope ", text, ": expected box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX");
+  return parse_box(text.substr(4), "--envelope");
+}
+
 StockSpec parse_stock(const std::string& text) {
   StockSpec spec;
   if (text.rfind("box:", 0) == 0) {
-    std::vector<double> v = parse_number_list(text.substr(4), "--stock box");
-    if (v.size() != 6)
-      input_error("--stock box: expected XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX (6 numbers), got ", v.size());
     spec.kind = StockSpec::Kind::box;
-    spec.box = Aabb{Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5])};
-    const char* names = "XYZ";
-    for (int a = 0; a < 3; ++a)
-      if (!(spec.box.min[a] < spec.box.max[a]))
-        input_error("--stock box: ", names[a], "MIN ", spec.box.min[a], " must be less than ",
-                    names[a], "MAX ", spec.box.max[a]);
+    spec.box = parse_box(text.substr(4), "--stock");
     return spec;
   }
   if (text == "auto" || text.rfind("auto:", 0) == 0) {

@@ -23,6 +23,12 @@ struct StockSpec {
 // Parses the option text; throws InputError naming the option and the offending part.
 StockSpec parse_stock(const std::string& text);
 
+// "XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX" (the part after "box:"), min below max on every axis; throws
+// InputError naming `option`.
+Aabb parse_box(const std::string& numbers, const std::string& option);
+// `check --envelope box:…`.
+Aabb parse_envelope(const std::string& text);
+
 // The automatic stock around `cutting_bounds` (the tool-tip box of the cutting moves), following
 // CAMotics: the top is the highest cut or z = 0 whichever is higher when the cuts go below 0, at
 // least 2 mm thick, then a margin on every side but the top when it is a percentage.

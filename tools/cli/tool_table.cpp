@@ -2,13 +2,15 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cmath>
-#include <fstream>
+#include <map>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "errors.hpp"
+#include "json_input.hpp"
 
 namespace tridex::cli {
 
@@ -25,7 +27,8 @@ double number_field(const nlohmann::json& tool, const std::string& where,
   for (const char* key : keys) {
     auto it = tool.find(key);
     if (it == tool.end()) continue;
-    if (!it->is_number()) input_error(where, ": \"", key, "\" must be a number, got ", it->dump());
+    if (!it->is_number())
+      input_error(where, ": \"", key, "\" must be a number, got ", json_type_name(*it));
     double value = it->get<double>();
     if (!std::isfinite(value) || value < 0)
       input_error(where, ": \"", key, "\" must be a finite non-negative number, got ", value);
@@ -95,25 +98,25 @@ ToolTable ToolTable::from_json(const nlohmann::json& table, const std::string& s
   if (!table.is_object())
     input_error(source, ": a tool table must be a JSON object keyed by tool number");
   ToolTable result;
+  std::map<int, std::string> key_of;  // tool number -> its key, to name both of a duplicate
   for (auto it = table.begin(); it != table.end(); ++it) {
     const std::string& key = it.key();
     std::string where = source + ": tool \"" + key + "\"";
-    std::size_t used = 0;
+    // Digits only: std::stoi would also take " 1" and "+1", and "01" is the same tool as "1".
     int number = -1;
-    try {
-      number = std::stoi(key, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != key.size() || number < 0)
-      input_error(where, ": the key must be a non-negative tool number");
+    auto [end, error] = std::from_chars(key.data(), key.data() + key.size(), number);
+    if (key.empty() || !std::isdigit(static_cast<unsigned char>(key[0])) || error != std::errc() ||
+        end != key.data() + key.size())
+      input_error(where, ": the key must be a non-negative tool number (digits only)");
+    if (auto [previous, inserted] = key_of.emplace(number, key); !inserted)
+      input_error(source, ": keys \"", previous->second, "\" and \"", key, "\" are both tool ", number);
     where = source + ": tool " + std::to_string(number);
     const nlohmann::json& tool = it.value();
-    if (!tool.is_object()) input_error(where, ": must be a JSON object");
+    if (!tool.is_object()) input_error(where, ": must be a JSON object, got ", json_type_name(tool));
 
     double scale = 1;
     if (auto units = tool.find("units"); units != tool.end()) {
-      if (!units->is_string()) input_error(where, ": \"units\" must be a string");
+      if (!units->is_string()) input_error(where, ": \"units\" must be a string, got ", json_type_name(*units));
       std::string u = lower(units->get<std::string>());
       if (u == "mm" || u == "metric") scale = 1;
       else if (u == "inch" || u == "in" || u == "imperial") scale = 25.4;
@@ -139,15 +142,7 @@ ToolTable ToolTable::from_json(const nlohmann::json& table, const std::string& s
 }
 
 ToolTable ToolTable::read(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) input_error("--tools ", path.string(), ": cannot open the file");
-  nlohmann::json table;
-  try {
-    table = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    input_error(path.string(), ": not valid JSON (", e.what(), ")");
-  }
-  return from_json(table, path.string());
+  return from_json(read_json_file(path), path.string());
 }
 
 }  // namespace tridex::cli

@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer harnesses of the command's input formats with clang and runs each for a
+# share of a bounded total time, with a fixed seed:
+#   tools/fuzz/run.sh [SECONDS=60] [BUILD_DIR=build-fuzz]
+#   stl         the STL reader, binary and ASCII (include/tridex/stl.hpp)
+#   tool_table  the tool table, CAMotics schema (tools/cli/tool_table.cpp, json_input.cpp)
+#   project     the .camotics project (tools/cli/project.cpp)
+#   options     --stock, --envelope and --max-memory (tools/cli/stock.cpp, memory.cpp)
+# Exit status 0: no crash in that time. A crash leaves its input as BUILD_DIR/<harness>-crash-*
+# and stops the script with a non-zero status; turn it into a named case in
+# tests/tools/test_bad_input.cpp with the input under tests/data/.
+# (The G-code front end has its own harness: gcode/fuzz/run.sh.)
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+seconds=${1:-60}
+build=${2:-build-fuzz}
+harnesses=(stl tool_table project options)
+share=$(( seconds / ${#harnesses[@]} ))
+[ "$share" -ge 1 ] || share=1
+flags=(-std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined
+       -Iinclude -Igcode/include -Itools/cli)
+mkdir -p "$build/inputs"
+# The command's parsers, compiled once (-fsanitize=fuzzer-no-link: instrumented, no main).
+objects=()
+for source in json_input memory numbers project stock tool_table; do
+  object="$build/inputs/$source.o"
+  if [ ! -f "$object" ] || [ "tools/cli/$source.cpp" -nt "$object" ]; then
+    clang++ "${flags[@]/-fsanitize=fuzzer,address,undefined/-fsanitize=fuzzer-no-link,address,undefined}" \
+      -c "tools/cli/$source.cpp" -o "$object"
+  fi
+  objects+=("$object")
+done
+for h in "${harnesses[@]}"; do
+  clang++ "${flags[@]}" "tools/fuzz/fuzz_$h.cpp" "${objects[@]}" -o "$build/inputs/fuzz_$h"
+done
+# A fixed seed (FUZZ_SEED, default 1) makes CI explore the same inputs in the same order.
+for h in "${harnesses[@]}"; do
+  mkdir -p "$build/inputs/corpus_$h"
+  echo "== fuzz_$h: ${share} s"
+  if ! "$build/inputs/fuzz_$h" -seed="${FUZZ_SEED:-1}" -max_total_time="$share" -timeout=10 -rss_limit_mb=2048 \
+      -max_len=4096 -artifact_prefix="$build/$h-" -print_final_stats=1 \
+      "$build/inputs/corpus_$h" "tools/fuzz/seeds/$h" >"$build/inputs/fuzz_$h.log" 2>&1; then
+    tail -n 40 "$build/inputs/fuzz_$h.log" >&2
+    echo "fuzz_$h found a crash: its input is $build/$h-crash-* (or -leak-, -timeout-, -oom-)" >&2
+    exit 1
+  fi
+  grep -E 'stat::(number_of_executed_units|new_units_added)' "$build/inputs/fuzz_$h.log"
+done
