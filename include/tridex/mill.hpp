@@ -287,12 +287,13 @@ struct MoveGeometry {
   // A supporting plane of the swept lower surface S at (x, y), where S(x, y) = p.z is finite:
   // S(q) ≥ p.z + gradient·(q − (x, y)) for every q. S is convex (the lower surface of a convex
   // swept solid), and where the cutter's lower surface is differentiable at the minimiser, the
-  // gradient is h'(d)·(q − C(t*))/d (joint convexity in (q, t) plus optimality of t*). False
-  // where that does not hold: at the rim (d = R) and at kinks of the profile.
+  // gradient is h'(d)·(q − C(t*))/d (joint convexity in (q, t) plus optimality of t*; where t*
+  // is clamped to an end of the move, the sign of f' there keeps the bound). False where that
+  // does not hold: at the rim (d = R) and near kinks of the profile (within far more than the
+  // minimiser's error: regula falsi ends on a bracket of 1e-13 in t).
   bool supporting_plane(double x, double y, const Lowest& p, Vec2& gradient) const {
     CutterShape shape = cutter->shape();
     if (shape == CutterShape::flat) return flat_supporting_plane(x, y, gradient);
-    if (shape != CutterShape::ball && shape != CutterShape::bull_nose) return false;
     double dx = x - (ax + p.t * vx), dy = y - (ay + p.t * vy);
     double d2 = dx * dx + dy * dy;
     if (d2 >= radius2 * (1 - 1e-7)) return false;
@@ -301,8 +302,20 @@ struct MoveGeometry {
       return true;
     }
     double d = std::sqrt(d2);
+    if (shape == CutterShape::general && near_kink(d)) return false;
     gradient = d > 0 ? (cutter->lower_slope(d) / d) * Vec2(dx, dy) : Vec2(0);
     return true;
+  }
+
+  // Whether h(|p|) may not be differentiable within 1e-8·R of distance d: at the joints of the
+  // profile's pieces, and on the axis where the profile starts sloped (a cone's point).
+  bool near_kink(double d) const {
+    const double tolerance = 1e-8 * radius;
+    const std::vector<ProfilePiece>& pieces = cutter->pieces();
+    if (d <= tolerance && pieces.front().derivative(0) != 0) return true;
+    for (std::size_t k = 1; k < pieces.size(); ++k)
+      if (std::abs(d - pieces[k].d0) <= tolerance) return true;
+    return false;
   }
 
   // The flat end's S is az + w·t_edge, t_edge the parameter where the end disc first (w > 0) or
