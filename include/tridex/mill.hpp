@@ -26,7 +26,11 @@
 //      when measured from P (so that sloped surfaces skip as well as flat ones), cut the tile
 //      row by row, each row read once and lowered by every move admitted there.
 // Ball end moves are bounded kLanes tiles at a time and evaluated kLanes points at a time, with
-// one square root per point (BallLanes). Every point ends at the minimum over moves of a value
+// one square root per point (BallLanes); flat end and bull nose moves are evaluated kLanes points
+// at a time too (FlatLanes: a closed form; BullLanes: Newton steps with no square root). The moves
+// left for a tile in pass 2 are cut lowest bound first, a run of one cutter at a time, each run
+// checked against what the tile holds by then: so a tile first cut by any cutter, or roughed
+// deeper by another cutter, still rejects the moves that cut air. Every point ends at the minimum over moves of a value
 // computed the same way whatever the order, so the result is identical for any thread count and
 // any move order (for one build: the vector width and FMA contraction change the last bits).
 #pragma once
