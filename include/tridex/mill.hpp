@@ -26,7 +26,11 @@
 //      when measured from P (so that sloped surfaces skip as well as flat ones), cut the tile
 //      row by row, each row read once and lowered by every move admitted there.
 // Ball end moves are bounded kLanes tiles at a time and evaluated kLanes points at a time, with
-// one square root per point (BallLanes). Every point ends at the minimum over moves of a value
+// one square root per point (BallLanes); flat end and bull nose moves are evaluated kLanes points
+// at a time too (FlatLanes: a closed form; BullLanes: Newton steps with no square root). The moves
+// left for a tile in pass 2 are cut lowest bound first, a run of one cutter at a time, each run
+// checked against what the tile holds by then: so a tile first cut by any cutter, or roughed
+// deeper by another cutter, still rejects the moves that cut air. Every point ends at the minimum over moves of a value
 // computed the same way whatever the order, so the result is identical for any thread count and
 // any move order (for one build: the vector width and FMA contraction change the last bits).
 #pragma once
@@ -287,12 +291,13 @@ struct MoveGeometry {
   // A supporting plane of the swept lower surface S at (x, y), where S(x, y) = p.z is finite:
   // S(q) ≥ p.z + gradient·(q − (x, y)) for every q. S is convex (the lower surface of a convex
   // swept solid), and where the cutter's lower surface is differentiable at the minimiser, the
-  // gradient is h'(d)·(q − C(t*))/d (joint convexity in (q, t) plus optimality of t*). False
-  // where that does not hold: at the rim (d = R) and at kinks of the profile.
+  // gradient is h'(d)·(q − C(t*))/d (joint convexity in (q, t) plus optimality of t*; where t*
+  // is clamped to an end of the move, the sign of f' there keeps the bound). False where that
+  // does not hold: at the rim (d = R) and near kinks of the profile (within far more than the
+  // minimiser's error: regula falsi ends on a bracket of 1e-13 in t).
   bool supporting_plane(double x, double y, const Lowest& p, Vec2& gradient) const {
     CutterShape shape = cutter->shape();
     if (shape == CutterShape::flat) return flat_supporting_plane(x, y, gradient);
-    if (shape != CutterShape::ball && shape != CutterShape::bull_nose) return false;
     double dx = x - (ax + p.t * vx), dy = y - (ay + p.t * vy);
     double d2 = dx * dx + dy * dy;
     if (d2 >= radius2 * (1 - 1e-7)) return false;
@@ -301,8 +306,20 @@ struct MoveGeometry {
       return true;
     }
     double d = std::sqrt(d2);
+    if (shape == CutterShape::general && near_kink(d)) return false;
     gradient = d > 0 ? (cutter->lower_slope(d) / d) * Vec2(dx, dy) : Vec2(0);
     return true;
+  }
+
+  // Whether h(|p|) may not be differentiable within 1e-8·R of distance d: at the joints of the
+  // profile's pieces, and on the axis where the profile starts sloped (a cone's point).
+  bool near_kink(double d) const {
+    const double tolerance = 1e-8 * radius;
+    const std::vector<ProfilePiece>& pieces = cutter->pieces();
+    if (d <= tolerance && pieces.front().derivative(0) != 0) return true;
+    for (std::size_t k = 1; k < pieces.size(); ++k)
+      if (std::abs(d - pieces[k].d0) <= tolerance) return true;
+    return false;
   }
 
   // The flat end's S is az + w·t_edge, t_edge the parameter where the end disc first (w > 0) or
@@ -481,6 +498,108 @@ struct BallLanes {
   }
 };
 
+// A non-vertical move stored rising (w ≥ 0; a falling move is the same swept solid run
+// backwards), for the flat end's and the bull nose's vector forms: which points its cutter of
+// radius R passes over, and the parameter interval [lo, hi] over which it covers each, as in
+// MoveGeometry::lowest.
+struct RisingMove {
+  double ax = 0, ay = 0, low = 0;  // start of the rising move and its tip height
+  double vx = 0, vy = 0, w = 0, vv = 0, inv_vv = 0, inv_len = 0, r2 = 0;
+
+  RisingMove() = default;
+
+  explicit RisingMove(const MoveGeometry& m) {
+    const bool falling = m.w < 0;
+    ax = falling ? m.ax + m.vx : m.ax, ay = falling ? m.ay + m.vy : m.ay;
+    vx = falling ? -m.vx : m.vx, vy = falling ? -m.vy : m.vy, w = std::abs(m.w);
+    low = m.lowest_tip();
+    vv = m.vv, inv_vv = m.inv_vv, inv_len = m.inv_len, r2 = m.radius2;
+  }
+
+  struct Cover {
+    DoubleN t_foot, e2, lo, hi;  // foot on the move's line, squared distance to it, the interval
+    MaskN covered;
+  };
+
+  // At offsets (ux, uy) from the start.
+  Cover cover(DoubleN ux, DoubleN uy) const {
+    DoubleN dot = ux * vx + uy * vy, t = dot * inv_vv;
+    DoubleN e2 = max_n(ux * ux + uy * uy - t * dot, splat(0));
+    DoubleN k = sqrt_n(max_n(r2 - e2, splat(0))) * inv_len;
+    DoubleN lo = t - k, hi = t + k;
+    return {t, e2, max_n(lo, splat(0)), min_n(hi, splat(1)), (e2 <= r2) & (lo <= 1) & (hi >= 0)};
+  }
+};
+
+// The flat end's swept surface S, kLanes points at a time (MoveGeometry::lowest's closed form):
+// a rising move is lowest above q where its end disc first covers q, S = low + w·lo.
+struct FlatLanes : RisingMove {
+  FlatLanes() = default;
+  explicit FlatLanes(const MoveGeometry& m) : RisingMove(m) {}
+
+  DoubleN at(DoubleN ux, DoubleN uy) const {
+    Cover c = cover(ux, uy);
+    return c.covered ? low + w * c.lo : splat(kInf);
+  }
+};
+
+// The bull nose's swept surface S, kLanes points at a time. A level move is lowest where it comes
+// closest to q (closed form). A rising move (slope m = w/|v| > 0) has f(t) = low + t·w + h(d(t)),
+// d(t)² = e² + s²|v|², s = t − t⊥, convex, with f' = w + h'(d)·s|v|²/d: w > 0 under the flat
+// bottom (d ≤ R0 = R − r) and behind the axis (s > 0), so its one root lies ahead (s < 0) on
+// the corner, reach ρ = d − R0 ∈ (0, r], where h'(d) = ρ/√(r² − ρ²). There f' = 0 reads
+// ρ·√(d² − e²) = m·d·√(r² − ρ²), and dividing its square by ρ²d²,
+//     Q(ρ) = 1 + m² − m²r²/ρ² − e²/(R0 + ρ)² = 0,
+// with Q increasing and concave on ρ > 0, Q ≤ 0 at max(mr/√(1 + m²), e − R0) and Q(r) ≥ 0. Newton's
+// method from that left end stays left of the root and converges monotonically (a tangent of a
+// concave function lies above it), with no square root per step: 3.7 steps on average to 1e-12·r.
+// Then t* = t⊥ − √(d*² − e²)/|v|, clamped to the interval that covers q (f is convex), and S = f(t*)
+// evaluated at a point of the move, so a step short of the root can only leave S a little high,
+// never cut below the swept solid.
+struct BullLanes : RisingMove {
+  double flat = 0, corner = 0, corner2 = 0, m2 = 0, start = 0;
+
+  BullLanes() = default;
+  explicit BullLanes(const MoveGeometry& m) : RisingMove(m) {
+    corner = m.cutter->corner_radius(), corner2 = corner * corner;
+    flat = m.radius - corner;
+    m2 = w * w * inv_vv;
+    start = corner * std::sqrt(m2 / (1 + m2));  // the root for e = 0
+  }
+
+  // The corner's height h at distance d from the axis (0 under the flat bottom).
+  DoubleN height(DoubleN d) const {
+    DoubleN reach = max_n(d - flat, splat(0));
+    return corner - sqrt_n(max_n(corner2 - reach * reach, splat(0)));
+  }
+
+  // S at the points where `wanted` (+infinity elsewhere and where the cutter does not pass).
+  DoubleN at(DoubleN ux, DoubleN uy, MaskN wanted) const {
+    Cover c = cover(ux, uy);
+    MaskN covered = c.covered & wanted;
+    if (!any_n(covered)) return splat(kInf);
+    DoubleN t;
+    if (w == 0) {
+      t = min_n(max_n(c.t_foot, c.lo), c.hi);
+    } else {
+      const DoubleN e2 = c.e2, mr2 = splat(m2 * corner2), q0 = splat(1 + m2);
+      DoubleN reach = max_n(sqrt_n(e2) - flat, splat(start));
+      for (int step = 0; step < 30; ++step) {
+        DoubleN inv_reach = 1 / reach, inv_d = 1 / (flat + reach);
+        DoubleN a = mr2 * inv_reach * inv_reach, b = e2 * inv_d * inv_d;
+        DoubleN delta = (q0 - a - b) / (2 * (a * inv_reach + b * inv_d));
+        reach = min_n(reach - delta, splat(corner));
+        if (!any_n(covered & (abs_n(delta) > 1e-12 * corner))) break;
+      }
+      DoubleN d = flat + reach;
+      t = c.t_foot - sqrt_n(max_n(d * d - e2, splat(0))) * inv_len;
+      t = min_n(max_n(t, c.lo), c.hi);
+    }
+    DoubleN s = t - c.t_foot;
+    return covered ? low + t * w + height(sqrt_n(c.e2 + s * s * vv)) : splat(kInf);
+  }
+};
+
 // The milling of one Z-map: moves are binned to work blocks; each block is milled by one thread,
 // one row of tiles at a time (see `mill_bin`).
 class Miller {
@@ -588,14 +707,32 @@ class Miller {
     int col;
   };
 
+  // How a move's swept surface is evaluated on a tile's points: kLanes at a time by the ball
+  // end's, the flat end's or the bull nose's vector form, or one point at a time
+  // (MoveGeometry::lowest: plunges and the other cutters).
+  enum class LaneKind : unsigned char { scalar, ball, flat, bull_nose };
+
+  static LaneKind lane_kind(const MoveGeometry& m) {
+    if (m.vertical) return LaneKind::scalar;
+    switch (m.cutter->shape()) {
+      case CutterShape::ball: return LaneKind::ball;
+      case CutterShape::flat: return LaneKind::flat;
+      case CutterShape::bull_nose: return LaneKind::bull_nose;
+      default: return LaneKind::scalar;
+    }
+  }
+
   struct BlockScratch {
     std::vector<BallBounds> ball_bounds;  // of the current row
     std::vector<FarMove> far_moves;       // of the current row
     std::vector<DeferredMove> deferred;   // of the current row
     std::vector<std::uint32_t> by_tip;    // the other cutters' moves, lowest tip first
     std::vector<MoveGeometry> moves;
-    std::vector<BallLanes> balls;  // parallel to `moves`; used where `is_ball`
-    std::vector<unsigned char> is_ball;
+    // Parallel to `moves`: how each is evaluated, and its vector form where it has one.
+    std::vector<LaneKind> kind;
+    std::vector<BallLanes> balls;
+    std::vector<FlatLanes> flats;
+    std::vector<BullLanes> bulls;
     std::vector<IndexBox> boxes;
     TileRow row;
   };
@@ -642,21 +779,25 @@ class Miller {
   void mill_bin(std::size_t bin, BlockScratch& scratch) {
     if (bin_start_[bin] == bin_start_[bin + 1]) return;
     scratch.moves.clear();
+    scratch.kind.clear();
     scratch.balls.clear();
-    scratch.is_ball.clear();
+    scratch.flats.clear();
+    scratch.bulls.clear();
     scratch.boxes.clear();
     for (std::size_t k = bin_start_[bin]; k < bin_start_[bin + 1]; ++k) {
       const CutMove& move = moves_[bin_moves_[k]];
       const MoveGeometry& m = scratch.moves.emplace_back(cutters_[move.cutter], move.tip);
-      const bool ball = m.cutter->shape() == CutterShape::ball && !m.vertical;
-      scratch.is_ball.push_back(ball);
-      scratch.balls.push_back(ball ? BallLanes(m) : BallLanes{});
+      const LaneKind kind = lane_kind(m);
+      scratch.kind.push_back(kind);
+      scratch.balls.push_back(kind == LaneKind::ball ? BallLanes(m) : BallLanes{});
+      scratch.flats.push_back(kind == LaneKind::flat ? FlatLanes(m) : FlatLanes{});
+      scratch.bulls.push_back(kind == LaneKind::bull_nose ? BullLanes(m) : BullLanes{});
       scratch.boxes.emplace_back();
       footprint_box(move, scratch.boxes.back());
     }
     scratch.by_tip.clear();
     for (std::size_t k = 0; k < scratch.moves.size(); ++k)
-      if (!scratch.is_ball[k]) scratch.by_tip.push_back(static_cast<std::uint32_t>(k));
+      if (scratch.kind[k] != LaneKind::ball) scratch.by_tip.push_back(static_cast<std::uint32_t>(k));
     std::sort(scratch.by_tip.begin(), scratch.by_tip.end(), [&](std::uint32_t a, std::uint32_t b) {
       const double ta = scratch.moves[a].lowest_tip(), tb = scratch.moves[b].lowest_tip();
       return ta < tb || (ta == tb && a < b);
@@ -760,7 +901,7 @@ class Miller {
     const double row_y0 = g_.y(last.box.j0), row_y1 = g_.y(last.box.j1);
     for_each_move(row, scratch, [&](std::size_t k, int col0, int col1) {
       const MoveGeometry& m = scratch.moves[k];
-      if (!scratch.is_ball[k]) return;
+      if (scratch.kind[k] != LaneKind::ball) return;
       const BallLanes& ball = scratch.balls[k];
       // Distance between the path's bounding box and the row's rectangle.
       const double dx = std::max({0.0, std::min(m.ax, m.ax + m.vx) - row_x1, row_x0 - std::max(m.ax, m.ax + m.vx)});
@@ -895,26 +1036,31 @@ class Miller {
     }
   }
 
-  // Cuts a tile with the moves left, lowest bound first: the ball end moves together, row by row
-  // (admitted by what the first cut left: their rows are cheap, a fresher test costs more than it
-  // saves), then each other move, checked again against what the tile holds by then (its points
-  // cost far more).
+  // Cuts a tile with the moves left, lowest bound first, so that deep cuts (a roughing pass
+  // below the finish, say) come before the moves they leave nothing for. A run of consecutive
+  // moves of one cutter with a vector form is milled together, row by row (admitted by what the
+  // tile held before the run: their rows are cheap, a fresher test costs more than it saves);
+  // each run, and each move without a vector form (its points cost far more), is checked again
+  // against what the tile holds by then.
   void cut_others(Tile& tile, const BlockScratch& scratch) {
     std::vector<Candidate>& candidates = tile.candidates;
-    if (candidates.empty()) return;
-    auto others = std::partition(candidates.begin(), candidates.end(),
-                                 [&](const Candidate& c) { return scratch.is_ball[c.move] != 0; });
-    auto by_bound = [](const Candidate& a, const Candidate& b) {
+    std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
       return a.bound < b.bound || (a.bound == b.bound && a.move < b.move);
-    };
-    std::sort(candidates.begin(), others, by_bound);
-    std::sort(others, candidates.end(), by_bound);
-    if (others != candidates.begin())
-      mill_tile(std::span<const Candidate>(&*candidates.begin(), static_cast<std::size_t>(others - candidates.begin())),
-                tile, scratch, false);
-    for (auto c = others; c != candidates.end(); ++c) {
+    });
+    for (auto c = candidates.begin(); c != candidates.end();) {
       if (c->bound >= tile.state.top) break;
-      if (can_cut(*c, tile)) mill_tile(std::span<const Candidate>(&*c, 1), tile, scratch, false);
+      if (scratch.kind[c->move] == LaneKind::scalar) {
+        if (can_cut(*c, tile)) mill_tile(std::span<const Candidate>(&*c, 1), tile, scratch, false);
+        ++c;
+        continue;
+      }
+      const Cutter* cutter = scratch.moves[c->move].cutter;
+      auto run_end = std::find_if(c, candidates.end(), [&](const Candidate& o) {
+        return scratch.kind[o.move] == LaneKind::scalar || scratch.moves[o.move].cutter != cutter;
+      });
+      auto kept = std::remove_if(c, run_end, [&](const Candidate& o) { return !can_cut(o, tile); });
+      if (kept != c) mill_tile(std::span<const Candidate>(&*c, static_cast<std::size_t>(kept - c)), tile, scratch, false);
+      c = run_end;
     }
   }
 
@@ -997,7 +1143,8 @@ class Miller {
       bool loaded = false;
       for (const Candidate& c : cuts) {
         const MoveGeometry& m = scratch.moves[c.move];
-        const BallLanes* ball = scratch.is_ball[c.move] ? &scratch.balls[c.move] : nullptr;
+        const LaneKind kind = scratch.kind[c.move];
+        const BallLanes* ball = kind == LaneKind::ball ? &scratch.balls[c.move] : nullptr;
         if (!every_row && !row_may_cut(c, ball, tile, j)) continue;
         if (!loaded) {
           for (int g = 0; g < kGroups; ++g) h[g] = load_heights(row + g * kLanes, count - g * kLanes);
@@ -1011,6 +1158,19 @@ class Miller {
             // Rounded to float and raised to the empty height once per row, below: heights are
             // floats and never below it, so min(h, round(max(z, empty))) = round(max(min(h, z), empty)).
             h[g] = min_n(h[g], ball->at(x[g] - ball->ax, splat(uy)));
+          }
+        } else if (kind == LaneKind::flat) {
+          // As the ball end: a closed form with one square root, cheaper than a test.
+          const FlatLanes& flat = scratch.flats[c.move];
+          const double uy = y - flat.ay;
+          for (int g = 0; g < kGroups; ++g) h[g] = min_n(h[g], flat.at(x[g] - flat.ax, splat(uy)));
+        } else if (kind == LaneKind::bull_nose) {
+          // Newton steps cost several square roots: only the points above the move's plane.
+          const BullLanes& bull = scratch.bulls[c.move];
+          const double move_row = (c.has_plane ? c.centre_z : -kInf) + c.gradient.y * dy, uy = y - bull.ay;
+          for (int g = 0; g < kGroups; ++g) {
+            const MaskN above = move_row + c.gradient.x * dx[g] < h[g];
+            if (any_n(above)) h[g] = min_n(h[g], bull.at(x[g] - bull.ax, splat(uy), above));
           }
         } else {
           const double move_row = (c.has_plane ? c.centre_z : -kInf) + c.gradient.y * dy;

@@ -112,6 +112,51 @@ TEST_CASE("the ball end's vector form agrees with the scalar one, and its plane 
   CHECK(planes > 1000);
 }
 
+TEST_CASE("the flat end's and the bull nose's vector forms agree with the scalar ones") {
+  // FlatLanes (closed form) and BullLanes (Newton on the corner's root equation) against
+  // MoveGeometry::lowest (the flat end's interval ends, the bull nose's bracketed Newton on f'):
+  // heights and coverage, on rising, falling, level and steep moves; and only the wanted lanes.
+  std::mt19937 rng(43);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int covered[2] = {0, 0};
+  for (int trial = 0; trial < 6000; ++trial) {
+    const double r = 1.7, corner = r * (0.5 + 0.45 * u(rng));
+    const bool flat = trial % 3 == 0;
+    const Cutter cutter = flat ? Cutter::flat(r) : Cutter::bull_nose(r, corner);
+    Segment s{Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng))};
+    if (trial % 4 == 0) s.b.z = s.a.z;                                                  // level
+    if (trial % 7 == 0) s.b = s.a + Vec3(0.01 * u(rng), 0.01 * u(rng), 2 * u(rng));  // steep
+    if (trial % 11 == 0) s.b = s.a + Vec3(2 * u(rng), 2 * u(rng), 1e-4 * u(rng));    // nearly level
+    detail::MoveGeometry m(cutter, s);
+    if (m.vertical) continue;
+    detail::FlatLanes flat_lanes(m);
+    detail::BullLanes bull_lanes(m);
+    detail::DoubleN x{}, y{};
+    detail::MaskN wanted{};
+    for (int l = 0; l < detail::kLanes; ++l) x[l] = 3 * u(rng), y[l] = 3 * u(rng), wanted[l] = l % 5 == 4 ? 0 : -1;
+    const detail::DoubleN z = flat ? flat_lanes.at(x - flat_lanes.ax, y - flat_lanes.ay)
+                                   : bull_lanes.at(x - bull_lanes.ax, y - bull_lanes.ay, wanted);
+    for (int l = 0; l < detail::kLanes; ++l) {
+      CAPTURE(trial);
+      CAPTURE(l);
+      const double expected = m.lowest_above(x[l], y[l]);
+      if (!flat && !wanted[l]) {
+        CHECK(z[l] > 1e300);
+        continue;
+      }
+      if (!(expected < 1e300)) {
+        const double rim_gap = std::sqrt(distance2_point_segment(Vec2(x[l], y[l]), Vec2(s.a), Vec2(s.b))) - r;
+        CHECK((z[l] > 1e300 || std::abs(rim_gap) < 1e-9));
+        continue;
+      }
+      ++covered[flat ? 0 : 1];
+      REQUIRE(z[l] == doctest::Approx(expected).epsilon(0).scale(1).epsilon(1e-9));
+    }
+  }
+  CHECK(covered[0] > 250 * detail::kLanes);
+  CHECK(covered[1] > 500 * detail::kLanes);
+}
+
 TEST_CASE("milled heights are the exact lowest point of the swept cutter (every cutter kind)") {
   std::mt19937 rng(2026);
   for (int trial = 0; trial < 12; ++trial) {
@@ -319,4 +364,49 @@ TEST_CASE("cut_depth: how deep a move would cut, equal to what milling it remove
   CHECK(cutting >= 6);
   CHECK(cut_depth(ZMap(ZMapGrid{Frame{}, 0, 0, 1, 4, 4}, 0, -1), Cutter::ball(1),
                   Segment{Vec3(100, 100, 0), Vec3(101, 100, 0)}).i == -1);
+}
+
+TEST_CASE("mixed cutters: random moves of every kind in one call, and roughing below or above a finish") {
+  // Each point at the lowest of every move, evaluated everywhere (no bounds): the vector forms,
+  // the scalar path and the tile, row and plane bounds of a tile whose first cut was any cutter.
+  std::mt19937 rng(77);
+  std::vector<Cutter> cutters;
+  for (int k = 0; k < 6; ++k) cutters.push_back(random_cutter(k, rng).cutter);
+  std::vector<CutMove> random_moves;
+  std::uniform_int_distribution<std::uint32_t> pick(0, 5);
+  for (const Segment& s : random_segments(rng, 240)) random_moves.push_back({s, pick(rng)});
+  // A flat end (1) or bull nose (2) raster 0.3 below or 0.2 above a ball end (0) raster.
+  const std::vector<Segment> path = dense_raster();
+  std::vector<Cutter> raster_cutters{Cutter::ball(0.7), Cutter::flat(1.2), Cutter::bull_nose(1.1, 0.35)};
+  std::vector<std::vector<CutMove>> raster_cases;
+  for (std::uint32_t rough : {1u, 2u})
+    for (double lift : {-0.3, 0.2}) {
+      std::vector<CutMove> moves;
+      for (std::size_t k = 0; k < path.size(); ++k) {
+        moves.push_back({path[k], 0});
+        if (k % 2 == 0) moves.push_back({Segment{path[k].a + Vec3(0, 0, lift), path[k].b + Vec3(0, 0, lift)}, rough});
+      }
+      raster_cases.push_back(moves);
+    }
+  auto check = [](const std::vector<Cutter>& kinds, const std::vector<CutMove>& moves) {
+    ZMapGrid g;
+    g.x0 = -0.5, g.y0 = -0.5, g.cell = 0.03, g.nx = 230, g.ny = 230;
+    ZMap map(g, 4, -1);
+    mill(map, kinds, moves, {.threads = 2});
+    std::vector<detail::MoveGeometry> geometry;
+    for (const CutMove& m : moves) geometry.emplace_back(kinds[m.cutter], m.tip);
+    int mismatches = 0, lowered = 0;
+    for (int j = 0; j < g.ny; j += 2)
+      for (int i = 0; i < g.nx; i += 2) {
+        double expected = 4;
+        for (const detail::MoveGeometry& m : geometry) expected = std::min(expected, m.lowest_above(g.x(i), g.y(j)));
+        expected = std::max(expected, -1.0);
+        if (std::abs(map.height(i, j) - expected) > 1e-5) ++mismatches;
+        if (expected < 4) ++lowered;
+      }
+    CHECK(mismatches == 0);
+    CHECK(lowered > 1000);
+  };
+  check(cutters, random_moves);
+  for (const std::vector<CutMove>& moves : raster_cases) check(raster_cutters, moves);
 }
