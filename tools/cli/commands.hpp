@@ -25,6 +25,7 @@ struct SimulateOptions : CommonOptions {
   double dexel_cell = 0;        // 0: from dexel_res
   int dexel_res = 0;            // 0: the default
   std::string output, png, report, dump_zmaps;
+  std::string html;             // --html OUT.html: the interactive report (html_report.hpp)
   unsigned threads = 0;         // 0: every hardware thread
   std::string max_memory;       // empty: 80 % of RAM
   std::string zmap_backend = "cpu";   // --zmap-backend: cpu | gl (tools/backends)
