@@ -156,7 +156,12 @@ Json toolpath_json(const HtmlPage& page, const HtmlLimits& limits) {
   path["moves"] = thinned.moves;
   path["segments"] = thinned.lines.size();
   path["tolerance_mm"] = thinned.tolerance;
-  path["program_lines"] = base64_of(thinned.program_lines);
+  // The lines as runs of consecutive numbers (first, count): a program is mostly one move a line.
+  std::vector<std::uint32_t> runs;
+  for (std::uint32_t line : thinned.program_lines)
+    if (!runs.empty() && runs[runs.size() - 2] + runs.back() == line) ++runs.back();
+    else runs.insert(runs.end(), {line, 1});
+  path["program_line_runs"] = base64_of(runs);
   if (thinned.lines.empty()) return path;
   const Aabb box = bounds_of(thinned.ends);
   path["box"] = box_json(box);
