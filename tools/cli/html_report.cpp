@@ -147,7 +147,10 @@ Json toolpath_json(const HtmlPage& page, const HtmlLimits& limits) {
   Aabb drawn;
   for (const gcode::MoveGroup& group : *page.groups)
     for (const gcode::Move& m : group.moves)
-      if (glm::length(m.start) < kFar && glm::length(m.end) < kFar) drawn.extend(m.start), drawn.extend(m.end);
+      if (glm::length(m.start) < kFar && glm::length(m.end) < kFar) {
+        drawn.extend(m.start);
+        drawn.extend(m.end);
+      }
   // A tolerance of about a quarter pixel of a 1000-pixel view first, doubled while there are too
   // many segments.
   double tolerance = std::max(1e-6, glm::length(drawn.size()) * limits.path_tolerance);
