@@ -24,6 +24,17 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
+# The browser tests' driver (tests/html: puppeteer-core, pinned by its package-lock.json; it uses
+# Debian's chromium from test.txt and downloads no browser).
+if [ "$mode" = test ]; then
+  if ! command -v npm > /dev/null; then
+    $sudo apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends nodejs npm
+  fi
+  echo "== npm ci (tests/html)"
+  (cd tests/html && npm ci --no-audit --no-fund --loglevel=error)
+fi
+
 jobs=$(nproc)
 if [ "$mode" = demo ]; then
   cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DTRIDEX_BUILD_TESTS=OFF -DTRIDEX_BUILD_BENCH=OFF

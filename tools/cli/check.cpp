@@ -27,6 +27,7 @@
 #include "commands.hpp"
 #include "deviation.hpp"
 #include "errors.hpp"
+#include "html_report.hpp"
 #include "memory.hpp"
 #include "numbers.hpp"
 #include "output.hpp"
@@ -218,7 +219,7 @@ int run_check(const CheckOptions& options) {
 
   PipelineRequest request;
   request.outputs = {{"-o", options.output}, {"--report", options.report}, {"--png", options.png},
-                     {"--ply", options.ply}};
+                     {"--ply", options.ply}, {"--html", options.html}};
   request.extra_inputs = {options.design};
   request.extra_bounds = {{"--design " + options.design, design.bounds()}};
   request.rapid_check = RapidCheck::in_program_order;
@@ -373,6 +374,13 @@ int run_check(const CheckOptions& options) {
   if (!options.report.empty()) {
     progress.stage("writing " + options.report);
     write_file_atomically(options.report, report.dump(2) + "\n");
+  }
+  if (!options.html.empty()) {
+    progress.stage("writing " + options.html);
+    write_html_report(options.html, {.title = "tridex check: " + r.input.program.filename().string() + " against " +
+                                              fs::path(options.design).filename().string(),
+                                     .report = report, .mesh = &mesh, .deviation = deviation, .groups = &r.groups,
+                                     .files = r.input.files});
   }
   progress.finish();
 

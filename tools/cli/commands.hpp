@@ -35,6 +35,7 @@ struct SimulateOptions : CommonOptions {
   double dexel_cell = 0;        // 0: from dexel_res
   int dexel_res = 0;            // 0: the default
   std::string output, png, report, dump_zmaps;
+  std::string html;             // --html OUT.html: the interactive report (html_report.hpp)
   unsigned threads = 0;         // 0: every hardware thread
   std::string zmap_backend = "cpu";   // --zmap-backend: cpu | gl (tools/backends)
   std::string dexel_backend = "scan";  // --dexel-backend: scan | tree | embree

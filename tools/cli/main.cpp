@@ -99,6 +99,9 @@ void add_simulate(CLI::App& command, SimulateOptions& options) {
                      "Steps 2-3: scan (scan conversion onto the ray grids, default), tree (the paper's grid\n"
                      "AABB tree) or embree (Embree 3 ray casting)")
       ->check(CLI::IsMember({"scan", "tree", "embree"}));
+  command.add_option("--html", options.html,
+                     "write an interactive HTML report: the part in 3D, the toolpath, the findings and the figures\n"
+                     "(one file that opens offline in a browser)");
   add_max_memory(command, options.max_memory);
 }
 

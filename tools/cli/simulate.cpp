@@ -10,6 +10,7 @@
 
 #include "commands.hpp"
 #include "errors.hpp"
+#include "html_report.hpp"
 #include "json_text.hpp"
 #include "memory.hpp"
 #include "output.hpp"
@@ -26,7 +27,8 @@ int run_simulate(const SimulateOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   Progress progress(!options.quiet && (options.progress || stderr_is_terminal()));
   PipelineRequest request;
-  request.outputs = {{"-o", options.output}, {"--png", options.png}, {"--report", options.report}};
+  request.outputs = {{"-o", options.output}, {"--png", options.png}, {"--report", options.report},
+                     {"--html", options.html}};
   SimulationResult r = simulate_program(options, progress, request);
   const ProgramInput& input = r.input;
   const std::vector<gcode::MoveGroup>& groups = r.groups;
@@ -103,12 +105,18 @@ int run_simulate(const SimulateOptions& options) {
     progress.stage("writing " + options.report);
     write_file_atomically(options.report, report.dump(2) + "\n");
   }
+  if (!options.html.empty()) {
+    progress.stage("writing " + options.html);
+    write_html_report(options.html, {.title = "tridex simulate: " + input.program.filename().string(),
+                                     .report = report, .mesh = &mesh, .deviation = {}, .groups = &groups,
+                                     .files = input.files});
+  }
   progress.finish();
 
   if (!options.quiet) {
     for (const std::string& w : warnings) std::cerr << "warning: " << w << '\n';
     std::string written;
-    for (const std::string& path : {options.output, options.png, options.report})
+    for (const std::string& path : {options.output, options.png, options.report, options.html})
       if (!path.empty()) written += (written.empty() ? " -> " : ", ") + path;
     std::printf("%s: %lld segments in %zu directions, %d x %d x %d dexels; %.1f mm^3 left, %.1f mm^3 "
                 "removed, %zu triangles, %s%s; %.2f s\n",

@@ -1,0 +1,44 @@
+// Opens a --html page in Debian's headless Chromium RUNS times (a fresh tab each) and prints its
+// size and the median time from navigation to the first frame drawn (window.tridexView.ready);
+// with --screenshot, keeps a picture of the last load. For bench/tools/README.md and docs/.
+//   node tests/html/open_page.mjs PAGE.html [--runs N] [--screenshot OUT.png] [--chromium PATH]
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+import { pathToFileURL } from 'node:url';
+import puppeteer from 'puppeteer-core';
+
+const args = process.argv.slice(2);
+const option = (name, fallback) => { const k = args.indexOf(name); return k >= 0 ? args[k + 1] : fallback; };
+const file = path.resolve(args[0]);
+const runs = Number(option('--runs', '3')), screenshot = option('--screenshot', ''), chromium = option('--chromium', '/usr/bin/chromium');
+const profile = fs.mkdtempSync(path.join(os.tmpdir(), 'tridex-chromium-'));
+const browser = await puppeteer.launch({
+  executablePath: chromium, headless: true, userDataDir: profile,
+  args: ['--headless=new', '--no-sandbox', '--disable-gpu', '--enable-unsafe-swiftshader', '--use-angle=swiftshader',
+         '--disable-background-networking', '--disable-component-update', '--no-first-run'],
+});
+const seconds = [];
+let errors = 0;
+try {
+  for (let r = 0; r < runs; ++r) {
+    const page = await browser.newPage();
+    await page.setViewport({ width: 1280, height: 800 });
+    page.on('pageerror', (e) => { ++errors; console.log('page error: ' + e); });
+    page.on('console', (m) => { if (m.type() === 'error') { ++errors; console.log('console error: ' + m.text()); } });
+    const start = performance.now();
+    await page.goto(pathToFileURL(file).href, { waitUntil: 'load', timeout: 300000 });
+    await page.waitForFunction('window.tridexView && window.tridexView.ready', { timeout: 300000 });
+    seconds.push((performance.now() - start) / 1000);
+    if (r === runs - 1 && screenshot) await page.screenshot({ path: screenshot });
+    await page.close();
+  }
+} finally {
+  await browser.close();
+  fs.rmSync(profile, { recursive: true, force: true });
+}
+seconds.sort((a, b) => a - b);
+console.log(`${path.basename(file)}: ${(fs.statSync(file).size / 1e6).toFixed(2)} MB; ready in ` +
+            `${seconds.map((s) => s.toFixed(2)).join(', ')} s (median ${seconds[Math.floor(runs / 2)].toFixed(2)} s)` +
+            (errors ? `; ${errors} console error(s)` : ''));
+process.exit(errors ? 1 : 0);

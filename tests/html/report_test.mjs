@@ -1,0 +1,170 @@
+// Browser tests of tridex's --html page (issue 15), in Debian's headless Chromium driven by
+// puppeteer-core: the page loads with no console error and no network request, the part is drawn
+// (pixels of its colour where it is, none when it is hidden), choosing a finding flies the camera
+// to it and lists its G-code lines, the slider changes the drawn toolpath, and pages for an empty
+// result and a program without moves say so. Screenshots are kept in OUT_DIR.
+//   node report_test.mjs TRIDEX OUT_DIR CHROMIUM      (run by run.sh, CTest's html_report_browser)
+import { spawnSync } from 'node:child_process';
+import fs from 'node:fs';
+import path from 'node:path';
+import { fileURLToPath, pathToFileURL } from 'node:url';
+import puppeteer from 'puppeteer-core';
+
+const [tridex, out, chromium] = process.argv.slice(2);
+const repo = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
+let passed = 0, failed = 0;
+function check(condition, what) {
+  if (condition) ++passed;
+  else { ++failed; console.log('FAILED: ' + what); }
+}
+
+function run(args, statuses = [0]) {
+  const r = spawnSync(tridex, args, { encoding: 'utf8' });
+  if (!statuses.includes(r.status)) throw new Error('tridex ' + args.join(' ') + ' exited ' + r.status + ':\n' + r.stderr);
+  return r;
+}
+const write = (name, text) => { fs.writeFileSync(path.join(out, name), text); return path.join(out, name); };
+
+// ---- the pages ---------------------------------------------------------------------------------
+// The bundled example (coarse, to keep the test quick).
+const examplePage = path.join(out, 'example.html');
+run(['simulate', path.join(repo, 'gcode/examples/mold_3plus2.camotics'), '--dexel-res', '128', '-q',
+     '--report', path.join(out, 'example.json'), '--html', examplePage]);
+// check's planted faults (tests/tools/test_check.cpp): a plunge 0.3 mm too deep in a tilted
+// direction (line 13) against the correct program's result, and an envelope the rapids leave.
+const tools = write('tools.json', '{"1": {"units": "mm", "shape": "cylindrical", "diameter": 6, "length": 20}}');
+const program = (z) => '%\nG21 G17 G90\nT1 M6\nS8000 M3\nG68.2 X10 Y10 Z10 I0 J20 K0\nG53.1\n' +
+  'G0 X-3 Y0\nG0 Z5\nG1 Z-1 F500\nG1 X3\nG0 Z5\nG0 X0 Y4\nG1 Z' + z + '\nG0 Z5\nG28 G91 Z0.\nG69\nM30\n%\n';
+const stock = ['--tools', tools, '--stock', 'box:0,0,0,20,20,10', '--dexel-cell', '0.1', '-q'];
+run(['simulate', write('good.nc', program(-2)), ...stock, '-o', path.join(out, 'design.stl')]);
+const checkPage = path.join(out, 'check.html');
+run(['check', write('gouge.nc', program(-2.3)), ...stock, '--design', path.join(out, 'design.stl'), '--tolerance', '0.1',
+     '--envelope', 'box:-1,-1,-1,21,21,14', '--report', path.join(out, 'check.json'), '--html', checkPage], [3]);
+// Nothing left: a cutter wider than the stock plunges through it. No moves: a program of words only.
+const emptyPage = path.join(out, 'empty.html');
+run(['simulate', write('through.nc', '%\nG21 G90\nT1 M6\nM3 S1000\nG0 X5 Y5 Z20\nG1 Z-20 F100\nG0 Z20\nM30\n%\n'),
+     '--tools', write('big.json', '{"1": {"units": "mm", "shape": "cylindrical", "diameter": 60, "length": 50}}'),
+     '--stock', 'box:0,0,0,10,10,10', '-q', '--html', emptyPage]);
+const noMovesPage = path.join(out, 'no_moves.html');
+run(['simulate', write('nothing.nc', '%\nG21 G90\nM30\n%\n'), '--stock', 'box:0,0,0,10,10,10', '-q', '--html', noMovesPage]);
+
+// ---- the browser ---------------------------------------------------------------------------------
+const profile = fs.mkdtempSync(path.join(out, 'profile-'));
+const browser = await puppeteer.launch({
+  executablePath: chromium,
+  headless: true,
+  userDataDir: profile,
+  args: ['--headless=new', '--no-sandbox', '--disable-gpu', '--enable-unsafe-swiftshader', '--use-angle=swiftshader',
+         '--disable-background-networking', '--disable-component-update', '--no-first-run'],
+});
+
+// Opens a page; returns it with the console errors and requests it made, and its load time.
+async function open(file) {
+  const page = await browser.newPage();
+  await page.setViewport({ width: 1280, height: 800 });
+  const errors = [], requests = [];
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  page.on('pageerror', (e) => errors.push(String(e)));
+  page.on('request', (r) => requests.push(r.url()));
+  const url = pathToFileURL(file).href, start = performance.now();
+  await page.goto(url, { waitUntil: 'load', timeout: 120000 });
+  await page.waitForFunction('window.tridexView && window.tridexView.ready', { timeout: 120000 });
+  const seconds = (performance.now() - start) / 1000;
+  console.log(path.basename(file) + ': ' + (fs.statSync(file).size / 1e6).toFixed(2) + ' MB, ready in ' + seconds.toFixed(2) + ' s');
+  const name = path.basename(file);
+  return { page, errors, seconds,
+           clean() { check(errors.length === 0, name + ': console errors: ' + errors.join(' | '));
+                     check(requests.length === 1 && requests[0] === url, name + ': requests other than the page: ' + requests.join(' ')); } };
+}
+const settle = (page) => page.waitForFunction('!window.tridexView.flying', { timeout: 30000 });
+const toggle = (page, id) => page.$eval('#' + id, (e) => e.click());
+async function setSlider(page, value) {
+  await page.$eval('#path-slider', (e, v) => { e.value = String(v === 'max' ? e.max : v); e.dispatchEvent(new Event('input')); }, value);
+}
+const pageData = (page) => page.$eval('#tridex-data', (e) => JSON.parse(e.textContent));
+
+try {
+  // The bundled example: the part where it is, the toolpath's slider.
+  {
+    const { page, clean } = await open(examplePage);
+    const data = await pageData(page);
+    check(JSON.stringify(data.report) === JSON.stringify(JSON.parse(fs.readFileSync(path.join(out, 'example.json')))),
+          'example: the page holds the report');
+    check(data.directions.length === data.report.groups.length, 'example: one preset view per direction');
+    check((await page.$$('#presets button')).length === data.report.groups.length, 'example: preset buttons');
+    await page.screenshot({ path: path.join(out, 'example.png') });
+    await toggle(page, 'show-path'); await toggle(page, 'show-rapids');
+    const [cx, cy] = await page.evaluate(() => window.tridexView.project(window.tridexView.centre));
+    const around = await page.evaluate((x, y) => window.tridexView.sample(x - 0.1, y - 0.1, x + 0.1, y + 0.1), cx, cy);
+    check(around.part > 0.8 * around.all, 'example: part-coloured pixels around the part centre: ' + JSON.stringify(around));
+    const whole = await page.evaluate(() => window.tridexView.sample());
+    check(whole.part > 0.05 * whole.all && whole.background > 0.05 * whole.all, 'example: part and background on screen: ' + JSON.stringify(whole));
+    await toggle(page, 'show-part');
+    const hidden = await page.evaluate(() => window.tridexView.sample());
+    check(hidden.part < 0.001 * hidden.all, 'example: no part-coloured pixels with the part hidden: ' + JSON.stringify(hidden));
+    // The slider: the whole program, then its first line with moves only.
+    await toggle(page, 'show-path');
+    await setSlider(page, 'max');
+    const full = await page.evaluate(() => [window.tridexView.drawnSegments(), window.tridexView.sample().checksum]);
+    await setSlider(page, 0);
+    const first = await page.evaluate(() => [window.tridexView.drawnSegments(), window.tridexView.sample().checksum]);
+    check(full[0] === data.toolpath.segments && first[0] < full[0] / 10, 'example: slider segments ' + first[0] + ' of ' + full[0]);
+    check(full[1] !== first[1], 'example: the slider changes the drawn path');
+    await setSlider(page, Math.floor((await page.$eval('#path-slider', (e) => Number(e.max))) / 2));
+    await page.screenshot({ path: path.join(out, 'example_path_half.png') });
+    clean();
+    await page.close();
+  }
+  // The check: findings listed as in the report; choosing one flies there and lists its lines.
+  {
+    const { page, clean } = await open(checkPage);
+    const report = JSON.parse(fs.readFileSync(path.join(out, 'check.json')));
+    const data = await pageData(page);
+    check(JSON.stringify(data.report) === JSON.stringify(report), 'check: the page holds the report');
+    const expected = report.gouges.length + report.excess.length + report.rapid_cuts.length + report.envelope.violations.length +
+                     ['missing', 'left'].filter((k) => report.design_side[k].samples > 0).length;
+    const items = await page.$$eval('#findings li', (l) => l.map((e) => e.textContent));
+    check(items.length === expected && report.gouges.length === 1, 'check: ' + items.length + ' findings listed, ' + expected + ' in the report');
+    check(items[0].startsWith('gouge'), 'check: the gouge first: ' + items[0]);
+    check(await page.$eval('#legend', (e) => !e.hidden), 'check: the deviation legend is shown');
+    const point = report.gouges[0].deepest_point;
+    const before = await page.evaluate((p) => window.tridexView.project(p), point);
+    await page.click('#findings li[data-index="0"]');
+    await settle(page);
+    const after = await page.evaluate((p) => window.tridexView.project(p), point);
+    check(Math.hypot(before[0], before[1]) > 0.05, 'check: the gouge is off the centre before: ' + before);
+    check(Math.abs(after[0]) < 0.02 && Math.abs(after[1]) < 0.02 && after[2] > -1 && after[2] < 1,
+          'check: the camera flew to the gouge: ' + after);
+    const listing = await page.$eval('#listing', (e) => e.textContent);
+    const hits = await page.$$eval('#listing .hit', (l) => l.map((e) => e.textContent.trim()));
+    check(hits.length === 1 && hits[0].startsWith('13') && hits[0].includes('G1 Z-2.3'), 'check: line 13 marked: ' + hits);
+    check(listing.includes('G0 X0 Y4') && listing.includes('G0 Z5'), 'check: its neighbouring lines listed');
+    await page.screenshot({ path: path.join(out, 'check_gouge.png') });
+    // An envelope finding has a point and a line too.
+    const envelope = items.findIndex((t) => t.includes('envelope'));
+    await page.click('#findings li[data-index="' + envelope + '"]');
+    await settle(page);
+    const tip = report.envelope.violations[0].tip, seen = await page.evaluate((p) => window.tridexView.project(p), tip);
+    check(Math.abs(seen[0]) < 0.02 && Math.abs(seen[1]) < 0.02, 'check: the camera flew to the envelope finding: ' + seen);
+    clean();
+    await page.close();
+  }
+  // Nothing to show: the page says so and still works.
+  for (const [file, message] of [[emptyPage, 'No material is left'], [noMovesPage, 'The program has no moves']]) {
+    const { page, clean } = await open(file);
+    const messages = await page.$$eval('.message', (l) => l.map((e) => e.textContent));
+    check(messages.some((m) => m.startsWith(message)), path.basename(file) + ': says "' + message + '": ' + messages);
+    await page.screenshot({ path: file.replace(/\.html$/, '.png') });
+    clean();
+    await page.close();
+  }
+} catch (e) {
+  ++failed;
+  console.log('FAILED: ' + (e.stack || e));
+} finally {
+  await browser.close();
+  fs.rmSync(profile, { recursive: true, force: true });
+}
+console.log('screenshots in ' + out);
+console.log(`html report: ${passed} passed, ${failed} failed`);
+process.exit(failed ? 1 : 0);

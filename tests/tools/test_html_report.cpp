@@ -1,0 +1,257 @@
+// The --html page's writer (tools/cli/html_report.*): base64 against RFC 4648's vectors, the
+// display mesh against its budget and the triangles it must keep, the thinned toolpath against the
+// moves (every line reachable, every move within the tolerance of the segment that stands for it),
+// the page's data against the report, and pages that say when there is nothing to show. The page
+// in a browser: tests/html (CTest's html_report_browser).
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "command_harness.hpp"
+#include "html_report.hpp"
+#include "tridex/gcode/interpreter.hpp"
+
+using namespace tridex;
+using namespace tridex::cli;
+using namespace tridex::test;
+using nlohmann::json;
+
+namespace {
+
+// The JSON inside the page's tridex-data block.
+json page_data(const std::string& html) {
+  const std::string open = "<script type=\"application/json\" id=\"tridex-data\">";
+  const std::size_t start = html.find(open);
+  REQUIRE(start != std::string::npos);
+  const std::size_t end = html.find("</script>", start);
+  REQUIRE(end != std::string::npos);
+  return json::parse(html.substr(start + open.size(), end - start - open.size()));
+}
+
+// A heightfield of n × n cells (2 n² triangles), gently curved so that simplifying costs error.
+Mesh heightfield(int n) {
+  Mesh m;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const double x = 100.0 * i / n, y = 100.0 * j / n;
+      m.positions.emplace_back(x, y, 5 * std::sin(x / 15) * std::cos(y / 20));
+    }
+  auto at = [&](int i, int j) { return static_cast<unsigned>(j * (n + 1) + i); };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      m.triangles.emplace_back(at(i, j), at(i + 1, j), at(i + 1, j + 1));
+      m.triangles.emplace_back(at(i, j), at(i + 1, j + 1), at(i, j + 1));
+    }
+  return m;
+}
+
+gcode::Move move(int line, gcode::MoveKind kind, Vec3 start, Vec3 end, int tool = 1) {
+  gcode::Move m;
+  m.line = line;
+  m.kind = kind;
+  m.start = start;
+  m.end = end;
+  m.tool = tool;
+  m.feed = kind == gcode::MoveKind::rapid ? 0 : 600;
+  return m;
+}
+
+double segment_distance(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = b - a;
+  const double t = glm::dot(ab, ab) > 0 ? std::clamp(glm::dot(p - a, ab) / glm::dot(ab, ab), 0.0, 1.0) : 0.0;
+  return glm::length(p - (a + t * ab));
+}
+
+}  // namespace
+
+TEST_CASE("base64 as RFC 4648 §10") {
+  auto encode = [](const std::string& s) {
+    return base64({reinterpret_cast<const std::uint8_t*>(s.data()), s.size()});
+  };
+  CHECK(encode("") == "");
+  CHECK(encode("f") == "Zg==");
+  CHECK(encode("fo") == "Zm8=");
+  CHECK(encode("foo") == "Zm9v");
+  CHECK(encode("foob") == "Zm9vYg==");
+  CHECK(encode("fooba") == "Zm9vYmE=");
+  CHECK(encode("foobar") == "Zm9vYmFy");
+  const std::vector<std::uint8_t> high = {0xff, 0xfe, 0x00};
+  CHECK(base64(high) == "//4A");
+}
+
+TEST_CASE("the display mesh meets its budget and keeps every out-of-tolerance triangle as it was") {
+  const Mesh mesh = heightfield(120);  // 28,800 triangles
+  // A gouge in a disc around (30, 60) and excess around (70, 30).
+  std::vector<double> deviation(mesh.positions.size(), 0.0);
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+    const glm::vec3& p = mesh.positions[v];
+    if (std::hypot(p.x - 30, p.y - 60) < 6) deviation[v] = -0.5;
+    if (std::hypot(p.x - 70, p.y - 30) < 4) deviation[v] = 0.3;
+  }
+  const std::size_t budget = 3000;
+  DisplayMesh shown = simplify_for_display(mesh, deviation, 0.1, 0.1, budget);
+  REQUIRE(shown.indices.size() % 3 == 0);
+  CHECK(shown.indices.size() / 3 <= budget);
+  CHECK(shown.indices.size() / 3 > budget / 2);  // not simplified further than needed
+  REQUIRE(shown.deviation.size() == shown.positions.size());
+  // Every shown vertex is an input vertex with its deviation.
+  std::map<std::array<float, 3>, double> input;
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v)
+    input[{mesh.positions[v].x, mesh.positions[v].y, mesh.positions[v].z}] = deviation[v];
+  for (std::size_t v = 0; v < shown.positions.size(); ++v) {
+    auto found = input.find({shown.positions[v].x, shown.positions[v].y, shown.positions[v].z});
+    REQUIRE(found != input.end());
+    CHECK(static_cast<float>(found->second) == shown.deviation[v]);
+  }
+  // Every triangle touching an out-of-tolerance vertex is still there.
+  std::set<std::array<std::uint32_t, 3>> triangles;
+  std::map<std::array<float, 3>, std::uint32_t> index_of;
+  for (std::size_t v = 0; v < shown.positions.size(); ++v)
+    index_of[{shown.positions[v].x, shown.positions[v].y, shown.positions[v].z}] = static_cast<std::uint32_t>(v);
+  for (std::size_t k = 0; k < shown.indices.size(); k += 3)
+    triangles.insert({shown.indices[k], shown.indices[k + 1], shown.indices[k + 2]});
+  std::size_t flagged = 0;
+  for (const glm::uvec3& t : mesh.triangles) {
+    if (deviation[t.x] == 0 && deviation[t.y] == 0 && deviation[t.z] == 0) continue;
+    ++flagged;
+    std::array<std::uint32_t, 3> mapped{};
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec3& p = mesh.positions[t[k]];
+      REQUIRE(index_of.count({p.x, p.y, p.z}));
+      mapped[static_cast<std::size_t>(k)] = index_of[{p.x, p.y, p.z}];
+    }
+    CHECK(triangles.count(mapped) == 1);
+  }
+  CHECK(flagged > 100);
+  // Without deviations the same budget holds; a mesh within it is merged where flat (all but the
+  // open border, which stays: 160 vertices there need about as many triangles).
+  CHECK(simplify_for_display(mesh, {}, 0, 0, budget).indices.size() / 3 <= budget);
+  Mesh flat = heightfield(40);
+  for (glm::vec3& p : flat.positions) p.z = 0;
+  const std::size_t flat_shown = simplify_for_display(flat, {}, 0, 0, 1'000'000).indices.size() / 3;
+  CHECK(flat_shown < 3200 / 10);
+  // The same grid curved keeps more (the first error bound holds the curvature).
+  CHECK(simplify_for_display(heightfield(40), {}, 0, 0, 1'000'000).indices.size() / 3 > flat_shown + 100);
+}
+
+TEST_CASE("the thinned toolpath keeps every line reachable and every move within its tolerance") {
+  using gcode::MoveKind;
+  std::vector<gcode::MoveGroup> groups(2);
+  groups[1].axis = Vec3(1, 0, 0);
+  int line = 1;
+  // Group 0: a rapid in, a straight feed in 50 pieces, a circle in 200 chords, a rapid out home.
+  groups[0].moves.push_back(move(line++, MoveKind::rapid, Vec3(0, 0, 20), Vec3(0, 0, 1)));
+  for (int k = 0; k < 50; ++k)
+    groups[0].moves.push_back(move(line++, MoveKind::feed, Vec3(k, 0, 1), Vec3(k + 1, 0, 1)));
+  Vec3 previous(50, 0, 1);
+  for (int k = 1; k <= 200; ++k) {
+    const double a = 2 * M_PI * k / 200;
+    Vec3 next(40 + 10 * std::cos(a), 10 * std::sin(a), 1);
+    groups[0].moves.push_back(move(line++, MoveKind::feed, previous, next, 2));
+    previous = next;
+  }
+  const int home_line = line++;
+  groups[0].moves.push_back(move(home_line, MoveKind::rapid, previous, Vec3(0, 0, gcode::MachineConfig::kDefaultFar)));
+  // Group 1, later in the program: a few feeds.
+  for (int k = 0; k < 5; ++k) groups[1].moves.push_back(move(line++, MoveKind::feed, Vec3(-1, k, 0), Vec3(-1, k + 1, 0)));
+
+  const double tolerance = 0.05;
+  DisplayPath path = thin_toolpath(groups, tolerance);
+  CHECK(path.moves == 257);
+  REQUIRE(path.program_lines.size() == static_cast<std::size_t>(line - 1));
+  for (std::size_t k = 0; k < path.program_lines.size(); ++k) CHECK(path.program_lines[k] == k + 1);
+  REQUIRE(path.ends.size() == 2 * path.lines.size());
+  CHECK(path.lines.size() < 60);  // the straight feed is one segment, the circle a few dozen
+  CHECK(std::is_sorted(path.lines.begin(), path.lines.end()));
+  // Every drawn move lies within the tolerance of the segment carrying its line (the first whose
+  // line is not before it), which has its tool and direction; the move home is not drawn.
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    for (const gcode::Move& m : groups[g].moves) {
+      if (m.line == home_line) continue;
+      const auto s = static_cast<std::size_t>(
+          std::lower_bound(path.lines.begin(), path.lines.end(), static_cast<std::uint32_t>(m.line)) - path.lines.begin());
+      REQUIRE(s < path.lines.size());
+      const Vec3 a(path.ends[2 * s]), b(path.ends[2 * s + 1]);
+      CHECK(segment_distance(m.start, a, b) <= tolerance + 1e-5);
+      CHECK(segment_distance(m.end, a, b) <= tolerance + 1e-5);
+      CHECK(path.tools[s] == m.tool);
+      CHECK((path.flags[s] & 127) == g);
+      CHECK(((path.flags[s] & 128) != 0) == (m.kind == MoveKind::rapid));
+    }
+  CHECK(path.lines.back() == static_cast<std::uint32_t>(line - 1));
+  for (const glm::vec3& p : path.ends) CHECK(glm::length(p) < 100);
+  // With no tolerance only exactly collinear moves merge: the circle's chords all stay.
+  CHECK(thin_toolpath(groups, 0).lines.size() >= 200);
+}
+
+TEST_CASE("the page holds the report, the listed source lines, and says when there is nothing to show") {
+  fs::path dir = scratch("html-writer");
+  const fs::path program = dir / "p.nc";
+  std::string text;
+  for (int k = 1; k <= 20; ++k) text += "G1 X" + std::to_string(k) + " ( line " + std::to_string(k) + " </script> )\n";
+  write_text(program, text);
+  HtmlPage page;
+  page.title = "a <title> & more";
+  page.report = {{"rapid_cuts", json::array({{{"line", 10}, {"where", {1, 2, 3}}}})}, {"note", "</script><b>"}};
+  page.files = {program};
+  HtmlLimits limits;
+  limits.max_source_bytes = 0;  // only the lines around findings
+  write_html_report(dir / "page.html", page, limits);
+  const std::string html = slurp(dir / "page.html");
+  CHECK(html.find("<title>a &lt;title&gt; &amp; more</title>") != std::string::npos);
+  CHECK(html.find("</script><b>") == std::string::npos);  // escaped inside the data
+  json data = page_data(html);
+  CHECK(data["report"] == page.report);
+  json expected_source = json::object();
+  for (int k = 7; k <= 13; ++k) expected_source[std::to_string(k)] = "G1 X" + std::to_string(k) + " ( line " + std::to_string(k) + " </script> )";
+  CHECK(data["source"] == expected_source);
+  CHECK(data["mesh"]["triangles_shown"] == 0);
+  CHECK(data["toolpath"]["segments"] == 0);
+  REQUIRE(data["messages"].size() == 2);
+  CHECK(data["messages"][0].get<std::string>().rfind("No material is left", 0) == 0);
+  CHECK(data["messages"][1].get<std::string>().rfind("The program has no moves", 0) == 0);
+  // With the whole (small) program inlined, and a mesh and moves: no messages.
+  Mesh mesh = heightfield(4);
+  std::vector<gcode::MoveGroup> groups(1);
+  groups[0].moves.push_back(move(3, gcode::MoveKind::feed, Vec3(0), Vec3(1, 0, 0)));
+  page.mesh = &mesh;
+  page.groups = &groups;
+  data = html_page_data(page, {});
+  CHECK(data["source"].size() == 20);
+  CHECK(data["messages"].empty());
+  CHECK(data["mesh"]["triangles"] == mesh.triangles.size());
+  CHECK(data["toolpath"]["segments"] == 1);
+  const std::vector<std::uint32_t> runs = {3, 1};  // line 3, one line
+  CHECK(data["toolpath"]["program_line_runs"] == base64({reinterpret_cast<const std::uint8_t*>(runs.data()), 8}));
+  CHECK(data["machining_time_s"].get<double>() == doctest::Approx(0.1));  // 1 mm at 600 mm/min
+  fs::remove_all(dir);
+}
+
+TEST_CASE("simulate --html: the page's report is the --report file; an unwritable page is refused up front") {
+  fs::path dir = scratch("html-command");
+  write_text(dir / "p.nc", "%\nG21 G90\nT1 M6\nM3 S1000\nG0 X5 Y5 Z20\nG1 Z5 F100\nG1 X15\nG0 Z20\nM30\n%\n");
+  write_text(dir / "tools.json", R"({"1": {"units": "mm", "shape": "ballnose", "diameter": 4, "length": 20}})");
+  const std::vector<std::string> common = {"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(),
+                                           "--stock", "box:0,0,0,20,10,10", "--dexel-res", "64", "-q"};
+  std::vector<std::string> args = common;
+  args.insert(args.end(), {"--report", (dir / "r.json").string(), "--html", (dir / "r.html").string()});
+  CommandResult r = run_tridex(args, dir);
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  json data = page_data(slurp(dir / "r.html"));
+  json report = json::parse(slurp(dir / "r.json"));
+  CHECK(data["report"] == report);
+  CHECK(data["toolpath"]["moves"] == report["segments"]);
+  CHECK(data["directions"].size() == report["groups"].size());
+  CHECK(data["mesh"]["triangles"] == report["result"]["triangles"]);
+  CHECK(data["source"]["7"] == "G1 X15");
+  args = common;
+  args.insert(args.end(), {"--html", (dir / "missing" / "r.html").string()});
+  r = run_tridex(args, dir);
+  CHECK(r.status == 2);
+  CHECK(r.err.find("--html") != std::string::npos);
+  fs::remove_all(dir);
+}

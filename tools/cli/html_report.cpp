@@ -1,0 +1,375 @@
+// tridex command — the interactive HTML report; see html_report.hpp. Mesh simplification:
+// meshoptimizer's meshopt_simplify (A. Kapoulkine, after Garland and Heckbert, "Surface
+// Simplification Using Quadric Error Metrics", SIGGRAPH 1997).
+#include "html_report.hpp"
+
+#include <meshoptimizer.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <stdexcept>
+#include <string_view>
+
+#include "output.hpp"
+#include "pipeline.hpp"
+#include "tridex/gcode/interpreter.hpp"
+
+// The page template and libjs-three's files, embedded at build time (cmake/embed_text.cmake).
+extern const char kTridexHtmlTemplate[];
+extern const char kTridexThreeJs[];
+extern const char kTridexOrbitControlsJs[];
+
+namespace tridex::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Positions this far from the origin are tridex's stand-in for home returns and reorientations
+// ("far along the tool axis"), not programmed points: they are not drawn.
+constexpr double kFar = 0.5 * gcode::MachineConfig::kDefaultFar;
+
+template <class T>
+std::string base64_of(const std::vector<T>& values) {
+  return base64({reinterpret_cast<const std::uint8_t*>(values.data()), values.size() * sizeof(T)});
+}
+
+// Points as uint16 per coordinate over `box` (the page's dequantise() inverts it): at most half
+// of 1/65535 of the box's side off, 1.5 µm on a 200 mm part.
+std::string quantised(const std::vector<glm::vec3>& points, const Aabb& box) {
+  std::vector<std::uint16_t> q;
+  q.reserve(points.size() * 3);
+  for (const glm::vec3& p : points)
+    for (int a = 0; a < 3; ++a) {
+      const double side = box.max[a] - box.min[a];
+      const double t = side > 0 ? (p[a] - box.min[a]) / side : 0;
+      q.push_back(static_cast<std::uint16_t>(std::lround(std::clamp(t, 0.0, 1.0) * 65535)));
+    }
+  return base64_of(q);
+}
+
+Json box_json(const Aabb& box) { return {{"min", to_json(box.min)}, {"max", to_json(box.max)}}; }
+
+Aabb bounds_of(const std::vector<glm::vec3>& points) {
+  Aabb box;
+  for (const glm::vec3& p : points) box.extend(Vec3(p));
+  return box;
+}
+
+double distance_to_segment(const glm::vec3& p, const glm::vec3& a, const glm::vec3& b) {
+  const glm::vec3 ab = b - a;
+  const float length2 = glm::dot(ab, ab);
+  const float t = length2 > 0 ? std::clamp(glm::dot(p - a, ab) / length2, 0.0f, 1.0f) : 0.0f;
+  return glm::length(p - (a + t * ab));
+}
+
+// The source lines a listing needs: each finding's lines and `context` lines either side.
+std::set<int> listed_lines(const Json& report, int context) {
+  std::set<int> wanted;
+  auto add = [&](const Json& line) {
+    if (!line.is_number_integer()) return;
+    for (int k = line.get<int>() - context; k <= line.get<int>() + context; ++k) wanted.insert(k);
+  };
+  for (const char* kind : {"gouges", "excess", "rapid_cuts"})
+    if (report.contains(kind))
+      for (const Json& f : report[kind]) {
+        if (f.contains("lines"))
+          for (const Json& line : f["lines"]) add(line);
+        if (f.contains("line")) add(f["line"]);
+      }
+  if (report.contains("envelope"))
+    for (const Json& v : report["envelope"]["violations"]) add(v["line"]);
+  return wanted;
+}
+
+// line -> text of the single G-code file: all of it when small, else the listed lines. With
+// several files a line number does not say which file, so there is no text.
+Json source_lines(const HtmlPage& page, const HtmlLimits& limits, std::string& note) {
+  Json source = Json::object();
+  if (page.files.size() != 1) {
+    note = page.files.empty() ? "no program file" : "the program spans several files";
+    return source;
+  }
+  std::error_code error;
+  const std::uintmax_t size = fs::file_size(page.files[0], error);
+  std::ifstream in(page.files[0], std::ios::binary);
+  if (error || !in) {
+    note = "the program file could not be read";
+    return source;
+  }
+  const bool everything = size <= limits.max_source_bytes;
+  const std::set<int> wanted = everything ? std::set<int>{} : listed_lines(page.report, limits.context);
+  note = everything ? "" : "the program is large: only the lines around findings are included";
+  std::string text;
+  for (int line = 1; std::getline(in, text); ++line) {
+    if (!everything && !wanted.count(line)) continue;
+    if (!text.empty() && text.back() == '\r') text.pop_back();
+    source[std::to_string(line)] = text;
+  }
+  return source;
+}
+
+// Feed time: each feed move's length at its F (rapids and dwells are machine-dependent: left out).
+double feed_time_s(const std::vector<gcode::MoveGroup>& groups) {
+  double minutes = 0;
+  for (const gcode::MoveGroup& group : groups)
+    for (const gcode::Move& m : group.moves)
+      if (m.kind != gcode::MoveKind::rapid && m.feed > 0) minutes += glm::length(m.end - m.start) / m.feed;
+  return minutes * 60;
+}
+
+Json mesh_json(const HtmlPage& page, const HtmlLimits& limits) {
+  Json mesh = {{"triangles", 0}, {"triangles_shown", 0}};
+  if (!page.mesh || page.mesh->triangles.empty()) return mesh;
+  double gouge_tol = 0, excess_tol = 0;
+  if (!page.deviation.empty()) {
+    gouge_tol = page.report.at("tolerances_mm").at("gouge").get<double>();
+    excess_tol = page.report.at("tolerances_mm").at("excess").get<double>();
+  }
+  DisplayMesh shown = simplify_for_display(*page.mesh, page.deviation, gouge_tol, excess_tol, limits.max_triangles);
+  const Aabb box = bounds_of(shown.positions);
+  mesh["triangles"] = page.mesh->triangles.size();
+  mesh["triangles_shown"] = shown.indices.size() / 3;
+  mesh["box"] = box_json(box);
+  mesh["positions"] = quantised(shown.positions, box);
+  mesh["indices"] = base64_of(shown.indices);
+  if (!shown.deviation.empty()) mesh["deviation"] = base64_of(shown.deviation);
+  return mesh;
+}
+
+Json toolpath_json(const HtmlPage& page, const HtmlLimits& limits) {
+  Json path = {{"segments", 0}, {"moves", 0}};
+  if (!page.groups) return path;
+  Aabb drawn;
+  for (const gcode::MoveGroup& group : *page.groups)
+    for (const gcode::Move& m : group.moves)
+      if (glm::length(m.start) < kFar && glm::length(m.end) < kFar) {
+        drawn.extend(m.start);
+        drawn.extend(m.end);
+      }
+  // A tolerance of about a quarter pixel of a 1000-pixel view first, doubled while there are too
+  // many segments.
+  double tolerance = std::max(1e-6, glm::length(drawn.size()) * limits.path_tolerance);
+  DisplayPath thinned = thin_toolpath(*page.groups, tolerance);
+  while (thinned.lines.size() > limits.max_segments) thinned = thin_toolpath(*page.groups, tolerance *= 2);
+  path["moves"] = thinned.moves;
+  path["segments"] = thinned.lines.size();
+  path["tolerance_mm"] = thinned.tolerance;
+  // The lines as runs of consecutive numbers (first, count): a program is mostly one move a line.
+  std::vector<std::uint32_t> runs;
+  for (std::uint32_t line : thinned.program_lines)
+    if (!runs.empty() && runs[runs.size() - 2] + runs.back() == line) ++runs.back();
+    else runs.insert(runs.end(), {line, 1});
+  path["program_line_runs"] = base64_of(runs);
+  if (thinned.lines.empty()) return path;
+  const Aabb box = bounds_of(thinned.ends);
+  path["box"] = box_json(box);
+  path["points"] = quantised(thinned.ends, box);
+  path["lines"] = base64_of(thinned.lines);
+  path["tools"] = base64_of(thinned.tools);
+  path["flags"] = base64_of(thinned.flags);
+  return path;
+}
+
+std::string html_escaped(std::string_view text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '&': out += "&amp;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string base64(std::span<const std::uint8_t> bytes) {
+  static constexpr char kDigits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((bytes.size() + 2) / 3 * 4);
+  std::size_t i = 0;
+  for (; i + 3 <= bytes.size(); i += 3) {
+    const std::uint32_t v = std::uint32_t{bytes[i]} << 16 | std::uint32_t{bytes[i + 1]} << 8 | bytes[i + 2];
+    for (int shift = 18; shift >= 0; shift -= 6) out += kDigits[(v >> shift) & 63];
+  }
+  if (const std::size_t rest = bytes.size() - i; rest > 0) {
+    const std::uint32_t v = std::uint32_t{bytes[i]} << 16 | (rest > 1 ? std::uint32_t{bytes[i + 1]} << 8 : 0);
+    out += kDigits[(v >> 18) & 63];
+    out += kDigits[(v >> 12) & 63];
+    out += rest > 1 ? kDigits[(v >> 6) & 63] : '=';
+    out += '=';
+  }
+  return out;
+}
+
+DisplayMesh simplify_for_display(const Mesh& mesh, std::span<const double> deviation, double gouge_tol,
+                                 double excess_tol, std::size_t max_triangles) {
+  if (!deviation.empty() && deviation.size() != mesh.positions.size())
+    throw std::logic_error("simplify_for_display: one deviation per vertex expected");
+  std::vector<std::uint32_t> locked, free;
+  auto out_of_tolerance = [&](std::uint32_t v) {
+    return !deviation.empty() && (deviation[v] < -gouge_tol || deviation[v] > excess_tol);
+  };
+  for (const glm::uvec3& t : mesh.triangles) {
+    const bool keep = out_of_tolerance(t.x) || out_of_tolerance(t.y) || out_of_tolerance(t.z);
+    for (int k = 0; k < 3; ++k) (keep ? locked : free).push_back(t[k]);
+  }
+  std::vector<std::uint32_t> indices;
+  {
+    // Locked triangles stay; the free part is simplified with its border locked (so it still
+    // meets them), under a rising error bound (relative to the mesh's extent) until it fits. The
+    // first bound, 5e-4 (0.1 mm on a 200 mm part, a quarter pixel of a 500-pixel view of it),
+    // mostly merges the flat faces that a dexel surface tiles finely and their sub-cell ripple.
+    // When the locked triangles alone take half the budget, everything is simplified.
+    unsigned options = meshopt_SimplifyLockBorder;
+    if (locked.size() / 3 >= max_triangles / 2) {
+      free.insert(free.end(), locked.begin(), locked.end());
+      locked.clear();
+      options = 0;
+    }
+    const std::size_t target = (max_triangles - locked.size() / 3) * 3;
+    std::vector<std::uint32_t> simplified(free.size());
+    for (float error : {5e-4f, 2e-3f, 8e-3f, 3e-2f, 1e-1f, 1.0f}) {
+      const std::size_t goal = error == 5e-4f ? 0 : target;  // as far as the first bound allows
+      simplified.resize(meshopt_simplify(simplified.data(), free.data(), free.size(), &mesh.positions[0].x,
+                                         mesh.positions.size(), sizeof(glm::vec3), goal, error, options));
+      if (simplified.size() <= target) break;
+      simplified.resize(free.size());
+    }
+    if (simplified.size() > target)  // the locked border alone is over the budget
+      simplified.resize(meshopt_simplifySloppy(simplified.data(), free.data(), free.size(), &mesh.positions[0].x,
+                                               mesh.positions.size(), sizeof(glm::vec3), target, 1.0f, nullptr));
+    indices = std::move(locked);
+    indices.insert(indices.end(), simplified.begin(), simplified.end());
+  }
+  // Only the vertices still used, renumbered in order of first use.
+  DisplayMesh shown;
+  std::vector<std::uint32_t> renumbered(mesh.positions.size(), UINT32_MAX);
+  for (std::uint32_t& v : indices) {
+    if (renumbered[v] == UINT32_MAX) {
+      renumbered[v] = static_cast<std::uint32_t>(shown.positions.size());
+      shown.positions.push_back(mesh.positions[v]);
+      if (!deviation.empty()) shown.deviation.push_back(static_cast<float>(deviation[v]));
+    }
+    v = renumbered[v];
+  }
+  shown.indices = std::move(indices);
+  return shown;
+}
+
+DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups, double tolerance) {
+  struct Ref {
+    const gcode::Move* move;
+    std::uint8_t group;
+  };
+  std::vector<Ref> moves;
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    for (const gcode::Move& m : groups[g].moves) moves.push_back({&m, static_cast<std::uint8_t>(g % 128)});
+  // Groups hold their moves in program order; merged by line (stable: a line's moves keep theirs).
+  std::stable_sort(moves.begin(), moves.end(), [](const Ref& a, const Ref& b) { return a.move->line < b.move->line; });
+
+  DisplayPath path;
+  path.moves = moves.size();
+  path.tolerance = tolerance;
+  constexpr std::size_t kLongestRun = 64;  // bounds the quadratic check of a run
+  std::vector<glm::vec3> run;              // the run's points: its start, then each move's end
+  const Ref* first = nullptr;
+  int last_line = 0;
+  auto flush = [&] {
+    if (run.size() < 2) return;
+    path.ends.push_back(run.front());
+    path.ends.push_back(run.back());
+    path.lines.push_back(static_cast<std::uint32_t>(last_line));
+    path.tools.push_back(static_cast<std::uint16_t>(std::clamp(first->move->tool, 0, 65535)));
+    path.flags.push_back(static_cast<std::uint8_t>(first->group | (first->move->kind == gcode::MoveKind::rapid ? 128 : 0)));
+    run.clear();
+  };
+  for (const Ref& ref : moves) {
+    const gcode::Move& m = *ref.move;
+    if (path.program_lines.empty() || path.program_lines.back() != static_cast<std::uint32_t>(m.line))
+      path.program_lines.push_back(static_cast<std::uint32_t>(m.line));
+    if (glm::length(m.start) >= kFar || glm::length(m.end) >= kFar) {
+      flush();
+      continue;
+    }
+    const glm::vec3 start(m.start), end(m.end);
+    bool joins = !run.empty() && run.size() < kLongestRun && first->group == ref.group &&
+                 first->move->tool == m.tool && (first->move->kind == gcode::MoveKind::rapid) == (m.kind == gcode::MoveKind::rapid) &&
+                 glm::length(run.back() - start) <= 1e-6f;
+    if (joins)
+      for (std::size_t k = 1; k < run.size() && joins; ++k) joins = distance_to_segment(run[k], run.front(), end) <= tolerance;
+    if (!joins) {
+      flush();
+      first = &ref;
+      run.push_back(start);
+    }
+    run.push_back(end);
+    last_line = m.line;
+  }
+  flush();
+  return path;
+}
+
+Json html_page_data(const HtmlPage& page, const HtmlLimits& limits) {
+  Json data;
+  data["title"] = page.title;
+  data["report"] = page.report;
+  data["mesh"] = mesh_json(page, limits);
+  data["toolpath"] = toolpath_json(page, limits);
+  Json directions = Json::array();
+  if (page.groups)
+    for (const gcode::MoveGroup& g : *page.groups) {
+      Json tools = Json::array();
+      for (int t : g.tools) tools.push_back(t);
+      directions.push_back({{"axis", to_json(g.axis)}, {"label", axis_label(g.axis)}, {"moves", g.moves.size()},
+                            {"tools", tools}});
+    }
+  data["directions"] = directions;
+  if (page.groups && !page.groups->empty()) data["machining_time_s"] = feed_time_s(*page.groups);
+  std::string note;
+  data["source"] = source_lines(page, limits, note);
+  data["source_note"] = note;
+  data["context"] = limits.context;
+  data["listing_lines"] = 20;  // of a finding's lines, the first this many are listed
+  Json messages = Json::array();
+  if (data["mesh"]["triangles_shown"] == 0)
+    messages.push_back("No material is left: the machined result has no triangles, so there is no part to show.");
+  if (!page.groups || data["toolpath"]["moves"] == 0)
+    messages.push_back("The program has no moves: there is no toolpath to show.");
+  data["messages"] = messages;
+  return data;
+}
+
+void write_html_report(const fs::path& path, const HtmlPage& page, const HtmlLimits& limits) {
+  // The data goes inside a <script> element: no '<' may appear in it ("</script>" would end the
+  // element), and JSON allows "\u003c" wherever a '<' could be (inside strings).
+  std::string data = html_page_data(page, limits).dump();
+  std::string escaped;
+  escaped.reserve(data.size());
+  for (char c : data) c == '<' ? escaped += "\\u003c" : escaped += c;
+
+  const std::string_view page_template = kTridexHtmlTemplate;
+  const std::array<std::pair<std::string_view, std::string_view>, 4> fills = {{
+      {"@TITLE@", {}}, {"@DATA@", escaped}, {"@THREE@", kTridexThreeJs}, {"@ORBIT@", kTridexOrbitControlsJs}}};
+  const std::string title = html_escaped(page.title);
+  AtomicOutput out(path);
+  std::size_t at = 0;
+  for (const auto& [marker, text] : fills) {
+    const std::size_t found = page_template.find(marker, at);
+    if (found == std::string_view::npos) throw std::logic_error("html_report.html lacks " + std::string(marker));
+    out.stream() << page_template.substr(at, found - at) << (marker == "@TITLE@" ? std::string_view(title) : text);
+    at = found + marker.size();
+  }
+  out.stream() << page_template.substr(at);
+  out.commit();
+}
+
+}  // namespace tridex::cli

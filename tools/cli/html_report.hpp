@@ -1,0 +1,86 @@
+// tridex command — `--html OUT.html` of simulate and check (issue 15): one self-contained page
+// with the machined part in a three.js view, the toolpath with a slider over the program, the
+// findings (choosing one flies the camera to it and lists its G-code lines) and the report's
+// figures. three.js and its OrbitControls (Debian's libjs-three, found by CMake) and the page
+// template (html_report.html) are embedded in the command and inlined into every page, so the page
+// opens offline and makes no request.
+//
+// Large results are made small enough to open quickly: the part is simplified with meshoptimizer
+// (Kapoulkine's edge collapse under quadric error, meshopt_simplify) to a triangle budget, keeping
+// every triangle that touches an out-of-tolerance vertex and the border around them, so the
+// deviation colours stay where they were; the toolpath is thinned to what the page can show (runs
+// of moves within a tolerance of one straight segment become that segment). Points are quantised
+// to 16 bits over their box and stored base64.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "json_text.hpp"
+#include "tridex/gcode/grouping.hpp"
+#include "tridex/mesh.hpp"
+
+namespace tridex::cli {
+
+struct HtmlLimits {
+  std::size_t max_triangles = 250'000;    // shown of the part (a budget; see simplify_for_display)
+  std::size_t max_segments = 1'000'000;   // of the toolpath after thinning
+  double path_tolerance = 1.0 / 4000;     // thinning, as a fraction of the toolpath's box diagonal
+  std::uintmax_t max_source_bytes = 4 << 20;  // the whole program text is inlined up to this size
+  int context = 3;                        // neighbouring lines shown around a finding's line
+};
+
+struct HtmlPage {
+  std::string title;
+  Json report;                                  // the report as --report writes it
+  const Mesh* mesh = nullptr;                   // the machined part; null or empty: none left
+  std::span<const double> deviation;            // check: signed deviation per mesh vertex
+  const std::vector<gcode::MoveGroup>* groups = nullptr;
+  std::vector<std::filesystem::path> files;     // the G-code file(s), for the listings
+};
+
+// Writes the page atomically (output.hpp).
+void write_html_report(const std::filesystem::path& path, const HtmlPage& page, const HtmlLimits& limits = {});
+
+// ---- the pieces, for the tests -------------------------------------------------------------
+
+std::string base64(std::span<const std::uint8_t> bytes);
+
+// The page's data (the JSON inside its tridex-data block).
+Json html_page_data(const HtmlPage& page, const HtmlLimits& limits);
+
+struct DisplayMesh {
+  std::vector<glm::vec3> positions;
+  std::vector<std::uint32_t> indices;  // three per triangle
+  std::vector<float> deviation;        // per position when the input had one
+};
+
+// At most `max_triangles`: meshopt_simplify with the out-of-tolerance triangles and the border
+// around them locked (everything free only if those alone take half the budget), first within an
+// error of 5e-4 of the mesh's extent (merging flat faces), then with rising bounds until the
+// budget is met. Kept vertices keep their positions and deviations exactly.
+DisplayMesh simplify_for_display(const Mesh& mesh, std::span<const double> deviation, double gouge_tol,
+                                 double excess_tol, std::size_t max_triangles);
+
+struct DisplayPath {
+  std::vector<glm::vec3> ends;           // two per segment, in program order
+  std::vector<std::uint32_t> lines;      // per segment: the last source line it stands for
+  std::vector<std::uint16_t> tools;      // per segment
+  std::vector<std::uint8_t> flags;       // per segment: direction (group) index | 128 for rapids
+  std::vector<std::uint32_t> program_lines;  // every distinct line that made a move, ascending
+  std::size_t moves = 0;
+  double tolerance = 0;                  // mm, what the thinning used
+};
+
+// The moves of all groups in line order, each run of moves of one kind, tool and direction that
+// joins end to start and stays within `tolerance` (mm) of the straight segment from its first start
+// to its last end drawn as that segment, carrying the run's last line. Positions "far along the
+// tool axis" (tridex's stand-in for home returns) are left out of the drawing; their lines are
+// still in program_lines.
+DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups, double tolerance);
+
+}  // namespace tridex::cli
