@@ -43,7 +43,7 @@ void add_simulate(CLI::App& command, SimulateOptions& options) {
                   "box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX | FILE.stl | auto[:MARGIN] (default auto: the box around\n"
                   "the cutting moves plus MARGIN mm, or 5 % of each side without one)");
   command.add_option("--zmap-cell", options.zmap_cell,
-                  "Z-map grid spacing, mm (default: stock diagonal / 1000)")
+                  "Z-map grid spacing, mm (default: stock diagonal / 1000, at most half the dexel spacing)")
       ->check(CLI::PositiveNumber);
   auto* dexel_cell = command.add_option("--dexel-cell", options.dexel_cell, "triple-dexel spacing, mm")
                          ->check(CLI::PositiveNumber);
