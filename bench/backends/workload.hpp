@@ -5,7 +5,7 @@
 // −X and −Y, each with four cutters: a 10 mm flat end and an 8 mm bull nose roughing in
 // Z levels, a 6 mm and a 3 mm ball end finishing. The surface each direction machines is
 // mold-like: a smooth dome with ripples, in that direction's feature frame (Fanuc G68.2, as
-// DESIGN.md defines it). Passes are zig-zag rasters of short G01 segments; the number of
+// docs/design.md defines it). Passes are zig-zag rasters of short G01 segments; the number of
 // segments is a parameter (the paper's models have 1.46 M to 5.17 M), split over directions
 // and cutters in fixed shares.
 #pragma once

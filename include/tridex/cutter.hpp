@@ -1,6 +1,6 @@
 // tridex — cutters: convex solids of revolution around the tool axis.
 //
-// The conventions of ../shared/DESIGN.md: the programmed point is the tool tip (the lowest point
+// The conventions of docs/design.md: the programmed point is the tool tip (the lowest point
 // on the axis); a cutter is given by its radius ρ(h) at height h above the tip and continues
 // upward at full radius forever. Milling needs the inverse view, the cutter's *lower surface*:
 // the height h(d) of its lowest point at horizontal distance d from the axis, for 0 ≤ d ≤ R.

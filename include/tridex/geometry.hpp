@@ -1,6 +1,6 @@
 // tridex — points, boxes, segments and rigid frames.
 //
-// A Frame is the rigid transform T_i of the method (../shared/DESIGN.md): its local z axis is a
+// A Frame is the rigid transform T_i of the method (docs/design.md): its local z axis is a
 // spindle direction. `to_local` maps world points into the frame (the spindle onto +z);
 // `to_world` is its inverse. The rotation's columns are the frame's x, y, z axes in world
 // coordinates, so `rotation * local + origin == world`.

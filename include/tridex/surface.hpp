@@ -1,5 +1,5 @@
 // tridex — surface extraction: triple dexel → closed, outward-oriented triangle mesh (Step 4 of
-// the method in ../shared/DESIGN.md).
+// the method in docs/design.md).
 //
 // Method. Marching cubes (Lorensen & Cline, SIGGRAPH 1987) on the triple-dexel lattice, with the
 // two refinements that triple dexels make natural:

@@ -38,7 +38,7 @@ std::string g682(const Vec3& o, double a, double b, double c) {
 
 }  // namespace
 
-TEST_CASE("G68.2: the four checks of DESIGN.md") {
+TEST_CASE("G68.2: the four checks of docs/design.md") {
   struct Check {
     double a, b, c;
     Vec3 axis;

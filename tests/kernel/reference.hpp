@@ -1,4 +1,4 @@
-// Brute-force references for the kernel tests, written from ../shared/DESIGN.md's formulas and
+// Brute-force references for the kernel tests, written from docs/design.md's formulas and
 // independent of the kernel's fast paths: a cutter is only its radius function ρ(h), and the
 // swept cutter is sampled densely along the move.
 #pragma once

@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "../kernel/edge_sampling.hpp"
 #include "command_harness.hpp"
 #include "tool_table.hpp"
 #include "tridex/gcode/interpreter.hpp"
@@ -82,6 +83,8 @@ struct Reference {
   std::vector<Cutter> cutters;
   std::vector<detail::MoveGeometry> moves;
   std::vector<Frame> frames;
+  std::vector<unsigned> direction;  // per move: the index of its spindle direction
+  std::vector<Vec3> axes;           // per direction
   // Moves bucketed by a uniform grid over the stock, each in every cell its removal region
   // (everything within the cutter radius of the segment and above it along the axis) can reach.
   Aabb box;
@@ -105,6 +108,9 @@ struct Reference {
       if (m.tool == 0) continue;  // no tool in the spindle
       frames.push_back(Frame::from_axis(m.axis));
       const Frame& f = frames.back();
+      auto same = std::find_if(axes.begin(), axes.end(), [&](const Vec3& a) { return glm::length(a - m.axis) < 1e-9; });
+      direction.push_back(static_cast<unsigned>(same - axes.begin()));
+      if (same == axes.end()) axes.push_back(m.axis);
       const Cutter& cutter = cutters[index.at(m.tool)];
       moves.emplace_back(cutter, Segment{f.to_local(m.start), f.to_local(m.end)});
       Aabb region;
@@ -128,6 +134,21 @@ struct Reference {
     }
   }
 
+  // 0 outside the stock, 1 kept, otherwise 2 << d for each direction d whose moves remove p.
+  unsigned label(const Vec3& p) const {
+    if (!in_stock(p)) return 0;
+    glm::ivec3 c;
+    for (int a = 0; a < 3; ++a)
+      c[a] = std::clamp(static_cast<int>(std::floor((p[a] - box.min[a]) / cell)), 0, n[a] - 1);
+    unsigned l = 0;
+    for (std::uint32_t m : buckets[static_cast<std::size_t>(c.x + n.x * (c.y + n.y * c.z))]) {
+      const unsigned bit = 2u << direction[m];
+      if (l & bit) continue;
+      Vec3 q = frames[m].to_local(p);
+      if (q.z >= moves[m].lowest_above(q.x, q.y)) l |= bit;
+    }
+    return l == 0 ? 1 : l;
+  }
   bool removed(const Vec3& p) const {
     glm::ivec3 c;
     for (int a = 0; a < 3; ++a)
@@ -144,47 +165,7 @@ struct Reference {
   bool kept(const Vec3& p) const { return in_stock(p) && !removed(p); }
 };
 
-// Point membership in a closed mesh by the parity of crossings of a ray along +z, with the
-// triangles bucketed by their x-y boxes.
-struct MeshInside {
-  const Mesh& mesh;
-  Aabb box;
-  double cell;
-  int nx, ny;
-  std::vector<std::vector<std::uint32_t>> buckets;
-
-  MeshInside(const Mesh& m, double bucket) : mesh(m), box(m.bounds()), cell(bucket) {
-    nx = std::max(1, static_cast<int>(std::ceil(box.size().x / cell)) + 1);
-    ny = std::max(1, static_cast<int>(std::ceil(box.size().y / cell)) + 1);
-    buckets.resize(static_cast<std::size_t>(nx) * ny);
-    for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
-      Aabb tb;
-      for (int k = 0; k < 3; ++k) tb.extend(Vec3(mesh.positions[mesh.triangles[t][k]]));
-      for (int j = bin(tb.min.y, box.min.y, ny); j <= bin(tb.max.y, box.min.y, ny); ++j)
-        for (int i = bin(tb.min.x, box.min.x, nx); i <= bin(tb.max.x, box.min.x, nx); ++i)
-          buckets[static_cast<std::size_t>(i + nx * j)].push_back(t);
-    }
-  }
-  int bin(double v, double lo, int count) const {
-    return std::clamp(static_cast<int>(std::floor((v - lo) / cell)), 0, count - 1);
-  }
-  bool inside(const Vec3& p) const {
-    if (!box.contains(p)) return false;
-    int crossings = 0;
-    for (std::uint32_t t : buckets[static_cast<std::size_t>(bin(p.x, box.min.x, nx) + nx * bin(p.y, box.min.y, ny))]) {
-      Vec3 a(mesh.positions[mesh.triangles[t].x]), b(mesh.positions[mesh.triangles[t].y]),
-          c(mesh.positions[mesh.triangles[t].z]);
-      double det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
-      if (det == 0) continue;
-      double wb = ((p.x - a.x) * (c.y - a.y) - (c.x - a.x) * (p.y - a.y)) / det;
-      double wc = ((b.x - a.x) * (p.y - a.y) - (p.x - a.x) * (b.y - a.y)) / det;
-      double wa = 1 - wb - wc;
-      if (wa < 0 || wb < 0 || wc < 0) continue;
-      if (wa * a.z + wb * b.z + wc * c.z > p.z) ++crossings;
-    }
-    return crossings % 2 == 1;
-  }
-};
+using tridex::test::MeshInside;
 
 struct Simulated {
   json report;
@@ -708,6 +689,20 @@ TEST_CASE("simulate: the bundled example, from its CAMotics project, matches the
   cli::ToolTable table = cli::ToolTable::read(examples + "mold_3plus2.tools.json");
   Reference ref(gcode::read_moves(examples + "mold_3plus2.nc"), table, Aabb{Vec3(0, 0, 0), Vec3(100, 80, 50)});
   check_against_reference(s, ref, 11);
+  // Along the edges where two directions' cuts meet (the +X bevel's top edge, the side
+  // features' rims). Documents today's rate with an honest bound, above the target of 2 in
+  // 10,000: at this resolution (h 0.5 mm, Z-map cell 0.4 h) 3 of 3000 points are wrong beyond
+  // h/2 (worst 0.63 h), none beyond 1.5 h. The walls' rims are off by up to a Z-map cell
+  // (docs/design.md, "Known errors"); tests/kernel/test_edges.cpp measures that.
+  std::mt19937 rng(13);
+  const double h = s.report["dexel"]["cell_mm"].get<double>();
+  test::EdgeErrors edges = test::measure_edges(ref.box, [&](const Vec3& p) { return ref.label(p); }, s.mesh, h, 3000, rng);
+  MESSAGE("the example's edges: " << edges.samples << " points, " << edges.wrong << " wrong, " << edges.beyond_half
+                                  << " beyond h/2, " << edges.beyond_one_and_half << " beyond 1.5h, worst " << edges.worst << " h");
+  CHECK(edges.samples == 3000);
+  CHECK(edges.beyond_one_and_half == 0);
+  CHECK(edges.beyond_half * 10000 <= 20 * edges.samples);
+  CHECK(edges.worst < 1.0);
   fs::remove_all(dir);
 }
 

@@ -31,7 +31,7 @@ struct ListOptions : CommonOptions {
 struct SimulateOptions : CommonOptions {
   std::string tools;            // --tools FILE (overrides a project's table)
   std::string stock;            // --stock (overrides a project's workpiece); empty: auto
-  double zmap_cell = 0;         // 0: stock diagonal / 1000
+  double zmap_cell = 0;         // 0: stock diagonal / 1000, at most half the dexel spacing
   double dexel_cell = 0;        // 0: from dexel_res
   int dexel_res = 0;            // 0: the default
   std::string output, png, report, dump_zmaps;
@@ -54,6 +54,7 @@ struct CheckOptions : SimulateOptions {
 
 constexpr int kDefaultDexelRes = 320;
 constexpr double kDefaultZmapCellFraction = 1.0 / 1000;  // of the stock's diagonal
+constexpr double kDefaultZmapCellOfSpacing = 0.5;      // at most this many dexel spacings
 
 int run_moves(const ListOptions& options);
 int run_groups(const ListOptions& options);

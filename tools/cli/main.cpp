@@ -77,7 +77,7 @@ void add_simulate(CLI::App& command, SimulateOptions& options) {
                   "the cutting moves plus MARGIN mm, or 5 % of each side without one)")
       ->check(kNotEmpty);
   command.add_option("--zmap-cell", options.zmap_cell,
-                  "Z-map grid spacing, mm (default: stock diagonal / 1000)")
+                  "Z-map grid spacing, mm (default: stock diagonal / 1000, at most half the dexel spacing)")
       ->check(kFinitePositive);
   auto* dexel_cell = command.add_option("--dexel-cell", options.dexel_cell, "triple-dexel spacing, mm")
                          ->check(kFinitePositive);

@@ -261,8 +261,6 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   r.stock = load_stock(stock_spec, cutting_bounds, max_memory);
   const Stock& stock = r.stock;
   const double diagonal = glm::length(stock.box.size());
-  const double zmap_cell = options.zmap_cell > 0 ? options.zmap_cell : diagonal * kDefaultZmapCellFraction;
-  r.zmap_cell = zmap_cell;
   try {
     r.lattice = options.dexel_cell > 0
                     ? DexelLattice::covering(stock.box, options.dexel_cell)
@@ -274,6 +272,13 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   check_reach(stock_spec.kind == StockSpec::Kind::mesh ? "--stock " + stock_spec.mesh_path.string() : "the stock",
               stock.box, lattice.spacing);
   for (const auto& [what, bounds] : request.extra_bounds) check_reach(what, bounds, lattice.spacing);
+  // A Z-map's polyhedron ramps across the cell where a wall parallel to its spindle drops, and
+  // is off by up to a cell at the wall's rims, where it meets the other directions' cuts
+  // (docs/design.md, "Known errors"); at most half a dexel spacing keeps those edges within h/2.
+  const double zmap_cell = options.zmap_cell > 0
+                               ? options.zmap_cell
+                               : std::min(diagonal * kDefaultZmapCellFraction, kDefaultZmapCellOfSpacing * lattice.spacing);
+  r.zmap_cell = zmap_cell;
   double zmap_points = 0;
   for (const gcode::MoveGroup& group : groups) {
     try {

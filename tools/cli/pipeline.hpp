@@ -34,7 +34,7 @@ struct Stock {
   Json description;
 };
 
-// How rapids are checked for cutting material (DESIGN.md: a rapid that touches stock is a
+// How rapids are checked for cutting material (docs/design.md: a rapid that touches stock is a
 // finding).
 enum class RapidCheck {
   // Against the direction's Z-map milled by its feed moves alone: rapids through material that no

@@ -1,4 +1,4 @@
-// tridex command — rapids that cut: a finding to report (../shared/DESIGN.md: every move removes
+// tridex command — rapids that cut: a finding to report (docs/design.md: every move removes
 // material, rapid or feed, and a rapid that touches the stock is a finding).
 //
 // Material removal does not depend on the order of moves, so the simulation cannot know what a

@@ -1,0 +1,189 @@
+// Accuracy along the edges where two spindle directions' cuts meet (issue 17), sampled there
+// (edge_sampling.hpp) because uniform samples, as in test_machine.cpp, almost never land on
+// them. Errors beyond h/2 and beyond 1.5 h are counted; the target is at most 2 in 10,000
+// beyond h/2 and none beyond 1.5 h.
+//
+// The first case meets the target. The second documents the error rate where one direction's
+// pocket wall meets the other's surface, with honest bounds it passes today: the Z-map
+// polyhedron ramps linearly across the cell where the milled height drops at a wall parallel to
+// the spindle, so at the wall's rim the solid is off by up to one Z-map cell across the wall
+// (docs/design.md, "Known errors"). With a cell of h/2 (the command's default at fine
+// spacings) 16 in 10,000 are wrong beyond h/2 here, still above the target, none beyond 1.5 h;
+// with 1.37 h (what the old default gave the bundled example at 0.1 mm dexels) nine times as
+// many, up to 1.24 h away. Tighten the bounds when walls are placed inside their cells.
+#include <doctest/doctest.h>
+
+#include <bit>
+#include <random>
+#include <string>
+#include <utility>
+
+#include "tridex/machine.hpp"
+#include "tridex/mill.hpp"
+#include "tridex/surface.hpp"
+#include "tridex/zmap.hpp"
+#include "edge_sampling.hpp"
+
+using namespace tridex;
+using tridex::test::EdgeErrors;
+
+namespace {
+
+struct Direction {
+  Frame frame;
+  std::vector<CutMove> moves;  // tool tip in the frame
+};
+
+// Point membership by the moves: p is removed by direction i iff one of its moves' swept
+// cutters reaches down to p's local height over p's local (x, y). The moves of each direction
+// are bucketed on a grid of its local x-y plane, so a query looks at a few of them.
+class EdgeReference {
+ public:
+  EdgeReference(const Aabb& stock, const std::vector<Direction>& program, const std::vector<Cutter>& cutters)
+      : stock_(stock), program_(program) {
+    for (const Direction& d : program) {
+      Bucketed b;
+      b.box = local_bounds(d.frame, stock).inflated(0.5);
+      b.nx = static_cast<int>(std::ceil(b.box.size().x / kBucket)) + 1;
+      b.ny = static_cast<int>(std::ceil(b.box.size().y / kBucket)) + 1;
+      b.cells.resize(static_cast<std::size_t>(b.nx * b.ny));
+      for (const CutMove& m : d.moves) {
+        b.moves.emplace_back(cutters[m.cutter], m.tip);
+        const double r = cutters[m.cutter].radius();
+        const auto index = static_cast<std::uint32_t>(b.moves.size() - 1);
+        for (int j = b.bin_y(std::min(m.tip.a.y, m.tip.b.y) - r); j <= b.bin_y(std::max(m.tip.a.y, m.tip.b.y) + r); ++j)
+          for (int i = b.bin_x(std::min(m.tip.a.x, m.tip.b.x) - r); i <= b.bin_x(std::max(m.tip.a.x, m.tip.b.x) + r); ++i)
+            b.cells[static_cast<std::size_t>(i + b.nx * j)].push_back(index);
+      }
+      buckets_.push_back(std::move(b));
+    }
+  }
+
+  // 0 outside the stock, 1 kept, otherwise 2 << i for each direction i that removes p.
+  unsigned label(const Vec3& p) const {
+    if (!stock_.contains(p)) return 0;
+    unsigned l = 0;
+    for (std::size_t i = 0; i < program_.size(); ++i) {
+      const Vec3 q = program_[i].frame.to_local(p);
+      const Bucketed& b = buckets_[i];
+      for (std::uint32_t m : b.cells[static_cast<std::size_t>(b.bin_x(q.x) + b.nx * b.bin_y(q.y))])
+        if (q.z >= b.moves[m].lowest(q.x, q.y).z) {
+          l |= 2u << i;
+          break;
+        }
+    }
+    return l == 0 ? 1 : l;
+  }
+  bool kept(const Vec3& p) const { return label(p) == 1; }
+
+ private:
+  static constexpr double kBucket = 0.5;
+  struct Bucketed {
+    Aabb box;
+    int nx = 0, ny = 0;
+    std::vector<detail::MoveGeometry> moves;
+    std::vector<std::vector<std::uint32_t>> cells;
+    int bin_x(double x) const { return std::clamp(static_cast<int>(std::floor((x - box.min.x) / kBucket)), 0, nx - 1); }
+    int bin_y(double y) const { return std::clamp(static_cast<int>(std::floor((y - box.min.y) / kBucket)), 0, ny - 1); }
+  };
+  Aabb stock_;
+  const std::vector<Direction>& program_;
+  std::vector<Bucketed> buckets_;
+};
+
+// A random pair: direction A, near +z, finishes a tilted, rippled surface with a ball end in
+// raster passes (scallops); direction B, tilted 50–80° from +z, faces a plane with a flat end
+// and, when `pocket`, sinks a pocket 0.8 deep into part of it (walls parallel to B's spindle
+// that meet A's surface).
+std::vector<Direction> random_pair(std::mt19937& rng, const Aabb& stock, bool pocket) {
+  std::uniform_real_distribution<double> unit(0, 1);
+  std::vector<Direction> program;
+  {
+    Direction d{Frame::from_axis(glm::normalize(Vec3(0.5 * (unit(rng) - 0.5), 0.5 * (unit(rng) - 0.5), 1))), {}};
+    const Aabb local = local_bounds(d.frame, stock);
+    const double z0 = local.max.z - 0.8 - 0.5 * unit(rng), sx = 0.15 * (unit(rng) - 0.5), sy = 0.15 * (unit(rng) - 0.5);
+    const double step = 0.5 + 0.4 * unit(rng);  // × the ball's radius, 1
+    auto z = [&](double x, double y) { return z0 + sx * (x - local.min.x) + sy * (y - local.min.y) + 0.2 * std::sin(x); };
+    for (double y = local.min.y - 1; y <= local.max.y + 1; y += step)
+      for (double x = local.min.x - 1; x < local.max.x + 1; x += 0.7)
+        d.moves.push_back({Segment{Vec3(x, y, z(x, y)), Vec3(x + 0.7, y, z(x + 0.7, y))}, 0});
+    program.push_back(d);
+  }
+  {
+    const double tilt = (50 + 30 * unit(rng)) * M_PI / 180, azimuth = 2 * M_PI * unit(rng);
+    Direction d{Frame::from_axis(Vec3(std::sin(tilt) * std::cos(azimuth), std::sin(tilt) * std::sin(azimuth), std::cos(tilt))), {}};
+    const Aabb local = local_bounds(d.frame, stock);
+    const double c = local.max.z - (0.25 + 0.2 * unit(rng)) * (local.max.z - local.min.z);
+    for (double y = local.min.y - 1; y <= local.max.y + 1; y += 1.5)
+      d.moves.push_back({Segment{Vec3(local.min.x - 1, y, c), Vec3(local.max.x + 1, y, c)}, 1});
+    if (pocket) {
+      const double y0 = local.min.y + (0.3 + 0.2 * unit(rng)) * (local.max.y - local.min.y);
+      for (double y = y0; y <= y0 + 1.5; y += 0.75)
+        d.moves.push_back({Segment{Vec3(local.min.x - 1, y, c - 0.8), Vec3(local.max.x + 1, y, c - 0.8)}, 1});
+    }
+    program.push_back(d);
+  }
+  return program;
+}
+
+EdgeErrors machine_and_measure(std::mt19937& rng, bool pocket, double h, double cell, int samples) {
+  std::uniform_real_distribution<double> unit(0, 1);
+  const Aabb stock{Vec3(0), Vec3(6 + unit(rng), 5 + unit(rng), 4 + unit(rng))};
+  const std::vector<Cutter> cutters{Cutter::ball(1.0), Cutter::flat(1.0)};
+  const std::vector<Direction> program = random_pair(rng, stock, pocket);
+  std::vector<ZMap> maps;
+  for (const Direction& d : program) {
+    maps.push_back(ZMap::from_box(d.frame, stock, cell));
+    const ZMap initial = maps.back();
+    mill(maps.back(), cutters, d.moves);
+    raise_uncut(maps.back(), initial);
+  }
+  const Mesh mesh = extract_surface(machine(stock, DexelLattice::covering(stock, h), maps));
+  const EdgeReference ref(stock, program, cutters);
+  return test::measure_edges(stock, [&](const Vec3& p) { return ref.label(p); }, mesh, h, samples, rng);
+}
+
+void add(EdgeErrors& total, const EdgeErrors& e) {
+  total.samples += e.samples, total.wrong += e.wrong, total.beyond_half += e.beyond_half;
+  total.beyond_one_and_half += e.beyond_one_and_half, total.worst = std::max(total.worst, e.worst);
+}
+
+}  // namespace
+
+TEST_CASE("edges where two directions meet: tilted planar and scalloped ball-end cuts, Z-map cell h/2") {
+  // Measured: 4500 edge points, 0 wrong beyond h/2, worst 0.37 h.
+  std::mt19937 rng(17);
+  const double h = 0.1;
+  EdgeErrors total;
+  for (int trial = 0; trial < 3; ++trial) add(total, machine_and_measure(rng, false, h, 0.5 * h, 1500));
+  MESSAGE("planar + scalloped, cell h/2: " << total.samples << " edge points, " << total.wrong << " wrong, "
+                                           << total.beyond_half << " beyond h/2, " << total.beyond_one_and_half
+                                           << " beyond 1.5h, worst " << total.worst << " h");
+  CHECK(total.samples == 4500);
+  CHECK(total.beyond_one_and_half == 0);
+  CHECK(total.beyond_half * 10000 <= 2 * total.samples);  // the target: 2 in 10,000
+  CHECK(total.worst < 0.75);
+}
+
+TEST_CASE("edges where two directions meet: a pocket wall of one direction meeting the other's scallops") {
+  // The same pairs with two Z-map cells: the wall's rims are off by up to a cell (docs/design.md,
+  // "Known errors"), so a cell over h/2 puts edge points wrong beyond h/2 that a cell of h/2
+  // keeps right.
+  const double h = 0.1;
+  EdgeErrors fine, coarse;
+  for (std::uint32_t seed : {29u, 31u, 37u}) {
+    std::mt19937 a(seed), b(seed);
+    add(fine, machine_and_measure(a, true, h, 0.5 * h, 1500));
+    add(coarse, machine_and_measure(b, true, h, 1.37 * h, 1500));
+  }
+  for (const auto& [name, e] : {std::pair{std::string("h/2"), fine}, std::pair{std::string("1.37 h"), coarse}})
+    MESSAGE("pocket wall + scalloped, cell " << name << ": " << e.samples << " edge points, " << e.wrong << " wrong, "
+                                             << e.beyond_half << " beyond h/2, " << e.beyond_one_and_half
+                                             << " beyond 1.5h, worst " << e.worst << " h");
+  CHECK(fine.samples == 4500);
+  CHECK(coarse.samples == 4500);
+  CHECK(fine.beyond_one_and_half == 0);
+  CHECK(coarse.beyond_one_and_half == 0);
+  CHECK(fine.beyond_half * 10000 <= 20 * fine.samples);  // measured: 7 in 4500, worst 0.62 h
+  CHECK(coarse.beyond_half > 3 * std::max(1, fine.beyond_half));  // measured: 64 in 4500, worst 1.24 h
+}
