@@ -97,9 +97,11 @@ class ProgramFlow {
 
   void note_label(std::string_view text, const Position& after);
   bool scan_for(const std::function<bool()>& found);
-  std::optional<Source::Label> find_program(int number);
   std::optional<std::pair<std::size_t, Source::Label>> find_external(const std::string& label,
                                                                      bool o_word);
+  template <class Key>
+  std::optional<Position> find_body(std::map<Key, Source::Label> Source::*table, const Key& key,
+                                    const std::string& label, bool o_word, int column);
 
   void skip_until(const std::function<bool(const Skim&)>& stop, const std::string& what, int column);
   void call(CallKind kind, const std::string& label, long long repeats, int column);
@@ -188,12 +190,6 @@ bool ProgramFlow::scan_for(const std::function<bool()>& found) {
   return ok;
 }
 
-std::optional<Source::Label> ProgramFlow::find_program(int number) {
-  Source& src = source();
-  if (!scan_for([&] { return src.programs.count(number) > 0; })) return std::nullopt;
-  return src.programs.at(number);
-}
-
 // A subprogram file: `O1234.nc`-style names for an O number, `name.ngc` for a LinuxCNC o-word,
 // in the machine's subprogram folders and the program's own folder.
 std::optional<std::pair<std::size_t, Source::Label>> ProgramFlow::find_external(
@@ -249,54 +245,51 @@ void ProgramFlow::skip_until(const std::function<bool(const Skim&)>& stop, const
   error(column, "no " + what + " after this line");
 }
 
+// Where a called program's body starts: in this file (reading ahead for its label if need be),
+// or in a subprogram file found by name, at its label (a LinuxCNC file must hold `o<name> sub`;
+// a Fanuc file without its O number runs from its top).
+template <class Key>
+std::optional<Position> ProgramFlow::find_body(std::map<Key, Source::Label> Source::*table,
+                                               const Key& key, const std::string& label,
+                                               bool o_word, int column) {
+  Source& src = source();
+  if (scan_for([&] { return (src.*table).count(key) > 0; })) {
+    Source::Label l = (src.*table).at(key);
+    return Position{current_, l.body, l.line};
+  }
+  auto external = find_external(label, o_word);
+  if (!external) return std::nullopt;
+  std::size_t k = external->first;
+  Source& file = *sources_[k];
+  Position back = here();
+  jump(Position{k, external->second.body, 0});
+  std::optional<Source::Label> inner;
+  if (scan_for([&] { return (file.*table).count(key) > 0; })) inner = (file.*table).at(key);
+  jump(back);
+  if (inner) return Position{k, inner->body, inner->line};
+  if (o_word) error(column, "o<" + label + "> call: " + file.name + " has no o<" + label + "> sub");
+  return Position{k, file.start, 0};
+}
+
 void ProgramFlow::call(CallKind kind, const std::string& label, long long repeats, int column) {
   if (repeats <= 0) return;
   if (static_cast<int>(calls_.size()) >= s_.options.max_call_depth)
     error(column, "subprogram calls nested deeper than " + std::to_string(s_.options.max_call_depth));
   Call c{kind, label, here(), {}, repeats, loops_.size(), branches_.size(), false};
-  const char* how = kind == CallKind::m98 ? "M98 P" : kind == CallKind::g65 ? "G65 P" : "o";
-  if (kind == CallKind::o_call) {
-    Source& src = source();
-    std::optional<Source::Label> body;
-    if (scan_for([&] { return src.subroutines.count(label) > 0; })) body = src.subroutines.at(label);
-    if (body) {
-      c.body = Position{current_, body->body, body->line};
-    } else if (auto external = find_external(label, true)) {
-      // A subroutine file holds `o<name> sub` … `o<name> endsub`: run from its sub line on.
-      std::size_t k = external->first;
-      Position back = here();
-      jump(Position{k, external->second.body, 0});
-      bool found = scan_for([&] { return sources_[k]->subroutines.count(label) > 0; });
-      if (!found) error(column, "o<" + label + "> call: " + sources_[k]->name + " has no o<" + label + "> sub");
-      Source::Label l = sources_[k]->subroutines.at(label);
-      jump(back);
-      c.body = Position{k, l.body, l.line};
-    } else {
+  std::optional<Position> body =
+      kind == CallKind::o_call ? find_body(&Source::subroutines, label, label, true, column)
+                               : find_body(&Source::programs, std::stoi(label), label, false, column);
+  if (!body) {
+    if (kind == CallKind::o_call)
       error(column, "o<" + label + "> call: no such subroutine in the program, and no " + label +
                         ".ngc in the subprogram folders");
-    }
-  } else {
-    int number = std::stoi(label);
-    std::optional<Source::Label> body = find_program(number);
-    if (body) {
-      c.body = Position{current_, body->body, body->line};
-    } else if (auto external = find_external(label, false)) {
-      std::size_t k = external->first;
-      Position back = here();
-      jump(Position{k, external->second.body, 0});
-      std::optional<Source::Label> inner;
-      if (scan_for([&] { return sources_[k]->programs.count(number) > 0; }))
-        inner = sources_[k]->programs.at(number);
-      jump(back);
-      c.body = inner ? Position{k, inner->body, inner->line} : Position{k, sources_[k]->start, 0};
-    } else {
-      std::string message = std::string(how) + label + ": no O" + label +
-                            " in the program nor in the subprogram folders (--subprograms)";
-      if (!s_.options.lenient) error(column, message);
-      s_.warn(column, message + "; the call is skipped (lenient mode)");
-      return;
-    }
+    std::string message = std::string(kind == CallKind::m98 ? "M98 P" : "G65 P") + label + ": no O" +
+                          label + " in the program nor in the subprogram folders (--subprograms)";
+    if (!s_.options.lenient) error(column, message);
+    s_.warn(column, message + "; the call is skipped (lenient mode)");
+    return;
   }
+  c.body = *body;
   if (kind != CallKind::m98) {
     s_.scopes.emplace_back();
     c.scope = true;

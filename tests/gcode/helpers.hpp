@@ -1,6 +1,7 @@
 // Shared helpers of the G-code suite: run a program held in a string.
 #pragma once
 
+#include <cmath>
 #include <doctest/doctest.h>
 
 #include <random>
@@ -48,6 +49,19 @@ inline MachineConfig at_origin(MachineConfig machine = {}) {
   machine.start_position = Vec3(0.0);
   machine.tool_change = ToolChange::in_place;
   return machine;
+}
+
+// Rotation by `degrees` about a unit axis (Rodrigues): a reference independent of the library's
+// rotation helpers.
+inline Mat3 about(const Vec3& k, double degrees) {
+  double t = degrees * std::acos(-1.0) / 180, c = std::cos(t), s = std::sin(t);
+  Mat3 m;
+  for (int col = 0; col < 3; ++col) {
+    Vec3 e(0.0);
+    e[col] = 1;
+    m[col] = e * c + glm::cross(k, e) * s + k * glm::dot(k, e) * (1 - c);
+  }
+  return m;
 }
 
 inline bool near(const Vec3& a, const Vec3& b, double eps = 1e-9) {

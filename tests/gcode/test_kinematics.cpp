@@ -17,21 +17,11 @@
 
 using namespace tridex;
 using namespace tridex::gcode;
+using tridex::gcode::test::about;
 using tridex::gcode::test::near;
 using nlohmann::json;
 
 namespace {
-
-Mat3 about(const Vec3& k, double degrees) {
-  double t = degrees * std::acos(-1.0) / 180, c = std::cos(t), s = std::sin(t);
-  Mat3 m;
-  for (int col = 0; col < 3; ++col) {
-    Vec3 e(0.0);
-    e[col] = 1;
-    m[col] = e * c + glm::cross(k, e) * s + k * glm::dot(k, e) * (1 - c);
-  }
-  return m;
-}
 
 const Vec3 kX(1, 0, 0), kY(0, 1, 0), kZ(0, 0, 1);
 

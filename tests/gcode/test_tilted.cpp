@@ -11,18 +11,6 @@ using namespace tridex::gcode::test;
 
 namespace {
 
-// Rotation by `degrees` about a unit axis (Rodrigues), independent of geometry.hpp's helpers.
-Mat3 about(const Vec3& k, double degrees) {
-  double t = degrees * std::acos(-1.0) / 180, c = std::cos(t), s = std::sin(t);
-  Mat3 m;
-  for (int col = 0; col < 3; ++col) {
-    Vec3 e(0.0);
-    e[col] = 1;
-    m[col] = e * c + glm::cross(k, e) * s + k * glm::dot(k, e) * (1 - c);
-  }
-  return m;
-}
-
 Mat3 euler_zxz(double a, double b, double c) {
   return about(Vec3(0, 0, 1), a) * about(Vec3(1, 0, 0), b) * about(Vec3(0, 0, 1), c);
 }
