@@ -111,6 +111,26 @@ TEST_CASE("machine files: --subprograms finds called programs") {
   fs::remove_all(dir);
 }
 
+TEST_CASE("machine files: kinematics by profile name or as an object") {
+  fs::path dir = scratch("machine-kinematics");
+  write_text(dir / "a.json", R"({"kinematics": "bc-trunnion"})");
+  gcode::MachineConfig m = cli::load_machine((dir / "a.json").string());
+  REQUIRE(m.kinematics.has_value());
+  CHECK(m.kinematics->find('B') != nullptr);
+  CHECK(m.kinematics->find('C') != nullptr);
+  CHECK(m.kinematics->find('A') == nullptr);
+  write_text(dir / "b.json", R"({"kinematics": {"type": "table-table", "axes": [
+      {"letter": "A", "on": "table", "direction": [2, 0, 0], "pivot": [0, 0, -50],
+       "limits": [-30, 90]}]}})");
+  m = cli::load_machine((dir / "b.json").string());
+  REQUIRE(m.kinematics.has_value());
+  REQUIRE(m.kinematics->axes.size() == 1);
+  CHECK(m.kinematics->axes[0].direction.x == doctest::Approx(1.0));
+  CHECK((*m.kinematics->axes[0].limits)[1] == 90.0);
+  CHECK(!cli::load_machine("default").kinematics.has_value());
+  fs::remove_all(dir);
+}
+
 TEST_CASE("machine files: bad files name the file, the key and the value") {
   fs::path dir = scratch("machine-bad");
   struct Case {
@@ -130,6 +150,11 @@ TEST_CASE("machine files: bad files name the file, the key and the value") {
       {"{\"units\": \"cm\"}", "\"units\""},
       {"{\"base\": \"haas\"}", "\"base\""},
       {"{\"kinematic\": {}}", "unknown key"},
+      {"{\"kinematics\": \"xyz-trunnion\"}", "kinematics: is not a bundled profile"},
+      {"{\"kinematics\": 5}", "kinematics"},
+      {"{\"kinematics\": {\"type\": \"table-table\", \"axes\": [{\"letter\": \"D\", \"on\": "
+       "\"table\", \"direction\": [1, 0, 0], \"pivot\": [0, 0, 0]}]}}",
+       "kinematics.axes[0].letter"},
       {"{\"start\": [0, 0, 1e999]}", "JSON"},
       {"{", "JSON"},
   };

@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "tridex/gcode/diagnostic.hpp"
+#include "tridex/gcode/kinematics.hpp"
 #include "tridex/gcode/move.hpp"
 #include "tridex/geometry.hpp"
 
@@ -89,6 +90,10 @@ struct MachineConfig {
   // Where M98 / G65 / o<name> call look for programs the file does not contain: O1234.nc-style
   // files (and name.ngc for LinuxCNC) in these folders, in order.
   std::vector<std::string> subprogram_dirs;
+
+  // The rotary axes (kinematics.hpp): with them, A/B/C words on G0/G1 index the tool, and Haas
+  // DWO (G254/G255) and Fanuc TCP (G43.4/G43.5) are read; without them a rotary word is an error.
+  std::optional<Kinematics> kinematics;
 
   void set_home(const Vec3& p) {
     home = p;
