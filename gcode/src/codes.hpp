@@ -48,7 +48,7 @@ struct Words {
 enum Group {
   kNonModal, kMotion, kPlane, kDistance, kArcDistance, kFeedMode, kUnits, kCutterComp,
   kToolLength, kReturn, kWork, kSpindleMode, kPolar, kPath, kTilt, kOrient, kSmoothing,
-  kGroupCount
+  kDynamicOffset, kGroupCount
 };
 
 inline int g_group(int code) {
@@ -63,7 +63,7 @@ inline int g_group(int code) {
     case 940: return kFeedMode;
     case 200: case 210: return kUnits;
     case 400: return kCutterComp;
-    case 430: case 440: case 490: return kToolLength;
+    case 430: case 434: case 435: case 440: case 490: return kToolLength;
     case 980: case 990: return kReturn;
     case 540: case 550: case 560: case 570: case 580: case 590: case 541: return kWork;
     case 970: return kSpindleMode;
@@ -72,6 +72,7 @@ inline int g_group(int code) {
     case 682: case 683: case 684: case 690: case 2680: case 2690: return kTilt;
     case 531: case 533: case 536: case 2530: return kOrient;
     case 51: case 80: case 1870: return kSmoothing;  // Fanuc G5.1 Q / G8 P, Haas G187 P E
+    case 2540: case 2550: return kDynamicOffset;     // Haas DWO
     default: return -1;
   }
 }

@@ -92,9 +92,10 @@ Flow Interpreter::State::execute(const Block& block) {
   if (w.find_g(910)) incremental = true;
   if (w.find_g(901)) arc_absolute = true;
   if (w.find_g(911)) arc_absolute = false;
-  if (w.find_g(430) || w.find_g(440)) {
+  if (w.find_g(430) || w.find_g(440) || w.find_g(434) || w.find_g(435)) {
     if (w.has('H')) integer('H', "tool length offset number", 0, 99'999'999);
   }
+  tool_center_codes();  // G43.4/G43.5 TCP, G254/G255 DWO (rotary.cpp)
   // Look-ahead and smoothing modes change how the control follows the path, not the path.
   if (w.find_g(51)) {
     for (char c : {'Q', 'R'})
@@ -192,6 +193,7 @@ Flow Interpreter::State::execute(const Block& block) {
     if (is_cycle(motion_code) && motion != motion_code) cycle_active = false;
     motion = motion_code;
   }
+  if (!axis_consumer && nonmodal != 280 && nonmodal != 300) rotary_words();
   if (nonmodal == 280 || nonmodal == 300) {
     if (motion_code >= 0 && motion_code != 800)
       error(motion_column, "G28/G30 with a motion code in the same block");
@@ -251,6 +253,9 @@ Flow Interpreter::State::execute(const Block& block) {
       std::size_t k = static_cast<std::size_t>(i);
       bool axis_letter = c == 'X' || c == 'Y' || c == 'Z';
       if (axis_letter) continue;  // axis words are consumed by construction or rejected above
+      if ((c == 'A' || c == 'B' || c == 'C') && !machine.kinematics)  // never dropped, even lenient
+        error(w.column[k], std::string("rotary word ") + c + format_number(w.value[k]) +
+                               ": reading A/B/C needs a machine file with \"kinematics\" (--machine)");
       // Only words that never carry geometry may be dropped: E (an extruder), D and H (offset
       // numbers, which tridex does not apply).
       bool skippable = c == 'E' || c == 'D' || c == 'H';

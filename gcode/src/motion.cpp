@@ -381,9 +381,13 @@ void Interpreter::State::home_return(bool second) {
   far = true;
   if (rotary) {
     // Rotary axes home: the spindle returns to the machine's +Z, and the tip goes far.
+    // With a kinematic model the named axes go to their zero and the direction follows.
     for (char c : {'A', 'B', 'C'})
-      if (w.has(c)) w.take(c);
-    axis = Vec3(0, 0, 1);
+      if (w.has(c)) {
+        w.take(c);
+        rotary_position[static_cast<std::size_t>(rotary_index(c))] = 0;
+      }
+    axis = machine.kinematics ? tool_direction(*machine.kinematics, rotary_position) : Vec3(0, 0, 1);
     far = true;
     update_frame();
   }

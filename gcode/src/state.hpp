@@ -67,7 +67,15 @@ struct Interpreter::State : ParameterReader {
   Mat3 rotation{1.0};
   Vec3 origin{0.0};
 
-  // Tool: spindle direction, tip position (machine coordinates) and the far flag.
+  // Rotary axes (rotary.cpp; only with MachineConfig::kinematics): their positions and how X Y Z
+  // are read. raw: machine coordinates (the part frame is machine_to_part of the rotaries);
+  // dwo (Haas G254) and tcp (Fanuc G43.4/G43.5): the part frame, as the control computes it.
+  RotaryPositions rotary_position{};
+  bool tcp = false;
+  bool dwo = false;
+
+  // Tool: spindle direction, tip position (the part frame as it sits with every rotary at 0,
+  // which is machine coordinates without kinematics) and the far flag.
   Vec3 axis{0.0, 0.0, 1.0};
   Vec3 pos{0.0};
   bool far = true;
@@ -235,6 +243,11 @@ struct Interpreter::State : ParameterReader {
     if (tilted) {
       rotation = tilt_rotation;
       origin = tilt_origin;
+    } else if (machine.kinematics && !tcp && !dwo) {
+      // Raw rotary programs: X Y Z (after the work offset) are the machine's linear axes.
+      Frame m = machine_to_part(*machine.kinematics, rotary_position);
+      rotation = m.rotation;
+      origin = m.to_world(work_offset + local_offset);
     } else {
       rotation = Mat3(1.0);
       origin = work_offset + local_offset;
@@ -262,6 +275,12 @@ struct Interpreter::State : ParameterReader {
     move.feed = move_feed;
     move.from_far = from_far;
     move.spindle = speed * spindle_direction;
+    if (machine.kinematics) {
+      for (const RotaryAxis& rotary_axis : machine.kinematics->axes)
+        move.rotary_axes |= static_cast<unsigned char>(1u << rotary_index(rotary_axis.letter));
+      move.rotary = rotary_position;
+      move.machine = machine_from_part(*machine.kinematics, b, rotary_position);
+    }
     if (tools_used.insert(tool).second) tool_first_line.emplace(tool, line);
     (*sink)(move);
   }
@@ -278,6 +297,11 @@ struct Interpreter::State : ParameterReader {
   void go_far() { far = true; }
   Flow macro_call(int column);          // G65 (modal.cpp)
   void local_offsets(int code, int column);  // G52, G92, G92.1, G92.2, G92.3 (modal.cpp)
+
+  // ---- rotary axes, DWO and TCP (rotary.cpp) ----
+  void tool_center_codes();
+  void rotary_words();
+  void set_rotary(const RotaryPositions& next);
 
   // ---- tilted planes (tilt.cpp) ----
   Frame plane_words(int code);

@@ -129,6 +129,13 @@ void Interpreter::State::orient_to_plane(int code) {
   if (!tilted) error(column, code_name('G', code) + " without an active tilted plane");
   if (code != 2530 && w.has('P')) integer('P', (code_name('G', code) + " P").c_str(), 0, 2);
   Vec3 direction = glm::normalize(tilt_rotation[2]);
+  if (machine.kinematics) {  // the machine must reach it; the rotaries it picks are remembered
+    try {
+      rotary_position = orient_tool(*machine.kinematics, direction, rotary_position);
+    } catch (const Error& e) {
+      error(column, code_name('G', code) + ": " + e.what());
+    }
+  }
   if (glm::dot(direction, axis) < 1 - kSameDirection) {
     axis = direction;
     go_far();  // the machine turns the tool: where the tip ends is the kinematics' business

@@ -111,6 +111,53 @@ TEST_CASE("machine files: --subprograms finds called programs") {
   fs::remove_all(dir);
 }
 
+TEST_CASE("machine files: kinematics by profile name or as an object") {
+  fs::path dir = scratch("machine-kinematics");
+  write_text(dir / "a.json", R"({"kinematics": "bc-trunnion"})");
+  gcode::MachineConfig m = cli::load_machine((dir / "a.json").string());
+  REQUIRE(m.kinematics.has_value());
+  CHECK(m.kinematics->find('B') != nullptr);
+  CHECK(m.kinematics->find('C') != nullptr);
+  CHECK(m.kinematics->find('A') == nullptr);
+  write_text(dir / "b.json", R"({"kinematics": {"type": "table-table", "axes": [
+      {"letter": "A", "on": "table", "direction": [2, 0, 0], "pivot": [0, 0, -50],
+       "limits": [-30, 90]}]}})");
+  m = cli::load_machine((dir / "b.json").string());
+  REQUIRE(m.kinematics.has_value());
+  REQUIRE(m.kinematics->axes.size() == 1);
+  CHECK(m.kinematics->axes[0].direction.x == doctest::Approx(1.0));
+  CHECK((*m.kinematics->axes[0].limits)[1] == 90.0);
+  CHECK(!cli::load_machine("default").kinematics.has_value());
+
+  // moves: each move's rotary positions and machine coordinates; groups: each group's positions.
+  write_text(dir / "p.nc", "G0 X10 Y0 Z20\nG1 X12 F100\nG28 G91 Z0\nG90 G0 B90 C0\n"
+                           "G0 X5 Y0 Z20\nG1 X6 F100\nM30\n");
+  CommandResult r = run_tridex({"moves", (dir / "p.nc").string(), "--machine",
+                                (dir / "a.json").string()}, dir);
+  REQUIRE(r.status == 0);
+  std::vector<nlohmann::json> moves = moves_of(r);
+  REQUIRE(moves.size() == 5);  // G28's intermediate point is a zero-length rapid
+  CHECK(moves[1]["rotary"] == nlohmann::json({{"B", 0.0}, {"C", 0.0}}));
+  CHECK(moves[1]["machine"] == nlohmann::json::array({12, 0, 20}));
+  CHECK(moves[4]["rotary"] == nlohmann::json({{"B", 90.0}, {"C", 0.0}}));
+  gcode::RotaryPositions b90{0, 90, 0};
+  Vec3 tip = gcode::tip_in_part(*gcode::kinematics_profile("bc-trunnion"), Vec3(6, 0, 20), b90);
+  for (int i = 0; i < 3; ++i) {
+    CHECK(moves[4]["machine"][i].get<double>() == doctest::Approx(Vec3(6, 0, 20)[i]));
+    CHECK(moves[4]["end"][i].get<double>() == doctest::Approx(tip[i]));
+  }
+  r = run_tridex({"groups", (dir / "p.nc").string(), "--machine", (dir / "a.json").string()}, dir);
+  REQUIRE(r.status == 0);
+  nlohmann::json groups = nlohmann::json::parse(r.out)["groups"];
+  REQUIRE(groups.size() == 2);
+  CHECK(groups[1]["rotary"] == nlohmann::json::array({{{"B", 90.0}, {"C", 0.0}}}));
+  // Without kinematics the same program is refused at the rotary word (exit 2).
+  r = run_tridex({"moves", (dir / "p.nc").string()}, dir);
+  CHECK(r.status == 2);
+  CHECK(r.err.find(":4:8:") != std::string::npos);
+  fs::remove_all(dir);
+}
+
 TEST_CASE("machine files: bad files name the file, the key and the value") {
   fs::path dir = scratch("machine-bad");
   struct Case {
@@ -130,6 +177,11 @@ TEST_CASE("machine files: bad files name the file, the key and the value") {
       {"{\"units\": \"cm\"}", "\"units\""},
       {"{\"base\": \"haas\"}", "\"base\""},
       {"{\"kinematic\": {}}", "unknown key"},
+      {"{\"kinematics\": \"xyz-trunnion\"}", "kinematics: is not a bundled profile"},
+      {"{\"kinematics\": 5}", "kinematics"},
+      {"{\"kinematics\": {\"type\": \"table-table\", \"axes\": [{\"letter\": \"D\", \"on\": "
+       "\"table\", \"direction\": [1, 0, 0], \"pivot\": [0, 0, 0]}]}}",
+       "kinematics.axes[0].letter"},
       {"{\"start\": [0, 0, 1e999]}", "JSON"},
       {"{", "JSON"},
   };

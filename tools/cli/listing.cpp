@@ -1,4 +1,6 @@
 // tridex moves / tridex groups: the interpreted program as JSON, for scripts and post checks.
+#include <algorithm>
+#include <array>
 #include <iostream>
 #include <sstream>
 
@@ -15,6 +17,14 @@
 namespace tridex::cli {
 
 namespace {
+
+// {"A": .., "C": ..}: the positions, in degrees, of the machine's rotary axes.
+Json rotary_json(const gcode::Move& m) {
+  Json j = Json::object();
+  for (std::size_t i = 0; i < 3; ++i)
+    if ((m.rotary_axes >> i) & 1u) j[std::string(1, static_cast<char>('A' + i))] = m.rotary[i];
+  return j;
+}
 
 // Writes through an atomic file, or to stdout for "-".
 template <class Write>
@@ -73,6 +83,12 @@ int run_moves(const ListOptions& options) {
       record += ",\"spindle\":";
       append_number(record, m.spindle);
       if (m.from_far) record += ",\"from_far\":true";
+      if (m.rotary_axes) {  // a kinematic model is in use (machine file)
+        record += ",\"rotary\":";
+        record += rotary_json(m).dump();
+        record += ",\"machine\":";
+        append_vec3(record, m.machine);
+      }
       record += "}\n";
       out << record;
     });
@@ -91,6 +107,7 @@ int run_groups(const ListOptions& options) {
     long long kinds[4] = {0, 0, 0, 0};
     int first_line = 0, last_line = 0;
     Aabb local;  // tool-tip box of the cutting moves in the group's frame
+    std::vector<std::array<double, 3>> rotary;  // the distinct rotary positions (kinematics)
   };
   std::vector<Extra> extras;
   InterpretResult result = interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t file) {
@@ -101,6 +118,8 @@ int run_groups(const ListOptions& options) {
     ++e.kinds[static_cast<int>(m.kind)];
     if (e.first_line == 0) e.first_line = m.line;
     e.last_line = m.line;
+    if (m.rotary_axes && std::find(e.rotary.begin(), e.rotary.end(), m.rotary) == e.rotary.end())
+      e.rotary.push_back(m.rotary);
     if (m.kind != gcode::MoveKind::rapid) {
       const Frame& frame = grouper.groups()[g].frame;
       if (!m.from_far) e.local.extend(frame.to_local(m.start));
@@ -121,6 +140,16 @@ int run_groups(const ListOptions& options) {
     j["by_kind"] = {{"rapid", e.kinds[0]}, {"feed", e.kinds[1]}, {"arc", e.kinds[2]}, {"cycle", e.kinds[3]}};
     j["tools"] = group.tools;
     j["lines"] = {e.first_line, e.last_line};
+    if (!group.moves.empty() && group.moves.front().rotary_axes) {
+      Json positions = Json::array();
+      for (const auto& r : e.rotary) {
+        gcode::Move m;
+        m.rotary_axes = group.moves.front().rotary_axes;
+        m.rotary = r;
+        positions.push_back(rotary_json(m));
+      }
+      j["rotary"] = std::move(positions);
+    }
     if (!e.local.empty())
       j["cutting_bounds_local"] = {{"min", to_json(e.local.min)}, {"max", to_json(e.local.max)}};
     groups.push_back(std::move(j));

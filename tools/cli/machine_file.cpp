@@ -121,6 +121,14 @@ gcode::MachineConfig parse(const json& doc, const std::string& file) {
       m.m_codes = m_code_list(value, where);
     } else if (key == "forbidden_m_codes") {
       m.forbidden_m_codes = m_code_list(value, where);
+    } else if (key == "kinematics") {
+      try {
+        m.kinematics = gcode::kinematics_from_json(value, cat(file, ": kinematics"));
+      } catch (const InputError&) {
+        throw;
+      } catch (const Error& e) {
+        input_error(e.what());
+      }
     } else if (key == "far_distance") {
       if (!value.is_number() || !(value.get<double>() > 0) || !std::isfinite(value.get<double>()))
         input_error(where, ": must be a positive number of mm, got ", value.dump());
@@ -133,7 +141,7 @@ gcode::MachineConfig parse(const json& doc, const std::string& file) {
     } else {
       input_error(where, ": unknown key (known: name, description, base, dialect, units, start, "
                          "tool_change, tool_loads_on_t, home, reference2, work_offsets, m_codes, "
-                         "forbidden_m_codes, far_distance, subprograms)");
+                         "forbidden_m_codes, far_distance, subprograms, kinematics)");
     }
   }
   for (int code : m.m_codes)

@@ -1,6 +1,8 @@
 // tridex::gcode — one tool-tip move, the unit the interpreter streams to the simulator.
 #pragma once
 
+#include <array>
+
 #include "tridex/geometry.hpp"
 
 namespace tridex::gcode {
@@ -31,6 +33,12 @@ struct Move {
   bool from_far = false;         // the approach from "far along the tool axis": `start` is a
                                  //   stand-in for where the machine put the tool, not a point
                                  //   of the program (docs/design.md, the far rule)
+  // With a kinematic model (MachineConfig::kinematics) only: the machine's rotary axes (bit 0
+  // A, 1 B, 2 C), their positions in degrees (A, B, C) and the machine coordinates of the linear
+  // axes at `end` (work offset included: where the machine's axes stand).
+  unsigned char rotary_axes = 0;
+  std::array<double, 3> rotary{};
+  Vec3 machine{0.0};
 };
 
 }  // namespace tridex::gcode

@@ -1,0 +1,100 @@
+// tridex::gcode — rotary axes on moves, Haas DWO and Fanuc TCP: 3+2 programs that index the
+// machine with A/B/C words instead of a tilted plane. The kinematic model (kinematics.hpp) says
+// where the tool points on the part and, without DWO or TCP, where machine coordinates put the
+// tip (the raw form simple posts write). Haas DWO (G254/G255, Haas mill operator's manual,
+// "Dynamic Work Offset") and Fanuc TCP (G43.4, G43.5 I J K; Fanuc B-64484EN, "tool center point
+// control") make X Y Z positions of the part frame (the work coordinates as measured with every
+// rotary at 0), which the control turns into machine coordinates itself.
+#include <cmath>
+
+#include "state.hpp"
+
+namespace tridex::gcode {
+
+// G43.4 / G43.5 switch TCP on (G43, G44 and G49 off: the same modal group); G254 / G255 switch
+// DWO on and off. G43.5 I J K gives the tool direction on the part directly.
+void Interpreter::State::tool_center_codes() {
+  bool was_tcp = tcp, was_dwo = dwo;
+  if (w.find_g(430) || w.find_g(440) || w.find_g(490)) tcp = false;
+  if (w.find_g(434)) tcp = true;
+  if (int column = w.find_g(435)) {
+    tcp = true;
+    if (w.has('I') || w.has('J') || w.has('K')) {
+      Vec3 direction(w.has('I') ? w.take('I') : 0.0, w.has('J') ? w.take('J') : 0.0,
+                     w.has('K') ? w.take('K') : 0.0);
+      if (!(glm::length(direction) > 1e-9) || !is_finite(direction))
+        error(column, "G43.5 I J K: the tool direction must not be the zero vector");
+      direction = glm::normalize(direction);
+      if (machine.kinematics) {
+        try {
+          rotary_position = orient_tool(*machine.kinematics, direction, rotary_position);
+        } catch (const Error& e) {
+          error(column, std::string("G43.5: ") + e.what());
+        }
+      }
+      if (glm::dot(direction, axis) < 1 - kSameDirection) go_far();
+      axis = direction;
+    }
+  }
+  if (w.find_g(2540)) dwo = true;
+  if (w.find_g(2550)) dwo = false;
+  if (tcp != was_tcp || dwo != was_dwo) update_frame();  // the tip stays where it is on the part
+}
+
+// A B C on a G0/G1 block (or alone under G0/G1 modal): each letter an axis of the machine, within
+// its limits; the tool direction becomes the kinematics'. An indexing move (G0) leaves the tool
+// far along its axis, except in raw form where the machine coordinates keep the tip known (the
+// sweep of the rotation itself is not simulated). Rotary motion during G1 is simultaneous
+// 5-axis: an error, or with lenient a warning and the move indexed at its end orientation.
+void Interpreter::State::rotary_words() {
+  int first = 0;
+  for (char c : {'A', 'B', 'C'}) {
+    bool unused = w.has(c) && !((w.used >> letter_index(c)) & 1u);
+    if (unused && (!first || w.col(c) < first)) first = w.col(c);
+  }
+  if (!first) return;
+  if (!machine.kinematics) return;  // the unused-word check refuses them, naming the machine file
+  const Kinematics& kin = *machine.kinematics;
+  if (motion != 0 && motion != 10)
+    error(first, "A/B/C words need G0 or G1 (a rotary word on an arc or a cycle is a 5-axis move)");
+  RotaryPositions next = rotary_position;
+  for (char c : {'A', 'B', 'C'}) {
+    if (!w.has(c) || ((w.used >> letter_index(c)) & 1u)) continue;
+    const RotaryAxis* a = kin.find(c);
+    if (!a) {
+      std::string letters;
+      for (const RotaryAxis& x : kin.axes) letters += (letters.empty() ? "" : ", ") + std::string(1, x.letter);
+      error(w.col(c), std::string("rotary word ") + c + format_number(w.value[static_cast<std::size_t>(letter_index(c))]) +
+                          ": the machine has no " + c + " axis (its rotary axes: " + letters + ")");
+    }
+    double v = w.take(c);
+    std::size_t i = static_cast<std::size_t>(rotary_index(c));
+    next[i] = incremental ? rotary_position[i] + v : v;
+    if (a->limits && (next[i] < (*a->limits)[0] || next[i] > (*a->limits)[1]))
+      error(w.col(c), std::string("rotary position ") + c + format_number(next[i]) + " is outside the " +
+                          c + " axis's limits [" + format_number((*a->limits)[0]) + ", " +
+                          format_number((*a->limits)[1]) + "] (machine file)");
+  }
+  if (next == rotary_position) return;
+  bool cut = motion == 10;
+  if (cut) {
+    std::string message = "rotary motion during a cut (G1 turning A/B/C: simultaneous 5-axis) is "
+                          "outside 3+2";
+    if (!options.lenient) error(first, message + "; index with G0 first");
+    warn(first, message + "; read as indexed at its end orientation (lenient mode)");
+  }
+  set_rotary(next);
+  if (!cut && (tilted || tcp || dwo)) go_far();
+}
+
+// New rotary positions: the tool direction and the raw frame follow; the tip keeps its machine
+// coordinates in raw form and its place on the part under TCP/DWO (the caller decides on far).
+void Interpreter::State::set_rotary(const RotaryPositions& next) {
+  Vec3 program_point = to_program(pos);
+  rotary_position = next;
+  axis = tool_direction(*machine.kinematics, rotary_position);
+  update_frame();
+  pos = to_machine(program_point);
+}
+
+}  // namespace tridex::gcode

@@ -1,0 +1,177 @@
+// Rotary-indexed 3+2 with a machine model: the same toolpath written four ways (G68.2 + G53.1,
+// rotary words with Haas DWO, rotary words under Fanuc TCP, raw rotary words with machine
+// coordinates from the kinematics) gives the same moves in the work frame on every bundled
+// profile; bad input (an axis the machine lacks, a position outside the limits, an unreachable
+// plane, rotary motion during a cut, rotary words without kinematics) is an error at its column.
+#include <cmath>
+#include <cstdio>
+
+#include "helpers.hpp"
+#include "tridex/gcode/kinematics.hpp"
+#include "tridex/gcode/tilted_plane.hpp"
+
+using namespace tridex;
+using namespace tridex::gcode;
+using namespace tridex::gcode::test;
+
+namespace {
+
+std::string num(double v) {
+  char text[48];
+  std::snprintf(text, sizeof text, "%.12f", v);
+  return text;
+}
+
+std::string xyz(const Vec3& p) { return cat("X", num(p.x), " Y", num(p.y), " Z", num(p.z)); }
+
+std::string rotary_words(const Kinematics& kin, const RotaryPositions& r) {
+  std::string words;
+  for (const RotaryAxis& a : kin.axes)
+    words += cat(" ", a.letter, num(r[static_cast<std::size_t>(rotary_index(a.letter))]));
+  return words;
+}
+
+MachineConfig with_kinematics(const char* name, const Vec3& g54 = Vec3(0.0)) {
+  MachineConfig m;
+  m.kinematics = kinematics_profile(name);
+  m.work_offsets[MachineConfig::g54_key(1)] = g54;
+  return m;
+}
+
+void check_same(const std::vector<Move>& a, const std::vector<Move>& b, const char* form) {
+  INFO(form);
+  REQUIRE(a.size() == b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    CHECK(a[i].kind == b[i].kind);
+    CHECK(a[i].from_far == b[i].from_far);
+    CHECK(near(a[i].start, b[i].start, 1e-6));
+    CHECK(near(a[i].end, b[i].end, 1e-6));
+    CHECK(near(a[i].axis, b[i].axis, 1e-9));
+    CHECK(near(a[i].machine, b[i].machine, 1e-6));
+    for (std::size_t k = 0; k < 3; ++k) CHECK(a[i].rotary[k] == doctest::Approx(b[i].rotary[k]).epsilon(1e-9));
+  }
+}
+
+}  // namespace
+
+TEST_CASE("rotary 3+2: G68.2 + G53.1, DWO, TCP and raw rotary words give the same moves") {
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> angle(-180, 180), tilt(5, 30), coord(-40, 40);
+  const Vec3 g54(-120, 35, -210);
+  for (const std::string& name : kinematics_profile_names()) {
+    MachineConfig machine = with_kinematics(name.c_str(), g54);
+    const Kinematics& kin = *machine.kinematics;
+    for (int n = 0; n < 6; ++n) {
+      INFO(name << " case " << n);
+      double i = angle(rng), j = tilt(rng), k = angle(rng);
+      Vec3 o(coord(rng), coord(rng), coord(rng) / 4);
+      Frame feature = fanuc_euler(o, i, j, k);
+      RotaryPositions r = orient_tool(kin, feature.rotation[2], {0, 0, 0});
+      std::vector<Vec3> path = {Vec3(coord(rng), coord(rng), 5), Vec3(coord(rng), coord(rng), -2),
+                                Vec3(coord(rng), coord(rng), -2), Vec3(coord(rng), coord(rng), 5)};
+      auto program = [&](const std::string& head, auto point, const std::string& tail) {
+        std::string text = cat("G21 G90 G54\n", head);
+        for (std::size_t p = 0; p < path.size(); ++p)
+          text += cat(p == 0 ? "G0 " : "G1 ", xyz(point(path[p])), p == 1 ? " F300\n" : "\n");
+        return cat(text, tail, "M30\n");
+      };
+      auto in_feature = [](const Vec3& p) { return p; };
+      auto in_work = [&](const Vec3& p) { return feature.to_world(p); };
+      auto in_machine = [&](const Vec3& p) {
+        return machine_from_part(kin, feature.to_world(p) + g54, r) - g54;
+      };
+      std::string rotary = cat("G0", rotary_words(kin, r), "\n");
+      Result tilted = run_program(program(cat("G68.2 ", xyz(o), " I", num(i), " J", num(j), " K",
+                                              num(k), "\nG53.1\n"),
+                                          in_feature, "G69\n"),
+                                  {}, machine);
+      Result dwo = run_program(program(cat(rotary, "G254\n"), in_work, "G255\n"), {}, machine);
+      Result tcp = run_program(program(cat("G43.4 H1\n", rotary), in_work, "G49\n"), {}, machine);
+      Result raw = run_program(program(rotary, in_machine, ""), {}, machine);
+      REQUIRE(tilted.moves.size() == 4);
+      CHECK(tilted.moves[0].from_far);
+      CHECK(near(tilted.moves[1].end, feature.to_world(path[1]), 1e-9));
+      CHECK(near(tilted.moves[1].axis, tool_direction(kin, r), 1e-9));
+      check_same(tilted.moves, dwo.moves, "DWO");
+      check_same(tilted.moves, tcp.moves, "TCP");
+      check_same(tilted.moves, raw.moves, "raw");
+      // The machine coordinates reported are where the linear axes stand.
+      CHECK(near(raw.moves[2].machine, in_machine(path[2]) + g54, 1e-6));
+    }
+  }
+}
+
+TEST_CASE("rotary 3+2: G43.5 I J K and the remembered G53.1 positions") {
+  MachineConfig machine = with_kinematics("ac-trunnion");
+  Vec3 d = glm::normalize(Vec3(0, -1, 1));
+  Result r = run_program("G43.5 I0 J-1 K1 H1\nG0 X1 Y2 Z3\nG1 Z0 F100\nM30\n", {}, machine);
+  REQUIRE(r.moves.size() == 2);
+  CHECK(near(r.moves[1].axis, d, 1e-12));
+  CHECK(near(tool_direction(*machine.kinematics, r.moves[1].rotary), d, 1e-9));
+  CHECK(near(r.moves[1].end, Vec3(1, 2, 0), 1e-12));
+  // G53.1 picks A±45 C0 for this plane; after G69 the raw frame keeps those positions.
+  r = run_program("G68.2 X0 Y0 Z0 I0 J45 K0\nG53.1\nG69\nG0 X0 Y0 Z10\nM30\n", {}, machine);
+  REQUIRE(r.moves.size() == 1);
+  RotaryPositions picked{r.moves[0].rotary[0], r.moves[0].rotary[1], r.moves[0].rotary[2]};
+  CHECK(std::abs(picked[0]) == doctest::Approx(45));
+  CHECK(picked[2] == doctest::Approx(0));
+  CHECK(near(tool_direction(*machine.kinematics, picked), fanuc_euler(Vec3(0), 0, 45, 0).rotation[2], 1e-9));
+  CHECK(near(r.moves[0].end, tip_in_part(*machine.kinematics, Vec3(0, 0, 10), picked), 1e-9));
+}
+
+TEST_CASE("rotary 3+2: raw rotary words keep the tip known; TCP indexing leaves it far") {
+  MachineConfig machine = with_kinematics("bc-trunnion");
+  const Kinematics& kin = *machine.kinematics;
+  Result r = run_program("G0 X10 Y0 Z20\nG0 B30\nG1 X12 F100\nM30\n", {}, machine);
+  REQUIRE(r.moves.size() == 2);
+  CHECK(near(r.moves[1].start, tip_in_part(kin, Vec3(10, 0, 20), {0, 30, 0}), 1e-9));
+  CHECK(near(r.moves[1].end, tip_in_part(kin, Vec3(12, 0, 20), {0, 30, 0}), 1e-9));
+  CHECK(near(r.moves[1].machine, Vec3(12, 0, 20), 1e-9));
+  // Under TCP the indexing leaves the tool far: the next move comes back along the tool.
+  r = run_program("G43.4 H1\nG0 X10 Y0 Z20\nG0 B30\nG1 X12 Y0 Z20 F100\nM30\n", {}, machine);
+  REQUIRE(r.moves.size() == 2);
+  CHECK(r.moves[1].from_far);
+  CHECK(near(r.moves[1].end, Vec3(12, 0, 20), 1e-12));
+  // Incremental rotary words add to the position.
+  r = run_program("G0 B10\nG91 G0 B20\nG90 G0 X0 Y0 Z5\nM30\n", {}, machine);
+  CHECK(r.moves[0].rotary[1] == doctest::Approx(30));
+}
+
+TEST_CASE("rotary 3+2: bad input is an error at its line and column") {
+  MachineConfig ac = with_kinematics("ac-trunnion");
+  Diagnostic d = error_of("G0 X0\nG0 X1 B10\n", {}, ac);
+  CHECK(d.line == 2);
+  CHECK(d.column == 7);
+  CHECK(d.message.find("no B axis") != std::string::npos);
+  d = error_of("G0 A-130 C0\n", {}, ac);
+  CHECK(d.column == 4);
+  CHECK(d.message.find("limits") != std::string::npos);
+  d = error_of("G68.2 X0 Y0 Z0 I0 J150 K0\n G53.1\n", {}, ac);
+  CHECK(d.line == 2);
+  CHECK(d.column == 2);
+  CHECK(d.message.find("G53.1") != std::string::npos);
+  d = error_of("G0 X0 Y0 Z0\nG1 X1 A10 F100\n", {}, ac);
+  CHECK(d.line == 2);
+  CHECK(d.column == 7);
+  CHECK(d.message.find("during a cut") != std::string::npos);
+  d = error_of("G2 X1 Y0 I0.5 A10 F100\n", {}, ac);
+  CHECK(d.column == 15);
+  // Lenient: a warning, the move indexed at its end orientation.
+  InterpreterOptions lenient;
+  lenient.lenient = true;
+  Result r = run_program("G0 X0 Y0 Z0\nG1 X1 A10 F100\nM30\n", lenient, ac);
+  REQUIRE(r.moves.size() == 2);
+  REQUIRE(r.warnings.size() == 1);
+  CHECK(r.warnings[0].line == 2);
+  CHECK(r.warnings[0].message.find("end orientation") != std::string::npos);
+  CHECK(near(r.moves[1].axis, tool_direction(*ac.kinematics, {10, 0, 0}), 1e-12));
+  // Without kinematics a rotary word is an error naming the machine file, even lenient.
+  for (bool is_lenient : {false, true}) {
+    InterpreterOptions options;
+    options.lenient = is_lenient;
+    d = error_of("G0 X0 Y0 Z0\nG0 C90\n", options);
+    CHECK(d.line == 2);
+    CHECK(d.column == 4);
+    CHECK(d.message.find("kinematics") != std::string::npos);
+  }
+}
