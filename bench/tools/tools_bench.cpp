@@ -28,7 +28,9 @@ double peak_rss_mib() {
 
 // Interpreting the example and formatting every move as `tridex moves` does (to memory).
 void BM_moves_json_lines(benchmark::State& state) {
-  cli::ProgramInput input = cli::resolve_program(kExamples + "mold_3plus2.nc");
+  cli::CommonOptions options;
+  options.program = kExamples + "mold_3plus2.nc";
+  cli::ProgramInput input = cli::resolve_program(options);
   long long moves = 0;
   std::size_t bytes = 0;
   for (auto _ : state) {
