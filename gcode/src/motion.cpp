@@ -350,7 +350,7 @@ void Interpreter::State::home_return(bool second) {
   if (is_default && !warned) {
     warn(column, std::string(second ? "G30" : "G28") +
                      " uses the default reference position (far above the work along +Z); "
-                     "set it in the machine configuration if the machine differs");
+                     "a machine file (--machine) sets it, \"home\" and \"reference2\"");
     warned = true;
   }
   // With the tool along +Z, returning X/Y only is a plain rapid at the current height (on any
