@@ -76,6 +76,7 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
     s.far = true;
   }
   run_program(s, program, file_name);
+  s.comp_finish();  // compensated moves still waiting for a next move
   // One line per kind of word lenient mode skipped, however many: never a silent skip.
   for (const auto& [cause, skipped] : s.skipped) {
     std::string lines;

@@ -37,8 +37,13 @@ Flow Interpreter::State::execute(const Block& block) {
   }
 
   // Units first, so that every length in this block is read in them.
-  if (w.find_g(200)) unit = 25.4;
-  if (w.find_g(210)) unit = 1.0;
+  for (int code : {200, 210}) {
+    int column = w.find_g(code);
+    if (!column) continue;
+    double next = code == 200 ? 25.4 : 1.0;
+    if (next != unit) comp_forbid(column, "changing units");
+    unit = next;
+  }
 
   if (w.has('F')) {
     double f = length('F');
@@ -53,6 +58,7 @@ Flow Interpreter::State::execute(const Block& block) {
   if (w.has('T')) tool_selected = static_cast<int>(integer('T', "tool number", 0, 99'999'999));
 
   if (w.find_m(6) || (w.has('T') && machine.tool_loads_on_t)) {
+    comp_forbid(w.find_m(6) ? w.find_m(6) : w.col('T'), "a tool change");
     tool = tool_selected;
     tool_first_line.emplace(tool, line);
     if (machine.tool_change == ToolChange::retract_far) go_far();
@@ -87,7 +93,13 @@ Flow Interpreter::State::execute(const Block& block) {
   }
 
   for (int code : {170, 180, 190})
-    if (w.find_g(code)) plane = code;
+    if (int column = w.find_g(code)) {
+      if (code != plane) comp_forbid(column, "changing the plane");
+      plane = code;
+    }
+  // Cutter radius compensation (comp.cpp): after the plane, before motion (NIST IR 6556 §3.8).
+  for (int code : {400, 410, 420, 411, 421})
+    if (int column = w.find_g(code)) cutter_comp_codes(code, column);
   if (w.find_g(900)) incremental = false;
   if (w.find_g(910)) incremental = true;
   if (w.find_g(901)) arc_absolute = true;
@@ -124,6 +136,7 @@ Flow Interpreter::State::execute(const Block& block) {
     }
     if (tilted && key != work_key)
       error(column, "work coordinates change while a tilted plane is active (cancel it first)");
+    if (key != work_key) comp_forbid(column, "changing the work coordinate system");
     work_key = key;
     auto it = offsets.find(key);
     work_offset = it == offsets.end() ? Vec3(0.0) : it->second;
@@ -133,6 +146,7 @@ Flow Interpreter::State::execute(const Block& block) {
   bool axis_consumer = false;  // a code other than motion that takes X/Y/Z
   if (nonmodal == 520 || (nonmodal >= 920 && nonmodal <= 923)) {
     axis_consumer = true;
+    comp_forbid(w.find_g(nonmodal), code_name('G', nonmodal));
     local_offsets(nonmodal, w.find_g(nonmodal));
   }
   if (nonmodal == 100) {
@@ -168,6 +182,7 @@ Flow Interpreter::State::execute(const Block& block) {
         if (w.has(kAxisLetter[i]))
           value[i] = relative_to_position ? pos[i] - local_offset[i] - length(kAxisLetter[i])
                                           : length(kAxisLetter[i]);
+      if (key == work_key) comp_forbid(column, "G10 on the active work offset");
       offsets[key] = value;
       if (key == work_key) {
         if (tilted) error(column, "G10 changes the active work offset under a tilted plane");
@@ -179,6 +194,7 @@ Flow Interpreter::State::execute(const Block& block) {
 
   // Tilted working plane (tilt.cpp).
   if (tilt >= 0) {
+    comp_forbid(w.find_g(tilt), code_name('G', tilt));
     if (tilt != 690 && tilt != 2690) axis_consumer = true;
     tilted_plane(tilt);
   }
@@ -193,12 +209,16 @@ Flow Interpreter::State::execute(const Block& block) {
     if (is_cycle(motion_code) && motion != motion_code) cycle_active = false;
     motion = motion_code;
   }
+  if (w.has('A') || w.has('B') || w.has('C'))
+    comp_forbid(w.col(w.has('A') ? 'A' : w.has('B') ? 'B' : 'C'), "a rotary axis word");
   if (!axis_consumer && nonmodal != 280 && nonmodal != 300) rotary_words();
   if (nonmodal == 280 || nonmodal == 300) {
     if (motion_code >= 0 && motion_code != 800)
       error(motion_column, "G28/G30 with a motion code in the same block");
+    comp_forbid(w.find_g(nonmodal), code_name('G', nonmodal));
     home_return(nonmodal == 300);
   } else if (nonmodal == 530) {
+    comp_forbid(w.find_g(530), "G53");
     if (motion != 0 && motion != 10)
       error(motion_column, "G53 needs G0 or G1 modal");
     if (motion == 10) require_feed();
@@ -223,7 +243,10 @@ Flow Interpreter::State::execute(const Block& block) {
       char cu = kCenterLetter[plane_axes(plane)[0]], cv = kCenterLetter[plane_axes(plane)[1]];
       if (axes || motion_code >= 0 || w.has(cu) || w.has(cv) || w.has('R')) arc(motion == 30);
     } else if (is_cycle(motion)) {
-      if (axes || motion_code >= 0 || w.has('R')) cycle(motion);
+      if (axes || motion_code >= 0 || w.has('R')) {
+        comp_forbid(motion_column, "a canned cycle");
+        cycle(motion);
+      }
     } else if (axes) {
       error(motion_column, "X/Y/Z without an active motion mode (G0, G1, G2, G3 or a cycle)");
     }
@@ -231,7 +254,10 @@ Flow Interpreter::State::execute(const Block& block) {
 
   // Program flow last.
   Flow flow = Flow::next;
-  if (w.find_m(2) || w.find_m(30)) flow = Flow::end;
+  if (w.find_m(2) || w.find_m(30)) {
+    comp_finish();
+    flow = Flow::end;
+  }
   if (int column = w.find_m(98)) {
     if (!w.has('P')) error(column, "M98 needs P (the O number to call)");
     call_label = static_cast<int>(integer('P', "M98 P", 0, 999'999'999));

@@ -46,7 +46,9 @@ void Interpreter::State::move_to(Vec3 target, const std::array<bool, 3>& set_abs
 }
 
 void Interpreter::State::linear(MoveKind kind, double move_feed) {
-  Vec3 current = to_program(pos);
+  // Under cutter compensation the programmed point, not the offset tip, is where coordinates
+  // count from (and, just after G40, until the next move).
+  Vec3 current = comp_programmed_current ? comp_programmed : to_program(pos);
   Vec3 target = current;
   std::array<bool, 3> set{};
   for (int i = 0; i < 3; ++i) {
@@ -56,6 +58,12 @@ void Interpreter::State::linear(MoveKind kind, double move_feed) {
     target[i] = incremental ? current[i] + v : v;
     set[static_cast<std::size_t>(i)] = !incremental;
   }
+  comp_programmed_current = false;
+  if (comp_active()) {
+    comp_straight(kind, target, move_feed);
+    return;
+  }
+  comp_arc_forbidden = false;
   move_to(target, set, rotation, origin, kind, move_feed);
 }
 
@@ -65,6 +73,14 @@ void Interpreter::State::require_feed() {
 
 // ---- arcs ----
 void Interpreter::State::arc(bool ccw) {
+  if (comp_arc_forbidden)
+    error(motion_column, "the move just after turning cutter compensation off (G40) must be straight, "
+                         "not an arc (as LinuxCNC requires)");
+  if (comp_active()) {
+    require_feed();
+    comp_arc(ccw);
+    return;
+  }
   if (far) {
     // The far rule: a move that leaves the coordinates along the tool axis unset stays far and
     // only changes the lateral position (a 2D program's arcs before any Z cut nothing).
@@ -84,9 +100,17 @@ void Interpreter::State::arc(bool ccw) {
     return;
   }
   require_feed();
-  const std::array<int, 3> axes = plane_axes(plane);
-  const int u = axes[0], v = axes[1], n = axes[2];
   Vec3 start = to_program(pos);
+  ArcData a = arc_data(start, ccw);
+  arc_chords(start, a.end, a.centre, ccw, arc_sweep(start, a.end, a.centre, ccw), feed);
+  pos = to_machine(a.end);
+}
+
+// The end point and centre of the G2/G3 of this block from `start` (program frame), with
+// RS274/NGC's checks: I/J/K or R, radii that agree, a radius long enough for its chord.
+Interpreter::State::ArcData Interpreter::State::arc_data(const Vec3& start, bool ccw) {
+  const std::array<int, 3> axes = plane_axes(plane);
+  const int u = axes[0], v = axes[1];
   Vec3 end = start;
   for (int i = 0; i < 3; ++i) {
     char c = kAxisLetter[i];
@@ -101,7 +125,8 @@ void Interpreter::State::arc(bool ccw) {
     error(motion_column, std::string("arc needs ") + cu + "/" + cv + " (in " +
                              code_name('G', plane) + ") or R");
   Vec2 s(start[u], start[v]), e(end[u], end[v]), c;
-  double r0, r1;
+  ArcData result;
+  result.end = end;
   if (has_center) {
     if (arc_absolute) {
       if (!w.has(cu) || !w.has(cv))
@@ -110,8 +135,8 @@ void Interpreter::State::arc(bool ccw) {
     } else {
       c = s + Vec2(w.has(cu) ? length(cu) : 0.0, w.has(cv) ? length(cv) : 0.0);
     }
-    r0 = glm::length(s - c);
-    r1 = glm::length(e - c);
+    double r0 = glm::length(s - c);
+    double r1 = glm::length(e - c);
     if (!(r0 > 1e-9)) error(motion_column, "zero-radius arc: the centre is the start point");
     if (!(r1 > 1e-9)) error(motion_column, "zero-radius arc: the centre is the end point");
     if (std::abs(r1 - r0) > options.arc_radius_tolerance)
@@ -127,6 +152,7 @@ void Interpreter::State::arc(bool ccw) {
     if (d > 2 * std::abs(r) + options.arc_radius_tolerance)
       error(w.col('R'), "arc radius " + format_number(std::abs(r)) +
                             " is too small for its chord of " + format_number(d));
+    result.programmed_radius = std::abs(r);
     double h = std::sqrt(std::max(0.0, r * r - d * d / 4));
     Vec2 dir = (e - s) / d;
     Vec2 left(-dir.y, dir.x);
@@ -134,18 +160,36 @@ void Interpreter::State::arc(bool ccw) {
     // counter-clockwise motion.
     bool centre_left = ccw == (r > 0);
     c = 0.5 * (s + e) + (centre_left ? h : -h) * left;
-    r0 = glm::length(s - c);
-    r1 = glm::length(e - c);
   }
+  result.centre = c;
+  return result;
+}
+
+// How far an arc from `start` to `end` (program frame) turns about `c` in the active plane:
+// (0, 2π], a full circle when the two points coincide.
+double Interpreter::State::arc_sweep(const Vec3& start, const Vec3& end, const Vec2& c, bool ccw) const {
+  const std::array<int, 3> axes = plane_axes(plane);
+  const int u = axes[0], v = axes[1];
+  Vec2 s(start[u], start[v]), e(end[u], end[v]);
   double a0 = std::atan2(s.y - c.y, s.x - c.x);
   double a1 = std::atan2(e.y - c.y, e.x - c.x);
   double sweep = ccw ? a1 - a0 : a0 - a1;
-  if (glm::length(e - s) <= 1e-9) {
-    sweep = 2 * kPi;  // start == end: a full circle
-  } else {
-    while (sweep <= 0) sweep += 2 * kPi;
-    while (sweep > 2 * kPi) sweep -= 2 * kPi;
-  }
+  if (glm::length(e - s) <= 1e-9) return 2 * kPi;  // start == end: a full circle
+  while (sweep <= 0) sweep += 2 * kPi;
+  while (sweep > 2 * kPi) sweep -= 2 * kPi;
+  return sweep;
+}
+
+// Emits the arc from the tip (at program point `start`) to `end` about `c`, turning `sweep`
+// radians, as chords within the arc tolerance; the radius and the height along the plane normal
+// change linearly (helices, and I/J/K arcs whose end radius differs slightly).
+void Interpreter::State::arc_chords(const Vec3& start, const Vec3& end, const Vec2& c, bool ccw,
+                                    double sweep, double move_feed) {
+  const std::array<int, 3> axes = plane_axes(plane);
+  const int u = axes[0], v = axes[1], n = axes[2];
+  Vec2 s(start[u], start[v]), e(end[u], end[v]);
+  double r0 = glm::length(s - c), r1 = glm::length(e - c);
+  double a0 = std::atan2(s.y - c.y, s.x - c.x);
   double r = std::max(r0, r1);
   long long pieces = 1;
   if (r > options.arc_tolerance) {
@@ -169,7 +213,7 @@ void Interpreter::State::arc(bool ccw) {
       p[n] = start[n] + (end[n] - start[n]) * t;
     }
     Vec3 m = to_machine(p);
-    emit(MoveKind::arc, previous, m, feed);
+    emit(MoveKind::arc, previous, m, move_feed);
     previous = m;
   }
   pos = to_machine(end);

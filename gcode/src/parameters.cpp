@@ -46,7 +46,7 @@ Value Interpreter::State::numbered(int n) {
     case 4003: return number(incremental ? 91 : 90);
     case 4005: return number(94);
     case 4006: return number(unit == 1.0 ? 21 : 20);
-    case 4007: return number(40);
+    case 4007: return number(comp_side == 0 ? 40 : comp_side > 0 ? 41 : 42);
     case 4008: return number(49);
     case 4009: return number(is_cycle(motion) ? motion / 10.0 : 80);
     case 4010: return number(retract_to_r ? 99 : 98);

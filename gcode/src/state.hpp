@@ -285,12 +285,56 @@ struct Interpreter::State : ParameterReader {
     (*sink)(move);
   }
 
+  // ---- cutter radius compensation (comp.cpp) ----
+  // Side: +1 left (G41), −1 right (G42), 0 off. Compensated moves wait in comp_queue until the
+  // next move tells where they end (LinuxCNC's queue of canonical moves, interp_queue.cc).
+  struct CompMove {
+    enum Kind { straight, arc } kind = straight;
+    MoveKind move_kind = MoveKind::feed;
+    int line = 0;
+    double feed = 0;
+    Vec2 direction{0.0};  // straight: the direction it was programmed in, for the gouge check
+    Vec3 end{0.0};        // program frame
+    Vec2 centre{0.0};     // arc
+    int turn = 0;         // arc: +1 counter-clockwise, −1 clockwise
+    double original_sweep = 0;  // arc: signed radians when queued (0: never checked)
+  };
+  int comp_side = 0;
+  double comp_radius = 0;              // mm, ≥ 0
+  bool comp_first = true;              // the next compensated move is the entry move
+  bool comp_arc_forbidden = false;     // just after G40: the next move must be straight
+  bool comp_programmed_current = false;  // coordinates count from comp_programmed, not the tip
+  Vec3 comp_programmed{0.0};           // the last programmed point (program frame)
+  Vec3 comp_current{0.0};              // where the queued moves end (program frame)
+  std::vector<CompMove> comp_queue;
+  Vec2 comp_endpoint{0.0};             // where the queued moves start (program frame)
+  bool comp_endpoint_valid = false;
+  bool comp_active() const { return comp_side != 0 && comp_radius > 0; }
+  void cutter_comp_codes(int code, int column);  // G40, G41, G42, G41.1, G42.1
+  void comp_forbid(int column, const std::string& what) const;
+  void comp_straight(MoveKind kind, const Vec3& target, double move_feed);
+  void comp_arc(bool ccw);
+  void comp_move_endpoint_and_flush(const Vec2& to);
+  void comp_dequeue();
+  void comp_finish() {  // at the end of the program: emit what waits
+    if (!comp_queue.empty()) comp_move_endpoint_and_flush(Vec2(comp_current));
+  }
+
   // ---- motion (motion.cpp) ----
   void move_to(Vec3 target, const std::array<bool, 3>& set_absolute, const Mat3& rot,
                const Vec3& org, MoveKind kind, double move_feed);
   void linear(MoveKind kind, double move_feed);
   void require_feed();
   void arc(bool ccw);
+  struct ArcData {
+    Vec3 end{0.0};             // program frame
+    Vec2 centre{0.0};          // in the plane's (u, v)
+    double programmed_radius = 0;  // R arcs: |R|; 0 for I/J/K
+  };
+  ArcData arc_data(const Vec3& start, bool ccw);
+  double arc_sweep(const Vec3& start, const Vec3& end, const Vec2& c, bool ccw) const;
+  void arc_chords(const Vec3& start, const Vec3& end, const Vec2& c, bool ccw, double sweep,
+                  double move_feed);
   void cycle(int code);
   void machine_move(const Vec3& target, unsigned mask, MoveKind kind, double move_feed);
   void home_return(bool second);

@@ -44,6 +44,17 @@ inline Diagnostic error_of(const std::string& text, InterpreterOptions options =
   return {};
 }
 
+// The message of the tridex::Error that `f` must throw.
+std::string message_of(auto&& f) {
+  try {
+    f();
+  } catch (const tridex::Error& e) {
+    return e.what();
+  }
+  FAIL("no error");
+  return {};
+}
+
 // A machine that starts at the origin and changes tools in place (as rs274 standalone does).
 inline MachineConfig at_origin(MachineConfig machine = {}) {
   machine.start_position = Vec3(0.0);

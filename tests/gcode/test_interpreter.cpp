@@ -134,9 +134,9 @@ TEST_CASE("rejected blocks name line, column and word") {
   d = error_of("G0 G1 X1\n");
   CHECK(d.column == 4);
   CHECK(d.message.find("conflicts") != std::string::npos);
-  d = error_of("G0 X1 Y1 Z1\nG41 D1\n");
-  CHECK(d.column == 1);
-  CHECK(d.message.find("G41") != std::string::npos);
+  d = error_of("G0 X1 Y1 Z1\nG41 D1\n");  // no tool table: D1 has no diameter
+  CHECK(d.column == 5);
+  CHECK(d.message.find("tool 1 is not in the tool table") != std::string::npos);
   d = error_of("G0 X1 I5\n");
   CHECK(d.column == 7);
   d = error_of("X1 Y2\n");
@@ -161,9 +161,9 @@ TEST_CASE("lenient mode turns unsupported words into warnings and skips them") {
   CHECK(r.warnings[0].line == 2);
   CHECK(r.warnings[3].message.find("skipped 1 × code G61.1 (lines 2)") != std::string::npos);
   CHECK(r.warnings[4].message.find("skipped 2 × unused word E (lines 3, 4)") != std::string::npos);
-  // What would change the path is never skipped: cutter compensation, an unknown code beside
-  // coordinates, a rotary word, a rotated coordinate system.
-  for (const char* text : {"G0 X1 Y1 Z1\nG41 D1\nM30\n", "G0 X1 Y1 Z1\nG16 X2\nM30\n",
+  // What would change the path is never skipped: an unknown code beside coordinates, a rotary
+  // word, a rotated coordinate system.
+  for (const char* text : {"G0 X1 Y1 Z1\nG16 X2\nM30\n",
                            "G0 X1 Y1 Z1\nG0 X2 B90\nM30\n", "G10 L2 P1 X0 R30\nM30\n"}) {
     Diagnostic d = error_of(text, options, at_origin());
     CAPTURE(d.message);

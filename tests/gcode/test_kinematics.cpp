@@ -18,6 +18,7 @@
 using namespace tridex;
 using namespace tridex::gcode;
 using tridex::gcode::test::about;
+using tridex::gcode::test::message_of;
 using tridex::gcode::test::near;
 using nlohmann::json;
 
@@ -29,16 +30,6 @@ Kinematics profile(const char* name) {
   std::optional<Kinematics> k = kinematics_profile(name);
   REQUIRE(k);
   return *k;
-}
-
-std::string message_of(auto&& f) {
-  try {
-    f();
-  } catch (const tridex::Error& e) {
-    return e.what();
-  }
-  FAIL("no error");
-  return {};
 }
 
 // Random positions inside each axis's limits (±400° for endless axes).

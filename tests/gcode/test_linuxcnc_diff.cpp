@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 #include <unistd.h>
 #include <vector>
@@ -30,6 +31,7 @@ struct Point {
   Vec3 p;
   double tolerance;  // mm
   int record;        // rs274 output line, or source line for tridex
+  bool chord = false;  // tridex: a chord end inside an arc (see compare_paths)
 };
 
 bool rs274_available() { return std::system("command -v rs274 > /dev/null 2>&1") == 0; }
@@ -53,10 +55,12 @@ void push(std::vector<Point>& points, const Point& point) {
   if (glm::length(point.p - previous) > 1e-9) points.push_back(point);
 }
 
-std::vector<Point> run_rs274(const fs::path& program, std::string& log) {
+// `tool_table`: a LinuxCNC tool table for -t (standalone rs274 reads its diameters in inches).
+std::vector<Point> run_rs274(const fs::path& program, std::string& log, const fs::path& tool_table = {}) {
   fs::path out = fs::temp_directory_path() /
                  ("tridex_rs274_" + std::to_string(::getpid()) + "_" + program.filename().string());
-  std::string command = "rs274 -g '" + program.string() + "' '" + out.string() +
+  std::string tools = tool_table.empty() ? "" : "-t '" + tool_table.string() + "' ";
+  std::string command = "rs274 " + tools + "-g '" + program.string() + "' '" + out.string() +
                         "' < /dev/null > '" + out.string() + ".log' 2>&1";
   int status = std::system(command.c_str());
   (void)status;  // rs274 exits 0 even on interpreter errors; its log is checked instead
@@ -112,13 +116,18 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log) {
   return points;
 }
 
-std::vector<Point> run_tridex(const fs::path& program) {
+// `tool_diameters`: the tool table for G41/G42 D (mm). With `chords`, every chord of an arc is a
+// point (marked `chord`, its last one not); without, only the end of each arc.
+std::vector<Point> run_tridex(const fs::path& program, const std::map<int, double>& tool_diameters = {},
+                              bool chords = false) {
   InterpreterOptions options;
   options.block_delete = false;  // rs274's block-delete switch is off by default
   std::vector<Point> points;
   std::ifstream in(program, std::ios::binary);
   REQUIRE(in);
-  Interpreter interpreter(options, *MachineConfig::bundled("linuxcnc"));
+  MachineConfig machine = *MachineConfig::bundled("linuxcnc");
+  machine.tool_diameters = tool_diameters;
+  Interpreter interpreter(options, machine);
   Move last_arc;
   bool in_arc = false;
   auto flush = [&] {
@@ -126,6 +135,10 @@ std::vector<Point> run_tridex(const fs::path& program) {
     in_arc = false;
   };
   interpreter.run(in, program.string(), [&](const Move& m) {
+    if (chords) {
+      push(points, Point{m.end, 0, m.line, m.kind == MoveKind::arc});
+      return;
+    }
     if (m.kind == MoveKind::arc) {
       if (in_arc && m.line != last_arc.line) flush();
       last_arc = m;
@@ -216,6 +229,19 @@ std::string random_program(std::mt19937_64& rng) {
   return text + "M2\n";
 }
 
+// rs274 reports an interpreter error as "<line>: <message>" (or the message and the block) and
+// stops: a corpus program must run to its end there, or the comparison would only cover a prefix.
+bool rs274_stopped(const std::string& log) {
+  for (std::size_t at = 0; at < log.size();) {
+    std::size_t end = log.find('\n', at);
+    std::string row = log.substr(at, end == std::string::npos ? std::string::npos : end - at);
+    std::size_t digits = row.find_first_not_of("0123456789");
+    if (digits > 0 && digits != std::string::npos && row.compare(digits, 2, ": ") == 0) return true;
+    at = end == std::string::npos ? log.size() : end + 1;
+  }
+  return false;
+}
+
 // Runs rs274 and tridex on `program` and checks that every move end point agrees within rs274's
 // printed precision, reporting at most `max_reports` disagreements; returns how many were compared
 // and whether all agreed.
@@ -229,17 +255,7 @@ Comparison compare_with_rs274(const fs::path& program, int max_reports) {
   std::vector<Point> theirs = run_rs274(program, log);
   std::vector<Point> ours = run_tridex(program);
   INFO("rs274 log: " << log.substr(0, 600));
-  // rs274 reports an interpreter error as "<line>: <message>" and stops: a corpus program must
-  // run to its end there, or the comparison would only cover a prefix.
-  bool rs274_error = false;
-  for (std::size_t at = 0; at < log.size();) {
-    std::size_t end = log.find('\n', at);
-    std::string row = log.substr(at, end == std::string::npos ? std::string::npos : end - at);
-    std::size_t digits = row.find_first_not_of("0123456789");
-    if (digits > 0 && digits != std::string::npos && row.compare(digits, 2, ": ") == 0) rs274_error = true;
-    at = end == std::string::npos ? log.size() : end + 1;
-  }
-  CHECK_MESSAGE(!rs274_error, "rs274 stopped on an error");
+  CHECK_MESSAGE(!rs274_stopped(log), "rs274 stopped on an error");
   CHECK(ours.size() == theirs.size());
   std::size_t n = std::min(ours.size(), theirs.size());
   int reported = 0;
@@ -256,7 +272,65 @@ Comparison compare_with_rs274(const fs::path& program, int max_reports) {
   return {n, reported == 0 && ours.size() == theirs.size()};
 }
 
+// Cutter compensation splits one block into a corner arc and its own arc, which rs274 prints as
+// two ARC_FEEDs: so here every rs274 end point must be met, in order, by a tridex chord end, and
+// the tridex points between them may only be chords inside arcs (never a straight move's end).
+void compare_paths(const fs::path& program, const fs::path& tool_table,
+                   const std::map<int, double>& tool_diameters) {
+  std::string log;
+  std::vector<Point> theirs = run_rs274(program, log, tool_table);
+  std::vector<Point> ours = run_tridex(program, tool_diameters, true);
+  INFO("rs274 log: " << log.substr(0, 600));
+  CHECK_MESSAGE(!rs274_stopped(log), "rs274 stopped on an error");
+  std::size_t j = 0;
+  bool ok = true;
+  for (std::size_t i = 0; i < theirs.size() && ok; ++i) {
+    auto near = [&](const Point& q) {
+      Vec3 d = glm::abs(q.p - theirs[i].p);
+      return std::max(d.x, std::max(d.y, d.z)) <= theirs[i].tolerance;
+    };
+    while (j < ours.size() && !near(ours[j])) {
+      if (!ours[j].chord) {
+        FAIL_CHECK("rs274 end point " << i << " (record " << theirs[i].record << ") "
+                   << theirs[i].p.x << " " << theirs[i].p.y << " " << theirs[i].p.z
+                   << ": tridex ends a move (line " << ours[j].record << ") at " << ours[j].p.x
+                   << " " << ours[j].p.y << " " << ours[j].p.z);
+        ok = false;
+        break;
+      }
+      ++j;
+    }
+    if (ok && j == ours.size()) {
+      FAIL_CHECK("rs274 end point " << i << " (record " << theirs[i].record << ") never reached");
+      ok = false;
+    }
+    ++j;
+  }
+  if (ok) CHECK_MESSAGE(j == ours.size(), "tridex moves on after rs274's last end point");
+  MESSAGE(program.filename().string() << ": " << theirs.size() << " rs274 end points met");
+}
+
 }  // namespace
+
+TEST_CASE("differential: cutter compensation (G41/G42) agrees with rs274") {
+  if (!rs274_available()) {
+    MESSAGE("SKIPPED: rs274 not found (install the Debian package linuxcnc-uspace); the LinuxCNC "
+            "differential test did not run");
+    return;
+  }
+  fs::path folder = fs::path(TRIDEX_TEST_DATA) / "gcode" / "linuxcnc" / "comp";
+  // tools.tbl in mm: T1 0.25 in, T2 0.5 in, T3 0.
+  const std::map<int, double> diameters{{1, 6.35}, {2, 12.7}, {3, 0.0}};
+  std::vector<fs::path> programs;
+  for (const auto& entry : fs::directory_iterator(folder))
+    if (entry.path().extension() == ".ngc") programs.push_back(entry.path());
+  std::sort(programs.begin(), programs.end());
+  REQUIRE(programs.size() >= 4);
+  for (const fs::path& program : programs) {
+    CAPTURE(program.string());
+    compare_paths(program, folder / "tools.tbl", diameters);
+  }
+}
 
 TEST_CASE("differential: random programs agree with rs274") {
   if (!rs274_available()) {

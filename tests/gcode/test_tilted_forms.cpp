@@ -14,6 +14,7 @@
 using namespace tridex;
 using namespace tridex::gcode;
 using tridex::gcode::test::about;
+using tridex::gcode::test::message_of;
 using tridex::gcode::test::near;
 
 namespace {
@@ -31,16 +32,6 @@ bool same_rotation(const Mat3& a, const Mat3& b, double eps = 1e-9) {
   for (int c = 0; c < 3; ++c)
     if (!near(a[c], b[c], eps)) return false;
   return true;
-}
-
-std::string message_of(auto&& f) {
-  try {
-    f();
-  } catch (const tridex::Error& e) {
-    return e.what();
-  }
-  FAIL("no error");
-  return {};
 }
 
 // A random proper rotation (Z-X-Z with uniform angles; not uniform on SO(3), which these tests

@@ -96,6 +96,9 @@ struct MachineConfig {
   // The rotary axes (kinematics.hpp): with them, A/B/C words on G0/G1 index the tool, and Haas
   // DWO (G254/G255) and Fanuc TCP (G43.4/G43.5) are read; without them a rotary word is an error.
   std::optional<Kinematics> kinematics;
+  // Tool diameters (mm) by tool number, from the tool table: G41/G42 D<n> (or the loaded tool)
+  // offsets by half of it. A tool that is not here cannot be compensated.
+  std::map<int, double> tool_diameters;
 
   void set_home(const Vec3& p) {
     home = p;

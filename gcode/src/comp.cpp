@@ -1,0 +1,389 @@
+// tridex::gcode — cutter radius compensation: G41/G42 D (the tool table's radius), LinuxCNC's
+// G41.1/G42.1 D (a diameter), G40. The offset path is computed as LinuxCNC computes it
+// (src/emc/rs274ngc/interp_convert.cc: convert_straight_comp1/2, convert_arc_comp1/2,
+// convert_cutter_compensation_on/off; interp_queue.cc: move_endpoint_and_flush), so that tridex
+// and `rs274` agree move for move, errors included:
+// - the entry move (the first after G41/G42) ends one radius to the side of its programmed end,
+//   perpendicular to itself; an entry no longer than the radius is an error;
+// - later moves end one radius to the side of their programmed ends; a convex corner gets an arc
+//   about the programmed corner (a G0 gets a straight piece instead); at a concave corner the
+//   moves still waiting in the queue are cut back to where the offset paths meet, an error when
+//   cutting back would reverse a move or shorten an arc past its start ("gouging");
+// - compensated moves therefore wait in a queue until the next move decides where they end;
+//   G40, M2/M30 and the end of the program emit them.
+// Compensation works in the XY plane of the program frame (G17) only: the milling case.
+#include <cmath>
+
+#include "state.hpp"
+
+namespace tridex::gcode {
+
+namespace {
+
+constexpr double kConcaveCorner = 0.05;  // rad, LinuxCNC's TOLERANCE_CONCAVE_CORNER
+constexpr double kEqual = 1e-6;          // LinuxCNC's TOLERANCE_EQUAL
+constexpr double kHalfPi = kPi / 2;
+
+Vec2 xy(const Vec3& p) { return Vec2(p.x, p.y); }
+Vec2 polar(double angle) { return Vec2(std::cos(angle), std::sin(angle)); }
+double angle_of(const Vec2& d) { return std::atan2(d.y, d.x); }
+
+// The signed angle an arc turns from `a` to `b` about `c` (LinuxCNC's find_turn for one turn).
+double find_turn(const Vec2& a, const Vec2& c, int turn, const Vec2& b) {
+  if (turn == 0) return 0.0;
+  double alpha = angle_of(a - c), beta = angle_of(b - c);
+  if (turn > 0) {
+    if (beta <= alpha) beta += 2 * kPi;
+    return beta - alpha;
+  }
+  if (alpha <= beta) alpha += 2 * kPi;
+  return beta - alpha;
+}
+
+// The tool runs inside the arc (LinuxCNC's TOOL_INSIDE_ARC): left of a counter-clockwise arc or
+// right of a clockwise one.
+bool inside_arc(int side, int turn) { return side * turn > 0; }
+
+}  // namespace
+
+void Interpreter::State::comp_forbid(int column, const std::string& what) const {
+  if (comp_side != 0)
+    error(column, what + " with cutter compensation on (turn it off with G40 first, as LinuxCNC requires)");
+}
+
+void Interpreter::State::cutter_comp_codes(int code, int column) {
+  if (code == 400) {
+    if (comp_active() && !comp_first) {
+      comp_move_endpoint_and_flush(xy(comp_current));
+      comp_dequeue();
+      comp_programmed_current = true;  // LinuxCNC: the current point is the programmed one
+      comp_arc_forbidden = true;
+    }
+    comp_side = 0;
+    comp_first = true;
+    return;
+  }
+  std::string name = code_name('G', code);
+  if (plane != 170)
+    error(column, name + " in " + code_name('G', plane) +
+                      ": cutter compensation works in the XY plane (G17) only");
+  if (comp_side != 0) error(column, name + " while cutter compensation is already on (G40 first)");
+  int side = code == 410 || code == 411 ? 1 : -1;
+  double radius = 0;
+  if (code == 411 || code == 421) {  // LinuxCNC: D is the diameter itself
+    if (!w.has('D')) error(column, name + " needs D (the tool diameter)");
+    if (w.has('L')) error(w.col('L'), name + " L (a lathe tool orientation) needs G18, which tridex does not compensate in");
+    radius = length('D') / 2;
+  } else {
+    int number = tool;
+    if (w.has('D')) number = static_cast<int>(integer('D', (name + " D (a tool number)").c_str(), 0, 99'999'999));
+    if (number != 0) {
+      auto it = machine.tool_diameters.find(number);
+      if (it == machine.tool_diameters.end())
+        error(w.has('D') ? w.col('D') : column,
+              name + ": tool " + std::to_string(number) +
+                  " is not in the tool table (its diameter sets the offset; give the tools with "
+                  "--tools or a project)");
+      radius = it->second / 2;
+    }
+  }
+  if (radius < 0) {  // a negative radius offsets to the other side (LinuxCNC)
+    radius = -radius;
+    side = -side;
+  }
+  comp_side = side;
+  comp_radius = radius;
+}
+
+void Interpreter::State::comp_dequeue() {
+  comp_endpoint_valid = false;
+  int saved_line = line;
+  for (const CompMove& q : comp_queue) {
+    line = q.line;
+    if (q.kind == CompMove::straight) {
+      Vec3 end = to_machine(q.end);
+      emit(q.move_kind, pos, end, q.feed);
+      pos = end;
+    } else {
+      Vec3 start = to_program(pos);
+      bool ccw = q.turn > 0;
+      arc_chords(start, q.end, q.centre, ccw, std::abs(find_turn(xy(start), q.centre, q.turn, xy(q.end))),
+                 q.feed);
+    }
+  }
+  line = saved_line;
+  comp_queue.clear();
+}
+
+// Moves the end of every queued move to `to` (where the offset paths of a concave corner meet)
+// and emits them; an error where that reverses a straight move or lengthens an arc.
+void Interpreter::State::comp_move_endpoint_and_flush(const Vec2& to) {
+  if (comp_queue.empty()) return;
+  for (CompMove& q : comp_queue) {
+    if (q.kind == CompMove::arc) {
+      double r1 = glm::length(xy(q.end) - q.centre), r2 = glm::length(to - q.centre);
+      double l2 = find_turn(comp_endpoint, q.centre, q.turn, to);
+      if (std::abs(r1 - r2) > 0.01 * unit)
+        error(motion_column, "cutter compensation made an arc with mismatched radii " +
+                                 format_number(r1) + " and " + format_number(r2) + " (a bug)");
+      if (q.original_sweep != 0.0 && comp_endpoint_valid &&
+          std::abs(l2) > std::abs(q.original_sweep) + 0.0254)
+        error(motion_column, "arc move in a concave corner cannot be reached by the tool without "
+                             "gouging (cutter compensation)");
+    } else {
+      double dot = glm::dot(q.direction, to - comp_endpoint);
+      if (comp_endpoint_valid && dot < 0)
+        error(motion_column, std::string(q.move_kind == MoveKind::rapid ? "straight traverse" : "straight feed") +
+                                 " in a concave corner cannot be reached by the tool without gouging "
+                                 "(cutter compensation: the corner is too small for the tool radius " +
+                                 format_number(comp_radius) + " mm)");
+    }
+    q.end.x = to.x;
+    q.end.y = to.y;
+  }
+  comp_dequeue();
+  comp_endpoint = to;
+  comp_endpoint_valid = true;
+}
+
+void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double move_feed) {
+  if (far)
+    error(motion_column, "cutter compensation from a retracted (far) position: the tool's position "
+                         "is unknown; position it with X, Y and Z first");
+  const double r = comp_radius;
+  const int side = comp_side;
+  const Vec2 p = xy(target);
+  CompMove move;
+  move.move_kind = kind;
+  move.line = line;
+  move.feed = move_feed;
+  if (comp_first) {  // the entry move (convert_straight_comp1)
+    Vec2 c = xy(to_program(pos));
+    double distance = glm::length(p - c);
+    if (distance <= r)
+      error(motion_column, "cutter compensation entry move of length " + format_number(distance) +
+                               " mm is not longer than the tool radius " + format_number(r) + " mm");
+    double alpha = angle_of(p - c) + (side > 0 ? kHalfPi : -kHalfPi);
+    Vec2 end = p + r * polar(alpha);
+    comp_endpoint = c;
+    comp_endpoint_valid = true;
+    move.direction = polar(alpha);  // as LinuxCNC records it
+    move.end = Vec3(end, target.z);
+    comp_queue.push_back(move);
+    comp_first = false;
+    comp_current = move.end;
+    comp_programmed = target;
+    comp_programmed_current = true;
+    return;
+  }
+  // Later moves (convert_straight_comp2).
+  const Vec2 c = xy(comp_current);
+  const Vec2 op = xy(comp_programmed);
+  Vec2 end = c;
+  if (p.x == op.x && p.y == op.y) {  // no XY motion: stays where the tool is, for now
+    move.direction = Vec2(0.0);
+  } else {
+    double theta = angle_of(c - op);
+    double alpha = angle_of(p - op);
+    double beta, gamma;
+    if (side > 0) {
+      if (theta < alpha) theta += 2 * kPi;
+      beta = theta - alpha - kHalfPi;
+      gamma = kHalfPi;
+    } else {
+      if (alpha < theta) alpha += 2 * kPi;
+      beta = alpha - theta - kHalfPi;
+      gamma = -kHalfPi;
+    }
+    end = p + r * polar(alpha + gamma);
+    Vec2 mid = op + r * polar(alpha + gamma);
+    const CompMove* front = comp_queue.empty() ? nullptr : &comp_queue.front();
+    bool front_arc = front && front->kind == CompMove::arc;
+    bool concave = beta < -kConcaveCorner || beta > kPi + kConcaveCorner;
+    // An "h" shape: over the round part, then down beside the straight one; LinuxCNC keeps the
+    // tool above and to the side instead of looping round.
+    if (!concave && beta > kPi - kConcaveCorner && front_arc &&
+        ((side < 0 && front->turn > 0) || (side > 0 && front->turn < 0)))
+      concave = true;
+    if (!concave && beta > kConcaveCorner) {  // convex corner: an arc about it (G0: a line)
+      comp_move_endpoint_and_flush(c);
+      CompMove corner = move;
+      corner.end = Vec3(mid, comp_current.z);
+      if (kind == MoveKind::rapid) {
+        corner.direction = Vec2(0.0);
+      } else {
+        corner.kind = CompMove::arc;
+        corner.move_kind = MoveKind::arc;
+        corner.centre = op;
+        corner.turn = side > 0 ? -1 : 1;
+      }
+      comp_queue.push_back(corner);
+      comp_dequeue();
+      comp_endpoint = mid;
+      comp_endpoint_valid = true;
+    } else if (concave) {
+      Vec2 meet;
+      if (!front_arc) {  // line to line: back along the offset path to where they cross
+        double half_corner = (beta + kPi) / 2;
+        if (half_corner == 0.0)
+          error(motion_column, "a zero-degree inside corner is invalid for cutter compensation");
+        double retreat = r / std::tan(half_corner);
+        meet = c + retreat * polar(theta + gamma);
+      } else {  // arc to line: where the offset arc meets the offset line
+        const CompMove& prev = *front;
+        double old_radius = glm::length(prev.centre - xy(prev.end));
+        double base = angle_of(p - op);
+        double th = prev.turn > 0 ? base + kHalfPi : base - kHalfPi;
+        double phi = angle_of(prev.centre - op);
+        bool inside = inside_arc(side, prev.turn);
+        double programmed_radius = inside ? old_radius + r : old_radius - r;
+        double d = programmed_radius * std::cos(th - phi);
+        double l = (inside ? d - r : d + r) / old_radius;
+        if (l > 1.0 || l < -1.0)
+          error(motion_column, "arc to straight motion makes a corner the compensated tool can't "
+                               "fit in without gouging (cutter compensation)");
+        double turn_sign = (prev.turn > 0) == inside ? -1.0 : 1.0;
+        double angle = turn_sign * std::acos(l) + th + kPi;
+        meet = prev.centre + old_radius * polar(angle);
+      }
+      comp_move_endpoint_and_flush(meet);
+    } else {  // straight on (collinear, or tangent from an arc)
+      comp_dequeue();
+      comp_endpoint = c;
+      comp_endpoint_valid = true;
+    }
+    move.direction = p - op;
+  }
+  move.end = Vec3(end, target.z);
+  comp_queue.push_back(move);
+  comp_current = move.end;
+  comp_programmed = target;
+  comp_programmed_current = true;
+}
+
+void Interpreter::State::comp_arc(bool ccw) {
+  if (far)
+    error(motion_column, "cutter compensation from a retracted (far) position: the tool's position "
+                         "is unknown; position it with X, Y and Z first");
+  const double r = comp_radius;
+  const int side = comp_side;
+  const int turn = ccw ? 1 : -1;
+  const bool inside = inside_arc(side, turn);
+  CompMove move;
+  move.kind = CompMove::arc;
+  move.move_kind = MoveKind::arc;
+  move.line = line;
+  move.feed = feed;
+  move.turn = turn;
+  const std::string too_small = "the tool radius " + format_number(r) +
+                                " mm is not less than the arc radius (cutter compensation)";
+  if (comp_first) {  // the entry arc (convert_arc_comp1)
+    Vec3 current = to_program(pos);
+    Vec2 c = xy(current);
+    ArcData a = arc_data(current, ccw);
+    Vec2 end = xy(a.end);
+    if (glm::length(end - c) <= r)
+      error(motion_column, "cutter compensation entry arc: its end is not farther than the tool "
+                           "radius " + format_number(r) + " mm from its start");
+    double arc_radius = a.programmed_radius > 0 ? a.programmed_radius : glm::length(a.centre - c);
+    if (arc_radius <= r && inside) error(motion_column, too_small);
+    double gamma = inside ? angle_of(a.centre - end) : angle_of(end - a.centre);
+    comp_first = false;
+    comp_programmed = a.end;
+    end += r * polar(gamma);
+    // The compensated arc keeps its start and passes through the new end: its centre lies on
+    // the line from the end through the programmed centre, equally far from both.
+    double b_len = glm::length(c - end) / 2;
+    double ab = angle_of(a.centre - end);
+    double a_angle = angle_of(c - end) - ab;
+    if (std::abs(std::cos(a_angle)) < kEqual) error(motion_column, too_small);
+    Vec2 centre = end + (b_len / std::cos(a_angle)) * polar(ab);
+    move.end = Vec3(end, a.end.z);
+    move.centre = centre;
+    move.original_sweep = find_turn(c, centre, turn, end);
+    comp_queue.push_back(move);
+    comp_current = move.end;
+    comp_programmed_current = true;
+    return;
+  }
+  // Later arcs (convert_arc_comp2).
+  const Vec2 op = xy(comp_programmed);
+  const Vec2 c = xy(comp_current);
+  ArcData a = arc_data(comp_programmed, ccw);
+  const Vec2 centre = a.centre, end = xy(a.end);
+  double arc_radius = glm::length(centre - end);
+  double theta = angle_of(c - op) + (side > 0 ? -kHalfPi : kHalfPi);
+  double delta = angle_of(centre - op);
+  double alpha = ccw ? delta - kHalfPi : delta + kHalfPi;
+  double beta = side > 0 ? theta - alpha : alpha - theta;
+  if (beta > 1.5 * kPi) beta -= 2 * kPi;
+  else if (beta < -kHalfPi) beta += 2 * kPi;
+  double gamma;
+  if (inside) {
+    gamma = angle_of(centre - end);
+    if (arc_radius <= r) error(motion_column, too_small);
+  } else {
+    gamma = angle_of(end - centre);
+    delta += kPi;
+  }
+  Vec2 new_end = end + r * polar(gamma);
+  move.end = Vec3(new_end, a.end.z);
+  move.centre = centre;
+  move.original_sweep = find_turn(op, centre, turn, end);
+  const std::string gouge = "arc move in a concave corner cannot be reached by the tool without "
+                            "gouging (cutter compensation)";
+  if (beta < -kConcaveCorner || beta > kPi + kConcaveCorner ||
+      (std::abs(beta - kPi) < kConcaveCorner && !inside)) {  // concave
+    const CompMove* front = comp_queue.empty() ? nullptr : &comp_queue.front();
+    Vec2 meet;
+    if (!front || front->kind != CompMove::arc) {  // line to arc
+      double along = arc_radius * std::sin(beta - kHalfPi);
+      double from_centre = inside ? arc_radius - r : arc_radius + r;
+      double l = (inside ? along + r : along - r) / from_centre;
+      if (l > 1.0 || l < -1.0) error(motion_column, gouge);
+      double angle = inside ? (turn > 0 ? theta + std::asin(l) : theta - std::asin(l))
+                            : (turn > 0 ? theta + kPi - std::asin(l) : theta + kPi + std::asin(l));
+      meet = centre + from_centre * polar(angle);
+    } else {  // arc to arc: where the two offset circles cross
+      const CompMove& prev = *front;
+      double old_radius = glm::length(prev.centre - xy(prev.end));
+      double new_radius = inside ? arc_radius - r : arc_radius + r;
+      double centres = glm::length(prev.centre - centre);
+      if (old_radius == 0 || centres == 0)
+        error(motion_column, "arc to arc motion is invalid because the arcs have the same centre "
+                             "(cutter compensation)");
+      double cos_pullback = (old_radius * old_radius + centres * centres - new_radius * new_radius) /
+                            (2 * old_radius * centres);
+      if (cos_pullback > 1.0 || cos_pullback < -1.0)
+        error(motion_column, "arc to arc motion makes a corner the compensated tool can't fit in "
+                             "without gouging (cutter compensation)");
+      double pullback = std::acos(cos_pullback);
+      double direction = angle_of(centre - prev.centre);
+      bool add = inside_arc(side, prev.turn) == (turn > 0);
+      meet = prev.centre + old_radius * polar(add ? direction + pullback : direction - pullback);
+    }
+    comp_move_endpoint_and_flush(meet);
+  } else if (beta > kConcaveCorner) {  // convex: an arc about the corner first
+    Vec2 mid = op + r * polar(delta);
+    comp_dequeue();
+    CompMove corner = move;
+    corner.end = Vec3(mid, comp_current.z);
+    corner.centre = op;
+    corner.turn = side > 0 ? -1 : 1;
+    corner.original_sweep = 0;
+    comp_queue.push_back(corner);
+    comp_dequeue();
+    comp_endpoint = mid;
+    comp_endpoint_valid = true;
+  } else {  // tangent
+    comp_dequeue();
+    comp_endpoint = c;
+    comp_endpoint_valid = true;
+  }
+  comp_queue.push_back(move);
+  comp_programmed = a.end;
+  comp_current = move.end;
+  comp_programmed_current = true;
+}
+
+}  // namespace tridex::gcode
