@@ -110,6 +110,8 @@ Flow Interpreter::State::execute(const Block& block) {
   tool_center_codes();  // G43.4/G43.5 TCP, G254/G255 DWO (rotary.cpp)
   // Look-ahead and smoothing modes change how the control follows the path, not the path.
   if (w.find_g(51)) {
+    if (machine.dialect == Dialect::linuxcnc)  // LinuxCNC's G5.1 is a quadratic spline: a move
+      error(w.find_g(51), "G5.1 (LinuxCNC's quadratic B-spline) is not supported");
     for (char c : {'Q', 'R'})
       if (w.has(c)) w.take(c);
   }

@@ -163,3 +163,15 @@ TEST_CASE("lenient mode runs G41/G42 like strict mode; #4007 reads the mode") {
   for (const Move& m : strict.moves) at_41 |= near(m.end, Vec3(41 - 3, 3, 0), 1e-9);
   CHECK(at_41);
 }
+
+TEST_CASE("probing (G38.x) and LinuxCNC's G5.1 spline are errors that name them, even lenient") {
+  InterpreterOptions lenient;
+  lenient.lenient = true;
+  for (const char* code : {"G38.2", "G38.3", "G38.4", "G38.5"}) {
+    Diagnostic d = error_of(std::string("G0 X0 Y0 Z0\n") + code + " Z-10 F100\nM2\n", lenient, at_origin());
+    CHECK(d.line == 2);
+    CHECK_MESSAGE(d.message.find(std::string(code) + " (probing) is not simulated") != std::string::npos, d.message);
+  }
+  Diagnostic d = error_of("G0 X0 Y0 Z0\nG5.1 X10 Y10 I5 J0\nM2\n", lenient, with_tools());
+  CHECK(d.message.find("quadratic B-spline") != std::string::npos);
+}

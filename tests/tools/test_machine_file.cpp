@@ -204,3 +204,22 @@ TEST_CASE("machine files: bad files name the file, the key and the value") {
   CHECK(!fs::exists(dir / "out.jsonl"));
   fs::remove_all(dir);
 }
+
+TEST_CASE("tools: G41/G42 D take the tool's diameter from --tools or the project's table") {
+  fs::path dir = scratch("comp_tools");
+  write_text(dir / "p.ngc", "G21 G17 G90 F300\nT1 M6\nG0 X-10 Y-10 Z0\nG41 D1 G1 X0 Y0\nG1 X0 Y20\n"
+                            "G40 G1 X-10 Y30\nM2\n");
+  write_text(dir / "t.json", R"({"1": {"shape": "cylindrical", "diameter": 8, "length": 30}})");
+  // Without a table the offset is unknown: exit 2 naming the tool.
+  CommandResult r = run_tridex({"moves", (dir / "p.ngc").string(), "--machine", "linuxcnc"}, dir);
+  CHECK(r.status == 2);
+  CHECK(r.err.find("tool 1 is not in the tool table") != std::string::npos);
+  r = run_tridex({"moves", (dir / "p.ngc").string(), "--machine", "linuxcnc", "--tools",
+                  (dir / "t.json").string()}, dir);
+  REQUIRE(r.status == 0);
+  // The side X0 Y0 -> X0 Y20 runs one radius (4 mm) to its left: x = -4.
+  bool side = false;
+  for (const nlohmann::json& m : moves_of(r))
+    side |= m["line"] == 5 && m["end"][0] == -4 && m["end"][1] == 20;
+  CHECK(side);
+}

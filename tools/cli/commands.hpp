@@ -18,6 +18,7 @@ struct CommonOptions {
   bool lenient = false;
   std::string machine;                    // --machine FILE|NAME (empty: the default machine)
   std::vector<std::string> subprograms;   // --subprograms DIR (repeatable)
+  std::string tools;            // --tools FILE (overrides a project's table; G41/G42 D read it)
   bool progress = false;
   bool quiet = false;
   long long max_blocks = kDefaultMaxBlocks;  // --max-blocks: executed blocks before exit status 2
@@ -29,7 +30,6 @@ struct ListOptions : CommonOptions {
 };
 
 struct SimulateOptions : CommonOptions {
-  std::string tools;            // --tools FILE (overrides a project's table)
   std::string stock;            // --stock (overrides a project's workpiece); empty: auto
   double zmap_cell = 0;         // 0: stock diagonal / 1000, at most half the dexel spacing
   double dexel_cell = 0;        // 0: from dexel_res

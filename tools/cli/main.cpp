@@ -54,6 +54,10 @@ void add_common(CLI::App& command, CommonOptions& options) {
   command.add_option("--subprograms", options.subprograms,
                      "folder of subprogram files (O9810.nc, name.ngc) that M98/G65/o-call may "
                      "call (repeatable)");
+  command.add_option("--tools", options.tools,
+                     "tool table, JSON in the CAMotics schema (overrides a project's tools; G41/G42 D\n"
+                     "offset by half a tool's diameter)")
+      ->check(kNotEmpty);
   command.add_flag("--progress", options.progress,
                    "show progress on stderr even when it is not a terminal");
   command.add_flag("-q,--quiet", options.quiet, "print nothing but errors")->excludes("--progress");
@@ -69,9 +73,6 @@ void add_max_memory(CLI::App& command, std::string& max_memory) {
 // simulate's options, shared by check.
 void add_simulate(CLI::App& command, SimulateOptions& options) {
   add_common(command, options);
-  command.add_option("--tools", options.tools,
-                  "tool table, JSON in the CAMotics schema (overrides a project's tools)")
-      ->check(kNotEmpty);
   command.add_option("--stock", options.stock,
                   "box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX | FILE.stl | auto[:MARGIN] (default auto: the box around\n"
                   "the cutting moves plus MARGIN mm, or 5 % of each side without one)")

@@ -170,8 +170,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   r.input = resolve_program(options);
   const ProgramInput& input = r.input;
   std::optional<ToolTable> table;
-  if (!options.tools.empty()) table = ToolTable::read(options.tools);
-  else if (r.input.tools) table = std::move(r.input.tools);
+  if (r.input.tools) table = std::move(r.input.tools);  // --tools, else the project's
   StockSpec stock_spec;
   if (!options.stock.empty()) stock_spec = parse_stock(options.stock);
   else if (input.stock) stock_spec = *input.stock;

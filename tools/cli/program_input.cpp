@@ -28,6 +28,9 @@ ProgramInput resolve_program(const CommonOptions& options) {
   } else {
     input.files.push_back(input.program);
   }
+  if (!options.tools.empty()) input.tools = ToolTable::read(options.tools);
+  if (input.tools)  // cutter compensation (G41/G42 D) offsets by half a tool's diameter
+    for (const auto& [number, spec] : input.tools->tools()) input.machine.tool_diameters[number] = spec.diameter_mm;
   return input;
 }
 

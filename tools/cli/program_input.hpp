@@ -19,7 +19,7 @@ namespace tridex::cli {
 struct ProgramInput {
   std::filesystem::path program;              // what the user named
   std::vector<std::filesystem::path> files;   // the G-code file(s), in order
-  std::optional<ToolTable> tools;             // from a project
+  std::optional<ToolTable> tools;             // --tools, else from a project
   std::optional<StockSpec> stock;             // from a project
   gcode::MachineConfig machine;               // --machine, --subprograms
 };
