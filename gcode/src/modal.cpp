@@ -59,6 +59,7 @@ Flow Interpreter::State::execute(const Block& block) {
 
   if (w.find_m(6) || (w.has('T') && machine.tool_loads_on_t)) {
     comp_forbid(w.find_m(6) ? w.find_m(6) : w.col('T'), "a tool change");
+    comp_programmed_current = false;  // LinuxCNC resynchronises with where the tool really is
     tool = tool_selected;
     tool_first_line.emplace(tool, line);
     if (machine.tool_change == ToolChange::retract_far) go_far();

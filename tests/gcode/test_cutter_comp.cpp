@@ -175,3 +175,13 @@ TEST_CASE("probing (G38.x) and LinuxCNC's G5.1 spline are errors that name them,
   Diagnostic d = error_of("G0 X0 Y0 Z0\nG5.1 X10 Y10 I5 J0\nM2\n", lenient, with_tools());
   CHECK(d.message.find("quadratic B-spline") != std::string::npos);
 }
+
+TEST_CASE("after G40 the next move counts from the programmed point, after a tool change from the tip") {
+  // LinuxCNC: G40 makes the programmed point current (a Z move then also returns X/Y to it); a
+  // tool change resynchronises with where the tool is (useful-subroutines.ngc relies on it).
+  const std::string head = "G21 G17 G90 F300\nT1 M6\nG0 X-10 Y-10 Z0\nG41 D1 G1 X0 Y0\nG1 X20 Y0\nG0 Z5\nG40\n";
+  Result plain = run_program(head + "G0 Z10\nM2\n", {}, with_tools());
+  CHECK(near(plain.moves.back().end, Vec3(20, 0, 10), 1e-9));
+  Result changed = run_program(head + "T2 M6\nG0 Z10\nM2\n", {}, with_tools());
+  CHECK(near(changed.moves.back().end, Vec3(20, 3, 10), 1e-9));
+}
