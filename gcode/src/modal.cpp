@@ -9,6 +9,8 @@ namespace tridex::gcode {
 
 Flow Interpreter::State::execute(const Block& block) {
   gather(block);
+  if (plane_blocks.code && !w.find_g(plane_blocks.code))  // a G68.2 P2/P3 plane is under way
+    error(block.words.front().column, incomplete_plane());
   if (int column = w.find_g(650)) return macro_call(column);
   motion_column = 0;
   int motion_code = -1, nonmodal = -1, tilt = -1, orient = -1;

@@ -10,6 +10,7 @@
 #include <functional>
 #include <map>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <unordered_map>
 #include <string>
@@ -66,6 +67,17 @@ struct Interpreter::State : ParameterReader {
   int tilt_line = 0;
   Mat3 rotation{1.0};
   Vec3 origin{0.0};
+  // G68.2 / G68.4 P2 (three points) and P3 (two vectors) are written over consecutive blocks,
+  // one Q each (tilt.cpp); their words are gathered here until the last one completes the plane.
+  struct PlaneBlocks {
+    int code = 0;  // 682 or 684 while a plane is under way; 0 otherwise
+    int p = 0;
+    int first_line = 0;
+    unsigned given = 0;  // bit q: the Q block has been read
+    std::array<Vec3, 4> xyz{}, ijk{};
+    double r = 0;
+  };
+  PlaneBlocks plane_blocks;
 
   // Rotary axes (rotary.cpp; only with MachineConfig::kinematics): their positions and how X Y Z
   // are read. raw: machine coordinates (the part frame is machine_to_part of the rotaries);
@@ -304,7 +316,9 @@ struct Interpreter::State : ParameterReader {
   void set_rotary(const RotaryPositions& next);
 
   // ---- tilted planes (tilt.cpp) ----
-  Frame plane_words(int code);
+  std::optional<Frame> plane_words(int code);  // nullopt: a several-block form awaits more blocks
+  std::optional<Frame> several_block_plane(int code, int p);
+  std::string incomplete_plane() const;
   void tilted_plane(int code);
   void orient_to_plane(int code);
 
