@@ -248,6 +248,13 @@ struct Interpreter::State : ParameterReader {
   bool has_axis_words() const { return w.has('X') || w.has('Y') || w.has('Z'); }
 
   // ---- frames ----
+  // Where the linear axes stand, in the coordinates offsets are added in (G92, G10 L20): the tip
+  // on the part, or in raw rotary form (kinematics without TCP or DWO) the machine coordinates,
+  // which differ from the tip's place on the part as soon as a table axis is turned.
+  bool raw_rotary() const { return machine.kinematics && !tcp && !dwo && !tilted; }
+  Vec3 linear_axes() const {
+    return raw_rotary() ? machine_from_part(*machine.kinematics, pos, rotary_position) : pos;
+  }
   Vec3 to_machine(const Vec3& p) const { return origin + rotation * p; }
   Vec3 to_program(const Vec3& m) const { return glm::transpose(rotation) * (m - origin); }
 
@@ -255,7 +262,7 @@ struct Interpreter::State : ParameterReader {
     if (tilted) {
       rotation = tilt_rotation;
       origin = tilt_origin;
-    } else if (machine.kinematics && !tcp && !dwo) {
+    } else if (raw_rotary()) {
       // Raw rotary programs: X Y Z (after the work offset) are the machine's linear axes.
       Frame m = machine_to_part(*machine.kinematics, rotary_position);
       rotation = m.rotation;
