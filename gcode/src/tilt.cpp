@@ -92,8 +92,10 @@ std::optional<Frame> Interpreter::State::plane_words(int code) {
 }
 
 // G68.2 / G68.4 P2 and P3: the plane written over consecutive blocks, one Q each, X Y Z the
-// work coordinates of a point (an omitted word is 0) and I J K a direction. Fanuc (30i/31i-A
-// B-63944EN §"Tilted working plane command", the forms as Fanuc posts write them):
+// work coordinates of a point (an omitted word is 0) and I J K a direction. Fanuc's forms, as
+// posts for Fanuc 30i-series controls write them (no Fanuc manual was at hand: the Q0 block's
+// reading follows a post's quote of it, "amount of shift from the first point to the origin of a
+// feature coordinate system", which it applies in the feature frame):
 //   P2 [Q0 X Y Z R]               optional: X Y Z the shift from the first point to the feature
 //                                 origin, in the feature frame; R turns the frame about its Z
 //      Q1 X Y Z, Q2 X Y Z, Q3 X Y Z  the three points of three_point_frame
@@ -103,7 +105,7 @@ std::optional<Frame> Interpreter::State::plane_words(int code) {
 //   P2 Q0 X Y Z R (the origin itself), Q1 Q2 Q3 the points (linuxcnc_three_point_frame)
 //   P3 Q0 X Y Z I J K R (I J K a point on X), Q1 I J K the Z direction (linuxcnc_two_vector_frame)
 // The blocks may come in any order; the plane takes effect with the block that completes it, and
-// any other block before that is an error (require_plane_complete): Fanuc alarms on it too.
+// any other block before that is an error (execute, with incomplete_plane's message).
 std::optional<Frame> Interpreter::State::several_block_plane(int code, int p) {
   const std::string form = code_name('G', code) + " P" + std::to_string(p);
   bool linuxcnc = machine.dialect == Dialect::linuxcnc;
