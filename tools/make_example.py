@@ -10,8 +10,15 @@ ball-end slot, a circular groove (G2 arcs) and an engraved wave; the tilted dire
 faces a 20-degree bevel and puts its features on it.
 
 It is written as a CAM post writes 3+2 work: per operation `G68.2 X Y Z I J K` (Euler Z-X-Z) +
-`G53.1`, positioning `G0 X Y`, `G43 Z H`, cutting, then `G28 G91 Z0.` and `G69`. Run it again
-to regenerate the files (the output is deterministic).
+`G53.1`, positioning `G0 X Y`, `G43 Z H`, cutting, then `G28 G91 Z0.` and `G69`.
+
+Its rotary-indexed twin, mold_3plus2_bc.nc with the machine file mold_3plus2_bc.machine.json
+(the bundled `bc-trunnion` kinematics, a Haas UMC-style B/C table), is the same part written as
+Autodesk's Haas posts write 3+2 work: `G0 B.. C..` to index the table, `G254` (dynamic work
+offset) and the moves in the part's work coordinates, `G255` to cancel. DWO arcs must lie in a
+G17/G18/G19 plane of the part, which the tilted face's are not, so the twin writes every arc as
+lines within 0.0005 mm (half of tridex's default arc tolerance). Run this script again to
+regenerate the files (the output is deterministic).
 """
 import json
 import math
@@ -87,6 +94,121 @@ class Post:
     def end_operation(self):
         self.move("G0", Z=self.clearance)
         self.emit("M5")
+
+
+class RotaryPost(Post):
+    """The Haas DWO twin: reads each line the G68.2 post writes and writes it for a B/C table.
+
+    The feature-frame position (u, v, w) is tracked; w is unknown (None) after a retract or an
+    index, as the tool is then far along its axis, and the first move that completes the position
+    writes it.
+    """
+
+    ARC_TOLERANCE = 0.0005  # mm, chord error of the lines that replace an arc
+
+    def __init__(self):
+        super().__init__()
+        self.origin = (0.0, 0.0, 0.0)
+        self.rot = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))  # columns: feature axes
+        self.u = self.v = self.w = None
+        self.motion = None
+
+    def to_work(self, u, v, w):
+        return tuple(self.origin[r] + sum(self.rot[c][r] * (u, v, w)[c] for c in range(3))
+                     for r in range(3))
+
+    def write(self, code, feed=None):
+        x, y, z = self.to_work(self.u, self.v, self.w)
+        line = f"{code} X{fmt(x)} Y{fmt(y)} Z{fmt(z)}"
+        self.lines.append(line + (f" F{feed}" if feed is not None else ""))
+
+    def set_plane(self, x, y, z, a, b, c):
+        def rz(t):
+            t = math.radians(t)
+            return ((math.cos(t), -math.sin(t), 0.0), (math.sin(t), math.cos(t), 0.0), (0.0, 0.0, 1.0))
+
+        def rx(t):
+            t = math.radians(t)
+            return ((1.0, 0.0, 0.0), (0.0, math.cos(t), -math.sin(t)), (0.0, math.sin(t), math.cos(t)))
+
+        def mul(p, q):
+            return tuple(tuple(sum(p[r][k] * q[k][col] for k in range(3)) for col in range(3))
+                         for r in range(3))
+
+        m = mul(mul(rz(a), rx(b)), rz(c))  # Fanuc's Euler Z-X-Z, rows
+        self.rot = tuple(tuple(m[r][col] for r in range(3)) for col in range(3))
+        self.origin = (x, y, z)
+        # bc-trunnion: the tool on the part is Rz(-C)·Ry(-B)·z = (-sin B cos C, sin B sin C, cos B).
+        d = self.rot[2]
+        b_angle = math.degrees(math.acos(max(-1.0, min(1.0, d[2]))))
+        c_angle = math.degrees(math.atan2(d[1], -d[0])) if abs(d[2]) < 1 - 1e-12 else 0.0
+        self.lines.append(f"G0 B{fmt(b_angle)} C{fmt(c_angle)}")
+        self.lines.append("G254")
+        self.w = None
+
+    def arc(self, ccw, u1, v1, i, j, feed):
+        cu, cv = self.u + i, self.v + j
+        r = math.hypot(i, j)
+        a0 = math.atan2(self.v - cv, self.u - cu)
+        a1 = math.atan2(v1 - cv, u1 - cu)
+        sweep = a1 - a0
+        if ccw and sweep <= 1e-12:
+            sweep += 2 * math.pi
+        if not ccw and sweep >= -1e-12:
+            sweep -= 2 * math.pi
+        step = 2 * math.acos(1 - self.ARC_TOLERANCE / r)
+        n = max(1, math.ceil(abs(sweep) / step))
+        for k in range(1, n + 1):
+            t = a0 + sweep * k / n
+            self.u, self.v = (u1, v1) if k == n else (cu + r * math.cos(t), cv + r * math.sin(t))
+            self.write("G1", feed if k == 1 else None)
+
+    def emit(self, text):
+        words = text.split()
+        if text.startswith("(") or not words:
+            self.lines.append(text)
+            return
+        value = {}
+        codes = []
+        for word in words:
+            if word[0] == "G":
+                codes.append(word)
+            else:
+                value[word[0]] = word[1:]
+        if codes[:1] == ["G68.2"]:
+            self.set_plane(*(float(value[k]) for k in "XYZIJK"))
+            return
+        if codes == ["G53.1"]:
+            return
+        if codes == ["G69"]:
+            self.lines.append("G255")
+            self.origin = (0.0, 0.0, 0.0)
+            self.rot = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+            return
+        if codes[:2] == ["G28", "G91"]:
+            self.lines.append(text)
+            self.w = None
+            return
+        motion = [c for c in codes if c in ("G0", "G1", "G2", "G3")]
+        if motion:
+            self.motion = motion[0]
+        feed = value.get("F")
+        if self.motion in ("G2", "G3") and motion:
+            self.arc(self.motion == "G3", float(value["X"]), float(value["Y"]), float(value["I"]),
+                     float(value["J"]), feed)
+            return
+        if not any(k in value for k in "XYZ"):
+            self.lines.append(text)
+            return
+        if "G43" in codes:  # G43 Z H: the length offset on its own line, then the position
+            self.lines.append(f"G43 H{value['H']}")
+        self.u = float(value.get("X", self.u if self.u is not None else 0.0))
+        self.v = float(value.get("Y", self.v if self.v is not None else 0.0))
+        if "Z" in value:
+            self.w = float(value["Z"])
+        if self.w is None:
+            return  # still far along the tool: the move that gives Z writes the position
+        self.write(self.motion, feed)
 
 
 def top(post):
@@ -248,12 +370,9 @@ def side(post, name, plane, region, clearance, bevel=None):
     post.end_operation()
 
 
-def main():
-    here = os.path.dirname(os.path.abspath(__file__))
-    out_dir = os.path.join(here, "..", "gcode", "examples")
-    post = Post()
+def program(post, title):
     post.emit("%")
-    post.emit("O3201 (TRIDEX 3+2 EXAMPLE: MOLD TOP AND FOUR SIDES)")
+    post.emit(title)
     post.emit("(STOCK X0 Y0 Z0 TO X100 Y80 Z50, WORK OFFSET G54 AT THE STOCK CORNER)")
     for number, tool in TOOLS.items():
         post.emit(f"(T{number} D={fmt(tool['diameter'])} {tool['description'].upper()})")
@@ -272,8 +391,19 @@ def main():
     post.emit("G69")
     post.emit("M30")
     post.emit("%")
+    return "\n".join(post.lines) + "\n"
+
+
+def main():
+    here = os.path.dirname(os.path.abspath(__file__))
+    out_dir = os.path.join(here, "..", "gcode", "examples")
     with open(os.path.join(out_dir, "mold_3plus2.nc"), "w", newline="\n") as f:
-        f.write("\n".join(post.lines) + "\n")
+        f.write(program(Post(), "O3201 (TRIDEX 3+2 EXAMPLE: MOLD TOP AND FOUR SIDES)"))
+    with open(os.path.join(out_dir, "mold_3plus2_bc.nc"), "w", newline="\n") as f:
+        f.write(program(RotaryPost(), "O3202 (TRIDEX 3+2 EXAMPLE, ROTARY-INDEXED TWIN: B/C TABLE, HAAS DWO G254)"))
+    with open(os.path.join(out_dir, "mold_3plus2_bc.machine.json"), "w", newline="\n") as f:
+        json.dump({"kinematics": "bc-trunnion"}, f, indent=2)
+        f.write("\n")
 
     table = {str(n): {"units": "mm", "shape": t["shape"], "length": t["length"],
                       "diameter": t["diameter"], "description": t["description"]}

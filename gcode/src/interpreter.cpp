@@ -77,6 +77,11 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
   }
   run_program(s, program, file_name);
   s.comp_finish();  // compensated moves still waiting for a next move
+  if (s.plane_blocks.code) {
+    s.file = &file_name;
+    s.line = s.plane_blocks.first_line;
+    s.error(0, s.incomplete_plane());
+  }
   // One line per kind of word lenient mode skipped, however many: never a silent skip.
   for (const auto& [cause, skipped] : s.skipped) {
     std::string lines;

@@ -140,6 +140,25 @@ void json_known_keys(const nlohmann::json& object, std::initializer_list<const c
       }(), ")");
 }
 
+// "travel": {"X": [min, max], ...}, each letter optional.
+std::array<std::optional<std::array<double, 2>>, 3> travel_from_json(const nlohmann::json& j,
+                                                                     const std::string& path) {
+  if (!j.is_object()) json_fail(path, "must be an object such as {\"X\": [-300, 300]}", j);
+  json_known_keys(j, {"X", "Y", "Z"}, path);
+  std::array<std::optional<std::array<double, 2>>, 3> travel;
+  for (int i = 0; i < 3; ++i) {
+    std::string letter(1, char('X' + i));
+    if (!j.contains(letter)) continue;
+    const nlohmann::json& range = j[letter];
+    std::string at = path + "." + letter;
+    if (!range.is_array() || range.size() != 2) json_fail(at, "must be [min, max] in mm", range);
+    double lo = json_number(range[0], at + "[0]"), hi = json_number(range[1], at + "[1]");
+    if (!(lo < hi)) json_fail(at, "min must be less than max", range);
+    travel[std::size_t(i)] = std::array<double, 2>{lo, hi};
+  }
+  return travel;
+}
+
 RotaryAxis axis_from_json(const nlohmann::json& j, const std::string& path) {
   if (!j.is_object()) json_fail(path, "must be an object", j);
   json_known_keys(j, {"letter", "on", "direction", "sense", "pivot", "limits"}, path);
@@ -279,6 +298,21 @@ void check_limits(const Kinematics& kin, const RotaryPositions& rotary) {
       detail::fail(axis.letter, v, " is outside the axis limits ", (*axis.limits)[0], " to ",
                    (*axis.limits)[1]);
   }
+}
+
+std::vector<TravelViolation> travel_violations(const Kinematics& kin, const Vec3& machine_xyz,
+                                               const RotaryPositions& rotary) {
+  std::vector<TravelViolation> out;
+  auto compare = [&](char letter, double v, const std::optional<std::array<double, 2>>& range) {
+    if (!range) return;
+    if (v < (*range)[0]) out.push_back({letter, v, (*range)[0]});
+    if (v > (*range)[1]) out.push_back({letter, v, (*range)[1]});
+  };
+  for (int i = 0; i < 3; ++i) compare(char('X' + i), machine_xyz[i], kin.travel[std::size_t(i)]);
+  for (char letter : {'A', 'B', 'C'})
+    if (const RotaryAxis* axis = kin.find(letter))
+      compare(letter, rotary[std::size_t(rotary_index(letter))], axis->limits);
+  return out;
 }
 
 RotaryPositions orient_tool(const Kinematics& kin, const Vec3& part_direction,
@@ -427,8 +461,15 @@ Kinematics kinematics_from_json(const nlohmann::json& value, const std::string& 
     return *profile;
   }
   if (!value.is_object()) json_fail(path, "must be a profile name or an object", value);
-  json_known_keys(value, {"type", "axes"}, path);
+  if (value.contains("profile")) {  // a bundled profile with the machine's own travel
+    json_known_keys(value, {"profile", "travel"}, path);
+    Kinematics kin = kinematics_from_json(value["profile"], path + ".profile");
+    if (value.contains("travel")) kin.travel = travel_from_json(value["travel"], path + ".travel");
+    return kin;
+  }
+  json_known_keys(value, {"type", "axes", "travel"}, path);
   Kinematics kin;
+  if (value.contains("travel")) kin.travel = travel_from_json(value["travel"], path + ".travel");
   const nlohmann::json& type = json_key(value, "type", path);
   if (type == "table-table") kin.type = MachineType::table_table;
   else if (type == "head-table") kin.type = MachineType::head_table;

@@ -9,6 +9,8 @@ namespace tridex::gcode {
 
 Flow Interpreter::State::execute(const Block& block) {
   gather(block);
+  if (plane_blocks.code && !w.find_g(plane_blocks.code))  // a G68.2 P2/P3 plane is under way
+    error(block.words.front().column, incomplete_plane());
   if (int column = w.find_g(650)) return macro_call(column);
   motion_column = 0;
   int motion_code = -1, nonmodal = -1, tilt = -1, orient = -1;
@@ -183,7 +185,7 @@ Flow Interpreter::State::execute(const Block& block) {
         error(column, "G10 L20 with the tool retracted far along its axis: its position is unknown");
       for (int i = 0; i < 3; ++i)
         if (w.has(kAxisLetter[i]))
-          value[i] = relative_to_position ? pos[i] - local_offset[i] - length(kAxisLetter[i])
+          value[i] = relative_to_position ? linear_axes()[i] - local_offset[i] - length(kAxisLetter[i])
                                           : length(kAxisLetter[i]);
       if (key == work_key) comp_forbid(column, "G10 on the active work offset");
       offsets[key] = value;
@@ -343,12 +345,13 @@ void Interpreter::State::local_offsets(int code, int column) {
       if (code == 520) {
         local_offset[i] = v;
       } else {
-        bool along_axis = std::abs(axis[i]) > kAxisEps;
+        // In raw rotary form "far" is along the turned tool, which any linear axis may follow.
+        bool along_axis = std::abs(axis[i]) > kAxisEps || raw_rotary();
         if (far && along_axis)
           error(w.col(c), std::string("G92 ") += c + std::string(
                               " with the tool retracted far along its axis: its position is "
                               "unknown (a machine file can set the start position)"));
-        local_offset[i] = pos[i] - work_offset[i] - v;
+        local_offset[i] = linear_axes()[i] - work_offset[i] - v;
       }
     }
     if (!any) error(column, code_name('G', code) + " needs X, Y or Z");

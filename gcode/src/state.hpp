@@ -10,6 +10,7 @@
 #include <functional>
 #include <map>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <unordered_map>
 #include <string>
@@ -66,6 +67,17 @@ struct Interpreter::State : ParameterReader {
   int tilt_line = 0;
   Mat3 rotation{1.0};
   Vec3 origin{0.0};
+  // G68.2 / G68.4 P2 (three points) and P3 (two vectors) are written over consecutive blocks,
+  // one Q each (tilt.cpp); their words are gathered here until the last one completes the plane.
+  struct PlaneBlocks {
+    int code = 0;  // 682 or 684 while a plane is under way; 0 otherwise
+    int p = 0;
+    int first_line = 0;
+    unsigned given = 0;  // bit q: the Q block has been read
+    std::array<Vec3, 4> xyz{}, ijk{};
+    double r = 0;
+  };
+  PlaneBlocks plane_blocks;
 
   // Rotary axes (rotary.cpp; only with MachineConfig::kinematics): their positions and how X Y Z
   // are read. raw: machine coordinates (the part frame is machine_to_part of the rotaries);
@@ -240,6 +252,13 @@ struct Interpreter::State : ParameterReader {
   bool has_axis_words() const { return w.has('X') || w.has('Y') || w.has('Z'); }
 
   // ---- frames ----
+  // Where the linear axes stand, in the coordinates offsets are added in (G92, G10 L20): the tip
+  // on the part, or in raw rotary form (kinematics without TCP or DWO) the machine coordinates,
+  // which differ from the tip's place on the part as soon as a table axis is turned.
+  bool raw_rotary() const { return machine.kinematics && !tcp && !dwo && !tilted; }
+  Vec3 linear_axes() const {
+    return raw_rotary() ? machine_from_part(*machine.kinematics, pos, rotary_position) : pos;
+  }
   Vec3 to_machine(const Vec3& p) const { return origin + rotation * p; }
   Vec3 to_program(const Vec3& m) const { return glm::transpose(rotation) * (m - origin); }
 
@@ -247,7 +266,7 @@ struct Interpreter::State : ParameterReader {
     if (tilted) {
       rotation = tilt_rotation;
       origin = tilt_origin;
-    } else if (machine.kinematics && !tcp && !dwo) {
+    } else if (raw_rotary()) {
       // Raw rotary programs: X Y Z (after the work offset) are the machine's linear axes.
       Frame m = machine_to_part(*machine.kinematics, rotary_position);
       rotation = m.rotation;
@@ -352,7 +371,9 @@ struct Interpreter::State : ParameterReader {
   void set_rotary(const RotaryPositions& next);
 
   // ---- tilted planes (tilt.cpp) ----
-  Frame plane_words(int code);
+  std::optional<Frame> plane_words(int code);  // nullopt: a several-block form awaits more blocks
+  std::optional<Frame> several_block_plane(int code, int p);
+  std::string incomplete_plane() const;
   void tilted_plane(int code);
   void orient_to_plane(int code);
 

@@ -11,6 +11,21 @@ Vec3 word_vector(Words& w, char a, char b, char c) {
   return Vec3(w.has(a) ? w.take(a) : 0.0, w.has(b) ? w.take(b) : 0.0, w.has(c) ? w.take(c) : 0.0);
 }
 
+// The Q numbers (bit q) a several-block form takes, and those it needs before its plane is known.
+unsigned several_block_allowed(int p, bool linuxcnc) {
+  return p == 2 ? 0b1111u : linuxcnc ? 0b0011u : 0b0110u;
+}
+unsigned several_block_needed(int p, bool linuxcnc) {
+  return p == 2 && !linuxcnc ? 0b1110u : several_block_allowed(p, linuxcnc);
+}
+
+std::string q_list(unsigned bits) {
+  std::string list;
+  for (int n = 0; n < 4; ++n)
+    if ((bits >> n) & 1u) list += (list.empty() ? "Q" : ", Q") + std::to_string(n);
+  return list;
+}
+
 }  // namespace
 
 // The frame of a G68.2 / G68.4 / G268 block in the frame it is written in (the work frame for
@@ -23,22 +38,22 @@ Vec3 word_vector(Words& w, char a, char b, char c) {
 //                                 LinuxCNC's dialect (machine file): I J K the first to third
 //                                 angle of the intrinsic order Q, and R about the work Z
 //   G268 X Y Z I J K [Q]          Haas: as P1 (Q123 when Q is absent)
-Frame Interpreter::State::plane_words(int code) {
+//   G68.2 P2 Qq …, G68.2 P3 Qq …  over several blocks: several_block_plane
+// nullopt while a several-block form waits for its next block.
+std::optional<Frame> Interpreter::State::plane_words(int code) {
   int column = w.find_g(code);
+  long long p = 0;
+  if (w.has('P')) {
+    if (code == 2680) error(w.col('P'), "G268 has no P word");
+    p = integer('P', "G68.2 P", 0, 3);
+  }
+  if (p == 2 || p == 3) return several_block_plane(code, static_cast<int>(p));
   Vec3 o(0.0);
   for (int i = 0; i < 3; ++i)
     if (w.has(kAxisLetter[i])) o[i] = length(kAxisLetter[i]);
   bool abc = w.has('A') || w.has('B') || w.has('C');
   bool uvw = w.has('U') || w.has('V') || w.has('W');
   bool ijk = w.has('I') || w.has('J') || w.has('K');
-  long long p = 0;
-  if (w.has('P')) {
-    if (code == 2680) error(w.col('P'), "G268 has no P word");
-    p = integer('P', "G68.2 P", 0, 3);
-  }
-  if (p == 2 || p == 3)
-    error(w.col('P'), code_name('G', code) + " P" + std::to_string(p) +
-                          " (three points / two vectors over several blocks) is not read yet");
   int q = code == 2680 || p == 1 ? 123 : 0;
   int q_column = column;
   if (w.has('Q')) {
@@ -76,6 +91,81 @@ Frame Interpreter::State::plane_words(int code) {
   }
 }
 
+// G68.2 / G68.4 P2 and P3: the plane written over consecutive blocks, one Q each, X Y Z the
+// work coordinates of a point (an omitted word is 0) and I J K a direction. Fanuc's forms, as
+// posts for Fanuc 30i-series controls write them (no Fanuc manual was at hand: the Q0 block's
+// reading follows a post's quote of it, "amount of shift from the first point to the origin of a
+// feature coordinate system", which it applies in the feature frame):
+//   P2 [Q0 X Y Z R]               optional: X Y Z the shift from the first point to the feature
+//                                 origin, in the feature frame; R turns the frame about its Z
+//      Q1 X Y Z, Q2 X Y Z, Q3 X Y Z  the three points of three_point_frame
+//   P3 Q1 X Y Z I J K             the origin and the feature X direction
+//      Q2 I J K                   the feature Z direction (two_vector_frame)
+// LinuxCNC's remap (g682; machine dialect linuxcnc) numbers them differently and needs every one:
+//   P2 Q0 X Y Z R (the origin itself), Q1 Q2 Q3 the points (linuxcnc_three_point_frame)
+//   P3 Q0 X Y Z I J K R (I J K a point on X), Q1 I J K the Z direction (linuxcnc_two_vector_frame)
+// The blocks may come in any order; the plane takes effect with the block that completes it, and
+// any other block before that is an error (execute, with incomplete_plane's message).
+std::optional<Frame> Interpreter::State::several_block_plane(int code, int p) {
+  const std::string form = code_name('G', code) + " P" + std::to_string(p);
+  bool linuxcnc = machine.dialect == Dialect::linuxcnc;
+  unsigned allowed = several_block_allowed(p, linuxcnc);
+  unsigned needed = several_block_needed(p, linuxcnc);
+  if (!w.has('Q') && !linuxcnc)
+    error(w.find_g(code), form + " needs Q (which of its blocks this is)");
+  int q_column = w.has('Q') ? w.col('Q') : w.find_g(code);
+  int q = w.has('Q') ? static_cast<int>(integer('Q', (form + " Q").c_str(), 0, 3)) : 0;
+  if (!((allowed >> q) & 1u))
+    error(q_column, form + " Q" + std::to_string(q) + ": this form's blocks are " + q_list(allowed));
+  PlaneBlocks& b = plane_blocks;
+  if (b.code == 0) b = PlaneBlocks{code, p, line, 0, {}, {}, 0.0};
+  if (b.code != code || b.p != p)
+    error(w.find_g(code), form + " while " + code_name('G', b.code) + " P" + std::to_string(b.p) +
+                              " begun at line " + std::to_string(b.first_line) + " is incomplete");
+  if ((b.given >> q) & 1u)
+    error(q_column, form + " Q" + std::to_string(q) + " given twice (the plane begun at line " +
+                        std::to_string(b.first_line) + ")");
+  b.given |= 1u << q;
+  // The direction-only block (Fanuc P3 Q2, LinuxCNC P3 Q1) has no point; R only on Q0.
+  bool direction_only = p == 3 && q == (linuxcnc ? 1 : 2);
+  for (int i = 0; i < 3; ++i) {
+    char c = kAxisLetter[i];
+    if (!w.has(c)) continue;
+    if (direction_only)
+      error(w.col(c), form + " Q" + std::to_string(q) + " takes only I J K (a direction), not " + c);
+    b.xyz[static_cast<std::size_t>(q)][i] = length(c);
+  }
+  if (p == 3) b.ijk[static_cast<std::size_t>(q)] = word_vector(w, 'I', 'J', 'K');
+  if (q == 0 && w.has('R')) b.r = w.take('R');
+  if ((b.given & needed) != needed) return std::nullopt;
+
+  PlaneBlocks done = b;
+  plane_blocks = PlaneBlocks{};
+  auto& xyz = done.xyz;
+  auto& ijk = done.ijk;
+  try {
+    if (linuxcnc)
+      return p == 2 ? linuxcnc_three_point_frame(xyz[0], done.r, xyz[1], xyz[2], xyz[3])
+                    : linuxcnc_two_vector_frame(xyz[0], ijk[0], done.r, ijk[1]);
+    if (p == 3) return two_vector_frame(xyz[1], ijk[1], ijk[2]);
+    Frame points = three_point_frame(xyz[1], xyz[2], xyz[3]);
+    points.origin = points.to_world(xyz[0]);
+    return rotated_about_own_z(points, done.r);
+  } catch (const Error& e) {
+    error(q_column, form + ": " + e.what());
+  }
+}
+
+// A several-block plane under way: what is missing, for the error of the block that is not its
+// next one (execute) or of the program's end (Interpreter::run).
+std::string Interpreter::State::incomplete_plane() const {
+  const PlaneBlocks& b = plane_blocks;
+  unsigned needed = several_block_needed(b.p, machine.dialect == Dialect::linuxcnc);
+  return code_name('G', b.code) + " P" + std::to_string(b.p) + " begun at line " +
+         std::to_string(b.first_line) + " is incomplete (" + q_list(needed & ~b.given) +
+         " missing): its blocks must follow one another";
+}
+
 void Interpreter::State::tilted_plane(int code) {
   if (code == 690 || code == 2690) {
     tilted = false;
@@ -109,9 +199,13 @@ void Interpreter::State::tilted_plane(int code) {
   } else if (code == 684) {
     // G68.4: the same forms as G68.2, given in the active feature frame and composed with it.
     if (!tilted) error(column, "G68.4 (incremental tilted plane) without an active tilted plane");
-    feature = compose(Frame{tilt_rotation, tilt_origin}, plane_words(684));
+    std::optional<Frame> incremental_frame = plane_words(684);
+    if (!incremental_frame) return;
+    feature = compose(Frame{tilt_rotation, tilt_origin}, *incremental_frame);
   } else {
-    feature = plane_words(code);
+    std::optional<Frame> written = plane_words(code);
+    if (!written) return;
+    feature = *written;
     feature.origin += work_offset + local_offset;  // on the active work coordinate system
   }
   tilt_rotation = feature.rotation;

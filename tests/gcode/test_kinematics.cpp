@@ -285,3 +285,46 @@ TEST_CASE("machine file: a profile name or an object, checked key by key") {
   CHECK(message_of([&] { kinematics_from_json(json(3), "machine.kinematics"); })
             .find("machine.kinematics") != std::string::npos);
 }
+
+TEST_CASE("travel: the machine file's linear travel and the rotary limits, axis by axis") {
+  json j = json::parse(R"({"type": "table-table", "axes": [
+      {"letter": "A", "on": "table", "direction": [1, 0, 0], "pivot": [0, 0, -75],
+       "limits": [-120, 120]},
+      {"letter": "C", "on": "table", "direction": [0, 0, 1], "pivot": [0, 0, 0]}],
+      "travel": {"X": [-300, 300], "Z": [-400, 0]}})");
+  Kinematics kin = kinematics_from_json(j);
+  REQUIRE(kin.travel[0].has_value());
+  CHECK(!kin.travel[1].has_value());  // Y not given: not limited
+  // Brute force over a grid of positions: a violation exactly where a coordinate passes an end.
+  for (double x : {-301.0, -300.0, 0.0, 300.0, 300.5})
+    for (double z : {-400.5, -400.0, -1.0, 0.0, 2.0})
+      for (double a : {-121.0, 0.0, 120.0, 130.0}) {
+        std::vector<TravelViolation> v = travel_violations(kin, Vec3(x, 1e6, z), {a, 0, 7e5});
+        std::vector<TravelViolation> want;
+        if (x < -300) want.push_back({'X', x, -300});
+        if (x > 300) want.push_back({'X', x, 300});
+        if (z < -400) want.push_back({'Z', z, -400});
+        if (z > 0) want.push_back({'Z', z, 0});
+        if (a < -120) want.push_back({'A', a, -120});
+        if (a > 120) want.push_back({'A', a, 120});
+        REQUIRE(v.size() == want.size());
+        for (std::size_t k = 0; k < v.size(); ++k) {
+          CHECK(v[k].axis == want[k].axis);
+          CHECK(v[k].value == want[k].value);
+          CHECK(v[k].limit == want[k].limit);
+        }
+      }
+  // A bundled profile with the machine's own travel.
+  Kinematics bc = kinematics_from_json(json::parse(R"({"profile": "bc-trunnion", "travel": {"Y": [-5, 5]}})"));
+  CHECK(bc.axes[0].letter == 'B');
+  CHECK(travel_violations(bc, Vec3(0, 6, 0), {0, 0, 0}).size() == 1);
+  auto error = [](const char* text) { return message_of([&] { kinematics_from_json(json::parse(text)); }); };
+  std::string m = error(R"({"profile": "bc-trunnion", "travel": {"Z": [1, -1]}})");
+  CHECK_MESSAGE(m.find("kinematics.travel.Z") != std::string::npos, m);
+  m = error(R"({"profile": "bc-trunnion", "travel": {"W": [1, 2]}})");
+  CHECK_MESSAGE(m.find("kinematics.travel.W: unknown key") != std::string::npos, m);
+  m = error(R"({"profile": "bc-trunnion", "axes": []})");
+  CHECK_MESSAGE(m.find("kinematics.axes: unknown key") != std::string::npos, m);
+  m = error(R"({"profile": "bc", "travel": {}})");
+  CHECK_MESSAGE(m.find("kinematics.profile") != std::string::npos, m);
+}

@@ -137,6 +137,33 @@ TEST_CASE("rotary 3+2: raw rotary words keep the tip known; TCP indexing leaves 
   CHECK(r.moves[0].rotary[1] == doctest::Approx(30));
 }
 
+TEST_CASE("rotary 3+2: G92 and G52 in raw form shift machine coordinates, rotaries turned or not") {
+  // Raw X Y Z are the machine's linear axes: G92 makes the linear axes' position (not the tip's
+  // place on the turned part) read as its words, and G52 shifts them. The reference is the same
+  // program with the offsets worked out by hand.
+  for (const char* name : {"ac-trunnion", "bc-trunnion", "b-head-c-table", "head-head"}) {
+    INFO(name);
+    MachineConfig machine = with_kinematics(name, Vec3(3, -4, 5));
+    const Kinematics& kin = *machine.kinematics;
+    RotaryPositions turned{};
+    for (const RotaryAxis& a : kin.axes) turned[static_cast<std::size_t>(rotary_index(a.letter))] = 25;
+    std::string index = cat("G0", rotary_words(kin, turned), "\n");
+    Result by_hand = run_program(cat("G0 X10 Y2 Z20\n", index, "G1 X15 Y1 Z18 F100\nM30\n"), {}, machine);
+    Result g92 = run_program(cat("G0 X10 Y2 Z20\n", index, "G92 X0 Y0 Z0\nG1 X5 Y-1 Z-2 F100\nM30\n"), {},
+                             machine);
+    Result g52 = run_program(cat("G52 X7 Y-3 Z1\nG0 X3 Y5 Z19\n", index, "G1 X8 Y4 Z17 F100\nM30\n"), {},
+                             machine);
+    REQUIRE(by_hand.moves.size() == 2);
+    REQUIRE(g92.moves.size() == 2);
+    REQUIRE(g52.moves.size() == 2);
+    CHECK(near(g92.moves[1].end, by_hand.moves[1].end, 1e-9));
+    CHECK(near(g92.moves[1].machine, by_hand.moves[1].machine, 1e-9));
+    CHECK(near(g52.moves[1].end, by_hand.moves[1].end, 1e-9));
+    const Vec3 g54(3, -4, 5);  // moves are reported from the G54 zero
+    CHECK(near(by_hand.moves[1].end, tip_in_part(kin, Vec3(15, 1, 18) + g54, turned) - g54, 1e-9));
+  }
+}
+
 TEST_CASE("rotary 3+2: bad input is an error at its line and column") {
   MachineConfig ac = with_kinematics("ac-trunnion");
   Diagnostic d = error_of("G0 X0\nG0 X1 B10\n", {}, ac);

@@ -125,7 +125,7 @@ TEST_CASE("G68.2 without G53.1: ambiguous direction is an error, unless the tool
   two.work_offsets[2] = Vec3(1, 2, 3);
   d = error_of(g682(Vec3(0.0), 0, 30, 0) + "G55\n", InterpreterOptions{}, two);
   CHECK(d.message.find("tilted") != std::string::npos);
-  CHECK(error_of("G68.2 P2 X0 Y0 Z0 I0 J0 K0\n").column == 7);  // several-block form, not read
+  CHECK(error_of("G68.2 P2 X0 Y0 Z0 I0 J0 K0\n").column == 1);  // several-block form needs Q
 }
 
 TEST_CASE("Haas G268 Q123 / G253 / G269: R = Rz(K)·Ry(J)·Rx(I)") {

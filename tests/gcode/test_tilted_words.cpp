@@ -5,6 +5,8 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <random>
 #include <string>
 
 #include "helpers.hpp"
@@ -38,6 +40,15 @@ bool same_moves(const Result& a, const Result& b, double eps = 1e-9) {
       return false;
   return true;
 }
+
+// Ten decimals: the written words must not cost the 1e-6 mm the forms are compared within.
+std::string num(double v) {
+  char text[48];
+  std::snprintf(text, sizeof text, "%.10f", v);
+  return text;
+}
+std::string xyz(const Vec3& p) { return cat("X", num(p.x), " Y", num(p.y), " Z", num(p.z)); }
+std::string ijk(const Vec3& v) { return cat("I", num(v.x), " J", num(v.y), " K", num(v.z)); }
 
 }  // namespace
 
@@ -120,10 +131,93 @@ TEST_CASE("tilted-plane words: bad combinations are errors with their column") {
   CHECK(d.column == 14);
   d = error_of("G68.2 X0 I1 J0 K0 U1 V0 W0\n");  // Hurco vectors not normal
   CHECK_MESSAGE(d.message.find("not normal") != std::string::npos, d.message);
-  d = error_of("G68.2 P2 Q1 X0 Y0 Z0\n");
-  CHECK_MESSAGE(d.message.find("P2") != std::string::npos, d.message);
   d = error_of("G68.2 P0 Q123 I10\n");  // LinuxCNC P0 takes proper Euler orders only
   CHECK_MESSAGE(d.message.find("Q123") != std::string::npos, d.message);
   d = error_of("G68.2 I10 R5\n");  // Fanuc P0 has no R
+  CHECK_MESSAGE(d.message.find("R5") != std::string::npos, d.message);
+}
+
+TEST_CASE("G68.2 P2 and P3 over several blocks agree with the P0 plane they describe") {
+  // Random planes written as Fanuc's P0 and as the several-block forms built from that plane's
+  // axes (tilted_plane.hpp's fanuc_euler is checked against the manual in test_tilted_forms.cpp).
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> angle(-180, 180), tilt(5, 85), coord(-30, 30),
+      scale(0.5, 40);
+  for (int n = 0; n < 40; ++n) {
+    double i = angle(rng), j = tilt(rng), k = angle(rng), r = angle(rng);
+    Vec3 o(coord(rng), coord(rng), coord(rng)), shift(coord(rng), coord(rng), coord(rng));
+    Frame f = fanuc_euler(o, i, j, k);
+    Vec3 x = f.rotation[0], y = f.rotation[1], z = f.rotation[2];
+    Vec3 p2 = o + scale(rng) * x, p3 = o + coord(rng) * x + scale(rng) * y;
+    std::string points = cat("G68.2 P2 Q1 ", xyz(o), "\nG68.2 P2 Q2 ", xyz(p2), "\nG68.2 P2 Q3 ",
+                             xyz(p3));
+    Result p0 = square_in(cat("G68.2 ", xyz(o), " I", num(i), " J", num(j), " K", num(k)));
+    CHECK(same_moves(square_in(points), p0, 1e-6));
+    // Fanuc P2 Q0: the shift from point 1 in the feature frame, then R about the feature Z —
+    // the P0 plane at o + R·shift with K + R.
+    Result shifted = square_in(cat("G68.2 ", xyz(f.to_world(shift)), " I", num(i), " J", num(j),
+                                   " K", num(k + r)));
+    CHECK(same_moves(square_in(cat("G68.2 P2 Q0 ", xyz(shift), " R", num(r), "\n", points)),
+                     shifted, 1e-6));
+    CHECK(same_moves(square_in(cat("G68.2 P2 Q2 ", xyz(p2), "\nG68.2 P2 Q0 ", xyz(shift), " R",
+                                   num(r), "\nG68.2 P2 Q1 ", xyz(o), "\nG68.2 P2 Q3 ", xyz(p3))),
+                     shifted, 1e-6));
+    // Fanuc P3: Q1 the origin and the X direction, Q2 the Z direction.
+    CHECK(same_moves(square_in(cat("G68.2 P3 Q1 ", xyz(o), " ", ijk(scale(rng) * x),
+                                   "\nG68.2 P3 Q2 ", ijk(scale(rng) * z))),
+                     p0, 1e-6));
+    // LinuxCNC's dialect: P2 Q0 the origin itself, P3 Q0 I J K a point on X; R about the work Z,
+    // as its P0 Q313 R.
+    MachineConfig linuxcnc = at_origin();
+    linuxcnc.dialect = Dialect::linuxcnc;
+    Vec3 at(coord(rng), coord(rng), coord(rng));
+    Result lc0 = square_in(cat("G68.2 P0 Q313 ", xyz(at), " I", num(i), " J", num(j), " K",
+                               num(k), " R", num(r)),
+                           "G53.1", linuxcnc);
+    CHECK(same_moves(square_in(cat("G68.2 P2 Q0 ", xyz(at), " R", num(r), "\n", points), "G53.1",
+                               linuxcnc),
+                     lc0, 1e-6));
+    CHECK(same_moves(square_in(cat("G68.2 P3 Q1 ", ijk(z), "\nG68.2 P3 Q0 ", xyz(at), " ",
+                                   ijk(at + scale(rng) * x), " R", num(r)),
+                               "G53.1", linuxcnc),
+                     lc0, 1e-6));
+  }
+  // G68.4 takes them too, composed with the active plane.
+  CHECK(same_moves(square_in("G68.2 X10 I0 J30 K0\nG68.4 P3 Q1 Z2 I1\nG68.4 P3 Q2 K1\nG68.4 J15"),
+                   square_in(cat("G68.2 X10 Y", fmt(-2 * std::sin(glm::radians(30.0))), " Z",
+                                 fmt(2 * std::cos(glm::radians(30.0))), " J45")),
+                   1e-4));
+}
+
+TEST_CASE("G68.2 P2 / P3: incomplete, repeated or misplaced blocks are errors") {
+  Diagnostic d = error_of("G68.2 P2 Q1 X0 Y0 Z0\nG68.2 P2 Q2 X1\nG0 X1\n");
+  CHECK(d.line == 3);
+  CHECK(d.column == 1);
+  CHECK_MESSAGE(d.message.find("begun at line 1 is incomplete (Q3 missing)") != std::string::npos,
+                d.message);
+  d = error_of("G68.2 P3 Q1 X0 Y0 Z0 I1\n");  // the program ends inside the plane
+  CHECK(d.line == 1);
+  CHECK_MESSAGE(d.message.find("Q2 missing") != std::string::npos, d.message);
+  d = error_of("G68.2 P2 Q1 X0\nG68.2 P2 Q1 X1\n");
+  CHECK(d.line == 2);
+  CHECK(d.column == 10);
+  CHECK_MESSAGE(d.message.find("given twice") != std::string::npos, d.message);
+  d = error_of("G68.2 P2 Q1 X0\nG68.2 P3 Q1 I1\n");
+  CHECK(d.line == 2);
+  CHECK_MESSAGE(d.message.find("P2 begun at line 1") != std::string::npos, d.message);
+  d = error_of("G68.2 P3 Q0 I1\n");  // Fanuc's P3 blocks are Q1 and Q2 (LinuxCNC's Q0 and Q1)
+  CHECK_MESSAGE(d.message.find("Q1, Q2") != std::string::npos, d.message);
+  d = error_of("G68.2 P3 Q1 X0 I1\nG68.2 P3 Q2 X5 K1\n");  // a direction has no point
+  CHECK(d.line == 2);
+  CHECK(d.column == 13);
+  d = error_of("G68.2 P2 X0 Y0 Z0\n");
+  CHECK_MESSAGE(d.message.find("needs Q") != std::string::npos, d.message);
+  d = error_of("G68.2 P2 Q1 X0\nG68.2 P2 Q2 X1\nG68.2 P2 Q3 X5\n");  // three points on one line
+  CHECK(d.line == 3);
+  CHECK(d.column == 10);
+  CHECK_MESSAGE(d.message.find("one line") != std::string::npos, d.message);
+  d = error_of("G68.2 P3 Q1 I1\nG68.2 P3 Q2 I1 K0.5\n");  // 63° apart, outside 85°–95°
+  CHECK_MESSAGE(d.message.find("85 to 95") != std::string::npos, d.message);
+  d = error_of("G68.2 P2 Q1 X0 R5\n");  // R belongs to Q0
   CHECK_MESSAGE(d.message.find("R5") != std::string::npos, d.message);
 }

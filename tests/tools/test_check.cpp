@@ -97,6 +97,12 @@ struct Fixture {
   json report() const { return json::parse(slurp(dir / "report.json")); }
 };
 
+std::string cat_warnings(const json& report) {
+  std::string all;
+  for (const json& w : report["warnings"]) all += w.get<std::string>() + "\n";
+  return all;
+}
+
 struct Ply {
   std::vector<Vec3> positions;
   std::vector<std::array<int, 3>> colours;
@@ -361,6 +367,66 @@ TEST_CASE("check: rapids through material are reported with their line, in progr
   CHECK(report["rapid_cuts"][0]["line"] == 8);
   REQUIRE(!report["gouges"].empty());
   CHECK(report["gouges"][0]["lines"] == json::array({8}));
+}
+
+TEST_CASE("check and simulate: positions outside the machine's travel") {
+  Fixture f("check-travel");
+  // The bundled B/C trunnion with a Z travel that the program's retracts leave, in machine
+  // coordinates (the tilt puts the part's points elsewhere on the machine than in the work frame).
+  write_text(f.dir / "m.json",
+             R"({"kinematics": {"profile": "bc-trunnion", "travel": {"X": [-200, 200], "Z": [-50, 5]}}})");
+  std::string machine = (f.dir / "m.json").string();
+  CommandResult r = f.check(program(-2), {"--machine", machine});
+  INFO(r.err);
+  CHECK(r.status == 3);
+  json report = f.report();
+  // The reference: every move of `tridex moves` whose machine position ends past a travel end,
+  // leaving out the positions "far along the tool axis" that stand in for home returns.
+  fs::path moves = f.dir / "moves.jsonl";
+  REQUIRE(run_tridex({"moves", (f.dir / "p.nc").string(), "--machine", machine, "-o", moves.string()}, f.dir)
+              .status == 0);
+  std::vector<std::pair<int, double>> expected;  // (line, machine z)
+  std::istringstream in(slurp(moves));
+  for (std::string line; std::getline(in, line);) {
+    json m = json::parse(line);
+    Vec3 end(m["end"][0].get<double>(), m["end"][1].get<double>(), m["end"][2].get<double>());
+    double x = m["machine"][0].get<double>(), z = m["machine"][2].get<double>();
+    CHECK(std::abs(x) < 200);
+    if (glm::length(end) < 5000 && (z > 5 || z < -50)) expected.emplace_back(m["line"].get<int>(), z);
+  }
+  REQUIRE(!expected.empty());
+  REQUIRE(report["travel"]["outside"].get<std::size_t>() == expected.size());
+  const json& violations = report["travel"]["violations"];
+  REQUIRE(violations.size() == expected.size());
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    CHECK(violations[k]["line"].get<int>() == expected[k].first);
+    CHECK(violations[k]["axis"] == "Z");
+    CHECK(violations[k]["value"].get<double>() == doctest::Approx(expected[k].second));
+    CHECK(violations[k]["limit"].get<double>() == 5.0);
+    CHECK(violations[k]["file"] == (f.dir / "p.nc").string());
+  }
+  CHECK(r.out.find("past the travel's end 5") != std::string::npos);
+  // Within the travel: no finding, and the report still says how many were outside (none).
+  write_text(f.dir / "wide.json", R"({"kinematics": {"profile": "bc-trunnion", "travel": {"Z": [-50, 500]}}})");
+  CHECK(f.check(program(-2), {"--machine", (f.dir / "wide.json").string()}).status == 0);
+  CHECK(f.report()["travel"]["outside"] == 0);
+  // simulate: one warning that counts them and names the first.
+  fs::path sim_report = f.dir / "sim.json";
+  CommandResult s = run_tridex({"simulate", (f.dir / "p.nc").string(), "--tools", f.tools.string(), "--stock",
+                                kStock, "--dexel-cell", "0.2", "--machine", machine, "--report",
+                                sim_report.string(), "-q"},
+                               f.dir);
+  REQUIRE(s.status == 0);
+  std::string warning = cat_warnings(json::parse(slurp(sim_report)));
+  CHECK_MESSAGE(warning.find(std::to_string(expected.size()) + " position(s) outside the machine's travel (first " +
+                             (f.dir / "p.nc").string() + ":" + std::to_string(expected[0].first) + ": Z ") !=
+                    std::string::npos,
+                warning);
+  // A bad travel is an input error naming the key.
+  write_text(f.dir / "bad.json", R"({"kinematics": {"profile": "bc-trunnion", "travel": {"Z": [5, -5]}}})");
+  CommandResult bad = f.check(program(-2), {"--machine", (f.dir / "bad.json").string()});
+  CHECK(bad.status == 2);
+  CHECK(bad.err.find("kinematics.travel.Z") != std::string::npos);
 }
 
 TEST_CASE("check: moves outside the envelope, bad designs and bad options") {

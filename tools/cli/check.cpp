@@ -316,6 +316,12 @@ int run_check(const CheckOptions& options) {
       envelope_list.push_back({{"line", outside[k].first}, {"tip", to_json(outside[k].second)}});
   }
 
+  // Machine travel (the kinematics' "travel" and rotary limits): a finding per axis and move.
+  Json travel_list = Json::array();
+  for (const TravelFinding& f : r.travel)
+    travel_list.push_back({{"file", f.file}, {"line", f.line}, {"axis", std::string(1, f.axis)},
+                           {"value", f.value}, {"limit", f.limit}});
+
   // ---- outputs ------------------------------------------------------------------------------
   if (!options.output.empty()) {
     progress.stage("writing " + options.output);
@@ -346,7 +352,7 @@ int run_check(const CheckOptions& options) {
                          " boundary, " + std::to_string(r.mesh_check.non_manifold_edges) + " non-manifold edges)");
 
   const bool failed = !gouges.empty() || !excesses.empty() || design_side_finding || !rapid_list.empty() ||
-                      envelope_outside > 0;
+                      envelope_outside > 0 || r.travel_count > 0;
   const double total_s = seconds_since(start);
   Json report;
   report["program"] = r.input.program.string();
@@ -365,6 +371,7 @@ int run_check(const CheckOptions& options) {
   if (envelope)
     report["envelope"] = {{"box", {{"min", to_json(envelope->min)}, {"max", to_json(envelope->max)}}},
                           {"outside", envelope_outside}, {"violations", envelope_list}};
+  if (r.input.machine.kinematics) report["travel"] = {{"outside", r.travel_count}, {"violations", travel_list}};
   report["result"] = {{"volume_mm3", r.volume}, {"triangles", mesh.triangles.size()},
                       {"watertight", r.mesh_check.closed()}};
   report["timings_s"] = {{"parse", r.timings.parse}, {"zmap", r.timings.zmap}, {"dexelize", r.timings.dexelize},
@@ -392,11 +399,11 @@ int run_check(const CheckOptions& options) {
       std::snprintf(range, sizeof range, "%.4g .. %.4g mm", d["min_mm"].get<double>(), d["max_mm"].get<double>());
     std::printf("%s vs %s: deviation %s; %zu gouge and %zu excess region(s) beyond -%g/+%g mm, design "
                 "samples %lld missing and %lld left, %zu rapid(s) cutting material, %zu move(s) outside the "
-                "envelope: %s; %.2f s\n",
+                "envelope, %lld outside the machine's travel: %s; %.2f s\n",
                 r.input.program.filename().string().c_str(), fs::path(options.design).filename().string().c_str(),
                 range, gouges.size(), excesses.size(), gouge_tol, excess_tol,
                 design_side["missing"]["samples"].get<long long>(), design_side["left"]["samples"].get<long long>(),
-                rapid_list.size(), envelope_outside, failed ? "FAIL" : "pass", total_s);
+                rapid_list.size(), envelope_outside, r.travel_count, failed ? "FAIL" : "pass", total_s);
     std::size_t printed = 0;
     for (const Json& g : gouge_list)
       if (g.contains("lines") && printed++ < kFindingsPrinted) {
@@ -415,7 +422,10 @@ int run_check(const CheckOptions& options) {
     for (std::size_t k = 0; k < envelope_list.size() && k < kFindingsPrinted; ++k)
       std::printf("  line %d: tool tip %s outside the envelope\n", envelope_list[k]["line"].get<int>(),
                   envelope_list[k]["tip"].dump().c_str());
-    if (rapid_list.size() > kFindingsPrinted || envelope_outside > kFindingsPrinted)
+    for (std::size_t k = 0; k < r.travel.size() && k < kFindingsPrinted; ++k)
+      std::printf("  %s:%d: %s\n", r.travel[k].file.c_str(), r.travel[k].line, travel_text(r.travel[k]).c_str());
+    if (rapid_list.size() > kFindingsPrinted || envelope_outside > kFindingsPrinted ||
+        r.travel_count > static_cast<long long>(kFindingsPrinted))
       std::printf("  (more in the report)\n");
   }
   return failed ? kFindings : kSuccess;

@@ -81,8 +81,9 @@ std::set<int> listed_lines(const Json& report, int context) {
           for (const Json& line : f["lines"]) add(line);
         if (f.contains("line")) add(f["line"]);
       }
-  if (report.contains("envelope"))
-    for (const Json& v : report["envelope"]["violations"]) add(v["line"]);
+  for (const char* kind : {"envelope", "travel"})
+    if (report.contains(kind))
+      for (const Json& v : report[kind]["violations"]) add(v["line"]);
   return wanted;
 }
 

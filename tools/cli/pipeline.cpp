@@ -144,6 +144,14 @@ void check_dump_names(const std::string& directory, const std::vector<gcode::Mov
 
 }  // namespace
 
+std::string travel_text(const TravelFinding& f) {
+  bool linear = f.axis == 'X' || f.axis == 'Y' || f.axis == 'Z';
+  char text[160];
+  std::snprintf(text, sizeof text, linear ? "%c %.6g mm, past the travel's end %.6g" : "%c %.6g°, past its limit %.6g",
+                f.axis, f.value, f.limit);
+  return text;
+}
+
 std::string axis_label(const Vec3& axis) {
   static const char* names[] = {"x", "y", "z"};
   for (int a = 0; a < 3; ++a) {
@@ -199,9 +207,16 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   // size), then as one direction's cutter sweeps while it is milled.
   MoveBudget budget(max_memory, 2.0 * sizeof(gcode::Move) + sizeof(CutMove) + sizeof(void*));
   Aabb cutting_bounds;
+  const std::optional<gcode::Kinematics>& kinematics = input.machine.kinematics;
+  // Positions "far along the tool axis" stand in for where the machine takes the tool: no travel.
+  const double far = 0.5 * input.machine.far_distance;
   InterpretResult parsed = interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t file) {
     budget.keep(m, input.files[file].string());
     grouper.add(m);
+    if (kinematics && glm::length(m.end) < far)
+      for (const gcode::TravelViolation& v : gcode::travel_violations(*kinematics, m.machine, m.rotary))
+        if (r.travel_count++ < static_cast<long long>(kTravelListed))
+          r.travel.push_back({input.files[file].string(), m.line, v.axis, v.value, v.limit});
     if (m.kind != gcode::MoveKind::rapid) {
       // An approach from "far along the tool axis" is not where the work is.
       if (!m.from_far) cutting_bounds.extend(m.start);

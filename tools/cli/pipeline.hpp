@@ -68,6 +68,17 @@ struct RapidFinding {
   std::size_t group = 0;
 };
 
+// A move that ends outside the machine's travel (the kinematics' "travel" in machine
+// coordinates, or a rotary axis's limits): `check` lists these as findings, `simulate` warns.
+struct TravelFinding {
+  std::string file;
+  int line = 0;
+  char axis = 'X';
+  double value = 0;  // mm (X Y Z, machine coordinates) or degrees (A B C)
+  double limit = 0;  // the end of the travel it passed
+};
+constexpr std::size_t kTravelListed = 1000;  // findings kept in the result; all are counted
+
 struct PipelineTimings {
   double parse = 0, zmap = 0, dexelize = 0, intersect = 0, mesh = 0;
 };
@@ -89,6 +100,8 @@ struct SimulationResult {
   double volume = 0;
   long long segments = 0;
   std::vector<RapidFinding> rapid_cuts;
+  std::vector<TravelFinding> travel;  // the first kTravelListed, in program order
+  long long travel_count = 0;
   std::vector<std::string> warnings;
   PipelineTimings timings;
 };
@@ -103,6 +116,8 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
                                   const PipelineRequest& request = {});
 
 std::string axis_label(const Vec3& axis);
+// "X 612.5 mm, past the travel's end 600" / "A -130°, past its limit -120".
+std::string travel_text(const TravelFinding& finding);
 void write_stl_file(const std::filesystem::path& path, const Mesh& mesh);
 
 }  // namespace tridex::cli

@@ -51,6 +51,12 @@ int run_simulate(const SimulateOptions& options) {
                        " rapid move(s) cut material that no feed move removes (lines " + lines +
                        (rapid_findings.size() > 10 ? ", …" : "") + "; see \"rapid_cuts\" in the report)");
   }
+  if (r.travel_count > 0) {
+    const TravelFinding& f = r.travel.front();
+    warnings.push_back(std::to_string(r.travel_count) + " position(s) outside the machine's travel (first " +
+                       f.file + ":" + std::to_string(f.line) + ": " + travel_text(f) +
+                       "; `tridex check` lists each)");
+  }
 
   // ---- outputs ------------------------------------------------------------------------------
   if (!options.output.empty()) {

@@ -31,7 +31,9 @@
 //        "sense": 1,                      // optional, 1 or -1: which way a positive angle turns
 //        "pivot": [0, 0, -75],            // a point on the line, mm, every rotary at 0
 //        "limits": [-110, 110]},          // optional, degrees; absent: turns without end
-//       {"letter": "C", "on": "table", "direction": [0, 0, 1], "pivot": [0, 0, 0]}]}
+//       {"letter": "C", "on": "table", "direction": [0, 0, 1], "pivot": [0, 0, 0]}],
+//     "travel": {"X": [-300, 300], "Y": [-250, 250], "Z": [-400, 0]}}  // optional, see below
+// or a bundled profile with the machine's travel: {"profile": "bc-trunnion", "travel": {...}}.
 // One or two axes; "table-table" has them all on the table, "head-head" all on the head,
 // "head-table" one of each. Errors name the key path and the value
 // (`kinematics.axes[1].direction: ...`).
@@ -67,6 +69,9 @@ int rotary_index(char letter);
 struct Kinematics {
   MachineType type = MachineType::table_table;
   std::vector<RotaryAxis> axes;  // chain order (see above)
+  // The travel of the linear axes X, Y, Z: [min, max] in machine coordinates (mm, the tool tip
+  // with every rotary at 0, as `Move::machine`); none: that axis is not limited.
+  std::array<std::optional<std::array<double, 2>>, 3> travel;
 
   // The axis with this letter, or nullptr when the machine has none.
   const RotaryAxis* find(char letter) const;
@@ -113,6 +118,20 @@ RotaryPositions orient_tool(const Kinematics& kin, const Vec3& part_direction,
 
 // Throws tridex::Error naming the axis, its position and its limits when a position is outside.
 void check_limits(const Kinematics& kin, const RotaryPositions& rotary);
+
+// One axis past its travel (X, Y, Z: machine coordinates, mm) or its limits (A, B, C: degrees).
+struct TravelViolation {
+  char axis = 'X';
+  double value = 0;
+  double limit = 0;  // the end of the travel it passed
+};
+
+// The axes of a machine position (linear machine coordinates and rotary positions) that lie
+// outside the kinematics' travel and rotary limits, in the order X Y Z A B C. (The interpreter
+// refuses a rotary word past its limits already; the rotary check is for positions from
+// elsewhere.)
+std::vector<TravelViolation> travel_violations(const Kinematics& kin, const Vec3& machine_xyz,
+                                               const RotaryPositions& rotary);
 
 // ---- profiles and the machine file ------------------------------------------------------------
 
