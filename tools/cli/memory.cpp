@@ -51,11 +51,12 @@ MemoryEstimate estimate_memory(double held_bytes, const MemoryShape& shape) {
   MemoryEstimate e;
   e.held = held_bytes;
   // Float heights and tile maxima (4.1 bytes a point, measured 6.1 with the milling's buffers);
-  // raise_uncut builds one stock map beside them; a kept copy, or a dumped polyhedron (a vertex
-  // and two triangles a point), add to the largest or to all.
+  // raise_uncut builds one stock map beside them; a kept copy adds to all. A dumped map's
+  // polyhedron (a vertex and two triangles a point) and its STL bytes (two 50-byte records a
+  // point, and more at the walls) add to the largest: measured 340 bytes a point on the example.
   e.zmaps = 8.0 * shape.zmap_points + 4.0 * shape.largest_map;
   if (shape.keep_maps) e.zmaps += 4.0 * shape.zmap_points;
-  if (shape.dump_maps) e.zmaps += 40.0 * shape.largest_map;
+  if (shape.dump_maps) e.zmaps += 400.0 * shape.largest_map;
   // A ray costs a 4-byte offset and, typically, one or two 8-byte intervals, in the stock and
   // in the result (measured 66-91 bytes a ray with the grid trees and the threads' buffers).
   e.dexels = 120.0 * shape.rays + 1.0 * shape.zmap_points;
