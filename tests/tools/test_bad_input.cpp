@@ -10,6 +10,7 @@
 
 #include <csignal>
 #include <cstdio>
+#include <cmath>
 #include <functional>
 #include <set>
 #include <thread>
@@ -228,10 +229,39 @@ const std::vector<BadInput>& cases() {
          return check_with(d, {"--design", at(d, "far.stl")});
        },
        {"--design", "far.stl", "represents exactly"}},
+      {"box stock cut 1 km from the origin",
+       [](const fs::path& d) {
+         auto a = simulate_with(d, {"--stock", "box:999990,-10,-10,1000010,10,0"});
+         write_text(d / "p.nc", "G21 G90\nT1 M6\nG0 X1000000 Y0 Z5\nG1 Z-1 F100\nG1 X1000005\nM30\n");
+         return a;
+       },
+       {"the stock reaches", "represents exactly", "100000 spacings"}},
+      // ---- machine files ------------------------------------------------------------------------
+      {"machine file with a number out of range",
+       [](const fs::path& d) {
+         write_text(d / "m.json", "{\"home\":\n [0, 0, 1e999]}");
+         return simulate_with(d, {"--machine", at(d, "m.json")});
+       },
+       {"m.json:2:", "1e999", "out of range"}},
+      {"machine file with a key twice",
+       [](const fs::path& d) {
+         write_text(d / "m.json", R"({"units": "mm", "units": "inch"})");
+         return simulate_with(d, {"--machine", at(d, "m.json")});
+       },
+       {"m.json", "\"units\" appears twice"}},
+      {"machine file a directory",
+       [](const fs::path& d) {
+         fs::create_directories(d / "machine");
+         return simulate_with(d, {"--machine", at(d, "machine")});
+       },
+       {"--machine", "machine", "neither a bundled machine"}},
+      {"--max-memory below what tridex holds before reading",
+       [](const fs::path& d) { return simulate_with(d, {"--max-memory", "4M", "-o", at(d, "o.stl")}); },
+       {"p.nc:", "before keeping any move", "--max-memory 4 MiB"}},
       // ---- programs that expand without bound -------------------------------------------------
       {"macro bomb through simulate",
        [](const fs::path& d) {
-         auto a = simulate_with(d, {"--max-memory", "16M", "-o", at(d, "o.stl")});
+         auto a = simulate_with(d, {"--max-memory", "200M", "-o", at(d, "o.stl")});
          write_text(d / "p.nc", kMacroBomb);
          return a;
        },
@@ -245,12 +275,12 @@ const std::vector<BadInput>& cases() {
       {"macro bomb through groups",
        [](const fs::path& d) {
          write_text(d / "p.nc", kMacroBomb);
-         return std::vector<std::string>{"groups", at(d, "p.nc"), "--max-memory", "8M", "-o", at(d, "g.json")};
+         return std::vector<std::string>{"groups", at(d, "p.nc"), "--max-memory", "200M", "-o", at(d, "g.json")};
        },
        {"p.nc:", "more than", "moves", "--max-memory"}},
       {"an arc of radius 1000 at --arc-tolerance 1e-10",
        [](const fs::path& d) {
-         auto a = simulate_with(d, {"--arc-tolerance", "1e-10", "--max-memory", "16M", "-o", at(d, "o.stl")});
+         auto a = simulate_with(d, {"--arc-tolerance", "1e-10", "--max-memory", "200M", "-o", at(d, "o.stl")});
          write_text(d / "p.nc", "G21 G90\nT1 M6\nG0 X1000 Y0 Z0\nG2 X1000 Y0 I-1000 J0 F100\nM30\n");
          return a;
        },
@@ -309,22 +339,33 @@ TEST_CASE("bad input: exit status 2, the place and the value in the message, no 
   }
 }
 
-TEST_CASE("a box stock that no move reaches comes out whole, with a warning") {
-  fs::path dir = scratch("uncut");
-  std::vector<std::string> args =
-      simulate_with(dir, {"--stock", "box:500,500,-10,520,520,0", "-o", at(dir, "out.stl")});
-  CommandResult r = run_tridex(args, dir);
-  REQUIRE(r.status == 0);
-  CHECK(r.err.find("nothing was cut") != std::string::npos);
-  Mesh mesh = read_binary_stl(dir / "out.stl");
-  REQUIRE(!mesh.triangles.empty());
-  // Every vertex on the stock box's boundary, and its volume the box's (one dexel layer of
-  // rounding at most).
-  Aabb box = mesh.bounds();
-  CHECK(box.min.x == doctest::Approx(500).epsilon(1e-3));
-  CHECK(box.max.y == doctest::Approx(520).epsilon(1e-3));
-  CHECK(mesh.signed_volume() == doctest::Approx(20.0 * 20 * 10).epsilon(0.05));
-  fs::remove_all(dir);
+TEST_CASE("a box stock that no move reaches comes out whole, with a warning, even 1 km away") {
+  // Near the work, and 1 km away (beyond the 10^5 spacings that a cut stock must keep within at
+  // the default resolution: only its faces need representing).
+  for (double offset : {500.0, 1e6}) {
+    CAPTURE(offset);
+    fs::path dir = scratch("uncut");
+    const double size = offset < 1e3 ? 20 : 100;
+    std::ostringstream stock;
+    stock.precision(17);
+    stock << "box:" << offset << "," << offset << ",-10," << offset + size << "," << offset + size << ",0";
+    std::vector<std::string> args = simulate_with(dir, {"--stock", stock.str(), "-o", at(dir, "out.stl")});
+    if (offset > 1e3) args.erase(args.begin() + 4, args.begin() + 6);  // the default resolution
+    CommandResult r = run_tridex(args, dir);
+    CAPTURE(r.err);
+    REQUIRE(r.status == 0);
+    CHECK(r.err.find("nothing was cut") != std::string::npos);
+    Mesh mesh = read_binary_stl(dir / "out.stl");
+    REQUIRE(!mesh.triangles.empty());
+    // Every vertex on the stock box's boundary, and its volume the box's (one dexel layer of
+    // rounding at most).
+    Aabb box = mesh.bounds();
+    CHECK(std::abs(box.min.x - offset) <= size / 24);  // within a dexel spacing (at most size/24)
+    CHECK(std::abs(box.max.y - (offset + size)) <= size / 24);
+    CHECK(std::abs(box.min.z + 10) <= size / 24);
+    CHECK(mesh.signed_volume() == doctest::Approx(size * size * 10).epsilon(0.05));
+    fs::remove_all(dir);
+  }
 }
 
 TEST_CASE("an existing special file is written in place, never renamed over") {

@@ -182,8 +182,9 @@ TEST_CASE("machine files: bad files name the file, the key and the value") {
       {"{\"kinematics\": {\"type\": \"table-table\", \"axes\": [{\"letter\": \"D\", \"on\": "
        "\"table\", \"direction\": [1, 0, 0], \"pivot\": [0, 0, 0]}]}}",
        "kinematics.axes[0].letter"},
-      {"{\"start\": [0, 0, 1e999]}", "JSON"},
+      {"{\"start\": [0, 0, 1e999]}", "1e999 is out of range"},
       {"{", "JSON"},
+      {"{\"units\": \"mm\", \"units\": \"inch\"}", "key \"units\" appears twice"},
   };
   for (const Case& c : cases) {
     fs::path file = dir / "m.json";

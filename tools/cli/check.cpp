@@ -223,6 +223,20 @@ int run_check(const CheckOptions& options) {
   request.extra_inputs = {options.design};
   request.extra_bounds = {{"--design " + options.design, design.bounds()}};
   request.rapid_check = RapidCheck::in_program_order;
+  // After the surface: the design's and the result's distance trees (about 130 bytes a triangle,
+  // measured), the deviations and colours of the result's vertices (about half as many as its
+  // triangles), and the design samples with their deviations (a point and a double each).
+  request.memory_after = [&design](double spacing, double triangles) {
+    double samples = static_cast<double>(design.positions.size());
+    for (const glm::uvec3& t : design.triangles) {
+      Vec3 a(design.positions[t.x]), b(design.positions[t.y]), c(design.positions[t.z]);
+      double longest = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
+      samples += std::pow(std::max(1.0, std::ceil(longest / (2 * spacing))), 2);
+    }
+    samples = std::min(samples, static_cast<double>(kMaxDesignSamples));
+    return 130.0 * static_cast<double>(design.triangles.size()) + (130.0 + 12.0) * triangles +
+           (sizeof(Vec3) + sizeof(double)) * samples;
+  };
   SimulationResult r = simulate_program(options, progress, request);
   const Mesh& mesh = r.mesh;
   const double spacing = r.lattice.spacing;
@@ -377,6 +391,8 @@ int run_check(const CheckOptions& options) {
   report["timings_s"] = {{"parse", r.timings.parse}, {"zmap", r.timings.zmap}, {"dexelize", r.timings.dexelize},
                          {"intersect", r.timings.intersect}, {"mesh", r.timings.mesh},
                          {"deviation", deviation_s}, {"total", total_s}};
+  report["memory_estimate_mib"] = r.memory.total() / (1 << 20);
+  report["peak_rss_mib"] = peak_rss_mib();
   report["warnings"] = r.warnings;
   if (!options.report.empty()) {
     progress.stage("writing " + options.report);

@@ -2,12 +2,12 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "errors.hpp"
+#include "json_input.hpp"
 
 namespace tridex::cli {
 
@@ -152,6 +152,14 @@ gcode::MachineConfig parse(const json& doc, const std::string& file) {
 
 }  // namespace
 
+gcode::MachineConfig machine_from_json(const json& doc, const std::string& file) {
+  try {
+    return parse(doc, file);
+  } catch (const json::exception& e) {
+    input_error(file, ": ", e.what());
+  }
+}
+
 gcode::MachineConfig load_machine(const std::string& name_or_file,
                                   const std::vector<std::string>& subprogram_dirs) {
   gcode::MachineConfig machine;
@@ -164,19 +172,7 @@ gcode::MachineConfig load_machine(const std::string& name_or_file,
     if (!fs::is_regular_file(name_or_file, error))
       input_error("--machine ", name_or_file, ": neither a bundled machine (", kBundledMachines,
                   ") nor a machine file");
-    std::ifstream in(name_or_file, std::ios::binary);
-    if (!in) input_error(name_or_file, ": cannot open the machine file");
-    json doc;
-    try {
-      doc = json::parse(in);
-    } catch (const json::exception& e) {
-      input_error(name_or_file, ": not valid JSON (byte ", in.tellg(), "): ", e.what());
-    }
-    try {
-      machine = parse(doc, name_or_file);
-    } catch (const json::exception& e) {
-      input_error(name_or_file, ": ", e.what());
-    }
+    machine = machine_from_json(read_json_file(name_or_file), name_or_file);
   }
   for (const std::string& dir : subprogram_dirs) {
     std::error_code error;

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "tridex/gcode/interpreter.hpp"
 
 namespace tridex::cli {
@@ -13,6 +15,9 @@ inline constexpr const char* kBundledMachines = "default, linuxcnc";
 
 // An empty name is the default machine. `subprogram_dirs` (--subprograms) are searched before
 // the machine file's own. Throws InputError naming the file, the key and the value.
+// The machine from a parsed machine file; `file` names it in messages. Throws InputError.
+gcode::MachineConfig machine_from_json(const nlohmann::json& doc, const std::string& file);
+
 gcode::MachineConfig load_machine(const std::string& name_or_file,
                                   const std::vector<std::string>& subprogram_dirs = {});
 

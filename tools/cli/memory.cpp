@@ -24,6 +24,8 @@ double peak_rss_mib() {
   return static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux reports KiB
 }
 
+double peak_rss_bytes() { return peak_rss_mib() * (1 << 20); }
+
 std::uint64_t parse_memory(const std::string& text) {
   std::size_t end = text.size();
   while (end > 0 && std::isalpha(static_cast<unsigned char>(text[end - 1]))) --end;
@@ -45,16 +47,20 @@ std::uint64_t max_memory_bytes(const std::string& option) {
   return option.empty() ? physical_memory_bytes() / 10 * 8 : parse_memory(option);
 }
 
-MemoryEstimate estimate_memory(double zmap_points, double nx, double ny, double nz) {
+MemoryEstimate estimate_memory(double held_bytes, const MemoryShape& shape) {
   MemoryEstimate e;
-  e.zmaps = 4.0 * zmap_points * 1.02;  // float heights plus tile maxima
-  // A ray costs a 4-byte offset and, typically, one or two 8-byte intervals; four triple dexels
-  // are alive at the peak (stock, one direction's, the running result and its successor).
-  double rays = nx * ny + ny * nz + nz * nx;
-  e.dexels = 4.0 * rays * (4.0 + 2 * 8.0);
-  // The surface crosses about as many lattice cells as the box's faces hold; two triangles per
-  // cell, a vertex per triangle (12 + 12 bytes), and as much again while it is built.
-  e.mesh = 2.0 * (2.0 * rays) * 2 * 24.0;
+  e.held = held_bytes;
+  // Float heights and tile maxima (4.1 bytes a point, measured 6.1 with the milling's buffers);
+  // raise_uncut builds one stock map beside them; a kept copy adds to all. A dumped map's
+  // polyhedron (a vertex and two triangles a point) and its STL bytes (two 50-byte records a
+  // point, and more at the walls) add to the largest: measured 340 bytes a point on the example.
+  e.zmaps = 8.0 * shape.zmap_points + 4.0 * shape.largest_map;
+  if (shape.keep_maps) e.zmaps += 4.0 * shape.zmap_points;
+  if (shape.dump_maps) e.zmaps += 400.0 * shape.largest_map;
+  // A ray costs a 4-byte offset and, typically, one or two 8-byte intervals, in the stock and
+  // in the result (measured 66-91 bytes a ray with the grid trees and the threads' buffers).
+  e.dexels = 120.0 * shape.rays + 1.0 * shape.zmap_points;
+  e.mesh = kTrianglesPerRay * shape.rays * kSurfaceBytesPerTriangle;
   return e;
 }
 

@@ -104,16 +104,39 @@ std::string describe_box(const Aabb& box) {
 
 // The kernel's meshes hold float positions, and the surface's vertices stay exact while they lie
 // within about 1e5 lattice spacings of the world origin (surface.hpp); beyond that the dexel and
-// Z-map arithmetic fails in ways that say nothing to the user.
+// Z-map arithmetic fails in ways that say nothing to the user. A stock that no move reaches is
+// only its own faces: those need a float step (2^-23 of the reach) of at most half a spacing, so
+// that neighbouring lattice nodes stay apart in the STL's floats.
 constexpr double kMaxReachSpacings = 1e5;
+constexpr double kMaxUncutReachSpacings = 0x1p23;
 
-void check_reach(const std::string& what, const Aabb& box, double spacing) {
+void check_reach(const std::string& what, const Aabb& box, double spacing, double limit = kMaxReachSpacings) {
   double reach = 0;
   for (int a = 0; a < 3; ++a) reach = std::max({reach, std::abs(box.min[a]), std::abs(box.max[a])});
-  if (!(reach <= kMaxReachSpacings * spacing))
+  if (!(reach <= limit * spacing))
     input_error(what, " reaches ", reach, " mm from the origin, beyond the coordinates tridex represents exactly at a ",
-                "dexel spacing of ", spacing, " mm (", kMaxReachSpacings * spacing, " mm, ", kMaxReachSpacings,
+                "dexel spacing of ", spacing, " mm (", limit * spacing, " mm, ", limit,
                 " spacings); move it nearer the origin or use a larger --dexel-cell");
+}
+
+// True when no move can touch the stock. In each direction's frame a cutter removes everything
+// above its profile (the Z-map model), so a move reaches the stock only where its path, widened
+// by the largest cutter's radius, overlaps the stock across the spindle, and the stock rises above
+// its lowest tip. Then the result is the stock itself, and no cut arithmetic happens at its
+// coordinates.
+bool no_move_reaches(const std::vector<gcode::MoveGroup>& groups, std::span<const Cutter> cutters, const Aabb& stock) {
+  double radius = 0;
+  for (const Cutter& c : cutters) radius = std::max(radius, c.radius());
+  for (const gcode::MoveGroup& group : groups) {
+    Aabb path;
+    for (const gcode::Move& m : group.moves) path.extend(group.frame.to_local(m.start)), path.extend(group.frame.to_local(m.end));
+    if (path.empty()) continue;
+    const Aabb local = local_bounds(group.frame, stock);
+    const bool apart = path.min.x - radius > local.max.x || path.max.x + radius < local.min.x ||
+                       path.min.y - radius > local.max.y || path.max.y + radius < local.min.y;
+    if (!apart && local.max.z >= path.min.z) return false;
+  }
+  return true;
 }
 
 // The files --dump-zmaps writes for the groups: DIR/zmap-<k>-<axis>.stl and .png.
@@ -204,7 +227,8 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   Clock::time_point t = Clock::now();
   gcode::DirectionGrouper grouper;
   // simulate must hold every move: grouped by direction (a vector's capacity can be twice its
-  // size), then as one direction's cutter sweeps while it is milled.
+  // size), then as one direction's cutter sweeps while it is milled. What the process already
+  // holds (the libraries, a design read) leaves that much less for them.
   MoveBudget budget(max_memory, 2.0 * sizeof(gcode::Move) + sizeof(CutMove) + sizeof(void*));
   Aabb cutting_bounds;
   const std::optional<gcode::Kinematics>& kinematics = input.machine.kinematics;
@@ -283,8 +307,10 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
     input_error("dexel resolution: ", e.what());
   }
   const DexelLattice& lattice = r.lattice;
+  // Where no move cuts, the stock's faces are all there is to represent (a wider range).
   check_reach(stock_spec.kind == StockSpec::Kind::mesh ? "--stock " + stock_spec.mesh_path.string() : "the stock",
-              stock.box, lattice.spacing);
+              stock.box, lattice.spacing,
+              no_move_reaches(groups, cutters, stock.box) ? kMaxUncutReachSpacings : kMaxReachSpacings);
   for (const auto& [what, bounds] : request.extra_bounds) check_reach(what, bounds, lattice.spacing);
   // A Z-map's polyhedron ramps across the cell where a wall parallel to its spindle drops, and
   // is off by up to a cell at the wall's rims, where it meets the other directions' cuts
@@ -293,24 +319,29 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
                                ? options.zmap_cell
                                : std::min(diagonal * kDefaultZmapCellFraction, kDefaultZmapCellOfSpacing * lattice.spacing);
   r.zmap_cell = zmap_cell;
-  double zmap_points = 0;
+  MemoryShape shape{.keep_maps = request.keep_maps, .dump_maps = !options.dump_zmaps.empty()};
   for (const gcode::MoveGroup& group : groups) {
     try {
       r.grids.push_back(ZMapGrid::covering(group.frame, local_bounds(group.frame, stock.box), zmap_cell));
     } catch (const tridex::Error& e) {
       input_error("--zmap-cell ", zmap_cell, ": ", e.what());
     }
-    zmap_points += static_cast<double>(r.grids.back().nx) * r.grids.back().ny;
+    const double points = static_cast<double>(r.grids.back().nx) * r.grids.back().ny;
+    shape.zmap_points += points;
+    shape.largest_map = std::max(shape.largest_map, points);
   }
-  r.memory = estimate_memory(zmap_points, lattice.n.x, lattice.n.y, lattice.n.z);
-  r.memory.moves = budget.bytes();
+  const glm::dvec3 n(lattice.n);
+  shape.rays = n.x * n.y + n.y * n.z + n.z * n.x;
+  // The peak so far holds the libraries, every move kept and the meshes read: all alive to the end.
+  r.memory = estimate_memory(peak_rss_bytes(), shape);
+  if (request.memory_after) r.memory.after = request.memory_after(lattice.spacing, kTrianglesPerRay * shape.rays);
   const MemoryEstimate& need = r.memory;
   if (need.total() > static_cast<double>(max_memory))
-    input_error("the resolution needs an estimated ", format_mib(need.total()), " (", budget.kept(), " moves ",
-                format_mib(need.moves), ", Z-maps ",
-                format_mib(need.zmaps), ", dexels ", format_mib(need.dexels), ", mesh ",
-                format_mib(need.mesh), "), more than --max-memory ",
-                format_mib(static_cast<double>(max_memory)),
+    input_error("the resolution needs an estimated ", format_mib(need.total()), " (in use before milling ",
+                format_mib(need.held), " with ", budget.kept(), " moves kept, Z-maps ", format_mib(need.zmaps),
+                ", dexels ", format_mib(need.dexels), ", surface ", format_mib(need.mesh),
+                need.after > 0 ? ", the comparison with the design " + format_mib(need.after) : std::string(),
+                "), more than --max-memory ", format_mib(static_cast<double>(max_memory)),
                 "; use a larger --zmap-cell or --dexel-cell, or a smaller --dexel-res");
 
   // ---- Step 1: one milled Z-map per direction ---------------------------------------------

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -56,6 +57,10 @@ struct PipelineRequest {
   std::vector<std::pair<std::string, Aabb>> extra_bounds;
   RapidCheck rapid_check = RapidCheck::against_feeds;
   bool keep_maps = false;  // keep the milled Z-maps (otherwise released after Step 3)
+  // What the caller allocates after the surface, in bytes, given the lattice spacing and the
+  // estimated triangle count of the surface (check: the design's and the result's distance
+  // trees, the deviations, the design samples); counted in the up-front memory check.
+  std::function<double(double spacing, double triangles)> memory_after;
 };
 
 // A rapid that cuts: `depth_mm` below the material along the spindle at `where` (work frame).

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "memory.hpp"
 #include "stock.hpp"
 #include "tool_table.hpp"
 #include "tridex/gcode/interpreter.hpp"
@@ -47,7 +48,9 @@ gcode::InterpreterOptions interpreter_options(const CommonOptions& options);
 // exit status 2 and the count instead of running out of memory.
 class MoveBudget {
  public:
-  MoveBudget(std::uint64_t max_bytes, double bytes_per_move) : max_bytes_(max_bytes), per_move_(bytes_per_move) {}
+  // What the process holds when the budget is made (its libraries, a design read) counts too.
+  MoveBudget(std::uint64_t max_bytes, double bytes_per_move)
+      : max_bytes_(max_bytes), per_move_(bytes_per_move), held_(peak_rss_bytes()) {}
   // Throws InputError, naming the file and line of the move that crosses the limit.
   void keep(const gcode::Move& move, const std::string& file);
   long long kept() const { return kept_; }
@@ -56,6 +59,7 @@ class MoveBudget {
  private:
   std::uint64_t max_bytes_;
   double per_move_;
+  double held_;
   long long kept_ = 0;
 };
 
