@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "collision_check.hpp"
 #include "commands.hpp"
 #include "json_text.hpp"
 #include "memory.hpp"
@@ -55,6 +56,9 @@ struct PipelineRequest {
   // its name for the message.
   std::vector<std::pair<std::string, Aabb>> extra_bounds;
   RapidCheck rapid_check = RapidCheck::against_feeds;
+  // With in_program_order: the tools' shanks and holders against the stock (collision_check.hpp),
+  // near misses within this clearance (mm); none: not checked.
+  std::optional<double> body_clearance;
   bool keep_maps = false;  // keep the milled Z-maps (otherwise released after Step 3)
 };
 
@@ -76,6 +80,7 @@ struct SimulationResult {
   ProgramInput input;
   std::vector<gcode::MoveGroup> groups;  // moves in program order within each group
   std::vector<Cutter> cutters;
+  std::vector<ToolBody> bodies;                 // the non-cutting parts, parallel to cutters
   std::map<int, std::uint32_t> cutter_of_tool;  // tool number -> index into cutters
   Stock stock;
   double zmap_cell = 0;
@@ -89,6 +94,7 @@ struct SimulationResult {
   double volume = 0;
   long long segments = 0;
   std::vector<RapidFinding> rapid_cuts;
+  BodyFindings body;  // collisions and near misses of shanks and holders (body_clearance only)
   std::vector<std::string> warnings;
   PipelineTimings timings;
 };
