@@ -154,3 +154,106 @@ TEST_CASE("swept shank and holder depths and near misses match the sampled swept
   CHECK(clear > 3);
   CHECK(widening > 5);
 }
+
+// ---- planted faults, end to end ------------------------------------------------------------------
+
+namespace {
+
+// T2 (no parts described) clears the stock 0..60 × 0..40 × 0..30 to z = 20 except a boss
+// beyond the round end of its first pass (x ≥ 30 + √(12² − (y − 8)²), y < 18). T1's holder (Ø30, 25 mm out) passes by the boss on line 16 with its face at
+// z1 + 25; T3's Ø8 shank, 3 mm above the tip of its Ø4 flutes, crosses the pocket's floor on line
+// 21 at z3 + 3.
+std::string fault_program(double z1, double z3) {
+  std::ostringstream p;
+  p << "%\nG21 G17 G90\nT2 M6\nS8000 M3\nG0 X-15 Y8 Z40\nG1 Z20 F500\nG1 X30\nG0 Z40\nG0 X-15 Y30\nG1 Z20\n"
+    << "G1 X75\nG0 Z40\nT1 M6\nG0 X30 Y45 Z40\nG1 Z" << z1 << " F300\nG1 Y-20\nG0 Z40\nT3 M6\nG0 X-10 Y30 Z40\nG1 Z"
+    << z3 << "\nG1 X70\nG0 Z40\nM30\n%\n";
+  return p.str();
+}
+
+const char* kFaultTools = R"({
+  "1": {"shape": "cylindrical", "diameter": 6, "stick-out": 25,
+        "holder": [{"bottom-diameter": 30, "top-diameter": 30, "length": 20}]},
+  "2": {"shape": "cylindrical", "diameter": 24},
+  "3": {"shape": "cylindrical", "diameter": 4, "flute-length": 3, "shank-diameter": 8}})";
+
+struct FaultRun {
+  CommandResult result;
+  json report;
+};
+
+FaultRun run_faults(const fs::path& dir, double z1, double z3, std::vector<std::string> more = {}) {
+  write_text(dir / "tools.json", kFaultTools);
+  write_text(dir / "p.nc", fault_program(z1, z3));
+  // The design is the program's own result: only the tool's parts can fail the check.
+  CommandResult made = run_tridex({"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(),
+                                   "--stock", "box:0,0,0,60,40,30", "--dexel-cell", "0.5", "-o",
+                                   (dir / "design.stl").string(), "-q"},
+                                  dir);
+  REQUIRE(made.status == 0);
+  std::vector<std::string> args{"check", (dir / "p.nc").string(), "--design", (dir / "design.stl").string(),
+                                "--tools", (dir / "tools.json").string(), "--stock", "box:0,0,0,60,40,30",
+                                "--dexel-cell", "0.5", "--tolerance", "0.6", "--report",
+                                (dir / "report.json").string()};
+  args.insert(args.end(), more.begin(), more.end());
+  FaultRun run{run_tridex(args, dir), json()};
+  if (fs::exists(dir / "report.json")) run.report = json::parse(slurp(dir / "report.json"));
+  return run;
+}
+
+}  // namespace
+
+TEST_CASE("check: a holder passing a boss and a shank on a pocket's floor are found at their lines") {
+  fs::path dir = scratch("collisions");
+  FaultRun run = run_faults(dir, 4, 16.5);
+  INFO(run.result.out, run.result.err);
+  CHECK(run.result.status == 3);
+  const json& c = run.report["collisions"];
+  REQUIRE(c.size() == 2);
+  // The holder's face at z = 29, the boss's top at 30.
+  CHECK(c[0]["line"] == 16);
+  CHECK(c[0]["tool"] == 1);
+  CHECK(c[0]["part"] == "holder section 1");
+  CHECK(c[0]["depth_mm"].get<double>() == doctest::Approx(1.0).epsilon(0.001));
+  CHECK(c[0]["point"][2].get<double>() == doctest::Approx(30));
+  // On the boss: outside the round end of T2's first pass (centre (30, 8), radius 12).
+  CHECK(std::hypot(c[0]["point"][0].get<double>() - 30, c[0]["point"][1].get<double>() - 8) >= 12 - 0.1);
+  CHECK(c[0]["point"][1].get<double>() < 20);
+  CHECK(c[0]["axis"] == json::array({0.0, 0.0, 1.0}));
+  // The shank's bottom at z = 19.5, the floor at 20.
+  CHECK(c[1]["line"] == 21);
+  CHECK(c[1]["tool"] == 3);
+  CHECK(c[1]["part"] == "shank");
+  CHECK(c[1]["depth_mm"].get<double>() == doctest::Approx(0.5).epsilon(0.001));
+  CHECK(c[1]["point"][2].get<double>() == doctest::Approx(20));
+  // The holder must come out 1 mm further (and the tolerance).
+  REQUIRE(run.report["stick_out"].size() == 1);
+  CHECK(run.report["stick_out"][0]["tool"] == 1);
+  CHECK(run.report["stick_out"][0]["needed_mm"].get<double>() == doctest::Approx(26.0).epsilon(0.001));
+  CHECK(run.result.out.find("line 16: tool 1's holder section 1 is 1.000 mm into the stock") != std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("check: a program whose holder and shank clear by a known margin passes, the margins as near misses") {
+  fs::path dir = scratch("near-misses");
+  FaultRun run = run_faults(dir, 6, 17.5, {"--clearance", "2"});
+  INFO(run.result.out, run.result.err);
+  CHECK(run.result.status == 0);
+  CHECK(run.report["collisions"].empty());
+  CHECK(run.report["stick_out"].empty());
+  const json& near = run.report["near_misses"];
+  CHECK(near["clearance_mm"] == 2.0);
+  REQUIRE(near["moves"].size() == 2);
+  // Within one Z-map cell (here diagonal / 1000 ≈ 0.08 mm) of the margins planted.
+  CHECK(near["moves"][0]["line"] == 16);
+  CHECK(near["moves"][0]["part"] == "holder section 1");
+  CHECK(std::abs(near["moves"][0]["distance_mm"].get<double>() - 1.0) <= 0.08);
+  CHECK(near["moves"][1]["line"] == 21);
+  CHECK(near["moves"][1]["part"] == "shank");
+  CHECK(std::abs(near["moves"][1]["distance_mm"].get<double>() - 0.5) <= 0.08);
+  // Below the margins: nothing.
+  run = run_faults(dir, 6, 17.5, {"--clearance", "0.4"});
+  CHECK(run.result.status == 0);
+  CHECK(run.report["near_misses"]["moves"].empty());
+  fs::remove_all(dir);
+}
