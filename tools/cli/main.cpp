@@ -80,7 +80,7 @@ void add_max_memory(CLI::App& command, std::string& max_memory) {
 void add_simulate(CLI::App& command, SimulateOptions& options) {
   add_common(command, options);
   command.add_option("--tools", options.tools,
-                  "tool table, JSON in the CAMotics schema (overrides a project's tools)")
+                  "tool table, JSON in the CAMotics schema or a Fusion tool library (overrides a project's tools)")
       ->check(kNotEmpty);
   command.add_option("--stock", options.stock,
                   "box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX | FILE.stl | auto[:MARGIN] (default auto: the box around\n"
