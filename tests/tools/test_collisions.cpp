@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <random>
+#include <tuple>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -255,5 +257,45 @@ TEST_CASE("check: a program whose holder and shank clear by a known margin passe
   run = run_faults(dir, 6, 17.5, {"--clearance", "0.4"});
   CHECK(run.result.status == 0);
   CHECK(run.report["near_misses"]["moves"].empty());
+  fs::remove_all(dir);
+}
+
+TEST_CASE("check: a hole by the stock's edge buries the holder along +Z and clears it tilted away") {
+  fs::path dir = scratch("tilted-clear");
+  write_text(dir / "tools.json", R"({"1": {"shape": "cylindrical", "diameter": 6, "stick-out": 20,
+      "holder": [{"bottom-diameter": 30, "top-diameter": 30, "length": 20}]}})");
+  auto run = [&](const std::string& program) {
+    write_text(dir / "p.nc", program);
+    CommandResult made = run_tridex({"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(),
+                                     "--stock", "box:0,0,0,60,40,30", "--dexel-cell", "0.5", "-o",
+                                     (dir / "design.stl").string(), "-q"},
+                                    dir);
+    REQUIRE(made.status == 0);
+    CommandResult r = run_tridex({"check", (dir / "p.nc").string(), "--design", (dir / "design.stl").string(), "--tools",
+                                  (dir / "tools.json").string(), "--stock", "box:0,0,0,60,40,30", "--dexel-cell", "0.5",
+                                  "--tolerance", "0.6", "--clearance", "3", "--report", (dir / "report.json").string()},
+                                 dir);
+    INFO(r.out, r.err);
+    return std::make_pair(r.status, json::parse(slurp(dir / "report.json")));
+  };
+  // A hole 25 mm deep, 4 mm from the front face: the holder's face at z = 25 under the top at 30.
+  auto [status, report] = run("%\nG21 G17 G90\nT1 M6\nS8000 M3\nG0 X30 Y4 Z40\nG1 Z5 F300\nG0 Z40\nM30\n%\n");
+  CHECK(status == 3);
+  REQUIRE(!report["collisions"].empty());
+  CHECK(report["collisions"][0]["line"] == 6);
+  CHECK(report["collisions"][0]["depth_mm"].get<double>() == doctest::Approx(5.0).epsilon(0.001));
+  // The same entry, 15 mm along a spindle tilted 45° out through the front face: the holder's face
+  // (centre entry + 5 mm back along the axis, radius 15) passes the top front edge at 2.172 mm
+  // (its distance along the axis; the edge lies within the face's radius).
+  std::tie(status, report) =
+      run("%\nG21 G17 G90\nT1 M6\nS8000 M3\nG68.2 X30 Y4 Z30 I0 J45 K0\nG53.1\nG0 X0 Y0 Z10\nG1 Z-15 F300\nG0 Z10\n"
+          "G69\nM30\n%\n");
+  CHECK(status == 0);
+  CHECK(report["collisions"].empty());
+  REQUIRE(!report["near_misses"]["moves"].empty());
+  const json& near = report["near_misses"]["moves"][0];
+  CHECK(near["line"] == 8);
+  CHECK(near["axis"][1].get<double>() == doctest::Approx(-std::sqrt(0.5)));
+  CHECK(std::abs(near["distance_mm"].get<double>() - 2.172) <= 0.08);  // one Z-map cell (diagonal / 1000)
   fs::remove_all(dir);
 }
