@@ -1,4 +1,5 @@
-// Benchmarks of the `tridex` command on the bundled example (gcode/examples/mold_3plus2.*).
+// Benchmarks of the `tridex` command on the bundled example (gcode/examples/mold_3plus2.*), and
+// the shank and holder check on it and on the paper-scale workload (bench/backends/workload.hpp).
 #include <benchmark/benchmark.h>
 
 #include <sys/resource.h>
@@ -9,8 +10,10 @@
 #include <filesystem>
 #include <fstream>
 
+#include "../backends/workload.hpp"
 #include "commands.hpp"
 #include "json_text.hpp"
+#include "pipeline.hpp"
 #include "program_input.hpp"
 #include "render.hpp"
 
@@ -105,6 +108,67 @@ void BM_simulate_example(benchmark::State& state) {
 BENCHMARK(BM_simulate_example)
     ->Args({128, 300})
     ->Args({cli::kDefaultDexelRes, 0})
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1);
+
+// A tool table whose tools (the given cutters) all have 25 mm flutes, a shank of their diameter,
+// 40 mm out of a Ø40 × 30 mm holder body under a cone widening to Ø63 over 20 mm.
+std::string tools_with_holders(const std::vector<std::pair<int, std::string>>& cutters) {
+  std::string text = "{";
+  for (const auto& [number, cutter] : cutters)
+    text += (text.size() > 1 ? ",\n" : "\n") + std::string("\"") + std::to_string(number) + "\": {" + cutter +
+            ", \"flute-length\": 25, \"stick-out\": 40, \"holder\": [{\"bottom-diameter\": 40, "
+            "\"top-diameter\": 40, \"length\": 30}, {\"bottom-diameter\": 40, \"top-diameter\": 63, \"length\": 20}]}";
+  return text + "}";
+}
+
+// `check`'s pipeline (every direction milled in program order, rapids checked) with the shank and
+// holder check (second argument 1) or without (0): on the example (first argument 0, at
+// --dexel-res 320) or on the paper-scale workload of that many thousand segments (--dexel-res 512).
+void BM_collision_check(benchmark::State& state) {
+  std::filesystem::path dir = std::filesystem::temp_directory_path() / ("tridex-bench-cc-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  cli::SimulateOptions options;
+  options.quiet = true;
+  options.tools = (dir / "tools.json").string();
+  if (state.range(0) == 0) {
+    options.program = kExamples + "mold_3plus2.camotics";
+    options.dexel_res = cli::kDefaultDexelRes;
+    std::ofstream(options.tools) << tools_with_holders({{1, R"("shape": "cylindrical", "diameter": 10)"},
+                                                       {2, R"("shape": "ballnose", "diameter": 8)"},
+                                                       {3, R"("shape": "ballnose", "diameter": 4)"},
+                                                       {4, R"("shape": "ballnose", "diameter": 2)"}});
+  } else {
+    options.program = (dir / "workload.nc").string();
+    std::FILE* out = std::fopen(options.program.c_str(), "w");
+    bench::write_workload(out, state.range(0) * 1000);
+    std::fclose(out);
+    options.stock = "box:0,0,0,200,200,130";
+    options.dexel_res = 512;
+    std::ofstream(options.tools) << tools_with_holders({{1, R"("shape": "cylindrical", "diameter": 10)"},
+                                                       {2, R"("shape": "bullnose", "diameter": 8, "corner-radius": 1)"},
+                                                       {3, R"("shape": "ballnose", "diameter": 6)"},
+                                                       {4, R"("shape": "ballnose", "diameter": 3)"}});
+  }
+  cli::PipelineRequest request;
+  request.rapid_check = cli::RapidCheck::in_program_order;
+  if (state.range(1)) request.body_clearance = cli::kDefaultClearance;
+  cli::Progress progress(false);
+  for (auto _ : state) {
+    cli::SimulationResult r = cli::simulate_program(options, progress, request);
+    state.counters["zmap_s"] = r.timings.zmap;
+    state.counters["body_s"] = r.body.seconds;
+    state.counters["collisions"] = static_cast<double>(r.body.collisions.size());
+    state.counters["near_misses"] = static_cast<double>(r.body.near_misses.size());
+    state.counters["segments"] = static_cast<double>(r.segments);
+  }
+  std::filesystem::remove_all(dir);
+}
+BENCHMARK(BM_collision_check)
+    ->Args({0, 0})
+    ->Args({0, 1})
+    ->Args({500, 0})
+    ->Args({500, 1})
     ->Unit(benchmark::kSecond)
     ->Iterations(1);
 

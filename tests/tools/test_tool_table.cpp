@@ -1,7 +1,13 @@
-// Tool tables (CAMotics schema) -> cutters, checked against the shapes' analytic profiles.
+// Tool tables (CAMotics schema, and Fusion's tool libraries) -> cutters, checked against the
+// shapes' analytic profiles; the shank and holder parts.
 #include <doctest/doctest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
 #include <random>
 
 #include <nlohmann/json.hpp>
@@ -12,6 +18,7 @@
 using namespace tridex;
 using namespace tridex::cli;
 using nlohmann::json;
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -94,4 +101,136 @@ TEST_CASE("bad tool tables are refused with the tool and the key named") {
   CHECK(error_of(R"({"10": {"shape": "bullnose", "diameter": 2, "corner-radius": 3}})").find("tool 10") != std::string::npos);
   CHECK(error_of(R"({"11": {"shape": "snubnose", "diameter": 2, "length": 3, "snub_diameter": 2}})").find("snub_diameter") != std::string::npos);
   CHECK(error_of(R"({"12": {"diameter": 2}})").find("missing \"shape\"") != std::string::npos);
+}
+
+TEST_CASE("the shank and holder keys give the tool's non-cutting parts") {
+  ToolTable tools = parse(R"({"1": {"shape": "cylindrical", "diameter": 0.25, "units": "inch", "flute-length": 0.5,
+      "shank-diameter": 0.375, "stick-out": 1.5,
+      "holder": [{"bottom-diameter": 1, "top-diameter": 1, "length": 1}, {"bottom-diameter": 1, "top-diameter": 2, "length": 0.5}]},
+      "2": {"shape": "ballnose", "diameter": 6, "flute-length": 12},
+      "3": {"shape": "ballnose", "diameter": 6}})");
+  const ToolBody& body = tools.find(1)->body;
+  REQUIRE(body.parts.size() == 3);
+  CHECK(body.stick_out == doctest::Approx(38.1));
+  CHECK(body.parts[0].name == "shank");
+  CHECK(body.parts[0].bottom == doctest::Approx(12.7));
+  CHECK(body.parts[0].shape.bottom_radius == doctest::Approx(4.7625));
+  CHECK(body.parts[0].shape.length == doctest::Approx(25.4));
+  CHECK(body.parts[1].name == "holder section 1");
+  CHECK(body.parts[1].bottom == doctest::Approx(38.1));
+  CHECK(body.parts[2].name == "holder section 2");
+  CHECK(body.parts[2].bottom == doctest::Approx(63.5));
+  CHECK(body.parts[2].shape.top_radius == doctest::Approx(25.4));
+  // The widening section's lower surface: its face, then the cone (0.5" up over 0.5" out).
+  Cutter cone = part_surface(body.parts[2], 0);
+  CHECK(cone.lower_height(10) == doctest::Approx(0));
+  CHECK(cone.lower_height(20) == doctest::Approx(20 - 12.7));
+  // Without a stick-out the shank goes on up; the shank diameter defaults to the cutter's.
+  REQUIRE(tools.find(2)->body.parts.size() == 1);
+  CHECK(tools.find(2)->body.parts[0].shape.bottom_radius == doctest::Approx(3));
+  CHECK(!tools.find(2)->body.has_holder());
+  CHECK(tools.find(3)->body.parts.empty());
+
+  CHECK(error_of(R"({"4": {"shape": "ballnose", "diameter": 2, "holder": [{"bottom-diameter": 9, "top-diameter": 9, "length": 9}]}})")
+            .find("tool 4: \"holder\" needs a positive \"stick-out\"") != std::string::npos);
+  CHECK(error_of(R"({"5": {"shape": "ballnose", "diameter": 2, "stick-out": 9, "holder": [{"bottom-diameter": 9, "length": 9}]}})")
+            .find("tool 5: \"holder\" section 1: missing \"top-diameter\"") != std::string::npos);
+  CHECK(error_of(R"({"6": {"shape": "ballnose", "diameter": 2, "flute-length": 10, "stick-out": 5}})")
+            .find("tool 6: \"flute-length\" 10 mm is longer than \"stick-out\" 5 mm") != std::string::npos);
+  CHECK(error_of(R"({"7": {"shape": "ballnose", "diameter": 2, "shank-diameter": 3}})")
+            .find("tool 7: \"shank-diameter\" needs \"flute-length\"") != std::string::npos);
+  CHECK(error_of(R"({"8": {"shape": "ballnose", "diameter": 2, "stick-out": 9, "holder": {}}})")
+            .find("tool 8: \"holder\" must be a non-empty list") != std::string::npos);
+}
+
+namespace {
+
+// A Fusion tool library written for the test from Autodesk's published schema (the library
+// export's "data" list; geometry keys DC, LCF, LB, OAL, SFDM, RE; holder segments bottom first).
+json fusion_library() {
+  return json::parse(R"({"version": 18, "data": [
+    {"type": "flat end mill", "unit": "millimeters", "description": "6mm flat", "guid": "a",
+     "geometry": {"DC": 6, "LCF": 18, "LB": 30, "OAL": 60, "SFDM": 6, "RE": 0, "NOF": 3},
+     "holder": {"type": "holder", "unit": "millimeters", "segments": [
+        {"height": 10, "lower-diameter": 20, "upper-diameter": 20},
+        {"height": 15, "lower-diameter": 32, "upper-diameter": 40}]},
+     "post-process": {"number": 1, "comment": ""}},
+    {"type": "ball end mill", "unit": "inches", "description": "1/4 ball", "guid": "b",
+     "geometry": {"DC": 0.25, "LCF": 0.75, "LB": 1.25, "OAL": 2.5, "SFDM": 0.25, "RE": 0.125},
+     "post-process": {"number": 2}},
+    {"type": "bull nose end mill", "unit": "millimeters", "description": "10R1",
+     "geometry": {"DC": 10, "LCF": 20, "LB": 35, "OAL": 75, "SFDM": 10, "RE": 1},
+     "post-process": {"number": 3}},
+    {"type": "drill", "unit": "millimeters", "geometry": {"DC": 5, "SIG": 118}, "post-process": {"number": 4}},
+    {"type": "holder", "unit": "millimeters", "segments": []}
+  ]})");
+}
+
+std::string fusion_error(const std::function<void(json&)>& spoil) {
+  json library = fusion_library();
+  spoil(library);
+  try {
+    ToolTable::from_fusion_json(library, "lib.json");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("Fusion tool libraries: the cutting part, the shank and the holder") {
+  ToolTable tools = ToolTable::from_fusion_json(fusion_library(), "lib.json");
+  CHECK(tools.tools().size() == 3);  // the drill and the lone holder are skipped
+  const ToolSpec& flat = *tools.find(1);
+  CHECK(flat.cutter.shape() == CutterShape::flat);
+  CHECK(flat.cutter.radius() == doctest::Approx(3));
+  CHECK(flat.description == "6mm flat");
+  REQUIRE(flat.body.parts.size() == 3);
+  CHECK(flat.body.parts[0].name == "shank");
+  CHECK(flat.body.parts[0].bottom == doctest::Approx(18));
+  CHECK(flat.body.parts[0].shape.length == doctest::Approx(12));
+  CHECK(flat.body.stick_out == doctest::Approx(30));
+  CHECK(flat.body.parts[1].bottom == doctest::Approx(30));
+  CHECK(flat.body.parts[1].shape.bottom_radius == doctest::Approx(10));
+  CHECK(flat.body.parts[2].bottom == doctest::Approx(40));
+  CHECK(flat.body.parts[2].shape.bottom_radius == doctest::Approx(16));
+  CHECK(flat.body.parts[2].shape.top_radius == doctest::Approx(20));
+  CHECK(tools.find(2)->cutter.shape() == CutterShape::ball);
+  CHECK(tools.find(2)->cutter.radius() == doctest::Approx(3.175));
+  CHECK(tools.find(2)->body.parts[0].bottom == doctest::Approx(19.05));
+  CHECK(!tools.find(2)->body.has_holder());
+  CHECK(tools.find(3)->cutter.shape() == CutterShape::bull_nose);
+  CHECK(tools.find(3)->cutter.corner_radius() == doctest::Approx(1));
+  CHECK(tools.find(4) == nullptr);
+
+  // A library file is told from a CAMotics table by its "data" list.
+  fs::path file = fs::temp_directory_path() / ("tridex-fusion-" + std::to_string(::getpid()) + ".json");
+  std::ofstream(file) << fusion_library().dump(1);
+  CHECK(ToolTable::read(file).find(3) != nullptr);
+  fs::remove(file);
+}
+
+TEST_CASE("Fusion tool libraries: a missing or malformed field names the tool and the field") {
+  auto has = [](const std::string& message, const std::string& part) {
+    INFO(message);
+    CHECK(message.find(part) != std::string::npos);
+  };
+  has(fusion_error([](json& l) { l["data"][0]["geometry"].erase("DC"); }),
+      "lib.json: tool 1 (\"6mm flat\"): \"geometry\": missing \"DC\"");
+  has(fusion_error([](json& l) { l["data"][0]["geometry"].erase("LB"); }), "tool 1 (\"6mm flat\"): \"geometry\": missing \"LB\"");
+  has(fusion_error([](json& l) { l["data"][1]["geometry"]["LCF"] = "long"; }),
+      "tool 2 (\"1/4 ball\"): \"geometry\": \"LCF\" must be a number, got a string");
+  has(fusion_error([](json& l) { l["data"][2]["geometry"].erase("RE"); }), "tool 3 (\"10R1\"): \"geometry\": missing \"RE\"");
+  has(fusion_error([](json& l) { l["data"][0]["holder"]["segments"][1].erase("height"); }),
+      "tool 1 (\"6mm flat\"): \"holder\": \"segments\"[1]: missing \"height\"");
+  has(fusion_error([](json& l) { l["data"][0]["holder"]["segments"][0]["lower-diameter"] = -3; }),
+      "\"lower-diameter\" must be a finite non-negative number, got -3");
+  has(fusion_error([](json& l) { l["data"][0]["geometry"]["LB"] = 70; }), "\"LB\" 70 mm is longer than \"OAL\" 60 mm");
+  has(fusion_error([](json& l) { l["data"][0]["geometry"]["LCF"] = 40; }), "\"LCF\" 40 mm is longer than \"LB\" 30 mm");
+  has(fusion_error([](json& l) { l["data"][1].erase("post-process"); }), "\"data\"[1] (\"1/4 ball\"): missing \"post-process\"");
+  has(fusion_error([](json& l) { l["data"][1]["post-process"]["number"] = 1; }), "\"data\"[0] and \"data\"[1] are both tool 1");
+  has(fusion_error([](json& l) { l["data"][0]["unit"] = "cubits"; }), "unknown \"unit\" \"cubits\"");
+  has(fusion_error([](json& l) { l["data"][0].erase("type"); }), "\"data\"[0]: missing \"type\"");
+  has(fusion_error([](json& l) { l["data"] = 3; }), "must be a JSON object with a \"data\" list");
 }

@@ -237,6 +237,7 @@ int run_check(const CheckOptions& options) {
     return 130.0 * static_cast<double>(design.triangles.size()) + (130.0 + 12.0) * triangles +
            (sizeof(Vec3) + sizeof(double)) * samples;
   };
+  request.body_clearance = options.clearance;
   SimulationResult r = simulate_program(options, progress, request);
   const Mesh& mesh = r.mesh;
   const double spacing = r.lattice.spacing;
@@ -314,6 +315,26 @@ int run_check(const CheckOptions& options) {
   for (const RapidFinding& f : r.rapid_cuts)
     rapid_list.push_back({{"line", f.line}, {"tool", f.tool}, {"axis", to_json(f.axis)},
                           {"depth_mm", f.depth_mm}, {"where", to_json(f.where)}});
+  // ---- shanks and holders -------------------------------------------------------------------
+  auto body_json = [&](const BodyFinding& f, const char* measure) {
+    return Json{{"line", f.line}, {"tool", f.tool}, {"part", f.part}, {measure, f.depth_mm},
+                {"point", to_json(f.where)}, {"axis", to_json(f.axis)}};
+  };
+  Json collision_list = Json::array(), near_list = Json::array();
+  for (std::size_t k = 0; k < r.body.collisions.size() && k < kFindingsListed; ++k)
+    collision_list.push_back(body_json(r.body.collisions[k], "depth_mm"));
+  for (std::size_t k = 0; k < r.body.near_misses.size() && k < kFindingsListed; ++k)
+    near_list.push_back(body_json(r.body.near_misses[k], "distance_mm"));
+  // The stick-out a program needs: the holder's lower surface rises with the stick-out, so the
+  // deepest holder collision of a tool in a direction is what it must grow by.
+  Json stick_out = Json::array();
+  for (const auto& [key, depth] : r.body.holder_depth) {
+    const auto& [tool, group] = key;
+    const ToolBody& body = r.bodies[r.cutter_of_tool.at(tool)];
+    stick_out.push_back({{"tool", tool}, {"axis", to_json(r.groups[group].axis)}, {"stick_out_mm", body.stick_out},
+                         {"needed_mm", body.stick_out + depth + kCollisionTolerance}});
+  }
+
   Json envelope_list = Json::array();
   std::size_t envelope_outside = 0;
   if (envelope) {
@@ -366,7 +387,7 @@ int run_check(const CheckOptions& options) {
                          " boundary, " + std::to_string(r.mesh_check.non_manifold_edges) + " non-manifold edges)");
 
   const bool failed = !gouges.empty() || !excesses.empty() || design_side_finding || !rapid_list.empty() ||
-                      envelope_outside > 0 || r.travel_count > 0;
+                      envelope_outside > 0 || r.travel_count > 0 || !r.body.collisions.empty();
   const double total_s = seconds_since(start);
   Json report;
   report["program"] = r.input.program.string();
@@ -382,6 +403,11 @@ int run_check(const CheckOptions& options) {
   report["excess"] = excess_list;
   report["design_side"] = design_side;
   report["rapid_cuts"] = rapid_list;
+  report["collisions"] = collision_list;
+  report["collisions_count"] = r.body.collisions.size();
+  report["near_misses"] = {{"clearance_mm", options.clearance}, {"count", r.body.near_misses.size()},
+                           {"moves", near_list}};
+  report["stick_out"] = stick_out;
   if (envelope)
     report["envelope"] = {{"box", {{"min", to_json(envelope->min)}, {"max", to_json(envelope->max)}}},
                           {"outside", envelope_outside}, {"violations", envelope_list}};
@@ -390,7 +416,7 @@ int run_check(const CheckOptions& options) {
                       {"watertight", r.mesh_check.closed()}};
   report["timings_s"] = {{"parse", r.timings.parse}, {"zmap", r.timings.zmap}, {"dexelize", r.timings.dexelize},
                          {"intersect", r.timings.intersect}, {"mesh", r.timings.mesh},
-                         {"deviation", deviation_s}, {"total", total_s}};
+                         {"collisions", r.body.seconds}, {"deviation", deviation_s}, {"total", total_s}};
   report["memory_estimate_mib"] = r.memory.total() / (1 << 20);
   report["peak_rss_mib"] = peak_rss_mib();
   report["warnings"] = r.warnings;
@@ -415,11 +441,12 @@ int run_check(const CheckOptions& options) {
       std::snprintf(range, sizeof range, "%.4g .. %.4g mm", d["min_mm"].get<double>(), d["max_mm"].get<double>());
     std::printf("%s vs %s: deviation %s; %zu gouge and %zu excess region(s) beyond -%g/+%g mm, design "
                 "samples %lld missing and %lld left, %zu rapid(s) cutting material, %zu move(s) outside the "
-                "envelope, %lld outside the machine's travel: %s; %.2f s\n",
+                "envelope, %lld outside the machine's travel, %zu shank/holder collision(s), %zu near miss(es) within %g mm: %s; %.2f s\n",
                 r.input.program.filename().string().c_str(), fs::path(options.design).filename().string().c_str(),
                 range, gouges.size(), excesses.size(), gouge_tol, excess_tol,
                 design_side["missing"]["samples"].get<long long>(), design_side["left"]["samples"].get<long long>(),
-                rapid_list.size(), envelope_outside, r.travel_count, failed ? "FAIL" : "pass", total_s);
+                rapid_list.size(), envelope_outside, r.travel_count, r.body.collisions.size(), r.body.near_misses.size(),
+                options.clearance, failed ? "FAIL" : "pass", total_s);
     std::size_t printed = 0;
     for (const Json& g : gouge_list)
       if (g.contains("lines") && printed++ < kFindingsPrinted) {
@@ -440,8 +467,16 @@ int run_check(const CheckOptions& options) {
                   envelope_list[k]["tip"].dump().c_str());
     for (std::size_t k = 0; k < r.travel.size() && k < kFindingsPrinted; ++k)
       std::printf("  %s:%d: %s\n", r.travel[k].file.c_str(), r.travel[k].line, travel_text(r.travel[k]).c_str());
+    for (std::size_t k = 0; k < r.body.collisions.size() && k < kFindingsPrinted; ++k) {
+      const BodyFinding& f = r.body.collisions[k];
+      std::printf("  line %d: tool %d's %s is %.3f mm into the stock at (%.3f, %.3f, %.3f), spindle %s\n", f.line,
+                  f.tool, f.part.c_str(), f.depth_mm, f.where.x, f.where.y, f.where.z, axis_label(f.axis).c_str());
+    }
+    for (const Json& s : stick_out)
+      std::printf("  tool %d along %s needs a stick-out of %.3f mm (it has %.3f)\n", s["tool"].get<int>(),
+                  s["axis"].dump().c_str(), s["needed_mm"].get<double>(), s["stick_out_mm"].get<double>());
     if (rapid_list.size() > kFindingsPrinted || envelope_outside > kFindingsPrinted ||
-        r.travel_count > static_cast<long long>(kFindingsPrinted))
+        r.travel_count > static_cast<long long>(kFindingsPrinted) || r.body.collisions.size() > kFindingsPrinted)
       std::printf("  (more in the report)\n");
   }
   return failed ? kFindings : kSuccess;

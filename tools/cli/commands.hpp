@@ -41,6 +41,9 @@ struct SimulateOptions : CommonOptions {
   std::string dexel_backend = "scan";  // --dexel-backend: scan | tree | embree
 };
 
+// A small safety distance (mm): shanks and holders closer than this to the stock are near misses.
+constexpr double kDefaultClearance = 1.0;
+
 // `check`: simulate's options (--report and --png are the check's own report and picture; -o still
 // writes the machined solid) and the design to compare with.
 struct CheckOptions : SimulateOptions {
@@ -50,6 +53,7 @@ struct CheckOptions : SimulateOptions {
   double excess_tol = 0;  // --excess-tol (overrides --tolerance)
   std::string ply;        // --ply OUT.ply: the machined mesh coloured by deviation
   std::string envelope;   // --envelope box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX
+  double clearance = kDefaultClearance;  // --clearance: near misses of shanks and holders, mm
 };
 
 constexpr int kDefaultDexelRes = 320;

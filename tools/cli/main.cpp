@@ -32,6 +32,16 @@ const CLI::Validator kFinitePositive(
     },
     "POSITIVE");
 
+// A distance that may be zero (a clearance).
+const CLI::Validator kFiniteNonNegative(
+    [](std::string& text) -> std::string {
+      double value = 0;
+      if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value >= 0))
+        return "must be a finite number, zero or more, got \"" + text + "\"";
+      return {};
+    },
+    "NONNEGATIVE");
+
 // An option given with an empty value (`--stock ''`, `-o ""`) is a mistake, not the default.
 const CLI::Validator kNotEmpty(
     [](std::string& text) -> std::string { return text.empty() ? "must not be empty" : std::string(); }, "");
@@ -55,8 +65,9 @@ void add_common(CLI::App& command, CommonOptions& options) {
                      "folder of subprogram files (O9810.nc, name.ngc) that M98/G65/o-call may "
                      "call (repeatable)");
   command.add_option("--tools", options.tools,
-                     "tool table, JSON in the CAMotics schema (overrides a project's tools; G41/G42 D\n"
-                     "offset by half a tool's diameter)")
+                     "tool table, JSON in the CAMotics schema or a Fusion tool library (overrides a project's\n"
+                     "tools; G41/G42 D"
+                     " offset by half a tool's diameter)")
       ->check(kNotEmpty);
   command.add_flag("--progress", options.progress,
                    "show progress on stderr even when it is not a terminal");
@@ -116,7 +127,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "tridex " TRIDEX_VERSION);
   app.require_subcommand(1);
   app.footer("Exit status: 0 success, 2 bad input (program, tool table, stock, options), 1 other failure;\n"
-             "`check` exits 3 when it finds a gouge, excess, a rapid into material or a move outside the envelope.\n"
+             "`check` exits 3 when it finds a gouge, excess, a rapid into material, a move outside the envelope\n"
+             "or a shank or holder in the material.\n"
              "Run `tridex COMMAND --help` for a command's options.");
 
   SimulateOptions simulate;
@@ -128,7 +140,8 @@ int main(int argc, char** argv) {
 
   CheckOptions check;
   CLI::App* chk = app.add_subcommand(
-      "check", "compare the machined result with a design: gouges, excess, rapids into stock, envelope;\n"
+      "check", "compare the machined result with a design: gouges, excess, rapids into stock, envelope,\n"
+               "shank and holder collisions;\n"
                "exit status 3 when anything is found");
   add_simulate(*chk, check);
   chk->add_option("--design", check.design, "the designed part, a closed STL")->required()->check(kNotEmpty);
@@ -144,6 +157,9 @@ int main(int argc, char** argv) {
   chk->add_option("--envelope", check.envelope,
                   "box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX: every move whose tool tip ends outside is a finding")
       ->check(kNotEmpty);
+  chk->add_option("--clearance", check.clearance,
+                  "report moves whose shank or holder comes closer than this to the stock, mm (0: none)")
+      ->check(kFiniteNonNegative);
   chk->add_option("-o,--output", check.output, "write the machined result as binary STL")->check(kNotEmpty);
   chk->add_option("--report", check.report, "write the JSON report of the check")->check(kNotEmpty);
   chk->add_option("--png", check.png, "write a picture coloured by deviation, with a legend")->check(kNotEmpty);

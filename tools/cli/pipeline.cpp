@@ -68,31 +68,39 @@ void write_png_file(const fs::path& path, const render::Image& image) {
 }
 
 // Mills one group's moves into `map` in program order, checking each rapid with cut_depth against
-// what the map holds when the rapid runs (RapidCheck::in_program_order).
+// what the map holds when the rapid runs (RapidCheck::in_program_order), and each move's shank and
+// holder when `bodies` is given (collision_check.hpp).
 void mill_in_program_order(ZMap& map, const gcode::MoveGroup& group, std::size_t g,
                            std::span<const Cutter> cutters,
                            const std::map<int, std::uint32_t>& cutter_of_tool,
                            backends::ZMapBackend backend, unsigned threads,
-                           std::vector<RapidFinding>& found) {
+                           std::vector<RapidFinding>& found, BodyCheck* bodies, BodyFindings& body_found) {
   // Heights only fall, so a rapid entirely above the initial top cuts nothing and needs no flush.
   float top = -std::numeric_limits<float>::infinity();
   for (float h : map.heights) top = std::max(top, h);
   std::vector<CutMove> batch;
+  auto flush = [&] {
+    if (batch.empty()) return;
+    // A handful of moves is milled faster than threads start.
+    backends::mill_with(backend, map, cutters, batch, batch.size() < 64 ? 1u : threads);
+    if (bodies) bodies->milled(map, cutters, batch);
+    batch.clear();
+  };
   for (const gcode::Move& m : group.moves) {
     CutMove cut{Segment{group.frame.to_local(m.start), group.frame.to_local(m.end)}, cutter_of_tool.at(m.tool)};
     if (m.kind == gcode::MoveKind::rapid &&
         std::min(cut.tip.a.z, cut.tip.b.z) < double(top) - kRapidTolerance) {
-      backends::mill_with(backend, map, cutters, batch, threads);
-      batch.clear();
+      flush();
       CutDepth deepest = cut_depth(map, cutters[cut.cutter], cut.tip);
       if (deepest.depth > kRapidTolerance) {
         Vec3 local(map.grid.x(deepest.i), map.grid.y(deepest.j), map.height(deepest.i, deepest.j));
         found.push_back(RapidFinding{m.line, m.tool, group.axis, deepest.depth, group.frame.to_world(local), g});
       }
     }
+    if (bodies) bodies->check(map, m, cut, group.axis, group.frame, g, batch.empty(), flush, body_found);
     batch.push_back(cut);
   }
-  backends::mill_with(backend, map, cutters, batch, threads);
+  flush();
 }
 
 std::string describe_box(const Aabb& box) {
@@ -264,6 +272,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
       if (spec) {
         cutter_of_tool[tool] = static_cast<std::uint32_t>(cutters.size());
         cutters.push_back(spec->cutter);
+        r.bodies.push_back(spec->body);
         continue;
       }
       if (tool == 0) continue;  // moves before the first tool change; checked below
@@ -365,8 +374,10 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
                               : ZMap::from_box(group.frame, stock.box, zmap_cell, limits));
     r.segments += static_cast<long long>(group.moves.size());
     if (request.rapid_check == RapidCheck::in_program_order) {
+      std::optional<BodyCheck> bodies;
+      if (request.body_clearance) bodies.emplace(maps.back(), r.bodies, *request.body_clearance);
       mill_in_program_order(maps.back(), group, g, cutters, cutter_of_tool, zmap_backend, options.threads,
-                            r.rapid_cuts);
+                            r.rapid_cuts, bodies ? &*bodies : nullptr, r.body);
       continue;
     }
     // Feed moves first; the rapids are checked against what the feeds leave, then milled too.

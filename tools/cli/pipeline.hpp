@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "collision_check.hpp"
 #include "commands.hpp"
 #include "json_text.hpp"
 #include "memory.hpp"
@@ -56,6 +57,9 @@ struct PipelineRequest {
   // its name for the message.
   std::vector<std::pair<std::string, Aabb>> extra_bounds;
   RapidCheck rapid_check = RapidCheck::against_feeds;
+  // With in_program_order: the tools' shanks and holders against the stock (collision_check.hpp),
+  // near misses within this clearance (mm); none: not checked.
+  std::optional<double> body_clearance;
   bool keep_maps = false;  // keep the milled Z-maps (otherwise released after Step 3)
   // What the caller allocates after the surface, in bytes, given the lattice spacing and the
   // estimated triangle count of the surface (check: the design's and the result's distance
@@ -92,6 +96,7 @@ struct SimulationResult {
   ProgramInput input;
   std::vector<gcode::MoveGroup> groups;  // moves in program order within each group
   std::vector<Cutter> cutters;
+  std::vector<ToolBody> bodies;                 // the non-cutting parts, parallel to cutters
   std::map<int, std::uint32_t> cutter_of_tool;  // tool number -> index into cutters
   Stock stock;
   double zmap_cell = 0;
@@ -107,6 +112,7 @@ struct SimulationResult {
   std::vector<RapidFinding> rapid_cuts;
   std::vector<TravelFinding> travel;  // the first kTravelListed, in program order
   long long travel_count = 0;
+  BodyFindings body;  // collisions and near misses of shanks and holders (body_clearance only)
   std::vector<std::string> warnings;
   PipelineTimings timings;
 };

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <vector>
 
@@ -52,7 +53,54 @@ std::vector<Vec2> spheroid_profile(double a, double b) {
   return points;
 }
 
+// The holder's sections in the CAMotics-style table: [{"bottom-diameter", "top-diameter", "length"}].
+std::vector<BodySection> holder_sections(const nlohmann::json& tool, const std::string& where, double scale) {
+  std::vector<BodySection> sections;
+  auto holder = tool.find("holder");
+  if (holder == tool.end()) return sections;
+  if (!holder->is_array() || holder->empty())
+    input_error(where, ": \"holder\" must be a non-empty list of sections, got ", json_type_name(*holder));
+  for (std::size_t k = 0; k < holder->size(); ++k) {
+    const nlohmann::json& section = (*holder)[k];
+    std::string at = where + ": \"holder\" section " + std::to_string(k + 1);
+    if (!section.is_object()) input_error(at, ": must be a JSON object, got ", json_type_name(section));
+    sections.push_back(BodySection{scale * number_field(section, at, {"bottom-diameter"}, true) / 2,
+                                   scale * number_field(section, at, {"top-diameter"}, true) / 2,
+                                   scale * number_field(section, at, {"length"}, true)});
+  }
+  return sections;
+}
+
 }  // namespace
+
+ToolBody make_body(const ToolSpec& spec, const std::string& where) {
+  ToolBody body;
+  if (spec.flute_length_mm > 0) {
+    double shank = spec.shank_diameter_mm > 0 ? spec.shank_diameter_mm : spec.diameter_mm;
+    if (spec.stick_out_mm > 0 && spec.flute_length_mm > spec.stick_out_mm)
+      input_error(where, ": \"flute-length\" ", spec.flute_length_mm, " mm is longer than \"stick-out\" ",
+                  spec.stick_out_mm, " mm");
+    double length = spec.stick_out_mm > 0 ? spec.stick_out_mm - spec.flute_length_mm
+                                          : std::numeric_limits<double>::infinity();
+    if (length > 0) body.parts.push_back(BodyPart{"shank", spec.flute_length_mm, BodySection{shank / 2, shank / 2, length}});
+  } else if (spec.shank_diameter_mm > 0) {
+    input_error(where, ": \"shank-diameter\" needs \"flute-length\" (where the shank begins)");
+  }
+  if (spec.holder.empty()) return body;
+  if (!(spec.stick_out_mm > 0)) input_error(where, ": \"holder\" needs a positive \"stick-out\"");
+  body.stick_out = spec.stick_out_mm;
+  double bottom = spec.stick_out_mm;
+  for (std::size_t k = 0; k < spec.holder.size(); ++k) {
+    const BodySection& s = spec.holder[k];
+    std::string name = "holder section " + std::to_string(k + 1);
+    if (!(s.length > 0)) input_error(where, ": ", name, ": the length must be positive");
+    if (!(s.bottom_radius > 0))
+      input_error(where, ": ", name, ": the bottom diameter must be positive (a holder has a face)");
+    body.parts.push_back(BodyPart{name, bottom, s});
+    bottom += s.length;
+  }
+  return body;
+}
 
 Cutter make_cutter(const ToolSpec& spec, const std::string& where) {
   double radius = spec.diameter_mm / 2;
@@ -135,14 +183,114 @@ ToolTable ToolTable::from_json(const nlohmann::json& table, const std::string& s
         scale * number_field(tool, where, {"snub_diameter", "snub-diameter"}, false);
     if (auto d = tool.find("description"); d != tool.end() && d->is_string())
       spec.description = d->get<std::string>();
+    spec.flute_length_mm = scale * number_field(tool, where, {"flute-length", "flute_length"}, false);
+    spec.shank_diameter_mm = scale * number_field(tool, where, {"shank-diameter", "shank_diameter"}, false);
+    spec.stick_out_mm = scale * number_field(tool, where, {"stick-out", "stick_out"}, false);
+    spec.holder = holder_sections(tool, where, scale);
     spec.cutter = make_cutter(spec, where);
+    spec.body = make_body(spec, where);
+    result.tools_.emplace(number, std::move(spec));
+  }
+  return result;
+}
+
+ToolTable ToolTable::from_fusion_json(const nlohmann::json& library, const std::string& source) {
+  auto data = library.is_object() ? library.find("data") : library.end();
+  if (data == library.end() || !data->is_array())
+    input_error(source, ": a Fusion tool library must be a JSON object with a \"data\" list");
+  // Fusion's types that tridex simulates; the others are skipped.
+  static const std::map<std::string, std::string> kShapes = {{"flat end mill", "cylindrical"},
+                                                             {"face mill", "cylindrical"},
+                                                             {"ball end mill", "ballnose"},
+                                                             {"bull nose end mill", "bullnose"}};
+  ToolTable result;
+  std::map<int, std::size_t> entry_of;  // tool number -> its index in "data"
+  for (std::size_t k = 0; k < data->size(); ++k) {
+    const nlohmann::json& tool = (*data)[k];
+    std::string where = source + ": \"data\"[" + std::to_string(k) + "]";
+    if (!tool.is_object()) input_error(where, ": must be a JSON object, got ", json_type_name(tool));
+    auto type = tool.find("type");
+    if (type == tool.end() || !type->is_string()) input_error(where, ": missing \"type\" (a string)");
+    auto shape = kShapes.find(lower(type->get<std::string>()));
+    if (shape == kShapes.end()) continue;
+    std::string description;
+    if (auto d = tool.find("description"); d != tool.end() && d->is_string()) description = d->get<std::string>();
+    if (!description.empty()) where += " (\"" + description + "\")";
+    // The number the program calls it by.
+    auto post = tool.find("post-process");
+    if (post == tool.end() || !post->is_object()) input_error(where, ": missing \"post-process\" (an object)");
+    auto number_key = post->find("number");
+    if (number_key == post->end() || !number_key->is_number_integer() || number_key->get<long long>() < 0 ||
+        number_key->get<long long>() > 1'000'000'000)
+      input_error(where, ": \"post-process\".\"number\" must be a non-negative integer tool number");
+    const int number = static_cast<int>(number_key->get<long long>());
+    if (auto [previous, inserted] = entry_of.emplace(number, k); !inserted)
+      input_error(source, ": \"data\"[", previous->second, "] and \"data\"[", k, "] are both tool ", number);
+    where = source + ": tool " + std::to_string(number) + (description.empty() ? "" : " (\"" + description + "\")");
+
+    auto unit_scale = [&](const nlohmann::json& object, const std::string& at, double fallback) {
+      auto unit = object.find("unit");
+      if (unit == object.end()) return fallback;
+      if (!unit->is_string()) input_error(at, ": \"unit\" must be a string, got ", json_type_name(*unit));
+      std::string u = lower(unit->get<std::string>());
+      if (u == "millimeters" || u == "mm") return 1.0;
+      if (u == "inches" || u == "inch" || u == "in") return 25.4;
+      input_error(at, ": unknown \"unit\" \"", u, "\" (expected millimeters or inches)");
+    };
+    auto unit = tool.find("unit");
+    if (unit == tool.end()) input_error(where, ": missing \"unit\"");
+    const double scale = unit_scale(tool, where, 1.0);
+    auto geometry = tool.find("geometry");
+    if (geometry == tool.end() || !geometry->is_object()) input_error(where, ": missing \"geometry\" (an object)");
+    const std::string at = where + ": \"geometry\"";
+    ToolSpec spec;
+    spec.number = number;
+    spec.shape = shape->second;
+    spec.description = description;
+    spec.diameter_mm = scale * number_field(*geometry, at, {"DC"}, true);
+    spec.flute_length_mm = scale * number_field(*geometry, at, {"LCF"}, true);
+    spec.stick_out_mm = scale * number_field(*geometry, at, {"LB"}, true);
+    const double overall = scale * number_field(*geometry, at, {"OAL"}, true);
+    spec.shank_diameter_mm = scale * number_field(*geometry, at, {"SFDM"}, true);
+    if (spec.shape == "bullnose") {
+      spec.corner_radius_mm = scale * number_field(*geometry, at, {"RE"}, true);
+      // Fusion keeps "bull nose" with RE equal to the radius for what is a ball.
+      if (spec.corner_radius_mm >= spec.diameter_mm / 2) spec.shape = "ballnose";
+    }
+    if (spec.stick_out_mm > overall)
+      input_error(at, ": \"LB\" ", spec.stick_out_mm, " mm is longer than \"OAL\" ", overall, " mm");
+    if (!(spec.flute_length_mm > 0)) input_error(at, ": \"LCF\" must be positive");
+    if (spec.flute_length_mm > spec.stick_out_mm)
+      input_error(at, ": \"LCF\" ", spec.flute_length_mm, " mm is longer than \"LB\" ", spec.stick_out_mm, " mm");
+    if (!(spec.shank_diameter_mm > 0)) input_error(at, ": \"SFDM\" must be positive");
+    if (auto holder = tool.find("holder"); holder != tool.end()) {
+      const std::string hat = where + ": \"holder\"";
+      if (!holder->is_object()) input_error(hat, ": must be a JSON object, got ", json_type_name(*holder));
+      const double holder_scale = unit_scale(*holder, hat, scale);
+      auto segments = holder->find("segments");
+      if (segments == holder->end() || !segments->is_array())
+        input_error(hat, ": missing \"segments\" (a list)");
+      for (std::size_t s = 0; s < segments->size(); ++s) {
+        const nlohmann::json& segment = (*segments)[s];
+        std::string sat = hat + ": \"segments\"[" + std::to_string(s) + "]";
+        if (!segment.is_object()) input_error(sat, ": must be a JSON object, got ", json_type_name(segment));
+        spec.holder.push_back(BodySection{holder_scale * number_field(segment, sat, {"lower-diameter"}, true) / 2,
+                                          holder_scale * number_field(segment, sat, {"upper-diameter"}, true) / 2,
+                                          holder_scale * number_field(segment, sat, {"height"}, true)});
+      }
+    }
+    spec.cutter = make_cutter(spec, where);
+    spec.body = make_body(spec, where);
     result.tools_.emplace(number, std::move(spec));
   }
   return result;
 }
 
 ToolTable ToolTable::read(const std::filesystem::path& path) {
-  return from_json(read_json_file(path), path.string());
+  nlohmann::json json = read_json_file(path);
+  if (json.is_object() && json.contains("data") && json["data"].is_array())
+    return from_fusion_json(json, path.string());
+  return from_json(json, path.string());
 }
 
 }  // namespace tridex::cli

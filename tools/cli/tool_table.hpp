@@ -11,6 +11,22 @@
 //   spheroid     the lower half of an ellipsoid of radius D/2 and height "length", as a fine
 //                convex polyline (64 pieces)
 // "description" and unknown keys are ignored, so that CAMotics tables load unchanged.
+//
+// The parts that do not cut (tridex/tool_body.hpp), all optional, in the tool's units:
+//   "flute-length"    the cutting length; above it the shank (none given: the flutes go on up)
+//   "shank-diameter"  the shank's diameter (default: "diameter")
+//   "stick-out"       the length out of the holder, tip to holder face
+//   "holder"          its sections from the holder face up, each {"bottom-diameter",
+//                     "top-diameter", "length"} (a cylinder when the diameters agree, else a
+//                     cone frustum); needs "stick-out"
+//
+// The second format, Autodesk Fusion's tool library export (`{"data": [tool, ...]}`), is read by
+// from_fusion_json: each tool's "post-process"."number" is its number, "unit" "millimeters" or
+// "inches", "type" "flat end mill", "face mill", "ball end mill" or "bull nose end mill" (other
+// entries — drills, holders, probes, turning tools — are skipped), and "geometry" DC (cutting
+// diameter), LCF (flute length), LB (length below the holder: the stick-out), OAL (overall
+// length), SFDM (shank diameter) and RE (corner radius, bull nose), with "holder"."segments" of
+// {"height", "lower-diameter", "upper-diameter"} from the holder face up.
 #pragma once
 
 #include <filesystem>
@@ -20,6 +36,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "tridex/cutter.hpp"
+#include "tridex/tool_body.hpp"
 
 namespace tridex::cli {
 
@@ -30,14 +47,22 @@ struct ToolSpec {
   double length_mm = 0;       // 0 when the table gives none
   double corner_radius_mm = 0;
   double snub_diameter_mm = 0;
+  double flute_length_mm = 0;    // 0 when the table gives none (flutes all the way up)
+  double shank_diameter_mm = 0;  // 0: the cutting diameter
+  double stick_out_mm = 0;       // 0 when the table gives none
+  std::vector<BodySection> holder;  // bottom (holder face) first; radii and lengths in mm
   std::string description;
   Cutter cutter = Cutter::flat(1);
+  ToolBody body;  // the shank and holder parts, from the fields above
 };
 
 class ToolTable {
  public:
   // Parses a table; `source` names it in error messages. Throws InputError naming the tool and key.
   static ToolTable from_json(const nlohmann::json& table, const std::string& source);
+  // Parses a Fusion tool library (`{"data": [...]}`); throws InputError naming the tool and field.
+  static ToolTable from_fusion_json(const nlohmann::json& library, const std::string& source);
+  // Reads either format (a Fusion library is an object with a "data" list).
   static ToolTable read(const std::filesystem::path& path);
 
   const ToolSpec* find(int number) const {
@@ -53,5 +78,9 @@ class ToolTable {
 
 // The cutter a tool description stands for (the mapping above); throws InputError.
 Cutter make_cutter(const ToolSpec& spec, const std::string& where);
+
+// The shank and holder parts of a tool description, checked (flutes within the stick-out, the
+// holder above a positive stick-out); throws InputError naming `where` and the key.
+ToolBody make_body(const ToolSpec& spec, const std::string& where);
 
 }  // namespace tridex::cli
