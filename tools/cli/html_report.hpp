@@ -1,8 +1,7 @@
 // tridex command — `--html OUT.html` of simulate and check (issue 15): one self-contained page
 // with the machined part in a three.js view (for check, the design as a translucent ghost over
-// it on request), the toolpath with a slider over the program, the
-// findings (choosing one flies the camera to it and lists its G-code lines) and the report's
-// figures. three.js and its OrbitControls (Debian's libjs-three, found by CMake) and the page
+// it on request), the toolpath with a slider over the program, the findings (choosing one flies
+// the camera to it and lists its G-code lines) and the report's figures. three.js and its OrbitControls (Debian's libjs-three, found by CMake) and the page
 // template (html_report.html) are embedded in the command and inlined into every page, so the page
 // opens offline and makes no request.
 //
