@@ -1,6 +1,8 @@
 // Opens a --html page in Debian's headless Chromium RUNS times (a fresh tab each) and prints its
-// size and the median time from navigation to the first frame drawn (window.tridexView.ready);
-// with --screenshot, keeps a picture of the last load. For bench/tools/README.md and docs/.
+// size and the median time from navigation to the first frame drawn (window.tridexView.ready), and
+// where that time goes: the page's own stage times (window.tridexView.timings, ms since
+// navigation), as medians over the runs. With --screenshot, keeps a picture of the last load. For
+// bench/tools/README.md and docs/.
 //   node tests/html/open_page.mjs PAGE.html [--runs N] [--screenshot OUT.png] [--chromium PATH]
 import fs from 'node:fs';
 import os from 'node:os';
@@ -18,7 +20,7 @@ const browser = await puppeteer.launch({
   args: ['--headless=new', '--no-sandbox', '--disable-gpu', '--enable-unsafe-swiftshader', '--use-angle=swiftshader',
          '--disable-background-networking', '--disable-component-update', '--no-first-run'],
 });
-const seconds = [];
+const seconds = [], stages = [];
 let errors = 0;
 try {
   for (let r = 0; r < runs; ++r) {
@@ -30,6 +32,7 @@ try {
     await page.goto(pathToFileURL(file).href, { waitUntil: 'load', timeout: 300000 });
     await page.waitForFunction('window.tridexView && window.tridexView.ready', { timeout: 300000 });
     seconds.push((performance.now() - start) / 1000);
+    stages.push(await page.evaluate(() => window.tridexView.timings));
     if (r === runs - 1 && screenshot) await page.screenshot({ path: screenshot });
     await page.close();
   }
@@ -41,4 +44,14 @@ seconds.sort((a, b) => a - b);
 console.log(`${path.basename(file)}: ${(fs.statSync(file).size / 1e6).toFixed(2)} MB; ready in ` +
             `${seconds.map((s) => s.toFixed(2)).join(', ')} s (median ${seconds[Math.floor(runs / 2)].toFixed(2)} s)` +
             (errors ? `; ${errors} console error(s)` : ''));
+// Each stage's median duration (from the previous stage's end; "script" is from navigation, so it
+// holds loading and parsing the HTML and running three.js).
+const median = (values) => values.sort((a, b) => a - b)[Math.floor(values.length / 2)];
+let previous = null;
+const parts = [];
+for (const stage of Object.keys(stages[0] || {})) {
+  parts.push(stage + ' ' + median(stages.map((t) => t[stage] - (previous ? t[previous] : 0))).toFixed(0));
+  previous = stage;
+}
+console.log('stages, median ms: ' + parts.join(', '));
 process.exit(errors ? 1 : 0);

@@ -127,6 +127,24 @@ try {
     check(items.length === expected && report.gouges.length === 1, 'check: ' + items.length + ' findings listed, ' + expected + ' in the report');
     check(items[0].startsWith('gouge'), 'check: the gouge first: ' + items[0]);
     check(await page.$eval('#legend', (e) => !e.hidden), 'check: the deviation legend is shown');
+    // The design ghost: off at first, then translucent amber over the part (and over the
+    // background where the part is hidden), off again with its checkbox.
+    check(await page.$eval('#design-toggle', (e) => !e.hidden) && data.design.triangles_shown > 0, 'check: the design toggle is offered');
+    await toggle(page, 'show-path'); await toggle(page, 'show-rapids');
+    const noGhost = await page.evaluate(() => window.tridexView.sample());
+    await toggle(page, 'show-design');
+    const ghost = await page.evaluate(() => window.tridexView.sample());
+    await page.screenshot({ path: path.join(out, 'check_design.png') });
+    await toggle(page, 'show-part');
+    const ghostOnly = await page.evaluate(() => window.tridexView.sample());
+    check(noGhost.ghost < 0.001 * noGhost.all && ghost.ghost > 0.05 * ghost.all && ghostOnly.ghost > 0.05 * ghostOnly.all,
+          'check: the design ghost is drawn when asked: ' + JSON.stringify([noGhost, ghost, ghostOnly]));
+    // Where the design is drawn: its own centre lies on ghost-coloured pixels, part hidden or not.
+    const [gx, gy] = await page.evaluate((b) => window.tridexView.project(b.min.map((x, a) => (x + b.max[a]) / 2)), data.design.box);
+    const aroundGhost = await page.evaluate((x, y) => window.tridexView.sample(x - 0.05, y - 0.05, x + 0.05, y + 0.05), gx, gy);
+    check(aroundGhost.ghost > 0.8 * aroundGhost.all, 'check: ghost pixels around the design centre: ' + JSON.stringify(aroundGhost));
+    await toggle(page, 'show-part'); await toggle(page, 'show-design');
+    await toggle(page, 'show-path'); await toggle(page, 'show-rapids');
     const point = report.gouges[0].deepest_point;
     const before = await page.evaluate((p) => window.tridexView.project(p), point);
     await page.click('#findings li[data-index="0"]');

@@ -227,6 +227,23 @@ TEST_CASE("the page holds the report, the listed source lines, and says when the
   const std::vector<std::uint32_t> runs = {3, 1};  // line 3, one line
   CHECK(data["toolpath"]["program_line_runs"] == base64({reinterpret_cast<const std::uint8_t*>(runs.data()), 8}));
   CHECK(data["machining_time_s"].get<double>() == doctest::Approx(0.1));  // 1 mm at 600 mm/min
+  CHECK(!data.contains("design"));
+  // check's design: its own mesh in the page, within its budget, over its own box.
+  const Mesh design = heightfield(60);  // 7,200 triangles
+  page.design = &design;
+  limits = {};
+  limits.max_design_triangles = 1000;
+  data = html_page_data(page, limits);
+  REQUIRE(data.contains("design"));
+  CHECK(data["design"]["triangles"] == design.triangles.size());
+  CHECK(data["design"]["triangles_shown"].get<std::size_t>() <= 1000);
+  CHECK(data["design"]["triangles_shown"].get<std::size_t>() > 100);
+  CHECK(!data["design"].contains("deviation"));
+  const Aabb design_box = design.bounds();
+  for (int a = 0; a < 3; ++a) {
+    CHECK(data["design"]["box"]["min"][a].get<double>() == doctest::Approx(design_box.min[a]).epsilon(1e-6));
+    CHECK(data["design"]["box"]["max"][a].get<double>() == doctest::Approx(design_box.max[a]).epsilon(1e-6));
+  }
   fs::remove_all(dir);
 }
 

@@ -428,7 +428,8 @@ int run_check(const CheckOptions& options) {
     progress.stage("writing " + options.html);
     write_html_report(options.html, {.title = "tridex check: " + r.input.program.filename().string() + " against " +
                                               fs::path(options.design).filename().string(),
-                                     .report = report, .mesh = &mesh, .deviation = deviation, .groups = &r.groups,
+                                     .report = report, .mesh = &mesh, .deviation = deviation, .design = &design,
+                                     .groups = &r.groups,
                                      .files = r.input.files});
   }
   progress.finish();

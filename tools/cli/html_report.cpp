@@ -123,23 +123,29 @@ double feed_time_s(const std::vector<gcode::MoveGroup>& groups) {
   return minutes * 60;
 }
 
+// A mesh as the page draws it: simplified to `budget` triangles, quantised points, base64.
+Json display_mesh_json(const Mesh* mesh, std::span<const double> deviation, double gouge_tol, double excess_tol,
+                       std::size_t budget) {
+  Json shown_json = {{"triangles", 0}, {"triangles_shown", 0}};
+  if (!mesh || mesh->triangles.empty()) return shown_json;
+  DisplayMesh shown = simplify_for_display(*mesh, deviation, gouge_tol, excess_tol, budget);
+  const Aabb box = bounds_of(shown.positions);
+  shown_json["triangles"] = mesh->triangles.size();
+  shown_json["triangles_shown"] = shown.indices.size() / 3;
+  shown_json["box"] = box_json(box);
+  shown_json["positions"] = quantised(shown.positions, box);
+  shown_json["indices"] = base64_of(shown.indices);
+  if (!shown.deviation.empty()) shown_json["deviation"] = base64_of(shown.deviation);
+  return shown_json;
+}
+
 Json mesh_json(const HtmlPage& page, const HtmlLimits& limits) {
-  Json mesh = {{"triangles", 0}, {"triangles_shown", 0}};
-  if (!page.mesh || page.mesh->triangles.empty()) return mesh;
   double gouge_tol = 0, excess_tol = 0;
   if (!page.deviation.empty()) {
     gouge_tol = page.report.at("tolerances_mm").at("gouge").get<double>();
     excess_tol = page.report.at("tolerances_mm").at("excess").get<double>();
   }
-  DisplayMesh shown = simplify_for_display(*page.mesh, page.deviation, gouge_tol, excess_tol, limits.max_triangles);
-  const Aabb box = bounds_of(shown.positions);
-  mesh["triangles"] = page.mesh->triangles.size();
-  mesh["triangles_shown"] = shown.indices.size() / 3;
-  mesh["box"] = box_json(box);
-  mesh["positions"] = quantised(shown.positions, box);
-  mesh["indices"] = base64_of(shown.indices);
-  if (!shown.deviation.empty()) mesh["deviation"] = base64_of(shown.deviation);
-  return mesh;
+  return display_mesh_json(page.mesh, page.deviation, gouge_tol, excess_tol, limits.max_triangles);
 }
 
 Json toolpath_json(const HtmlPage& page, const HtmlLimits& limits) {
@@ -325,6 +331,7 @@ Json html_page_data(const HtmlPage& page, const HtmlLimits& limits) {
   data["report"] = page.report;
   data["mesh"] = mesh_json(page, limits);
   data["toolpath"] = toolpath_json(page, limits);
+  if (page.design) data["design"] = display_mesh_json(page.design, {}, 0, 0, limits.max_design_triangles);
   Json directions = Json::array();
   if (page.groups)
     for (const gcode::MoveGroup& g : *page.groups) {

@@ -1,7 +1,7 @@
 // tridex command — `--html OUT.html` of simulate and check (issue 15): one self-contained page
-// with the machined part in a three.js view, the toolpath with a slider over the program, the
-// findings (choosing one flies the camera to it and lists its G-code lines) and the report's
-// figures. three.js and its OrbitControls (Debian's libjs-three, found by CMake) and the page
+// with the machined part in a three.js view (for check, the design as a translucent ghost over
+// it on request), the toolpath with a slider over the program, the findings (choosing one flies
+// the camera to it and lists its G-code lines) and the report's figures. three.js and its OrbitControls (Debian's libjs-three, found by CMake) and the page
 // template (html_report.html) are embedded in the command and inlined into every page, so the page
 // opens offline and makes no request.
 //
@@ -28,6 +28,7 @@ namespace tridex::cli {
 
 struct HtmlLimits {
   std::size_t max_triangles = 250'000;    // shown of the part (a budget; see simplify_for_display)
+  std::size_t max_design_triangles = 100'000;  // of check's design ghost (drawn translucent)
   std::size_t max_segments = 1'000'000;   // of the toolpath after thinning
   double path_tolerance = 1.0 / 4000;     // thinning, as a fraction of the toolpath's box diagonal
   std::uintmax_t max_source_bytes = 4 << 20;  // the whole program text is inlined up to this size
@@ -39,6 +40,7 @@ struct HtmlPage {
   Json report;                                  // the report as --report writes it
   const Mesh* mesh = nullptr;                   // the machined part; null or empty: none left
   std::span<const double> deviation;            // check: signed deviation per mesh vertex
+  const Mesh* design = nullptr;                 // check: the design, shown as a ghost on request
   const std::vector<gcode::MoveGroup>* groups = nullptr;
   std::vector<std::filesystem::path> files;     // the G-code file(s), for the listings
 };
