@@ -7,7 +7,8 @@
 // is never built: its top triangles come straight from the height grid, two per cell along the
 // diagonal (i, j)–(i+1, j+1); the walls drop from the border to the bottom; the bottom is one
 // rectangle. Most cells are smaller than a ray spacing and are rejected by a bounding-box test
-// on four projected points.
+// on four projected points. A fine cell (ZMapFineCells) is scanned as its sub-grid's triangles
+// and its vertical steps to plain neighbours (polyhedron.hpp).
 //
 // Exactness follows dexelize.hpp (b): projected points live on a fixed-point grid of 2^F
 // subdivisions of the lattice spacing, where point-in-triangle tests are exact, and a ray lying
