@@ -16,8 +16,10 @@
 // so the pieces tile the range exactly; a node whose height range (or plane band) lies wholly
 // above or below the ray over its piece is settled without descending (the paper's pruning,
 // tightened for flat regions), and a leaf
-// walks its cells, cutting at grid lines and cell diagonals, where g is linear. The result is a
-// sorted list of disjoint intervals — boundary crossings come out paired by construction.
+// walks its cells, cutting at grid lines and cell diagonals (and, in a fine cell, at its
+// sub-grid's lines and diagonals), where g is linear. The result is a sorted list of disjoint
+// intervals — boundary crossings come out paired by construction. A fine cell's vertical steps
+// need no faces here: H jumps between the pieces on either side of the cell's edge.
 #pragma once
 
 #include <algorithm>
@@ -197,6 +199,18 @@ class GridTree {
           lo = std::min(lo, static_cast<float>(h)), hi = std::max(hi, static_cast<float>(h));
           deviation = std::max(deviation, std::abs(h - plane_at(node, r, g.x(i), g.y(j))));
         }
+      // A fine cell's sub-points may stray beyond its corners (a rib between grid points).
+      constexpr int kSteps = ZMapFineCells::kSteps, kSide = ZMapFineCells::kSide;
+      for (int j = r.j0; j < r.j1 && !map_->fine.empty(); ++j)
+        for (int i = r.i0; i < r.i1; ++i)
+          if (const float* f = map_->fine_cell(i, j))
+            for (int b = 0; b < kSide; ++b)
+              for (int a = 0; a < kSide; ++a) {
+                const float h = f[a + kSide * b];
+                lo = std::min(lo, h), hi = std::max(hi, h);
+                const double x = g.x(i) + a * (g.cell / kSteps), y = g.y(j) + b * (g.cell / kSteps);
+                deviation = std::max(deviation, std::abs(double(h) - plane_at(node, r, x, y)));
+              }
       node.lo = lo, node.hi = hi, node.left = 0, node.deviation = round_up(deviation);
       nodes_[index] = node;
       return;
@@ -316,11 +330,49 @@ class GridTree {
       int i = std::clamp(static_cast<int>(std::floor((o.x + tm * d.x - g.x0) / g.cell)), r.i0, r.i1 - 1);
       int j = std::clamp(static_cast<int>(std::floor((o.y + tm * d.y - g.y0) / g.cell)), r.j0, r.j1 - 1);
       const ZMap& map = *tree.map_;
+      if (const float* f = map.fine_cell(i, j)) return fine_piece(i, j, f, t0, t1);
       double h00 = detail::zmap_top(map, g.index(i, j)), h10 = detail::zmap_top(map, g.index(i + 1, j));
       double h01 = detail::zmap_top(map, g.index(i, j + 1)), h11 = detail::zmap_top(map, g.index(i + 1, j + 1));
-      // Cell-local coordinates along the ray: f(t) = (o + t·d − corner) / cell.
-      double fx0 = (o.x - g.x(i)) / g.cell, fdx = d.x / g.cell;
-      double fy0 = (o.y - g.y(j)) / g.cell, fdy = d.y / g.cell;
+      quad_piece(g.x(i), g.y(j), g.cell, h00, h10, h01, h11, t0, t1);
+    }
+
+    // A fine cell (ZMapFineCells): cut [t0, t1] at its sub-grid lines, each sub-cell a quad.
+    void fine_piece(int i, int j, const float* f, double t0, double t1) {
+      constexpr int kSteps = ZMapFineCells::kSteps, kSide = ZMapFineCells::kSide;
+      const ZMapGrid& g = tree.map_->grid;
+      const double step = g.cell / kSteps, x0 = g.x(i), y0 = g.y(j);
+      double cuts[2 * kSteps];
+      int count = 0;
+      cuts[count++] = t0;
+      for (int m = 1; m < kSteps; ++m) {
+        if (d.x != 0) {
+          double t = (x0 + m * step - o.x) / d.x;
+          if (t > t0 && t < t1) cuts[count++] = t;
+        }
+        if (d.y != 0) {
+          double t = (y0 + m * step - o.y) / d.y;
+          if (t > t0 && t < t1) cuts[count++] = t;
+        }
+      }
+      for (int k = 2; k < count; ++k)
+        for (int m = k; m > 1 && cuts[m] < cuts[m - 1]; --m) std::swap(cuts[m], cuts[m - 1]);
+      cuts[count++] = t1;
+      for (int k = 0; k + 1 < count; ++k) {
+        const double tm = 0.5 * (cuts[k] + cuts[k + 1]);
+        const int a = std::clamp(static_cast<int>(std::floor((o.x + tm * d.x - x0) / step)), 0, kSteps - 1);
+        const int b = std::clamp(static_cast<int>(std::floor((o.y + tm * d.y - y0) / step)), 0, kSteps - 1);
+        quad_piece(x0 + a * step, y0 + b * step, step, f[a + kSide * b], f[a + 1 + kSide * b], f[a + kSide * (b + 1)],
+                   f[a + 1 + kSide * (b + 1)], cuts[k], cuts[k + 1]);
+      }
+    }
+
+    // The piece [t0, t1] over one square of the triangulation (a cell, or a fine cell's
+    // sub-cell) with corner (x0, y0), side `size` and corner heights h00 … h11.
+    void quad_piece(double x0, double y0, double size, double h00, double h10, double h01, double h11, double t0,
+                    double t1) {
+      // Square-local coordinates along the ray: f(t) = (o + t·d − corner) / size.
+      double fx0 = (o.x - x0) / size, fdx = d.x / size;
+      double fy0 = (o.y - y0) / size, fdy = d.y / size;
       auto g_lower = [&](double t) {  // triangle fx ≥ fy
         return o.z + t * d.z - (h00 + (fx0 + t * fdx) * (h10 - h00) + (fy0 + t * fdy) * (h11 - h10));
       };

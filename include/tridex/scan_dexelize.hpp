@@ -7,7 +7,8 @@
 // is never built: its top triangles come straight from the height grid, two per cell along the
 // diagonal (i, j)–(i+1, j+1); the walls drop from the border to the bottom; the bottom is one
 // rectangle. Most cells are smaller than a ray spacing and are rejected by a bounding-box test
-// on four projected points.
+// on four projected points. A fine cell (ZMapFineCells) is scanned as its sub-grid's triangles
+// and its vertical steps to plain neighbours (polyhedron.hpp).
 //
 // Exactness follows dexelize.hpp (b): projected points live on a fixed-point grid of 2^F
 // subdivisions of the lattice spacing, where point-in-triangle tests are exact, and a ray lying
@@ -30,6 +31,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <thread>
 #include <vector>
@@ -73,7 +75,9 @@ class ZMapScanner {
       bx[k] = r[0][w] * c / s, by[k] = r[1][w] * c / s, bz[k] = r[2][w] / s;
     }
     t0_ = r[0][axis] * grid_.x0 + r[1][axis] * grid_.y0 + o[axis];
-    tx_ = r[0][axis] * c, ty_ = r[1][axis] * c, tz_ = r[2][axis];
+    // Per sub-step of a fine cell (kSteps a power of two, so a grid step is exactly kSteps of
+    // them and a grid point's t is the same computed either way).
+    tx_ = r[0][axis] * c / kSteps, ty_ = r[1][axis] * c / kSteps, tz_ = r[2][axis];
     // Fixed point: every |Q| below 2^61 so that differences stay below 2^62 and the edge
     // functions (sums of two products) below 2^125.
     double top = bottom_;
@@ -91,9 +95,11 @@ class ZMapScanner {
       fail("scan dexelize: the Z-map reaches ", reach, " spacings from the lattice origin, too far for exact ray tests");
     bits_ = std::min(bits, 40);
     const double scale = std::ldexp(1.0, bits_);
+    // A grid step is exactly kSteps fine sub-steps, so a grid point has the same fixed-point
+    // coordinates whether a plain cell or a fine one asks.
     for (int k = 0; k < 2; ++k) {
-      q0_[k] = std::llround(a[k] * scale), qx_[k] = std::llround(bx[k] * scale), qy_[k] = std::llround(by[k] * scale);
-      qz_[k] = bz[k] * scale;
+      q0_[k] = std::llround(a[k] * scale), qz_[k] = bz[k] * scale;
+      qx_[k] = kSteps * std::llround(bx[k] / kSteps * scale), qy_[k] = kSteps * std::llround(by[k] / kSteps * scale);
     }
   }
 
@@ -105,8 +111,17 @@ class ZMapScanner {
     fill_row(j0, lower, hl);
     for (int j = j0; j < j1; ++j) {
       fill_row(j + 1, upper, hu);
+      // The row's fine cells, in ascending order: each is scanned as its sub-grid instead.
+      const std::uint32_t* fine = map_.fine.empty() ? nullptr : map_.fine.cells.data() + map_.fine.row_begin[static_cast<std::size_t>(j)];
+      const std::uint32_t* fine_end = fine ? map_.fine.cells.data() + map_.fine.row_begin[static_cast<std::size_t>(j) + 1] : nullptr;
+      const std::size_t row_base = grid_.index(0, j);
       for (int i = 0; i + 1 < nx; ++i) {
         const auto ii = static_cast<std::size_t>(i);
+        if (fine != fine_end && *fine == row_base + ii) {
+          fine_cell(i, j, map_.fine.heights.data() + static_cast<std::size_t>(fine - map_.fine.cells.data()) * ZMapFineCells::kPoints, hits);
+          ++fine;
+          continue;
+        }
         const ScanVertex &p00 = lower[ii], &p10 = lower[ii + 1], &p01 = upper[ii], &p11 = upper[ii + 1];
         std::int64_t lo_u = std::min(std::min(p00.u, p10.u), std::min(p01.u, p11.u));
         std::int64_t hi_u = std::max(std::max(p00.u, p10.u), std::max(p01.u, p11.u));
@@ -118,8 +133,9 @@ class ZMapScanner {
         if (iv0 > iv1) continue;
         // The t of each corner is only needed now.
         ScanVertex a = p00, b = p10, c = p11, d = p01;
-        a.t = world_t(i, j, hl[ii]), b.t = world_t(i + 1, j, hl[ii + 1]);
-        c.t = world_t(i + 1, j + 1, hu[ii + 1]), d.t = world_t(i, j + 1, hu[ii]);
+        const std::int64_t I = std::int64_t{kSteps} * i, J = std::int64_t{kSteps} * j;
+        a.t = world_t(I, J, hl[ii]), b.t = world_t(I + kSteps, J, hl[ii + 1]);
+        c.t = world_t(I + kSteps, J + kSteps, hu[ii + 1]), d.t = world_t(I, J + kSteps, hu[ii]);
         triangle(a, b, c, hits);
         triangle(a, c, d, hits);
       }
@@ -152,17 +168,58 @@ class ZMapScanner {
   int bits() const { return bits_; }
 
  private:
+  static constexpr int kSteps = ZMapFineCells::kSteps;
+
+  // A fine cell (ZMapFineCells): the triangles of its sub-grid, and the vertical steps along its
+  // edges to plain neighbours (polyhedron.hpp, fine_cell_step).
+  void fine_cell(int i, int j, const float* f, std::vector<MeshHit>& hits) const {
+    constexpr int kSide = ZMapFineCells::kSide;
+    ScanVertex p[ZMapFineCells::kPoints];
+    std::int64_t lo_u = std::numeric_limits<std::int64_t>::max(), hi_u = std::numeric_limits<std::int64_t>::min();
+    std::int64_t lo_v = lo_u, hi_v = hi_u;
+    for (int b = 0; b < kSide; ++b)
+      for (int a = 0; a < kSide; ++a) {
+        ScanVertex& q = p[a + kSide * b];
+        q = sub_vertex(std::int64_t{kSteps} * i + a, std::int64_t{kSteps} * j + b, double(f[a + kSide * b]));
+        lo_u = std::min(lo_u, q.u), hi_u = std::max(hi_u, q.u), lo_v = std::min(lo_v, q.v), hi_v = std::max(hi_v, q.v);
+      }
+    // The steps lie between the cell's sub-points and its straight edges, so within this box too.
+    if (ceil_units(lo_u) > ceil_units(hi_u) - 1 || ceil_units(lo_v) > ceil_units(hi_v) - 1) return;
+    for (int b = 0; b < kSteps; ++b)
+      for (int a = 0; a < kSteps; ++a) {
+        const ScanVertex &p00 = p[a + kSide * b], &p10 = p[a + 1 + kSide * b];
+        const ScanVertex &p01 = p[a + kSide * (b + 1)], &p11 = p[a + 1 + kSide * (b + 1)];
+        triangle(p00, p10, p11, hits);
+        triangle(p00, p11, p01, hits);
+      }
+    for (const FineSide& side : fine_sides()) {
+      if (is_fine_cell(map_, i + side.di, j + side.dj)) continue;
+      const ScanVertex* q[kSide];
+      for (int m = 0; m < kSide; ++m) q[m] = &p[side.point[m]];
+      fine_cell_step(q, [&](const ScanVertex* a, const ScanVertex* b, const ScanVertex* c) { triangle(*a, *b, *c, hits); });
+    }
+  }
+
+  // The vertex at fine sub-point (I, J) (grid point (i, j) is (kSteps·i, kSteps·j)).
+  ScanVertex sub_vertex(std::int64_t I, std::int64_t J, double h) const {
+    return {q0_[0] + I * (qx_[0] / kSteps) + J * (qy_[0] / kSteps) + round_fixed(h * qz_[0]),
+            q0_[1] + I * (qx_[1] / kSteps) + J * (qy_[1] / kSteps) + round_fixed(h * qz_[1]), world_t(I, J, h)};
+  }
+
   std::int64_t ceil_units(std::int64_t x) const { return -((-x) >> bits_); }
 
   // Rounding to the nearest fixed-point unit (ties away from zero), inline: llround is a libm
   // call and was a seventh of the scan. |x| < 2^62 here.
   static std::int64_t round_fixed(double x) { return static_cast<std::int64_t>(x + (x >= 0 ? 0.5 : -0.5)); }
 
-  double world_t(int i, int j, double h) const { return t0_ + i * tx_ + j * ty_ + h * tz_; }
+  // The world coordinate along the ray axis at fine sub-point (I, J) and height h.
+  double world_t(std::int64_t I, std::int64_t J, double h) const {
+    return t0_ + double(I) * tx_ + double(J) * ty_ + h * tz_;
+  }
 
   ScanVertex vertex(int i, int j, double h) const {
     return {q0_[0] + i * qx_[0] + j * qy_[0] + round_fixed(h * qz_[0]),
-            q0_[1] + i * qx_[1] + j * qy_[1] + round_fixed(h * qz_[1]), world_t(i, j, h)};
+            q0_[1] + i * qx_[1] + j * qy_[1] + round_fixed(h * qz_[1]), world_t(std::int64_t{kSteps} * i, std::int64_t{kSteps} * j, h)};
   }
 
   void fill_row(int j, std::vector<ScanVertex>& row, std::vector<double>& h) const {

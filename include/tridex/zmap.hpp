@@ -41,11 +41,54 @@ struct ZMapLimits {
   std::size_t max_points = std::size_t{1} << 30;  // 4 GiB of heights
 };
 
+// Steep cells in finer detail (issue 17). Where a wall parallel to the spindle crosses a cell,
+// the heights at its corners say only that the surface drops somewhere inside it, and the
+// two triangles ramp across the whole cell: the solid is off by up to a cell at the wall's rims,
+// where other directions' cuts meet it. A fine cell carries the surface's heights on a
+// kSteps × kSteps sub-grid of its own (refine_steep_cells in zmap_walls.hpp takes them from the
+// moves), triangulated like the grid, so the ramp spans a sub-cell only. Its corners are the
+// map's points; two fine cells that share an edge share its sub-points; where a fine cell meets
+// a plain one (or the grid's border) the solid's top steps vertically along their edge, between
+// the fine cell's sub-points and the plain cell's straight edge.
+struct ZMapFineCells {
+  static constexpr int kSteps = 4;  // sub-cells along each side (a power of two: exact sub-steps)
+  static constexpr int kSide = kSteps + 1;
+  static constexpr int kPoints = kSide * kSide;  // sub-point (a, b) at a + kSide·b, a along x
+
+  std::vector<std::uint32_t> cells;      // grid.index(i, j) of each fine cell's (i, j) corner, ascending
+  std::vector<std::uint32_t> row_begin;  // fine cells of cell row j: [row_begin[j], row_begin[j + 1])
+  std::vector<float> heights;            // kPoints per fine cell, in the order of `cells`; tops
+                                         // (never below the map's empty height)
+  bool empty() const { return cells.empty(); }
+};
+
 class ZMap {
  public:
   ZMapGrid grid;
   float empty_height = 0;      // height of points with no material above them
   std::vector<float> heights;  // point (i, j) at heights[grid.index(i, j)]
+  ZMapFineCells fine;          // steep cells in finer detail; none unless set_fine_cells was called
+
+  // The sub-grid heights of cell (i, j) (ZMapFineCells::kPoints of them), or nullptr for a
+  // plain cell.
+  const float* fine_cell(int i, int j) const {
+    if (fine.cells.empty()) return nullptr;
+    const auto row = static_cast<std::size_t>(j);
+    const auto first = fine.cells.begin() + fine.row_begin[row], last = fine.cells.begin() + fine.row_begin[row + 1];
+    if (first == last) return nullptr;
+    const auto key = static_cast<std::uint32_t>(grid.index(i, j));
+    const auto at = std::lower_bound(first, last, key);
+    if (at == last || *at != key) return nullptr;
+    return fine.heights.data() + static_cast<std::size_t>(at - fine.cells.begin()) * ZMapFineCells::kPoints;
+  }
+
+  // Makes the cells `cells` (grid.index of their (i, j) corners, any order, no repeats) fine,
+  // with `sub_heights` (ZMapFineCells::kPoints per cell, in the order given). Each fine cell's
+  // corners are set to the map's heights there and every height is raised to the empty
+  // height; where two fine cells meet, the cell on the right (or above) takes the shared
+  // edge's sub-points from the other, so they agree exactly. Change `heights` first: the fine
+  // cells' corners are read here. Throws tridex::Error for a cell outside the grid's cells.
+  void set_fine_cells(std::vector<std::uint32_t> cells, std::vector<float> sub_heights);
 
   ZMap() = default;
   ZMap(const ZMapGrid& g, float initial_height, float empty, ZMapLimits limits = {})
@@ -206,6 +249,48 @@ inline ZMap ZMap::from_mesh(const Frame& frame, const Mesh& stock, double cell,
   return map;
 }
 
+inline void ZMap::set_fine_cells(std::vector<std::uint32_t> cells, std::vector<float> sub_heights) {
+  constexpr int kSide = ZMapFineCells::kSide, kSteps = ZMapFineCells::kSteps;
+  constexpr auto kPoints = static_cast<std::size_t>(ZMapFineCells::kPoints);
+  if (sub_heights.size() != cells.size() * kPoints)
+    detail::fail("Z-map fine cells: ", sub_heights.size(), " sub-heights for ", cells.size(), " cells");
+  // Sort the cells, carrying their heights along.
+  std::vector<std::uint32_t> order(cells.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<std::uint32_t>(k);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return cells[a] < cells[b]; });
+  fine = {};
+  fine.cells.reserve(cells.size());
+  fine.heights.reserve(sub_heights.size());
+  for (std::uint32_t k : order) {
+    const std::uint32_t c = cells[k];
+    const int i = static_cast<int>(c % static_cast<std::uint32_t>(grid.nx)), j = static_cast<int>(c / static_cast<std::uint32_t>(grid.nx));
+    if (i + 1 >= grid.nx || j + 1 >= grid.ny) detail::fail("Z-map fine cells: point ", c, " is not the corner of a cell");
+    if (!fine.cells.empty() && fine.cells.back() == c) detail::fail("Z-map fine cells: cell ", c, " given twice");
+    fine.cells.push_back(c);
+    const float* from = sub_heights.data() + k * kPoints;
+    for (std::size_t p = 0; p < kPoints; ++p) fine.heights.push_back(std::max(from[p], empty_height));
+    float* h = fine.heights.data() + fine.heights.size() - kPoints;
+    auto corner = [&](int di, int dj) { return std::max(height(i + di, j + dj), empty_height); };
+    h[0] = corner(0, 0), h[kSteps] = corner(1, 0);
+    h[kSteps * kSide] = corner(0, 1), h[kSteps + kSteps * kSide] = corner(1, 1);
+  }
+  fine.row_begin.assign(static_cast<std::size_t>(grid.ny), 0);
+  for (std::size_t k = 0, row = 0; row < fine.row_begin.size(); ++row) {
+    while (k < fine.cells.size() && fine.cells[k] < row * static_cast<std::size_t>(grid.nx)) ++k;
+    fine.row_begin[row] = static_cast<std::uint32_t>(k);
+  }
+  // Shared edges: copied from the left or lower neighbour, which comes first in the order.
+  for (std::size_t k = 0; k < fine.cells.size(); ++k) {
+    const int i = static_cast<int>(fine.cells[k] % static_cast<std::uint32_t>(grid.nx)),
+              j = static_cast<int>(fine.cells[k] / static_cast<std::uint32_t>(grid.nx));
+    float* h = fine.heights.data() + k * kPoints;
+    if (const float* left = i > 0 ? fine_cell(i - 1, j) : nullptr)
+      for (int b = 0; b < kSide; ++b) h[b * kSide] = left[kSteps + b * kSide];
+    if (const float* below = j > 0 ? fine_cell(i, j - 1) : nullptr)
+      for (int a = 0; a < kSide; ++a) h[a] = below[a + kSteps * kSide];
+  }
+}
+
 inline void raise_uncut(ZMap& milled, const ZMap& initial) {
   const ZMapGrid &a = milled.grid, &b = initial.grid;
   if (a.nx != b.nx || a.ny != b.ny || a.x0 != b.x0 || a.y0 != b.y0 || a.cell != b.cell ||
@@ -233,6 +318,7 @@ inline void raise_uncut(ZMap& milled, const ZMap& initial) {
       if (best > -std::numeric_limits<float>::infinity())
         continued.emplace_back(a.index(i, j), std::clamp(best, milled.empty_height, above));
     }
+  milled.fine = {};  // the heights change under any fine cells
   for (std::size_t p = 0; p < milled.heights.size(); ++p)
     if (milled.heights[p] == initial.heights[p]) milled.heights[p] = above;
   for (const auto& [p, h] : continued) milled.heights[p] = h;

@@ -13,6 +13,7 @@
 #include "tridex/dexel.hpp"
 #include "tridex/mill.hpp"
 #include "tridex/zmap.hpp"
+#include "tridex/zmap_walls.hpp"
 
 namespace backend_tests {
 
@@ -26,7 +27,9 @@ inline Frame random_frame(std::mt19937& rng, bool tilted) {
 
 // A box stock's Z-map in `frame`, milled by random ball, flat and bull-nose moves, some of them
 // through the stock (so that some points become empty).
-inline ZMap random_milled_map(std::mt19937& rng, const Aabb& stock, const Frame& frame, double cell, int moves_count = 12) {
+// With `fine`, the steep cells are then refined from the same moves (zmap_walls.hpp).
+inline ZMap random_milled_map(std::mt19937& rng, const Aabb& stock, const Frame& frame, double cell, int moves_count = 12,
+                              bool fine = false) {
   ZMap map = ZMap::from_box(frame, stock, cell);
   std::uniform_real_distribution<double> unit(0, 1);
   Aabb local = local_bounds(frame, stock);
@@ -41,6 +44,7 @@ inline ZMap random_milled_map(std::mt19937& rng, const Aabb& stock, const Frame&
     moves.push_back({Segment{point(), point()}, static_cast<std::uint32_t>(k % 3)});
   }
   mill(map, cutters, moves, {.threads = 1});
+  if (fine) refine_steep_cells(map, cutters, moves, {.threads = 1});
   return map;
 }
 

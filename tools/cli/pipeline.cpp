@@ -18,6 +18,7 @@
 #include "tridex/polyhedron.hpp"
 #include "tridex/stl.hpp"
 #include "tridex/surface.hpp"
+#include "tridex/zmap_walls.hpp"
 
 namespace tridex::cli {
 
@@ -67,6 +68,11 @@ void write_png_file(const fs::path& path, const render::Image& image) {
   write_file_atomically(path, render::encode_png(image));
 }
 
+// A move of `group` as the kernel mills it: the tool tip in the group's frame.
+CutMove cut_move(const gcode::MoveGroup& group, const gcode::Move& m, const std::map<int, std::uint32_t>& cutter_of_tool) {
+  return CutMove{Segment{group.frame.to_local(m.start), group.frame.to_local(m.end)}, cutter_of_tool.at(m.tool)};
+}
+
 // Mills one group's moves into `map` in program order, checking each rapid with cut_depth against
 // what the map holds when the rapid runs (RapidCheck::in_program_order), and each move's shank and
 // holder when `bodies` is given (collision_check.hpp).
@@ -87,7 +93,7 @@ void mill_in_program_order(ZMap& map, const gcode::MoveGroup& group, std::size_t
     batch.clear();
   };
   for (const gcode::Move& m : group.moves) {
-    CutMove cut{Segment{group.frame.to_local(m.start), group.frame.to_local(m.end)}, cutter_of_tool.at(m.tool)};
+    CutMove cut = cut_move(group, m, cutter_of_tool);
     if (m.kind == gcode::MoveKind::rapid &&
         std::min(cut.tip.a.z, cut.tip.b.z) < double(top) - kRapidTolerance) {
       flush();
@@ -385,7 +391,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
     std::vector<const gcode::Move*> rapid_moves;
     feeds.reserve(group.moves.size());
     for (const gcode::Move& m : group.moves) {
-      CutMove cut{Segment{group.frame.to_local(m.start), group.frame.to_local(m.end)}, cutter_of_tool.at(m.tool)};
+      CutMove cut = cut_move(group, m, cutter_of_tool);
       if (m.kind == gcode::MoveKind::rapid) {
         rapids.push_back(cut);
         rapid_moves.push_back(&m);
@@ -421,9 +427,16 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   // stays as milled; the raised copy is the one intersected.
   std::vector<ZMap> kept_maps;
   if (request.keep_maps) kept_maps = maps;
-  for (std::size_t g = 0; g < maps.size(); ++g)
+  // Then walls parallel to a spindle are placed inside their cells: the steep cells take finer
+  // heights from the moves (zmap_walls.hpp).
+  for (std::size_t g = 0; g < maps.size(); ++g) {
     raise_uncut(maps[g], stock.mesh ? ZMap::from_mesh(groups[g].frame, *stock.mesh, zmap_cell, limits)
                                     : ZMap::from_box(groups[g].frame, stock.box, zmap_cell, limits));
+    std::vector<CutMove> moves;
+    moves.reserve(groups[g].moves.size());
+    for (const gcode::Move& m : groups[g].moves) moves.push_back(cut_move(groups[g], m, cutter_of_tool));
+    refine_steep_cells(maps[g], cutters, moves, {.threads = options.threads});
+  }
   progress.stage("dexelizing the stock");
   TripleDexel stock_dexel = stock.mesh ? dexelize(*stock.mesh, lattice, DexelizeOptions{options.threads})
                                        : TripleDexel::box(lattice, stock.box);
