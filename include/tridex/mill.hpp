@@ -30,9 +30,12 @@
 // at a time too (FlatLanes: a closed form; BullLanes: Newton steps with no square root). The moves
 // left for a tile in pass 2 are cut lowest bound first, a run of one cutter at a time, each run
 // checked against what the tile holds by then: so a tile first cut by any cutter, or roughed
-// deeper by another cutter, still rejects the moves that cut air. Every point ends at the minimum over moves of a value
-// computed the same way whatever the order, so the result is identical for any thread count and
-// any move order (for one build: the vector width and FMA contraction change the last bits).
+// deeper by another cutter, still rejects the moves that cut air. Runs of flat end and bull nose
+// moves are short, and each of their moves is checked against each row as it stands by then
+// (their neighbouring passes cut nearly equal surfaces: Miller::cut_others). Every point ends at
+// the minimum over moves of a value computed the same way whatever the order (a move is skipped
+// only where it cannot lower a point), so the result is identical for any thread count and any
+// move order (for one build: the vector width and FMA contraction change the last bits).
 #pragma once
 
 #include <algorithm>
@@ -72,6 +75,9 @@ namespace detail {
 constexpr int kTile = 16;        // points along each side of a tile
 constexpr int kBinTiles = 8;     // tiles along each side of a work block
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// Moves of a flat end or a bull nose milled together before the tile is measured again (see
+// Miller::cut_others): 1, 2, 4, 8 and 16 measured on the flat end's raster of bench_mill, 8 best.
+constexpr std::ptrdiff_t kOtherRun = 8;
 
 // Doubles processed as one value (GCC/Clang vector extension): eight with AVX-512, four with
 // AVX, two with the SSE2 of every x86-64, two in plain scalar code elsewhere; the compiler's
@@ -1038,10 +1044,15 @@ class Miller {
 
   // Cuts a tile with the moves left, lowest bound first, so that deep cuts (a roughing pass
   // below the finish, say) come before the moves they leave nothing for. A run of consecutive
-  // moves of one cutter with a vector form is milled together, row by row (admitted by what the
-  // tile held before the run: their rows are cheap, a fresher test costs more than it saves);
-  // each run, and each move without a vector form (its points cost far more), is checked again
-  // against what the tile holds by then.
+  // moves of one cutter with a vector form is milled together, row by row (a ball end's admitted
+  // by what the tile held before the run: their rows are cheap, a fresher test costs more than it
+  // saves); each run, and each move without a vector form (its points cost far more), is checked
+  // again against what the tile holds by then. A flat end's or a bull nose's run is at most
+  // kOtherRun moves, and each row is measured again after each of its moves (mill_tile): their
+  // neighbouring passes leave nearly equal surfaces, so that the first cut leaves a tile far from
+  // its final shape (a flat end's raster on a slope is lowest under the side of a neighbouring
+  // pass, which covers a few rows of a tile), and a test against the state after the first cut
+  // admitted 20 times the rows that the ball end's did.
   void cut_others(Tile& tile, const BlockScratch& scratch) {
     std::vector<Candidate>& candidates = tile.candidates;
     std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
@@ -1058,6 +1069,7 @@ class Miller {
       auto run_end = std::find_if(c, candidates.end(), [&](const Candidate& o) {
         return scratch.kind[o.move] == LaneKind::scalar || scratch.moves[o.move].cutter != cutter;
       });
+      if (scratch.kind[c->move] != LaneKind::ball && run_end - c > kOtherRun) run_end = c + kOtherRun;
       auto kept = std::remove_if(c, run_end, [&](const Candidate& o) { return !can_cut(o, tile); });
       if (kept != c) mill_tile(std::span<const Candidate>(&*c, static_cast<std::size_t>(kept - c)), tile, scratch, false);
       c = run_end;
@@ -1082,9 +1094,10 @@ class Miller {
     return c;
   }
 
-  // Whether move c may lower row j of a tile (from its bounds and the row's state).
-  bool row_may_cut(const Candidate& c, const BallLanes* ball, const Tile& tile, int j) const {
-    std::size_t r = static_cast<std::size_t>(j - tile.box.j0);
+  // Whether move c may lower row j of a tile, whose highest point is row_top and whose largest
+  // height above the tile's plane is row_excess.
+  bool row_may_cut(const Candidate& c, const BallLanes* ball, const Tile& tile, int j, double row_top,
+                   double row_excess) const {
     double dy = g_.y(j) - tile.yc;
     // The ball end's rise across the move (BallLanes::across), at its least on this row.
     double across = 0;
@@ -1093,8 +1106,8 @@ class Miller {
       across = a * a * ball->inv_diameter;
     }
     double row_bound = c.has_plane ? c.centre_z + c.gradient.y * dy - std::abs(c.gradient.x) * tile.hx + across : c.bound;
-    if (row_bound >= tile.state.row_top[r]) return false;
-    return !tile.plane.valid || above_plane(c, tile, dy, 0) + across < tile.state.row_excess[r];
+    if (row_bound >= row_top) return false;
+    return !tile.plane.valid || above_plane(c, tile, dy, 0) + across < row_excess;
   }
 
   // kLanes heights of a map row as doubles; of the last `available` < kLanes of a row, the rest
@@ -1119,7 +1132,8 @@ class Miller {
   }
 
   // Lowers a tile to the swept surfaces of `cuts`, row by row: each row is read once, lowered by
-  // every move whose bounds admit it (all of them on every row if `every_row`), and its state
+  // every move whose bounds admit it (all of them on every row if `every_row`; a ball end's by
+  // the row's state before, the others' by its state after the moves before them), and its state
   // (measured against the tile's plane) updated once. Other cutters than the ball end skip the
   // points already below the move's supporting plane.
   void mill_tile(std::span<const Candidate> cuts, Tile& tile, const BlockScratch& scratch, bool every_row) {
@@ -1139,13 +1153,18 @@ class Miller {
     for (int j = t.j0; j <= t.j1; ++j) {
       const double y = g_.y(j), dy = y - tile.yc;
       float* row = &map_.heights[g_.index(t.i0, j)];
+      const double tile_row = plane.z + plane.gradient.y * dy;
       DoubleN h[kGroups];
       bool loaded = false;
+      // The row's highest point and largest height above P as its moves lower it (in double: a
+      // move whose bounds are not below them leaves every point as it is, rounded or not).
+      const std::size_t r = static_cast<std::size_t>(j - t.j0);
+      double row_top = state.row_top[r], row_excess = state.row_excess[r];
       for (const Candidate& c : cuts) {
         const MoveGeometry& m = scratch.moves[c.move];
         const LaneKind kind = scratch.kind[c.move];
         const BallLanes* ball = kind == LaneKind::ball ? &scratch.balls[c.move] : nullptr;
-        if (!every_row && !row_may_cut(c, ball, tile, j)) continue;
+        if (!every_row && !row_may_cut(c, ball, tile, j, row_top, row_excess)) continue;
         if (!loaded) {
           for (int g = 0; g < kGroups; ++g) h[g] = load_heights(row + g * kLanes, count - g * kLanes);
           loaded = true;
@@ -1181,10 +1200,21 @@ class Miller {
                 h[g][l] = std::min(h[g][l], std::max(static_cast<double>(static_cast<float>(z)), empty));
               }
         }
+        if (!ball && !every_row) {
+          // The other cutters' near-equal surfaces (a flat end's neighbouring passes) leave a
+          // row's first cut far from its final shape, often not covering it all: measured again
+          // after each move, the row rejects the moves that it has become lower than.
+          DoubleN top = h[0], excess = h[0] - (tile_row + plane.gradient.x * dx[0]);
+          for (int g = 1; g < kGroups; ++g) {
+            top = max_n(top, h[g]);
+            excess = max_n(excess, h[g] - (tile_row + plane.gradient.x * dx[g]));
+          }
+          row_top = max_lane(top);
+          if (plane.valid) row_excess = max_lane(excess);
+        }
       }
       if (!loaded) continue;
       changed = true;
-      const double tile_row = plane.z + plane.gradient.y * dy;
       DoubleN top = splat(-kInf), excess = splat(-kInf);
       for (int g = 0; g < kGroups; ++g) {
         h[g] = max_n(__builtin_convertvector(__builtin_convertvector(h[g], FloatN), DoubleN), splat(empty));
@@ -1192,7 +1222,6 @@ class Miller {
         top = max_n(top, h[g]);
         excess = max_n(excess, h[g] - (tile_row + plane.gradient.x * dx[g]));
       }
-      std::size_t r = static_cast<std::size_t>(j - t.j0);
       state.row_top[r] = max_lane(top);
       state.row_excess[r] = plane.valid ? max_lane(excess) : -kInf;
     }
