@@ -524,6 +524,7 @@ struct RisingMove {
 
   struct Cover {
     DoubleN t_foot, e2, lo, hi;  // foot on the move's line, squared distance to it, the interval
+    DoubleN half;                // half the interval's length before clipping to [0, 1]: k/|v|
     MaskN covered;
   };
 
@@ -533,19 +534,41 @@ struct RisingMove {
     DoubleN e2 = max_n(ux * ux + uy * uy - t * dot, splat(0));
     DoubleN k = sqrt_n(max_n(r2 - e2, splat(0))) * inv_len;
     DoubleN lo = t - k, hi = t + k;
-    return {t, e2, max_n(lo, splat(0)), min_n(hi, splat(1)), (e2 <= r2) & (lo <= 1) & (hi >= 0)};
+    return {t, e2, max_n(lo, splat(0)), min_n(hi, splat(1)), k, (e2 <= r2) & (lo <= 1) & (hi >= 0)};
   }
 };
 
 // The flat end's swept surface S, kLanes points at a time (MoveGeometry::lowest's closed form):
 // a rising move is lowest above q where its end disc first covers q, S = low + w·lo.
 struct FlatLanes : RisingMove {
+  double side = 0;  // k/|v| for k = 1e-6·R: closer to the footprint's side, no plane
+
   FlatLanes() = default;
-  explicit FlatLanes(const MoveGeometry& m) : RisingMove(m) {}
+  explicit FlatLanes(const MoveGeometry& m) : RisingMove(m), side(1e-6 * m.radius * m.inv_len) {}
 
   DoubleN at(DoubleN ux, DoubleN uy) const {
     Cover c = cover(ux, uy);
     return c.covered ? low + w * c.lo : splat(kInf);
+  }
+
+  // S and its supporting plane's slope (MoveGeometry::flat_supporting_plane): w·∇t_edge, with
+  // t_edge = t⊥ − k/|v| the entry parameter, ∇t⊥ = v/|v|², ∇k = −(u − t⊥·v)/k; zero where t_edge
+  // is clipped. No plane where q is not covered or is within 1e-6·R of the footprint's side.
+  struct Plane {
+    DoubleN z, gx, gy;
+    MaskN has_plane;
+  };
+  Plane plane_at(DoubleN ux, DoubleN uy) const {
+    Cover c = cover(ux, uy);
+    Plane p;
+    p.z = low + w * c.lo;
+    p.has_plane = c.covered & (c.half > side);
+    const DoubleN entry = c.t_foot - c.half;
+    const MaskN sloped = (entry > 0) & (entry < 1) & p.has_plane;
+    const DoubleN scale = sloped ? w * inv_vv / max_n(c.half, splat(side)) : splat(0);  // w·∇t_edge across
+    p.gx = (sloped ? splat(w * vx * inv_vv) : splat(0)) + scale * (ux - c.t_foot * vx);
+    p.gy = (sloped ? splat(w * vy * inv_vv) : splat(0)) + scale * (uy - c.t_foot * vy);
+    return p;
   }
 };
 
@@ -940,6 +963,10 @@ class Miller {
       int col0, col1;
       if (!columns(row, scratch.boxes[k], col0, col1)) continue;
       const MoveGeometry& m = scratch.moves[k];
+      // A flat end's bounds are found kLanes tiles at a time (as the ball end's), the others'
+      // one tile at a time.
+      const bool flat = scratch.kind[k] == LaneKind::flat;
+      FlatBounds flat_bounds;
       for (int col = col0; col <= col1; ++col) {
         Tile& tile = row.tiles[static_cast<std::size_t>(col)];
         if (m.lowest_tip() >= tile.state.top) continue;
@@ -947,7 +974,7 @@ class Miller {
           scratch.deferred.push_back({k, col});
           continue;
         }
-        Candidate c = bound_at_centre(m, tile, k);
+        Candidate c = flat ? flat_bounds.at(scratch.flats[k], m, row, k, col) : bound_at_centre(m, tile, k);
         if (c.bound >= tile.state.top) continue;
         tile.candidates.push_back(c);
         if (c.has_plane && (c.centre_z < lanes.first_z[col] ||
@@ -1001,11 +1028,15 @@ class Miller {
       std::erase_if(tile.candidates,
                     [&](const Candidate& c) { return (has_first && c.move == first) || !can_cut(c, tile); });
     }
+    // A move's deferred tiles are consecutive: a flat end's bounds are found kLanes tiles at a time.
+    FlatBounds flat_bounds;
     for (const DeferredMove& d : scratch.deferred) {
       Tile& tile = row.tiles[static_cast<std::size_t>(d.col)];
       const MoveGeometry& m = scratch.moves[d.move];
       if (m.lowest_tip() >= tile.state.top || static_cast<double>(d.move) == lanes.first[d.col]) continue;
-      Candidate c = bound_at_centre(m, tile, d.move);
+      const Candidate c = scratch.kind[d.move] == LaneKind::flat
+                              ? flat_bounds.at(scratch.flats[d.move], m, row, d.move, d.col)
+                              : bound_at_centre(m, tile, d.move);
       if (can_cut(c, tile)) tile.candidates.push_back(c);
     }
     for (const BallBounds& b : scratch.ball_bounds) keep_other_cuts(row, b);
@@ -1076,6 +1107,36 @@ class Miller {
     }
   }
 
+  // bound_at_centre for a flat end's move, from FlatLanes::plane_at at the centres of kLanes
+  // tiles of a row at once (`at` computes them for the tiles around column col when needed).
+  struct FlatBounds {
+    FlatLanes::Plane plane;
+    DoubleN bound;
+    std::uint32_t move = 0;
+    int lane0 = -1;
+
+    Candidate at(const FlatLanes& flat, const MoveGeometry& m, const TileRow& row, std::uint32_t index, int col) {
+      if (index != move || col / kLanes * kLanes != lane0) {
+        move = index, lane0 = col / kLanes * kLanes;
+        const DoubleN ux = load_n(&row.lanes.xc[lane0]) - flat.ax, uy = splat(row.tiles[0].yc - flat.ay);
+        plane = flat.plane_at(ux, uy);
+        bound = plane.z - abs_n(plane.gx) * load_n(&row.lanes.hx[lane0]) - abs_n(plane.gy) * row.tiles[0].hy;
+      }
+      const int l = col - lane0;
+      if (plane.has_plane[l]) return {index, true, bound[l], plane.z[l], Vec2(plane.gx[l], plane.gy[l])};
+      return {index, false, bound_without_plane(m, row.tiles[static_cast<std::size_t>(col)]), kInf, Vec2(0)};
+    }
+  };
+
+  // A lower bound of a move's swept surface over a tile where it has no plane at the centre: the
+  // lowest tip plus the cutter's height at the tile's distance from the path.
+  static double bound_without_plane(const MoveGeometry& m, const Tile& tile) {
+    double distance = std::max(0.0, std::sqrt(distance2_point_segment(Vec2(tile.xc, tile.yc), Vec2(m.ax, m.ay),
+                                                                       Vec2(m.ax + m.vx, m.ay + m.vy))) -
+                                        tile.half_diagonal);
+    return distance <= m.radius ? m.lowest_tip() + m.cutter->lower_height(distance) : kInf;
+  }
+
   // The bounds of one move over one tile, for any cutter.
   static Candidate bound_at_centre(const MoveGeometry& m, const Tile& tile, std::uint32_t index) {
     Candidate c{index, false, kInf, kInf, Vec2(0)};
@@ -1087,10 +1148,7 @@ class Miller {
       return c;
     }
     c.gradient = Vec2(0);
-    double distance = std::max(0.0, std::sqrt(distance2_point_segment(Vec2(tile.xc, tile.yc), Vec2(m.ax, m.ay),
-                                                                       Vec2(m.ax + m.vx, m.ay + m.vy))) -
-                                        tile.half_diagonal);
-    if (distance <= m.radius) c.bound = m.lowest_tip() + m.cutter->lower_height(distance);
+    c.bound = bound_without_plane(m, tile);
     return c;
   }
 
