@@ -179,7 +179,7 @@ TEST_CASE("the flat end's vector supporting plane: the scalar one, and below S e
       CAPTURE(trial);
       CAPTURE(l);
       detail::MoveGeometry::Lowest centre;
-      Vec2 gradient;
+      Vec2 gradient(0);
       const bool scalar_plane = m.lowest_with_plane(x[l], y[l], centre, gradient);
       if (!p.has_plane[l]) continue;
       ++planes;
