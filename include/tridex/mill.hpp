@@ -30,9 +30,12 @@
 // at a time too (FlatLanes: a closed form; BullLanes: Newton steps with no square root). The moves
 // left for a tile in pass 2 are cut lowest bound first, a run of one cutter at a time, each run
 // checked against what the tile holds by then: so a tile first cut by any cutter, or roughed
-// deeper by another cutter, still rejects the moves that cut air. Every point ends at the minimum over moves of a value
-// computed the same way whatever the order, so the result is identical for any thread count and
-// any move order (for one build: the vector width and FMA contraction change the last bits).
+// deeper by another cutter, still rejects the moves that cut air. Runs of flat end and bull nose
+// moves are short, and each of their moves is checked against each row as it stands by then
+// (their neighbouring passes cut nearly equal surfaces: Miller::cut_others). Every point ends at
+// the minimum over moves of a value computed the same way whatever the order (a move is skipped
+// only where it cannot lower a point), so the result is identical for any thread count and any
+// move order (for one build: the vector width and FMA contraction change the last bits).
 #pragma once
 
 #include <algorithm>
@@ -72,6 +75,9 @@ namespace detail {
 constexpr int kTile = 16;        // points along each side of a tile
 constexpr int kBinTiles = 8;     // tiles along each side of a work block
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// Moves of a flat end or a bull nose milled together before the tile is measured again (see
+// Miller::cut_others): 1, 2, 4, 8 and 16 measured on the flat end's raster of bench_mill, 8 best.
+constexpr std::ptrdiff_t kOtherRun = 8;
 
 // Doubles processed as one value (GCC/Clang vector extension): eight with AVX-512, four with
 // AVX, two with the SSE2 of every x86-64, two in plain scalar code elsewhere; the compiler's
@@ -518,6 +524,7 @@ struct RisingMove {
 
   struct Cover {
     DoubleN t_foot, e2, lo, hi;  // foot on the move's line, squared distance to it, the interval
+    DoubleN half;                // half the interval's length before clipping to [0, 1]: k/|v|
     MaskN covered;
   };
 
@@ -527,19 +534,41 @@ struct RisingMove {
     DoubleN e2 = max_n(ux * ux + uy * uy - t * dot, splat(0));
     DoubleN k = sqrt_n(max_n(r2 - e2, splat(0))) * inv_len;
     DoubleN lo = t - k, hi = t + k;
-    return {t, e2, max_n(lo, splat(0)), min_n(hi, splat(1)), (e2 <= r2) & (lo <= 1) & (hi >= 0)};
+    return {t, e2, max_n(lo, splat(0)), min_n(hi, splat(1)), k, (e2 <= r2) & (lo <= 1) & (hi >= 0)};
   }
 };
 
 // The flat end's swept surface S, kLanes points at a time (MoveGeometry::lowest's closed form):
 // a rising move is lowest above q where its end disc first covers q, S = low + w·lo.
 struct FlatLanes : RisingMove {
+  double side = 0;  // k/|v| for k = 1e-6·R: closer to the footprint's side, no plane
+
   FlatLanes() = default;
-  explicit FlatLanes(const MoveGeometry& m) : RisingMove(m) {}
+  explicit FlatLanes(const MoveGeometry& m) : RisingMove(m), side(1e-6 * m.radius * m.inv_len) {}
 
   DoubleN at(DoubleN ux, DoubleN uy) const {
     Cover c = cover(ux, uy);
     return c.covered ? low + w * c.lo : splat(kInf);
+  }
+
+  // S and its supporting plane's slope (MoveGeometry::flat_supporting_plane): w·∇t_edge, with
+  // t_edge = t⊥ − k/|v| the entry parameter, ∇t⊥ = v/|v|², ∇k = −(u − t⊥·v)/k; zero where t_edge
+  // is clipped. No plane where q is not covered or is within 1e-6·R of the footprint's side.
+  struct Plane {
+    DoubleN z, gx, gy;
+    MaskN has_plane;
+  };
+  Plane plane_at(DoubleN ux, DoubleN uy) const {
+    Cover c = cover(ux, uy);
+    Plane p;
+    p.z = low + w * c.lo;
+    p.has_plane = c.covered & (c.half > side);
+    const DoubleN entry = c.t_foot - c.half;
+    const MaskN sloped = (entry > 0) & (entry < 1) & p.has_plane;
+    const DoubleN scale = sloped ? w * inv_vv / max_n(c.half, splat(side)) : splat(0);  // w·∇t_edge across
+    p.gx = (sloped ? splat(w * vx * inv_vv) : splat(0)) + scale * (ux - c.t_foot * vx);
+    p.gy = (sloped ? splat(w * vy * inv_vv) : splat(0)) + scale * (uy - c.t_foot * vy);
+    return p;
   }
 };
 
@@ -934,6 +963,10 @@ class Miller {
       int col0, col1;
       if (!columns(row, scratch.boxes[k], col0, col1)) continue;
       const MoveGeometry& m = scratch.moves[k];
+      // A flat end's bounds are found kLanes tiles at a time (as the ball end's), the others'
+      // one tile at a time.
+      const bool flat = scratch.kind[k] == LaneKind::flat;
+      FlatBounds flat_bounds;
       for (int col = col0; col <= col1; ++col) {
         Tile& tile = row.tiles[static_cast<std::size_t>(col)];
         if (m.lowest_tip() >= tile.state.top) continue;
@@ -941,7 +974,7 @@ class Miller {
           scratch.deferred.push_back({k, col});
           continue;
         }
-        Candidate c = bound_at_centre(m, tile, k);
+        Candidate c = flat ? flat_bounds.at(scratch.flats[k], m, row, k, col) : bound_at_centre(m, tile, k);
         if (c.bound >= tile.state.top) continue;
         tile.candidates.push_back(c);
         if (c.has_plane && (c.centre_z < lanes.first_z[col] ||
@@ -995,11 +1028,15 @@ class Miller {
       std::erase_if(tile.candidates,
                     [&](const Candidate& c) { return (has_first && c.move == first) || !can_cut(c, tile); });
     }
+    // A move's deferred tiles are consecutive: a flat end's bounds are found kLanes tiles at a time.
+    FlatBounds flat_bounds;
     for (const DeferredMove& d : scratch.deferred) {
       Tile& tile = row.tiles[static_cast<std::size_t>(d.col)];
       const MoveGeometry& m = scratch.moves[d.move];
       if (m.lowest_tip() >= tile.state.top || static_cast<double>(d.move) == lanes.first[d.col]) continue;
-      Candidate c = bound_at_centre(m, tile, d.move);
+      const Candidate c = scratch.kind[d.move] == LaneKind::flat
+                              ? flat_bounds.at(scratch.flats[d.move], m, row, d.move, d.col)
+                              : bound_at_centre(m, tile, d.move);
       if (can_cut(c, tile)) tile.candidates.push_back(c);
     }
     for (const BallBounds& b : scratch.ball_bounds) keep_other_cuts(row, b);
@@ -1038,10 +1075,15 @@ class Miller {
 
   // Cuts a tile with the moves left, lowest bound first, so that deep cuts (a roughing pass
   // below the finish, say) come before the moves they leave nothing for. A run of consecutive
-  // moves of one cutter with a vector form is milled together, row by row (admitted by what the
-  // tile held before the run: their rows are cheap, a fresher test costs more than it saves);
-  // each run, and each move without a vector form (its points cost far more), is checked again
-  // against what the tile holds by then.
+  // moves of one cutter with a vector form is milled together, row by row (a ball end's admitted
+  // by what the tile held before the run: their rows are cheap, a fresher test costs more than it
+  // saves); each run, and each move without a vector form (its points cost far more), is checked
+  // again against what the tile holds by then. A flat end's or a bull nose's run is at most
+  // kOtherRun moves, and each row is measured again after each of its moves (mill_tile): their
+  // neighbouring passes leave nearly equal surfaces, so that the first cut leaves a tile far from
+  // its final shape (a flat end's raster on a slope is lowest under the side of a neighbouring
+  // pass, which covers a few rows of a tile), and a test against the state after the first cut
+  // admitted 20 times the rows that the ball end's did.
   void cut_others(Tile& tile, const BlockScratch& scratch) {
     std::vector<Candidate>& candidates = tile.candidates;
     std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
@@ -1058,10 +1100,41 @@ class Miller {
       auto run_end = std::find_if(c, candidates.end(), [&](const Candidate& o) {
         return scratch.kind[o.move] == LaneKind::scalar || scratch.moves[o.move].cutter != cutter;
       });
+      if (scratch.kind[c->move] != LaneKind::ball && run_end - c > kOtherRun) run_end = c + kOtherRun;
       auto kept = std::remove_if(c, run_end, [&](const Candidate& o) { return !can_cut(o, tile); });
       if (kept != c) mill_tile(std::span<const Candidate>(&*c, static_cast<std::size_t>(kept - c)), tile, scratch, false);
       c = run_end;
     }
+  }
+
+  // bound_at_centre for a flat end's move, from FlatLanes::plane_at at the centres of kLanes
+  // tiles of a row at once (`at` computes them for the tiles around column col when needed).
+  struct FlatBounds {
+    FlatLanes::Plane plane;
+    DoubleN bound;
+    std::uint32_t move = 0;
+    int lane0 = -1;
+
+    Candidate at(const FlatLanes& flat, const MoveGeometry& m, const TileRow& row, std::uint32_t index, int col) {
+      if (index != move || col / kLanes * kLanes != lane0) {
+        move = index, lane0 = col / kLanes * kLanes;
+        const DoubleN ux = load_n(&row.lanes.xc[lane0]) - flat.ax, uy = splat(row.tiles[0].yc - flat.ay);
+        plane = flat.plane_at(ux, uy);
+        bound = plane.z - abs_n(plane.gx) * load_n(&row.lanes.hx[lane0]) - abs_n(plane.gy) * row.tiles[0].hy;
+      }
+      const int l = col - lane0;
+      if (plane.has_plane[l]) return {index, true, bound[l], plane.z[l], Vec2(plane.gx[l], plane.gy[l])};
+      return {index, false, bound_without_plane(m, row.tiles[static_cast<std::size_t>(col)]), kInf, Vec2(0)};
+    }
+  };
+
+  // A lower bound of a move's swept surface over a tile where it has no plane at the centre: the
+  // lowest tip plus the cutter's height at the tile's distance from the path.
+  static double bound_without_plane(const MoveGeometry& m, const Tile& tile) {
+    double distance = std::max(0.0, std::sqrt(distance2_point_segment(Vec2(tile.xc, tile.yc), Vec2(m.ax, m.ay),
+                                                                       Vec2(m.ax + m.vx, m.ay + m.vy))) -
+                                        tile.half_diagonal);
+    return distance <= m.radius ? m.lowest_tip() + m.cutter->lower_height(distance) : kInf;
   }
 
   // The bounds of one move over one tile, for any cutter.
@@ -1075,16 +1148,14 @@ class Miller {
       return c;
     }
     c.gradient = Vec2(0);
-    double distance = std::max(0.0, std::sqrt(distance2_point_segment(Vec2(tile.xc, tile.yc), Vec2(m.ax, m.ay),
-                                                                       Vec2(m.ax + m.vx, m.ay + m.vy))) -
-                                        tile.half_diagonal);
-    if (distance <= m.radius) c.bound = m.lowest_tip() + m.cutter->lower_height(distance);
+    c.bound = bound_without_plane(m, tile);
     return c;
   }
 
-  // Whether move c may lower row j of a tile (from its bounds and the row's state).
-  bool row_may_cut(const Candidate& c, const BallLanes* ball, const Tile& tile, int j) const {
-    std::size_t r = static_cast<std::size_t>(j - tile.box.j0);
+  // Whether move c may lower row j of a tile, whose highest point is row_top and whose largest
+  // height above the tile's plane is row_excess.
+  bool row_may_cut(const Candidate& c, const BallLanes* ball, const Tile& tile, int j, double row_top,
+                   double row_excess) const {
     double dy = g_.y(j) - tile.yc;
     // The ball end's rise across the move (BallLanes::across), at its least on this row.
     double across = 0;
@@ -1093,8 +1164,8 @@ class Miller {
       across = a * a * ball->inv_diameter;
     }
     double row_bound = c.has_plane ? c.centre_z + c.gradient.y * dy - std::abs(c.gradient.x) * tile.hx + across : c.bound;
-    if (row_bound >= tile.state.row_top[r]) return false;
-    return !tile.plane.valid || above_plane(c, tile, dy, 0) + across < tile.state.row_excess[r];
+    if (row_bound >= row_top) return false;
+    return !tile.plane.valid || above_plane(c, tile, dy, 0) + across < row_excess;
   }
 
   // kLanes heights of a map row as doubles; of the last `available` < kLanes of a row, the rest
@@ -1119,7 +1190,8 @@ class Miller {
   }
 
   // Lowers a tile to the swept surfaces of `cuts`, row by row: each row is read once, lowered by
-  // every move whose bounds admit it (all of them on every row if `every_row`), and its state
+  // every move whose bounds admit it (all of them on every row if `every_row`; a ball end's by
+  // the row's state before, the others' by its state after the moves before them), and its state
   // (measured against the tile's plane) updated once. Other cutters than the ball end skip the
   // points already below the move's supporting plane.
   void mill_tile(std::span<const Candidate> cuts, Tile& tile, const BlockScratch& scratch, bool every_row) {
@@ -1139,13 +1211,18 @@ class Miller {
     for (int j = t.j0; j <= t.j1; ++j) {
       const double y = g_.y(j), dy = y - tile.yc;
       float* row = &map_.heights[g_.index(t.i0, j)];
+      const double tile_row = plane.z + plane.gradient.y * dy;
       DoubleN h[kGroups];
       bool loaded = false;
+      // The row's highest point and largest height above P as its moves lower it (in double: a
+      // move whose bounds are not below them leaves every point as it is, rounded or not).
+      const std::size_t r = static_cast<std::size_t>(j - t.j0);
+      double row_top = state.row_top[r], row_excess = state.row_excess[r];
       for (const Candidate& c : cuts) {
         const MoveGeometry& m = scratch.moves[c.move];
         const LaneKind kind = scratch.kind[c.move];
         const BallLanes* ball = kind == LaneKind::ball ? &scratch.balls[c.move] : nullptr;
-        if (!every_row && !row_may_cut(c, ball, tile, j)) continue;
+        if (!every_row && !row_may_cut(c, ball, tile, j, row_top, row_excess)) continue;
         if (!loaded) {
           for (int g = 0; g < kGroups; ++g) h[g] = load_heights(row + g * kLanes, count - g * kLanes);
           loaded = true;
@@ -1181,10 +1258,21 @@ class Miller {
                 h[g][l] = std::min(h[g][l], std::max(static_cast<double>(static_cast<float>(z)), empty));
               }
         }
+        if (!ball && !every_row) {
+          // The other cutters' near-equal surfaces (a flat end's neighbouring passes) leave a
+          // row's first cut far from its final shape, often not covering it all: measured again
+          // after each move, the row rejects the moves that it has become lower than.
+          DoubleN top = h[0], excess = h[0] - (tile_row + plane.gradient.x * dx[0]);
+          for (int g = 1; g < kGroups; ++g) {
+            top = max_n(top, h[g]);
+            excess = max_n(excess, h[g] - (tile_row + plane.gradient.x * dx[g]));
+          }
+          row_top = max_lane(top);
+          if (plane.valid) row_excess = max_lane(excess);
+        }
       }
       if (!loaded) continue;
       changed = true;
-      const double tile_row = plane.z + plane.gradient.y * dy;
       DoubleN top = splat(-kInf), excess = splat(-kInf);
       for (int g = 0; g < kGroups; ++g) {
         h[g] = max_n(__builtin_convertvector(__builtin_convertvector(h[g], FloatN), DoubleN), splat(empty));
@@ -1192,7 +1280,6 @@ class Miller {
         top = max_n(top, h[g]);
         excess = max_n(excess, h[g] - (tile_row + plane.gradient.x * dx[g]));
       }
-      std::size_t r = static_cast<std::size_t>(j - t.j0);
       state.row_top[r] = max_lane(top);
       state.row_excess[r] = plane.valid ? max_lane(excess) : -kInf;
     }
