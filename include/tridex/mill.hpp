@@ -1329,21 +1329,34 @@ struct CutDepth {
   int i = -1, j = -1;                                        // where (−1 when off the grid)
 };
 
+// The grid points within `radius` of the move's box across the spindle, clipped to the grid
+// (empty when none): the points a cutter of that radius on `tip` can reach.
+struct PointRange {
+  int i0 = 0, i1 = -1, j0 = 0, j1 = -1;
+  bool empty() const { return i0 > i1 || j0 > j1; }
+};
+
+inline PointRange footprint_points(const ZMapGrid& g, double radius, const Segment& tip) {
+  // In double until clipped: a move far off the grid must not overflow an int.
+  double i0 = std::ceil((std::min(tip.a.x, tip.b.x) - radius - g.x0) / g.cell);
+  double i1 = std::floor((std::max(tip.a.x, tip.b.x) + radius - g.x0) / g.cell);
+  double j0 = std::ceil((std::min(tip.a.y, tip.b.y) - radius - g.y0) / g.cell);
+  double j1 = std::floor((std::max(tip.a.y, tip.b.y) + radius - g.y0) / g.cell);
+  i0 = std::max(i0, 0.0), j0 = std::max(j0, 0.0);
+  i1 = std::min(i1, g.nx - 1.0), j1 = std::min(j1, g.ny - 1.0);
+  if (i0 > i1 || j0 > j1) return {};
+  return {static_cast<int>(i0), static_cast<int>(i1), static_cast<int>(j0), static_cast<int>(j1)};
+}
+
 inline CutDepth cut_depth(const ZMap& map, const Cutter& cutter, const Segment& tip) {
   if (!is_finite(tip.a) || !is_finite(tip.b)) detail::fail("cut_depth: move is not finite");
   const ZMapGrid& g = map.grid;
-  const double r = cutter.radius();
-  double i0 = std::ceil((std::min(tip.a.x, tip.b.x) - r - g.x0) / g.cell);
-  double i1 = std::floor((std::max(tip.a.x, tip.b.x) + r - g.x0) / g.cell);
-  double j0 = std::ceil((std::min(tip.a.y, tip.b.y) - r - g.y0) / g.cell);
-  double j1 = std::floor((std::max(tip.a.y, tip.b.y) + r - g.y0) / g.cell);
-  i0 = std::max(i0, 0.0), j0 = std::max(j0, 0.0);
-  i1 = std::min(i1, g.nx - 1.0), j1 = std::min(j1, g.ny - 1.0);
+  const PointRange points = footprint_points(g, cutter.radius(), tip);
   CutDepth deepest;
-  if (i0 > i1 || j0 > j1) return deepest;
+  if (points.empty()) return deepest;
   detail::MoveGeometry m(cutter, tip);
-  for (int j = static_cast<int>(j0); j <= static_cast<int>(j1); ++j)
-    for (int i = static_cast<int>(i0); i <= static_cast<int>(i1); ++i) {
+  for (int j = points.j0; j <= points.j1; ++j)
+    for (int i = points.i0; i <= points.i1; ++i) {
       if (map.is_empty(i, j)) continue;
       double depth = map.height(i, j) - m.lowest_above(g.x(i), g.y(j));
       if (depth > deepest.depth) deepest = {depth, i, j};

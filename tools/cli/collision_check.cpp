@@ -75,16 +75,10 @@ void BodyCheck::milled(const ZMap& map, std::span<const Cutter> cutters, std::sp
 
 CutDepth BodyCheck::contact_depth(const ZMap& map, const Cutter& surface, const Segment& tip) const {
   const ZMapGrid& g = map.grid;
-  const double r = surface.radius();
-  double i0 = std::ceil((std::min(tip.a.x, tip.b.x) - r - g.x0) / g.cell);
-  double i1 = std::floor((std::max(tip.a.x, tip.b.x) + r - g.x0) / g.cell);
-  double j0 = std::ceil((std::min(tip.a.y, tip.b.y) - r - g.y0) / g.cell);
-  double j1 = std::floor((std::max(tip.a.y, tip.b.y) + r - g.y0) / g.cell);
-  i0 = std::max(i0, 0.0), j0 = std::max(j0, 0.0);
-  i1 = std::min(i1, g.nx - 1.0), j1 = std::min(j1, g.ny - 1.0);
+  const PointRange points = footprint_points(g, surface.radius(), tip);
   CutDepth deepest;
-  if (i0 > i1 || j0 > j1) return deepest;
-  const int ia = static_cast<int>(i0), ib = static_cast<int>(i1), ja = static_cast<int>(j0), jb = static_cast<int>(j1);
+  if (points.empty()) return deepest;
+  const int ia = points.i0, ib = points.i1, ja = points.j0, jb = points.j1;
   // The swept surface lies nowhere below the tip's lowest point: a tile whose highest material
   // is not above it cannot be reached.
   const double floor_z = std::min(tip.a.z, tip.b.z);
