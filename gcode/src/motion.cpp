@@ -391,10 +391,15 @@ void Interpreter::State::home_return(bool second) {
   const Vec3& target = second ? machine.reference2 : machine.home;
   bool is_default = second ? machine.reference2_is_default : machine.home_is_default;
   bool& warned = second ? warned_reference2 : warned_home;
-  if (is_default && !warned) {
+  // Returning Z alone (the posts' `G28 G91 Z0`) retracts to the top of Z's travel on any mill,
+  // which the far rule models exactly; only a return of X or Y lands at a position the default
+  // reference has to guess.
+  bool guesses_lateral = (mask & 3u) != 0;
+  if (is_default && guesses_lateral && !warned) {
     warn(column, std::string(second ? "G30" : "G28") +
-                     " uses the default reference position (far above the work along +Z); "
-                     "a machine file (--machine) sets it, \"home\" and \"reference2\"");
+                     " returns X or Y to the default reference position (unknown: the tool is "
+                     "left far above the work); a machine file (--machine) sets it, \"home\" "
+                     "and \"reference2\"");
     warned = true;
   }
   // With the tool along +Z, returning X/Y only is a plain rapid at the current height (on any

@@ -90,9 +90,13 @@ TEST_CASE("program start and home returns: far along the tool axis, approach str
   CHECK(near(r.moves[2].start, r.moves[2].end));  // G28's intermediate point: where it is
   CHECK(near(r.moves[3].start, Vec3(50, 50, 3 + far)));  // G28 retracted; X Y stayed far
   CHECK(near(r.moves[3].end, Vec3(50, 50, 3)));
-  REQUIRE(r.warnings.size() == 1);  // the default home was used
-  CHECK(r.warnings[0].line == 5);
-  CHECK(r.warnings[0].message.find("default") != std::string::npos);
+  CHECK(r.warnings.empty());  // Z alone: the top of Z's travel, no guess
+  r = run_program("G0 X10 Y20 Z5\nG28\nG91 G28 X0\nG30 Y0\nM30\n");
+  REQUIRE(r.warnings.size() == 2);  // X and Y went to default references: once per code
+  CHECK(r.warnings[0].line == 2);
+  CHECK(r.warnings[0].message.find("default reference") != std::string::npos);
+  CHECK(r.warnings[1].line == 4);
+  CHECK(r.warnings[1].message.find("G30") != std::string::npos);
 }
 
 TEST_CASE("G28 X Y with a vertical tool rapids to home X Y; G53 moves in machine coordinates") {
