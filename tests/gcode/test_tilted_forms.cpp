@@ -43,7 +43,7 @@ Mat3 random_rotation(std::mt19937& rng) {
 
 }  // namespace
 
-TEST_CASE("G68.2 P0 I J K is Euler Z-X-Z, with DESIGN.md's check directions") {
+TEST_CASE("G68.2 P0 I J K is Euler Z-X-Z, with docs/design.md's check directions") {
   CHECK(near(fanuc_euler(Vec3(0), 90, 90, 0).rotation[2], kX));
   CHECK(near(fanuc_euler(Vec3(0), -90, 90, 0).rotation[2], -kX));
   CHECK(near(fanuc_euler(Vec3(0), 0, 90, 0).rotation[2], -kY));
@@ -86,7 +86,7 @@ TEST_CASE("G68.2 P1 / G268: rotations about the fixed axes in the order Q names"
       CHECK_MESSAGE(same_rotation(f.rotation, r), "Q" << q);
     }
   }
-  // Haas G268 Q123 (DESIGN.md): R = Rz(K)·Ry(J)·Rx(I).
+  // Haas G268 Q123 (docs/design.md): R = Rz(K)·Ry(J)·Rx(I).
   Frame haas = fixed_axis_angles(Vec3(0), 10, 20, 30, 123);
   CHECK(same_rotation(haas.rotation, about(kZ, 30) * about(kY, 20) * about(kX, 10)));
 }
