@@ -27,7 +27,8 @@
 //      row by row, each row read once and lowered by every move admitted there.
 // Ball end moves are bounded kLanes tiles at a time and evaluated kLanes points at a time, with
 // one square root per point (BallLanes); flat end and bull nose moves are evaluated kLanes points
-// at a time too (FlatLanes: a closed form; BullLanes: Newton steps with no square root). The moves
+// at a time too (FlatLanes: a closed form; BullLanes: the still cutter where the minimum is at
+// an end of the move, else Newton steps with no square root). The moves
 // left for a tile in pass 2 are cut lowest bound first, a run of one cutter at a time, each run
 // checked against what the tile holds by then: so a tile first cut by any cutter, or roughed
 // deeper by another cutter, still rejects the moves that cut air. Runs of flat end and bull nose
@@ -581,10 +582,13 @@ struct FlatLanes : RisingMove {
 //     Q(ρ) = 1 + m² − m²r²/ρ² − e²/(R0 + ρ)² = 0,
 // with Q increasing and concave on ρ > 0, Q ≤ 0 at max(mr/√(1 + m²), e − R0) and Q(r) ≥ 0. Newton's
 // method from that left end stays left of the root and converges monotonically (a tangent of a
-// concave function lies above it), with no square root per step: 3.7 steps on average to 1e-12·r.
-// Then t* = t⊥ − √(d*² − e²)/|v|, clamped to the interval that covers q (f is convex), and S = f(t*)
-// evaluated at a point of the move, so a step short of the root can only leave S a little high,
-// never cut below the swept solid.
+// concave function lies above it), with no square root and one division per step (Q times ρ²d²):
+// 3.7 steps on average to 1e-12·r. Then t* = t⊥ − √(d*² − e²)/|v|, and S = f(t*) evaluated at a
+// point of the move, so a step short of the root can only leave S a little high, never cut below
+// the swept solid. Most points a move is tested on have their minimum clamped to an end of the
+// move (the neighbouring move of the same pass is lower there), and that needs no root: t* ≤ 0
+// exactly when t⊥ ≤ 0 or d* ≥ |u| (d(0) = |u|), i.e. Q(|u| − R0) ≤ 0 since Q increases; t* ≥ 1
+// exactly when t⊥ ≥ 1 and Q(|u − v| − R0) ≥ 0. There S is the still cutter at that end.
 struct BullLanes : RisingMove {
   double flat = 0, corner = 0, corner2 = 0, m2 = 0, start = 0;
 
@@ -604,28 +608,77 @@ struct BullLanes : RisingMove {
 
   // S at the points where `wanted` (+infinity elsewhere and where the cutter does not pass).
   DoubleN at(DoubleN ux, DoubleN uy, MaskN wanted) const {
-    Cover c = cover(ux, uy);
-    MaskN covered = c.covered & wanted;
-    if (!any_n(covered)) return splat(kInf);
-    DoubleN t;
-    if (w == 0) {
-      t = min_n(max_n(c.t_foot, c.lo), c.hi);
-    } else {
-      const DoubleN e2 = c.e2, mr2 = splat(m2 * corner2), q0 = splat(1 + m2);
-      DoubleN reach = max_n(sqrt_n(e2) - flat, splat(start));
-      for (int step = 0; step < 30; ++step) {
-        DoubleN inv_reach = 1 / reach, inv_d = 1 / (flat + reach);
-        DoubleN a = mr2 * inv_reach * inv_reach, b = e2 * inv_d * inv_d;
-        DoubleN delta = (q0 - a - b) / (2 * (a * inv_reach + b * inv_d));
-        reach = min_n(reach - delta, splat(corner));
-        if (!any_n(covered & (abs_n(delta) > 1e-12 * corner))) break;
-      }
-      DoubleN d = flat + reach;
-      t = c.t_foot - sqrt_n(max_n(d * d - e2, splat(0))) * inv_len;
-      t = min_n(max_n(t, c.lo), c.hi);
+    DoubleN z[1];
+    at<1>({ux}, uy, {wanted}, z);
+    return z[0];
+  }
+
+  // The same for G groups of kLanes points of one row at once: their Newton steps are
+  // independent, so interleaved they overlap each other's division latency (a step is one
+  // dependent chain through a division).
+  template <int G>
+  void at(const DoubleN (&ux)[G], DoubleN uy, const MaskN (&wanted)[G], DoubleN (&z)[G]) const {
+    Cover c[G];
+    MaskN covered[G], any_covered{};
+    for (int g = 0; g < G; ++g) {
+      c[g] = cover(ux[g], uy);
+      covered[g] = c[g].covered & wanted[g];
+      any_covered |= covered[g];
+      z[g] = splat(kInf);
     }
-    DoubleN s = t - c.t_foot;
-    return covered ? low + t * w + height(sqrt_n(c.e2 + s * s * vv)) : splat(kInf);
+    if (!any_n(any_covered)) return;
+    if (w == 0) {  // level: lowest where the axis comes closest to q
+      for (int g = 0; g < G; ++g) {
+        const DoubleN t = min_n(max_n(c[g].t_foot, c[g].lo), c[g].hi), s = t - c[g].t_foot;
+        z[g] = covered[g] ? low + height(sqrt_n(c[g].e2 + s * s * vv)) : splat(kInf);
+      }
+      return;
+    }
+    {
+      const DoubleN mr2 = splat(m2 * corner2), q0 = splat(1 + m2);
+      // P(ρ) = ρ²d²·Q(ρ) with d = R0 + ρ: the sign of Q without a division.
+      auto p = [&](DoubleN e2, DoubleN reach, DoubleN d) {
+        const DoubleN rr = reach * reach, dd = d * d;
+        return q0 * rr * dd - mr2 * dd - e2 * rr;
+      };
+      DoubleN reach[G], d_start[G], d_end[G];
+      MaskN before[G], after[G], inside[G], any_inside{};
+      for (int g = 0; g < G; ++g) {
+        // Where the root lies before the start or past the end, S is the cutter at that end (see
+        // above): Q(ρ_a) ≤ 0 at the start's reach ρ_a = |u| − R0, Q(ρ_b) ≥ 0 at the end's.
+        const DoubleN e2 = c[g].e2, ex = ux[g] - vx, ey = uy - vy;
+        const DoubleN da = sqrt_n(ux[g] * ux[g] + uy * uy), db = sqrt_n(ex * ex + ey * ey);
+        const DoubleN reach_a = da - flat, reach_b = db - flat;
+        d_start[g] = da, d_end[g] = db;
+        before[g] = (c[g].t_foot <= 0) | (reach_a <= 0) | (p(e2, reach_a, da) <= 0);
+        after[g] = (c[g].t_foot >= 1) & (reach_b > 0) & (p(e2, reach_b, db) >= 0) & ~before[g];
+        inside[g] = covered[g] & ~before[g] & ~after[g];
+        any_inside |= inside[g];
+        // Lower bounds of the root: e ≤ d, the root for e = 0 and, past the end, ρ_b.
+        reach[g] = max_n(max_n(sqrt_n(e2) - flat, splat(start)), c[g].t_foot >= 1 ? reach_b : splat(0));
+      }
+      for (int step = 0; step < 30 && any_n(any_inside); ++step) {
+        MaskN moving{};
+        for (int g = 0; g < G; ++g) {
+          // Q/Q' with Q' = 2m²r²/ρ³ + 2e²/d³, both multiplied by ρ³d³: one division per step.
+          const DoubleN e2 = c[g].e2, r = reach[g], d = flat + r;
+          const DoubleN delta = r * d * p(e2, r, d) / (2 * (mr2 * d * d * d + e2 * r * r * r));
+          reach[g] = min_n(r - delta, splat(corner));
+          moving |= inside[g] & (abs_n(delta) > 1e-12 * corner);
+        }
+        if (!any_n(moving)) break;
+      }
+      for (int g = 0; g < G; ++g) {
+        // At an end, d is the distance to that end; inside, d(t*) is the root's d (t* = t⊥ −
+        // √(d² − e²)/|v| gives d(t*)² = d²), clamped only by rounding.
+        const DoubleN root_d = flat + reach[g];
+        DoubleN t_root = c[g].t_foot - sqrt_n(max_n(root_d * root_d - c[g].e2, splat(0))) * inv_len;
+        t_root = min_n(max_n(t_root, c[g].lo), c[g].hi);
+        const DoubleN tg = before[g] ? c[g].lo : after[g] ? c[g].hi : t_root;
+        const DoubleN d = before[g] ? d_start[g] : after[g] ? d_end[g] : root_d;
+        z[g] = covered[g] ? low + tg * w + height(d) : splat(kInf);
+      }
+    }
   }
 };
 
@@ -1245,10 +1298,14 @@ class Miller {
           // Newton steps cost several square roots: only the points above the move's plane.
           const BullLanes& bull = scratch.bulls[c.move];
           const double move_row = (c.has_plane ? c.centre_z : -kInf) + c.gradient.y * dy, uy = y - bull.ay;
+          DoubleN ux[kGroups], z[kGroups];
+          MaskN above[kGroups];
           for (int g = 0; g < kGroups; ++g) {
-            const MaskN above = move_row + c.gradient.x * dx[g] < h[g];
-            if (any_n(above)) h[g] = min_n(h[g], bull.at(x[g] - bull.ax, splat(uy), above));
+            ux[g] = x[g] - bull.ax;
+            above[g] = move_row + c.gradient.x * dx[g] < h[g];
           }
+          bull.at<kGroups>(ux, splat(uy), above, z);
+          for (int g = 0; g < kGroups; ++g) h[g] = min_n(h[g], z[g]);
         } else {
           const double move_row = (c.has_plane ? c.centre_z : -kInf) + c.gradient.y * dy;
           for (int g = 0; g < kGroups; ++g)
