@@ -363,8 +363,52 @@ struct MoveGeometry {
     return true;
   }
 
-  // min over t ∈ [lo, hi] of f(t) = az + t·w + h(√(e² + (t − t⊥)²·|v|²)), for any cutter.
+  // min over t ∈ [lo, hi] of f(t) = az + t·w + h(√(e² + (t − t⊥)²·|v|²)), for any cutter, on
+  // a move that is not level. The minimiser lies on the side of the foot where the move is lower
+  // (s = t − t⊥ of the sign of −w: on the other side both terms of f' = w + h'(d)·s|v|²/d have
+  // w's sign), at the distance d* where
+  //     φ(d) = h'(d)·√(d² − e²)/d = m,   m = |w|/|v|,
+  // φ non-decreasing on [e, R] (h' is, and √(d² − e²)/d is). Per profile piece the root is
+  // explicit: a line of slope k gives d*² = e²k²/(k² − m²); an arc centred on the axis (radius a)
+  // d*² = (e² + m²a²)/(1 + m²); a jump of φ at a joint of the pieces (a kink) puts d* on the
+  // joint. Then t* = t⊥ ∓ √(d*² − e²)/|v|, clamped to [lo, hi] (f is convex). An arc off the axis
+  // (only the bull nose's corner, which has its own path) falls back to regula falsi.
   Lowest convex_minimum(double e2, double t_foot, double lo, double hi) const {
+    const double e = std::sqrt(e2), m = std::abs(w) * inv_len;
+    auto phi = [&](const ProfilePiece& piece, double d) {
+      if (d <= 0) return piece.derivative(0);
+      return piece.derivative(d) * std::sqrt(std::max(0.0, d * d - e2)) / d;
+    };
+    double root_d = radius;  // φ < m up to the rim: the minimiser leaves the footprint
+    bool closed = true;
+    for (const ProfilePiece& piece : cutter->pieces()) {
+      if (piece.d1 < e) continue;
+      const double from = std::max(piece.d0, e), to = std::min(piece.d1, radius);
+      if (phi(piece, from) >= m) {  // a kink at the joint, or e itself
+        root_d = from;
+        break;
+      }
+      if (phi(piece, to) < m) continue;
+      if (!piece.is_arc) {
+        root_d = std::sqrt(e2 * piece.slope * piece.slope / (piece.slope * piece.slope - m * m));
+      } else if (piece.centre_d == 0) {
+        root_d = std::sqrt((e2 + m * m * piece.radius * piece.radius) / (1 + m * m));
+      } else {
+        closed = false;
+      }
+      root_d = std::clamp(root_d, from, to);
+      break;
+    }
+    if (closed) {
+      const double side = std::sqrt(std::max(0.0, root_d * root_d - e2)) * inv_len;
+      const double t = std::clamp(w > 0 ? t_foot - side : t_foot + side, lo, hi), s = t - t_foot;
+      return {az + t * w + cutter->lower_height(std::sqrt(e2 + s * s * vv)), t};
+    }
+    return convex_regula_falsi(e2, t_foot, lo, hi);
+  }
+
+  // The same by regula falsi on f', for any convex profile.
+  Lowest convex_regula_falsi(double e2, double t_foot, double lo, double hi) const {
     auto f = [&](double t) {
       double s = t - t_foot;
       return az + t * w + cutter->lower_height(std::sqrt(e2 + s * s * vv));
