@@ -634,10 +634,11 @@ struct FlatLanes : RisingMove {
 // exactly when t⊥ ≤ 0 or d* ≥ |u| (d(0) = |u|), i.e. Q(|u| − R0) ≤ 0 since Q increases; t* ≥ 1
 // exactly when t⊥ ≥ 1 and Q(|u − v| − R0) ≥ 0. There S is the still cutter at that end.
 struct BullLanes : RisingMove {
-  double flat = 0, corner = 0, corner2 = 0, m2 = 0, start = 0;
+  double radius = 0, flat = 0, corner = 0, corner2 = 0, m2 = 0, start = 0;
 
   BullLanes() = default;
   explicit BullLanes(const MoveGeometry& m) : RisingMove(m) {
+    radius = m.radius;
     corner = m.cutter->corner_radius(), corner2 = corner * corner;
     flat = m.radius - corner;
     m2 = w * w * inv_vv;
@@ -662,67 +663,63 @@ struct BullLanes : RisingMove {
   // dependent chain through a division).
   template <int G>
   void at(const DoubleN (&ux)[G], DoubleN uy, const MaskN (&wanted)[G], DoubleN (&z)[G]) const {
-    Cover c[G];
-    MaskN covered[G], any_covered{};
-    for (int g = 0; g < G; ++g) {
-      c[g] = cover(ux[g], uy);
-      covered[g] = c[g].covered & wanted[g];
-      any_covered |= covered[g];
-      z[g] = splat(kInf);
-    }
-    if (!any_n(any_covered)) return;
     if (w == 0) {  // level: lowest where the axis comes closest to q
       for (int g = 0; g < G; ++g) {
-        const DoubleN t = min_n(max_n(c[g].t_foot, c[g].lo), c[g].hi), s = t - c[g].t_foot;
-        z[g] = covered[g] ? low + height(sqrt_n(c[g].e2 + s * s * vv)) : splat(kInf);
+        const Cover c = cover(ux[g], uy);
+        const DoubleN t = min_n(max_n(c.t_foot, c.lo), c.hi), s = t - c.t_foot;
+        z[g] = c.covered & wanted[g] ? low + height(sqrt_n(c.e2 + s * s * vv)) : splat(kInf);
       }
       return;
     }
-    {
-      const DoubleN mr2 = splat(m2 * corner2), q0 = splat(1 + m2);
-      // P(ρ) = ρ²d²·Q(ρ) with d = R0 + ρ: the sign of Q without a division.
-      auto p = [&](DoubleN e2, DoubleN reach, DoubleN d) {
-        const DoubleN rr = reach * reach, dd = d * d;
-        return q0 * rr * dd - mr2 * dd - e2 * rr;
-      };
-      DoubleN reach[G], d_start[G], d_end[G];
-      MaskN before[G], after[G], inside[G], any_inside{};
-      for (int g = 0; g < G; ++g) {
-        // Where the root lies before the start or past the end, S is the cutter at that end (see
-        // above): Q(ρ_a) ≤ 0 at the start's reach ρ_a = |u| − R0, Q(ρ_b) ≥ 0 at the end's.
-        const DoubleN e2 = c[g].e2, ex = ux[g] - vx, ey = uy - vy;
-        const DoubleN da = sqrt_n(ux[g] * ux[g] + uy * uy), db = sqrt_n(ex * ex + ey * ey);
-        const DoubleN reach_a = da - flat, reach_b = db - flat;
-        d_start[g] = da, d_end[g] = db;
-        before[g] = (c[g].t_foot <= 0) | (reach_a <= 0) | (p(e2, reach_a, da) <= 0);
-        after[g] = (c[g].t_foot >= 1) & (reach_b > 0) & (p(e2, reach_b, db) >= 0) & ~before[g];
-        inside[g] = covered[g] & ~before[g] & ~after[g];
-        any_inside |= inside[g];
-        // Lower bounds of the root: e ≤ d, the root for e = 0 and, past the end, ρ_b.
-        reach[g] = max_n(max_n(sqrt_n(e2) - flat, splat(start)), c[g].t_foot >= 1 ? reach_b : splat(0));
-      }
-      for (int step = 0; step < 30 && any_n(any_inside); ++step) {
+    const DoubleN mr2 = splat(m2 * corner2), q0 = splat(1 + m2);
+    // P(ρ) = ρ²d²·Q(ρ) with d = R0 + ρ: the sign of Q without a division.
+    auto p = [&](DoubleN e2, DoubleN reach, DoubleN d) {
+      const DoubleN rr = reach * reach, dd = d * d;
+      return q0 * rr * dd - mr2 * dd - e2 * rr;
+    };
+    DoubleN t_foot[G], e2[G], reach[G], t[G], d[G];
+    MaskN inside[G], any_inside{};
+    for (int g = 0; g < G; ++g) {
+      const DoubleN dot = ux[g] * vx + uy * vy, uu = ux[g] * ux[g] + uy * uy, ex = ux[g] - vx, ey = uy - vy;
+      t_foot[g] = dot * inv_vv;
+      e2[g] = max_n(uu - t_foot[g] * dot, splat(0));
+      // Where the root lies before the start or past the end, S is the cutter at that end (see
+      // above): Q(ρ_a) ≤ 0 at the start's reach ρ_a = |u| − R0, Q(ρ_b) ≥ 0 at the end's. There q
+      // is covered if that end covers it; inside, if e ≤ R (then ρ* ≤ r, as Q(r) = 1 − e²/R² ≥ 0).
+      const DoubleN da = sqrt_n(uu), db = sqrt_n(ex * ex + ey * ey), reach_a = da - flat, reach_b = db - flat;
+      const MaskN before = (t_foot[g] <= 0) | (reach_a <= 0) | (p(e2[g], reach_a, da) <= 0);
+      const MaskN after = ~before & (t_foot[g] >= 1) & (reach_b > 0) & (p(e2[g], reach_b, db) >= 0);
+      const MaskN covered = wanted[g] & (before ? da <= radius : after ? db <= radius : e2[g] <= r2);
+      inside[g] = covered & ~before & ~after;
+      any_inside |= inside[g];
+      t[g] = before ? splat(0) : splat(1);
+      d[g] = before ? da : after ? db : splat(kInf);
+      d[g] = covered ? d[g] : splat(kInf);
+      // Lower bounds of the root: the root for e = 0 and, past the end, ρ_b.
+      reach[g] = max_n(splat(start), t_foot[g] >= 1 ? reach_b : splat(0));
+    }
+    if (any_n(any_inside)) {
+      for (int g = 0; g < G; ++g) reach[g] = max_n(reach[g], sqrt_n(e2[g]) - flat);  // and e ≤ d
+      for (int step = 0; step < 30; ++step) {
         MaskN moving{};
         for (int g = 0; g < G; ++g) {
           // Q/Q' with Q' = 2m²r²/ρ³ + 2e²/d³, both multiplied by ρ³d³: one division per step.
-          const DoubleN e2 = c[g].e2, r = reach[g], d = flat + r;
-          const DoubleN delta = r * d * p(e2, r, d) / (2 * (mr2 * d * d * d + e2 * r * r * r));
+          const DoubleN r = reach[g], dr = flat + r;
+          const DoubleN delta = r * dr * p(e2[g], r, dr) / (2 * (mr2 * dr * dr * dr + e2[g] * r * r * r));
           reach[g] = min_n(r - delta, splat(corner));
           moving |= inside[g] & (abs_n(delta) > 1e-12 * corner);
         }
         if (!any_n(moving)) break;
       }
       for (int g = 0; g < G; ++g) {
-        // At an end, d is the distance to that end; inside, d(t*) is the root's d (t* = t⊥ −
-        // √(d² − e²)/|v| gives d(t*)² = d²), clamped only by rounding.
+        // t* = t⊥ − √(d*² − e²)/|v| has d(t*) = d*; clamped only by rounding.
         const DoubleN root_d = flat + reach[g];
-        DoubleN t_root = c[g].t_foot - sqrt_n(max_n(root_d * root_d - c[g].e2, splat(0))) * inv_len;
-        t_root = min_n(max_n(t_root, c[g].lo), c[g].hi);
-        const DoubleN tg = before[g] ? c[g].lo : after[g] ? c[g].hi : t_root;
-        const DoubleN d = before[g] ? d_start[g] : after[g] ? d_end[g] : root_d;
-        z[g] = covered[g] ? low + tg * w + height(d) : splat(kInf);
+        const DoubleN root_t = t_foot[g] - sqrt_n(max_n(root_d * root_d - e2[g], splat(0))) * inv_len;
+        t[g] = inside[g] ? min_n(max_n(root_t, splat(0)), splat(1)) : t[g];
+        d[g] = inside[g] ? root_d : d[g];
       }
     }
+    for (int g = 0; g < G; ++g) z[g] = d[g] < kInf ? low + t[g] * w + height(d[g]) : splat(kInf);
   }
 };
 
