@@ -12,7 +12,9 @@
 //     hit of a vertical line with a capsule);
 //   * bull nose: f' has one sign under the flat bottom, so the minimum lies on one side of it,
 //     where Newton's method (kept in a bracket) finds the root of f' on the corner torus;
-//   * other cutters: regula falsi (Illinois) on the non-decreasing f', to double precision.
+//   * other cutters: f' = 0 where φ(d) = h'(d)·√(d² − e²)/d equals the move's slope, explicit
+//     per profile piece (a line, or an arc centred on the axis) or at a joint of two pieces
+//     (MoveGeometry::convex_minimum).
 //
 // Speed comes from touching only what a move can still lower (Miller below). S is convex too (the
 // lower surface of a convex swept solid), so its tangent plane at any point bounds it from below
