@@ -665,6 +665,9 @@ struct BullLanes : RisingMove {
   // dependent chain through a division).
   template <int G>
   void at(const DoubleN (&ux)[G], DoubleN uy, const MaskN (&wanted)[G], DoubleN (&z)[G]) const {
+    MaskN any_wanted{};
+    for (int g = 0; g < G; ++g) z[g] = splat(kInf), any_wanted |= wanted[g];
+    if (!any_n(any_wanted)) return;
     if (w == 0) {  // level: lowest where the axis comes closest to q
       for (int g = 0; g < G; ++g) {
         const Cover c = cover(ux[g], uy);
