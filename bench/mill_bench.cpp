@@ -85,15 +85,14 @@ void flat_d10_rough_above(benchmark::State& s) { roughing(s, Cutter::flat(5), 0.
 void ball_and_flat_d10_above(benchmark::State& s) { roughing(s, Cutter::flat(5), 0.3, true); }
 
 // Argument: thread count (0 = every hardware thread). One thread's CPU time is the figure to
-// trust on a loaded machine; the cone, chamfer, tapered ball and profile are far slower and run
-// with every thread only.
+// trust on a loaded machine.
 BENCHMARK(ball_d6)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(flat_d6)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(bull_d6_r1)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(cone_d6_45)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(chamfer_d6_tip1_45)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(tapered_d6_r1_10)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(profile_d6)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(cone_d6_45)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(chamfer_d6_tip1_45)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(tapered_d6_r1_10)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(profile_d6)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(flat_d10_rough_below)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(ball_and_flat_d10_below)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(bull_d8_rough_below)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -56,6 +56,7 @@ struct Options {
   double gl_tolerance = 0;  // 0: a quarter of the Z-map cell
   bool fused = true;
   std::string maps;  // cache of the cpu backend's milled maps: saved after Step 1, loaded if present
+  bench::WorkloadVariant variant;  // of the program written (--sloped-roughing, --balls-only)
   std::vector<std::pair<be::ZMapBackend, be::DexelBackend>> configs;
 };
 
@@ -80,7 +81,8 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 [[noreturn]] void usage(const char* message) {
   std::fprintf(stderr,
                "%s\nusage: bench_backends_driver [--segments N | --program FILE] [--write FILE] [--zmap N] [--dexel N]\n"
-               "       [--runs R] [--threads T] [--gl-tolerance E] [--no-fused] [--maps DIR] [--configs cpu+scan,cpu+tree,...]\n",
+               "       [--runs R] [--threads T] [--gl-tolerance E] [--no-fused] [--maps DIR] [--configs cpu+scan,cpu+tree,...]\n"
+               "       [--sloped-roughing] [--balls-only]   (variants of the program written)\n",
                message);
   std::exit(2);
 }
@@ -103,6 +105,8 @@ Options parse(int argc, char** argv) {
     else if (a == "--threads") o.threads = static_cast<unsigned>(std::stoul(value()));
     else if (a == "--gl-tolerance") o.gl_tolerance = std::stod(value());
     else if (a == "--no-fused") o.fused = false;
+    else if (a == "--sloped-roughing") o.variant.sloped_roughing = true;
+    else if (a == "--balls-only") o.variant.balls_only = true;
     else if (a == "--maps") o.maps = value();
     else if (a == "--configs") configs = value();
     else usage(("unknown option " + a).c_str());
@@ -287,7 +291,7 @@ int main(int argc, char** argv) {
     auto t = std::chrono::steady_clock::now();
     std::FILE* out = std::fopen(o.write.c_str(), "w");
     if (!out) usage(("cannot write " + o.write).c_str());
-    long long written = bench::write_workload(out, o.segments);
+    long long written = bench::write_workload(out, o.segments, o.variant);
     std::fclose(out);
     std::printf("wrote %s: %lld G01 segments in %.1f s\n", o.write.c_str(), written, seconds_since(t));
     path = o.write;

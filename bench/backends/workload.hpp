@@ -123,9 +123,18 @@ inline void raster(Writer& w, const Direction& d, double radius, int levels, dou
 
 }  // namespace detail
 
+// Variants of the program. `sloped_roughing`: the flat end and the bull nose rough in one 3D
+// raster following the surface at their allowance (sloped moves, as a mold's roughing or rest
+// machining), instead of in Z levels. `balls_only`: the same program without the roughing tools
+// (the ball ends' moves unchanged), to compare Step 1 of all cutters with the ball ends alone.
+struct WorkloadVariant {
+  bool sloped_roughing = false;
+  bool balls_only = false;
+};
+
 // Writes the program; returns the number of G01 segments (within a fraction of a percent of
-// `segments`).
-inline long long write_workload(std::FILE* out, long long segments) {
+// `segments`, less the roughing's with `balls_only`).
+inline long long write_workload(std::FILE* out, long long segments, WorkloadVariant variant = {}) {
   detail::Writer w(out);
   w.line("%");
   w.line("O5000 (TRIDEX PAPER-SCALE 3+2 WORKLOAD: FIVE DIRECTIONS, FOUR CUTTERS EACH)");
@@ -135,6 +144,7 @@ inline long long write_workload(std::FILE* out, long long segments) {
   const double tool_share[4] = {0.15, 0.15, 0.25, 0.45};
   for (const detail::Direction& d : detail::directions()) {
     for (std::size_t t = 0; t < tools.size(); ++t) {
+      if (variant.balls_only && t < 2) continue;
       char text[160];
       std::snprintf(text, sizeof text, "(%s, T%d %s)", d.name, tools[t].number, tools[t].comment);
       w.line(text);
@@ -156,7 +166,7 @@ inline long long write_workload(std::FILE* out, long long segments) {
       // Without G68.2 (+Z) the feature frame is the work frame: the raster is shifted to the
       // origin instead.
       const Vec2 shift = d.tilted ? Vec2(0) : Vec2(d.origin.x, d.origin.y);
-      const int levels = t == 0 ? 4 : (t == 1 ? 2 : 0);
+      const int levels = variant.sloped_roughing ? 0 : (t == 0 ? 4 : (t == 1 ? 2 : 0));
       const double allowance = t == 0 ? 1.0 : (t == 1 ? 0.5 : (t == 2 ? 0.2 : 0));
       detail::raster(w, d, radius, levels, allowance, t != 3, budget, shift);
       w.line("M5");

@@ -12,7 +12,9 @@
 //     hit of a vertical line with a capsule);
 //   * bull nose: f' has one sign under the flat bottom, so the minimum lies on one side of it,
 //     where Newton's method (kept in a bracket) finds the root of f' on the corner torus;
-//   * other cutters: regula falsi (Illinois) on the non-decreasing f', to double precision.
+//   * other cutters: f' = 0 where φ(d) = h'(d)·√(d² − e²)/d equals the move's slope, explicit
+//     per profile piece (a line, or an arc centred on the axis) or at a joint of two pieces
+//     (MoveGeometry::convex_minimum).
 //
 // Speed comes from touching only what a move can still lower (Miller below). S is convex too (the
 // lower surface of a convex swept solid), so its tangent plane at any point bounds it from below
@@ -27,7 +29,8 @@
 //      row by row, each row read once and lowered by every move admitted there.
 // Ball end moves are bounded kLanes tiles at a time and evaluated kLanes points at a time, with
 // one square root per point (BallLanes); flat end and bull nose moves are evaluated kLanes points
-// at a time too (FlatLanes: a closed form; BullLanes: Newton steps with no square root). The moves
+// at a time too (FlatLanes: a closed form; BullLanes: the still cutter where the minimum is at
+// an end of the move, else Newton steps with no square root). The moves
 // left for a tile in pass 2 are cut lowest bound first, a run of one cutter at a time, each run
 // checked against what the tile holds by then: so a tile first cut by any cutter, or roughed
 // deeper by another cutter, still rejects the moves that cut air. Runs of flat end and bull nose
@@ -362,8 +365,52 @@ struct MoveGeometry {
     return true;
   }
 
-  // min over t ∈ [lo, hi] of f(t) = az + t·w + h(√(e² + (t − t⊥)²·|v|²)), for any cutter.
+  // min over t ∈ [lo, hi] of f(t) = az + t·w + h(√(e² + (t − t⊥)²·|v|²)), for any cutter, on
+  // a move that is not level. The minimiser lies on the side of the foot where the move is lower
+  // (s = t − t⊥ of the sign of −w: on the other side both terms of f' = w + h'(d)·s|v|²/d have
+  // w's sign), at the distance d* where
+  //     φ(d) = h'(d)·√(d² − e²)/d = m,   m = |w|/|v|,
+  // φ non-decreasing on [e, R] (h' is, and √(d² − e²)/d is). Per profile piece the root is
+  // explicit: a line of slope k gives d*² = e²k²/(k² − m²); an arc centred on the axis (radius a)
+  // d*² = (e² + m²a²)/(1 + m²); a jump of φ at a joint of the pieces (a kink) puts d* on the
+  // joint. Then t* = t⊥ ∓ √(d*² − e²)/|v|, clamped to [lo, hi] (f is convex). An arc off the axis
+  // (only the bull nose's corner, which has its own path) falls back to regula falsi.
   Lowest convex_minimum(double e2, double t_foot, double lo, double hi) const {
+    const double e = std::sqrt(e2), m = std::abs(w) * inv_len;
+    auto phi = [&](const ProfilePiece& piece, double d) {
+      if (d <= 0) return piece.derivative(0);
+      return piece.derivative(d) * std::sqrt(std::max(0.0, d * d - e2)) / d;
+    };
+    double root_d = radius;  // φ < m up to the rim: the minimiser leaves the footprint
+    bool closed = true;
+    for (const ProfilePiece& piece : cutter->pieces()) {
+      if (piece.d1 < e) continue;
+      const double from = std::max(piece.d0, e), to = std::min(piece.d1, radius);
+      if (phi(piece, from) >= m) {  // a kink at the joint, or e itself
+        root_d = from;
+        break;
+      }
+      if (phi(piece, to) < m) continue;
+      if (!piece.is_arc) {
+        root_d = std::sqrt(e2 * piece.slope * piece.slope / (piece.slope * piece.slope - m * m));
+      } else if (piece.centre_d == 0) {
+        root_d = std::sqrt((e2 + m * m * piece.radius * piece.radius) / (1 + m * m));
+      } else {
+        closed = false;
+      }
+      root_d = std::clamp(root_d, from, to);
+      break;
+    }
+    if (closed) {
+      const double side = std::sqrt(std::max(0.0, root_d * root_d - e2)) * inv_len;
+      const double t = std::clamp(w > 0 ? t_foot - side : t_foot + side, lo, hi), s = t - t_foot;
+      return {az + t * w + cutter->lower_height(std::sqrt(e2 + s * s * vv)), t};
+    }
+    return convex_regula_falsi(e2, t_foot, lo, hi);
+  }
+
+  // The same by regula falsi on f', for any convex profile.
+  Lowest convex_regula_falsi(double e2, double t_foot, double lo, double hi) const {
     auto f = [&](double t) {
       double s = t - t_foot;
       return az + t * w + cutter->lower_height(std::sqrt(e2 + s * s * vv));
@@ -581,15 +628,19 @@ struct FlatLanes : RisingMove {
 //     Q(ρ) = 1 + m² − m²r²/ρ² − e²/(R0 + ρ)² = 0,
 // with Q increasing and concave on ρ > 0, Q ≤ 0 at max(mr/√(1 + m²), e − R0) and Q(r) ≥ 0. Newton's
 // method from that left end stays left of the root and converges monotonically (a tangent of a
-// concave function lies above it), with no square root per step: 3.7 steps on average to 1e-12·r.
-// Then t* = t⊥ − √(d*² − e²)/|v|, clamped to the interval that covers q (f is convex), and S = f(t*)
-// evaluated at a point of the move, so a step short of the root can only leave S a little high,
-// never cut below the swept solid.
+// concave function lies above it), with no square root and one division per step (Q times ρ²d²):
+// 3.7 steps on average to 1e-12·r. Then t* = t⊥ − √(d*² − e²)/|v|, and S = f(t*) evaluated at a
+// point of the move, so a step short of the root can only leave S a little high, never cut below
+// the swept solid. Most points a move is tested on have their minimum clamped to an end of the
+// move (the neighbouring move of the same pass is lower there), and that needs no root: t* ≤ 0
+// exactly when t⊥ ≤ 0 or d* ≥ |u| (d(0) = |u|), i.e. Q(|u| − R0) ≤ 0 since Q increases; t* ≥ 1
+// exactly when t⊥ ≥ 1 and Q(|u − v| − R0) ≥ 0. There S is the still cutter at that end.
 struct BullLanes : RisingMove {
-  double flat = 0, corner = 0, corner2 = 0, m2 = 0, start = 0;
+  double radius = 0, flat = 0, corner = 0, corner2 = 0, m2 = 0, start = 0;
 
   BullLanes() = default;
   explicit BullLanes(const MoveGeometry& m) : RisingMove(m) {
+    radius = m.radius;
     corner = m.cutter->corner_radius(), corner2 = corner * corner;
     flat = m.radius - corner;
     m2 = w * w * inv_vv;
@@ -604,28 +655,76 @@ struct BullLanes : RisingMove {
 
   // S at the points where `wanted` (+infinity elsewhere and where the cutter does not pass).
   DoubleN at(DoubleN ux, DoubleN uy, MaskN wanted) const {
-    Cover c = cover(ux, uy);
-    MaskN covered = c.covered & wanted;
-    if (!any_n(covered)) return splat(kInf);
-    DoubleN t;
-    if (w == 0) {
-      t = min_n(max_n(c.t_foot, c.lo), c.hi);
-    } else {
-      const DoubleN e2 = c.e2, mr2 = splat(m2 * corner2), q0 = splat(1 + m2);
-      DoubleN reach = max_n(sqrt_n(e2) - flat, splat(start));
-      for (int step = 0; step < 30; ++step) {
-        DoubleN inv_reach = 1 / reach, inv_d = 1 / (flat + reach);
-        DoubleN a = mr2 * inv_reach * inv_reach, b = e2 * inv_d * inv_d;
-        DoubleN delta = (q0 - a - b) / (2 * (a * inv_reach + b * inv_d));
-        reach = min_n(reach - delta, splat(corner));
-        if (!any_n(covered & (abs_n(delta) > 1e-12 * corner))) break;
+    DoubleN z[1];
+    at<1>({ux}, uy, {wanted}, z);
+    return z[0];
+  }
+
+  // The same for G groups of kLanes points of one row at once: their Newton steps are
+  // independent, so interleaved they overlap each other's division latency (a step is one
+  // dependent chain through a division).
+  template <int G>
+  void at(const DoubleN (&ux)[G], DoubleN uy, const MaskN (&wanted)[G], DoubleN (&z)[G]) const {
+    MaskN any_wanted{};
+    for (int g = 0; g < G; ++g) z[g] = splat(kInf), any_wanted |= wanted[g];
+    if (!any_n(any_wanted)) return;
+    if (w == 0) {  // level: lowest where the axis comes closest to q
+      for (int g = 0; g < G; ++g) {
+        const Cover c = cover(ux[g], uy);
+        const DoubleN t = min_n(max_n(c.t_foot, c.lo), c.hi), s = t - c.t_foot;
+        z[g] = c.covered & wanted[g] ? low + height(sqrt_n(c.e2 + s * s * vv)) : splat(kInf);
       }
-      DoubleN d = flat + reach;
-      t = c.t_foot - sqrt_n(max_n(d * d - e2, splat(0))) * inv_len;
-      t = min_n(max_n(t, c.lo), c.hi);
+      return;
     }
-    DoubleN s = t - c.t_foot;
-    return covered ? low + t * w + height(sqrt_n(c.e2 + s * s * vv)) : splat(kInf);
+    const DoubleN mr2 = splat(m2 * corner2), q0 = splat(1 + m2);
+    // P(ρ) = ρ²d²·Q(ρ) with d = R0 + ρ: the sign of Q without a division.
+    auto p = [&](DoubleN e2, DoubleN reach, DoubleN d) {
+      const DoubleN rr = reach * reach, dd = d * d;
+      return q0 * rr * dd - mr2 * dd - e2 * rr;
+    };
+    DoubleN t_foot[G], e2[G], reach[G], t[G], d[G];
+    MaskN inside[G], any_inside{};
+    for (int g = 0; g < G; ++g) {
+      const DoubleN dot = ux[g] * vx + uy * vy, uu = ux[g] * ux[g] + uy * uy, ex = ux[g] - vx, ey = uy - vy;
+      t_foot[g] = dot * inv_vv;
+      e2[g] = max_n(uu - t_foot[g] * dot, splat(0));
+      // Where the root lies before the start or past the end, S is the cutter at that end (see
+      // above): Q(ρ_a) ≤ 0 at the start's reach ρ_a = |u| − R0, Q(ρ_b) ≥ 0 at the end's. There q
+      // is covered if that end covers it; inside, if e ≤ R (then ρ* ≤ r, as Q(r) = 1 − e²/R² ≥ 0).
+      const DoubleN da = sqrt_n(uu), db = sqrt_n(ex * ex + ey * ey), reach_a = da - flat, reach_b = db - flat;
+      const MaskN before = (t_foot[g] <= 0) | (reach_a <= 0) | (p(e2[g], reach_a, da) <= 0);
+      const MaskN after = ~before & (t_foot[g] >= 1) & (reach_b > 0) & (p(e2[g], reach_b, db) >= 0);
+      const MaskN covered = wanted[g] & (before ? da <= radius : after ? db <= radius : e2[g] <= r2);
+      inside[g] = covered & ~before & ~after;
+      any_inside |= inside[g];
+      t[g] = before ? splat(0) : splat(1);
+      d[g] = before ? da : after ? db : splat(kInf);
+      d[g] = covered ? d[g] : splat(kInf);
+      // Lower bounds of the root: the root for e = 0 and, past the end, ρ_b.
+      reach[g] = max_n(splat(start), t_foot[g] >= 1 ? reach_b : splat(0));
+    }
+    if (any_n(any_inside)) {
+      for (int g = 0; g < G; ++g) reach[g] = max_n(reach[g], sqrt_n(e2[g]) - flat);  // and e ≤ d
+      for (int step = 0; step < 30; ++step) {
+        MaskN moving{};
+        for (int g = 0; g < G; ++g) {
+          // Q/Q' with Q' = 2m²r²/ρ³ + 2e²/d³, both multiplied by ρ³d³: one division per step.
+          const DoubleN r = reach[g], dr = flat + r;
+          const DoubleN delta = r * dr * p(e2[g], r, dr) / (2 * (mr2 * dr * dr * dr + e2[g] * r * r * r));
+          reach[g] = min_n(r - delta, splat(corner));
+          moving |= inside[g] & (abs_n(delta) > 1e-12 * corner);
+        }
+        if (!any_n(moving)) break;
+      }
+      for (int g = 0; g < G; ++g) {
+        // t* = t⊥ − √(d*² − e²)/|v| has d(t*) = d*; clamped only by rounding.
+        const DoubleN root_d = flat + reach[g];
+        const DoubleN root_t = t_foot[g] - sqrt_n(max_n(root_d * root_d - e2[g], splat(0))) * inv_len;
+        t[g] = inside[g] ? min_n(max_n(root_t, splat(0)), splat(1)) : t[g];
+        d[g] = inside[g] ? root_d : d[g];
+      }
+    }
+    for (int g = 0; g < G; ++g) z[g] = d[g] < kInf ? low + t[g] * w + height(d[g]) : splat(kInf);
   }
 };
 
@@ -1245,10 +1344,14 @@ class Miller {
           // Newton steps cost several square roots: only the points above the move's plane.
           const BullLanes& bull = scratch.bulls[c.move];
           const double move_row = (c.has_plane ? c.centre_z : -kInf) + c.gradient.y * dy, uy = y - bull.ay;
+          DoubleN ux[kGroups], z[kGroups];
+          MaskN above[kGroups];
           for (int g = 0; g < kGroups; ++g) {
-            const MaskN above = move_row + c.gradient.x * dx[g] < h[g];
-            if (any_n(above)) h[g] = min_n(h[g], bull.at(x[g] - bull.ax, splat(uy), above));
+            ux[g] = x[g] - bull.ax;
+            above[g] = move_row + c.gradient.x * dx[g] < h[g];
           }
+          bull.at<kGroups>(ux, splat(uy), above, z);
+          for (int g = 0; g < kGroups; ++g) h[g] = min_n(h[g], z[g]);
         } else {
           const double move_row = (c.has_plane ? c.centre_z : -kInf) + c.gradient.y * dy;
           for (int g = 0; g < kGroups; ++g)
