@@ -111,6 +111,35 @@ BENCHMARK(BM_simulate_example)
     ->Unit(benchmark::kSecond)
     ->Iterations(1);
 
+// Steps 1-3 of `simulate` on the example with fine cells at the walls (second argument 1) or
+// without (0), at --dexel-res RES (first argument): what the refinement (zmap_walls.hpp) costs.
+// Counters: Step 1 (zmap_s), the maps' preparation for Step 2 with the refinement
+// (prepare_s: raise_uncut, refine_steep_cells, the stock's triple dexel), Steps 2-3 (intersect_s,
+// where the scan converter reads the fine cells).
+void BM_simulate_fine_cells(benchmark::State& state) {
+  cli::SimulateOptions options;
+  options.quiet = true;
+  options.program = kExamples + "mold_3plus2.camotics";
+  options.dexel_res = static_cast<int>(state.range(0));
+  cli::PipelineRequest request;
+  request.fine_cells = state.range(1) != 0;
+  cli::Progress progress(false);
+  for (auto _ : state) {
+    cli::SimulationResult r = cli::simulate_program(options, progress, request);
+    state.counters["zmap_s"] = r.timings.zmap;
+    state.counters["prepare_s"] = r.timings.dexelize;
+    state.counters["intersect_s"] = r.timings.intersect;
+    state.counters["steps123_s"] = r.timings.zmap + r.timings.dexelize + r.timings.intersect;
+  }
+}
+BENCHMARK(BM_simulate_fine_cells)
+    ->Args({cli::kDefaultDexelRes, 0})
+    ->Args({cli::kDefaultDexelRes, 1})
+    ->Args({640, 0})
+    ->Args({640, 1})
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1);
+
 // A tool table whose tools (the given cutters) all have 25 mm flutes, a shank of their diameter,
 // 40 mm out of a Ø40 × 30 mm holder body under a cone widening to Ø63 over 20 mm.
 std::string tools_with_holders(const std::vector<std::pair<int, std::string>>& cutters) {

@@ -15,6 +15,7 @@
 #include <functional>
 #include <limits>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include <doctest/doctest.h>
@@ -69,6 +70,7 @@ class MeshInside {
 struct EdgeErrors {
   int samples = 0, wrong = 0, beyond_half = 0, beyond_one_and_half = 0;
   double worst = 0;  // in spacings
+  std::vector<std::pair<Vec3, double>> beyond_half_at;  // where, and how far (spacings)
 };
 
 // 64 directions spread over the sphere (a Fibonacci lattice).
@@ -148,6 +150,7 @@ inline EdgeErrors measure_edges(const Aabb& stock, const std::function<unsigned(
     const double d = distance(p) / h;
     e.worst = std::max(e.worst, d);
     e.beyond_half += d > 0.5;
+    if (d > 0.5) e.beyond_half_at.emplace_back(p, d);
     e.beyond_one_and_half += d > 1.5;
   }
   return e;

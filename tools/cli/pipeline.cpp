@@ -435,7 +435,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
     std::vector<CutMove> moves;
     moves.reserve(groups[g].moves.size());
     for (const gcode::Move& m : groups[g].moves) moves.push_back(cut_move(groups[g], m, cutter_of_tool));
-    refine_steep_cells(maps[g], cutters, moves, {.threads = options.threads});
+    if (request.fine_cells) refine_steep_cells(maps[g], cutters, moves, {.threads = options.threads});
   }
   progress.stage("dexelizing the stock");
   TripleDexel stock_dexel = stock.mesh ? dexelize(*stock.mesh, lattice, DexelizeOptions{options.threads})
