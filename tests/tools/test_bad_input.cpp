@@ -141,6 +141,10 @@ const std::vector<BadInput>& cases() {
          return check_with(d, {"--design", at(d, "part.stl"), "--envelope", "box:0,0,0,nan,1,1"});
        },
        {"--envelope", "\"nan\" is not a number"}},
+      {"--max-memory nan", [](const fs::path& d) { return simulate_with(d, {"--max-memory", "nan"}); },
+       {"--max-memory", "\"nan\" is not a size"}},
+      {"--max-memory 1e999M", [](const fs::path& d) { return simulate_with(d, {"--max-memory", "1e999M"}); },
+       {"--max-memory", "1e999"}},
       {"--max-blocks 0", [](const fs::path& d) { return simulate_with(d, {"--max-blocks", "0"}); }, {"--max-blocks"}},
       {"-o ''", [](const fs::path& d) { return simulate_with(d, {"-o", ""}); }, {"--output", "must not be empty"}},
       {"--dump-zmaps ''", [](const fs::path& d) { return simulate_with(d, {"--dump-zmaps", ""}); },
@@ -401,34 +405,64 @@ TEST_CASE("SIGTERM removes the temporary file of an output being written") {
   fs::remove_all(dir);
 }
 
-TEST_CASE("SIGINT to a running simulate while it writes its STL leaves no temporary or partial file") {
-  fs::path dir = scratch("sigint");
+namespace {
+
+// Runs the bundled example through `command` (simulate or check) at `resolution` with `extra`
+// arguments, waits for the temporary file of `output` (a file in the scratch folder) to appear,
+// sends `signal`, and checks that the process died of it leaving only the inputs behind.
+void interrupt_while_writing(const std::string& command, const std::string& resolution,
+                             const std::vector<std::string>& extra, const std::string& output, int signal) {
+  fs::path dir = scratch("interrupted");
   const fs::path example = fs::path(TRIDEX_SOURCE_DIR) / "gcode" / "examples" / "mold_3plus2.camotics";
-  for (const char* name : {"mold_3plus2.camotics", "mold_3plus2.nc", "mold_3plus2.tools.json"})
-    fs::copy_file(example.parent_path() / name, dir / name);
-  const std::string output = (dir / "big.stl").string();
+  const std::set<std::string> inputs{"mold_3plus2.camotics", "mold_3plus2.nc", "mold_3plus2.tools.json"};
+  for (const std::string& name : inputs) fs::copy_file(example.parent_path() / name, dir / name);
+  std::vector<std::string> args{TRIDEX_COMMAND, command, (dir / "mold_3plus2.camotics").string(), "--dexel-res", resolution,
+                                "--threads", "2", "-q"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  args.push_back(command == "check" ? "--ply" : "-o");
+  args.push_back((dir / output).string());
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
   pid_t child = ::fork();
   REQUIRE(child >= 0);
   if (child == 0) {
     std::freopen("/dev/null", "w", stdout);
     std::freopen("/dev/null", "w", stderr);
-    ::execl(TRIDEX_COMMAND, TRIDEX_COMMAND, "simulate", (dir / "mold_3plus2.camotics").c_str(), "--dexel-res", "400",
-            "--threads", "2", "-q", "-o", output.c_str(), static_cast<char*>(nullptr));
+    ::execv(TRIDEX_COMMAND, argv.data());
     std::_Exit(127);
   }
-  // Wait for the temporary file of the STL, then interrupt.
+  // Wait for the temporary file of the output, then interrupt.
+  const std::string temporary = "." + output + ".tmp-";
   bool seen = false;
   int status = 0;
   while (!seen && ::waitpid(child, &status, WNOHANG) == 0) {
     for (const std::string& name : listing(dir))
-      if (name.rfind(".big.stl.tmp-", 0) == 0) seen = true;
-    if (seen) ::kill(child, SIGINT);
+      if (name.rfind(temporary, 0) == 0) seen = true;
+    if (seen) ::kill(child, signal);
     else std::this_thread::sleep_for(std::chrono::microseconds(500));
   }
   if (seen) ::waitpid(child, &status, 0);
   REQUIRE(seen);  // the run ended before its output was being written: the test proved nothing
   CHECK(WIFSIGNALED(status));
-  CHECK(WTERMSIG(status) == SIGINT);
-  CHECK(listing(dir) == std::set<std::string>{"mold_3plus2.camotics", "mold_3plus2.nc", "mold_3plus2.tools.json"});
+  CHECK(WTERMSIG(status) == signal);
+  std::set<std::string> left = listing(dir);
+  CHECK(left == inputs);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+
+TEST_CASE("SIGINT to a running simulate while it writes its STL leaves no temporary or partial file") {
+  interrupt_while_writing("simulate", "400", {}, "big.stl", SIGINT);
+}
+
+TEST_CASE("SIGTERM to a running check while it writes its PLY leaves no temporary or partial file") {
+  // The design is the bundled example's own result, written first (not interrupted).
+  fs::path dir = scratch("design-for-check");
+  const fs::path example = fs::path(TRIDEX_SOURCE_DIR) / "gcode" / "examples" / "mold_3plus2.camotics";
+  REQUIRE(run_tridex({"simulate", example.string(), "--dexel-res", "64", "-q", "-o", (dir / "design.stl").string()}, dir)
+              .status == 0);
+  interrupt_while_writing("check", "200", {"--design", (dir / "design.stl").string()}, "big.ply", SIGTERM);
   fs::remove_all(dir);
 }

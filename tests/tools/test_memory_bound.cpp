@@ -2,8 +2,9 @@
 // built command as a child process, once to read its estimate from the report, then again with
 // --max-memory just above that estimate, and the child's peak resident size (wait4's ru_maxrss)
 // must not exceed the limit. Just below the estimate the same run is refused with exit status 2.
-// Shapes: many directions, a fine resolution, a large STL stock, check with a large design, and
-// groups holding many moves.
+// Shapes: many directions, a fine resolution, a large STL stock, check with a large design,
+// groups holding many moves, --html, --dump-zmaps, and a field of slots whose walls make many
+// Z-map cells fine (zmap_walls.hpp), counted only once the maps are milled.
 #include <doctest/doctest.h>
 
 #include <spawn.h>
@@ -15,8 +16,11 @@
 #include <numbers>
 
 #include "command_harness.hpp"
+#include "pipeline.hpp"
 #include "tridex/gcode/move.hpp"
+#include "tridex/mill.hpp"
 #include "tridex/stl.hpp"
+#include "tridex/zmap_walls.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -104,6 +108,16 @@ std::string many_directions(int directions) {
   return p + "M30\n";
 }
 
+// Slots 1 mm wide and 3 mm deep, 1.5 mm apart, across a 60 mm square stock: two walls each.
+std::string slot_field() {
+  std::string p = "G21 G90\nT1 M6\nS1000 M3\n";
+  for (int k = 0; k < 39; ++k) {
+    const std::string y = std::to_string(-28.5 + 1.5 * k);
+    p += "G0 X-31 Y" + y + " Z5\nG1 Z-3 F300\nG1 X31\nG0 Z5\n";
+  }
+  return p + "M30\n";
+}
+
 // A closed UV sphere of about 2·nu·nu/2 triangles.
 Mesh sphere(int nu, double radius, Vec3 centre) {
   const int nv = nu / 2;
@@ -172,6 +186,80 @@ TEST_CASE("memory: the estimate bounds the peak of check with a large design") {
                "box:-30,-30,-40,30,30,20", "--design", (dir / "design.stl").string(), "--dexel-res", "80",
                "--ply", (dir / "out.ply").string()},
               dir, 3);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("memory: the steep cells counted before refining are those refine_steep_cells makes fine") {
+  // Slots and a ball's groove in a tilted frame (walls off the grid), milled, raised, then refined: the
+  // count the memory check uses must be the refinement's, cell for cell in number.
+  const Aabb stock{Vec3(0), Vec3(12, 9, 4)};
+  const Frame frame = Frame::from_axis(glm::normalize(Vec3(0.2, 0.1, 1)));
+  for (double cell : {0.07, 0.13}) {
+    CAPTURE(cell);
+    ZMap map = ZMap::from_box(frame, stock, cell);
+    const ZMap initial = map;
+    const Aabb local = local_bounds(frame, stock);
+    const std::vector<Cutter> cutters{Cutter::flat(0.5), Cutter::ball(0.8)};
+    std::vector<CutMove> moves;
+    for (int k = 0; k < 5; ++k) {
+      const double y = local.min.y + 1.5 + 1.6 * k;
+      moves.push_back({Segment{Vec3(local.min.x - 1, y, local.max.z - 2), Vec3(local.max.x + 1, y, local.max.z - 2)}, 0});
+    }
+    moves.push_back({Segment{Vec3(local.min.x + 3, local.min.y + 3, local.max.z - 1),
+                             Vec3(local.min.x + 6, local.min.y + 5, local.max.z - 1)}, 1});
+    mill(map, cutters, moves, {.threads = 1});
+    raise_uncut(map, initial);
+    const std::size_t counted = cli::count_steep_cells(map, WallOptions{}.steep_slope);
+    refine_steep_cells(map, cutters, moves, {.threads = 2});
+    CHECK(counted > 100);
+    CHECK(counted == map.fine.cells.size());
+    // The bytes counted cover what the refined map keeps.
+    CHECK(cli::fine_cell_bytes(static_cast<double>(counted), map.grid.ny, static_cast<double>(moves.size())) >=
+          static_cast<double>((map.fine.cells.size() + map.fine.row_begin.size()) * 4 +
+                              map.fine.heights.size() * sizeof(float)));
+  }
+}
+
+TEST_CASE("memory: the estimate bounds the peak of simulate with many steep walls, and refuses their cells") {
+  fs::path dir = scratch("memory-walls");
+  write_text(dir / "p.nc", slot_field());
+  write_text(dir / "tools.json", R"({"1": {"units": "mm", "shape": "cylindrical", "diameter": 1, "length": 20}})");
+  const std::vector<std::string> args{"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(),
+                                      "--stock", "box:-30,-30,-10,30,30,0", "--dexel-res", "120",
+                                      "--zmap-cell", "0.05", "-o", (dir / "out.stl").string()};
+  check_bound(args, dir);
+  // A limit that holds everything but the walls' sub-grids: refused once they are counted.
+  std::vector<std::string> first = args;
+  first.insert(first.end(), {"--report", (dir / "report.json").string()});
+  REQUIRE(run_tridex(first, dir).status == 0);
+  const nlohmann::json report = nlohmann::json::parse(slurp(dir / "report.json"));
+  const double total = report["memory_estimate_mib"].get<double>(), walls = report["memory_walls_mib"].get<double>();
+  MESSAGE("walls: " << walls << " MiB of " << total << " MiB");
+  REQUIRE(walls > 4);
+  std::vector<std::string> below = args;
+  below.insert(below.end(), {"--max-memory", std::to_string(static_cast<long long>(total - walls) + 2) + "M"});
+  fs::remove(dir / "out.stl");
+  CommandResult refused = run_tridex(below, dir);
+  CHECK(refused.status == 2);
+  CHECK(refused.err.find("steep Z-map cells") != std::string::npos);
+  CHECK(!fs::exists(dir / "out.stl"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("memory: the estimate bounds the peak of simulate with --html and with --dump-zmaps") {
+  fs::path dir = scratch("memory-outputs");
+  write_text(dir / "p.nc", many_directions(5));
+  write_text(dir / "tools.json", kTools);
+  const std::vector<std::string> args{"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(),
+                                      "--stock", "box:-30,-30,-40,30,30,20", "--dexel-res", "200",
+                                      "-o", (dir / "out.stl").string()};
+  std::vector<std::string> html = args;
+  html.insert(html.end(), {"--html", (dir / "page.html").string()});
+  check_bound(html, dir);
+  fs::create_directories(dir / "maps");
+  std::vector<std::string> dump = args;
+  dump.insert(dump.end(), {"--dump-zmaps", (dir / "maps").string()});
+  check_bound(dump, dir);
   fs::remove_all(dir);
 }
 

@@ -418,6 +418,7 @@ int run_check(const CheckOptions& options) {
                          {"intersect", r.timings.intersect}, {"mesh", r.timings.mesh},
                          {"collisions", r.body.seconds}, {"deviation", deviation_s}, {"total", total_s}};
   report["memory_estimate_mib"] = r.memory.total() / (1 << 20);
+  report["memory_walls_mib"] = r.memory.walls / (1 << 20);
   report["peak_rss_mib"] = peak_rss_mib();
   report["warnings"] = r.warnings;
   if (!options.report.empty()) {

@@ -26,7 +26,8 @@ struct MemoryEstimate {
   double dexels = 0;  // the stock triple dexel, the result, the grid trees over the Z-maps
   double mesh = 0;    // the surface while it is extracted
   double after = 0;   // what the caller needs after the surface (check: trees, samples)
-  double total() const { return held + zmaps + dexels + mesh + after; }
+  double walls = 0;   // the steep cells' sub-grids (zmap_walls.hpp), counted once the maps are milled
+  double total() const { return held + zmaps + dexels + mesh + after + walls; }
 };
 
 struct MemoryShape {

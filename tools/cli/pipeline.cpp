@@ -181,6 +181,27 @@ void check_dump_names(const std::string& directory, const std::vector<gcode::Mov
 
 }  // namespace
 
+std::size_t count_steep_cells(const ZMap& map, double steep_slope) {
+  const ZMapGrid& g = map.grid;
+  auto top = [&](int i, int j) { return std::max(map.height(i, j), map.empty_height); };
+  const double steep = steep_slope * g.cell;
+  std::size_t cells = 0;
+  for (int j = 0; j + 1 < g.ny; ++j)
+    for (int i = 0; i + 1 < g.nx; ++i) {
+      const float a = top(i, j), b = top(i + 1, j), c = top(i, j + 1), d = top(i + 1, j + 1);
+      if (double(std::max({a, b, c, d})) - double(std::min({a, b, c, d})) > steep) ++cells;
+    }
+  return cells;
+}
+
+double fine_cell_bytes(double cells, double rows, double moves) {
+  constexpr double kSubHeights = 4.0 * ZMapFineCells::kPoints;
+  const double per_cell = (kSubHeights + 2 * 4) + (kSubHeights + 4 + 4);
+  const double per_row = 8 + 4;  // refine's row starts, the map's
+  const double per_move = sizeof(CutMove) + sizeof(detail::MoveGeometry);
+  return per_cell * cells + per_row * rows + per_move * moves;
+}
+
 std::string travel_text(const TravelFinding& f) {
   bool linear = f.axis == 'X' || f.axis == 'Y' || f.axis == 'Z';
   char text[160];
@@ -429,9 +450,25 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   if (request.keep_maps) kept_maps = maps;
   // Then walls parallel to a spindle are placed inside their cells: the steep cells take finer
   // heights from the moves (zmap_walls.hpp).
-  for (std::size_t g = 0; g < maps.size(); ++g) {
+  for (std::size_t g = 0; g < maps.size(); ++g)
     raise_uncut(maps[g], stock.mesh ? ZMap::from_mesh(groups[g].frame, *stock.mesh, zmap_cell, limits)
                                     : ZMap::from_box(groups[g].frame, stock.box, zmap_cell, limits));
+  // How many cells are steep is known only now: their sub-grids are checked against
+  // --max-memory before any is allocated.
+  std::size_t steep_cells = 0;
+  double rows = 0, most_moves = 0;
+  for (std::size_t g = 0; g < maps.size(); ++g) {
+    steep_cells += count_steep_cells(maps[g], WallOptions{}.steep_slope);
+    rows += maps[g].grid.ny;
+    most_moves = std::max(most_moves, static_cast<double>(groups[g].moves.size()));
+  }
+  r.memory.walls = fine_cell_bytes(static_cast<double>(steep_cells), rows, most_moves);
+  if (r.memory.total() > static_cast<double>(max_memory))
+    input_error("the walls need finer heights in ", steep_cells, " steep Z-map cells: an estimated ",
+                format_mib(r.memory.walls), " on top of ", format_mib(r.memory.total() - r.memory.walls),
+                ", more than --max-memory ", format_mib(static_cast<double>(max_memory)),
+                "; use a larger --zmap-cell or --dexel-cell, or a smaller --dexel-res");
+  for (std::size_t g = 0; g < maps.size(); ++g) {
     std::vector<CutMove> moves;
     moves.reserve(groups[g].moves.size());
     for (const gcode::Move& m : groups[g].moves) moves.push_back(cut_move(groups[g], m, cutter_of_tool));

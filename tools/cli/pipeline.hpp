@@ -5,6 +5,7 @@
 // -> surface. The callers write the outputs; the pipeline only checks their paths up front.
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -128,6 +129,19 @@ constexpr double kRapidTolerance = 0.005;
 // `request` that cannot be written or names an input; writes --dump-zmaps if asked.
 SimulationResult simulate_program(const SimulateOptions& options, Progress& progress,
                                   const PipelineRequest& request = {});
+
+// The cells refine_steep_cells (zmap_walls.hpp) will make fine in `map`, counted with its own
+// rule (corners, raised to the empty height, differing by more than steep_slope cells) so that
+// their memory is known before any is allocated. How many there are depends on the walls the
+// program cuts (every cell along a pocket's side, or the whole map for a field of narrow slots),
+// so it is counted on the milled maps, not guessed up front.
+std::size_t count_steep_cells(const ZMap& map, double steep_slope);
+
+// Bytes at refine_steep_cells's peak for `cells` fine cells over maps with `rows` cell rows in
+// all, while it holds `moves` moves of one direction: per cell the sub-heights and index being
+// built (104 bytes, the index up to twice over while it grows), the sorted copy set_fine_cells
+// makes of both (108), and each move as a CutMove and its MoveGeometry.
+double fine_cell_bytes(double cells, double rows, double moves);
 
 std::string axis_label(const Vec3& axis);
 // "X 612.5 mm, past the travel's end 600" / "A -130°, past its limit -120".

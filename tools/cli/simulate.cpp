@@ -96,6 +96,7 @@ int run_simulate(const SimulateOptions& options) {
   report["dexel"] = {{"cell_mm", lattice.spacing}, {"res", {lattice.n.x, lattice.n.y, lattice.n.z}}};
   report["backends"] = {{"zmap", options.zmap_backend}, {"dexel", options.dexel_backend}};
   report["memory_estimate_mib"] = r.memory.total() / (1 << 20);
+  report["memory_walls_mib"] = r.memory.walls / (1 << 20);
   report["timings_s"] = {{"parse", r.timings.parse}, {"zmap", r.timings.zmap},
                          {"dexelize", r.timings.dexelize}, {"intersect", r.timings.intersect},
                          {"mesh", r.timings.mesh}, {"total", total_s}};
