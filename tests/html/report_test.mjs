@@ -194,7 +194,7 @@ try {
           data.files.map((f) => f.name));
     const items = await page.$$eval('#findings li', (l) => l.map((e) => e.textContent));
     const index = items.findIndex((t) => t.startsWith('collision'));
-    check(index >= 0 && items[index].includes('holder section 1'), 'holder: the collision is listed: ' + items);
+    check(index >= 0 && items[index].startsWith('collision at O1002.nc:3: holder section 1'), 'holder: the collision is listed: ' + items);
     await toggle(page, 'show-path'); await toggle(page, 'show-rapids');
     const point = report.collisions[0].point;
     await page.click('#findings li[data-index="' + index + '"]');
