@@ -1,6 +1,7 @@
 // The --html page's writer (tools/cli/html_report.*): base64 against RFC 4648's vectors, the
 // display mesh against its budget and the triangles it must keep, the thinned toolpath against the
-// moves (every line reachable, every move within the tolerance of the segment that stands for it),
+// moves (every stop reachable in program order, every move within the tolerance of the segment that
+// stands for it), the program order across groups and files,
 // the page's data against the report, and pages that say when there is nothing to show. The page
 // in a browser: tests/html (CTest's html_report_browser).
 #include <doctest/doctest.h>
