@@ -82,6 +82,8 @@ class ProgramFlow {
       : s_(state) {
     sources_.push_back(std::make_unique<Source>(file_name, program));
     s_.file = &sources_[0]->name;
+    s_.files = {file_name};  // sources_ and s_.files share their indices
+    s_.file_index = 0;
   }
 
   void run();
@@ -162,6 +164,7 @@ void ProgramFlow::note_label(std::string_view text, const Position& after) {
 void ProgramFlow::jump(const Position& to) {
   current_ = to.source;
   s_.file = &source().name;
+  s_.file_index = static_cast<int>(current_);
   if (!source().reader.seek(to.offset))
     error(0, "calls, loops and jumps need a seekable input stream");
   line_ = to.line;
@@ -223,6 +226,7 @@ std::optional<std::pair<std::size_t, Source::Label>> ProgramFlow::find_external(
       auto src = std::make_unique<Source>(shown, *file);
       src->owned = std::move(file);
       sources_.push_back(std::move(src));
+      s_.files.push_back(shown);
       return std::pair{sources_.size() - 1, Source::Label{sources_.back()->start, 0}};
     }
   }

@@ -52,6 +52,7 @@ const std::vector<Diagnostic>& Interpreter::warnings() const { return state_->wa
 const std::set<int>& Interpreter::tools_used() const { return state_->tools_used; }
 const std::map<int, int>& Interpreter::tool_first_line() const { return state_->tool_first_line; }
 long long Interpreter::blocks() const { return state_->blocks; }
+const std::vector<std::string>& Interpreter::files() const { return state_->files; }
 
 void Interpreter::run(std::istream& program, const std::string& file_name,
                       const std::function<void(const Move&)>& sink) {

@@ -39,6 +39,8 @@ struct Interpreter::State : ParameterReader {
 
   // Context of the block being executed.
   const std::string* file = nullptr;
+  int file_index = 0;              // of `file` in `files` (Move::file)
+  std::vector<std::string> files;  // every file of the run, in the order first read
   const std::function<void(const Move&)>* sink = nullptr;
   int line = 0;
   int motion_column = 1;
@@ -290,6 +292,7 @@ struct Interpreter::State : ParameterReader {
     }
     Move move;
     move.line = line;
+    move.file = file_index;
     move.kind = kind;
     move.tool = tool;
     move.start = a - world_origin;

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <sstream>
 #include <functional>
 #include <string>
 #include <unistd.h>
@@ -236,6 +237,18 @@ TEST_CASE("macros: subprogram files are found by name") {
   REQUIRE(r.moves.size() == 3);
   CHECK(near(r.moves[0].end, Vec3(4, 5, 1)));
   CHECK(near(r.moves[2].end, Vec3(3, 3, 2)));
+  // Each move names its file (an index into Interpreter::files()) and its line in that file.
+  CHECK((r.moves[0].file == 1 && r.moves[0].line == 3 && r.moves[1].file == 1 && r.moves[2].file == 2 &&
+         r.moves[2].line == 2));
+  Interpreter interpreter({}, m);
+  std::istringstream program("G0 X0 Y0 Z0\no<corner> call [3]\nM98 P9810\nG0 X1\nM30\n");
+  std::vector<std::pair<int, int>> places;
+  interpreter.run(program, "main.nc", [&](const Move& move) { places.emplace_back(move.file, move.line); });
+  CHECK(places == std::vector<std::pair<int, int>>{{0, 1}, {1, 2}, {2, 3}, {0, 4}});
+  REQUIRE(interpreter.files().size() == 3);
+  CHECK(interpreter.files()[0] == "main.nc");
+  CHECK(fs::path(interpreter.files()[1]).filename() == "corner.ngc");
+  CHECK(fs::path(interpreter.files()[2]).filename() == "O9810.nc");
   // Not found: an error naming the program; with lenient, a warning and the call skipped.
   Diagnostic d = error_of("G65 P9999\nM30\n", {}, m);
   CHECK(d.message.find("O9999") != std::string::npos);

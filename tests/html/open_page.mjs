@@ -1,5 +1,6 @@
 // Opens a --html page in Debian's headless Chromium RUNS times (a fresh tab each) and prints its
-// size and the median time from navigation to the first frame drawn (window.tridexView.ready), and
+// size, the median time from navigation to the page ready (window.tridexView.ready: the toolpath,
+// drawn after the part's first frame, drawn too) and to the part's first frame, and
 // where that time goes: the page's own stage times (window.tridexView.timings, ms since
 // navigation), as medians over the runs. With --screenshot, keeps a picture of the last load. For
 // bench/tools/README.md and docs/.
@@ -41,8 +42,11 @@ try {
   fs.rmSync(profile, { recursive: true, force: true });
 }
 seconds.sort((a, b) => a - b);
+// The part's first frame (the page's "drawn" stage: the toolpath follows it), in page time.
+const first = stages.map((t) => t.drawn / 1000).sort((a, b) => a - b);
 console.log(`${path.basename(file)}: ${(fs.statSync(file).size / 1e6).toFixed(2)} MB; ready in ` +
             `${seconds.map((s) => s.toFixed(2)).join(', ')} s (median ${seconds[Math.floor(runs / 2)].toFixed(2)} s)` +
+            `; the part first drawn at ${first.map((s) => s.toFixed(2)).join(', ')} s (median ${first[Math.floor(runs / 2)].toFixed(2)} s)` +
             (errors ? `; ${errors} console error(s)` : ''));
 // Each stage's median duration (from the previous stage's end; "script" is from navigation, so it
 // holds loading and parsing the HTML and running three.js).

@@ -1,7 +1,8 @@
 // Browser tests of tridex's --html page (issue 15), in Debian's headless Chromium driven by
 // puppeteer-core: the page loads with no console error and no network request, the part is drawn
 // (pixels of its colour where it is, none when it is hidden), choosing a finding flies the camera
-// to it and lists its G-code lines, the slider changes the drawn toolpath, and pages for an empty
+// to it and lists its G-code lines (a holder collision in a subprogram file: that file's line),
+// the slider changes the drawn toolpath (in program order, through the subprogram), and pages for an empty
 // result and a program without moves say so. Screenshots are kept in OUT_DIR.
 //   node report_test.mjs TRIDEX OUT_DIR CHROMIUM      (run by run.sh, CTest's html_report_browser)
 import { spawnSync } from 'node:child_process';
@@ -40,6 +41,19 @@ run(['simulate', write('good.nc', program(-2)), ...stock, '-o', path.join(out, '
 const checkPage = path.join(out, 'check.html');
 run(['check', write('gouge.nc', program(-2.3)), ...stock, '--design', path.join(out, 'design.stl'), '--tolerance', '0.1',
      '--envelope', 'box:-1,-1,-1,21,21,14', '--report', path.join(out, 'check.json'), '--html', checkPage], [3]);
+// A holder that hits, in a subprogram file (M98 P1002 finds O1002.nc beside the program): a hole
+// 25 mm deep 4 mm from the front face buries the Ø30 holder 20 mm out (tests/tools/test_collisions.cpp)
+// at the subprogram's line 3; the main program's line 3 (T1 M6) makes no move.
+const holderTools = write('holder_tools.json', '{"1": {"shape": "cylindrical", "diameter": 6, "stick-out": 20, ' +
+                          '"holder": [{"bottom-diameter": 30, "top-diameter": 30, "length": 20}]}}');
+write('O1002.nc', 'O1002\nG0 X30 Y4 Z40\nG1 Z5 F300\nG0 Z40\nM99\n');
+const holderProgram = write('holder.nc', '%\nG21 G17 G90\nT1 M6\nS8000 M3\nG0 X30 Y4 Z40\nM98 P1002\nG0 X50 Y30 Z40\n' +
+                            'G1 Z28 F300\nG0 Z40\nM30\n%\n');
+const holderArgs = ['--tools', holderTools, '--stock', 'box:0,0,0,60,40,30', '--dexel-cell', '0.5', '-q'];
+run(['simulate', holderProgram, ...holderArgs, '-o', path.join(out, 'holder_design.stl')]);
+const holderPage = path.join(out, 'holder.html');
+run(['check', holderProgram, ...holderArgs, '--design', path.join(out, 'holder_design.stl'), '--tolerance', '0.6',
+     '--report', path.join(out, 'holder.json'), '--html', holderPage], [3]);
 // Nothing left: a cutter wider than the stock plunges through it. No moves: a program of words only.
 const emptyPage = path.join(out, 'empty.html');
 run(['simulate', write('through.nc', '%\nG21 G90\nT1 M6\nM3 S1000\nG0 X5 Y5 Z20\nG1 Z-20 F100\nG0 Z20\nM30\n%\n'),
@@ -122,6 +136,7 @@ try {
     const data = await pageData(page);
     check(JSON.stringify(data.report) === JSON.stringify(report), 'check: the page holds the report');
     const expected = report.gouges.length + report.excess.length + report.rapid_cuts.length + report.envelope.violations.length +
+                     report.collisions.length + report.near_misses.moves.length +
                      ['missing', 'left'].filter((k) => report.design_side[k].samples > 0).length;
     const items = await page.$$eval('#findings li', (l) => l.map((e) => e.textContent));
     check(items.length === expected && report.gouges.length === 1, 'check: ' + items.length + ' findings listed, ' + expected + ' in the report');
@@ -164,6 +179,46 @@ try {
     await settle(page);
     const tip = report.envelope.violations[0].tip, seen = await page.evaluate((p) => window.tridexView.project(p), tip);
     check(Math.abs(seen[0]) < 0.02 && Math.abs(seen[1]) < 0.02, 'check: the camera flew to the envelope finding: ' + seen);
+    clean();
+    await page.close();
+  }
+  // A holder collision in a subprogram file: listed, flown to, its line shown from that file; the
+  // slider goes through the program in execution order, into the subprogram and back.
+  {
+    const { page, clean } = await open(holderPage);
+    const report = JSON.parse(fs.readFileSync(path.join(out, 'holder.json')));
+    const data = await pageData(page);
+    check(report.collisions.length > 0 && report.collisions[0].line === 3 && report.collisions[0].part.startsWith('holder'),
+          'holder: the report has the holder collision at line 3: ' + JSON.stringify(report.collisions));
+    check(data.files.length === 2 && data.files[1].name.endsWith('O1002.nc'), 'holder: both files in the page: ' +
+          data.files.map((f) => f.name));
+    const items = await page.$$eval('#findings li', (l) => l.map((e) => e.textContent));
+    const index = items.findIndex((t) => t.startsWith('collision'));
+    check(index >= 0 && items[index].startsWith('collision at O1002.nc:3: holder section 1'), 'holder: the collision is listed: ' + items);
+    await toggle(page, 'show-path'); await toggle(page, 'show-rapids');
+    const point = report.collisions[0].point;
+    await page.click('#findings li[data-index="' + index + '"]');
+    await settle(page);
+    const seen = await page.evaluate((p) => window.tridexView.project(p), point);
+    check(Math.abs(seen[0]) < 0.02 && Math.abs(seen[1]) < 0.02 && seen[2] > -1 && seen[2] < 1,
+          'holder: the camera flew to the collision: ' + seen);
+    const hits = await page.$$eval('#listing .hit', (l) => l.map((e) => e.textContent.trim()));
+    const files = await page.$$eval('#listing .file', (l) => l.map((e) => e.textContent));
+    check(hits.length === 1 && hits[0].startsWith('3') && hits[0].includes('G1 Z5 F300'),
+          'holder: the subprogram\'s line 3 marked, not the main file\'s: ' + hits);
+    check(files.length === 1 && files[0].endsWith('O1002.nc'), 'holder: the listing names the subprogram file: ' + files);
+    await toggle(page, 'show-path'); await toggle(page, 'show-rapids');
+    await page.screenshot({ path: path.join(out, 'holder_collision.png') });
+    // Stops: holder.nc:5, O1002.nc:2, 3, 4, holder.nc:7, 8, 9.
+    const label = async () => page.$eval('#path-label', (e) => e.textContent);
+    const stops = await page.$eval('#path-slider', (e) => Number(e.max) + 1);
+    await setSlider(page, 2);
+    const inSub = await label(), drawnInSub = await page.evaluate(() => window.tridexView.drawnSegments());
+    await setSlider(page, 'max');
+    const atEnd = await label(), drawnAtEnd = await page.evaluate(() => window.tridexView.drawnSegments());
+    check(stops === 7 && inSub.startsWith('toolpath up to O1002.nc:3 ') && inSub.includes('G1 Z5 F300') &&
+          atEnd.startsWith('toolpath up to holder.nc:9 '), 'holder: the slider in program order: ' + [stops, inSub, atEnd]);
+    check(drawnInSub > 0 && drawnInSub < drawnAtEnd, 'holder: segments drawn in the subprogram ' + drawnInSub + ' of ' + drawnAtEnd);
     clean();
     await page.close();
   }

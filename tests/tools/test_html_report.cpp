@@ -1,6 +1,7 @@
 // The --html page's writer (tools/cli/html_report.*): base64 against RFC 4648's vectors, the
 // display mesh against its budget and the triangles it must keep, the thinned toolpath against the
-// moves (every line reachable, every move within the tolerance of the segment that stands for it),
+// moves (every stop reachable in program order, every move within the tolerance of the segment that
+// stands for it), the program order across groups and files,
 // the page's data against the report, and pages that say when there is nothing to show. The page
 // in a browser: tests/html (CTest's html_report_browser).
 #include <doctest/doctest.h>
@@ -137,15 +138,26 @@ TEST_CASE("the display mesh meets its budget and keeps every out-of-tolerance tr
   CHECK(simplify_for_display(heightfield(40), {}, 0, 0, 1'000'000).indices.size() / 3 > flat_shown + 100);
 }
 
-TEST_CASE("the thinned toolpath keeps every line reachable and every move within its tolerance") {
+TEST_CASE("the thinned toolpath keeps every stop reachable in program order, every move within its tolerance") {
   using gcode::MoveKind;
   std::vector<gcode::MoveGroup> groups(2);
   groups[1].axis = Vec3(1, 0, 0);
+  // Program order: group 0's rapid in and a straight feed in 50 pieces (file 0, lines 1-51), then
+  // a subprogram file (file 1, lines 1-5, numbers the main file uses too) in group 1, then group 0
+  // again: a circle in 200 chords and a rapid out home (file 0, lines 60-260), then the
+  // subprogram's lines 2-3 called again.
   int line = 1;
-  // Group 0: a rapid in, a straight feed in 50 pieces, a circle in 200 chords, a rapid out home.
   groups[0].moves.push_back(move(line++, MoveKind::rapid, Vec3(0, 0, 20), Vec3(0, 0, 1)));
   for (int k = 0; k < 50; ++k)
     groups[0].moves.push_back(move(line++, MoveKind::feed, Vec3(k, 0, 1), Vec3(k + 1, 0, 1)));
+  auto sub = [&](int first, int last) {
+    for (int k = first; k <= last; ++k) {
+      groups[1].moves.push_back(move(k, MoveKind::feed, Vec3(-1, k, 0), Vec3(-1, k + 1, 0)));
+      groups[1].moves.back().file = 1;
+    }
+  };
+  sub(1, 5);
+  line = 60;
   Vec3 previous(50, 0, 1);
   for (int k = 1; k <= 200; ++k) {
     const double a = 2 * M_PI * k / 200;
@@ -155,36 +167,58 @@ TEST_CASE("the thinned toolpath keeps every line reachable and every move within
   }
   const int home_line = line++;
   groups[0].moves.push_back(move(home_line, MoveKind::rapid, previous, Vec3(0, 0, gcode::MachineConfig::kDefaultFar)));
-  // Group 1, later in the program: a few feeds.
-  for (int k = 0; k < 5; ++k) groups[1].moves.push_back(move(line++, MoveKind::feed, Vec3(-1, k, 0), Vec3(-1, k + 1, 0)));
+  sub(2, 3);
+  const std::vector<GroupRun> order = {{0, 51}, {1, 5}, {0, 201}, {1, 2}};
+
+  // The reference: the moves in program order and the stop of each.
+  std::vector<std::pair<const gcode::Move*, std::size_t>> program;
+  std::vector<std::pair<int, int>> stops;  // (file, line)
+  std::vector<std::size_t> next(2, 0);
+  for (const GroupRun& run : order)
+    for (std::uint64_t k = 0; k < run.moves; ++k) {
+      const gcode::Move& m = groups[run.group].moves[next[run.group]++];
+      if (stops.empty() || stops.back() != std::pair{m.file, m.line}) stops.emplace_back(m.file, m.line);
+      program.emplace_back(&m, run.group);
+    }
 
   const double tolerance = 0.05;
-  DisplayPath path = thin_toolpath(groups, tolerance);
-  CHECK(path.moves == 257);
-  REQUIRE(path.program_lines.size() == static_cast<std::size_t>(line - 1));
-  for (std::size_t k = 0; k < path.program_lines.size(); ++k) CHECK(path.program_lines[k] == k + 1);
-  REQUIRE(path.ends.size() == 2 * path.lines.size());
-  CHECK(path.lines.size() < 60);  // the straight feed is one segment, the circle a few dozen
-  CHECK(std::is_sorted(path.lines.begin(), path.lines.end()));
-  // Every drawn move lies within the tolerance of the segment carrying its line (the first whose
-  // line is not before it), which has its tool and direction; the move home is not drawn.
-  for (std::size_t g = 0; g < groups.size(); ++g)
-    for (const gcode::Move& m : groups[g].moves) {
-      if (m.line == home_line) continue;
-      const auto s = static_cast<std::size_t>(
-          std::lower_bound(path.lines.begin(), path.lines.end(), static_cast<std::uint32_t>(m.line)) - path.lines.begin());
-      REQUIRE(s < path.lines.size());
-      const Vec3 a(path.ends[2 * s]), b(path.ends[2 * s + 1]);
-      CHECK(segment_distance(m.start, a, b) <= tolerance + 1e-5);
-      CHECK(segment_distance(m.end, a, b) <= tolerance + 1e-5);
-      CHECK(path.tools[s] == m.tool);
-      CHECK((path.flags[s] & 127) == g);
-      CHECK(((path.flags[s] & 128) != 0) == (m.kind == MoveKind::rapid));
-    }
-  CHECK(path.lines.back() == static_cast<std::uint32_t>(line - 1));
+  DisplayPath path = thin_toolpath(groups, order, tolerance);
+  CHECK(path.moves == 259);
+  REQUIRE(path.stop_count == stops.size());
+  std::vector<std::pair<int, int>> decoded;
+  for (std::size_t r = 0; r + 2 < path.stop_runs.size(); r += 3)
+    for (std::uint32_t k = 0; k < path.stop_runs[r + 2]; ++k)
+      decoded.emplace_back(static_cast<int>(path.stop_runs[r]), static_cast<int>(path.stop_runs[r + 1] + k));
+  CHECK(decoded == stops);
+  CHECK(path.stop_runs.size() == 3 * 4);  // file 0 from line 1, file 1 from 1, file 0 from 60, file 1 from 2
+  REQUIRE(path.ends.size() == 2 * path.stops.size());
+  CHECK(path.stops.size() < 60);  // the straight feed is one segment, the circle a few dozen
+  CHECK(std::is_sorted(path.stops.begin(), path.stops.end()));
+  // Every drawn move lies within the tolerance of the segment carrying its stop (the first whose
+  // stop is not before it), which has its tool and direction; the move home is not drawn.
+  std::size_t stop = 0;
+  for (std::size_t k = 0; k < program.size(); ++k) {
+    const auto& [m, g] = program[k];
+    while (stops[stop] != std::pair{m->file, m->line}) ++stop;
+    if (m->line == home_line) continue;
+    const auto s = static_cast<std::size_t>(
+        std::lower_bound(path.stops.begin(), path.stops.end(), static_cast<std::uint32_t>(stop)) - path.stops.begin());
+    REQUIRE(s < path.stops.size());
+    const Vec3 a(path.ends[2 * s]), b(path.ends[2 * s + 1]);
+    CHECK(segment_distance(m->start, a, b) <= tolerance + 1e-5);
+    CHECK(segment_distance(m->end, a, b) <= tolerance + 1e-5);
+    CHECK(path.tools[s] == m->tool);
+    CHECK((path.flags[s] & 127) == g);
+    CHECK(((path.flags[s] & 128) != 0) == (m->kind == MoveKind::rapid));
+  }
+  CHECK(path.stops.back() == stops.size() - 1);
   for (const glm::vec3& p : path.ends) CHECK(glm::length(p) < 100);
   // With no tolerance only exactly collinear moves merge: the circle's chords all stay.
-  CHECK(thin_toolpath(groups, 0).lines.size() >= 200);
+  CHECK(thin_toolpath(groups, order, 0).stops.size() >= 200);
+  // Without an order, each group in turn; an order that does not match the groups is a defect.
+  CHECK(thin_toolpath(groups, {}, tolerance).stop_runs[0] == 0);
+  const std::vector<GroupRun> wrong = {{0, 300}};
+  CHECK_THROWS_AS(thin_toolpath(groups, wrong, tolerance), std::logic_error);
 }
 
 TEST_CASE("the page holds the report, the listed source lines, and says when there is nothing to show") {
@@ -196,7 +230,7 @@ TEST_CASE("the page holds the report, the listed source lines, and says when the
   HtmlPage page;
   page.title = "a <title> & more";
   page.report = {{"rapid_cuts", json::array({{{"line", 10}, {"where", {1, 2, 3}}}})}, {"note", "</script><b>"}};
-  page.files = {program};
+  page.files = {program.string()};
   HtmlLimits limits;
   limits.max_source_bytes = 0;  // only the lines around findings
   write_html_report(dir / "page.html", page, limits);
@@ -207,7 +241,9 @@ TEST_CASE("the page holds the report, the listed source lines, and says when the
   CHECK(data["report"] == page.report);
   json expected_source = json::object();
   for (int k = 7; k <= 13; ++k) expected_source[std::to_string(k)] = "G1 X" + std::to_string(k) + " ( line " + std::to_string(k) + " </script> )";
-  CHECK(data["source"] == expected_source);
+  REQUIRE(data["files"].size() == 1);
+  CHECK(data["files"][0]["name"] == program.string());
+  CHECK(data["files"][0]["source"] == expected_source);
   CHECK(data["mesh"]["triangles_shown"] == 0);
   CHECK(data["toolpath"]["segments"] == 0);
   REQUIRE(data["messages"].size() == 2);
@@ -220,12 +256,13 @@ TEST_CASE("the page holds the report, the listed source lines, and says when the
   page.mesh = &mesh;
   page.groups = &groups;
   data = html_page_data(page, {});
-  CHECK(data["source"].size() == 20);
+  CHECK(data["files"][0]["source"].size() == 20);
   CHECK(data["messages"].empty());
   CHECK(data["mesh"]["triangles"] == mesh.triangles.size());
   CHECK(data["toolpath"]["segments"] == 1);
-  const std::vector<std::uint32_t> runs = {3, 1};  // line 3, one line
-  CHECK(data["toolpath"]["program_line_runs"] == base64({reinterpret_cast<const std::uint8_t*>(runs.data()), 8}));
+  const std::vector<std::uint32_t> runs = {0, 3, 1};  // file 0, line 3, one stop
+  CHECK(data["toolpath"]["stop_runs"] == base64({reinterpret_cast<const std::uint8_t*>(runs.data()), 12}));
+  CHECK(data["toolpath"]["stop_count"] == 1);
   CHECK(data["machining_time_s"].get<double>() == doctest::Approx(0.1));  // 1 mm at 600 mm/min
   CHECK(!data.contains("design"));
   // check's design: its own mesh in the page, within its budget, over its own box.
@@ -264,11 +301,34 @@ TEST_CASE("simulate --html: the page's report is the --report file; an unwritabl
   CHECK(data["toolpath"]["moves"] == report["segments"]);
   CHECK(data["directions"].size() == report["groups"].size());
   CHECK(data["mesh"]["triangles"] == report["result"]["triangles"]);
-  CHECK(data["source"]["7"] == "G1 X15");
+  CHECK(data["files"][0]["source"]["7"] == "G1 X15");
   args = common;
   args.insert(args.end(), {"--html", (dir / "missing" / "r.html").string()});
   r = run_tridex(args, dir);
   CHECK(r.status == 2);
   CHECK(r.err.find("--html") != std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("simulate --html with a subprogram file: each file's text, the stops in program order across the files") {
+  fs::path dir = scratch("html-subprogram");
+  write_text(dir / "p.nc", "%\nG21 G90\nT1 M6\nM3 S1000\nG0 X5 Y5 Z20\nM98 P1001\nG0 Z20\nM30\n%\n");
+  write_text(dir / "O1001.nc", "O1001\nG0 Z12\nG1 Z5 F100\nG1 X15\nM99\n");
+  write_text(dir / "tools.json", R"({"1": {"units": "mm", "shape": "ballnose", "diameter": 4, "length": 20}})");
+  CommandResult r = run_tridex({"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(), "--stock",
+                                "box:0,0,0,20,10,10", "--dexel-res", "64", "-q", "--html", (dir / "r.html").string()},
+                               dir);
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  json data = page_data(slurp(dir / "r.html"));
+  REQUIRE(data["files"].size() == 2);
+  CHECK(fs::path(data["files"][0]["name"].get<std::string>()).filename() == "p.nc");
+  CHECK(fs::path(data["files"][1]["name"].get<std::string>()).filename() == "O1001.nc");
+  CHECK(data["files"][0]["source"]["4"] == "M3 S1000");
+  CHECK(data["files"][1]["source"]["4"] == "G1 X15");
+  // Line 5 of p.nc, lines 2-4 of O1001.nc, line 7 of p.nc: (file, first line, count) runs.
+  const std::vector<std::uint32_t> runs = {0, 5, 1, 1, 2, 3, 0, 7, 1};
+  CHECK(data["toolpath"]["stop_runs"] == base64({reinterpret_cast<const std::uint8_t*>(runs.data()), 4 * runs.size()}));
+  CHECK(data["toolpath"]["stop_count"] == 5);
   fs::remove_all(dir);
 }

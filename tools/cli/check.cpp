@@ -430,8 +430,7 @@ int run_check(const CheckOptions& options) {
     write_html_report(options.html, {.title = "tridex check: " + r.input.program.filename().string() + " against " +
                                               fs::path(options.design).filename().string(),
                                      .report = report, .mesh = &mesh, .deviation = deviation, .design = &design,
-                                     .groups = &r.groups,
-                                     .files = r.input.files});
+                                     .groups = &r.groups, .order = r.order, .files = r.files});
   }
   progress.finish();
 

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <string_view>
@@ -74,7 +75,7 @@ std::set<int> listed_lines(const Json& report, int context) {
     if (!line.is_number_integer()) return;
     for (int k = line.get<int>() - context; k <= line.get<int>() + context; ++k) wanted.insert(k);
   };
-  for (const char* kind : {"gouges", "excess", "rapid_cuts"})
+  for (const char* kind : {"gouges", "excess", "rapid_cuts", "collisions"})
     if (report.contains(kind))
       for (const Json& f : report[kind]) {
         if (f.contains("lines"))
@@ -84,34 +85,42 @@ std::set<int> listed_lines(const Json& report, int context) {
   for (const char* kind : {"envelope", "travel"})
     if (report.contains(kind))
       for (const Json& v : report[kind]["violations"]) add(v["line"]);
+  if (report.contains("near_misses"))
+    for (const Json& v : report["near_misses"]["moves"]) add(v["line"]);
   return wanted;
 }
 
-// line -> text of the single G-code file: all of it when small, else the listed lines. With
-// several files a line number does not say which file, so there is no text.
-Json source_lines(const HtmlPage& page, const HtmlLimits& limits, std::string& note) {
-  Json source = Json::object();
-  if (page.files.size() != 1) {
-    note = page.files.empty() ? "no program file" : "the program spans several files";
-    return source;
+// Each G-code file of the program (Move::file's table) with its text, line -> text: whole files
+// while their total stays within max_source_bytes, of the others only the lines around findings (a
+// report's line does not name its file: those lines are taken from every file).
+Json source_files(const HtmlPage& page, const HtmlLimits& limits) {
+  Json files = Json::array();
+  std::uintmax_t budget = limits.max_source_bytes;
+  std::optional<std::set<int>> wanted;
+  for (const std::string& name : page.files) {
+    Json file = {{"name", name}, {"source", Json::object()}, {"note", ""}};
+    std::error_code error;
+    const std::uintmax_t size = fs::file_size(name, error);
+    std::ifstream in(name, std::ios::binary);
+    if (error || !in) {
+      file["note"] = "the file could not be read";
+      files.push_back(std::move(file));
+      continue;
+    }
+    const bool everything = size <= budget;
+    if (everything) budget -= size;
+    else if (!wanted) wanted = listed_lines(page.report, limits.context);
+    if (!everything) file["note"] = "the program is large: only the lines around findings are included";
+    Json& source = file["source"];
+    std::string text;
+    for (int line = 1; std::getline(in, text); ++line) {
+      if (!everything && !wanted->count(line)) continue;
+      if (!text.empty() && text.back() == '\r') text.pop_back();
+      source[std::to_string(line)] = text;
+    }
+    files.push_back(std::move(file));
   }
-  std::error_code error;
-  const std::uintmax_t size = fs::file_size(page.files[0], error);
-  std::ifstream in(page.files[0], std::ios::binary);
-  if (error || !in) {
-    note = "the program file could not be read";
-    return source;
-  }
-  const bool everything = size <= limits.max_source_bytes;
-  const std::set<int> wanted = everything ? std::set<int>{} : listed_lines(page.report, limits.context);
-  note = everything ? "" : "the program is large: only the lines around findings are included";
-  std::string text;
-  for (int line = 1; std::getline(in, text); ++line) {
-    if (!everything && !wanted.count(line)) continue;
-    if (!text.empty() && text.back() == '\r') text.pop_back();
-    source[std::to_string(line)] = text;
-  }
-  return source;
+  return files;
 }
 
 // Feed time: each feed move's length at its F (rapids and dwells are machine-dependent: left out).
@@ -161,22 +170,18 @@ Json toolpath_json(const HtmlPage& page, const HtmlLimits& limits) {
   // A tolerance of about a quarter pixel of a 1000-pixel view first, doubled while there are too
   // many segments.
   double tolerance = std::max(1e-6, glm::length(drawn.size()) * limits.path_tolerance);
-  DisplayPath thinned = thin_toolpath(*page.groups, tolerance);
-  while (thinned.lines.size() > limits.max_segments) thinned = thin_toolpath(*page.groups, tolerance *= 2);
+  DisplayPath thinned = thin_toolpath(*page.groups, page.order, tolerance);
+  while (thinned.stops.size() > limits.max_segments) thinned = thin_toolpath(*page.groups, page.order, tolerance *= 2);
   path["moves"] = thinned.moves;
-  path["segments"] = thinned.lines.size();
+  path["segments"] = thinned.stops.size();
   path["tolerance_mm"] = thinned.tolerance;
-  // The lines as runs of consecutive numbers (first, count): a program is mostly one move a line.
-  std::vector<std::uint32_t> runs;
-  for (std::uint32_t line : thinned.program_lines)
-    if (!runs.empty() && runs[runs.size() - 2] + runs.back() == line) ++runs.back();
-    else runs.insert(runs.end(), {line, 1});
-  path["program_line_runs"] = base64_of(runs);
-  if (thinned.lines.empty()) return path;
+  path["stop_count"] = thinned.stop_count;
+  path["stop_runs"] = base64_of(thinned.stop_runs);
+  if (thinned.stops.empty()) return path;
   const Aabb box = bounds_of(thinned.ends);
   path["box"] = box_json(box);
   path["points"] = quantised(thinned.ends, box);
-  path["lines"] = base64_of(thinned.lines);
+  path["stops"] = base64_of(thinned.stops);
   path["tools"] = base64_of(thinned.tools);
   path["flags"] = base64_of(thinned.flags);
   return path;
@@ -272,16 +277,23 @@ DisplayMesh simplify_for_display(const Mesh& mesh, std::span<const double> devia
   return shown;
 }
 
-DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups, double tolerance) {
+DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups, std::span<const GroupRun> order, double tolerance) {
   struct Ref {
     const gcode::Move* move;
     std::uint8_t group;
   };
+  // The moves in program order: the groups keep it within each, `order` across them.
+  std::vector<GroupRun> whole;
+  if (order.empty())
+    for (std::size_t g = 0; g < groups.size(); ++g) whole.push_back({static_cast<std::uint32_t>(g), groups[g].moves.size()});
   std::vector<Ref> moves;
-  for (std::size_t g = 0; g < groups.size(); ++g)
-    for (const gcode::Move& m : groups[g].moves) moves.push_back({&m, static_cast<std::uint8_t>(g % 128)});
-  // Groups hold their moves in program order; merged by line (stable: a line's moves keep theirs).
-  std::stable_sort(moves.begin(), moves.end(), [](const Ref& a, const Ref& b) { return a.move->line < b.move->line; });
+  std::vector<std::size_t> next(groups.size(), 0);
+  for (const GroupRun& run : order.empty() ? std::span<const GroupRun>(whole) : order) {
+    if (run.group >= groups.size() || next[run.group] + run.moves > groups[run.group].moves.size())
+      throw std::logic_error("thin_toolpath: the program order does not match the groups");
+    for (std::uint64_t k = 0; k < run.moves; ++k)
+      moves.push_back({&groups[run.group].moves[next[run.group]++], static_cast<std::uint8_t>(run.group % 128)});
+  }
 
   DisplayPath path;
   path.moves = moves.size();
@@ -289,20 +301,28 @@ DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups, double to
   constexpr std::size_t kLongestRun = 64;  // bounds the quadratic check of a run
   std::vector<glm::vec3> run;              // the run's points: its start, then each move's end
   const Ref* first = nullptr;
-  int last_line = 0;
+  std::uint32_t run_stop = 0;              // the stop of the run's last move
   auto flush = [&] {
     if (run.size() < 2) return;
     path.ends.push_back(run.front());
     path.ends.push_back(run.back());
-    path.lines.push_back(static_cast<std::uint32_t>(last_line));
+    path.stops.push_back(run_stop);
     path.tools.push_back(static_cast<std::uint16_t>(std::clamp(first->move->tool, 0, 65535)));
     path.flags.push_back(static_cast<std::uint8_t>(first->group | (first->move->kind == gcode::MoveKind::rapid ? 128 : 0)));
     run.clear();
   };
+  const gcode::Move* previous = nullptr;
   for (const Ref& ref : moves) {
     const gcode::Move& m = *ref.move;
-    if (path.program_lines.empty() || path.program_lines.back() != static_cast<std::uint32_t>(m.line))
-      path.program_lines.push_back(static_cast<std::uint32_t>(m.line));
+    if (!previous || previous->file != m.file || previous->line != m.line) {
+      // A new stop: it extends the last run when it is the next line of the same file.
+      std::vector<std::uint32_t>& runs = path.stop_runs;
+      const auto file = static_cast<std::uint32_t>(m.file), line = static_cast<std::uint32_t>(m.line);
+      if (!runs.empty() && runs[runs.size() - 3] == file && runs[runs.size() - 2] + runs.back() == line) ++runs.back();
+      else runs.insert(runs.end(), {file, line, 1});
+      ++path.stop_count;
+    }
+    previous = &m;
     if (glm::length(m.start) >= kFar || glm::length(m.end) >= kFar) {
       flush();
       continue;
@@ -319,7 +339,7 @@ DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups, double to
       run.push_back(start);
     }
     run.push_back(end);
-    last_line = m.line;
+    run_stop = static_cast<std::uint32_t>(path.stop_count - 1);
   }
   flush();
   return path;
@@ -342,9 +362,7 @@ Json html_page_data(const HtmlPage& page, const HtmlLimits& limits) {
     }
   data["directions"] = directions;
   if (page.groups && !page.groups->empty()) data["machining_time_s"] = feed_time_s(*page.groups);
-  std::string note;
-  data["source"] = source_lines(page, limits, note);
-  data["source_note"] = note;
+  data["files"] = source_files(page, limits);
   data["context"] = limits.context;
   data["listing_lines"] = 20;  // of a finding's lines, the first this many are listed
   Json messages = Json::array();

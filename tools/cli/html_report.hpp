@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "json_text.hpp"
+#include "pipeline.hpp"
 #include "tridex/gcode/grouping.hpp"
 #include "tridex/mesh.hpp"
 
@@ -42,7 +43,8 @@ struct HtmlPage {
   std::span<const double> deviation;            // check: signed deviation per mesh vertex
   const Mesh* design = nullptr;                 // check: the design, shown as a ghost on request
   const std::vector<gcode::MoveGroup>* groups = nullptr;
-  std::vector<std::filesystem::path> files;     // the G-code file(s), for the listings
+  std::span<const GroupRun> order;              // the groups' moves in program order (pipeline.hpp)
+  std::vector<std::string> files;               // Move::file's table: the G-code files, listed
 };
 
 // Writes the page atomically (output.hpp).
@@ -69,20 +71,24 @@ DisplayMesh simplify_for_display(const Mesh& mesh, std::span<const double> devia
                                  double excess_tol, std::size_t max_triangles);
 
 struct DisplayPath {
-  std::vector<glm::vec3> ends;           // two per segment, in program order
-  std::vector<std::uint32_t> lines;      // per segment: the last source line it stands for
+  std::vector<glm::vec3> ends;           // two per segment, in program (execution) order
+  std::vector<std::uint32_t> stops;      // per segment: the last program stop it stands for
   std::vector<std::uint16_t> tools;      // per segment
   std::vector<std::uint8_t> flags;       // per segment: direction (group) index | 128 for rapids
-  std::vector<std::uint32_t> program_lines;  // every distinct line that made a move, ascending
+  // The program's stops in execution order: a stop is a move whose (file, line) differs from the
+  // move before it. Stored as runs (file, first line, count) of stops in one file on consecutive
+  // lines (a straight program is one run a file, a loop repeats its runs).
+  std::vector<std::uint32_t> stop_runs;
+  std::size_t stop_count = 0;
   std::size_t moves = 0;
   double tolerance = 0;                  // mm, what the thinning used
 };
 
-// The moves of all groups in line order, each run of moves of one kind, tool and direction that
-// joins end to start and stays within `tolerance` (mm) of the straight segment from its first start
-// to its last end drawn as that segment, carrying the run's last line. Positions "far along the
-// tool axis" (tridex's stand-in for home returns) are left out of the drawing; their lines are
-// still in program_lines.
-DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups, double tolerance);
+// The moves of all groups in program order (`order`; empty: each group in turn), each run of moves
+// of one kind, tool and direction that joins end to start and stays within `tolerance` (mm) of the
+// straight segment from its first start to its last end drawn as that segment, carrying the run's
+// last stop. Positions "far along the tool axis" (tridex's stand-in for home returns) are left out
+// of the drawing; their lines are still stops.
+DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups, std::span<const GroupRun> order, double tolerance);
 
 }  // namespace tridex::cli

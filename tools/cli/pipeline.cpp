@@ -271,7 +271,9 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   const double far = 0.5 * input.machine.far_distance;
   InterpretResult parsed = interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t file) {
     budget.keep(m, input.files[file].string());
-    grouper.add(m);
+    const auto group = static_cast<std::uint32_t>(grouper.add(m));
+    if (r.order.empty() || r.order.back().group != group) r.order.push_back({group, 0});
+    ++r.order.back().moves;
     if (kinematics && glm::length(m.end) < far)
       for (const gcode::TravelViolation& v : gcode::travel_violations(*kinematics, m.machine, m.rotary))
         if (r.travel_count++ < static_cast<long long>(kTravelListed))
@@ -284,6 +286,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   });
   r.groups = grouper.take();
   std::vector<gcode::MoveGroup>& groups = r.groups;
+  r.files = std::move(parsed.files);
   r.warnings = parsed.warnings;
   r.timings.parse = seconds_since(t);
   if (!options.dump_zmaps.empty()) check_dump_names(options.dump_zmaps, groups, request.outputs, inputs);
@@ -314,7 +317,17 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
     }
   // Without a tool in the spindle nothing cuts; rapids before the first tool change are only
   // positioning and are skipped, but a feed move then is an error.
-  if (!cutter_of_tool.count(0))
+  if (!cutter_of_tool.count(0)) {
+    // The program order loses them too: each run keeps the count of its moves that stay.
+    std::vector<std::size_t> next(groups.size(), 0);
+    for (GroupRun& run : r.order) {
+      const std::vector<gcode::Move>& moves = groups[run.group].moves;
+      const std::size_t end = next[run.group] + run.moves;
+      run.moves = static_cast<std::uint64_t>(std::count_if(moves.begin() + static_cast<std::ptrdiff_t>(next[run.group]),
+                                                           moves.begin() + static_cast<std::ptrdiff_t>(end),
+                                                           [](const gcode::Move& m) { return m.tool != 0; }));
+      next[run.group] = end;
+    }
     for (gcode::MoveGroup& group : groups) {
       std::vector<gcode::Move> kept;
       kept.reserve(group.moves.size());
@@ -327,6 +340,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
       }
       group.moves = std::move(kept);
     }
+  }
   if (toolless_rapids > 0)
     r.warnings.push_back(std::to_string(toolless_rapids) +
                          " rapid move(s) before the first tool change were not simulated (no tool)");

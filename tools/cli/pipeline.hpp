@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -96,9 +97,18 @@ struct PipelineTimings {
   double parse = 0, zmap = 0, dexelize = 0, intersect = 0, mesh = 0;
 };
 
+// The program's order across the groups (the groups keep it only within each): runs of moves
+// that follow each other in execution order and fall in one group.
+struct GroupRun {
+  std::uint32_t group = 0;
+  std::uint64_t moves = 0;
+};
+
 struct SimulationResult {
   ProgramInput input;
   std::vector<gcode::MoveGroup> groups;  // moves in program order within each group
+  std::vector<GroupRun> order;           // the groups' moves in program order: what follows what
+  std::vector<std::string> files;        // Move::file's table (InterpretResult::files)
   std::vector<Cutter> cutters;
   std::vector<ToolBody> bodies;                 // the non-cutting parts, parallel to cutters
   std::map<int, std::uint32_t> cutter_of_tool;  // tool number -> index into cutters

@@ -1,5 +1,6 @@
 #include "program_input.hpp"
 
+#include <algorithm>
 #include <fstream>
 
 #include "errors.hpp"
@@ -64,10 +65,20 @@ InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOpt
     const fs::path& path = input.files[f];
     std::ifstream in(path, std::ios::binary);
     if (!in) input_error(path.string(), ": cannot open the program file");
+    // The interpreter numbers the files of each run from 0: mapped into result.files as they come.
+    std::vector<int> global;
     try {
       interpreter.run(in, path.string(), [&](const gcode::Move& move) {
         ++result.moves;
-        sink(move, f);
+        while (global.size() <= static_cast<std::size_t>(move.file)) {
+          const std::string& name = interpreter.files()[global.size()];
+          const auto known = std::find(result.files.begin(), result.files.end(), name);
+          global.push_back(static_cast<int>(known - result.files.begin()));
+          if (known == result.files.end()) result.files.push_back(name);
+        }
+        gcode::Move renumbered = move;
+        renumbered.file = global[static_cast<std::size_t>(move.file)];
+        sink(renumbered, f);
       });
     } catch (const gcode::GcodeError& e) {
       if (options.max_blocks <= 0 || interpreter.blocks() <= options.max_blocks) throw;

@@ -38,6 +38,8 @@ struct InterpretResult {
   std::vector<std::string> warnings;           // "file:line:col: message"
   std::map<int, ToolSelection> tool_first_line;
   long long moves = 0;
+  std::vector<std::string> files;  // Move::file's table over all runs: the program's files, then
+                                   // the subprogram files they called, each once
 };
 
 // The interpreter's options from the command's: arc tolerance, --lenient and --max-blocks.
@@ -64,7 +66,8 @@ class MoveBudget {
 };
 
 // Runs every file of the program through the interpreter, streaming moves to `sink` with the
-// index of the file they came from. GcodeError propagates (exit status 2); running past
+// index of the program file they came from (input.files) and with Move::file renumbered into
+// InterpretResult::files (one table for all the runs). GcodeError propagates (exit status 2); running past
 // options.max_blocks is an InputError that names --max-blocks.
 InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOptions& options,
                           const std::function<void(const gcode::Move&, std::size_t file)>& sink);

@@ -116,7 +116,7 @@ int run_simulate(const SimulateOptions& options) {
     progress.stage("writing " + options.html);
     write_html_report(options.html, {.title = "tridex simulate: " + input.program.filename().string(),
                                      .report = report, .mesh = &mesh, .deviation = {}, .groups = &groups,
-                                     .files = input.files});
+                                     .order = r.order, .files = r.files});
   }
   progress.finish();
 

@@ -25,6 +25,8 @@ struct Move {
   int line = 0;                  // 1-based source line of the block that made the move
   MoveKind kind = MoveKind::rapid;
   int tool = 0;                  // the tool in the spindle (last M6); 0 before any tool change
+  int file = 0;                  // the file of `line`: an index into Interpreter::files() (0: the
+                                 //   program run() read; then the subprogram files it called)
   Vec3 start{0.0};               // tool tip, mm, in the work frame (the simulation's world frame:
   Vec3 end{0.0};                 //   machine table frame after the G54 offset, no tilted plane)
   Vec3 axis{0.0, 0.0, 1.0};      // unit spindle direction (tip towards holder), work frame
