@@ -284,6 +284,12 @@ TEST_CASE("check: a hole by the stock's edge buries the holder along +Z and clea
   REQUIRE(!report["collisions"].empty());
   CHECK(report["collisions"][0]["line"] == 6);
   CHECK(report["collisions"][0]["depth_mm"].get<double>() == doctest::Approx(5.0).epsilon(0.001));
+  // The stick-out the program needs, for this tool along this direction: 20 mm + 5 mm.
+  REQUIRE(report["stick_out"].size() == 1);
+  CHECK(report["stick_out"][0]["tool"] == 1);
+  CHECK(report["stick_out"][0]["axis"] == json::array({0.0, 0.0, 1.0}));
+  CHECK(report["stick_out"][0]["stick_out_mm"] == 20.0);
+  CHECK(report["stick_out"][0]["needed_mm"].get<double>() == doctest::Approx(25.0).epsilon(0.001));
   // The same entry, 15 mm along a spindle tilted 45° out through the front face: the holder's face
   // (centre entry + 5 mm back along the axis, radius 15) passes the top front edge at 2.172 mm
   // (its distance along the axis; the edge lies within the face's radius).
@@ -292,6 +298,7 @@ TEST_CASE("check: a hole by the stock's edge buries the holder along +Z and clea
           "G69\nM30\n%\n");
   CHECK(status == 0);
   CHECK(report["collisions"].empty());
+  CHECK(report["stick_out"].empty());
   REQUIRE(!report["near_misses"]["moves"].empty());
   const json& near = report["near_misses"]["moves"][0];
   CHECK(near["line"] == 8);
