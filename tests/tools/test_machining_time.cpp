@@ -170,7 +170,7 @@ TEST_CASE("machining time: the machine file's rates, refused when bad, in the re
                  dir);
   REQUIRE(r.status == 0);
   CHECK(json::parse(slurp(dir / "report.json"))["machining_time"] == mt);
-  CHECK(r.out.find("machining time 10.6 s (feed 8.0 s, rapid 0.6 s, dwell 2.0 s; rapids at 3000 mm/min, from ") !=
+  CHECK(r.out.find("machining time 10.6 s (feed 8.0 s, rapid 0.6 s, dwell 2.0 s) with rapids at 3000 mm/min (from ") !=
         std::string::npos);
 
   for (const char* bad : {R"({"rapid_rate_mm_per_min": -1})", R"({"rapid_rate_mm_per_min": [1000, 2000]})",

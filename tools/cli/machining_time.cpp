@@ -108,8 +108,8 @@ std::string machining_time_text(const MachiningTimer& timer) {
   else
     std::snprintf(rate, sizeof rate, "%g", rates.rapid_mm_per_min.x);
   return "machining time " + duration_text(t.total_s()) + " (feed " + duration_text(t.feed_s) + ", rapid " +
-         duration_text(t.rapid_s) + ", dwell " + duration_text(t.dwell_s) + "; rapids at " + rate +
-         " mm/min, " + (rates.source == "default" ? std::string("the default") : "from " + rates.source) + ")";
+         duration_text(t.rapid_s) + ", dwell " + duration_text(t.dwell_s) + ") with rapids at " + rate +
+         " mm/min (" + (rates.source == "default" ? std::string("the default") : "from " + rates.source) + ")";
 }
 
 }  // namespace tridex::cli

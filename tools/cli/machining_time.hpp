@@ -63,7 +63,8 @@ class MachiningTimer {
 Json machining_time_json(const MachiningTimer& timer);
 // "1 h 02 min 05 s" style, for the summary lines.
 std::string duration_text(double seconds);
-// "machining time 12 min 03 s (feed …, rapid …, dwell …; rapids at 10000 mm/min, default)".
+// "machining time 12 min 03 s (feed …, rapid …, dwell …) with rapids at 10000 mm/min (the
+// default)": no ';', which ends the summary line's timing.
 std::string machining_time_text(const MachiningTimer& timer);
 
 }  // namespace tridex::cli
