@@ -198,6 +198,8 @@ BENCHMARK(BM_collision_check)
     ->Args({0, 1})
     ->Args({500, 0})
     ->Args({500, 1})
+    ->Args({5000, 0})  // the paper's size (its model D has 5.17 M segments)
+    ->Args({5000, 1})
     ->Unit(benchmark::kSecond)
     ->Iterations(1);
 

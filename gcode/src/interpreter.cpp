@@ -56,6 +56,12 @@ const std::vector<std::string>& Interpreter::files() const { return state_->file
 
 void Interpreter::run(std::istream& program, const std::string& file_name,
                       const std::function<void(const Move&)>& sink) {
+  run(program, file_name, sink, {});
+}
+
+void Interpreter::run(std::istream& program, const std::string& file_name,
+                      const std::function<void(const Move&)>& sink,
+                      const std::function<void(const Dwell&)>& dwell_sink) {
   // A fresh machine for every run.
   auto fresh = std::make_unique<State>();
   fresh->options = state_->options;
@@ -64,6 +70,7 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
   State& s = *state_;
   s.file = &file_name;
   s.sink = &sink;
+  s.dwell_sink = &dwell_sink;
   s.offsets = s.machine.work_offsets;
   if (auto it = s.offsets.find(1); it != s.offsets.end()) s.work_offset = it->second;
   s.world_origin = s.work_offset;

@@ -91,8 +91,10 @@ Flow Interpreter::State::execute(const Block& block) {
     bool x_dwell = !w.has('P') && w.has('X') && motion_code < 0;
     char c = w.has('P') ? 'P' : x_dwell ? 'X' : 0;
     if (!c) error(w.find_g(40), "G4 needs a dwell time P");
-    if (w.take(c) < 0) error(w.col(c), "dwell time must not be negative");
+    double time = w.take(c);
+    if (time < 0) error(w.col(c), "dwell time must not be negative");
     if (c == 'X') w.present &= ~(1u << letter_index('X'));  // a time here, not a coordinate
+    emit_dwell(c == 'X' ? time : dwell_seconds(time));
   }
 
   for (int code : {170, 180, 190})

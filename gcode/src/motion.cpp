@@ -245,7 +245,9 @@ void Interpreter::State::cycle(int code) {
       error(motion_column, code_name('G', code) + " needs a positive peck depth Q");
   }
   if ((code == 820 || code == 860 || code == 890) && w.has('P')) {
-    if (w.take('P') < 0) error(w.col('P'), "dwell P must not be negative");
+    double p = w.take('P');
+    if (p < 0) error(w.col('P'), "dwell P must not be negative");
+    cycle_dwell = dwell_seconds(p);
   }
   if (!has_cycle_r) error(motion_column, code_name('G', code) + " needs R (retract plane)");
   if (!has_cycle_z)
@@ -338,16 +340,19 @@ void Interpreter::State::cycle(int code) {
         }
         cut(at(hole_u, hole_v, bottom));
         break;
-      case 850:  // out at feed to R (then rapid to the clear level)
+      default:  // the others go down at feed in one piece
         cut(at(hole_u, hole_v, bottom));
+        break;
+    }
+    if (code == 820 || code == 860 || code == 890) emit_dwell(cycle_dwell);  // at the bottom
+    switch (code) {  // the way out: at feed for these, at rapid for the others (below)
+      case 850:  // to R (then rapid to the clear level)
         cut(at(hole_u, hole_v, r_level));
         break;
-      case 890:  // out at feed all the way to the clear level, as LinuxCNC does
-        cut(at(hole_u, hole_v, bottom));
+      case 890:  // all the way to the clear level, as LinuxCNC does
         cut(at(hole_u, hole_v, clear_far ? r_level : clear));
         break;
-      default:  // 810, 820, 860: down at feed, out at rapid
-        cut(at(hole_u, hole_v, bottom));
+      default:
         break;
     }
     Vec3 out = at(hole_u, hole_v, clear);

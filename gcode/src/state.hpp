@@ -42,6 +42,7 @@ struct Interpreter::State : ParameterReader {
   int file_index = 0;              // of `file` in `files` (Move::file)
   std::vector<std::string> files;  // every file of the run, in the order first read
   const std::function<void(const Move&)>* sink = nullptr;
+  const std::function<void(const Dwell&)>* dwell_sink = nullptr;  // may hold no function
   int line = 0;
   int motion_column = 1;
 
@@ -107,6 +108,7 @@ struct Interpreter::State : ParameterReader {
   bool cycle_initial_far = false;
   double cycle_initial = 0;
   double cycle_r = 0, cycle_z = 0, cycle_q = 0;
+  double cycle_dwell = 0;  // seconds at the hole's bottom (G82, G86, G89)
   bool has_cycle_r = false, has_cycle_z = false, has_cycle_q = false;
 
   // Subprogram calls requested by the block just executed (flow.cpp carries them out).
@@ -309,6 +311,14 @@ struct Interpreter::State : ParameterReader {
     }
     if (tools_used.insert(tool).second) tool_first_line.emplace(tool, line);
     (*sink)(move);
+  }
+
+  // A G4 or cycle P word's time in seconds: LinuxCNC reads seconds, Fanuc milliseconds.
+  double dwell_seconds(double p) const {
+    return machine.dialect == Dialect::linuxcnc ? p : p / 1000.0;
+  }
+  void emit_dwell(double seconds) {
+    if (seconds > 0 && dwell_sink && *dwell_sink) (*dwell_sink)(Dwell{line, tool, axis, seconds});
   }
 
   // ---- cutter radius compensation (comp.cpp) ----

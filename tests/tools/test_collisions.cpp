@@ -284,6 +284,12 @@ TEST_CASE("check: a hole by the stock's edge buries the holder along +Z and clea
   REQUIRE(!report["collisions"].empty());
   CHECK(report["collisions"][0]["line"] == 6);
   CHECK(report["collisions"][0]["depth_mm"].get<double>() == doctest::Approx(5.0).epsilon(0.001));
+  // The stick-out the program needs, for this tool along this direction: 20 mm + 5 mm.
+  REQUIRE(report["stick_out"].size() == 1);
+  CHECK(report["stick_out"][0]["tool"] == 1);
+  CHECK(report["stick_out"][0]["axis"] == json::array({0.0, 0.0, 1.0}));
+  CHECK(report["stick_out"][0]["stick_out_mm"] == 20.0);
+  CHECK(report["stick_out"][0]["needed_mm"].get<double>() == doctest::Approx(25.0).epsilon(0.001));
   // The same entry, 15 mm along a spindle tilted 45° out through the front face: the holder's face
   // (centre entry + 5 mm back along the axis, radius 15) passes the top front edge at 2.172 mm
   // (its distance along the axis; the edge lies within the face's radius).
@@ -292,10 +298,41 @@ TEST_CASE("check: a hole by the stock's edge buries the holder along +Z and clea
           "G69\nM30\n%\n");
   CHECK(status == 0);
   CHECK(report["collisions"].empty());
+  CHECK(report["stick_out"].empty());
   REQUIRE(!report["near_misses"]["moves"].empty());
   const json& near = report["near_misses"]["moves"][0];
   CHECK(near["line"] == 8);
   CHECK(near["axis"][1].get<double>() == doctest::Approx(-std::sqrt(0.5)));
   CHECK(std::abs(near["distance_mm"].get<double>() - 2.172) <= 0.08);  // one Z-map cell (diagonal / 1000)
+  fs::remove_all(dir);
+}
+
+TEST_CASE("check: a shank working down its own slot meets only what the earlier passes left") {
+  // Three passes down a slot, one batch (no rapid in the material between them): the shank above
+  // the 10 mm flutes of the last pass stands where the first two passes cut. Checked against the
+  // map before those passes are milled it would hit 5 mm of material; the check must see them.
+  fs::path dir = scratch("own-slot");
+  write_text(dir / "tools.json", R"({"1": {"shape": "cylindrical", "diameter": 6, "flute-length": 10,
+      "shank-diameter": 5.8, "stick-out": 30, "holder": [{"bottom-diameter": 30, "top-diameter": 30, "length": 20}]}})");
+  write_text(dir / "p.nc", "%\nG21 G17 G90\nT1 M6\nS8000 M3\nG0 X10 Y20 Z35\nG1 Z25 F300\nG1 X50\nG1 Z20\nG1 X10\n"
+                           "G1 Z15\nG1 X50\nG0 Z40\nM30\n%\n");
+  CommandResult made = run_tridex({"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(),
+                                   "--stock", "box:0,0,0,60,40,30", "--dexel-cell", "0.5", "-o",
+                                   (dir / "design.stl").string(), "-q"},
+                                  dir);
+  REQUIRE(made.status == 0);
+  CommandResult r = run_tridex({"check", (dir / "p.nc").string(), "--design", (dir / "design.stl").string(), "--tools",
+                                (dir / "tools.json").string(), "--stock", "box:0,0,0,60,40,30", "--dexel-cell", "0.5",
+                                "--tolerance", "0.6", "--report", (dir / "report.json").string()},
+                               dir);
+  INFO(r.out, r.err);
+  CHECK(r.status == 0);
+  json report = json::parse(slurp(dir / "report.json"));
+  CHECK(report["collisions"].empty());
+  // The shank passes the slot's walls 0.1 mm away on the last pass.
+  bool walls = false;
+  for (const json& m : report["near_misses"]["moves"])
+    if (m["line"] == 11 && m["part"] == "shank") walls = std::abs(m["distance_mm"].get<double>() - 0.1) <= 0.08;
+  CHECK(walls);
   fs::remove_all(dir);
 }

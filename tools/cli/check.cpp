@@ -408,6 +408,7 @@ int run_check(const CheckOptions& options) {
   report["near_misses"] = {{"clearance_mm", options.clearance}, {"count", r.body.near_misses.size()},
                            {"moves", near_list}};
   report["stick_out"] = stick_out;
+  report["machining_time"] = machining_time_json(r.machining);
   if (envelope)
     report["envelope"] = {{"box", {{"min", to_json(envelope->min)}, {"max", to_json(envelope->max)}}},
                           {"outside", envelope_outside}, {"violations", envelope_list}};
@@ -448,6 +449,7 @@ int run_check(const CheckOptions& options) {
                 design_side["missing"]["samples"].get<long long>(), design_side["left"]["samples"].get<long long>(),
                 rapid_list.size(), envelope_outside, r.travel_count, r.body.collisions.size(), r.body.near_misses.size(),
                 options.clearance, failed ? "FAIL" : "pass", total_s);
+    std::printf("  %s\n", machining_time_text(r.machining).c_str());
     std::size_t printed = 0;
     for (const Json& g : gouge_list)
       if (g.contains("lines") && printed++ < kFindingsPrinted) {

@@ -43,7 +43,16 @@ BodyCheck::BodyCheck(const ZMap& map, std::span<const ToolBody> bodies, double c
   tiles_y_ = (map.grid.ny + kTile - 1) / kTile;
   tile_top_.assign(static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(tiles_y_),
                    -std::numeric_limits<float>::infinity());
+  tile_pending_.assign(tile_top_.size(), 0);
   refresh_tiles(map, 0, map.grid.nx - 1, 0, map.grid.ny - 1);
+}
+
+void BodyCheck::will_mill(const ZMap& map, const Cutter& cutter, const CutMove& move) {
+  const PointRange points = footprint_points(map.grid, cutter.radius(), move.tip);
+  if (points.empty()) return;
+  for (int tj = points.j0 / kTile; tj <= points.j1 / kTile; ++tj)
+    for (int ti = points.i0 / kTile; ti <= points.i1 / kTile; ++ti)
+      tile_pending_[static_cast<std::size_t>(ti) + static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(tj)] = 1;
 }
 
 void BodyCheck::refresh_tiles(const ZMap& map, int i0, int i1, int j0, int j1) {
@@ -54,7 +63,9 @@ void BodyCheck::refresh_tiles(const ZMap& map, int i0, int i1, int j0, int j1) {
       for (int j = tj * kTile; j < std::min(g.ny, (tj + 1) * kTile); ++j)
         for (int i = ti * kTile; i < std::min(g.nx, (ti + 1) * kTile); ++i)
           if (!map.is_empty(i, j)) top = std::max(top, map.height(i, j));
-      tile_top_[static_cast<std::size_t>(ti) + static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(tj)] = top;
+      const std::size_t t = static_cast<std::size_t>(ti) + static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(tj);
+      tile_top_[t] = top;
+      tile_pending_[t] = 0;
     }
 }
 
@@ -73,7 +84,7 @@ void BodyCheck::milled(const ZMap& map, std::span<const Cutter> cutters, std::sp
   refresh_tiles(map, static_cast<int>(i0), static_cast<int>(i1), static_cast<int>(j0), static_cast<int>(j1));
 }
 
-CutDepth BodyCheck::contact_depth(const ZMap& map, const Cutter& surface, const Segment& tip) const {
+CutDepth BodyCheck::contact_depth(const ZMap& map, const Cutter& surface, const Segment& tip, bool* stale) const {
   const ZMapGrid& g = map.grid;
   const PointRange points = footprint_points(g, surface.radius(), tip);
   CutDepth deepest;
@@ -85,15 +96,15 @@ CutDepth BodyCheck::contact_depth(const ZMap& map, const Cutter& surface, const 
   std::optional<detail::MoveGeometry> geometry;
   for (int tj = ja / kTile; tj <= jb / kTile; ++tj)
     for (int ti = ia / kTile; ti <= ib / kTile; ++ti) {
-      if (double(tile_top_[static_cast<std::size_t>(ti) + static_cast<std::size_t>(tiles_x_) *
-                                                           static_cast<std::size_t>(tj)]) <= floor_z)
-        continue;
+      const std::size_t t = static_cast<std::size_t>(ti) + static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(tj);
+      if (double(tile_top_[t]) <= floor_z) continue;
       if (!geometry) geometry.emplace(surface, tip);
       for (int j = std::max(ja, tj * kTile); j <= std::min(jb, tj * kTile + kTile - 1); ++j)
         for (int i = std::max(ia, ti * kTile); i <= std::min(ib, ti * kTile + kTile - 1); ++i) {
           if (map.is_empty(i, j) || double(map.height(i, j)) <= floor_z) continue;
           double depth = map.height(i, j) - geometry->lowest_above(g.x(i), g.y(j));
           if (depth > deepest.depth) deepest = {depth, i, j};
+          if (stale && depth > 0 && tile_pending_[t]) *stale = true;
         }
     }
   return deepest;
@@ -108,8 +119,12 @@ void BodyCheck::check(const ZMap& map, const gcode::Move& move, const CutMove& c
   for (std::size_t k = 0; k < body.parts.size(); ++k) {
     const BodyPart& part = body.parts[k];
     const Cutter& grown = grown_[cut.cutter][k];
-    if (contact_depth(map, grown, raised(cut.tip, part.bottom - clearance_)).depth <= 0) continue;
-    if (!up_to_date) {
+    bool stale = false;
+    if (contact_depth(map, grown, raised(cut.tip, part.bottom - clearance_), up_to_date ? nullptr : &stale).depth <= 0)
+      continue;
+    // Every test below reaches a subset of these points (a smaller growth reaches less): where
+    // none lies under a pending move, the map's heights there are the true ones.
+    if (stale) {
       // The map may still hold what the pending moves remove: mill them and look again.
       const auto paused = std::chrono::steady_clock::now();
       flush();

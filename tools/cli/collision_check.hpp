@@ -8,9 +8,12 @@
 //
 // The map is milled in batches (mill() does not depend on the order within a batch), so it may
 // still hold material that moves since the last batch removed; heights only fall, so a part clear
-// of the stale map is clear of the true one, and only a part that comes near is tested again
-// after the pending moves are milled (`flush`). Tiles of 16×16 grid points keep their highest
-// height, refreshed after every batch, so that parts above all material cost little.
+// of the stale map is clear of the true one, and only a part that comes near material that a
+// pending move may remove (in a tile under a pending move's footprint) is tested again after the
+// pending moves are milled (`flush`): elsewhere the stale heights are the true ones, so the batch
+// goes on growing while a tool works near walls it has already cut. Tiles of 16×16 grid points
+// keep their highest height, refreshed after every batch, so that parts above all material cost
+// little.
 //
 // Across directions the check is conservative, as the rapid check is (pipeline.hpp): material that
 // another direction's moves removed earlier still counts in this direction's map, so a holder may
@@ -65,12 +68,18 @@ class BodyCheck {
              const Frame& frame, std::size_t group, bool up_to_date, const std::function<void()>& flush,
              BodyFindings& found);
 
-  // To be told after each batch is milled into the map: refreshes the tiles it touched.
+  // To be told of each move put in the batch (not yet milled): marks the tiles it may lower.
+  void will_mill(const ZMap& map, const Cutter& cutter, const CutMove& move);
+
+  // To be told after each batch is milled into the map: refreshes the tiles it touched and clears
+  // their pending marks.
   void milled(const ZMap& map, std::span<const Cutter> cutters, std::span<const CutMove> batch);
 
   // The largest height − S(q) of the swept surface over the footprint, where it exceeds 0 (grid
   // points in tiles wholly below the tip are skipped, so a result ≤ 0 only says "no contact").
-  CutDepth contact_depth(const ZMap& map, const Cutter& surface, const Segment& tip) const;
+  // `stale`, where given, is set when a point of contact lies in a tile that a pending move (one
+  // not yet milled) may lower.
+  CutDepth contact_depth(const ZMap& map, const Cutter& surface, const Segment& tip, bool* stale = nullptr) const;
 
  private:
   void refresh_tiles(const ZMap& map, int i0, int i1, int j0, int j1);
@@ -80,6 +89,7 @@ class BodyCheck {
   std::vector<std::vector<Cutter>> plain_, grown_;  // per cutter, per part
   int tiles_x_ = 0, tiles_y_ = 0;
   std::vector<float> tile_top_;
+  std::vector<unsigned char> tile_pending_;  // 1: a move of the batch not yet milled reaches it
 };
 
 }  // namespace tridex::cli

@@ -123,15 +123,6 @@ Json source_files(const HtmlPage& page, const HtmlLimits& limits) {
   return files;
 }
 
-// Feed time: each feed move's length at its F (rapids and dwells are machine-dependent: left out).
-double feed_time_s(const std::vector<gcode::MoveGroup>& groups) {
-  double minutes = 0;
-  for (const gcode::MoveGroup& group : groups)
-    for (const gcode::Move& m : group.moves)
-      if (m.kind != gcode::MoveKind::rapid && m.feed > 0) minutes += glm::length(m.end - m.start) / m.feed;
-  return minutes * 60;
-}
-
 // A mesh as the page draws it: simplified to `budget` triangles, quantised points, base64.
 Json display_mesh_json(const Mesh* mesh, std::span<const double> deviation, double gouge_tol, double excess_tol,
                        std::size_t budget) {
@@ -361,7 +352,6 @@ Json html_page_data(const HtmlPage& page, const HtmlLimits& limits) {
                             {"tools", tools}});
     }
   data["directions"] = directions;
-  if (page.groups && !page.groups->empty()) data["machining_time_s"] = feed_time_s(*page.groups);
   data["files"] = source_files(page, limits);
   data["context"] = limits.context;
   data["listing_lines"] = 20;  // of a finding's lines, the first this many are listed

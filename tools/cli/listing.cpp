@@ -110,8 +110,10 @@ int run_groups(const ListOptions& options) {
     std::vector<std::array<double, 3>> rotary;  // the distinct rotary positions (kinematics)
   };
   std::vector<Extra> extras;
+  MachiningTimer timer(input.rates);
   InterpretResult result = interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t file) {
     budget.keep(m, input.files[file].string());
+    timer.add(m);
     std::size_t g = grouper.add(m);
     if (g >= extras.size()) extras.resize(g + 1);
     Extra& e = extras[g];
@@ -125,7 +127,7 @@ int run_groups(const ListOptions& options) {
       if (!m.from_far) e.local.extend(frame.to_local(m.start));
       e.local.extend(frame.to_local(m.end));
     }
-  });
+  }, [&](const gcode::Dwell& d) { timer.add(d); });
   Json groups = Json::array();
   const auto& list = grouper.groups();
   for (std::size_t g = 0; g < list.size(); ++g) {
@@ -158,6 +160,7 @@ int run_groups(const ListOptions& options) {
   document["program"] = input.program.string();
   document["segments"] = result.moves;
   document["groups"] = std::move(groups);
+  document["machining_time"] = machining_time_json(timer);
   document["warnings"] = result.warnings;
   write_output(options.output, [&](std::ostream& out) { out << document.dump(2) << '\n'; });
   print_warnings(result.warnings, options.quiet);

@@ -68,7 +68,14 @@ int work_offset_key(const std::string& name, const std::string& where) {
   input_error(where, ": unknown work offset \"", name, "\" (G54..G59 or \"G54.1 P1\"..\"G54.1 P300\")");
 }
 
-gcode::MachineConfig parse(const json& doc, const std::string& file) {
+// A positive, finite number of mm/min.
+double rate(const json& value, const std::string& where) {
+  if (!value.is_number() || !(value.get<double>() > 0) || !std::isfinite(value.get<double>()))
+    input_error(where, ": must be a positive number of mm/min, got ", value.dump());
+  return value.get<double>();
+}
+
+gcode::MachineConfig parse(const json& doc, const std::string& file, MachineRates* rates) {
   if (!doc.is_object()) input_error(file, ": a machine file is a JSON object");
   gcode::MachineConfig m;
   if (auto base = doc.find("base"); base != doc.end()) {
@@ -133,6 +140,23 @@ gcode::MachineConfig parse(const json& doc, const std::string& file) {
       if (!value.is_number() || !(value.get<double>() > 0) || !std::isfinite(value.get<double>()))
         input_error(where, ": must be a positive number of mm, got ", value.dump());
       m.far_distance = value.get<double>();
+    } else if (key == "rapid_rate_mm_per_min") {
+      MachineRates r;
+      if (value.is_array()) {
+        if (value.size() != 3) input_error(where, ": one rate, or [x, y, z] in mm/min, got ", value.dump());
+        for (int a = 0; a < 3; ++a) r.rapid_mm_per_min[a] = rate(value[static_cast<std::size_t>(a)], where);
+        r.rapid_per_axis = true;
+      } else {
+        r.rapid_mm_per_min = Vec3(rate(value, where));
+      }
+      r.source = file;
+      if (rates) {
+        r.max_feed_mm_per_min = rates->max_feed_mm_per_min;
+        *rates = r;
+      }
+    } else if (key == "max_feed_mm_per_min") {
+      double max_feed = rate(value, where);
+      if (rates) rates->max_feed_mm_per_min = max_feed;
     } else if (key == "subprograms") {
       if (!value.is_array()) input_error(where, ": must be a list of folders");
       fs::path base = fs::path(file).parent_path();
@@ -141,7 +165,8 @@ gcode::MachineConfig parse(const json& doc, const std::string& file) {
     } else {
       input_error(where, ": unknown key (known: name, description, base, dialect, units, start, "
                          "tool_change, tool_loads_on_t, home, reference2, work_offsets, m_codes, "
-                         "forbidden_m_codes, far_distance, subprograms, kinematics)");
+                         "forbidden_m_codes, far_distance, subprograms, kinematics, "
+                         "rapid_rate_mm_per_min, max_feed_mm_per_min)");
     }
   }
   for (int code : m.m_codes)
@@ -152,16 +177,16 @@ gcode::MachineConfig parse(const json& doc, const std::string& file) {
 
 }  // namespace
 
-gcode::MachineConfig machine_from_json(const json& doc, const std::string& file) {
+gcode::MachineConfig machine_from_json(const json& doc, const std::string& file, MachineRates* rates) {
   try {
-    return parse(doc, file);
+    return parse(doc, file, rates);
   } catch (const json::exception& e) {
     input_error(file, ": ", e.what());
   }
 }
 
 gcode::MachineConfig load_machine(const std::string& name_or_file,
-                                  const std::vector<std::string>& subprogram_dirs) {
+                                  const std::vector<std::string>& subprogram_dirs, MachineRates* rates) {
   gcode::MachineConfig machine;
   if (name_or_file.empty()) {
     machine = *gcode::MachineConfig::bundled("default");
@@ -172,7 +197,7 @@ gcode::MachineConfig load_machine(const std::string& name_or_file,
     if (!fs::is_regular_file(name_or_file, error))
       input_error("--machine ", name_or_file, ": neither a bundled machine (", kBundledMachines,
                   ") nor a machine file");
-    machine = machine_from_json(read_json_file(name_or_file), name_or_file);
+    machine = machine_from_json(read_json_file(name_or_file), name_or_file, rates);
   }
   for (const std::string& dir : subprogram_dirs) {
     std::error_code error;

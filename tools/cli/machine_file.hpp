@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "machining_time.hpp"
 #include "tridex/gcode/interpreter.hpp"
 
 namespace tridex::cli {
@@ -16,9 +17,12 @@ inline constexpr const char* kBundledMachines = "default, linuxcnc";
 // An empty name is the default machine. `subprogram_dirs` (--subprograms) are searched before
 // the machine file's own. Throws InputError naming the file, the key and the value.
 // The machine from a parsed machine file; `file` names it in messages. Throws InputError.
-gcode::MachineConfig machine_from_json(const nlohmann::json& doc, const std::string& file);
+// `rates`, where given, receives the machine's speeds (left as they are where the file has none).
+gcode::MachineConfig machine_from_json(const nlohmann::json& doc, const std::string& file,
+                                       MachineRates* rates = nullptr);
 
 gcode::MachineConfig load_machine(const std::string& name_or_file,
-                                  const std::vector<std::string>& subprogram_dirs = {});
+                                  const std::vector<std::string>& subprogram_dirs = {},
+                                  MachineRates* rates = nullptr);
 
 }  // namespace tridex::cli

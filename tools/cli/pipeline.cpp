@@ -105,6 +105,7 @@ void mill_in_program_order(ZMap& map, const gcode::MoveGroup& group, std::size_t
     }
     if (bodies) bodies->check(map, m, cut, group.axis, group.frame, g, batch.empty(), flush, body_found);
     batch.push_back(cut);
+    if (bodies) bodies->will_mill(map, cutters[cut.cutter], cut);
   }
   flush();
 }
@@ -269,11 +270,13 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   const std::optional<gcode::Kinematics>& kinematics = input.machine.kinematics;
   // Positions "far along the tool axis" stand in for where the machine takes the tool: no travel.
   const double far = 0.5 * input.machine.far_distance;
+  r.machining = MachiningTimer(input.rates);
   InterpretResult parsed = interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t file) {
     budget.keep(m, input.files[file].string());
     const auto group = static_cast<std::uint32_t>(grouper.add(m));
     if (r.order.empty() || r.order.back().group != group) r.order.push_back({group, 0});
     ++r.order.back().moves;
+    r.machining.add(m);
     if (kinematics && glm::length(m.end) < far)
       for (const gcode::TravelViolation& v : gcode::travel_violations(*kinematics, m.machine, m.rotary))
         if (r.travel_count++ < static_cast<long long>(kTravelListed))
@@ -283,7 +286,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
       if (!m.from_far) cutting_bounds.extend(m.start);
       cutting_bounds.extend(m.end);
     }
-  });
+  }, [&](const gcode::Dwell& d) { r.machining.add(d); });
   r.groups = grouper.take();
   std::vector<gcode::MoveGroup>& groups = r.groups;
   r.files = std::move(parsed.files);

@@ -18,6 +18,7 @@
 #include "collision_check.hpp"
 #include "commands.hpp"
 #include "json_text.hpp"
+#include "machining_time.hpp"
 #include "memory.hpp"
 #include "program_input.hpp"
 #include "progress.hpp"
@@ -127,6 +128,7 @@ struct SimulationResult {
   std::vector<TravelFinding> travel;  // the first kTravelListed, in program order
   long long travel_count = 0;
   BodyFindings body;  // collisions and near misses of shanks and holders (body_clearance only)
+  MachiningTimer machining;  // the program's machining time
   std::vector<std::string> warnings;
   PipelineTimings timings;
 };

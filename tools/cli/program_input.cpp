@@ -15,7 +15,7 @@ namespace fs = std::filesystem;
 ProgramInput resolve_program(const CommonOptions& options) {
   const std::string& program = options.program;
   ProgramInput input;
-  input.machine = load_machine(options.machine, options.subprograms);
+  input.machine = load_machine(options.machine, options.subprograms, &input.rates);
   input.program = program;
   std::error_code error;
   if (fs::is_directory(input.program, error)) input_error(program, ": is a directory, not a program file");
@@ -58,7 +58,8 @@ void MoveBudget::keep(const gcode::Move& move, const std::string& file) {
 }
 
 InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOptions& options,
-                          const std::function<void(const gcode::Move&, std::size_t file)>& sink) {
+                          const std::function<void(const gcode::Move&, std::size_t file)>& sink,
+                          const std::function<void(const gcode::Dwell&)>& dwell_sink) {
   InterpretResult result;
   gcode::Interpreter interpreter(options, input.machine);
   for (std::size_t f = 0; f < input.files.size(); ++f) {
@@ -79,7 +80,7 @@ InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOpt
         gcode::Move renumbered = move;
         renumbered.file = global[static_cast<std::size_t>(move.file)];
         sink(renumbered, f);
-      });
+      }, dwell_sink);
     } catch (const gcode::GcodeError& e) {
       if (options.max_blocks <= 0 || interpreter.blocks() <= options.max_blocks) throw;
       input_error(e.where.file, ":", e.where.line, ":", e.where.column, ": more than ", options.max_blocks,

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "machining_time.hpp"
 #include "memory.hpp"
 #include "stock.hpp"
 #include "tool_table.hpp"
@@ -23,6 +24,7 @@ struct ProgramInput {
   std::optional<ToolTable> tools;             // --tools, else from a project
   std::optional<StockSpec> stock;             // from a project
   gcode::MachineConfig machine;               // --machine, --subprograms
+  MachineRates rates;                         // the machine file's speeds, for the machining time
 };
 
 // Throws InputError if the file is missing, the project is malformed or the machine unknown.
@@ -67,9 +69,11 @@ class MoveBudget {
 
 // Runs every file of the program through the interpreter, streaming moves to `sink` with the
 // index of the program file they came from (input.files) and with Move::file renumbered into
-// InterpretResult::files (one table for all the runs). GcodeError propagates (exit status 2); running past
-// options.max_blocks is an InputError that names --max-blocks.
+// InterpretResult::files (one table for all the runs), and dwells to `dwell_sink` where given.
+// GcodeError propagates (exit status 2); running past options.max_blocks is an InputError that
+// names --max-blocks.
 InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOptions& options,
-                          const std::function<void(const gcode::Move&, std::size_t file)>& sink);
+                          const std::function<void(const gcode::Move&, std::size_t file)>& sink,
+                          const std::function<void(const gcode::Dwell&)>& dwell_sink = {});
 
 }  // namespace tridex::cli

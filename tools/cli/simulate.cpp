@@ -107,6 +107,7 @@ int run_simulate(const SimulateOptions& options) {
                       {"triangles", mesh.triangles.size()},
                       {"watertight", check.closed()}};
   report["rapid_cuts"] = rapid_findings;
+  report["machining_time"] = machining_time_json(r.machining);
   report["warnings"] = warnings;
   if (!options.report.empty()) {
     progress.stage("writing " + options.report);
@@ -130,6 +131,7 @@ int run_simulate(const SimulateOptions& options) {
                 input.program.filename().string().c_str(), segments, groups.size(), lattice.n.x,
                 lattice.n.y, lattice.n.z, volume, stock.volume - volume, mesh.triangles.size(),
                 check.closed() ? "watertight" : "NOT watertight", written.c_str(), total_s);
+    std::printf("  %s\n", machining_time_text(r.machining).c_str());
   }
   return kSuccess;
 }

@@ -140,6 +140,13 @@ class Interpreter {
   // from a fresh machine state. M98 needs a seekable stream (files and string streams are).
   void run(std::istream& program, const std::string& file_name,
            const std::function<void(const Move&)>& sink);
+  // The same, streaming every dwell to `dwell_sink` as well. The time word follows the dialect:
+  // LinuxCNC reads G4 P and a cycle's P in seconds; Fanuc reads P in milliseconds and G4 X in
+  // seconds (Haas's `P1.`, seconds for its decimal point, reads as 1 ms). A cycle's P is sticky,
+  // as its Q is.
+  void run(std::istream& program, const std::string& file_name,
+           const std::function<void(const Move&)>& sink,
+           const std::function<void(const Dwell&)>& dwell_sink);
 
   const std::vector<Diagnostic>& warnings() const;
   const std::set<int>& tools_used() const;              // tools of the emitted moves

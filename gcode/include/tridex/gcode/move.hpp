@@ -43,4 +43,13 @@ struct Move {
   Vec3 machine{0.0};
 };
 
+// A pause with the tool standing still: G4, and the pause at a hole's bottom in G82, G86 and
+// G89. Not a move (it removes nothing); it counts for the machining time only.
+struct Dwell {
+  int line = 0;             // 1-based source line of the block that dwells
+  int tool = 0;             // the tool in the spindle
+  Vec3 axis{0.0, 0.0, 1.0}; // the spindle direction, work frame
+  double seconds = 0;       // as programmed, converted to seconds (see Interpreter::run)
+};
+
 }  // namespace tridex::gcode

@@ -1,0 +1,70 @@
+// tridex command — the machining time: each move's time from its feed or the machine's rapid
+// rate, and the dwells as programmed, summed per tool, per spindle direction and in total.
+//
+// A feed move (line, arc chord, cycle piece) takes length / feed: the interpreter gives the feed
+// in mm/min (G20 feeds converted), an arc as its chords (their summed length is the arc's to the
+// arc tolerance), a canned cycle as its pieces (feed 0 marks the rapid ones). A rapid moves every
+// linear axis at most at its rate: with one rate for all, length / rate; with one per axis, the
+// longest of |Δx|/x, |Δy|/y, |Δz|/z (a straight rapid as LinuxCNC plans it), along the work frame's
+// axes. Acceleration, tool changes and the approach from "far along the tool axis" (whose start
+// is a stand-in, docs/design.md) are not timed; the approaches are counted. G93 inverse-time
+// feeds are not read by the interpreter (an error), so every feed here is units per minute.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "json_text.hpp"
+#include "tridex/gcode/move.hpp"
+#include "tridex/geometry.hpp"
+
+namespace tridex::cli {
+
+// The machine file's speeds (README "Machine files"): "rapid_rate_mm_per_min" (a number, or
+// [x, y, z]) and "max_feed_mm_per_min" (feeds above it run at it).
+struct MachineRates {
+  static constexpr double kDefaultRapid = 10000;  // mm/min, when the machine file gives none
+
+  Vec3 rapid_mm_per_min{kDefaultRapid};
+  bool rapid_per_axis = false;
+  std::optional<double> max_feed_mm_per_min;
+  std::string source = "default";  // where the rapid rate came from: "default" or the file
+};
+
+struct MachiningTime {
+  double feed_s = 0, rapid_s = 0, dwell_s = 0;
+  std::map<int, double> by_tool;                  // tool number -> seconds
+  std::vector<std::pair<Vec3, double>> by_direction;  // in order of first appearance
+  long long untimed_approaches = 0;  // moves back from "far": where they start is not known
+  long long capped_feeds = 0;        // feed moves run at max_feed_mm_per_min instead
+  double total_s() const { return feed_s + rapid_s + dwell_s; }
+};
+
+class MachiningTimer {
+ public:
+  MachiningTimer() = default;
+  explicit MachiningTimer(MachineRates rates);
+  void add(const gcode::Move& move);
+  void add(const gcode::Dwell& dwell);
+  const MachiningTime& time() const { return time_; }
+  const MachineRates& rates() const { return rates_; }
+
+ private:
+  void charge(int tool, const Vec3& axis, double seconds);
+
+  MachineRates rates_;
+  MachiningTime time_;
+  std::size_t last_direction_ = 0;
+};
+
+// The report's "machining_time" object.
+Json machining_time_json(const MachiningTimer& timer);
+// "1 h 02 min 05 s" style, for the summary lines.
+std::string duration_text(double seconds);
+// "machining time 12 min 03 s (feed …, rapid …, dwell …) with rapids at 10000 mm/min (the
+// default)": no ';', which ends the summary line's timing.
+std::string machining_time_text(const MachiningTimer& timer);
+
+}  // namespace tridex::cli
