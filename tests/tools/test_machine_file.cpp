@@ -1,5 +1,6 @@
-// --machine and --subprograms: the bundled machines, a machine file's every key changing what a
-// program means, and bad machine files refused with the file and the key (exit 2).
+// --machine and --subprograms: the bundled machines (the kinematics profiles among them, on every
+// command), a machine file's every key changing what a program means, bad machine files refused
+// with the file and the key (exit 2), and rotary bad input refused at its file:line:col.
 #include <doctest/doctest.h>
 
 #include <nlohmann/json.hpp>

@@ -1,9 +1,10 @@
 // `tridex simulate` on rotary-indexed 3+2: the bundled example's rotary twin (Haas DWO on the
 // bc-trunnion profile) gives the same solid as the G68.2 example, and one tilted pocket written
 // in each way of writing a plane (Fanuc G68.2 I J K, G68.2 P1, Mazak A B C, G68.2 P2 and P3,
-// rotary words with DWO, rotary words under TCP) machines the same volume. The moves themselves
-// are compared within 1e-6 mm in tests/gcode (test_rotary.cpp, test_tilted_words.cpp); this is
-// the end-to-end check through the command.
+// rotary words with DWO, rotary words under TCP) machines the same volume; and on every bundled
+// profile, by its --machine name, the four ways (G68.2, DWO, TCP, raw rotary words) give
+// the same moves within 1e-6 mm and the same volume. The interpreter's side is in tests/gcode
+// (test_rotary.cpp, test_tilted_words.cpp); this is the end-to-end check through the command.
 #include <doctest/doctest.h>
 
 #include <cmath>
