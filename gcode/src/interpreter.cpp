@@ -90,15 +90,20 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
     s.line = s.plane_blocks.first_line;
     s.error(0, s.incomplete_plane());
   }
-  // One line per kind of word lenient mode skipped, however many: never a silent skip.
-  for (const auto& [cause, skipped] : s.skipped) {
-    std::string lines;
-    for (int l : skipped.lines) lines += (lines.empty() ? "" : ", ") + std::to_string(l);
-    if (skipped.count > static_cast<long long>(skipped.lines.size())) lines += ", …";
-    s.warnings.push_back(Diagnostic{file_name, 0, 0,
-                                    "lenient mode skipped " + std::to_string(skipped.count) + " × " +
-                                        cause + " (lines " + lines + ")"});
-  }
+  // One line per kind of word lenient mode skipped or block it read otherwise, however many:
+  // never silent.
+  auto summarize = [&](const std::map<std::string, State::Skipped>& causes, const char* verb) {
+    for (const auto& [cause, skipped] : causes) {
+      std::string lines;
+      for (int l : skipped.lines) lines += (lines.empty() ? "" : ", ") + std::to_string(l);
+      if (skipped.count > static_cast<long long>(skipped.lines.size())) lines += ", …";
+      s.warnings.push_back(Diagnostic{file_name, 0, 0,
+                                      std::string("lenient mode ") + verb + " " + std::to_string(skipped.count) +
+                                          " × " + cause + " (lines " + lines + ")"});
+    }
+  };
+  summarize(s.skipped, "skipped");
+  summarize(s.read_as, "read");
 }
 
 std::optional<MachineConfig> MachineConfig::bundled(const std::string& name) {

@@ -76,14 +76,16 @@ void Interpreter::State::rotary_words() {
                           format_number((*a->limits)[1]) + "] (machine file)");
   }
   if (next == rotary_position) return;
-  bool cut = motion == 10;
-  if (cut) {
-    std::string message = "rotary motion during a cut (G1 turning A/B/C: simultaneous 5-axis) is "
-                          "outside 3+2";
-    if (!options.lenient) error(first, message + "; index with G0 first");
-    warn(first, message + "; read as indexed at its end orientation (lenient mode)");
-  }
+  const bool cut = motion == 10;
+  const std::string message = "rotary motion during a cut (G1 turning A/B/C: simultaneous 5-axis) is "
+                              "outside 3+2";
+  if (cut && !options.lenient) error(first, message + "; index with G0 first");
   set_rotary(next);
+  if (cut)  // lenient: said on the line and counted per direction for the run's summary
+    lenient_read(first,
+                 message + "; read as indexed at its end orientation, direction " + direction_text(axis) +
+                     " (lenient mode)",
+                 "rotary motion during a cut read as indexed along " + direction_text(axis));
   if (!cut && (tilted || tcp || dwo)) go_far();
 }
 

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <functional>
 #include <map>
 #include <numbers>
@@ -95,7 +96,6 @@ struct Interpreter::State : ParameterReader {
   Vec3 pos{0.0};
   bool far = true;
   bool ambiguous = false;
-  bool warned_ambiguous = false;
   bool warned_home = false;
   bool warned_reference2 = false;
   std::set<int> warned_m_codes;
@@ -156,8 +156,25 @@ struct Interpreter::State : ParameterReader {
   struct Skipped {
     long long count = 0;
     std::vector<int> lines;  // the first few
+    int last_line = 0;
   };
   std::map<std::string, Skipped> skipped;
+  // Lenient mode reads a block it cannot take as written in a stated way (`cause`, which names
+  // the direction it was read along): a warning for the line, and a count per cause for the
+  // run's summary, however many (the warnings themselves stop at 1000).
+  void lenient_read(int column, const std::string& message, const std::string& cause) {
+    Skipped& s = read_as[cause];
+    if (s.count > 0 && s.last_line == line) return;  // one per line: an arc's chords
+    s.last_line = line;
+    warn(column, message);
+    if (s.count++ < 5) s.lines.push_back(line);
+  }
+  std::map<std::string, Skipped> read_as;
+  static std::string direction_text(const Vec3& d) {
+    char text[112];  // snprintf: GCC 12 warns falsely on "literal" + std::string chains
+    std::snprintf(text, sizeof text, "(%.10g, %.10g, %.10g)", d.x, d.y, d.z);
+    return text;
+  }
 
   // ---- words ----
   void gather(const Block& block) {
@@ -289,8 +306,9 @@ struct Interpreter::State : ParameterReader {
                             std::to_string(tilt_line) +
                             " is not normal to the tool and no G53.1/G53.6/G253 has oriented it";
       if (!options.lenient) error(motion_column, message);
-      if (!warned_ambiguous) warn(motion_column, message + "; keeping the current direction");
-      warned_ambiguous = true;
+      lenient_read(motion_column, message + "; read along the current direction " + direction_text(axis) +
+                                      " (lenient mode)",
+                   "move under an ambiguous tilted plane along the current direction " + direction_text(axis));
     }
     Move move;
     move.line = line;

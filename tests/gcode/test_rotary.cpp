@@ -188,9 +188,10 @@ TEST_CASE("rotary 3+2: bad input is an error at its line and column") {
   lenient.lenient = true;
   Result r = run_program("G0 X0 Y0 Z0\nG1 X1 A10 F100\nM30\n", lenient, ac);
   REQUIRE(r.moves.size() == 2);
-  REQUIRE(r.warnings.size() == 1);
+  REQUIRE(r.warnings.size() == 2);  // the line's, then the run's summary of the cause
   CHECK(r.warnings[0].line == 2);
   CHECK(r.warnings[0].message.find("end orientation") != std::string::npos);
+  CHECK(r.warnings[1].message.find("lenient mode read 1 × rotary motion during a cut") == 0);
   CHECK(near(r.moves[1].axis, tool_direction(*ac.kinematics, {10, 0, 0}), 1e-12));
   // Without kinematics a rotary word is an error naming the machine file, even lenient.
   for (bool is_lenient : {false, true}) {
@@ -201,4 +202,38 @@ TEST_CASE("rotary 3+2: bad input is an error at its line and column") {
     CHECK(d.column == 4);
     CHECK(d.message.find("kinematics") != std::string::npos);
   }
+}
+
+TEST_CASE("rotary 3+2, lenient: every line read otherwise is counted, past the 1000-warning cap") {
+  // 1500 cuts that turn A (each read as indexed at its end orientation), then 1200 moves under a
+  // plane not normal to the tool: the warnings stop at 1000, the summaries count every line and
+  // say along which direction they were read.
+  MachineConfig ac = with_kinematics("ac-trunnion");
+  std::string text = "G0 X0 Y0 Z0\n";
+  for (int k = 1; k <= 1500; ++k) text += cat("G1 X", k % 7, " A", k % 2 == 0 ? 10 : 20, " F100\n");
+  text += "G0 A0\nG68.2 X0 Y0 Z0 I0 J30 K0\n";
+  for (int k = 0; k < 1200; ++k) text += cat("G1 X", k % 5, " Y1 Z-1\n");
+  text += "M30\n";
+  InterpreterOptions lenient;
+  lenient.lenient = true;
+  Result r = run_program(text, lenient, ac);
+  REQUIRE(r.moves.size() == 1 + 1500 + 1200);
+  CHECK(near(r.moves[1500].axis, tool_direction(*ac.kinematics, {10, 0, 0}), 1e-12));  // k = 1500: A10
+  auto summary = [&](const std::string& start) {
+    for (const Diagnostic& d : r.warnings)
+      if (d.message.rfind(start, 0) == 0) return d.message;
+    return std::string();
+  };
+  auto direction = [&](double a) {
+    Vec3 d = tool_direction(*ac.kinematics, {a, 0, 0});
+    char words[128];
+    std::snprintf(words, sizeof words, "(%.10g, %.10g, %.10g)", d.x, d.y, d.z);
+    return std::string(words);
+  };
+  const std::string cut = "lenient mode read 750 × rotary motion during a cut read as indexed along ";
+  CHECK(summary(cut + direction(20) + " (lines 2, 4, 6, 8, 10, …)") != "");
+  CHECK(summary(cut + direction(10) + " (lines 3, 5, 7, 9, 11, …)") != "");
+  CHECK(summary("lenient mode read 1200 × move under an ambiguous tilted plane along the current direction (0, 0, 1) "
+                "(lines 1504, 1505, 1506, 1507, 1508, …)") != "");
+  CHECK(r.warnings.size() == 1000 + 3);  // capped per line; three summaries (A10, A20, the plane)
 }

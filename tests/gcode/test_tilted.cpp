@@ -119,7 +119,11 @@ TEST_CASE("G68.2 without G53.1: ambiguous direction is an error, unless the tool
   r = run_program("G21 G90\nG0 X0 Y0 Z50\n" + g682(Vec3(0.0), 0, 30, 0) + "G0 X1 Y1 Z5\nM30\n",
                   lenient);
   CHECK(near(r.moves.back().axis, Vec3(0, 0, 1)));
-  CHECK(r.warnings.size() == 1);
+  REQUIRE(r.warnings.size() == 2);  // the line's, then the run's summary of the cause
+  CHECK(r.warnings[0].line == 4);
+  CHECK(r.warnings[1].message ==
+        "lenient mode read 1 × move under an ambiguous tilted plane along the current direction "
+        "(0, 0, 1) (lines 4)");
   CHECK(error_of("G53.1\n").message.find("without") != std::string::npos);
   MachineConfig two;
   two.work_offsets[2] = Vec3(1, 2, 3);

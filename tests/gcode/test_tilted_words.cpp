@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <random>
 #include <string>
+#include <tuple>
 
 #include "helpers.hpp"
 #include "tridex/gcode/tilted_plane.hpp"
@@ -187,6 +188,32 @@ TEST_CASE("G68.2 P2 and P3 over several blocks agree with the P0 plane they desc
                    square_in(cat("G68.2 X10 Y", fmt(-2 * std::sin(glm::radians(30.0))), " Z",
                                  fmt(2 * std::cos(glm::radians(30.0))), " J45")),
                    1e-4));
+}
+
+TEST_CASE("G68.2 P2 by hand: Q1 the origin, Q1 -> Q2 the X axis, Q3 on the +Y side") {
+  // Fanuc's three-point form as its 30i-series posts describe it: the first point is the feature
+  // origin, the second gives +X from it, the third lies in the plane on the +Y side; Z = X x Y.
+  // Q0 X Y Z shifts the origin in the feature frame, R then turns the frame about its Z.
+  auto end_of = [](const std::string& plane, const Vec3& feature_point) {
+    Result r = run_program(cat("G21 G90\nG0 X0 Y0 Z50\n", plane, "\nG53.1\nG0 ", "X", num(feature_point.x), " Y",
+                               num(feature_point.y), " Z", num(feature_point.z), "\nM30\n"),
+                           {}, at_origin());
+    REQUIRE(r.moves.size() >= 1);
+    return std::pair<Vec3, Vec3>{r.moves.back().end, r.moves.back().axis};
+  };
+  // The plane level, X along work +Y: feature (1, 2, 3) is (10, 20, 5) + 1·(0,1,0) + 2·(-1,0,0) + 3·Z.
+  const std::string level = "G68.2 P2 Q1 X10 Y20 Z5\nG68.2 P2 Q2 X10 Y30 Z5\nG68.2 P2 Q3 X0 Y25 Z5";
+  auto [end, axis] = end_of(level, Vec3(1, 2, 3));
+  CHECK(near(end, Vec3(8, 21, 8), 1e-12));
+  CHECK(near(axis, Vec3(0, 0, 1), 1e-12));
+  // Q0 X1 R90: origin (11 on feature X) = (10, 21, 5); then X' = old Y = (-1, 0, 0), Y' = -old X.
+  std::tie(end, axis) = end_of("G68.2 P2 Q0 X1 R90\n" + level, Vec3(1, 2, 3));
+  CHECK(near(end, Vec3(9, 19, 8), 1e-12));
+  // Tilted 45° about X: Z = (1,0,0) x (0,10,10) normalised = (0, -s, s), Y = (0, s, s).
+  const double s = std::sqrt(0.5);
+  std::tie(end, axis) = end_of("G68.2 P2 Q1 X0 Y0 Z0\nG68.2 P2 Q2 X10 Y0 Z0\nG68.2 P2 Q3 X0 Y10 Z10", Vec3(0, 2, 1));
+  CHECK(near(axis, Vec3(0, -s, s), 1e-12));
+  CHECK(near(end, Vec3(0, 2 * s - s, 2 * s + s), 1e-12));
 }
 
 TEST_CASE("G68.2 P2 / P3: incomplete, repeated or misplaced blocks are errors") {

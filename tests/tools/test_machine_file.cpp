@@ -1,5 +1,6 @@
-// --machine and --subprograms: the bundled machines, a machine file's every key changing what a
-// program means, and bad machine files refused with the file and the key (exit 2).
+// --machine and --subprograms: the bundled machines (the kinematics profiles among them, on every
+// command), a machine file's every key changing what a program means, bad machine files refused
+// with the file and the key (exit 2), and rotary bad input refused at its file:line:col.
 #include <doctest/doctest.h>
 
 #include <nlohmann/json.hpp>
@@ -155,6 +156,93 @@ TEST_CASE("machine files: kinematics by profile name or as an object") {
   r = run_tridex({"moves", (dir / "p.nc").string()}, dir);
   CHECK(r.status == 2);
   CHECK(r.err.find(":4:8:") != std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("machine files: a bundled kinematics profile is a --machine name on every command") {
+  fs::path dir = scratch("machine-profile-names");
+  write_text(dir / "tools.json", R"({"1": {"units": "mm", "shape": "ballnose", "diameter": 6, "length": 30}})");
+  for (const std::string& name : gcode::kinematics_profile_names()) {
+    INFO(name);
+    CHECK(std::string(cli::kBundledMachines).find(name) != std::string::npos);  // --help lists it
+    // The name is the default machine with that profile: as {"kinematics": NAME}.
+    write_text(dir / "m.json", "{\"kinematics\": \"" + name + "\"}");
+    gcode::MachineConfig by_name = cli::load_machine(name), by_file = cli::load_machine((dir / "m.json").string());
+    REQUIRE(by_name.kinematics.has_value());
+    CHECK(by_name.kinematics->axes.size() == by_file.kinematics->axes.size());
+    CHECK(!by_name.start_position.has_value());  // the default machine's far start
+    write_text(dir / "base.json", "{\"base\": \"" + name + "\", \"units\": \"mm\"}");
+    CHECK(cli::load_machine((dir / "base.json").string()).kinematics.has_value());
+    // A program indexing the profile's second axis, run through every command.
+    const gcode::Kinematics& kin = *by_name.kinematics;
+    const char letter = kin.axes.back().letter;
+    write_text(dir / "p.nc", std::string("G21 G90 G54 T1 M6 S9000 M3\nG0 ") + letter +
+                                 "30\nG0 X5 Y5 Z20\nG1 Z-1 F300\nG1 X15\nG0 Z20\nM30\n");
+    const std::string program = (dir / "p.nc").string();
+    CommandResult r = run_tridex({"moves", program, "--machine", name}, dir);
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    std::vector<nlohmann::json> moves = moves_of(r);
+    REQUIRE(moves.size() == 4);
+    CHECK(moves[1]["rotary"][std::string(1, letter)] == 30.0);
+    r = run_tridex({"groups", program, "--machine", name}, dir);
+    REQUIRE(r.status == 0);
+    CHECK(nlohmann::json::parse(r.out)["groups"].size() == 1);
+    const std::vector<std::string> mill{"--machine", name, "--tools", (dir / "tools.json").string(), "--stock",
+                                        "box:-20,-20,-20,20,20,0", "--dexel-cell", "1", "--quiet"};
+    std::vector<std::string> args{"simulate", program, "-o", (dir / "out.stl").string()};
+    args.insert(args.end(), mill.begin(), mill.end());
+    r = run_tridex(args, dir);
+    INFO(r.err);
+    CHECK(r.status == 0);
+    args = {"check", program, "--design", (dir / "out.stl").string()};
+    args.insert(args.end(), mill.begin(), mill.end());
+    r = run_tridex(args, dir);
+    CHECK((r.status == 0 || r.status == 3));  // read; its findings (a rapid, a near miss) are its own
+  }
+  // Without the name, the same program is refused at its rotary word.
+  CommandResult r = run_tridex({"moves", (dir / "p.nc").string()}, dir);
+  CHECK(r.status == 2);
+  CHECK(r.err.find("p.nc:2:") != std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("rotary bad input through the command: file:line:col, exit 2; lenient says each line") {
+  fs::path dir = scratch("machine-rotary-bad");
+  const std::string program = (dir / "p.nc").string();
+  struct Case {
+    const char* text;
+    const char* at;  // file:line:col after the program's path
+    const char* expected;
+  } cases[] = {
+      {"G0 X0 Y0 Z50\nG0 A-130 C0\n", ":2:4: ", "outside the A axis's limits [-120, 120]"},  // ac-trunnion
+      {"G0 X0 Y0 Z50\nG0 C10 B5\n", ":2:8: ", "the machine has no B axis"},
+      {"G68.2 X0 Y0 Z0 I0 J150 K0\n G53.1\n", ":2:2: ", "G53.1"},                       // beyond A's limits
+      {"G0 X0 Y0 Z0\nG1 X1 A10 F100\n", ":2:7: ", "during a cut"},
+  };
+  for (const Case& c : cases) {
+    write_text(program, std::string(c.text) + "M30\n");
+    CommandResult r = run_tridex({"moves", program, "--machine", "ac-trunnion", "-o", (dir / "m.jsonl").string()}, dir);
+    INFO(c.text << " -> " << r.err);
+    CHECK(r.status == 2);
+    CHECK(r.err.find(program + c.at) != std::string::npos);
+    CHECK(r.err.find(c.expected) != std::string::npos);
+    CHECK(!fs::exists(dir / "m.jsonl"));
+  }
+  // Lenient: the cut that turns A is read as indexed at its end orientation, said on its line and
+  // in the run's summary, in the report of simulate too.
+  write_text(program, "G0 X0 Y0 Z0\nG1 X1 A10 F100\nG1 X2 A20\nM30\n");
+  CommandResult r = run_tridex({"moves", program, "--machine", "ac-trunnion", "--lenient"}, dir);
+  REQUIRE(r.status == 0);
+  CHECK(r.err.find(program + ":2:7: rotary motion during a cut") != std::string::npos);
+  CHECK(r.err.find(program + ":3:7: rotary motion during a cut") != std::string::npos);
+  CHECK(r.err.find("lenient mode read 1 × rotary motion during a cut read as indexed along") != std::string::npos);
+  CHECK(r.err.find("(lines 2)") != std::string::npos);
+  CHECK(r.err.find("(lines 3)") != std::string::npos);
+  std::vector<nlohmann::json> moves = moves_of(r);
+  REQUIRE(moves.size() == 3);
+  CHECK(moves[1]["rotary"]["A"] == 10.0);
+  CHECK(moves[2]["rotary"]["A"] == 20.0);
   fs::remove_all(dir);
 }
 

@@ -1,13 +1,16 @@
 // `tridex simulate` on rotary-indexed 3+2: the bundled example's rotary twin (Haas DWO on the
 // bc-trunnion profile) gives the same solid as the G68.2 example, and one tilted pocket written
 // in each way of writing a plane (Fanuc G68.2 I J K, G68.2 P1, Mazak A B C, G68.2 P2 and P3,
-// rotary words with DWO, rotary words under TCP) machines the same volume. The moves themselves
-// are compared within 1e-6 mm in tests/gcode (test_rotary.cpp, test_tilted_words.cpp); this is
-// the end-to-end check through the command.
+// rotary words with DWO, rotary words under TCP) machines the same volume; and on every bundled
+// profile, by its --machine name, the issue's four ways (G68.2, DWO, TCP, raw rotary words) give
+// the same moves within 1e-6 mm and the same volume. The interpreter's side is in tests/gcode
+// (test_rotary.cpp, test_tilted_words.cpp); this is the end-to-end check through the command.
 #include <doctest/doctest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <random>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -114,6 +117,81 @@ TEST_CASE("simulate: one tilted pocket written every way gives the same volume")
     if (reference == 0) reference = removed;
     CHECK(removed > 100);  // the pocket cuts: 10 x 8 mm, 2 mm deep, with a 6 mm ball
     CHECK(removed == doctest::Approx(reference).epsilon(1e-6));
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("moves and simulate: one toolpath written four ways agrees on every bundled profile") {
+  // The issue's equivalence, end to end through the command (`--machine NAME`): for a random
+  // feature frame per profile, the same pocket written as G68.2 I J K + G53.1, as rotary words +
+  // G254 (DWO), as rotary words under G43.4 (TCP) and as raw rotary words with the machine X Y Z
+  // computed here from the kinematics, gives the same work-frame moves (1e-6 mm) and the same
+  // machined volume. tests/gcode/test_rotary.cpp checks more frames at the interpreter's level.
+  fs::path dir = scratch("rotary-four-ways");
+  write_text(dir / "tools.json", R"({"1": {"units": "mm", "shape": "ballnose", "diameter": 6, "length": 30}})");
+  std::mt19937 rng(1212);
+  std::uniform_real_distribution<double> angle(-180, 180), tilt(5, 30);
+  const Vec3 path[] = {{-5, -4, 5}, {-5, -4, -2}, {5, -4, -2}, {5, 4, -2}, {-5, 4, -2}, {-5, -4, -2}, {-5, -4, 5}};
+  auto moves_of = [](const std::string& out) {
+    std::vector<json> moves;
+    std::istringstream in(out);
+    for (std::string line; std::getline(in, line);)
+      if (!line.empty()) moves.push_back(json::parse(line));
+    return moves;
+  };
+  for (const std::string& profile : gcode::kinematics_profile_names()) {
+    const gcode::Kinematics kin = *gcode::kinematics_profile(profile);
+    const double i = angle(rng), j = tilt(rng), k = angle(rng);
+    const Vec3 o(20, 15, 20);  // the feature origin on the stock's top face
+    const Frame f = gcode::fanuc_euler(o, i, j, k);
+    const gcode::RotaryPositions r = gcode::orient_tool(kin, f.rotation[2], {});
+    std::string index = "G0";
+    for (const gcode::RotaryAxis& a : kin.axes)
+      index += std::string(" ") + a.letter + num(r[static_cast<std::size_t>(gcode::rotary_index(a.letter))]);
+    auto program = [&](const std::string& head, auto point, const std::string& tail) {
+      std::string p = "G21 G90 G54 T1 M6 S9000 M3\n" + head + "\n";
+      for (std::size_t n = 0; n < std::size(path); ++n)
+        p += std::string(n == 0 || n + 1 == std::size(path) ? "G0 " : "G1 ") + xyz(point(path[n])) +
+             (n == 1 ? " F300" : "") + "\n";
+      return p + tail + "M30\n";
+    };
+    auto in_feature = [](const Vec3& p) { return p; };
+    auto in_work = [&](const Vec3& p) { return f.to_world(p); };
+    // Raw: X Y Z are the linear axes' machine position (the default machine's G54 is zero).
+    auto in_machine = [&](const Vec3& p) { return gcode::machine_from_part(kin, f.to_world(p), r); };
+    const std::pair<const char*, std::string> ways[] = {
+        {"g682", program("G68.2 " + xyz(o) + " I" + num(i) + " J" + num(j) + " K" + num(k) + "\nG53.1", in_feature,
+                         "G69\n")},
+        {"dwo", program(index + "\nG254", in_work, "G255\n")},
+        {"tcp", program("G43.4 H1\n" + index, in_work, "G49\n")},
+        {"raw", program(index, in_machine, "")},
+    };
+    std::vector<json> reference_moves;
+    double reference_volume = 0;
+    for (const auto& [name, text] : ways) {
+      INFO(profile << " " << name << " (I" << i << " J" << j << " K" << k << ")");
+      const std::string file = (dir / (std::string(name) + ".nc")).string();
+      write_text(file, text);
+      CommandResult listed = run_tridex({"moves", file, "--machine", profile}, dir);
+      INFO(listed.err);
+      REQUIRE(listed.status == 0);
+      std::vector<json> moves = moves_of(listed.out);
+      REQUIRE(moves.size() == std::size(path));
+      for (std::size_t c = 0; c < 3; ++c)
+        CHECK(std::abs(moves[2]["end"][c].get<double>() - f.to_world(path[2])[static_cast<int>(c)]) <= 1e-6);
+      if (reference_moves.empty()) reference_moves = moves;
+      for (std::size_t n = 0; n < moves.size(); ++n)
+        for (const char* key : {"start", "end", "axis", "machine"})
+          for (std::size_t c = 0; c < 3; ++c)
+            CHECK(std::abs(moves[n][key][c].get<double>() - reference_moves[n][key][c].get<double>()) <= 1e-6);
+      json report = simulate_report(dir, std::string(name) + "-" + profile,
+                                    {file, "--tools", (dir / "tools.json").string(), "--machine", profile,
+                                     "--stock", "box:0,0,0,40,30,20", "--dexel-cell", "0.5"});
+      const double removed = report["result"]["removed_mm3"].get<double>();
+      CHECK(removed > 100);  // the 10 x 8 mm pocket, 2 mm deep, cuts
+      if (reference_volume == 0) reference_volume = removed;
+      CHECK(removed == doctest::Approx(reference_volume).epsilon(1e-6));
+    }
   }
   fs::remove_all(dir);
 }

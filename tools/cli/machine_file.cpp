@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -75,12 +76,24 @@ double rate(const json& value, const std::string& where) {
   return value.get<double>();
 }
 
+// A bundled machine: MachineConfig's own ("default", "linuxcnc"), or a bundled kinematics
+// profile by name (the default machine with that profile's rotary axes), so that
+// `--machine bc-trunnion` reads rotary words as `{"kinematics": "bc-trunnion"}` does.
+std::optional<gcode::MachineConfig> bundled_machine(const std::string& name) {
+  if (auto machine = gcode::MachineConfig::bundled(name)) return machine;
+  auto profile = gcode::kinematics_profile(name);
+  if (!profile) return std::nullopt;
+  gcode::MachineConfig machine = *gcode::MachineConfig::bundled("default");
+  machine.kinematics = std::move(profile);
+  return machine;
+}
+
 gcode::MachineConfig parse(const json& doc, const std::string& file, MachineRates* rates) {
   if (!doc.is_object()) input_error(file, ": a machine file is a JSON object");
   gcode::MachineConfig m;
   if (auto base = doc.find("base"); base != doc.end()) {
     std::string name = string_value(*base, cat(file, ": \"base\"")).get<std::string>();
-    auto bundled = gcode::MachineConfig::bundled(name);
+    auto bundled = bundled_machine(name);
     if (!bundled) input_error(file, ": \"base\": no bundled machine \"", name, "\" (", kBundledMachines, ")");
     m = *bundled;
   }
@@ -190,7 +203,7 @@ gcode::MachineConfig load_machine(const std::string& name_or_file,
   gcode::MachineConfig machine;
   if (name_or_file.empty()) {
     machine = *gcode::MachineConfig::bundled("default");
-  } else if (auto bundled = gcode::MachineConfig::bundled(name_or_file)) {
+  } else if (auto bundled = bundled_machine(name_or_file)) {
     machine = *bundled;
   } else {
     std::error_code error;

@@ -11,6 +11,7 @@
 
 #include "commands.hpp"
 #include "errors.hpp"
+#include "machine_file.hpp"
 #include "output.hpp"
 #include "tridex/gcode/diagnostic.hpp"
 
@@ -60,7 +61,8 @@ void add_common(CLI::App& command, CommonOptions& options) {
   command.add_flag("--lenient", options.lenient,
                    "unsupported G-code words become warnings and are skipped");
   command.add_option("--machine", options.machine,
-                     "machine file (JSON) or bundled machine: default, linuxcnc (README: Machine files)");
+                     std::string("machine file (JSON) or bundled machine: ") + kBundledMachines +
+                         " (README: Machine files)");
   command.add_option("--subprograms", options.subprograms,
                      "folder of subprogram files (O9810.nc, name.ngc) that M98/G65/o-call may "
                      "call (repeatable)");
