@@ -102,6 +102,7 @@ std::optional<MachineConfig> MachineConfig::bundled(const std::string& name) {
     m.tool_change = ToolChange::in_place;
     m.set_home(Vec3(0.0));
     m.set_reference2(Vec3(0.0));
+    m.g53_literal = true;
     return m;
   }
   return std::nullopt;

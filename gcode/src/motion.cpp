@@ -360,17 +360,25 @@ void Interpreter::State::cycle(int code) {
 // The machine's Z is the spindle's own axis (on a table-tilting machine it stays along the tool
 // in the work frame; on a head-tilting one it retracts the head), so a machine-coordinate move
 // of Z is a retract: the tip goes far along the tool axis. X/Y alone move the tip in machine
-// coordinates, which is only unambiguous with the tool along +Z.
+// coordinates, which is only unambiguous with the tool along +Z. A machine whose zero is known
+// (MachineConfig::g53_literal, e.g. LinuxCNC's rs274) moves to the point named, as G28 does to a
+// configured position.
 void Interpreter::State::machine_move(const Vec3& target, unsigned mask, MoveKind kind, double move_feed) {
   Vec3 end = pos;
   for (int i = 0; i < 3; ++i)
     if ((mask >> i) & 1u) end[i] = target[i];
-  if ((mask & 4u) || far) {
+  bool along_z = glm::dot(axis, Vec3(0, 0, 1)) >= 1 - kSameDirection;
+  if (machine.g53_literal && along_z && far) {
+    pos = end;
+    if (mask & 4u) far = false;  // the height is now known
+    return;
+  }
+  if (((mask & 4u) && !(machine.g53_literal && along_z)) || far) {
     pos = end;
     far = true;
     return;
   }
-  if (glm::dot(axis, Vec3(0, 0, 1)) < 1 - kSameDirection)
+  if (!along_z)
     error(motion_column, "G53 X/Y with a tilted tool depends on the machine's kinematics; "
                          "retract with G53 Z (or G28) first");
   emit(kind, pos, end, move_feed);
