@@ -404,6 +404,12 @@ class LineLexer : public Parser {
         first = false;
         continue;
       }
+      if (c == '@' || c == '^') {  // LinuxCNC's polar radius and angle (the interpreter checks)
+        std::size_t start = i_++;
+        word(c, start);
+        first = false;
+        continue;
+      }
       if (!is_alpha(c)) {
         if (c == '[' || c == ']' || c == '=')
           fail(i_, describe(c) + (parameters_ ? " where a word was expected"
