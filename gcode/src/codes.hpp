@@ -9,7 +9,10 @@
 
 namespace tridex::gcode {
 
-inline int letter_index(char c) { return c - 'A'; }
+// 'A'..'Z' are 0..25; LinuxCNC's polar words '@' (radius) and '^' (angle) take 26 and 29 ('^' -
+// 'A'), so one 32-bit mask still holds every word of a block.
+inline int letter_index(char c) { return c == '@' ? 26 : c - 'A'; }
+inline constexpr std::size_t kWordSlots = 30;
 
 struct Code {
   int code;    // G and M codes times ten: G53.1 -> 531, G1 -> 10
@@ -17,8 +20,8 @@ struct Code {
 };
 
 struct Words {
-  std::array<double, 26> value{};
-  std::array<int, 26> column{};
+  std::array<double, kWordSlots> value{};
+  std::array<int, kWordSlots> column{};
   std::uint32_t present = 0;
   std::uint32_t used = 0;
   std::array<Code, 24> g{};

@@ -75,6 +75,7 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
   if (auto it = s.offsets.find(1); it != s.offsets.end()) s.work_offset = it->second;
   s.world_origin = s.work_offset;
   s.unit = s.machine.inch_at_start ? 25.4 : 1.0;
+  s.retract_to_r = s.machine.g99_at_start;
   s.update_frame();
   if (s.machine.start_position) {
     s.pos = *s.machine.start_position;
@@ -115,6 +116,8 @@ std::optional<MachineConfig> MachineConfig::bundled(const std::string& name) {
     m.tool_change = ToolChange::in_place;
     m.set_home(Vec3(0.0));
     m.set_reference2(Vec3(0.0));
+    m.g53_literal = true;
+    m.g99_at_start = true;
     return m;
   }
   return std::nullopt;

@@ -404,6 +404,12 @@ class LineLexer : public Parser {
         first = false;
         continue;
       }
+      if (c == '@' || c == '^') {  // LinuxCNC's polar radius and angle (the interpreter checks)
+        std::size_t start = i_++;
+        word(c, start);
+        first = false;
+        continue;
+      }
       if (!is_alpha(c)) {
         if (c == '[' || c == ']' || c == '=')
           fail(i_, describe(c) + (parameters_ ? " where a word was expected"
@@ -603,9 +609,13 @@ class LineLexer : public Parser {
         {"ENDREPEAT", OKeyword::endrepeat}, {"REPEAT", OKeyword::repeat},
         {"BREAK", OKeyword::break_},        {"CONTINUE", OKeyword::continue_},
         {"RETURN", OKeyword::return_}};
+    // The keyword is the whole run of letters: `callsub` is not `call` followed by junk.
+    std::size_t end = j;
+    while (end < n_ && is_alpha(text_[end])) ++end;
+    std::string_view name = text_.substr(j, end - j);
     i_ = j;
     for (const auto& [word, kw] : kKeywords) {
-      if (keyword(word)) {
+      if (name.size() == word.size() && keyword(word)) {
         if (!parameters_) fail(at, "o-words are not supported here");
         Control& control = block_.control;
         control.kind = ControlKind::o_word;
@@ -618,7 +628,9 @@ class LineLexer : public Parser {
         return true;
       }
     }
-    fail(j, "unknown o-word keyword");
+    fail(j, "unknown o-word keyword '" + std::string(name) +
+                "' (LinuxCNC's are sub, endsub, call, return, if, elseif, else, endif, while, endwhile, "
+                "do, repeat, endrepeat, break, continue)");
   }
 
   Block& block_;

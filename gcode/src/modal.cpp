@@ -116,7 +116,8 @@ Flow Interpreter::State::execute(const Block& block) {
   // Look-ahead and smoothing modes change how the control follows the path, not the path.
   if (w.find_g(51)) {
     if (machine.dialect == Dialect::linuxcnc)  // LinuxCNC's G5.1 is a quadratic spline: a move
-      error(w.find_g(51), "G5.1 (LinuxCNC's quadratic B-spline) is not supported");
+      error(w.find_g(51), "G5.1 (LinuxCNC's quadratic B-spline) is not supported: write the curve as "
+                          "G1 or G2/G3 moves");
     for (char c : {'Q', 'R'})
       if (w.has(c)) w.take(c);
   }
@@ -216,6 +217,7 @@ Flow Interpreter::State::execute(const Block& block) {
     if (is_cycle(motion_code) && motion != motion_code) cycle_active = false;
     motion = motion_code;
   }
+  if (w.has('@') || w.has('^')) polar_words(axis_consumer, nonmodal);
   if (w.has('A') || w.has('B') || w.has('C'))
     comp_forbid(w.col(w.has('A') ? 'A' : w.has('B') ? 'B' : 'C'), "a rotary axis word");
   if (!axis_consumer && nonmodal != 280 && nonmodal != 300) rotary_words();

@@ -266,7 +266,10 @@ void Interpreter::State::cycle(int code) {
   }
   if (far && incremental)
     error(motion_column, "incremental canned cycle from a retracted (far) position");
-  double r_level = incremental ? current[n] + cycle_r : cycle_r;
+  // G91: R counts from the initial level of the cycle (kept while the cycle mode lasts, as
+  // LinuxCNC's cycle_il and Fanuc's initial point), not from where the last hole left the tool.
+  double incremental_base = cycle_initial_far ? current[n] : cycle_initial;
+  double r_level = incremental ? incremental_base + cycle_r : cycle_r;
   double bottom = incremental ? r_level + cycle_z : cycle_z;
   if (bottom > r_level)
     error(motion_column, "hole bottom " + format_number(bottom) + " is above the R plane " +
@@ -290,6 +293,10 @@ void Interpreter::State::cycle(int code) {
   double dv = w.has(kAxisLetter[v]) ? length(kAxisLetter[v]) : 0.0;
   double hole_u = incremental ? current[u] : (w.has(kAxisLetter[u]) ? du : current[u]);
   double hole_v = incremental ? current[v] : (w.has(kAxisLetter[v]) ? dv : current[v]);
+  // LinuxCNC's polar words under G91 (polar_words() left them): each repeat moves the hole out
+  // by @ and turns it by ^ about the program origin (CYCLE_MACRO, interp_cycles.cc).
+  double step_radius = w.has('@') ? length('@') : 0.0;
+  double step_angle = w.has('^') ? glm::radians(w.take('^')) : 0.0;
 
   auto at = [&](double uu, double vv, double depth) {
     Vec3 p;
@@ -311,6 +318,14 @@ void Interpreter::State::cycle(int code) {
     if (incremental) {
       hole_u += du;
       hole_v += dv;
+    }
+    if (step_radius != 0 || step_angle != 0) {
+      if (hole_u == 0 && hole_v == 0)
+        error(motion_column, "incremental (G91) polar coordinates at the origin: the direction is unknown");
+      double radius = std::hypot(hole_u, hole_v) + step_radius;
+      double angle = std::atan2(hole_v, hole_u) + step_angle;
+      hole_u = radius * std::cos(angle);
+      hole_v = radius * std::sin(angle);
     }
     if (far) {
       // Come back from far straight down the axis onto the R plane of the hole.
@@ -361,21 +376,75 @@ void Interpreter::State::cycle(int code) {
   }
 }
 
+// ---- LinuxCNC polar coordinates ----
+// `@` is a radius and `^` an angle (degrees, from +X) about the program origin in the XY plane
+// (LinuxCNC's find_ends and convert_cycle_xy, interp_find.cc and interp_cycles.cc). G90: a word
+// left out keeps the current point's radius or angle. G91: `@` adds to the current radius, `^`
+// turns the current point about the origin. The result is written back as the block's X and Y
+// (in program units, incremental under G91), so lines, arcs, cycles and compensation read it;
+// in a G91 cycle they are a step of each repeat instead (cycle()).
+void Interpreter::State::polar_words(bool axis_consumer, int nonmodal) {
+  int column = w.col(w.has('@') ? '@' : '^');
+  if (machine.dialect != Dialect::linuxcnc)
+    error(column, "'@' and '^' (polar coordinates) are LinuxCNC's words: use --machine linuxcnc");
+  if (nonmodal == 530) error(column, "polar coordinates cannot be used with G53");
+  bool moving = motion == 0 || motion == 10 || motion == 20 || motion == 30 || is_cycle(motion);
+  if (axis_consumer || nonmodal == 280 || nonmodal == 300 || !moving)
+    error(column, "polar coordinates can only be used for motion (G0, G1, G2, G3 or a cycle)");
+  if (plane != 170) error(column, "polar coordinates need the XY plane (G17)");
+  for (char c : {'X', 'Y'})
+    if (w.has(c)) error(w.col(c), std::string("polar coordinates and an ") + c + " word in the same block");
+  bool cycle_block = is_cycle(motion);
+  if (cycle_block && incremental) return;  // a step of every repeat: cycle() reads the words
+  Vec3 current = (comp_programmed_current ? comp_programmed : to_program(pos)) / unit;
+  double x = current.x, y = current.y;
+  bool has_radius = w.has('@'), has_angle = w.has('^');
+  double radius = has_radius ? w.take('@') : 0, angle = has_angle ? glm::radians(w.take('^')) : 0;
+  bool at_origin = x == 0 && y == 0;
+  if (!incremental) {
+    if (!has_angle && at_origin && !cycle_block)
+      error(column, "polar radius without an angle at the origin: the direction is unknown");
+    if (!has_radius) radius = std::hypot(x, y);
+    if (!has_angle) angle = std::atan2(y, x);
+  } else {
+    if (at_origin)
+      error(column, "incremental (G91) polar coordinates at the origin: the direction is unknown");
+    radius += std::hypot(x, y);
+    angle += std::atan2(y, x);
+  }
+  w.present &= ~((1u << letter_index('@')) | (1u << letter_index('^')));  // read: now X and Y
+  double new_x = radius * std::cos(angle), new_y = radius * std::sin(angle);
+  for (char c : {'X', 'Y'}) {
+    std::size_t i = static_cast<std::size_t>(letter_index(c));
+    w.present |= 1u << i;
+    w.value[i] = c == 'X' ? (incremental ? new_x - x : new_x) : (incremental ? new_y - y : new_y);
+    w.column[i] = column;
+  }
+}
+
 // ---- returns and machine-coordinate moves ----
 // The machine's Z is the spindle's own axis (on a table-tilting machine it stays along the tool
 // in the work frame; on a head-tilting one it retracts the head), so a machine-coordinate move
 // of Z is a retract: the tip goes far along the tool axis. X/Y alone move the tip in machine
-// coordinates, which is only unambiguous with the tool along +Z.
+// coordinates, which is only unambiguous with the tool along +Z. A machine whose zero is known
+// (MachineConfig::g53_literal, e.g. LinuxCNC's rs274) moves to the point named, as G28 does to a
+// configured position.
 void Interpreter::State::machine_move(const Vec3& target, unsigned mask, MoveKind kind, double move_feed) {
   Vec3 end = pos;
   for (int i = 0; i < 3; ++i)
     if ((mask >> i) & 1u) end[i] = target[i];
-  if ((mask & 4u) || far) {
+  bool along_z = glm::dot(axis, Vec3(0, 0, 1)) >= 1 - kSameDirection;
+  if (machine.g53_literal && along_z && far) {
+    pos = end;
+    if (mask & 4u) far = false;  // the height is now known
+    return;
+  }
+  if (((mask & 4u) && !(machine.g53_literal && along_z)) || far) {
     pos = end;
     far = true;
     return;
   }
-  if (glm::dot(axis, Vec3(0, 0, 1)) < 1 - kSameDirection)
+  if (!along_z)
     error(motion_column, "G53 X/Y with a tilted tool depends on the machine's kinematics; "
                          "retract with G53 Z (or G28) first");
   emit(kind, pos, end, move_feed);

@@ -219,6 +219,17 @@ struct Interpreter::State : ParameterReader {
             error(word.column, name + " (probing) is not simulated: where the probe touches, and so "
                                       "where the tool goes next, is known only on the machine; "
                                       "leave the probing cycle out of the program tridex reads");
+          if (word.letter == 'G' && integral && machine.dialect == Dialect::linuxcnc) {
+            // Never skipped, even lenient: each moves the tool. LinuxCNC's lathe codes (G7
+            // diameter mode, G33 threading, G70-G72 turning cycles, G76 threading cycle) have no
+            // meaning on a mill; G5 and G5.2 are splines tridex does not follow.
+            static constexpr int kLathe[] = {70, 330, 700, 710, 711, 712, 720, 721, 722, 760};
+            if (std::find(std::begin(kLathe), std::end(kLathe), code) != std::end(kLathe))
+              error(word.column, name + " is a lathe code: tridex simulates milling machines");
+            if (code == 50 || code == 52)
+              error(word.column, name + " (LinuxCNC's " + (code == 50 ? "cubic spline" : "NURBS") +
+                                     ") is not supported: write the curve as G1 or G2/G3 moves");
+          }
           unsupported(word.column, "unsupported code " + name, "code " + name, harmless && !coordinates);
           continue;
         }
@@ -270,7 +281,9 @@ struct Interpreter::State : ParameterReader {
     return static_cast<long long>(std::llround(v));
   }
 
-  bool has_axis_words() const { return w.has('X') || w.has('Y') || w.has('Z'); }
+  bool has_axis_words() const {
+    return w.has('X') || w.has('Y') || w.has('Z') || w.has('@') || w.has('^');
+  }
 
   // ---- frames ----
   // Where the linear axes stand, in the coordinates offsets are added in (G92, G10 L20): the tip
@@ -391,6 +404,7 @@ struct Interpreter::State : ParameterReader {
                   double move_feed);
   void cycle(int code);
   void machine_move(const Vec3& target, unsigned mask, MoveKind kind, double move_feed);
+  void polar_words(bool axis_consumer, int nonmodal);  // LinuxCNC @ and ^ become X and Y (motion.cpp)
   void home_return(bool second);
   void go_far() { far = true; }
   Flow macro_call(int column);          // G65 (modal.cpp)

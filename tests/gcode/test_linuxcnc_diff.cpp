@@ -163,7 +163,8 @@ std::vector<fs::path> corpus() {
     return files;
   }
   for (const char* name : {"3D_Chips.ngc", "3dtest.ngc", "arcspiral.ngc", "cds.ngc", "flowsnake.ngc",
-                           "lathe_pawn.ngc", "plasmatest.ngc", "tort.ngc"})
+                           "hole-circle.ngc", "lathe_pawn.ngc", "plasmatest.ngc", "polar.ngc",
+                           "spiral.ngc", "tort.ngc"})
     files.push_back(fs::path("/usr/share/linuxcnc/ncfiles") / name);
   return files;
 }

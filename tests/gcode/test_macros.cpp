@@ -279,6 +279,13 @@ TEST_CASE("macros: bad input is an error at its line and column") {
   CHECK(error_of("WHILE [0] DO1\nG0 X1 Y1 Z1\n", {}, m).message.find("END 1") != std::string::npos);
   CHECK(error_of("o1 if [0]\nG0 X1 Y1 Z1\n", {}, dialect(Dialect::linuxcnc)).message.find("endif") !=
         std::string::npos);
+  // LinuxCNC's own nestedcall.ngc says `o<g20sub> callsub`: rs274 refuses it too ("Unexpected
+  // character after O-word"). The keyword is the whole word, named in the message.
+  d = error_of("o<g20sub> callsub\n", {}, dialect(Dialect::linuxcnc));
+  CHECK(d.column == 11);
+  CHECK(d.message.find("unknown o-word keyword 'callsub'") != std::string::npos);
+  CHECK(error_of("o100 ifx [1]\n", {}, dialect(Dialect::linuxcnc)).message.find("'ifx'") !=
+        std::string::npos);
   // Endless loops stop at the block limit.
   InterpreterOptions bounded;
   bounded.max_blocks = 10000;

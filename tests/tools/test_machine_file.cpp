@@ -93,6 +93,32 @@ TEST_CASE("machine files: T alone loads the tool where the control does so") {
   fs::remove_all(dir);
 }
 
+TEST_CASE("machine files: \"g53\" says whether G53 Z retracts far or goes where it says") {
+  fs::path dir = scratch("machine-g53");
+  write_text(dir / "p.nc", "G21 G90\nG0 X1 Y2 Z3\nG53 G0 Z50\nG0 X4\nG1 Z1 F100\nM30\n");
+  write_text(dir / "far.json", R"({"base": "linuxcnc", "g53": "far"})");
+  write_text(dir / "literal.json", R"({"g53": "literal", "start": [0, 0, 100]})");
+  CommandResult r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", "linuxcnc"}, dir);
+  REQUIRE(r.status == 0);
+  auto m = moves_of(r);
+  REQUIRE(m.size() == 4);
+  CHECK(m[1]["end"] == nlohmann::json::array({1, 2, 50}));  // machine Z50, straight up
+  CHECK(m[2]["end"] == nlohmann::json::array({4, 2, 50}));
+  r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "literal.json").string()}, dir);
+  REQUIRE(r.status == 0);
+  CHECK(moves_of(r)[1]["end"] == nlohmann::json::array({1, 2, 50}));
+  r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "far.json").string()}, dir);
+  REQUIRE(r.status == 0);
+  m = moves_of(r);
+  REQUIRE(m.size() == 2);  // G53 Z retracts far: X4 stays up there, G1 Z1 comes down along Z
+  CHECK(m[1]["end"] == nlohmann::json::array({4, 2, 1}));
+  write_text(dir / "bad.json", R"({"g53": "machine"})");
+  r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "bad.json").string()}, dir);
+  CHECK(r.status == 2);
+  CHECK(r.err.find("\"g53\"") != std::string::npos);
+  fs::remove_all(dir);
+}
+
 TEST_CASE("machine files: --subprograms finds called programs") {
   fs::path dir = scratch("machine-subs");
   fs::create_directories(dir / "macros");

@@ -129,6 +129,10 @@ gcode::MachineConfig parse(const json& doc, const std::string& file, MachineRate
     } else if (key == "tool_loads_on_t") {
       if (!value.is_boolean()) input_error(where, ": must be true or false, got ", value.dump());
       m.tool_loads_on_t = value.get<bool>();
+    } else if (key == "g53") {
+      std::string g = string_value(value, where).get<std::string>();
+      if (g != "far" && g != "literal") input_error(where, ": \"far\" or \"literal\", got \"", g, "\"");
+      m.g53_literal = g == "literal";
     } else if (key == "home") {
       m.set_home(point(value, where));
     } else if (key == "reference2") {

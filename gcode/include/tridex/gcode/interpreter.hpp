@@ -83,6 +83,13 @@ struct MachineConfig {
   Vec3 tool_change_position{0.0};  // machine coordinates, for ToolChange::to_position
   bool tool_loads_on_t = false;    // the control loads a tool on T alone (no M6 needed)
   bool inch_at_start = false;      // units before any G20/G21: inch (true) or mm
+  // G53 with the tool along +Z: false, a G53 Z is a retract (the tip goes far along the tool, as
+  // G28 with the default position); true, G53 goes to the machine coordinates it names, because
+  // this machine's zero is known (the work offsets and G28/G30 positions are measured from it).
+  bool g53_literal = false;
+  // Canned cycles retract to the R plane (G99) until the program says G98; false: to the
+  // initial level (G98). rs274 standalone starts in G99.
+  bool g99_at_start = false;
 
   // M-codes beyond the ones the interpreter acts on (M0-M9, M30, M98, M99): declared ones are
   // accepted quietly, forbidden ones are errors, any other is accepted with one warning per code
@@ -113,7 +120,8 @@ struct MachineConfig {
   static int g54_1_key(int p) { return 100 + p; }  // G54.1 Pp
 
   // The bundled machines: "default" (the far rule) and "linuxcnc" (rs274 run standalone: start
-  // at the origin, M6 in place, G28/G30 at the origin, LinuxCNC's dialect); nullopt otherwise.
+  // at the origin, M6 in place, G28/G30 at the origin, G53 literal, G99, LinuxCNC's dialect);
+  // nullopt otherwise.
   static std::optional<MachineConfig> bundled(const std::string& name);
 };
 

@@ -34,7 +34,7 @@
 namespace tridex::gcode {
 
 struct Word {
-  char letter = 0;     // 'A'..'Z', upper case
+  char letter = 0;     // 'A'..'Z' upper case, or LinuxCNC's polar '@' and '^'
   double value = 0;    // finite, |value| <= kMaxWordValue
   int column = 0;      // 1-based column of the letter
 };
