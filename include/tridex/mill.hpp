@@ -806,6 +806,9 @@ class Miller {
       // The move to cut first: its index (as a double), centre height, plane slope and bound.
       alignas(32) double first[kBinTiles], first_z[kBinTiles], first_gx[kBinTiles], first_gy[kBinTiles],
           first_bound[kBinTiles];
+      // Whether that move's footprint covers the whole tile (ball ends count as covering: see
+      // find_first_cuts).
+      alignas(32) double first_covers[kBinTiles];
       // The tile's plane P and its largest height above P (P valid where plane_valid ≠ 0).
       alignas(32) double plane_valid[kBinTiles], plane_z[kBinTiles], plane_gx[kBinTiles], plane_gy[kBinTiles],
           excess[kBinTiles];
@@ -971,6 +974,7 @@ class Miller {
       lanes.half_diagonal[col] = tile.half_diagonal;
       lanes.first[col] = -1, lanes.first_z[col] = kInf, lanes.first_bound[col] = kInf;
       lanes.first_gx[col] = lanes.first_gy[col] = 0;
+      lanes.first_covers[col] = 0;
     }
   }
 
@@ -1044,8 +1048,10 @@ class Miller {
             scratch.ball_bounds.emplace_back(ball_bounds(ball, row, static_cast<std::uint32_t>(k), lane0, col0, col1));
         const DoubleN first_z = load_n(&lanes.first_z[lane0]), first_bound = load_n(&lanes.first_bound[lane0]);
         const MaskN better = b.in_range & b.has_plane & (b.bound < load_n(&lanes.top[lane0])) &
-                             ((b.z < first_z) | ((b.z == first_z) & (b.bound < first_bound)));
+                             ((load_n(&lanes.first_covers[lane0]) == 0) | (b.z < first_z) |
+                              ((b.z == first_z) & (b.bound < first_bound)));
         if (!any_n(better)) continue;
+        store_n(&lanes.first_covers[lane0], better ? splat(1) : load_n(&lanes.first_covers[lane0]));
         store_n(&lanes.first[lane0], better ? splat(static_cast<double>(k)) : load_n(&lanes.first[lane0]));
         store_n(&lanes.first_z[lane0], better ? b.z : first_z);
         store_n(&lanes.first_gx[lane0], better ? b.gx : load_n(&lanes.first_gx[lane0]));
@@ -1057,6 +1063,13 @@ class Miller {
     // height found for a tile cannot be its first cut, and waits for pass 2 (where, after the
     // first cut, most such moves fall to the same cheap test against the tile's top: the upper
     // levels of a Z-level roughing, for instance).
+    //
+    // A move whose footprint covers the whole tile is preferred to one lower at the centre that
+    // does not: a flat end's surface is lowest at the side of its footprint wherever the program
+    // slopes across its passes (the bench's raster), and a first cut that leaves part of the tile
+    // untouched leaves its top where it was, so that no later move is rejected (on bench_mill's
+    // flat raster, 84 moves a tile were left for pass 2, against 4 for the ball). Ball ends count
+    // as covering: their first cut is chosen as before.
     scratch.deferred.clear();
     for (std::uint32_t k : scratch.by_tip) {
       int col0, col1;
@@ -1069,18 +1082,23 @@ class Miller {
       for (int col = col0; col <= col1; ++col) {
         Tile& tile = row.tiles[static_cast<std::size_t>(col)];
         if (m.lowest_tip() >= tile.state.top) continue;
-        if (m.lowest_tip() >= lanes.first_z[col]) {
+        const bool first_covers = lanes.first_covers[col] != 0;
+        if (first_covers && m.lowest_tip() >= lanes.first_z[col]) {
           scratch.deferred.push_back({k, col});
           continue;
         }
         Candidate c = flat ? flat_bounds.at(scratch.flats[k], m, row, k, col) : bound_at_centre(m, tile, k);
         if (c.bound >= tile.state.top) continue;
         tile.candidates.push_back(c);
-        if (c.has_plane && (c.centre_z < lanes.first_z[col] ||
-                            (c.centre_z == lanes.first_z[col] && c.bound < lanes.first_bound[col]))) {
+        if (!c.has_plane) continue;
+        const bool lower = c.centre_z < lanes.first_z[col] ||
+                           (c.centre_z == lanes.first_z[col] && c.bound < lanes.first_bound[col]);
+        if (!lower && first_covers) continue;
+        const bool covers = covers_tile(m, tile);
+        if (covers ? (lower || !first_covers) : (lower && !first_covers)) {
           lanes.first[col] = static_cast<double>(k), lanes.first_z[col] = c.centre_z;
           lanes.first_gx[col] = c.gradient.x, lanes.first_gy[col] = c.gradient.y;
-          lanes.first_bound[col] = c.bound;
+          lanes.first_bound[col] = c.bound, lanes.first_covers[col] = covers;
         }
       }
     }
@@ -1234,6 +1252,14 @@ class Miller {
                                                                        Vec2(m.ax + m.vx, m.ay + m.vy))) -
                                         tile.half_diagonal);
     return distance <= m.radius ? m.lowest_tip() + m.cutter->lower_height(distance) : kInf;
+  }
+
+  // Whether the move's footprint (every point within the cutter's radius of its path) holds the
+  // whole tile.
+  static bool covers_tile(const MoveGeometry& m, const Tile& tile) {
+    const double reach = m.radius - tile.half_diagonal;
+    return reach > 0 && distance2_point_segment(Vec2(tile.xc, tile.yc), Vec2(m.ax, m.ay),
+                                                Vec2(m.ax + m.vx, m.ay + m.vy)) < reach * reach;
   }
 
   // The bounds of one move over one tile, for any cutter.
