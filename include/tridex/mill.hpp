@@ -665,24 +665,57 @@ struct BullLanes : RisingMove {
   // dependent chain through a division).
   template <int G>
   void at(const DoubleN (&ux)[G], DoubleN uy, const MaskN (&wanted)[G], DoubleN (&z)[G]) const {
+    DoubleN t[G], d[G];
+    if (!lowest<G>(ux, uy, wanted, t, d)) {
+      for (int g = 0; g < G; ++g) z[g] = splat(kInf);
+      return;
+    }
+    for (int g = 0; g < G; ++g) z[g] = d[g] < kInf ? low + t[g] * w + height(d[g]) : splat(kInf);
+  }
+
+  // S and its supporting plane's slope at the points (MoveGeometry::supporting_plane): h'(d)/d
+  // times q − C(t*), h'(d) = ρ/√(r² − ρ²) on the corner and 0 under the flat bottom. No plane
+  // where the cutter does not pass or q is within 1e-7·R² (in d²) of the rim.
+  using Plane = FlatLanes::Plane;
+  Plane plane_at(DoubleN ux, DoubleN uy) const {
+    DoubleN t[1], d[1];
+    MaskN all{};
+    all = all == 0;
+    Plane p{splat(kInf), splat(0), splat(0), MaskN{}};
+    if (!lowest<1>({ux}, uy, {all}, t, d)) return p;
+    const DoubleN px = ux - t[0] * vx, py = uy - t[0] * vy, d2 = px * px + py * py;
+    p.has_plane = (d[0] < kInf) & (d2 < r2 * (1 - 1e-7));
+    const DoubleN dist = sqrt_n(d2), reach = max_n(dist - flat, splat(0));
+    const DoubleN root = sqrt_n(max_n(corner2 - reach * reach, splat(corner2 * 1e-14)));
+    const DoubleN factor = p.has_plane & (reach > 0) ? reach / (root * dist) : splat(0);
+    p.z = d[0] < kInf ? low + t[0] * w + height(d[0]) : splat(kInf);
+    p.gx = factor * px, p.gy = factor * py;
+    return p;
+  }
+
+  // Where S is reached, t* and d(t*), at the points where `wanted` (d = +infinity elsewhere and
+  // where the cutter does not pass); false if no point is wanted.
+  template <int G>
+  bool lowest(const DoubleN (&ux)[G], DoubleN uy, const MaskN (&wanted)[G], DoubleN (&t)[G], DoubleN (&d)[G]) const {
     MaskN any_wanted{};
-    for (int g = 0; g < G; ++g) z[g] = splat(kInf), any_wanted |= wanted[g];
-    if (!any_n(any_wanted)) return;
+    for (int g = 0; g < G; ++g) any_wanted |= wanted[g];
+    if (!any_n(any_wanted)) return false;
     if (w == 0) {  // level: lowest where the axis comes closest to q
       for (int g = 0; g < G; ++g) {
         const Cover c = cover(ux[g], uy);
-        const DoubleN t = min_n(max_n(c.t_foot, c.lo), c.hi), s = t - c.t_foot;
-        z[g] = c.covered & wanted[g] ? low + height(sqrt_n(c.e2 + s * s * vv)) : splat(kInf);
+        t[g] = min_n(max_n(c.t_foot, c.lo), c.hi);
+        const DoubleN s = t[g] - c.t_foot;
+        d[g] = c.covered & wanted[g] ? sqrt_n(c.e2 + s * s * vv) : splat(kInf);
       }
-      return;
+      return true;
     }
     const DoubleN mr2 = splat(m2 * corner2), q0 = splat(1 + m2);
     // P(ρ) = ρ²d²·Q(ρ) with d = R0 + ρ: the sign of Q without a division.
-    auto p = [&](DoubleN e2, DoubleN reach, DoubleN d) {
-      const DoubleN rr = reach * reach, dd = d * d;
+    auto p = [&](DoubleN e2, DoubleN reach, DoubleN dist) {
+      const DoubleN rr = reach * reach, dd = dist * dist;
       return q0 * rr * dd - mr2 * dd - e2 * rr;
     };
-    DoubleN t_foot[G], e2[G], reach[G], t[G], d[G];
+    DoubleN t_foot[G], e2[G], reach[G];
     MaskN inside[G], any_inside{};
     for (int g = 0; g < G; ++g) {
       const DoubleN dot = ux[g] * vx + uy * vy, uu = ux[g] * ux[g] + uy * uy, ex = ux[g] - vx, ey = uy - vy;
@@ -724,7 +757,7 @@ struct BullLanes : RisingMove {
         d[g] = inside[g] ? root_d : d[g];
       }
     }
-    for (int g = 0; g < G; ++g) z[g] = d[g] < kInf ? low + t[g] * w + height(d[g]) : splat(kInf);
+    return true;
   }
 };
 
@@ -1075,10 +1108,9 @@ class Miller {
       int col0, col1;
       if (!columns(row, scratch.boxes[k], col0, col1)) continue;
       const MoveGeometry& m = scratch.moves[k];
-      // A flat end's bounds are found kLanes tiles at a time (as the ball end's), the others'
-      // one tile at a time.
-      const bool flat = scratch.kind[k] == LaneKind::flat;
-      FlatBounds flat_bounds;
+      // A flat end's and a bull nose's bounds are found kLanes tiles at a time (as the ball
+      // end's), the others' one tile at a time.
+      MoveBounds bounds;
       for (int col = col0; col <= col1; ++col) {
         Tile& tile = row.tiles[static_cast<std::size_t>(col)];
         if (m.lowest_tip() >= tile.state.top) continue;
@@ -1087,7 +1119,7 @@ class Miller {
           scratch.deferred.push_back({k, col});
           continue;
         }
-        Candidate c = flat ? flat_bounds.at(scratch.flats[k], m, row, k, col) : bound_at_centre(m, tile, k);
+        Candidate c = bounds.at(scratch, row, k, col);
         if (c.bound >= tile.state.top) continue;
         tile.candidates.push_back(c);
         if (!c.has_plane) continue;
@@ -1145,15 +1177,13 @@ class Miller {
       std::erase_if(tile.candidates,
                     [&](const Candidate& c) { return (has_first && c.move == first) || !can_cut(c, tile); });
     }
-    // A move's deferred tiles are consecutive: a flat end's bounds are found kLanes tiles at a time.
-    FlatBounds flat_bounds;
+    // A move's deferred tiles are consecutive: bounds are found kLanes tiles at a time.
+    MoveBounds bounds;
     for (const DeferredMove& d : scratch.deferred) {
       Tile& tile = row.tiles[static_cast<std::size_t>(d.col)];
       const MoveGeometry& m = scratch.moves[d.move];
       if (m.lowest_tip() >= tile.state.top || static_cast<double>(d.move) == lanes.first[d.col]) continue;
-      const Candidate c = scratch.kind[d.move] == LaneKind::flat
-                              ? flat_bounds.at(scratch.flats[d.move], m, row, d.move, d.col)
-                              : bound_at_centre(m, tile, d.move);
+      const Candidate c = bounds.at(scratch, row, d.move, d.col);
       if (can_cut(c, tile)) tile.candidates.push_back(c);
     }
     for (const BallBounds& b : scratch.ball_bounds) keep_other_cuts(row, b);
@@ -1224,24 +1254,42 @@ class Miller {
     }
   }
 
-  // bound_at_centre for a flat end's move, from FlatLanes::plane_at at the centres of kLanes
-  // tiles of a row at once (`at` computes them for the tiles around column col when needed).
-  struct FlatBounds {
+  // bound_at_centre for a flat end's or a bull nose's move, from FlatLanes::plane_at or
+  // BullLanes::plane_at at the centres of kLanes tiles of a row at once (`at` computes them for
+  // the tiles around column col when needed).
+  template <class Lanes>
+  struct LaneBounds {
     FlatLanes::Plane plane;
     DoubleN bound;
     std::uint32_t move = 0;
     int lane0 = -1;
 
-    Candidate at(const FlatLanes& flat, const MoveGeometry& m, const TileRow& row, std::uint32_t index, int col) {
+    Candidate at(const Lanes& lanes, const MoveGeometry& m, const TileRow& row, std::uint32_t index, int col) {
       if (index != move || col / kLanes * kLanes != lane0) {
         move = index, lane0 = col / kLanes * kLanes;
-        const DoubleN ux = load_n(&row.lanes.xc[lane0]) - flat.ax, uy = splat(row.tiles[0].yc - flat.ay);
-        plane = flat.plane_at(ux, uy);
+        const DoubleN ux = load_n(&row.lanes.xc[lane0]) - lanes.ax, uy = splat(row.tiles[0].yc - lanes.ay);
+        plane = lanes.plane_at(ux, uy);
         bound = plane.z - abs_n(plane.gx) * load_n(&row.lanes.hx[lane0]) - abs_n(plane.gy) * row.tiles[0].hy;
       }
       const int l = col - lane0;
       if (plane.has_plane[l]) return {index, true, bound[l], plane.z[l], Vec2(plane.gx[l], plane.gy[l])};
       return {index, false, bound_without_plane(m, row.tiles[static_cast<std::size_t>(col)]), kInf, Vec2(0)};
+    }
+  };
+
+  // The bounds of one move over the tile at column col, kLanes tiles at a time where the move has
+  // a vector form for them.
+  struct MoveBounds {
+    LaneBounds<FlatLanes> flat;
+    LaneBounds<BullLanes> bull;
+
+    Candidate at(const BlockScratch& scratch, const TileRow& row, std::uint32_t k, int col) {
+      const MoveGeometry& m = scratch.moves[k];
+      switch (scratch.kind[k]) {
+        case LaneKind::flat: return flat.at(scratch.flats[k], m, row, k, col);
+        case LaneKind::bull_nose: return bull.at(scratch.bulls[k], m, row, k, col);
+        default: return bound_at_centre(m, row.tiles[static_cast<std::size_t>(col)], k);
+      }
     }
   };
 

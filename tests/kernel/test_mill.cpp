@@ -157,46 +157,54 @@ TEST_CASE("the flat end's and the bull nose's vector forms agree with the scalar
   CHECK(covered[1] > 500 * detail::kLanes);
 }
 
-TEST_CASE("the flat end's vector supporting plane: the scalar one, and below S everywhere") {
-  // FlatLanes::plane_at against MoveGeometry::lowest_with_plane, and S(q) ≥ S(c) + g·(q − c) at
-  // random q around c (S is convex; the plane is its tangent at the end disc's entry edge).
+TEST_CASE("the flat end's and the bull nose's vector supporting planes: the scalar ones, and below S everywhere") {
+  // FlatLanes::plane_at and BullLanes::plane_at against MoveGeometry::lowest_with_plane, and
+  // S(q) ≥ S(c) + g·(q − c) at random q around c (S is convex; the flat end's plane is its tangent
+  // at the end disc's entry edge, the bull nose's h'(d)/d·(q − C(t*))).
   std::mt19937 rng(47);
   std::uniform_real_distribution<double> u(-1, 1);
   const double r = 1.3;
-  const Cutter flat = Cutter::flat(r);
-  int planes = 0, sloped = 0;
-  for (int trial = 0; trial < 4000; ++trial) {
-    Segment s{Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng))};
-    if (trial % 4 == 0) s.b.z = s.a.z;                                                  // level
-    if (trial % 7 == 0) s.b = s.a + Vec3(0.01 * u(rng), 0.01 * u(rng), 2 * u(rng));  // steep
-    detail::MoveGeometry m(flat, s);
-    if (m.vertical) continue;
-    detail::FlatLanes lanes(m);
-    detail::DoubleN x{}, y{};
-    for (int l = 0; l < detail::kLanes; ++l) x[l] = 2.5 * u(rng), y[l] = 2.5 * u(rng);
-    const detail::FlatLanes::Plane p = lanes.plane_at(x - lanes.ax, y - lanes.ay);
-    for (int l = 0; l < detail::kLanes; ++l) {
-      CAPTURE(trial);
-      CAPTURE(l);
-      detail::MoveGeometry::Lowest centre;
-      Vec2 gradient(0);
-      const bool scalar_plane = m.lowest_with_plane(x[l], y[l], centre, gradient);
-      if (!p.has_plane[l]) continue;
-      ++planes;
-      REQUIRE(scalar_plane);
-      REQUIRE(p.z[l] == doctest::Approx(centre.z).epsilon(1e-9));
-      REQUIRE(p.gx[l] == doctest::Approx(gradient.x).epsilon(1e-6).scale(1));
-      REQUIRE(p.gy[l] == doctest::Approx(gradient.y).epsilon(1e-6).scale(1));
-      if (p.gx[l] != 0 || p.gy[l] != 0) ++sloped;
-      for (int k = 0; k < 20; ++k) {
-        const double qx = x[l] + 0.5 * u(rng), qy = y[l] + 0.5 * u(rng);
-        const double s_q = m.lowest_above(qx, qy);
-        if (s_q < 1e300) REQUIRE(s_q >= p.z[l] + p.gx[l] * (qx - x[l]) + p.gy[l] * (qy - y[l]) - 1e-9);
+  auto check = [&](const Cutter& cutter, auto make_lanes, int& planes, int& sloped) {
+    for (int trial = 0; trial < 4000; ++trial) {
+      Segment s{Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng))};
+      if (trial % 4 == 0) s.b.z = s.a.z;                                                  // level
+      if (trial % 7 == 0) s.b = s.a + Vec3(0.01 * u(rng), 0.01 * u(rng), 2 * u(rng));  // steep
+      detail::MoveGeometry m(cutter, s);
+      if (m.vertical) continue;
+      const auto lanes = make_lanes(m);
+      detail::DoubleN x{}, y{};
+      for (int l = 0; l < detail::kLanes; ++l) x[l] = 2.5 * u(rng), y[l] = 2.5 * u(rng);
+      const detail::FlatLanes::Plane p = lanes.plane_at(x - lanes.ax, y - lanes.ay);
+      for (int l = 0; l < detail::kLanes; ++l) {
+        CAPTURE(trial);
+        CAPTURE(l);
+        detail::MoveGeometry::Lowest centre;
+        Vec2 gradient(0);
+        const bool scalar_plane = m.lowest_with_plane(x[l], y[l], centre, gradient);
+        if (!p.has_plane[l]) continue;
+        ++planes;
+        REQUIRE(scalar_plane);
+        REQUIRE(p.z[l] == doctest::Approx(centre.z).epsilon(1e-9));
+        REQUIRE(p.gx[l] == doctest::Approx(gradient.x).epsilon(1e-6).scale(1));
+        REQUIRE(p.gy[l] == doctest::Approx(gradient.y).epsilon(1e-6).scale(1));
+        if (p.gx[l] != 0 || p.gy[l] != 0) ++sloped;
+        for (int k = 0; k < 20; ++k) {
+          const double qx = x[l] + 0.5 * u(rng), qy = y[l] + 0.5 * u(rng);
+          const double s_q = m.lowest_above(qx, qy);
+          if (s_q < 1e300) REQUIRE(s_q >= p.z[l] + p.gx[l] * (qx - x[l]) + p.gy[l] * (qy - y[l]) - 1e-9);
+        }
       }
     }
-  }
+  };
+  int planes = 0, sloped = 0;
+  check(Cutter::flat(r), [](const detail::MoveGeometry& m) { return detail::FlatLanes(m); }, planes, sloped);
   CHECK(planes > 1000);
   CHECK(sloped > 300);
+  int bull_planes = 0, bull_sloped = 0;
+  check(Cutter::bull_nose(r, 0.6), [](const detail::MoveGeometry& m) { return detail::BullLanes(m); }, bull_planes,
+        bull_sloped);
+  CHECK(bull_planes > 1000);
+  CHECK(bull_sloped > 1000);
 }
 
 TEST_CASE("milled heights are the exact lowest point of the swept cutter (every cutter kind)") {
