@@ -22,15 +22,16 @@
 // The grid is cut into 16×16-point tiles and the tiles into 8×8-tile work blocks, milled on all
 // threads. A block is milled one row of tiles at a time, in two passes over its moves:
 //   1. every move is bounded over every tile of the row it reaches, by S's tangent plane at the
-//      tile's centre, and each tile is cut first by the move lowest at its centre: that leaves
-//      it close to its final shape, and that move's plane P then follows its surface;
+//      tile's centre, and each tile is cut first by the move lowest at its centre among those
+//      whose footprint covers the whole tile (if any does): that leaves it close to its final
+//      shape, and that move's plane P then follows its surface;
 //   2. the moves whose bound is still below the tile's highest point, and below max(height − P)
 //      when measured from P (so that sloped surfaces skip as well as flat ones), cut the tile
 //      row by row, each row read once and lowered by every move admitted there.
 // Ball end moves are bounded kLanes tiles at a time and evaluated kLanes points at a time, with
-// one square root per point (BallLanes); flat end and bull nose moves are evaluated kLanes points
-// at a time too (FlatLanes: a closed form; BullLanes: the still cutter where the minimum is at
-// an end of the move, else Newton steps with no square root). The moves
+// one square root per point (BallLanes); flat end and bull nose moves are bounded and evaluated
+// kLanes at a time too (FlatLanes: a closed form; BullLanes: the still cutter where the minimum is
+// at an end of the move, else Newton steps with no square root). The moves
 // left for a tile in pass 2 are cut lowest bound first, a run of one cutter at a time, each run
 // checked against what the tile holds by then: so a tile first cut by any cutter, or roughed
 // deeper by another cutter, still rejects the moves that cut air. Runs of flat end and bull nose
