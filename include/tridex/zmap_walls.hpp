@@ -40,7 +40,8 @@ inline double point_segment_distance_xy(double x, double y, const Segment& s) {
   const double vx = s.b.x - s.a.x, vy = s.b.y - s.a.y, ux = x - s.a.x, uy = y - s.a.y;
   const double vv = vx * vx + vy * vy;
   const double t = vv > 0 ? std::clamp((ux * vx + uy * vy) / vv, 0.0, 1.0) : 0.0;
-  return std::hypot(ux - t * vx, uy - t * vy);
+  const double dx = ux - t * vx, dy = uy - t * vy;
+  return std::sqrt(dx * dx + dy * dy);
 }
 
 // Makes the steep cells of `map` fine, with sub-point heights from the moves it was milled with
@@ -103,8 +104,8 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
       for (auto [b0, b1] = band_range(moves[m]); b0 <= b1; ++b0)
         band_moves[at[static_cast<std::size_t>(b0)]++] = static_cast<std::uint32_t>(m);
   }
-  // The highest sub-point of each fine cell so far: a move whose tip never goes below it cannot
-  // lower any of them (every cutter's surface lies on or above its tip), and is skipped exactly.
+  // The highest sub-point of each fine cell so far: a move whose swept cutter cannot reach below
+  // it over the cell cannot lower any of them, and is skipped.
   std::vector<float> cell_top(cells.size(), ceiling);
   const double half_diagonal = g.cell * std::sqrt(0.5) * (1 + 1e-9);
   std::atomic<int> next{0};
@@ -135,9 +136,14 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
             const auto index = static_cast<std::size_t>(c - cells.begin());
             if (tip >= double(cell_top[index])) continue;
             const int i = static_cast<int>(*c - base);
-            // No sub-point of the cell is within the cutter's radius of the tip path.
+            // The cell's sub-points lie at least `reach` from the tip path in XY. Beyond the
+            // radius the cutter never passes over them; within it, the swept cutter stands at
+            // least the profile's height at `reach` above its lowest tip there (profiles rise
+            // outward), less a rounding margin far below float heights.
             const double cx = g.x0 + (i + 0.5) * g.cell, cy = g.y0 + (j + 0.5) * g.cell;
-            if (point_segment_distance_xy(cx, cy, s) > r + half_diagonal) continue;
+            const double reach = point_segment_distance_xy(cx, cy, s) - half_diagonal;
+            if (reach > r) continue;
+            if (tip + move.cutter->lower_height(std::max(0.0, reach)) - 1e-6 >= double(cell_top[index])) continue;
             float* h = sub.data() + index * kPoints;
             for (int b = 0; b < kSide; ++b)
               for (int a = 0; a < kSide; ++a) {

@@ -229,7 +229,7 @@ TEST_CASE("refine steep cells: a pocket's walls lie within a sub-cell of where t
 TEST_CASE("refine steep cells: every inner sub-point is the brute-force lowest point over all moves") {
   // Random short and long moves of mixed cutters, level, sloped and vertical, over a map of many
   // 16-row bands (the moves are sorted into bands and skipped by their lowest tip and by their
-  // distance to a cell): each fine cell's sub-points other than its corners (which are the
+  // distance to a cell and the profile's height there): each fine cell's sub-points other than its corners (which are the
   // map's own points) must be min(ceiling, min over every move of MoveGeometry::lowest), raised
   // to the empty height, exactly.
   std::mt19937 rng(1717);
@@ -240,7 +240,7 @@ TEST_CASE("refine steep cells: every inner sub-point is the brute-force lowest p
   const ZMap initial = map;
   const Aabb local = local_bounds(frame, stock);
   const std::vector<Cutter> cutters{Cutter::ball(0.5), Cutter::flat(0.4), Cutter::bull_nose(0.6, 0.2),
-                                    Cutter::cone(0.5, 30)};
+                                    Cutter::cone(0.5, 30), Cutter::tapered_ball(0.7, 0.3, 10)};
   std::vector<CutMove> moves;
   auto point = [&] {
     return Vec3(local.min.x - 1 + (local.max.x - local.min.x + 2) * unit(rng),
