@@ -108,6 +108,13 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
   // it over the cell cannot lower any of them, and is skipped.
   std::vector<float> cell_top(cells.size(), ceiling);
   const double half_diagonal = g.cell * std::sqrt(0.5) * (1 + 1e-9);
+  // Which tiles (a band's rows by as many columns) hold a fine cell.
+  constexpr std::size_t kTile = kBandRows;
+  const std::size_t tiles_x = (static_cast<std::size_t>(g.nx) - 1 + kTile - 1) / kTile;
+  const double tile_half_diagonal = kTile * half_diagonal;
+  std::vector<std::uint8_t> tile_walls(static_cast<std::size_t>(bands) * tiles_x, 0);
+  for (std::uint32_t c : cells)
+    tile_walls[c / static_cast<std::uint32_t>(g.nx) / kBandRows * tiles_x + c % static_cast<std::uint32_t>(g.nx) / kTile] = 1;
   std::atomic<int> next{0};
   auto worker = [&] {
     for (int band; (band = next.fetch_add(1)) < bands;) {
@@ -124,8 +131,21 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
         const int row1 = std::min(j1 - 1, static_cast<int>(std::floor((hi_y - g.y0) / g.cell)));
         if (row0 > row1) continue;
         const double lo_x = std::min(s.a.x, s.b.x) - r, hi_x = std::max(s.a.x, s.b.x) + r;
-        const auto i0 = static_cast<std::uint32_t>(std::clamp(std::floor((lo_x - g.x0) / g.cell), 0.0, double(g.nx)));
-        const auto i1 = static_cast<std::uint32_t>(std::clamp(std::floor((hi_x - g.x0) / g.cell), 0.0, double(g.nx)));
+        auto i0 = static_cast<std::uint32_t>(std::clamp(std::floor((lo_x - g.x0) / g.cell), 0.0, double(g.nx)));
+        auto i1 = static_cast<std::uint32_t>(std::clamp(std::floor((hi_x - g.x0) / g.cell), 0.0, double(g.nx)));
+        // Only the band's tiles that hold a fine cell and come within the radius of the tip
+        // path: most of a map has no wall, and a move's box spans many cell rows.
+        const std::size_t tx0 = i0 / kTile, tx1 = std::min<std::size_t>(i1, static_cast<std::size_t>(g.nx - 2)) / kTile;
+        std::size_t first_tile = tiles_x, last_tile = 0;
+        for (std::size_t tx = tx0; tx <= tx1; ++tx) {
+          if (!tile_walls[static_cast<std::size_t>(band) * tiles_x + tx]) continue;
+          const double cx = g.x0 + (double(tx) + 0.5) * kTile * g.cell, cy = g.y0 + 0.5 * (j0 + j1) * g.cell;
+          if (point_segment_distance_xy(cx, cy, s) > r + tile_half_diagonal) continue;
+          first_tile = std::min(first_tile, tx), last_tile = tx;
+        }
+        if (first_tile > last_tile) continue;
+        i0 = std::max(i0, static_cast<std::uint32_t>(first_tile * kTile));
+        i1 = std::min(i1, static_cast<std::uint32_t>(last_tile * kTile + kTile - 1));
         const double tip = move.lowest_tip();
         for (int j = row0; j <= row1; ++j) {
           const auto row = static_cast<std::size_t>(j), base = row * static_cast<std::size_t>(g.nx);
@@ -142,7 +162,7 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
             // outward), less a rounding margin far below float heights.
             const double cx = g.x0 + (i + 0.5) * g.cell, cy = g.y0 + (j + 0.5) * g.cell;
             const double reach = point_segment_distance_xy(cx, cy, s) - half_diagonal;
-            if (reach > r) continue;
+            if (reach > r + tile_half_diagonal) continue;
             if (tip + move.cutter->lower_height(std::max(0.0, reach)) - 1e-6 >= double(cell_top[index])) continue;
             float* h = sub.data() + index * kPoints;
             for (int b = 0; b < kSide; ++b)
