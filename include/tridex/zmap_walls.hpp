@@ -28,6 +28,9 @@
 
 namespace tridex {
 
+// refine_steep_cells works on bands of this many cell rows (and tiles this many columns wide).
+inline constexpr int kWallBandRows = 16;
+
 struct WallOptions {
   // A cell is steep when its corners' heights differ by more than this many cell widths:
   // raise_uncut's lift (two cells) at the edge of every cut passes it, a 55° slope does not.
@@ -84,7 +87,7 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
   // Bands of cell rows, one thread each at a time. Each band gets the moves whose swept box
   // reaches it, in program order (a counting sort: one pass to count, one to place), so that a
   // band never scans the whole program: a 5000-row map has 313 bands.
-  constexpr int kBandRows = 16;
+  constexpr int kBandRows = kWallBandRows;
   const int bands = (g.ny - 1 + kBandRows - 1) / kBandRows;
   auto band_range = [&](const CutMove& m) {
     const double r = cutters[m.cutter].radius();
