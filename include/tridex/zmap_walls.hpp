@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <span>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "tridex/dexel_ops.hpp"
@@ -27,12 +28,24 @@
 
 namespace tridex {
 
+// refine_steep_cells works on bands of this many cell rows (and tiles this many columns wide).
+inline constexpr int kWallBandRows = 16;
+
 struct WallOptions {
   // A cell is steep when its corners' heights differ by more than this many cell widths:
   // raise_uncut's lift (two cells) at the edge of every cut passes it, a 55° slope does not.
   double steep_slope = 1.5;
   unsigned threads = 0;  // 0: every hardware thread
 };
+
+// The distance in XY from (x, y) to the tip path's projection.
+inline double point_segment_distance_xy(double x, double y, const Segment& s) {
+  const double vx = s.b.x - s.a.x, vy = s.b.y - s.a.y, ux = x - s.a.x, uy = y - s.a.y;
+  const double vv = vx * vx + vy * vy;
+  const double t = vv > 0 ? std::clamp((ux * vx + uy * vy) / vv, 0.0, 1.0) : 0.0;
+  const double dx = ux - t * vx, dy = uy - t * vy;
+  return std::sqrt(dx * dx + dy * dy);
+}
 
 // Makes the steep cells of `map` fine, with sub-point heights from the moves it was milled with
 // (the same cutters and moves, in its frame). Call it on a map prepared by raise_uncut, last:
@@ -71,40 +84,98 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
   geometry.reserve(moves.size());
   for (const CutMove& m : moves) geometry.emplace_back(cutters[m.cutter], m.tip);
   const double step = g.cell / kSteps;  // exact: kSteps is a power of two
-  // Bands of cell rows, one thread each at a time; a band looks at the moves whose swept box
-  // reaches it.
-  constexpr int kBandRows = 16;
+  // Bands of cell rows, one thread each at a time. Each band gets the moves whose swept box
+  // reaches it, in program order (a counting sort: one pass to count, one to place), so that a
+  // band never scans the whole program: a 5000-row map has 313 bands.
+  constexpr int kBandRows = kWallBandRows;
   const int bands = (g.ny - 1 + kBandRows - 1) / kBandRows;
+  auto band_range = [&](const CutMove& m) {
+    const double r = cutters[m.cutter].radius();
+    const double lo_y = std::min(m.tip.a.y, m.tip.b.y) - r, hi_y = std::max(m.tip.a.y, m.tip.b.y) + r;
+    const double row0 = std::floor((lo_y - g.y0) / g.cell), row1 = std::floor((hi_y - g.y0) / g.cell);
+    return std::pair{static_cast<int>(std::clamp(row0, 0.0, double(g.ny - 1))) / kBandRows,
+                     row1 < 0 ? -1 : static_cast<int>(std::min(row1, double(g.ny - 2))) / kBandRows};
+  };
+  std::vector<std::size_t> band_begin(static_cast<std::size_t>(bands) + 1, 0);
+  for (const CutMove& m : moves)
+    for (auto [b0, b1] = band_range(m); b0 <= b1; ++b0) ++band_begin[static_cast<std::size_t>(b0) + 1];
+  for (std::size_t b = 0; b < static_cast<std::size_t>(bands); ++b) band_begin[b + 1] += band_begin[b];
+  std::vector<std::uint32_t> band_moves(band_begin.back());
+  {
+    std::vector<std::size_t> at(band_begin.begin(), band_begin.end() - 1);
+    for (std::size_t m = 0; m < moves.size(); ++m)
+      for (auto [b0, b1] = band_range(moves[m]); b0 <= b1; ++b0)
+        band_moves[at[static_cast<std::size_t>(b0)]++] = static_cast<std::uint32_t>(m);
+  }
+  // The highest sub-point of each fine cell so far: a move whose swept cutter cannot reach below
+  // it over the cell cannot lower any of them, and is skipped.
+  std::vector<float> cell_top(cells.size(), ceiling);
+  const double half_diagonal = g.cell * std::sqrt(0.5) * (1 + 1e-9);
+  // Which tiles (a band's rows by as many columns) hold a fine cell.
+  constexpr std::size_t kTile = kBandRows;
+  const std::size_t tiles_x = (static_cast<std::size_t>(g.nx) - 1 + kTile - 1) / kTile;
+  const double tile_half_diagonal = kTile * half_diagonal;
+  std::vector<std::uint8_t> tile_walls(static_cast<std::size_t>(bands) * tiles_x, 0);
+  for (std::uint32_t c : cells)
+    tile_walls[c / static_cast<std::uint32_t>(g.nx) / kBandRows * tiles_x + c % static_cast<std::uint32_t>(g.nx) / kTile] = 1;
   std::atomic<int> next{0};
   auto worker = [&] {
     for (int band; (band = next.fetch_add(1)) < bands;) {
       const int j0 = band * kBandRows, j1 = std::min(g.ny - 1, j0 + kBandRows);
       if (row_begin[static_cast<std::size_t>(j0)] == row_begin[static_cast<std::size_t>(j1)]) continue;
-      for (std::size_t m = 0; m < moves.size(); ++m) {
+      for (std::size_t at = band_begin[static_cast<std::size_t>(band)]; at < band_begin[static_cast<std::size_t>(band) + 1];
+           ++at) {
+        const std::size_t m = band_moves[at];
         const Segment& s = moves[m].tip;
-        const double r = cutters[moves[m].cutter].radius();
+        const detail::MoveGeometry& move = geometry[m];
+        const double r = move.radius;
         const double lo_y = std::min(s.a.y, s.b.y) - r, hi_y = std::max(s.a.y, s.b.y) + r;
         const int row0 = std::max(j0, static_cast<int>(std::floor((lo_y - g.y0) / g.cell)));
         const int row1 = std::min(j1 - 1, static_cast<int>(std::floor((hi_y - g.y0) / g.cell)));
         if (row0 > row1) continue;
         const double lo_x = std::min(s.a.x, s.b.x) - r, hi_x = std::max(s.a.x, s.b.x) + r;
-        const auto i0 = static_cast<std::uint32_t>(std::clamp(std::floor((lo_x - g.x0) / g.cell), 0.0, double(g.nx)));
-        const auto i1 = static_cast<std::uint32_t>(std::clamp(std::floor((hi_x - g.x0) / g.cell), 0.0, double(g.nx)));
+        auto i0 = static_cast<std::uint32_t>(std::clamp(std::floor((lo_x - g.x0) / g.cell), 0.0, double(g.nx)));
+        auto i1 = static_cast<std::uint32_t>(std::clamp(std::floor((hi_x - g.x0) / g.cell), 0.0, double(g.nx)));
+        // Only the band's tiles that hold a fine cell and come within the radius of the tip
+        // path: most of a map has no wall, and a move's box spans many cell rows.
+        const std::size_t tx0 = i0 / kTile, tx1 = std::min<std::size_t>(i1, static_cast<std::size_t>(g.nx - 2)) / kTile;
+        std::size_t first_tile = tiles_x, last_tile = 0;
+        for (std::size_t tx = tx0; tx <= tx1; ++tx) {
+          if (!tile_walls[static_cast<std::size_t>(band) * tiles_x + tx]) continue;
+          const double cx = g.x0 + (double(tx) + 0.5) * kTile * g.cell, cy = g.y0 + 0.5 * (j0 + j1) * g.cell;
+          if (point_segment_distance_xy(cx, cy, s) > r + tile_half_diagonal) continue;
+          first_tile = std::min(first_tile, tx), last_tile = tx;
+        }
+        if (first_tile > last_tile) continue;
+        i0 = std::max(i0, static_cast<std::uint32_t>(first_tile * kTile));
+        i1 = std::min(i1, static_cast<std::uint32_t>(last_tile * kTile + kTile - 1));
+        const double tip = move.lowest_tip();
         for (int j = row0; j <= row1; ++j) {
           const auto row = static_cast<std::size_t>(j), base = row * static_cast<std::size_t>(g.nx);
           const auto first = cells.begin() + static_cast<std::ptrdiff_t>(row_begin[row]);
           const auto last = cells.begin() + static_cast<std::ptrdiff_t>(row_begin[row + 1]);
           for (auto c = std::lower_bound(first, last, static_cast<std::uint32_t>(base + i0));
                c != last && *c <= base + i1; ++c) {
+            const auto index = static_cast<std::size_t>(c - cells.begin());
+            if (tip >= double(cell_top[index])) continue;
             const int i = static_cast<int>(*c - base);
-            float* h = sub.data() + static_cast<std::size_t>(c - cells.begin()) * kPoints;
+            // The cell's sub-points lie at least `reach` from the tip path in XY. Beyond the
+            // radius the cutter never passes over them; within it, the swept cutter stands at
+            // least the profile's height at `reach` above its lowest tip there (profiles rise
+            // outward), less a rounding margin far below float heights.
+            const double cx = g.x0 + (i + 0.5) * g.cell, cy = g.y0 + (j + 0.5) * g.cell;
+            const double reach = point_segment_distance_xy(cx, cy, s) - half_diagonal;
+            if (reach > r + tile_half_diagonal) continue;
+            if (tip + move.cutter->lower_height(std::max(0.0, reach)) - 1e-6 >= double(cell_top[index])) continue;
+            float* h = sub.data() + index * kPoints;
             for (int b = 0; b < kSide; ++b)
               for (int a = 0; a < kSide; ++a) {
                 const double x = g.x0 + (kSteps * i + a) * step, y = g.y0 + (kSteps * j + b) * step;
-                const double z = geometry[m].lowest(x, y).z;
+                const double z = move.lowest(x, y).z;
                 float& to = h[a + kSide * b];
                 if (z < double(to)) to = static_cast<float>(z);
               }
+            cell_top[index] = *std::max_element(h, h + kPoints);
           }
         }
       }

@@ -225,3 +225,61 @@ TEST_CASE("refine steep cells: a pocket's walls lie within a sub-cell of where t
   CHECK(worst_plain > 2 * sub);  // the plain map's ramp is off farther: the test can tell
   CHECK(wrong_fine * 3 < wrong_plain);
 }
+
+TEST_CASE("refine steep cells: every inner sub-point is the brute-force lowest point over all moves") {
+  // Random short and long moves of mixed cutters, level, sloped and vertical, over a map of many
+  // 16-row bands (the moves are sorted into bands and skipped by their lowest tip and by their
+  // distance to a cell and the profile's height there): each fine cell's sub-points other than its corners (which are the
+  // map's own points) must be min(ceiling, min over every move of MoveGeometry::lowest), raised
+  // to the empty height, exactly.
+  std::mt19937 rng(1717);
+  std::uniform_real_distribution<double> unit(0, 1);
+  const Aabb stock{Vec3(0), Vec3(12, 9, 4)};
+  const Frame frame = Frame::from_rotation(rotation_z(23) * rotation_x(9));
+  ZMap map = ZMap::from_box(frame, stock, 0.09);
+  const ZMap initial = map;
+  const Aabb local = local_bounds(frame, stock);
+  const std::vector<Cutter> cutters{Cutter::ball(0.5), Cutter::flat(0.4), Cutter::bull_nose(0.6, 0.2),
+                                    Cutter::cone(0.5, 30), Cutter::tapered_ball(0.7, 0.3, 10)};
+  std::vector<CutMove> moves;
+  auto point = [&] {
+    return Vec3(local.min.x - 1 + (local.max.x - local.min.x + 2) * unit(rng),
+                local.min.y - 1 + (local.max.y - local.min.y + 2) * unit(rng), local.max.z - 2.5 * unit(rng));
+  };
+  for (int k = 0; k < 400; ++k) {
+    const Vec3 a = point();
+    Vec3 b = k % 3 == 0 ? point() : a + Vec3(1.5 * unit(rng) - 0.75, 1.5 * unit(rng) - 0.75, 0.4 * unit(rng) - 0.2);
+    if (k % 7 == 0) b = Vec3(a.x, a.y, b.z);  // vertical
+    if (k % 5 == 0) b.z = a.z;                // level
+    moves.push_back({Segment{a, b}, static_cast<std::uint32_t>(k % cutters.size())});
+  }
+  mill(map, cutters, moves, {.threads = 1});
+  raise_uncut(map, initial);
+  float ceiling = map.empty_height;
+  for (float h : map.heights) ceiling = std::max(ceiling, h);
+  refine_steep_cells(map, cutters, moves, {.threads = 2});
+  REQUIRE(map.fine.cells.size() > 500);
+  REQUIRE(map.grid.ny > 4 * 16);
+
+  std::vector<detail::MoveGeometry> geometry;
+  for (const CutMove& m : moves) geometry.emplace_back(cutters[m.cutter], m.tip);
+  const ZMapGrid& g = map.grid;
+  const double step = g.cell / kSteps;
+  std::size_t compared = 0, wrong = 0;
+  for (std::size_t k = 0; k < map.fine.cells.size(); ++k) {
+    const int i = static_cast<int>(map.fine.cells[k] % static_cast<std::uint32_t>(g.nx));
+    const int j = static_cast<int>(map.fine.cells[k] / static_cast<std::uint32_t>(g.nx));
+    for (int b = 0; b < kSide; ++b)
+      for (int a = 0; a < kSide; ++a) {
+        if ((a == 0 || a == kSteps) && (b == 0 || b == kSteps)) continue;
+        const double x = g.x0 + (kSteps * i + a) * step, y = g.y0 + (kSteps * j + b) * step;
+        double lowest = ceiling;
+        for (const detail::MoveGeometry& m : geometry) lowest = std::min(lowest, m.lowest(x, y).z);
+        const float expected = std::max(static_cast<float>(lowest), map.empty_height);
+        wrong += map.fine.heights[k * ZMapFineCells::kPoints + static_cast<std::size_t>(a + kSide * b)] != expected;
+        ++compared;
+      }
+  }
+  CHECK(compared > 10000);
+  CHECK(wrong == 0);
+}

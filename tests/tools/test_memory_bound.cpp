@@ -214,7 +214,7 @@ TEST_CASE("memory: the steep cells counted before refining are those refine_stee
     CHECK(counted > 100);
     CHECK(counted == map.fine.cells.size());
     // The bytes counted cover what the refined map keeps.
-    CHECK(cli::fine_cell_bytes(static_cast<double>(counted), map.grid.ny, static_cast<double>(moves.size())) >=
+    CHECK(cli::fine_cell_bytes(static_cast<double>(counted), map.grid.ny, static_cast<double>(moves.size()), 1) >=
           static_cast<double>((map.fine.cells.size() + map.fine.row_begin.size()) * 4 +
                               map.fine.heights.size() * sizeof(float)));
   }

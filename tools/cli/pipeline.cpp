@@ -195,11 +195,11 @@ std::size_t count_steep_cells(const ZMap& map, double steep_slope) {
   return cells;
 }
 
-double fine_cell_bytes(double cells, double rows, double moves) {
+double fine_cell_bytes(double cells, double rows, double moves, double bands_per_move) {
   constexpr double kSubHeights = 4.0 * ZMapFineCells::kPoints;
-  const double per_cell = (kSubHeights + 2 * 4) + (kSubHeights + 4 + 4);
+  const double per_cell = (kSubHeights + 2 * 4 + 4) + (kSubHeights + 4 + 4);
   const double per_row = 8 + 4;  // refine's row starts, the map's
-  const double per_move = sizeof(CutMove) + sizeof(detail::MoveGeometry);
+  const double per_move = sizeof(CutMove) + sizeof(detail::MoveGeometry) + 4 * bands_per_move;
   return per_cell * cells + per_row * rows + per_move * moves;
 }
 
@@ -479,7 +479,12 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
     rows += maps[g].grid.ny;
     most_moves = std::max(most_moves, static_cast<double>(groups[g].moves.size()));
   }
-  r.memory.walls = fine_cell_bytes(static_cast<double>(steep_cells), rows, most_moves);
+  // A move is listed in the bands its swept box spans: its width plus one band at each end for
+  // the short moves of most programs.
+  double widest = 0;
+  for (const Cutter& c : cutters) widest = std::max(widest, 2 * c.radius());
+  const double bands_per_move = 2 + widest / (kWallBandRows * zmap_cell);
+  r.memory.walls = fine_cell_bytes(static_cast<double>(steep_cells), rows, most_moves, bands_per_move);
   if (r.memory.total() > static_cast<double>(max_memory))
     input_error("the walls need finer heights in ", steep_cells, " steep Z-map cells: an estimated ",
                 format_mib(r.memory.walls), " on top of ", format_mib(r.memory.total() - r.memory.walls),

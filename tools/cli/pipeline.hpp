@@ -150,10 +150,11 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
 std::size_t count_steep_cells(const ZMap& map, double steep_slope);
 
 // Bytes at refine_steep_cells's peak for `cells` fine cells over maps with `rows` cell rows in
-// all, while it holds `moves` moves of one direction: per cell the sub-heights and index being
-// built (104 bytes, the index up to twice over while it grows), the sorted copy set_fine_cells
-// makes of both (108), and each move as a CutMove and its MoveGeometry.
-double fine_cell_bytes(double cells, double rows, double moves);
+// all, while it holds `moves` moves of one direction, each listed in about `bands_per_move` of
+// its row bands: per cell the sub-heights, index and highest sub-point being built (108 bytes,
+// the index up to twice over while it grows), the sorted copy set_fine_cells makes of both
+// (108), and each move as a CutMove, its MoveGeometry and its places in the bands.
+double fine_cell_bytes(double cells, double rows, double moves, double bands_per_move);
 
 std::string axis_label(const Vec3& axis);
 // "X 612.5 mm, past the travel's end 600" / "A -130°, past its limit -120".
