@@ -691,9 +691,9 @@ TEST_CASE("simulate: the bundled example, from its CAMotics project, matches the
   check_against_reference(s, ref, 11);
   // Along the edges where two directions' cuts meet (the +X bevel's top edge, the side
   // features' rims). At this resolution (h 0.5 mm, Z-map cell 0.4 h) with fine cells at the
-  // walls (zmap_walls.hpp): 1 of 3000 points wrong beyond h/2, at 0.504 h, none beyond 1.5 h;
-  // without them 3, up to 0.63 h (the walls' rims off by up to a Z-map cell, docs/design.md,
-  // "Known errors"). The target, 2 in 10,000, is below what 3000 points resolve.
+  // walls (zmap_walls.hpp): none of 3000 points wrong beyond h/2 (the worst 0.19 h); without
+  // them the walls' rims are off by up to a Z-map cell (docs/design.md, "Known errors"). The
+  // target, 2 in 10,000, is below what 3000 points resolve.
   std::mt19937 rng(13);
   const double h = s.report["dexel"]["cell_mm"].get<double>();
   test::EdgeErrors edges = test::measure_edges(ref.box, [&](const Vec3& p) { return ref.label(p); }, s.mesh, h, 3000, rng);
