@@ -745,13 +745,13 @@ namespace {
 // A part in the manner of the paper's five-direction model (Inui, Chen and Umezu 2022, §6): a
 // 40 x 40 x 25 mm block whose top a 4 mm ball end finishes along X (scallops 0.09 mm high), and
 // whose sides spindles tilted 15-40 degrees above horizontal cut, either faced flat by a 6 mm
-// flat end or finished by the ball end (scallops 0.14 mm high), a flat side also slotted across.
+// flat end or finished by the ball end (scallops 0.14 mm high), and may be slotted across.
 // Every tilted cut runs past the top and the neighbouring sides, so that planar and scalloped
 // cuts of two directions meet along the top's edges and at the corners.
 struct TiltedSide {
   double azimuth, b;  // G68.2 I and J: the spindle points to the side, 90 - b degrees above horizontal
   bool ball;          // a ball-end raster (scalloped), else a flat-end facing (planar)
-  bool slot;          // a flat-end slot across the faced plane, 1.5 mm deep
+  bool slot;          // then a slot 1.5 mm deep across it with the same tool
 };
 const char* kPartTools = R"({"1": {"units": "mm", "shape": "cylindrical", "diameter": 6, "length": 30},
                             "2": {"units": "mm", "shape": "ballnose", "diameter": 4, "length": 30}})";
@@ -831,16 +831,17 @@ const std::vector<TiltedSide> kFiveDirections{
 
 TEST_CASE("simulate: random pairs of a scalloped top and a tilted planar or scalloped side agree with the moves at their edges") {
   // +Z and one tilted side (random azimuth, 15-40 degrees above horizontal, planar or
-  // scalloped) at h = 0.4 mm: no point near their edges wrong beyond 1.5 h, at most 2 in 1000
-  // beyond h/2.
+  // scalloped, slotted or not) at h = 0.4 mm: no point near their edges wrong beyond 1.5 h, at
+  // most 2 in 1000 beyond h/2.
   std::mt19937 rng(1717);
   std::uniform_int_distribution<int> quarter(0, 3), coin(0, 1);
   std::uniform_real_distribution<double> b(50, 75);
   for (int pair = 0; pair < 4; ++pair) {
-    const TiltedSide side{90.0 * quarter(rng) - 90, b(rng), coin(rng) == 1, false};
+    const TiltedSide side{90.0 * quarter(rng) - 90, b(rng), coin(rng) == 1, coin(rng) == 1};
     CAPTURE(side.azimuth);
     CAPTURE(side.b);
     CAPTURE(side.ball);
+    CAPTURE(side.slot);
     test::EdgeErrors edges = tilted_part_edges("edge-pair", {side}, "100", 1000, 100 + static_cast<std::uint32_t>(pair));
     CHECK(edges.beyond_one_and_half == 0);
     CHECK(edges.beyond_half <= 2);
