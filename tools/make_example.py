@@ -381,8 +381,10 @@ def program(post, title):
     # Directions and their feature planes (G68.2 Euler Z-X-Z angles a, b, c; tool axis
     # (sin a sin b, -cos a sin b, cos b)). Regions are (u0, u1, v0, v1) in the feature plane.
     tilt = 70.0  # b = 70 degrees: the spindle 20 degrees above horizontal, pointing to +X
+    # The bevel's top edge, where it meets the mold surface, lies 13.9-16.1 mm up the bevel
+    # (v); its features stop below 13 mm so that none cuts through that edge.
     side(post, "+X TILTED 20 DEG", ((100.0, 40.0, 22.0), (90.0, tilt, 0.0)),
-         (-36.0, 36.0, 1.0, 15.0), 15.0, bevel=(-45.0, 45.0, 0.0, 32.0))
+         (-36.0, 36.0, 0.5, 12.5), 15.0, bevel=(-45.0, 45.0, 0.0, 32.0))
     side(post, "+Y", ((50.0, 80.0, 18.0), (180.0, 90.0, 0.0)), (-42.0, 42.0, -13.0, 13.0), 10.0)
     side(post, "-X", ((0.0, 40.0, 18.0), (-90.0, 90.0, 0.0)), (-32.0, 32.0, -13.0, 13.0), 10.0)
     side(post, "-Y", ((50.0, 0.0, 18.0), (0.0, 90.0, 0.0)), (-42.0, 42.0, -13.0, 13.0), 10.0)

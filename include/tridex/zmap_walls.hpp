@@ -38,6 +38,15 @@ struct WallOptions {
   unsigned threads = 0;  // 0: every hardware thread
 };
 
+// Whether cell (i, j) of `map` (its corners i..i+1, j..j+1) is steep: its corners' heights,
+// those below the empty height raised to it, differ by more than `steep_slope` cell widths.
+// refine_steep_cells makes these cells fine; the command counts them with it beforehand.
+inline bool is_steep_cell(const ZMap& map, int i, int j, double steep_slope) {
+  auto top = [&](int a, int b) { return double(std::max(map.height(a, b), map.empty_height)); };
+  const double a = top(i, j), b = top(i + 1, j), c = top(i, j + 1), d = top(i + 1, j + 1);
+  return std::max({a, b, c, d}) - std::min({a, b, c, d}) > steep_slope * map.grid.cell;
+}
+
 // The distance in XY from (x, y) to the tip path's projection.
 inline double point_segment_distance_xy(double x, double y, const Segment& s) {
   const double vx = s.b.x - s.a.x, vy = s.b.y - s.a.y, ux = x - s.a.x, uy = y - s.a.y;
@@ -59,17 +68,12 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
       detail::fail("refine steep cells: move ", k, " uses cutter ", moves[k].cutter, " but only ", cutters.size(),
                    " are given");
   const ZMapGrid& g = map.grid;
-  auto top = [&](int i, int j) { return std::max(map.height(i, j), map.empty_height); };
   float ceiling = map.empty_height;
   for (float h : map.heights) ceiling = std::max(ceiling, h);
-  const double steep = options.steep_slope * g.cell;
   std::vector<std::uint32_t> cells;
   for (int j = 0; j + 1 < g.ny; ++j)
-    for (int i = 0; i + 1 < g.nx; ++i) {
-      const float a = top(i, j), b = top(i + 1, j), c = top(i, j + 1), d = top(i + 1, j + 1);
-      if (double(std::max({a, b, c, d})) - double(std::min({a, b, c, d})) > steep)
-        cells.push_back(static_cast<std::uint32_t>(g.index(i, j)));
-    }
+    for (int i = 0; i + 1 < g.nx; ++i)
+      if (is_steep_cell(map, i, j, options.steep_slope)) cells.push_back(static_cast<std::uint32_t>(g.index(i, j)));
   if (cells.empty()) {
     map.fine = {};
     return;

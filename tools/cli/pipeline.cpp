@@ -183,15 +183,9 @@ void check_dump_names(const std::string& directory, const std::vector<gcode::Mov
 }  // namespace
 
 std::size_t count_steep_cells(const ZMap& map, double steep_slope) {
-  const ZMapGrid& g = map.grid;
-  auto top = [&](int i, int j) { return std::max(map.height(i, j), map.empty_height); };
-  const double steep = steep_slope * g.cell;
   std::size_t cells = 0;
-  for (int j = 0; j + 1 < g.ny; ++j)
-    for (int i = 0; i + 1 < g.nx; ++i) {
-      const float a = top(i, j), b = top(i + 1, j), c = top(i, j + 1), d = top(i + 1, j + 1);
-      if (double(std::max({a, b, c, d})) - double(std::min({a, b, c, d})) > steep) ++cells;
-    }
+  for (int j = 0; j + 1 < map.grid.ny; ++j)
+    for (int i = 0; i + 1 < map.grid.nx; ++i) cells += is_steep_cell(map, i, j, steep_slope) ? 1 : 0;
   return cells;
 }
 
@@ -470,31 +464,33 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   for (std::size_t g = 0; g < maps.size(); ++g)
     raise_uncut(maps[g], stock.mesh ? ZMap::from_mesh(groups[g].frame, *stock.mesh, zmap_cell, limits)
                                     : ZMap::from_box(groups[g].frame, stock.box, zmap_cell, limits));
-  // How many cells are steep is known only now: their sub-grids are checked against
-  // --max-memory before any is allocated.
-  std::size_t steep_cells = 0;
-  double rows = 0, most_moves = 0;
-  for (std::size_t g = 0; g < maps.size(); ++g) {
-    steep_cells += count_steep_cells(maps[g], WallOptions{}.steep_slope);
-    rows += maps[g].grid.ny;
-    most_moves = std::max(most_moves, static_cast<double>(groups[g].moves.size()));
-  }
-  // A move is listed in the bands its swept box spans: its width plus one band at each end for
-  // the short moves of most programs.
-  double widest = 0;
-  for (const Cutter& c : cutters) widest = std::max(widest, 2 * c.radius());
-  const double bands_per_move = 2 + widest / (kWallBandRows * zmap_cell);
-  r.memory.walls = fine_cell_bytes(static_cast<double>(steep_cells), rows, most_moves, bands_per_move);
-  if (r.memory.total() > static_cast<double>(max_memory))
-    input_error("the walls need finer heights in ", steep_cells, " steep Z-map cells: an estimated ",
-                format_mib(r.memory.walls), " on top of ", format_mib(r.memory.total() - r.memory.walls),
-                ", more than --max-memory ", format_mib(static_cast<double>(max_memory)),
-                "; use a larger --zmap-cell or --dexel-cell, or a smaller --dexel-res");
-  for (std::size_t g = 0; g < maps.size(); ++g) {
-    std::vector<CutMove> moves;
-    moves.reserve(groups[g].moves.size());
-    for (const gcode::Move& m : groups[g].moves) moves.push_back(cut_move(groups[g], m, cutter_of_tool));
-    if (request.fine_cells) refine_steep_cells(maps[g], cutters, moves, {.threads = options.threads});
+  if (request.fine_cells) {
+    // How many cells are steep is known only now: their sub-grids are checked against
+    // --max-memory before any is allocated.
+    std::size_t steep_cells = 0;
+    double rows = 0, most_moves = 0;
+    for (std::size_t g = 0; g < maps.size(); ++g) {
+      steep_cells += count_steep_cells(maps[g], WallOptions{}.steep_slope);
+      rows += maps[g].grid.ny;
+      most_moves = std::max(most_moves, static_cast<double>(groups[g].moves.size()));
+    }
+    // A move is listed in the bands its swept box spans: its width plus one band at each end
+    // for the short moves of most programs.
+    double widest = 0;
+    for (const Cutter& c : cutters) widest = std::max(widest, 2 * c.radius());
+    const double bands_per_move = 2 + widest / (kWallBandRows * zmap_cell);
+    r.memory.walls = fine_cell_bytes(static_cast<double>(steep_cells), rows, most_moves, bands_per_move);
+    if (r.memory.total() > static_cast<double>(max_memory))
+      input_error("the walls need finer heights in ", steep_cells, " steep Z-map cells: an estimated ",
+                  format_mib(r.memory.walls), " on top of ", format_mib(r.memory.total() - r.memory.walls),
+                  ", more than --max-memory ", format_mib(static_cast<double>(max_memory)),
+                  "; use a larger --zmap-cell or --dexel-cell, or a smaller --dexel-res");
+    for (std::size_t g = 0; g < maps.size(); ++g) {
+      std::vector<CutMove> moves;
+      moves.reserve(groups[g].moves.size());
+      for (const gcode::Move& m : groups[g].moves) moves.push_back(cut_move(groups[g], m, cutter_of_tool));
+      refine_steep_cells(maps[g], cutters, moves, {.threads = options.threads});
+    }
   }
   progress.stage("dexelizing the stock");
   TripleDexel stock_dexel = stock.mesh ? dexelize(*stock.mesh, lattice, DexelizeOptions{options.threads})

@@ -143,8 +143,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
                                   const PipelineRequest& request = {});
 
 // The cells refine_steep_cells (zmap_walls.hpp) will make fine in `map`, counted with its own
-// rule (corners, raised to the empty height, differing by more than steep_slope cells) so that
-// their memory is known before any is allocated. How many there are depends on the walls the
+// rule (is_steep_cell) so that their memory is known before any is allocated. How many there are depends on the walls the
 // program cuts (every cell along a pocket's side, or the whole map for a field of narrow slots),
 // so it is counted on the milled maps, not guessed up front.
 std::size_t count_steep_cells(const ZMap& map, double steep_slope);
