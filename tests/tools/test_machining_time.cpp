@@ -162,16 +162,24 @@ TEST_CASE("machining time: the machine file's rates, refused when bad, in the re
   CHECK(mt["total_s"].get<double>() == doctest::Approx(10.62));
   CHECK(mt["by_direction"][0]["direction"] == json::array({0.0, 0.0, 1.0}));
 
-  // simulate reports the same object and prints it.
+  // simulate and check report the same object and print it.
   write_text(dir / "tools.json", R"({"1": {"shape": "cylindrical", "diameter": 6}})");
   r = run_tridex({"simulate", (dir / "p.nc").string(), "--machine", (dir / "m.json").string(), "--tools",
                   (dir / "tools.json").string(), "--stock", "box:-10,-10,-5,30,10,0", "--dexel-cell", "1",
-                  "--report", (dir / "report.json").string()},
+                  "--report", (dir / "report.json").string(), "-o", (dir / "made.stl").string()},
                  dir);
   REQUIRE(r.status == 0);
   CHECK(json::parse(slurp(dir / "report.json"))["machining_time"] == mt);
-  CHECK(r.out.find("machining time 10.6 s (feed 8.0 s, rapid 0.6 s, dwell 2.0 s) with rapids at 3000 mm/min (from ") !=
-        std::string::npos);
+  const std::string line = "machining time 10.6 s (feed 8.0 s, rapid 0.6 s, dwell 2.0 s) with rapids at 3000 mm/min (from ";
+  CHECK(r.out.find(line) != std::string::npos);
+  r = run_tridex({"check", (dir / "p.nc").string(), "--design", (dir / "made.stl").string(), "--machine",
+                  (dir / "m.json").string(), "--tools", (dir / "tools.json").string(), "--stock",
+                  "box:-10,-10,-5,30,10,0", "--dexel-cell", "1", "--report", (dir / "check.json").string()},
+                 dir);
+  INFO(r.out, r.err);
+  REQUIRE(r.status == 0);
+  CHECK(json::parse(slurp(dir / "check.json"))["machining_time"] == mt);
+  CHECK(r.out.find(line) != std::string::npos);
 
   for (const char* bad : {R"({"rapid_rate_mm_per_min": -1})", R"({"rapid_rate_mm_per_min": [1000, 2000]})",
                           R"({"rapid_rate_mm_per_min": "fast"})", R"({"max_feed_mm_per_min": 0})"}) {
