@@ -179,15 +179,18 @@ const char* kFaultTools = R"({
   "2": {"shape": "cylindrical", "diameter": 24},
   "3": {"shape": "cylindrical", "diameter": 4, "flute-length": 3, "shank-diameter": 8}})";
 
-struct FaultRun {
+struct CheckRun {
   CommandResult result;
-  json report;
+  json report;  // null where check wrote none
 };
 
-FaultRun run_faults(const fs::path& dir, double z1, double z3, std::vector<std::string> more = {}) {
-  write_text(dir / "tools.json", kFaultTools);
-  write_text(dir / "p.nc", fault_program(z1, z3));
-  // The design is the program's own result: only the tool's parts can fail the check.
+// Simulates the program into its own design, then checks the program against that design on
+// the stock 0..60 × 0..40 × 0..30: only the tools' non-cutting parts can fail the check.
+CheckRun simulate_then_check(const fs::path& dir, const std::string& program, const std::string& tools,
+                             const std::vector<std::string>& more = {}) {
+  write_text(dir / "tools.json", tools);
+  write_text(dir / "p.nc", program);
+  fs::remove(dir / "report.json");
   CommandResult made = run_tridex({"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(),
                                    "--stock", "box:0,0,0,60,40,30", "--dexel-cell", "0.5", "-o",
                                    (dir / "design.stl").string(), "-q"},
@@ -198,16 +201,20 @@ FaultRun run_faults(const fs::path& dir, double z1, double z3, std::vector<std::
                                 "--dexel-cell", "0.5", "--tolerance", "0.6", "--report",
                                 (dir / "report.json").string()};
   args.insert(args.end(), more.begin(), more.end());
-  FaultRun run{run_tridex(args, dir), json()};
+  CheckRun run{run_tridex(args, dir), json()};
   if (fs::exists(dir / "report.json")) run.report = json::parse(slurp(dir / "report.json"));
   return run;
+}
+
+CheckRun run_faults(const fs::path& dir, double z1, double z3, const std::vector<std::string>& more = {}) {
+  return simulate_then_check(dir, fault_program(z1, z3), kFaultTools, more);
 }
 
 }  // namespace
 
 TEST_CASE("check: a holder passing a boss and a shank on a pocket's floor are found at their lines") {
   fs::path dir = scratch("collisions");
-  FaultRun run = run_faults(dir, 4, 16.5);
+  CheckRun run = run_faults(dir, 4, 16.5);
   INFO(run.result.out, run.result.err);
   CHECK(run.result.status == 3);
   const json& c = run.report["collisions"];
@@ -238,7 +245,7 @@ TEST_CASE("check: a holder passing a boss and a shank on a pocket's floor are fo
 
 TEST_CASE("check: a program whose holder and shank clear by a known margin passes, the margins as near misses") {
   fs::path dir = scratch("near-misses");
-  FaultRun run = run_faults(dir, 6, 17.5, {"--clearance", "2"});
+  CheckRun run = run_faults(dir, 6, 17.5, {"--clearance", "2"});
   INFO(run.result.out, run.result.err);
   CHECK(run.result.status == 0);
   CHECK(run.report["collisions"].empty());
@@ -262,21 +269,12 @@ TEST_CASE("check: a program whose holder and shank clear by a known margin passe
 
 TEST_CASE("check: a hole by the stock's edge buries the holder along +Z and clears it tilted away") {
   fs::path dir = scratch("tilted-clear");
-  write_text(dir / "tools.json", R"({"1": {"shape": "cylindrical", "diameter": 6, "stick-out": 20,
-      "holder": [{"bottom-diameter": 30, "top-diameter": 30, "length": 20}]}})");
+  const std::string tools = R"({"1": {"shape": "cylindrical", "diameter": 6, "stick-out": 20,
+      "holder": [{"bottom-diameter": 30, "top-diameter": 30, "length": 20}]}})";
   auto run = [&](const std::string& program) {
-    write_text(dir / "p.nc", program);
-    CommandResult made = run_tridex({"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(),
-                                     "--stock", "box:0,0,0,60,40,30", "--dexel-cell", "0.5", "-o",
-                                     (dir / "design.stl").string(), "-q"},
-                                    dir);
-    REQUIRE(made.status == 0);
-    CommandResult r = run_tridex({"check", (dir / "p.nc").string(), "--design", (dir / "design.stl").string(), "--tools",
-                                  (dir / "tools.json").string(), "--stock", "box:0,0,0,60,40,30", "--dexel-cell", "0.5",
-                                  "--tolerance", "0.6", "--clearance", "3", "--report", (dir / "report.json").string()},
-                                 dir);
-    INFO(r.out, r.err);
-    return std::make_pair(r.status, json::parse(slurp(dir / "report.json")));
+    CheckRun r = simulate_then_check(dir, program, tools, {"--clearance", "3"});
+    INFO(r.result.out, r.result.err);
+    return std::make_pair(r.result.status, r.report);
   };
   // A hole 25 mm deep, 4 mm from the front face: the holder's face at z = 25 under the top at 30.
   auto [status, report] = run("%\nG21 G17 G90\nT1 M6\nS8000 M3\nG0 X30 Y4 Z40\nG1 Z5 F300\nG0 Z40\nM30\n%\n");
@@ -312,22 +310,14 @@ TEST_CASE("check: a shank working down its own slot meets only what the earlier 
   // the 10 mm flutes of the last pass stands where the first two passes cut. Checked against the
   // map before those passes are milled it would hit 5 mm of material; the check must see them.
   fs::path dir = scratch("own-slot");
-  write_text(dir / "tools.json", R"({"1": {"shape": "cylindrical", "diameter": 6, "flute-length": 10,
+  CheckRun run = simulate_then_check(dir,
+                                     "%\nG21 G17 G90\nT1 M6\nS8000 M3\nG0 X10 Y20 Z35\nG1 Z25 F300\nG1 X50\nG1 Z20\n"
+                                     "G1 X10\nG1 Z15\nG1 X50\nG0 Z40\nM30\n%\n",
+                                     R"({"1": {"shape": "cylindrical", "diameter": 6, "flute-length": 10,
       "shank-diameter": 5.8, "stick-out": 30, "holder": [{"bottom-diameter": 30, "top-diameter": 30, "length": 20}]}})");
-  write_text(dir / "p.nc", "%\nG21 G17 G90\nT1 M6\nS8000 M3\nG0 X10 Y20 Z35\nG1 Z25 F300\nG1 X50\nG1 Z20\nG1 X10\n"
-                           "G1 Z15\nG1 X50\nG0 Z40\nM30\n%\n");
-  CommandResult made = run_tridex({"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(),
-                                   "--stock", "box:0,0,0,60,40,30", "--dexel-cell", "0.5", "-o",
-                                   (dir / "design.stl").string(), "-q"},
-                                  dir);
-  REQUIRE(made.status == 0);
-  CommandResult r = run_tridex({"check", (dir / "p.nc").string(), "--design", (dir / "design.stl").string(), "--tools",
-                                (dir / "tools.json").string(), "--stock", "box:0,0,0,60,40,30", "--dexel-cell", "0.5",
-                                "--tolerance", "0.6", "--report", (dir / "report.json").string()},
-                               dir);
-  INFO(r.out, r.err);
-  CHECK(r.status == 0);
-  json report = json::parse(slurp(dir / "report.json"));
+  INFO(run.result.out, run.result.err);
+  CHECK(run.result.status == 0);
+  const json& report = run.report;
   CHECK(report["collisions"].empty());
   // The shank passes the slot's walls 0.1 mm away on the last pass.
   bool walls = false;

@@ -162,16 +162,24 @@ TEST_CASE("machining time: the machine file's rates, refused when bad, in the re
   CHECK(mt["total_s"].get<double>() == doctest::Approx(10.62));
   CHECK(mt["by_direction"][0]["direction"] == json::array({0.0, 0.0, 1.0}));
 
-  // simulate reports the same object and prints it.
+  // simulate and check report the same object and print it.
   write_text(dir / "tools.json", R"({"1": {"shape": "cylindrical", "diameter": 6}})");
   r = run_tridex({"simulate", (dir / "p.nc").string(), "--machine", (dir / "m.json").string(), "--tools",
                   (dir / "tools.json").string(), "--stock", "box:-10,-10,-5,30,10,0", "--dexel-cell", "1",
-                  "--report", (dir / "report.json").string()},
+                  "--report", (dir / "report.json").string(), "-o", (dir / "made.stl").string()},
                  dir);
   REQUIRE(r.status == 0);
   CHECK(json::parse(slurp(dir / "report.json"))["machining_time"] == mt);
-  CHECK(r.out.find("machining time 10.6 s (feed 8.0 s, rapid 0.6 s, dwell 2.0 s) with rapids at 3000 mm/min (from ") !=
-        std::string::npos);
+  const std::string line = "machining time 10.6 s (feed 8.0 s, rapid 0.6 s, dwell 2.0 s) with rapids at 3000 mm/min (from ";
+  CHECK(r.out.find(line) != std::string::npos);
+  r = run_tridex({"check", (dir / "p.nc").string(), "--design", (dir / "made.stl").string(), "--machine",
+                  (dir / "m.json").string(), "--tools", (dir / "tools.json").string(), "--stock",
+                  "box:-10,-10,-5,30,10,0", "--dexel-cell", "1", "--report", (dir / "check.json").string()},
+                 dir);
+  INFO(r.out, r.err);
+  REQUIRE(r.status == 0);
+  CHECK(json::parse(slurp(dir / "check.json"))["machining_time"] == mt);
+  CHECK(r.out.find(line) != std::string::npos);
 
   for (const char* bad : {R"({"rapid_rate_mm_per_min": -1})", R"({"rapid_rate_mm_per_min": [1000, 2000]})",
                           R"({"rapid_rate_mm_per_min": "fast"})", R"({"max_feed_mm_per_min": 0})"}) {
@@ -186,4 +194,89 @@ TEST_CASE("machining time: the machine file's rates, refused when bad, in the re
     }
   }
   fs::remove_all(dir);
+}
+
+namespace {
+
+// The program's time on the machine a machine file describes (its kinematics and rates).
+cli::MachiningTime time_on(const std::string& machine_file, const std::string& program) {
+  cli::MachineRates rates;
+  gcode::MachineConfig machine = cli::machine_from_json(json::parse(machine_file), "m.json", &rates);
+  gcode::Interpreter interpreter({}, machine);
+  cli::MachiningTimer timer(rates, machine.kinematics);
+  std::istringstream in(program);
+  interpreter.run(in, "t.nc", [&](const gcode::Move& m) { timer.add(m); });
+  return timer.time();
+}
+
+// An A/C trunnion (A tilts the table about X) whose Z is six times slower than X and Y.
+constexpr const char* kTrunnion =
+    R"({"base": "ac-trunnion", "start": [0, 0, 0], "tool_change": "in_place",
+        "rapid_rate_mm_per_min": [6000, 6000, 1000], "rapid_rate_deg_per_min": {"A": 3600, "C": 7200}})";
+
+}  // namespace
+
+TEST_CASE("machining time: rapids on a tilted plane move the machine's axes, not the part's") {
+  // The plane tilted 30° about X: the trunnion turns the table by A so that the plane lies
+  // level, and a rapid along the plane's Y moves only the machine's Y: 40 mm at 6000 mm/min =
+  // 0.4 s. Along the part's axes it would be 40·cos 30° in Y and 40·sin 30° = 20 mm in Z, 1.2 s.
+  // The approach after the turn comes from far (not timed); the retract is 10 mm of machine Z.
+  const std::string program =
+      "G21 G90 G17\n"
+      "G0 X0 Y0 Z30\n"                        // 30 mm of Z at 1000: 1.8 s
+      "G68.2 X0 Y0 Z0 I0 J30 K0\n"
+      "G53.1\n"
+      "G0 X0 Y0 Z10\n"                        // from far: not timed
+      "G0 Y40\n"                              // machine Y 40: 0.4 s
+      "G1 Z0 F600\n"                          // 10 mm at 600: 1 s
+      "G0 Z10\n";                             // machine Z 10 at 1000: 0.6 s
+  cli::MachiningTime t = time_on(kTrunnion, program);
+  CHECK(t.untimed_approaches == 1);
+  CHECK(t.rapid_s == doctest::Approx(1.8 + 0.4 + 0.6));
+  CHECK(t.feed_s == doctest::Approx(1.0));
+  CHECK(t.untimed_turns == 0);
+}
+
+TEST_CASE("machining time: rapids in raw rotary form, with the turn at the rotary rate") {
+  // Without TCP the program's X Y Z are the machine's: turning A by 15° (0.25 s at 3600°/min)
+  // with 100 mm of Y (1 s at 6000 mm/min) takes 1 s, where the part sees that move tilted, with
+  // tens of mm along Z (seconds at Z's rate). C180 at 7200°/min with 12 mm of X: 1.5 s.
+  // (A block that only turns makes no move: its turn is timed with the next rapid's.)
+  const std::string program =
+      "G21 G90\n"
+      "G0 X0 Y0 Z30\n"     // 1.8 s
+      "G0 Y100 A15\n"      // max(1 s, 0.25 s)
+      "G0 X12 C180\n";     // max(0.12 s, 1.5 s)
+  cli::MachiningTime t = time_on(kTrunnion, program);
+  CHECK(t.rapid_s == doctest::Approx(1.8 + 1 + 1.5));
+  CHECK(t.untimed_turns == 0);
+
+  // Without a rotary rate the turns are not timed, and counted.
+  t = time_on(R"({"base": "ac-trunnion", "start": [0, 0, 0], "rapid_rate_mm_per_min": [6000, 6000, 1000]})",
+              program);
+  CHECK(t.rapid_s == doctest::Approx(1.8 + 1 + 0.12));
+  CHECK(t.untimed_turns == 2);
+}
+
+TEST_CASE("machining time: the rotary rates in the machine file") {
+  cli::MachineRates rates;
+  cli::machine_from_json(json::parse(R"({"rapid_rate_deg_per_min": 5400})"), "m.json", &rates);
+  CHECK(rates.rapid_deg_per_min == std::array<double, 3>{5400, 5400, 5400});
+  // Read in either order with the linear rates (a JSON object's keys are unordered).
+  cli::machine_from_json(json::parse(R"({"rapid_rate_mm_per_min": 8000, "rapid_rate_deg_per_min": {"B": 900}})"),
+                         "m.json", &rates);
+  CHECK(rates.rapid_deg_per_min == std::array<double, 3>{0, 900, 0});
+  CHECK(rates.rapid_mm_per_min == Vec3(8000));
+  cli::MachiningTimer timer(rates);
+  CHECK(cli::machining_time_json(timer)["rapid_rate_deg_per_min"] == json{{"B", 900.0}});
+  for (const char* bad : {R"({"rapid_rate_deg_per_min": 0})", R"({"rapid_rate_deg_per_min": {"X": 100}})",
+                          R"({"rapid_rate_deg_per_min": {"A": -5}})", R"({"rapid_rate_deg_per_min": [1, 2]})"}) {
+    try {
+      cli::machine_from_json(json::parse(bad), "bad.json", &rates);
+      FAIL(bad);
+    } catch (const cli::InputError& e) {
+      std::string message = e.what();
+      CHECK(message.find("bad.json: \"rapid_rate_deg_per_min\"") != std::string::npos);
+    }
+  }
 }

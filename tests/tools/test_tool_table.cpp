@@ -156,7 +156,7 @@ json fusion_library() {
         {"height": 15, "lower-diameter": 32, "upper-diameter": 40}]},
      "post-process": {"number": 1, "comment": ""}},
     {"type": "ball end mill", "unit": "inches", "description": "1/4 ball", "guid": "b",
-     "geometry": {"DC": 0.25, "LCF": 0.75, "LB": 1.25, "OAL": 2.5, "SFDM": 0.25, "RE": 0.125},
+     "geometry": {"DC": 0.25, "LCF": 0.75, "LB": 1.25, "OAL": 2.5, "SFDM": 0.375, "RE": 0.125},
      "post-process": {"number": 2}},
     {"type": "bull nose end mill", "unit": "millimeters", "description": "10R1",
      "geometry": {"DC": 10, "LCF": 20, "LB": 35, "OAL": 75, "SFDM": 10, "RE": 1},
@@ -199,6 +199,7 @@ TEST_CASE("Fusion tool libraries: the cutting part, the shank and the holder") {
   CHECK(tools.find(2)->cutter.shape() == CutterShape::ball);
   CHECK(tools.find(2)->cutter.radius() == doctest::Approx(3.175));
   CHECK(tools.find(2)->body.parts[0].bottom == doctest::Approx(19.05));
+  CHECK(tools.find(2)->body.parts[0].shape.bottom_radius == doctest::Approx(4.7625));  // SFDM 3/8"
   CHECK(!tools.find(2)->body.has_holder());
   CHECK(tools.find(3)->cutter.shape() == CutterShape::bull_nose);
   CHECK(tools.find(3)->cutter.corner_radius() == doctest::Approx(1));

@@ -1,5 +1,6 @@
 #include "machine_file.hpp"
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -74,6 +75,27 @@ double rate(const json& value, const std::string& where) {
   if (!value.is_number() || !(value.get<double>() > 0) || !std::isfinite(value.get<double>()))
     input_error(where, ": must be a positive number of mm/min, got ", value.dump());
   return value.get<double>();
+}
+
+// Rotary rapid rates, degrees per minute, indexed A, B, C (0 where not given): one number for
+// every rotary axis, or {"A": …, "B": …, "C": …}.
+std::array<double, 3> rotary_rates(const json& value, const std::string& where) {
+  std::array<double, 3> rates{};
+  if (value.is_object()) {
+    for (const auto& [letter, r] : value.items()) {
+      if (letter != "A" && letter != "B" && letter != "C")
+        input_error(where, ": \"", letter, "\" is not a rotary axis (A, B or C)");
+      if (!r.is_number() || !(r.get<double>() > 0) || !std::isfinite(r.get<double>()))
+        input_error(where, ": \"", letter, "\" must be a positive number of degrees per minute, got ", r.dump());
+      rates[static_cast<std::size_t>(letter[0] - 'A')] = r.get<double>();
+    }
+  } else if (value.is_number() && value.get<double>() > 0 && std::isfinite(value.get<double>())) {
+    rates.fill(value.get<double>());
+  } else {
+    input_error(where, ": one rate for every rotary axis, or {\"A\": …, \"C\": …}, in degrees per minute, got ",
+                value.dump());
+  }
+  return rates;
 }
 
 // A bundled machine: MachineConfig's own ("default", "linuxcnc"), or a bundled kinematics
@@ -166,11 +188,14 @@ gcode::MachineConfig parse(const json& doc, const std::string& file, MachineRate
       } else {
         r.rapid_mm_per_min = Vec3(rate(value, where));
       }
-      r.source = file;
       if (rates) {
-        r.max_feed_mm_per_min = rates->max_feed_mm_per_min;
-        *rates = r;
+        rates->rapid_mm_per_min = r.rapid_mm_per_min;
+        rates->rapid_per_axis = r.rapid_per_axis;
+        rates->source = file;
       }
+    } else if (key == "rapid_rate_deg_per_min") {
+      std::array<double, 3> turn = rotary_rates(value, where);
+      if (rates) rates->rapid_deg_per_min = turn;
     } else if (key == "max_feed_mm_per_min") {
       double max_feed = rate(value, where);
       if (rates) rates->max_feed_mm_per_min = max_feed;
@@ -183,7 +208,7 @@ gcode::MachineConfig parse(const json& doc, const std::string& file, MachineRate
       input_error(where, ": unknown key (known: name, description, base, dialect, units, start, "
                          "tool_change, tool_loads_on_t, home, reference2, work_offsets, m_codes, "
                          "forbidden_m_codes, far_distance, subprograms, kinematics, "
-                         "rapid_rate_mm_per_min, max_feed_mm_per_min)");
+                         "rapid_rate_mm_per_min, rapid_rate_deg_per_min, max_feed_mm_per_min)");
     }
   }
   for (int code : m.m_codes)

@@ -16,7 +16,8 @@ const double kSameDirection = std::cos(glm::radians(1e-3));
 
 }  // namespace
 
-MachiningTimer::MachiningTimer(MachineRates rates) : rates_(std::move(rates)) {}
+MachiningTimer::MachiningTimer(MachineRates rates, std::optional<gcode::Kinematics> kinematics)
+    : rates_(std::move(rates)), kinematics_(std::move(kinematics)) {}
 
 void MachiningTimer::charge(int tool, const Vec3& axis, double seconds) {
   time_.by_tool[tool] += seconds;
@@ -36,12 +37,48 @@ void MachiningTimer::charge(int tool, const Vec3& axis, double seconds) {
   last_direction_ = found;
 }
 
+// The slowest axis's minutes: every axis of the machine moves at most at its rapid rate.
+double MachiningTimer::rapid_minutes(const gcode::Move& move) {
+  Vec3 linear = move.end - move.start;
+  gcode::RotaryPositions turned{};
+  if (kinematics_ && move.rotary_axes) {
+    // The first move starts where the machine puts its start point at the current rotaries.
+    Vec3 start = have_last_ ? last_machine_ : gcode::machine_from_part(*kinematics_, move.start, move.rotary);
+    linear = move.machine - start;
+    if (have_last_)
+      for (std::size_t i = 0; i < 3; ++i) turned[i] = std::abs(move.rotary[i] - last_rotary_[i]);
+  }
+  double minutes = 0;
+  if (rates_.rapid_per_axis) {
+    for (int a = 0; a < 3; ++a) minutes = std::max(minutes, std::abs(linear[a]) / rates_.rapid_mm_per_min[a]);
+  } else {
+    minutes = glm::length(linear) / rates_.rapid_mm_per_min.x;
+  }
+  bool untimed = false;
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (turned[i] == 0) continue;
+    if (rates_.rapid_deg_per_min[i] > 0)
+      minutes = std::max(minutes, turned[i] / rates_.rapid_deg_per_min[i]);
+    else
+      untimed = true;
+  }
+  if (untimed) ++time_.untimed_turns;
+  return minutes;
+}
+
 void MachiningTimer::add(const gcode::Move& move) {
+  // A rapid's machine deltas are from the previous move's end, the far approaches included.
+  auto remember = [&] {
+    if (!kinematics_ || !move.rotary_axes) return;
+    have_last_ = true;
+    last_machine_ = move.machine;
+    last_rotary_ = move.rotary;
+  };
   if (move.from_far) {
     ++time_.untimed_approaches;
+    remember();
     return;
   }
-  Vec3 delta = move.end - move.start;
   double seconds = 0;
   if (move.feed > 0) {
     double feed = move.feed;
@@ -49,18 +86,13 @@ void MachiningTimer::add(const gcode::Move& move) {
       feed = *rates_.max_feed_mm_per_min;
       ++time_.capped_feeds;
     }
-    seconds = 60 * glm::length(delta) / feed;
+    seconds = 60 * glm::length(move.end - move.start) / feed;
     time_.feed_s += seconds;
   } else {
-    double minutes = 0;
-    if (rates_.rapid_per_axis) {
-      for (int a = 0; a < 3; ++a) minutes = std::max(minutes, std::abs(delta[a]) / rates_.rapid_mm_per_min[a]);
-    } else {
-      minutes = glm::length(delta) / rates_.rapid_mm_per_min.x;
-    }
-    seconds = 60 * minutes;
+    seconds = 60 * rapid_minutes(move);
     time_.rapid_s += seconds;
   }
+  remember();
   charge(move.tool, move.axis, seconds);
 }
 
@@ -80,8 +112,13 @@ Json machining_time_json(const MachiningTimer& timer) {
             {"by_tool", by_tool}, {"by_direction", by_direction}};
   j["rapid_rate_mm_per_min"] = rates.rapid_per_axis ? to_json(rates.rapid_mm_per_min) : Json(rates.rapid_mm_per_min.x);
   j["rapid_rate_source"] = rates.source;
+  Json turn_rates = Json::object();
+  for (std::size_t i = 0; i < 3; ++i)
+    if (rates.rapid_deg_per_min[i] > 0) turn_rates[std::string(1, static_cast<char>('A' + i))] = rates.rapid_deg_per_min[i];
+  if (!turn_rates.empty()) j["rapid_rate_deg_per_min"] = turn_rates;
   if (rates.max_feed_mm_per_min) j["max_feed_mm_per_min"] = *rates.max_feed_mm_per_min;
   j["feeds_capped"] = t.capped_feeds;
+  j["untimed_turns"] = t.untimed_turns;
   j["untimed_approaches"] = t.untimed_approaches;
   return j;
 }

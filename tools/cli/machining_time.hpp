@@ -11,24 +11,28 @@
 // feeds are not read by the interpreter (an error), so every feed here is units per minute.
 #pragma once
 
+#include <array>
 #include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "json_text.hpp"
+#include "tridex/gcode/kinematics.hpp"
 #include "tridex/gcode/move.hpp"
 #include "tridex/geometry.hpp"
 
 namespace tridex::cli {
 
 // The machine file's speeds (README "Machine files"): "rapid_rate_mm_per_min" (a number, or
-// [x, y, z]) and "max_feed_mm_per_min" (feeds above it run at it).
+// [x, y, z]), "rapid_rate_deg_per_min" (a number for every rotary axis, or {"A": …, "C": …}) and
+// "max_feed_mm_per_min" (feeds above it run at it).
 struct MachineRates {
   static constexpr double kDefaultRapid = 10000;  // mm/min, when the machine file gives none
 
   Vec3 rapid_mm_per_min{kDefaultRapid};
   bool rapid_per_axis = false;
+  std::array<double, 3> rapid_deg_per_min{};  // A, B, C; 0: not given (such turns are not timed)
   std::optional<double> max_feed_mm_per_min;
   std::string source = "default";  // where the rapid rate came from: "default" or the file
 };
@@ -39,13 +43,15 @@ struct MachiningTime {
   std::vector<std::pair<Vec3, double>> by_direction;  // in order of first appearance
   long long untimed_approaches = 0;  // moves back from "far": where they start is not known
   long long capped_feeds = 0;        // feed moves run at max_feed_mm_per_min instead
+  long long untimed_turns = 0;       // rapids turning a rotary axis that has no rate
   double total_s() const { return feed_s + rapid_s + dwell_s; }
 };
 
 class MachiningTimer {
  public:
   MachiningTimer() = default;
-  explicit MachiningTimer(MachineRates rates);
+  // `kinematics`: the machine's model, where it has one (MachineConfig::kinematics).
+  explicit MachiningTimer(MachineRates rates, std::optional<gcode::Kinematics> kinematics = std::nullopt);
   void add(const gcode::Move& move);
   void add(const gcode::Dwell& dwell);
   const MachiningTime& time() const { return time_; }
@@ -53,10 +59,17 @@ class MachiningTimer {
 
  private:
   void charge(int tool, const Vec3& axis, double seconds);
+  double rapid_minutes(const gcode::Move& move);
 
   MachineRates rates_;
+  std::optional<gcode::Kinematics> kinematics_;
   MachiningTime time_;
   std::size_t last_direction_ = 0;
+  // Where the machine's axes stood after the previous move (kinematic model only): a rotary
+  // turn between moves shows as this move's start differing from it.
+  bool have_last_ = false;
+  Vec3 last_machine_{0.0};
+  gcode::RotaryPositions last_rotary_{};
 };
 
 // The report's "machining_time" object.

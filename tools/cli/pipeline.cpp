@@ -264,7 +264,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   const std::optional<gcode::Kinematics>& kinematics = input.machine.kinematics;
   // Positions "far along the tool axis" stand in for where the machine takes the tool: no travel.
   const double far = 0.5 * input.machine.far_distance;
-  r.machining = MachiningTimer(input.rates);
+  r.machining = MachiningTimer(input.rates, kinematics);
   InterpretResult parsed = interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t file) {
     budget.keep(m, input.files[file].string());
     const auto group = static_cast<std::uint32_t>(grouper.add(m));
