@@ -293,4 +293,19 @@ TEST_CASE("macros: bad input is an error at its line and column") {
   CHECK(d.message.find("10000 blocks") != std::string::npos);
   d = error_of("N1 GOTO 1\n", bounded, m);
   CHECK(d.message.find("blocks") != std::string::npos);
+  // The limit names the statement that passed it: its line and the column where it starts.
+  d = error_of("G21\n  WHILE [1] DO1\n   #100 = [#100 + 1]\nEND1\n", bounded, m);
+  CHECK(d.line == 3);
+  CHECK(d.column == 4);
+  bounded.max_blocks = 10001;
+  d = error_of("G21\n  WHILE [1] DO1\n   #100 = [#100 + 1]\nEND1\n", bounded, m);
+  CHECK(d.line == 4);  // the END of the loop
+  CHECK(d.column == 1);
+  bounded.max_blocks = 10002;
+  d = error_of("G21\n  WHILE [1] DO1\n   #100 = [#100 + 1]\nEND1\n", bounded, m);
+  CHECK(d.line == 2);
+  CHECK(d.column == 3);
+  d = error_of("G21\nM98 P2 L9999\nM30\nO2\n N5 G4 P0\nM99\n", bounded, m);
+  CHECK(d.line == 5);
+  CHECK(d.column == 2);
 }
