@@ -633,9 +633,9 @@ void ProgramFlow::run() {
     }
     started_ = true;
     // The statement starts at its first word or assignment, whichever comes first on the line.
-    int column = block_.words.empty() ? block_.assignments.front().column : block_.words.front().column;
-    if (!block_.assignments.empty()) column = std::min(column, block_.assignments.front().column);
-    count_block(column);
+    int statement = block_.words.empty() ? block_.assignments.front().column : block_.words.front().column;
+    if (!block_.assignments.empty()) statement = std::min(statement, block_.assignments.front().column);
+    count_block(statement);
     for (const Assignment& a : block_.assignments) s_.assign(a);
     if (block_.words.empty()) continue;
     Flow flow = s_.execute(block_);
