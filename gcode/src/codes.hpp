@@ -66,7 +66,7 @@ inline int g_group(int code) {
     case 940: return kFeedMode;
     case 200: case 210: return kUnits;
     case 400: case 410: case 420: case 411: case 421: return kCutterComp;
-    case 430: case 434: case 435: case 440: case 490: return kToolLength;
+    case 430: case 431: case 434: case 435: case 440: case 490: return kToolLength;
     case 980: case 990: return kReturn;
     case 540: case 550: case 560: case 570: case 580: case 590: case 541: return kWork;
     case 970: return kSpindleMode;

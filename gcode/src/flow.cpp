@@ -95,7 +95,7 @@ class ProgramFlow {
   void jump(const Position& to);
   Position here() { return Position{current_, source().reader.offset(), line_}; }
   [[noreturn]] void error(int column, const std::string& message) { s_.error(column, message); }
-  void count_block();
+  void count_block(int column);  // column: the statement's, named if it passes the block limit
 
   void note_label(std::string_view text, const Position& after);
   bool scan_for(const std::function<bool()>& found);
@@ -170,9 +170,9 @@ void ProgramFlow::jump(const Position& to) {
   line_ = to.line;
 }
 
-void ProgramFlow::count_block() {
+void ProgramFlow::count_block(int column) {
   if (++s_.blocks > s_.options.max_blocks && s_.options.max_blocks > 0)
-    error(0, "more than " + std::to_string(s_.options.max_blocks) +
+    error(column, "more than " + std::to_string(s_.options.max_blocks) +
                  " blocks executed (the block limit; an endless loop?)");
 }
 
@@ -595,7 +595,7 @@ void ProgramFlow::run() {
     if (block_.block_delete && s_.options.block_delete) continue;
     const Control& control = block_.control;
     if (control.kind != ControlKind::none) {
-      count_block();
+      count_block(control.column);
       started_ = true;
       for (const Assignment& a : block_.assignments) s_.assign(a);
       if (control.kind == ControlKind::o_word) {
@@ -632,7 +632,10 @@ void ProgramFlow::run() {
       break;
     }
     started_ = true;
-    count_block();
+    // The statement starts at its first word or assignment, whichever comes first on the line.
+    int statement = block_.words.empty() ? block_.assignments.front().column : block_.words.front().column;
+    if (!block_.assignments.empty()) statement = std::min(statement, block_.assignments.front().column);
+    count_block(statement);
     for (const Assignment& a : block_.assignments) s_.assign(a);
     if (block_.words.empty()) continue;
     Flow flow = s_.execute(block_);

@@ -7,6 +7,54 @@
 
 namespace tridex::gcode {
 
+// A tool goes into the spindle: the gauge point stays, so the tip moves by the difference of
+// the two tools' lengths (no move: the tool changed, rs274's CHANGE_TOOL keeps the position).
+void Interpreter::State::load_tool(int number) {
+  double before = loaded_length();
+  tool = number;
+  pos += (before - loaded_length()) * axis;
+  update_frame();
+}
+
+// Tool length offsets (RS274/NGC, NIST IR 6556 §3.6.3; LinuxCNC's G43, G43.1, G49): G43 H n
+// takes tool n's length (no H: the loaded tool's, as LinuxCNC does; H0: none), Fanuc's G44 H n
+// its negative, LinuxCNC's G43.1 Z the length written, G49 none. G43.4/G43.5 H n (TCP) take it as
+// G43 does. With no tool lengths in the machine, they all leave the path alone.
+void Interpreter::State::tool_length_codes() {
+  int code = 0, column = 0;
+  for (int c : {430, 431, 434, 435, 440, 490})
+    if (int at = w.find_g(c)) {
+      code = c;
+      column = at;
+    }
+  if (!code) return;
+  double next = 0;
+  if (code == 431) {
+    if (machine.dialect != Dialect::linuxcnc)
+      unsupported(column, "G43.1 (LinuxCNC's dynamic tool length offset) needs --machine linuxcnc", "G43.1", false);
+    for (char c : {'X', 'Y'})
+      if (w.has(c)) error(w.col(c), std::string("G43.1 ") + c + ": a sideways tool offset is not simulated");
+    if (!w.has('Z')) error(column, "G43.1 needs Z (the tool length offset)");
+    next = length('Z');
+    w.present &= ~(1u << letter_index('Z'));  // an offset here, not a coordinate
+  } else if (code != 490) {
+    int number = tool;
+    if (w.has('H')) number = static_cast<int>(integer('H', "tool length offset number", 0, 99'999'999));
+    auto it = machine.tool_lengths.find(number);
+    if (it != machine.tool_lengths.end()) {
+      next = code == 440 ? -it->second : it->second;
+    } else if (number != 0 && !machine.tool_lengths.empty()) {
+      error(w.has('H') ? w.col('H') : column,
+            "H" + std::to_string(number) + ": tool " + std::to_string(number) +
+                " has no length in the tool table (\"tool-length\", or Z in a LinuxCNC .tbl)");
+    }
+  }
+  if (machine.tool_lengths.empty()) next = 0;  // no lengths known: the programmed point is the tip
+  if (next != length_offset) comp_forbid(column, "changing the tool length offset");
+  length_offset = next;
+  update_frame();
+}
+
 Flow Interpreter::State::execute(const Block& block) {
   gather(block);
   if (plane_blocks.code && !w.find_g(plane_blocks.code))  // a G68.2 P2/P3 plane is under way
@@ -62,7 +110,7 @@ Flow Interpreter::State::execute(const Block& block) {
   if (w.find_m(6) || (w.has('T') && machine.tool_loads_on_t)) {
     comp_forbid(w.find_m(6) ? w.find_m(6) : w.col('T'), "a tool change");
     comp_programmed_current = false;  // LinuxCNC resynchronises with where the tool really is
-    tool = tool_selected;
+    load_tool(tool_selected);
     tool_first_line.emplace(tool, line);
     if (machine.tool_change == ToolChange::retract_far) go_far();
     if (machine.tool_change == ToolChange::to_position) {
@@ -70,17 +118,15 @@ Flow Interpreter::State::execute(const Block& block) {
         error(w.find_m(6) ? w.find_m(6) : w.col('T'),
               "a tool change to the machine's tool-change position with a tilted tool depends on "
               "the kinematics; retract (G28 or G53 Z) and cancel the tilt first");
-      if (far) {
-        pos = machine.tool_change_position;
-      } else {
-        emit(MoveKind::rapid, pos, machine.tool_change_position, 0.0);
-        pos = machine.tool_change_position;
-      }
+      Vec3 tip = tip_below(machine.tool_change_position);
+      if (!far) emit(MoveKind::rapid, pos, tip, 0.0);
+      pos = tip;
     }
   }
   if (int column = w.find_m(61)) {  // LinuxCNC: the tool in the spindle is Q (nothing moves)
     if (!w.has('Q')) error(column, "M61 needs Q (the tool number)");
-    tool = tool_selected = static_cast<int>(integer('Q', "M61 tool number", 0, 99'999'999));
+    tool_selected = static_cast<int>(integer('Q', "M61 tool number", 0, 99'999'999));
+    load_tool(tool_selected);
   }
   if (w.find_m(3)) spindle_direction = 1;
   if (w.find_m(4)) spindle_direction = -1;
@@ -109,9 +155,7 @@ Flow Interpreter::State::execute(const Block& block) {
   if (w.find_g(910)) incremental = true;
   if (w.find_g(901)) arc_absolute = true;
   if (w.find_g(911)) arc_absolute = false;
-  if (w.find_g(430) || w.find_g(440) || w.find_g(434) || w.find_g(435)) {
-    if (w.has('H')) integer('H', "tool length offset number", 0, 99'999'999);
-  }
+  tool_length_codes();
   tool_center_codes();  // G43.4/G43.5 TCP, G254/G255 DWO (rotary.cpp)
   // Look-ahead and smoothing modes change how the control follows the path, not the path.
   if (w.find_g(51)) {

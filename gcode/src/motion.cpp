@@ -429,7 +429,8 @@ void Interpreter::State::polar_words(bool axis_consumer, int nonmodal) {
 // coordinates, which is only unambiguous with the tool along +Z. A machine whose zero is known
 // (MachineConfig::g53_literal, e.g. LinuxCNC's rs274) moves to the point named, as G28 does to a
 // configured position.
-void Interpreter::State::machine_move(const Vec3& target, unsigned mask, MoveKind kind, double move_feed) {
+void Interpreter::State::machine_move(const Vec3& gauge, unsigned mask, MoveKind kind, double move_feed) {
+  Vec3 target = tip_below(gauge);
   Vec3 end = pos;
   for (int i = 0; i < 3; ++i)
     if ((mask >> i) & 1u) end[i] = target[i];
@@ -489,7 +490,7 @@ void Interpreter::State::home_return(bool second) {
   if (!is_default && !rotary && glm::dot(axis, Vec3(0, 0, 1)) >= 1 - kSameDirection) {
     Vec3 end = pos;
     for (int i = 0; i < 3; ++i)
-      if ((mask >> i) & 1u) end[i] = target[i];
+      if ((mask >> i) & 1u) end[i] = tip_below(target)[i];
     if (!far) {
       emit(MoveKind::rapid, pos, end, 0.0);
       pos = end;

@@ -62,6 +62,19 @@ struct Interpreter::State : ParameterReader {
   int spindle_direction = 0;
   int tool_selected = 0;
   int tool = 0;
+  // Tool length offset (G43 H, G43.1 Z, G44 H; 0 under G49), mm. The program names the point
+  // this far below the spindle's gauge point, and the loaded tool's tip lies its own length
+  // below it: the tip is length_shift() from the programmed point (rs274ngc's tool_offset,
+  // interp_convert.cc convert_tool_length_offset). Without tool lengths both stay 0.
+  double length_offset = 0;
+  double loaded_length() const {
+    auto it = machine.tool_lengths.find(tool);
+    return it == machine.tool_lengths.end() ? 0.0 : it->second;
+  }
+  Vec3 length_shift() const { return (length_offset - loaded_length()) * axis; }
+  // A machine position names the gauge point (G53, G28/G30, the tool-change position, with the
+  // tool along +Z): the tip lies the loaded tool's length below it.
+  Vec3 tip_below(const Vec3& gauge) const { return gauge - Vec3(0, 0, loaded_length()); }
 
   // Tilted working plane and the active program frame (program point p -> machine
   // origin + rotation·p).
@@ -291,7 +304,7 @@ struct Interpreter::State : ParameterReader {
   // which differ from the tip's place on the part as soon as a table axis is turned.
   bool raw_rotary() const { return machine.kinematics && !tcp && !dwo && !tilted; }
   Vec3 linear_axes() const {
-    return raw_rotary() ? machine_from_part(*machine.kinematics, pos, rotary_position) : pos;
+    return raw_rotary() ? machine_from_part(*machine.kinematics, pos, rotary_position) : pos - length_shift();
   }
   Vec3 to_machine(const Vec3& p) const { return origin + rotation * p; }
   Vec3 to_program(const Vec3& m) const { return glm::transpose(rotation) * (m - origin); }
@@ -299,7 +312,7 @@ struct Interpreter::State : ParameterReader {
   void update_frame() {
     if (tilted) {
       rotation = tilt_rotation;
-      origin = tilt_origin;
+      origin = tilt_origin + length_shift();
     } else if (raw_rotary()) {
       // Raw rotary programs: X Y Z (after the work offset) are the machine's linear axes.
       Frame m = machine_to_part(*machine.kinematics, rotary_position);
@@ -307,7 +320,7 @@ struct Interpreter::State : ParameterReader {
       origin = m.to_world(work_offset + local_offset);
     } else {
       rotation = Mat3(1.0);
-      origin = work_offset + local_offset;
+      origin = work_offset + local_offset + length_shift();
     }
     ambiguous = tilted && glm::dot(tilt_rotation[2], axis) < 1 - kSameDirection;
   }
@@ -323,6 +336,11 @@ struct Interpreter::State : ParameterReader {
                                       " (lenient mode)",
                    "move under an ambiguous tilted plane along the current direction " + direction_text(axis));
     }
+    if (machine.kinematics && length_shift() != Vec3(0.0))
+      error(motion_column, "the tool length offset (" + format_number(length_offset) + " mm) differs from the loaded tool " +
+                               std::to_string(tool) + "'s length (" + format_number(loaded_length()) +
+                               " mm) on a machine with rotary axes, which tridex does not simulate: "
+                               "use G43 H" + std::to_string(tool) + " (or G43.4), or a tool table without tool lengths");
     Move move;
     move.line = line;
     move.file = file_index;
@@ -406,6 +424,8 @@ struct Interpreter::State : ParameterReader {
   void machine_move(const Vec3& target, unsigned mask, MoveKind kind, double move_feed);
   void polar_words(bool axis_consumer, int nonmodal);  // LinuxCNC @ and ^ become X and Y (motion.cpp)
   void home_return(bool second);
+  void tool_length_codes();               // G43 H, G43.1, G44 H, G49 (modal.cpp)
+  void load_tool(int number);              // the tip moves with the tool's length (modal.cpp)
   void go_far() { far = true; }
   Flow macro_call(int column);          // G65 (modal.cpp)
   void local_offsets(int code, int column);  // G52, G92, G92.1, G92.2, G92.3 (modal.cpp)

@@ -55,8 +55,17 @@ void push(std::vector<Point>& points, const Point& point) {
   if (glm::length(point.p - previous) > 1e-9) points.push_back(point);
 }
 
-// `tool_table`: a LinuxCNC tool table for -t (standalone rs274 reads its diameters in inches).
-std::vector<Point> run_rs274(const fs::path& program, std::string& log, const fs::path& tool_table = {}) {
+// rs274 run standalone without -t loads its own tool table (the same as LinuxCNC's sample
+// sim.tbl): T1 0.511 in long, T2 0.1 in, T3 1.273 in, T98876 0.1 in. In mm:
+const std::map<int, double> kRs274ToolLengths{{1, 0.511 * 25.4}, {2, 0.1 * 25.4}, {3, 1.273 * 25.4},
+                                              {98876, 0.1 * 25.4}};
+
+// `tool_table`: a LinuxCNC tool table for -t (standalone rs274 reads its diameters in inches);
+// `tool_lengths` (mm) the lengths it holds. rs274 prints the controlled point: the tip of a tool
+// as long as the active offset (USE_TOOL_LENGTH_OFFSET, program units). tridex follows the tip of
+// the tool in the spindle (CHANGE_TOOL), which lies (offset − its length) from that point.
+std::vector<Point> run_rs274(const fs::path& program, std::string& log, const fs::path& tool_table = {},
+                             const std::map<int, double>& tool_lengths = kRs274ToolLengths) {
   fs::path out = fs::temp_directory_path() /
                  ("tridex_rs274_" + std::to_string(::getpid()) + "_" + program.filename().string());
   std::string tools = tool_table.empty() ? "" : "-t '" + tool_table.string() + "' ";
@@ -71,6 +80,8 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log, const fs
   double scale = 1;
   Vec3 offset(0.0);  // mm, G5x
   Vec3 local(0.0);   // mm, G92 / G52
+  double length_offset = 0, loaded_length = 0;  // mm
+  Vec3 last_controlled(0.0);
   char plane = 'Z';  // XY: Z, XZ: Y, YZ: X (the arc's axis)
   std::string line;
   int record = 0;
@@ -92,6 +103,17 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log, const fs
       REQUIRE(v.size() >= 3);
       local = Vec3(v[0], v[1], v[2]) * scale;
     }
+    if ((at = line.find("USE_TOOL_LENGTH_OFFSET(")) != std::string::npos) {
+      auto v = arguments(line, line.find('(', at));
+      REQUIRE(v.size() >= 3);
+      length_offset = v[2] * scale;
+    }
+    if ((at = line.find("CHANGE_TOOL(")) != std::string::npos) {
+      auto v = arguments(line, line.find('(', at));
+      REQUIRE(v.size() >= 1);
+      auto it = tool_lengths.find(static_cast<int>(v[0]));
+      loaded_length = it == tool_lengths.end() ? 0.0 : it->second;
+    }
     Vec3 p;
     if ((at = line.find("STRAIGHT_TRAVERSE(")) != std::string::npos ||
         (at = line.find("STRAIGHT_FEED(")) != std::string::npos) {
@@ -109,7 +131,12 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log, const fs
     } else {
       continue;
     }
-    push(points, Point{p * scale + offset + local, 0.5e-4 * scale + 1e-6, record});
+    // rs274 prints a block with no axis words under G0 as a move to where it is: dropped here
+    // by the printed point, which (unlike the tip) starts at the origin as tridex's first point.
+    Vec3 controlled = p * scale + offset + local;
+    if (glm::length(controlled - last_controlled) <= 1e-9) continue;
+    last_controlled = controlled;
+    push(points, Point{controlled + Vec3(0, 0, length_offset - loaded_length), 0.5e-4 * scale + 1e-6, record});
   }
   fs::remove(out);
   fs::remove(out.string() + ".log");
@@ -119,7 +146,8 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log, const fs
 // `tool_diameters`: the tool table for G41/G42 D (mm). With `chords`, every chord of an arc is a
 // point (marked `chord`, its last one not); without, only the end of each arc.
 std::vector<Point> run_tridex(const fs::path& program, const std::map<int, double>& tool_diameters = {},
-                              bool chords = false) {
+                              bool chords = false,
+                              const std::map<int, double>& tool_lengths = kRs274ToolLengths) {
   InterpreterOptions options;
   options.block_delete = false;  // rs274's block-delete switch is off by default
   std::vector<Point> points;
@@ -127,6 +155,7 @@ std::vector<Point> run_tridex(const fs::path& program, const std::map<int, doubl
   REQUIRE(in);
   MachineConfig machine = *MachineConfig::bundled("linuxcnc");
   machine.tool_diameters = tool_diameters;
+  machine.tool_lengths = tool_lengths;
   Interpreter interpreter(options, machine);
   Move last_arc;
   bool in_arc = false;
@@ -279,8 +308,8 @@ Comparison compare_with_rs274(const fs::path& program, int max_reports) {
 void compare_paths(const fs::path& program, const fs::path& tool_table,
                    const std::map<int, double>& tool_diameters) {
   std::string log;
-  std::vector<Point> theirs = run_rs274(program, log, tool_table);
-  std::vector<Point> ours = run_tridex(program, tool_diameters, true);
+  std::vector<Point> theirs = run_rs274(program, log, tool_table, {});  // tools.tbl: every Z is 0
+  std::vector<Point> ours = run_tridex(program, tool_diameters, true, {});
   INFO("rs274 log: " << log.substr(0, 600));
   CHECK_MESSAGE(!rs274_stopped(log), "rs274 stopped on an error");
   std::size_t j = 0;
@@ -368,4 +397,39 @@ TEST_CASE("differential: LinuxCNC rs274 and tridex agree on every move end point
     std::size_t n = compare_with_rs274(program, 5).compared;
     MESSAGE(program.filename().string() << ": " << n << " end points compared");
   }
+}
+
+// LinuxCNC's skeleton.ngc loads tool 1 and takes its length (0.511 in in rs274's own table) with
+// `T1 M06 G43 H1`. Run standalone, rs274 re-reads its position after a tool change from the last
+// point it printed, which drops the G43 of the same block from the position of the axes the next
+// move leaves out (a real control re-reads it from the machine, offset applied): with G43 in a
+// block of its own, rs274 shifts the position as tridex does. The installed program is read (GPL:
+// not copied here) and run with that one block split.
+TEST_CASE("differential: skeleton.ngc's tool length offset agrees with rs274") {
+  if (!rs274_available()) {
+    MESSAGE("SKIPPED: rs274 not found (install the Debian package linuxcnc-uspace); the LinuxCNC "
+            "differential test did not run");
+    return;
+  }
+  const fs::path installed = "/usr/share/linuxcnc/ncfiles/skeleton.ngc";
+  REQUIRE_MESSAGE(fs::exists(installed), "corpus file missing");
+  std::ifstream in(installed);
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  const std::string block = "T1 M06 G43 H1";
+  std::size_t at = text.find(block);
+  REQUIRE(at != std::string::npos);
+  text.replace(at, block.size(), "T1 M06\nG43 H1");
+  fs::path program = fs::temp_directory_path() / ("tridex_skeleton_" + std::to_string(::getpid()) + ".ngc");
+  {
+    std::ofstream out(program);
+    out << text;
+  }
+  Comparison c = compare_with_rs274(program, 5);
+  CHECK(c.agreed);
+  CHECK(c.compared >= 4);
+  // The tip stands the tool's length below the gauge point G53 Z0 put at the machine's zero.
+  std::vector<Point> ours = run_tridex(program);
+  REQUIRE(!ours.empty());
+  CHECK(ours.front().p.z == doctest::Approx(-0.511 * 25.4));
+  fs::remove(program);
 }

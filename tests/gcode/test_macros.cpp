@@ -293,4 +293,21 @@ TEST_CASE("macros: bad input is an error at its line and column") {
   CHECK(d.message.find("10000 blocks") != std::string::npos);
   d = error_of("N1 GOTO 1\n", bounded, m);
   CHECK(d.message.find("blocks") != std::string::npos);
+  // The limit names the statement that passed it: its line and the column where it starts.
+  // Blocks: G21 is 1, then WHILE, #100, END repeat (3k+2, 3k+3, 3k+4): block 10001 is a WHILE.
+  const std::string loop = "G21\n  WHILE [1] DO1\n   #100 = [#100 + 1]\nEND1\n";
+  d = error_of(loop, bounded, m);
+  CHECK(d.line == 2);
+  CHECK(d.column == 3);
+  bounded.max_blocks = 10001;
+  d = error_of(loop, bounded, m);
+  CHECK(d.line == 3);  // an assignment alone
+  CHECK(d.column == 4);
+  bounded.max_blocks = 10002;
+  d = error_of(loop, bounded, m);
+  CHECK(d.line == 4);  // the END of the loop
+  CHECK(d.column == 1);
+  d = error_of("G21\nM98 P2 L9999\nM30\nO2\n N5 G4 P0\nM99\n", bounded, m);
+  CHECK(d.line == 5);
+  CHECK(d.column == 2);
 }

@@ -338,3 +338,28 @@ TEST_CASE("tools: G41/G42 D take the tool's diameter from --tools or the project
     side |= m["line"] == 5 && m["end"][0] == -4 && m["end"][1] == 20;
   CHECK(side);
 }
+
+TEST_CASE("--tools with tool lengths: G43 H names the tip, G49 the gauge point (.tbl and JSON)") {
+  fs::path dir = scratch("tool-lengths");
+  write_text(dir / "p.ngc", "G21 G90\nG53 G0 Z0\nT1 M6\nG0 X1 Y1\nG43 H1\nG0 X2\nG0 Z5\nM2\n");
+  write_text(dir / "t.tbl", "T1 P1 D0.125 Z+0.5 ;1/8 end mill\n");
+  write_text(dir / "t.json", R"({"1": {"shape": "cylindrical", "diameter": 3.175, "tool-length": 12.7}})");
+  for (const char* table : {"t.tbl", "t.json"}) {
+    CAPTURE(table);
+    CommandResult r = run_tridex({"moves", (dir / "p.ngc").string(), "--machine", "linuxcnc", "--tools",
+                                  (dir / table).string()},
+                                 dir);
+    REQUIRE(r.status == 0);
+    auto m = moves_of(r);
+    REQUIRE(m.size() == 4);  // the G53 Z0 where the machine starts, then three
+    // The gauge point at machine Z0: the tip 12.7 mm below, where G43 H1 keeps it; Z5 is the tip.
+    CHECK(m[1]["end"] == nlohmann::json::array({1, 1, -12.7}));
+    CHECK(m[2]["end"] == nlohmann::json::array({2, 1, -12.7}));
+    CHECK(m[3]["end"] == nlohmann::json::array({2, 1, 5}));
+  }
+  write_text(dir / "bad.tbl", "T1 P1 D0.125 Z+0.5\nT2 P2 Dx\n");
+  CommandResult r = run_tridex({"moves", (dir / "p.ngc").string(), "--tools", (dir / "bad.tbl").string()}, dir);
+  CHECK(r.status == 2);
+  CHECK(r.err.find("bad.tbl:2:7: \"Dx\"") != std::string::npos);
+  fs::remove_all(dir);
+}

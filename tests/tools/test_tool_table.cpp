@@ -235,3 +235,66 @@ TEST_CASE("Fusion tool libraries: a missing or malformed field names the tool an
   has(fusion_error([](json& l) { l["data"][0].erase("type"); }), "\"data\"[0]: missing \"type\"");
   has(fusion_error([](json& l) { l["data"] = 3; }), "must be a JSON object with a \"data\" list");
 }
+
+TEST_CASE("LinuxCNC .tbl tool tables: diameters and lengths in inches, comments as descriptions") {
+  ToolTable table = ToolTable::from_tbl(
+      "T1 P1 D0.125000 Z+0.511000 ;1/8 end mill\n"
+      "\n"
+      "; a comment line\n"
+      "t2 p2 z-0.25 d0.5 x0 i0 ;lower case, a negative length\n"
+      "T98876 P543 Z+0.100000 ;no diameter: a length, no cutter\n",
+      "sim.tbl");
+  REQUIRE(table.tools().size() == 2);
+  const ToolSpec* one = table.find(1);
+  REQUIRE(one != nullptr);
+  CHECK(one->diameter_mm == doctest::Approx(3.175));
+  CHECK(one->shape == "cylindrical");
+  CHECK(one->description == "1/8 end mill");
+  CHECK(table.find(2)->diameter_mm == doctest::Approx(12.7));
+  CHECK(table.find(98876) == nullptr);
+  REQUIRE(table.tool_lengths().size() == 3);
+  CHECK(table.tool_lengths().at(1) == doctest::Approx(12.9794));
+  CHECK(table.tool_lengths().at(2) == doctest::Approx(-6.35));
+  CHECK(table.tool_lengths().at(98876) == doctest::Approx(2.54));
+}
+
+TEST_CASE("LinuxCNC .tbl tool tables: bad lines name file, line, column and the word") {
+  auto error_of_tbl = [](const std::string& text) {
+    try {
+      ToolTable::from_tbl(text, "t.tbl");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  CHECK(error_of_tbl("T1 D0.1\nT2 Zfoo\n").find("t.tbl:2:4: \"Zfoo\"") != std::string::npos);
+  CHECK(error_of_tbl("P1 D0.1\n").find("t.tbl:1: no tool number T") != std::string::npos);
+  CHECK(error_of_tbl("T1.5 D0.1\n").find("t.tbl:1:1: T1.5") != std::string::npos);
+  CHECK(error_of_tbl("T1 D0.1\nT1 D0.2\n").find("tool 1 again (first at line 1)") != std::string::npos);
+  CHECK(error_of_tbl("T1 D0.1 Y0.2\n").find("t.tbl:1:9: tool 1 has a sideways offset Y0.2") != std::string::npos);
+  CHECK(error_of_tbl("T1 D0.1 Z1 Z2\n").find("repeated word Z") != std::string::npos);
+  CHECK(error_of_tbl("T1 D-0.1\n").find("must not be negative") != std::string::npos);
+}
+
+TEST_CASE("LinuxCNC .tbl tool tables: the sample configurations' tables load") {
+  // LinuxCNC's own tables (GPL: read where the package installed them, not copied here).
+  const fs::path sim = "/usr/share/doc/linuxcnc/examples/sample-configs/sim/axis/simtcl/sim.tbl";
+  if (!fs::exists(sim)) {
+    MESSAGE("SKIPPED: " << sim << " not found (Debian package linuxcnc-uspace)");
+    return;
+  }
+  ToolTable table = ToolTable::read(sim);
+  CHECK(table.tool_lengths().at(1) == doctest::Approx(0.511 * 25.4));  // rs274's own default table
+  CHECK(table.find(3)->diameter_mm == doctest::Approx(0.201 * 25.4));
+}
+
+TEST_CASE("a JSON tool table's \"tool-length\" is the length for G43") {
+  ToolTable table = parse(R"({"1": {"shape": "cylindrical", "diameter": 6, "tool-length": 75.5},
+                              "2": {"shape": "ballnose", "diameter": 0.25, "units": "inch", "tool_length": -1},
+                              "3": {"shape": "cylindrical", "diameter": 6, "length": 20}})");
+  REQUIRE(table.tool_lengths().size() == 2);
+  CHECK(table.tool_lengths().at(1) == 75.5);
+  CHECK(table.tool_lengths().at(2) == doctest::Approx(-25.4));
+  CHECK(error_of(R"({"1": {"shape": "cylindrical", "diameter": 6, "tool-length": "long"}})")
+            .find("table: tool 1: \"tool-length\" must be a finite number") != std::string::npos);
+}

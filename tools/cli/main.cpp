@@ -67,9 +67,8 @@ void add_common(CLI::App& command, CommonOptions& options) {
                      "folder of subprogram files (O9810.nc, name.ngc) that M98/G65/o-call may "
                      "call (repeatable)");
   command.add_option("--tools", options.tools,
-                     "tool table, JSON in the CAMotics schema or a Fusion tool library (overrides a project's\n"
-                     "tools; G41/G42 D"
-                     " offset by half a tool's diameter)")
+                     "tool table, JSON in the CAMotics schema, a Fusion tool library or a LinuxCNC .tbl (overrides a project's\n"
+                     "tools; G41/G42 D offset by half a tool's diameter, G43 H by its tool length)")
       ->check(kNotEmpty);
   command.add_flag("--progress", options.progress,
                    "show progress on stderr even when it is not a terminal");

@@ -30,8 +30,10 @@ ProgramInput resolve_program(const CommonOptions& options) {
     input.files.push_back(input.program);
   }
   if (!options.tools.empty()) input.tools = ToolTable::read(options.tools);
-  if (input.tools)  // cutter compensation (G41/G42 D) offsets by half a tool's diameter
+  if (input.tools) {  // cutter compensation (G41/G42 D) offsets by half a tool's diameter
     for (const auto& [number, spec] : input.tools->tools()) input.machine.tool_diameters[number] = spec.diameter_mm;
+    input.machine.tool_lengths = input.tools->tool_lengths();  // G43 H
+  }
   return input;
 }
 

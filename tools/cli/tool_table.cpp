@@ -4,6 +4,8 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <vector>
@@ -187,6 +189,80 @@ ToolTable ToolTable::from_json(const nlohmann::json& table, const std::string& s
     spec.shank_diameter_mm = scale * number_field(tool, where, {"shank-diameter", "shank_diameter"}, false);
     spec.stick_out_mm = scale * number_field(tool, where, {"stick-out", "stick_out"}, false);
     spec.holder = holder_sections(tool, where, scale);
+    for (const char* name : {"tool-length", "tool_length"})
+      if (auto length = tool.find(name); length != tool.end()) {
+        if (!length->is_number() || !std::isfinite(length->get<double>()))
+          input_error(where, ": \"", name, "\" must be a finite number, got ", length->dump());
+        result.tool_lengths_[number] = scale * length->get<double>();
+      }
+    spec.cutter = make_cutter(spec, where);
+    spec.body = make_body(spec, where);
+    result.tools_.emplace(number, std::move(spec));
+  }
+  return result;
+}
+
+ToolTable ToolTable::from_tbl(const std::string& text, const std::string& source) {
+  ToolTable result;
+  std::map<int, int> line_of;  // tool number -> its line, to name both of a duplicate
+  int line = 0;
+  for (std::size_t at = 0; at < text.size();) {
+    std::size_t end = text.find('\n', at);
+    if (end == std::string::npos) end = text.size();
+    std::string row = text.substr(at, end - at);
+    at = end + 1;
+    ++line;
+    std::string description;
+    if (std::size_t semicolon = row.find(';'); semicolon != std::string::npos) {
+      description = row.substr(semicolon + 1);
+      row.resize(semicolon);
+    }
+    std::map<char, std::pair<double, int>> words;  // letter -> value, column
+    for (std::size_t i = 0; i < row.size();) {
+      if (std::isspace(static_cast<unsigned char>(row[i]))) {
+        ++i;
+        continue;
+      }
+      const int column = static_cast<int>(i) + 1;
+      const char letter = static_cast<char>(std::toupper(static_cast<unsigned char>(row[i])));
+      std::size_t stop = row.find_first_of(" \t\r", i);
+      if (stop == std::string::npos) stop = row.size();
+      const std::string word = row.substr(i, stop - i);
+      i = stop;
+      double value = 0;
+      const char* first = word.data() + 1;
+      if (*first == '+') ++first;  // LinuxCNC writes Z+0.511000
+      auto [rest, error] = std::from_chars(first, word.data() + word.size(), value);
+      if (!std::isalpha(static_cast<unsigned char>(letter)) || word.size() < 2 || error != std::errc() ||
+          rest != word.data() + word.size() || !std::isfinite(value))
+        input_error(source, ":", line, ":", column, ": \"", word, "\" is not a tool table word (a letter and a number)");
+      if (words.count(letter)) input_error(source, ":", line, ":", column, ": repeated word ", letter);
+      words[letter] = {value, column};
+    }
+    if (words.empty()) continue;
+    auto t = words.find('T');
+    if (t == words.end()) input_error(source, ":", line, ": no tool number T");
+    const auto [tool_value, tool_column] = t->second;
+    if (tool_value < 0 || tool_value > 1e9 || tool_value != std::floor(tool_value))
+      input_error(source, ":", line, ":", tool_column, ": T", tool_value, " is not a tool number");
+    const int number = static_cast<int>(tool_value);
+    if (auto [previous, inserted] = line_of.emplace(number, line); !inserted)
+      input_error(source, ":", line, ": tool ", number, " again (first at line ", previous->second, ")");
+    for (char c : {'X', 'Y'})
+      if (auto it = words.find(c); it != words.end() && it->second.first != 0)
+        input_error(source, ":", line, ":", it->second.second, ": tool ", number, " has a sideways offset ", c,
+                    it->second.first, ", which tridex does not simulate");
+    constexpr double kInch = 25.4;  // rs274 standalone's units for a tool table
+    if (auto z = words.find('Z'); z != words.end()) result.tool_lengths_[number] = kInch * z->second.first;
+    auto d = words.find('D');
+    if (d == words.end() || d->second.first == 0) continue;  // a length only: it cannot cut
+    std::string where = source + ":" + std::to_string(line) + ": tool " + std::to_string(number);
+    if (d->second.first < 0) input_error(where, ": the diameter D must not be negative, got ", d->second.first);
+    ToolSpec spec;
+    spec.number = number;
+    spec.shape = "cylindrical";
+    spec.diameter_mm = kInch * d->second.first;
+    spec.description = description;
     spec.cutter = make_cutter(spec, where);
     spec.body = make_body(spec, where);
     result.tools_.emplace(number, std::move(spec));
@@ -287,6 +363,12 @@ ToolTable ToolTable::from_fusion_json(const nlohmann::json& library, const std::
 }
 
 ToolTable ToolTable::read(const std::filesystem::path& path) {
+  if (lower(path.extension().string()) == ".tbl") {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) input_error(path.string(), ": cannot open the tool table");
+    std::string text((std::istreambuf_iterator<char>(in)), {});
+    return from_tbl(text, path.string());
+  }
   nlohmann::json json = read_json_file(path);
   if (json.is_object() && json.contains("data") && json["data"].is_array())
     return from_fusion_json(json, path.string());

@@ -20,6 +20,17 @@
 //                     "top-diameter", "length"} (a cylinder when the diameters agree, else a
 //                     cone frustum); needs "stick-out"
 //
+// "tool-length" (or "tool_length"), optional, is the tool's length from the spindle's gauge point
+// to the tip, for tool length offsets (G43 H; gcode/README.md "Tool length offsets"); it may be
+// negative (measured from a master tool). CAMotics' "length" is the cutting shape's, not this.
+//
+// The third format, a LinuxCNC tool table (.tbl), is read by from_tbl: one tool a line,
+// `T1 P1 Z0.511 D0.125 ;comment`, T the tool number, Z its length, D its diameter (a flat end
+// mill), in inches, as rs274 run standalone reads them; the comment is its description. X/Y
+// offsets other than 0 are an error (tridex does not simulate them); P, the pocket, and the
+// other axes' offsets and lathe entries (I J Q) are ignored. A tool without D keeps its length
+// (for G43) but cannot cut.
+//
 // The second format, Autodesk Fusion's tool library export (`{"data": [tool, ...]}`), is read by
 // from_fusion_json: each tool's "post-process"."number" is its number, "unit" "millimeters" or
 // "inches", "type" "flat end mill", "face mill", "ball end mill" or "bull nose end mill" (other
@@ -62,7 +73,9 @@ class ToolTable {
   static ToolTable from_json(const nlohmann::json& table, const std::string& source);
   // Parses a Fusion tool library (`{"data": [...]}`); throws InputError naming the tool and field.
   static ToolTable from_fusion_json(const nlohmann::json& library, const std::string& source);
-  // Reads either format (a Fusion library is an object with a "data" list).
+  // Parses a LinuxCNC tool table; throws InputError naming source:line:column and the word.
+  static ToolTable from_tbl(const std::string& text, const std::string& source);
+  // Reads any format (a .tbl file name: LinuxCNC; a Fusion library is an object with a "data" list).
   static ToolTable read(const std::filesystem::path& path);
 
   const ToolSpec* find(int number) const {
@@ -71,9 +84,12 @@ class ToolTable {
   }
   const std::map<int, ToolSpec>& tools() const { return tools_; }
   bool empty() const { return tools_.empty(); }
+  // Tool lengths (mm, gauge point to tip) of the tools whose entry gives one.
+  const std::map<int, double>& tool_lengths() const { return tool_lengths_; }
 
  private:
   std::map<int, ToolSpec> tools_;
+  std::map<int, double> tool_lengths_;
 };
 
 // The cutter a tool description stands for (the mapping above); throws InputError.
