@@ -43,11 +43,11 @@ run(['check', write('gouge.nc', program(-2.3)), ...stock, '--design', path.join(
      '--envelope', 'box:-1,-1,-1,21,21,14', '--report', path.join(out, 'check.json'), '--html', checkPage], [3]);
 // A holder that hits, in a subprogram file (M98 P1002 finds O1002.nc beside the program): a hole
 // 25 mm deep 4 mm from the front face buries the Ø30 holder 20 mm out (tests/tools/test_collisions.cpp)
-// at the subprogram's line 3; the main program's line 3 (T1 M6) makes no move.
+// at the subprogram's line 3; the main program's line 3 moves too (its listing must not be marked).
 const holderTools = write('holder_tools.json', '{"1": {"shape": "cylindrical", "diameter": 6, "stick-out": 20, ' +
                           '"holder": [{"bottom-diameter": 30, "top-diameter": 30, "length": 20}]}}');
 write('O1002.nc', 'O1002\nG0 X30 Y4 Z40\nG1 Z5 F300\nG0 Z40\nM99\n');
-const holderProgram = write('holder.nc', '%\nG21 G17 G90\nT1 M6\nS8000 M3\nG0 X30 Y4 Z40\nM98 P1002\nG0 X50 Y30 Z40\n' +
+const holderProgram = write('holder.nc', '%\nG21 G17 G90 T1 M6\nS8000 M3 G0 X30 Y4 Z40\nM98 P1002\nG0 X50 Y30 Z40\n' +
                             'G1 Z28 F300\nG0 Z40\nM30\n%\n');
 const holderArgs = ['--tools', holderTools, '--stock', 'box:0,0,0,60,40,30', '--dexel-cell', '0.5', '-q'];
 run(['simulate', holderProgram, ...holderArgs, '-o', path.join(out, 'holder_design.stl')]);
@@ -188,8 +188,9 @@ try {
     const { page, clean } = await open(holderPage);
     const report = JSON.parse(fs.readFileSync(path.join(out, 'holder.json')));
     const data = await pageData(page);
-    check(report.collisions.length > 0 && report.collisions[0].line === 3 && report.collisions[0].part.startsWith('holder'),
-          'holder: the report has the holder collision at line 3: ' + JSON.stringify(report.collisions));
+    check(report.collisions.length > 0 && report.collisions[0].line === 3 && report.collisions[0].file.endsWith('O1002.nc') &&
+          report.collisions[0].part.startsWith('holder'),
+          'holder: the report has the holder collision at O1002.nc:3: ' + JSON.stringify(report.collisions));
     check(data.files.length === 2 && data.files[1].name.endsWith('O1002.nc'), 'holder: both files in the page: ' +
           data.files.map((f) => f.name));
     const items = await page.$$eval('#findings li', (l) => l.map((e) => e.textContent));
@@ -209,7 +210,7 @@ try {
     check(files.length === 1 && files[0].endsWith('O1002.nc'), 'holder: the listing names the subprogram file: ' + files);
     await toggle(page, 'show-path'); await toggle(page, 'show-rapids');
     await page.screenshot({ path: path.join(out, 'holder_collision.png') });
-    // Stops: holder.nc:5, O1002.nc:2, 3, 4, holder.nc:7, 8, 9.
+    // Stops: holder.nc:3, O1002.nc:2, 3, 4, holder.nc:5, 6, 7.
     const label = async () => page.$eval('#path-label', (e) => e.textContent);
     const stops = await page.$eval('#path-slider', (e) => Number(e.max) + 1);
     await setSlider(page, 2);
@@ -217,7 +218,7 @@ try {
     await setSlider(page, 'max');
     const atEnd = await label(), drawnAtEnd = await page.evaluate(() => window.tridexView.drawnSegments());
     check(stops === 7 && inSub.startsWith('toolpath up to O1002.nc:3 ') && inSub.includes('G1 Z5 F300') &&
-          atEnd.startsWith('toolpath up to holder.nc:9 '), 'holder: the slider in program order: ' + [stops, inSub, atEnd]);
+          atEnd.startsWith('toolpath up to holder.nc:7 '), 'holder: the slider in program order: ' + [stops, inSub, atEnd]);
     check(drawnInSub > 0 && drawnInSub < drawnAtEnd, 'holder: segments drawn in the subprogram ' + drawnInSub + ' of ' + drawnAtEnd);
     clean();
     await page.close();

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command_harness.hpp"
+#include "deviation.hpp"
 #include "html_report.hpp"
 #include "tridex/gcode/interpreter.hpp"
 
@@ -137,6 +138,26 @@ TEST_CASE("the display mesh meets its budget and keeps every out-of-tolerance tr
   CHECK(flat_shown < 3200 / 10);
   // The same grid curved keeps more (the first error bound holds the curvature).
   CHECK(simplify_for_display(heightfield(40), {}, 0, 0, 1'000'000).indices.size() / 3 > flat_shown + 100);
+}
+
+TEST_CASE("the display mesh keeps sharp edges: every input vertex near the simplified surface") {
+  // Terraces: flat steps joined by steep one-cell walls, so every wall meets its terraces at a
+  // crease. Simplified within the budget, the flat parts merge and the creases stay where they
+  // are: every input vertex lies within the first error bound (5e-4 of the extent) of the shown
+  // surface, up to the quadric's approximation of it (a factor of 2 here).
+  Mesh terraces = heightfield(60);
+  for (glm::vec3& p : terraces.positions) p.z = 5 * std::floor(p.x / 25.01f) + (p.y > 70 ? 3 : 0);
+  const DisplayMesh shown = simplify_for_display(terraces, {}, 0, 0, 1'000'000);
+  CHECK(shown.indices.size() / 3 < terraces.triangles.size() / 10);
+  Mesh simplified;
+  simplified.positions = shown.positions;
+  for (std::size_t k = 0; k < shown.indices.size(); k += 3)
+    simplified.triangles.emplace_back(shown.indices[k], shown.indices[k + 1], shown.indices[k + 2]);
+  const DistanceTree tree(simplified);
+  const double extent = glm::length(terraces.bounds().size());
+  double farthest = 0;
+  for (const glm::vec3& p : terraces.positions) farthest = std::max(farthest, tree.nearest(Vec3(p)).distance);
+  CHECK(farthest <= 2 * 5e-4 * extent);
 }
 
 TEST_CASE("the thinned toolpath keeps every stop reachable in program order, every move within its tolerance") {
