@@ -96,6 +96,13 @@ async function setSlider(page, value) {
   await page.$eval('#path-slider', (e, v) => { e.value = String(v === 'max' ? e.max : v); e.dispatchEvent(new Event('input')); }, value);
 }
 const pageData = (page) => page.$eval('#tridex-data', (e) => JSON.parse(e.textContent));
+const view = (page, call, ...args) => page.evaluate((c, a) => window.tridexView[c](...a), call, args);
+const near = (a, b, tolerance) => a.every((x, i) => Math.abs(x - b[i]) <= tolerance);
+async function setClip(page, axis, at, flip) {
+  await page.$eval('#clip-axis', (e, v) => { e.value = v; e.dispatchEvent(new Event('input')); }, axis);
+  await page.$eval('#clip-flip', (e, v) => { e.checked = v; e.dispatchEvent(new Event('input')); }, flip);
+  await page.$eval('#clip-at', (e, v) => { e.value = String(v); e.dispatchEvent(new Event('input')); }, at);
+}
 
 try {
   // The bundled example: the part where it is, the toolpath's slider.
@@ -126,6 +133,59 @@ try {
     check(full[1] !== first[1], 'example: the slider changes the drawn path');
     await setSlider(page, Math.floor((await page.$eval('#path-slider', (e) => Number(e.max))) / 2));
     await page.screenshot({ path: path.join(out, 'example_path_half.png') });
+    // Rapids and feeds apart, colour by tool or by direction: each changes the drawn path.
+    await setSlider(page, 'max');
+    const withRapids = (await view(page, 'sample')).checksum;
+    await toggle(page, 'show-rapids');
+    check((await view(page, 'sample')).checksum !== withRapids, 'example: the rapids checkbox changes the drawn path');
+    await toggle(page, 'show-rapids');
+    await page.select('#path-colour', 'direction');
+    check((await view(page, 'sample')).checksum !== withRapids, 'example: colouring by direction changes the drawn path');
+    await page.select('#path-colour', 'tool');
+    check((await view(page, 'sample')).checksum === withRapids, 'example: colouring by tool again restores it');
+    await toggle(page, 'show-path'); await toggle(page, 'show-rapids'); await toggle(page, 'show-part');
+    // The mouse: drag to orbit, wheel to zoom, right-drag to pan; Fit brings the whole part back.
+    const box = await (await page.$('#view')).boundingBox(), mx = box.x + box.width / 2, my = box.y + box.height / 2;
+    const fitted = [await view(page, 'viewDirection'), await view(page, 'distance'), await view(page, 'project', data.mesh.box.min)];
+    check(near((await view(page, 'project', await page.evaluate(() => window.tridexView.centre))).slice(0, 2), [0, 0], 1e-6),
+          'example: fitted on the part centre');
+    await page.mouse.move(mx, my); await page.mouse.down(); await page.mouse.move(mx + 150, my + 40, { steps: 5 }); await page.mouse.up();
+    const orbited = await view(page, 'viewDirection');
+    check(!near(orbited, fitted[0], 0.05), 'example: a drag orbits: ' + [fitted[0], orbited]);
+    await page.mouse.wheel({ deltaY: -600 });
+    const zoomed = await view(page, 'distance');
+    check(zoomed < 0.9 * fitted[1], 'example: the wheel zooms in: ' + [fitted[1], zoomed]);
+    const beforePan = await view(page, 'project', data.mesh.box.min);
+    await page.mouse.move(mx, my); await page.mouse.down({ button: 'right' }); await page.mouse.move(mx - 120, my, { steps: 5 });
+    await page.mouse.up({ button: 'right' });
+    const panned = await view(page, 'project', data.mesh.box.min);
+    check(near(await view(page, 'viewDirection'), orbited, 1e-6) && panned[0] < beforePan[0] - 0.1,
+          'example: a right-drag pans: ' + [beforePan, panned]);
+    await toggle(page, 'fit');
+    await settle(page);
+    check(near(await view(page, 'viewDirection'), fitted[0], 1e-6) && Math.abs(await view(page, 'distance') - fitted[1]) < 1e-6 * fitted[1],
+          'example: Fit restores the fitted view');
+    // A preset view per spindle direction: the camera looks along it, from the holder's side.
+    const presets = await page.$$('#presets button');
+    for (const [i, g] of data.directions.entries()) {
+      await presets[i].click();
+      await settle(page);
+      const d = await view(page, 'viewDirection'), dot = d.reduce((sum, x, a) => sum + x * g.axis[a], 0);
+      check(dot > 0.9999, 'example: preset ' + (i + 1) + ' looks along ' + g.axis + ': ' + d);
+    }
+    // The clipping plane: at the bottom of the part on one side nothing is left, on the other all.
+    await toggle(page, 'fit');
+    await settle(page);
+    const unclipped = (await view(page, 'sample')).part;
+    const clipped = [];
+    for (const flip of [false, true])
+      for (const at of [0, 500, 1000]) { await setClip(page, '2', at, flip); clipped.push((await view(page, 'sample')).part); }
+    await page.screenshot({ path: path.join(out, 'example_clip.png') });
+    await setClip(page, '', 500, false);
+    check((await view(page, 'sample')).part === unclipped, 'example: no clipping draws the whole part again');
+    const [low, middle, high, flipLow, flipMiddle, flipHigh] = clipped.map((n) => n / unclipped);
+    check(low < 0.01 && high > 0.98 && flipLow > 0.98 && flipHigh < 0.01 && middle > 0.01 && middle < 0.99 &&
+          flipMiddle > 0.01 && flipMiddle < 0.99, 'example: the clipping plane (Z at 0, ½, 1; flipped): ' + clipped + ' of ' + unclipped);
     clean();
     await page.close();
   }
@@ -142,6 +202,13 @@ try {
     check(items.length === expected && report.gouges.length === 1, 'check: ' + items.length + ' findings listed, ' + expected + ' in the report');
     check(items[0].startsWith('gouge'), 'check: the gouge first: ' + items[0]);
     check(await page.$eval('#legend', (e) => !e.hidden), 'check: the deviation legend is shown');
+    // The summary: the report's figures.
+    const summary = Object.fromEntries(await page.$$eval('#summary tr', (l) => l.map((r) => [r.cells[0].textContent, r.cells[1].textContent])));
+    check(summary.verdict === 'fail' && summary.tolerances === '−0.1 / +0.1 mm' &&
+          summary['machining time'].startsWith((report.machining_time.total_s / 60).toPrecision(4) + ' min') &&
+          summary['volume left'] === report.result.volume_mm3.toPrecision(6) + ' mm³' &&
+          summary['direction 2'].includes(data.directions[1].moves.toLocaleString('en') + ' moves'),
+          'check: the summary gives the report\'s figures: ' + JSON.stringify(summary));
     // The design ghost: off at first, then translucent amber over the part (and over the
     // background where the part is hidden), off again with its checkbox.
     check(await page.$eval('#design-toggle', (e) => !e.hidden) && data.design.triangles_shown > 0, 'check: the design toggle is offered');
@@ -168,6 +235,13 @@ try {
     check(Math.hypot(before[0], before[1]) > 0.05, 'check: the gouge is off the centre before: ' + before);
     check(Math.abs(after[0]) < 0.02 && Math.abs(after[1]) < 0.02 && after[2] > -1 && after[2] < 1,
           'check: the camera flew to the gouge: ' + after);
+    const marked = await view(page, 'marked');
+    check(marked !== null && near(marked, point, 1e-4), 'check: the gouge is marked: ' + marked);
+    // Its deviation colour: red where the gouge is, none on the holder page's part (all within tolerance).
+    await toggle(page, 'show-path'); await toggle(page, 'show-rapids');
+    const atGouge = await view(page, 'sample', after[0] - 0.5, after[1] - 0.5, after[0] + 0.5, after[1] + 0.5);
+    check(atGouge.gouge > 0.02 * atGouge.all, 'check: gouge-red pixels around the gouge: ' + JSON.stringify(atGouge));
+    await toggle(page, 'show-path'); await toggle(page, 'show-rapids');
     const listing = await page.$eval('#listing', (e) => e.textContent);
     const hits = await page.$$eval('#listing .hit', (l) => l.map((e) => e.textContent.trim()));
     check(hits.length === 1 && hits[0].startsWith('13') && hits[0].includes('G1 Z-2.3'), 'check: line 13 marked: ' + hits);
@@ -203,6 +277,8 @@ try {
     const seen = await page.evaluate((p) => window.tridexView.project(p), point);
     check(Math.abs(seen[0]) < 0.02 && Math.abs(seen[1]) < 0.02 && seen[2] > -1 && seen[2] < 1,
           'holder: the camera flew to the collision: ' + seen);
+    const calm = await view(page, 'sample');
+    check(calm.gouge === 0 && calm.background < 0.95 * calm.all, 'holder: no gouge-red pixels within the tolerance: ' + JSON.stringify(calm));
     const hits = await page.$$eval('#listing .hit', (l) => l.map((e) => e.textContent.trim()));
     const files = await page.$$eval('#listing .file', (l) => l.map((e) => e.textContent));
     check(hits.length === 1 && hits[0].startsWith('3') && hits[0].includes('G1 Z5 F300'),
