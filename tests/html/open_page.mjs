@@ -2,9 +2,11 @@
 // size, the median time from navigation to the page ready (window.tridexView.ready: the toolpath,
 // drawn after the part's first frame, drawn too) and to the part's first frame, and
 // where that time goes: the page's own stage times (window.tridexView.timings, ms since
-// navigation), as medians over the runs. With --screenshot, keeps a picture of the last load. For
-// bench/tools/README.md and docs/.
-//   node tests/html/open_page.mjs PAGE.html [--runs N] [--screenshot OUT.png] [--chromium PATH]
+// navigation), as medians over the runs. With --screenshot, keeps a picture of the last load (in a
+// window of --viewport pixels, 1280x800 unless given; with --slider F, the toolpath drawn up to
+// that fraction of the program). For bench/tools/README.md and docs/.
+//   node tests/html/open_page.mjs PAGE.html [--runs N] [--screenshot OUT.png] [--viewport WxH] [--slider F]
+//                                 [--chromium PATH]
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
@@ -15,6 +17,7 @@ const args = process.argv.slice(2);
 const option = (name, fallback) => { const k = args.indexOf(name); return k >= 0 ? args[k + 1] : fallback; };
 const file = path.resolve(args[0]);
 const runs = Number(option('--runs', '3')), screenshot = option('--screenshot', ''), chromium = option('--chromium', '/usr/bin/chromium');
+const [width, height] = option('--viewport', '1280x800').split('x').map(Number), slider = option('--slider', '');
 const profile = fs.mkdtempSync(path.join(os.tmpdir(), 'tridex-chromium-'));
 const browser = await puppeteer.launch({
   executablePath: chromium, headless: true, userDataDir: profile,
@@ -26,7 +29,7 @@ let errors = 0;
 try {
   for (let r = 0; r < runs; ++r) {
     const page = await browser.newPage();
-    await page.setViewport({ width: 1280, height: 800 });
+    await page.setViewport({ width, height });
     page.on('pageerror', (e) => { ++errors; console.log('page error: ' + e); });
     page.on('console', (m) => { if (m.type() === 'error') { ++errors; console.log('console error: ' + m.text()); } });
     const start = performance.now();
@@ -34,7 +37,12 @@ try {
     await page.waitForFunction('window.tridexView && window.tridexView.ready', { timeout: 300000 });
     seconds.push((performance.now() - start) / 1000);
     stages.push(await page.evaluate(() => window.tridexView.timings));
-    if (r === runs - 1 && screenshot) await page.screenshot({ path: screenshot });
+    if (r === runs - 1 && screenshot) {
+      if (slider !== '')
+        await page.$eval('#path-slider', (e, f) => { e.value = String(Math.round(f * Number(e.max))); e.dispatchEvent(new Event('input')); },
+                         Number(slider));
+      await page.screenshot({ path: screenshot });
+    }
     await page.close();
   }
 } finally {

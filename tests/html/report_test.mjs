@@ -43,11 +43,11 @@ run(['check', write('gouge.nc', program(-2.3)), ...stock, '--design', path.join(
      '--envelope', 'box:-1,-1,-1,21,21,14', '--report', path.join(out, 'check.json'), '--html', checkPage], [3]);
 // A holder that hits, in a subprogram file (M98 P1002 finds O1002.nc beside the program): a hole
 // 25 mm deep 4 mm from the front face buries the Ø30 holder 20 mm out (tests/tools/test_collisions.cpp)
-// at the subprogram's line 3; the main program's line 3 (T1 M6) makes no move.
+// at the subprogram's line 3; the main program's line 3 moves too (its listing must not be marked).
 const holderTools = write('holder_tools.json', '{"1": {"shape": "cylindrical", "diameter": 6, "stick-out": 20, ' +
                           '"holder": [{"bottom-diameter": 30, "top-diameter": 30, "length": 20}]}}');
 write('O1002.nc', 'O1002\nG0 X30 Y4 Z40\nG1 Z5 F300\nG0 Z40\nM99\n');
-const holderProgram = write('holder.nc', '%\nG21 G17 G90\nT1 M6\nS8000 M3\nG0 X30 Y4 Z40\nM98 P1002\nG0 X50 Y30 Z40\n' +
+const holderProgram = write('holder.nc', '%\nG21 G17 G90 T1 M6\nS8000 M3 G0 X30 Y4 Z40\nM98 P1002\nG0 X50 Y30 Z40\n' +
                             'G1 Z28 F300\nG0 Z40\nM30\n%\n');
 const holderArgs = ['--tools', holderTools, '--stock', 'box:0,0,0,60,40,30', '--dexel-cell', '0.5', '-q'];
 run(['simulate', holderProgram, ...holderArgs, '-o', path.join(out, 'holder_design.stl')]);
@@ -96,6 +96,13 @@ async function setSlider(page, value) {
   await page.$eval('#path-slider', (e, v) => { e.value = String(v === 'max' ? e.max : v); e.dispatchEvent(new Event('input')); }, value);
 }
 const pageData = (page) => page.$eval('#tridex-data', (e) => JSON.parse(e.textContent));
+const view = (page, call, ...args) => page.evaluate((c, a) => window.tridexView[c](...a), call, args);
+const near = (a, b, tolerance) => a.every((x, i) => Math.abs(x - b[i]) <= tolerance);
+async function setClip(page, axis, at, flip) {
+  await page.$eval('#clip-axis', (e, v) => { e.value = v; e.dispatchEvent(new Event('input')); }, axis);
+  await page.$eval('#clip-flip', (e, v) => { e.checked = v; e.dispatchEvent(new Event('input')); }, flip);
+  await page.$eval('#clip-at', (e, v) => { e.value = String(v); e.dispatchEvent(new Event('input')); }, at);
+}
 
 try {
   // The bundled example: the part where it is, the toolpath's slider.
@@ -126,6 +133,63 @@ try {
     check(full[1] !== first[1], 'example: the slider changes the drawn path');
     await setSlider(page, Math.floor((await page.$eval('#path-slider', (e) => Number(e.max))) / 2));
     await page.screenshot({ path: path.join(out, 'example_path_half.png') });
+    // Rapids and feeds apart, colour by tool or by direction: each changes the drawn path.
+    await setSlider(page, 'max');
+    const withRapids = (await view(page, 'sample')).checksum;
+    await toggle(page, 'show-rapids');
+    check((await view(page, 'sample')).checksum !== withRapids, 'example: the rapids checkbox changes the drawn path');
+    await toggle(page, 'show-rapids');
+    await page.select('#path-colour', 'direction');
+    check((await view(page, 'sample')).checksum !== withRapids, 'example: colouring by direction changes the drawn path');
+    await page.select('#path-colour', 'tool');
+    check((await view(page, 'sample')).checksum === withRapids, 'example: colouring by tool again restores it');
+    await toggle(page, 'show-path'); await toggle(page, 'show-rapids'); await toggle(page, 'show-part');
+    // The mouse: drag to orbit, wheel to zoom, right-drag to pan; Fit brings the whole part back.
+    const box = await (await page.$('#view')).boundingBox(), mx = box.x + box.width / 2, my = box.y + box.height / 2;
+    const fitted = [await view(page, 'viewDirection'), await view(page, 'distance'), await view(page, 'project', data.mesh.box.min)];
+    check(near((await view(page, 'project', await page.evaluate(() => window.tridexView.centre))).slice(0, 2), [0, 0], 1e-6),
+          'example: fitted on the part centre');
+    await page.mouse.move(mx, my); await page.mouse.down(); await page.mouse.move(mx + 150, my + 40, { steps: 5 }); await page.mouse.up();
+    const orbited = await view(page, 'viewDirection');
+    check(!near(orbited, fitted[0], 0.05), 'example: a drag orbits: ' + [fitted[0], orbited]);
+    for (let k = 0; k < 5; ++k) await page.mouse.wheel({ deltaY: -100 });
+    const zoomed = await view(page, 'distance');
+    check(zoomed < 0.9 * fitted[1], 'example: the wheel zooms in: ' + [fitted[1], zoomed]);
+    const beforePan = await view(page, 'project', data.mesh.box.min);
+    await page.mouse.move(mx, my); await page.mouse.down({ button: 'right' }); await page.mouse.move(mx - 120, my, { steps: 5 });
+    await page.mouse.up({ button: 'right' });
+    const panned = await view(page, 'project', data.mesh.box.min);
+    check(near(await view(page, 'viewDirection'), orbited, 1e-6) && panned[0] < beforePan[0] - 0.1,
+          'example: a right-drag pans: ' + [beforePan, panned]);
+    await toggle(page, 'fit');
+    await settle(page);
+    check(near(await view(page, 'viewDirection'), fitted[0], 1e-6) && Math.abs(await view(page, 'distance') - fitted[1]) < 1e-6 * fitted[1],
+          'example: Fit restores the fitted view');
+    // A preset view per spindle direction: the camera looks along it, from the holder's side.
+    const presets = await page.$$('#presets button');
+    for (const [i, g] of data.directions.entries()) {
+      await presets[i].click();
+      await settle(page);
+      const d = await view(page, 'viewDirection'), dot = d.reduce((sum, x, a) => sum + x * g.axis[a], 0);
+      check(dot > 0.9999, 'example: preset ' + (i + 1) + ' looks along ' + g.axis + ': ' + d);
+    }
+    // The clipping plane along Z: flipped, it keeps what lies above it (all of the part at the
+    // bottom, none at the top); else what lies below (the part seen cut open in the middle: its
+    // inside faces show, so the pixels change but need not be fewer).
+    await toggle(page, 'fit');
+    await settle(page);
+    const unclipped = await view(page, 'sample');
+    const clipped = [];
+    for (const flip of [false, true])
+      for (const at of [0, 500, 1000]) { await setClip(page, '2', at, flip); clipped.push(await view(page, 'sample')); }
+    await setClip(page, '2', 500, false);
+    await page.screenshot({ path: path.join(out, 'example_clip.png') });
+    await setClip(page, '', 500, false);
+    check((await view(page, 'sample')).checksum === unclipped.checksum, 'example: no clipping draws the whole part again');
+    const [, middle, high, flipLow, flipMiddle, flipHigh] = clipped.map((c) => c.part / unclipped.part);
+    check(flipLow > 0.98 && flipHigh < 0.01 && flipMiddle > 0.01 && flipMiddle < 0.99 && high > 0.98 &&
+          clipped[1].checksum !== unclipped.checksum && middle > 0.01,
+          'example: the clipping plane (Z at 0, ½, 1; flipped): ' + clipped.map((c) => c.part) + ' of ' + unclipped.part);
     clean();
     await page.close();
   }
@@ -142,6 +206,13 @@ try {
     check(items.length === expected && report.gouges.length === 1, 'check: ' + items.length + ' findings listed, ' + expected + ' in the report');
     check(items[0].startsWith('gouge'), 'check: the gouge first: ' + items[0]);
     check(await page.$eval('#legend', (e) => !e.hidden), 'check: the deviation legend is shown');
+    // The summary: the report's figures.
+    const summary = Object.fromEntries(await page.$$eval('#summary tr', (l) => l.map((r) => [r.cells[0].textContent, r.cells[1].textContent])));
+    check(summary.verdict === 'fail' && summary.tolerances === '−0.1 / +0.1 mm' &&
+          summary['machining time'].startsWith((report.machining_time.total_s / 60).toPrecision(4) + ' min') &&
+          summary['volume left'] === report.result.volume_mm3.toPrecision(6) + ' mm³' &&
+          summary['direction 1'].includes(data.directions[0].moves.toLocaleString('en') + ' moves'),
+          'check: the summary gives the report\'s figures: ' + JSON.stringify(summary));
     // The design ghost: off at first, then translucent amber over the part (and over the
     // background where the part is hidden), off again with its checkbox.
     check(await page.$eval('#design-toggle', (e) => !e.hidden) && data.design.triangles_shown > 0, 'check: the design toggle is offered');
@@ -168,6 +239,13 @@ try {
     check(Math.hypot(before[0], before[1]) > 0.05, 'check: the gouge is off the centre before: ' + before);
     check(Math.abs(after[0]) < 0.02 && Math.abs(after[1]) < 0.02 && after[2] > -1 && after[2] < 1,
           'check: the camera flew to the gouge: ' + after);
+    const marked = await view(page, 'marked');
+    check(marked !== null && near(marked, point, 1e-4), 'check: the gouge is marked: ' + marked);
+    // Its deviation colour: red where the gouge is, none on the holder page's part (all within tolerance).
+    await toggle(page, 'show-path'); await toggle(page, 'show-rapids');
+    const atGouge = await view(page, 'sample', after[0] - 0.5, after[1] - 0.5, after[0] + 0.5, after[1] + 0.5);
+    check(atGouge.gouge > 0.02 * atGouge.all, 'check: gouge-red pixels around the gouge: ' + JSON.stringify(atGouge));
+    await toggle(page, 'show-path'); await toggle(page, 'show-rapids');
     const listing = await page.$eval('#listing', (e) => e.textContent);
     const hits = await page.$$eval('#listing .hit', (l) => l.map((e) => e.textContent.trim()));
     check(hits.length === 1 && hits[0].startsWith('13') && hits[0].includes('G1 Z-2.3'), 'check: line 13 marked: ' + hits);
@@ -188,8 +266,9 @@ try {
     const { page, clean } = await open(holderPage);
     const report = JSON.parse(fs.readFileSync(path.join(out, 'holder.json')));
     const data = await pageData(page);
-    check(report.collisions.length > 0 && report.collisions[0].line === 3 && report.collisions[0].part.startsWith('holder'),
-          'holder: the report has the holder collision at line 3: ' + JSON.stringify(report.collisions));
+    check(report.collisions.length > 0 && report.collisions[0].line === 3 && report.collisions[0].file.endsWith('O1002.nc') &&
+          report.collisions[0].part.startsWith('holder'),
+          'holder: the report has the holder collision at O1002.nc:3: ' + JSON.stringify(report.collisions));
     check(data.files.length === 2 && data.files[1].name.endsWith('O1002.nc'), 'holder: both files in the page: ' +
           data.files.map((f) => f.name));
     const items = await page.$$eval('#findings li', (l) => l.map((e) => e.textContent));
@@ -202,6 +281,8 @@ try {
     const seen = await page.evaluate((p) => window.tridexView.project(p), point);
     check(Math.abs(seen[0]) < 0.02 && Math.abs(seen[1]) < 0.02 && seen[2] > -1 && seen[2] < 1,
           'holder: the camera flew to the collision: ' + seen);
+    const calm = await view(page, 'sample');
+    check(calm.gouge === 0 && calm.background < 0.95 * calm.all, 'holder: no gouge-red pixels within the tolerance: ' + JSON.stringify(calm));
     const hits = await page.$$eval('#listing .hit', (l) => l.map((e) => e.textContent.trim()));
     const files = await page.$$eval('#listing .file', (l) => l.map((e) => e.textContent));
     check(hits.length === 1 && hits[0].startsWith('3') && hits[0].includes('G1 Z5 F300'),
@@ -209,7 +290,7 @@ try {
     check(files.length === 1 && files[0].endsWith('O1002.nc'), 'holder: the listing names the subprogram file: ' + files);
     await toggle(page, 'show-path'); await toggle(page, 'show-rapids');
     await page.screenshot({ path: path.join(out, 'holder_collision.png') });
-    // Stops: holder.nc:5, O1002.nc:2, 3, 4, holder.nc:7, 8, 9.
+    // Stops: holder.nc:3, O1002.nc:2, 3, 4, holder.nc:5, 6, 7.
     const label = async () => page.$eval('#path-label', (e) => e.textContent);
     const stops = await page.$eval('#path-slider', (e) => Number(e.max) + 1);
     await setSlider(page, 2);
@@ -217,7 +298,7 @@ try {
     await setSlider(page, 'max');
     const atEnd = await label(), drawnAtEnd = await page.evaluate(() => window.tridexView.drawnSegments());
     check(stops === 7 && inSub.startsWith('toolpath up to O1002.nc:3 ') && inSub.includes('G1 Z5 F300') &&
-          atEnd.startsWith('toolpath up to holder.nc:9 '), 'holder: the slider in program order: ' + [stops, inSub, atEnd]);
+          atEnd.startsWith('toolpath up to holder.nc:7 '), 'holder: the slider in program order: ' + [stops, inSub, atEnd]);
     check(drawnInSub > 0 && drawnInSub < drawnAtEnd, 'holder: segments drawn in the subprogram ' + drawnInSub + ' of ' + drawnAtEnd);
     clean();
     await page.close();

@@ -6,12 +6,14 @@
 // in a browser: tests/html (CTest's html_report_browser).
 #include <doctest/doctest.h>
 
+#include <array>
 #include <cmath>
 #include <set>
 
 #include <nlohmann/json.hpp>
 
 #include "command_harness.hpp"
+#include "deviation.hpp"
 #include "html_report.hpp"
 #include "tridex/gcode/interpreter.hpp"
 
@@ -138,6 +140,26 @@ TEST_CASE("the display mesh meets its budget and keeps every out-of-tolerance tr
   CHECK(simplify_for_display(heightfield(40), {}, 0, 0, 1'000'000).indices.size() / 3 > flat_shown + 100);
 }
 
+TEST_CASE("the display mesh keeps sharp edges: every input vertex near the simplified surface") {
+  // Terraces: flat steps joined by steep one-cell walls, so every wall meets its terraces at a
+  // crease. Simplified within the budget, the flat parts merge and the creases stay where they
+  // are: every input vertex lies within the first error bound (5e-4 of the extent) of the shown
+  // surface, up to the quadric's approximation of it (a factor of 2 here).
+  Mesh terraces = heightfield(60);
+  for (glm::vec3& p : terraces.positions) p.z = 5 * std::floor(p.x / 25.01f) + (p.y > 70 ? 3 : 0);
+  const DisplayMesh shown = simplify_for_display(terraces, {}, 0, 0, 1'000'000);
+  CHECK(shown.indices.size() / 3 < terraces.triangles.size() / 10);
+  Mesh simplified;
+  simplified.positions = shown.positions;
+  for (std::size_t k = 0; k < shown.indices.size(); k += 3)
+    simplified.triangles.emplace_back(shown.indices[k], shown.indices[k + 1], shown.indices[k + 2]);
+  const DistanceTree tree(simplified);
+  const double extent = glm::length(terraces.bounds().size());
+  double farthest = 0;
+  for (const glm::vec3& p : terraces.positions) farthest = std::max(farthest, tree.nearest(Vec3(p)).distance);
+  CHECK(farthest <= 2 * 5e-4 * extent);
+}
+
 TEST_CASE("the thinned toolpath keeps every stop reachable in program order, every move within its tolerance") {
   using gcode::MoveKind;
   std::vector<gcode::MoveGroup> groups(2);
@@ -223,14 +245,18 @@ TEST_CASE("the thinned toolpath keeps every stop reachable in program order, eve
 
 TEST_CASE("the page holds the report, the listed source lines, and says when there is nothing to show") {
   fs::path dir = scratch("html-writer");
-  const fs::path program = dir / "p.nc";
+  // Two files with the same line numbers: a finding's lines come from its own file only.
+  const fs::path program = dir / "p.nc", subprogram = dir / "O1001.nc";
   std::string text;
   for (int k = 1; k <= 20; ++k) text += "G1 X" + std::to_string(k) + " ( line " + std::to_string(k) + " </script> )\n";
   write_text(program, text);
+  write_text(subprogram, text);
   HtmlPage page;
   page.title = "a <title> & more";
-  page.report = {{"rapid_cuts", json::array({{{"line", 10}, {"where", {1, 2, 3}}}})}, {"note", "</script><b>"}};
-  page.files = {program.string()};
+  page.report = {{"rapid_cuts", json::array({{{"file", program.string()}, {"line", 10}, {"where", {1, 2, 3}}}})},
+                 {"gouges", json::array({{{"lines", {2, 18}}, {"files", {subprogram.string(), subprogram.string()}}}})},
+                 {"note", "</script><b>"}};
+  page.files = {program.string(), subprogram.string()};
   HtmlLimits limits;
   limits.max_source_bytes = 0;  // only the lines around findings
   write_html_report(dir / "page.html", page, limits);
@@ -239,11 +265,17 @@ TEST_CASE("the page holds the report, the listed source lines, and says when the
   CHECK(html.find("</script><b>") == std::string::npos);  // escaped inside the data
   json data = page_data(html);
   CHECK(data["report"] == page.report);
-  json expected_source = json::object();
-  for (int k = 7; k <= 13; ++k) expected_source[std::to_string(k)] = "G1 X" + std::to_string(k) + " ( line " + std::to_string(k) + " </script> )";
-  REQUIRE(data["files"].size() == 1);
+  auto source_lines = [](std::initializer_list<std::pair<int, int>> ranges) {
+    json source = json::object();
+    for (const auto& [first, last] : ranges)
+      for (int k = first; k <= last; ++k) source[std::to_string(k)] = "G1 X" + std::to_string(k) + " ( line " + std::to_string(k) + " </script> )";
+    return source;
+  };
+  REQUIRE(data["files"].size() == 2);
   CHECK(data["files"][0]["name"] == program.string());
-  CHECK(data["files"][0]["source"] == expected_source);
+  CHECK(data["files"][0]["source"] == source_lines({{7, 13}}));
+  CHECK(data["files"][1]["name"] == subprogram.string());
+  CHECK(data["files"][1]["source"] == source_lines({{1, 5}, {15, 20}}));
   CHECK(data["mesh"]["triangles_shown"] == 0);
   CHECK(data["toolpath"]["segments"] == 0);
   REQUIRE(data["messages"].size() == 2);
@@ -257,6 +289,7 @@ TEST_CASE("the page holds the report, the listed source lines, and says when the
   page.groups = &groups;
   data = html_page_data(page, {});
   CHECK(data["files"][0]["source"].size() == 20);
+  CHECK(data["files"][1]["source"].size() == 20);
   CHECK(data["messages"].empty());
   CHECK(data["mesh"]["triangles"] == mesh.triangles.size());
   CHECK(data["toolpath"]["segments"] == 1);
@@ -329,5 +362,35 @@ TEST_CASE("simulate --html with a subprogram file: each file's text, the stops i
   const std::vector<std::uint32_t> runs = {0, 5, 1, 1, 2, 3, 0, 7, 1};
   CHECK(data["toolpath"]["stop_runs"] == base64({reinterpret_cast<const std::uint8_t*>(runs.data()), 4 * runs.size()}));
   CHECK(data["toolpath"]["stop_count"] == 5);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("the findings name their file: a rapid into the stock in a subprogram file, both files with moves on its line") {
+  fs::path dir = scratch("html-finding-file");
+  write_text(dir / "p.nc", "%\nG21 G90 T1 M6\nM3 S1000 G0 X5 Y5 Z20\nM98 P1001\nG0 Z20\nM30\n%\n");
+  write_text(dir / "O1001.nc", "O1001\nG0 X5 Y5 Z12\nG0 Z5\nG0 Z20\nM99\n");
+  write_text(dir / "tools.json", R"({"1": {"units": "mm", "shape": "ballnose", "diameter": 4, "length": 20}})");
+  CommandResult r = run_tridex({"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(), "--stock",
+                                "box:0,0,0,20,10,10", "--dexel-res", "64", "-q", "--report", (dir / "r.json").string(),
+                                "--html", (dir / "r.html").string()},
+                               dir);
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  const json report = json::parse(slurp(dir / "r.json"));
+  // The plunge (line 3) and the retract from it (line 4): no feed move removes that material.
+  REQUIRE(report["rapid_cuts"].size() == 2);
+  CHECK(report["rapid_cuts"][1]["line"] == 4);
+  CHECK(report["rapid_cuts"][1]["file"] == report["rapid_cuts"][0]["file"]);
+  const json& cut = report["rapid_cuts"][0];
+  CHECK(cut["line"] == 3);
+  CHECK(fs::path(cut["file"].get<std::string>()).filename() == "O1001.nc");
+  CHECK(cut["depth_mm"].get<double>() == doctest::Approx(5).epsilon(1e-3));
+  for (int a = 0; a < 3; ++a) CHECK(cut["where"][a].get<double>() == doctest::Approx(std::array{5.0, 5.0, 5.0}[a]));
+  // The page names the same file: the finding's "file" is one of its files' names.
+  const json data = page_data(slurp(dir / "r.html"));
+  REQUIRE(data["files"].size() == 2);
+  CHECK(data["files"][1]["name"] == cut["file"]);
+  CHECK(data["files"][0]["source"]["3"] == "M3 S1000 G0 X5 Y5 Z20");
+  CHECK(data["files"][1]["source"]["3"] == "G0 Z5");
   fs::remove_all(dir);
 }

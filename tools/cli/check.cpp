@@ -110,15 +110,16 @@ Json statistics(std::vector<double> values) {
   return s;
 }
 
-// Source lines of the moves whose swept cutter reaches the region's deepest vertices.
-std::vector<int> gouging_lines(const DeviationRegion& region, const Mesh& mesh, const std::vector<double>& deviation,
+// Source lines of the moves whose swept cutter reaches the region's deepest vertices, as
+// (Move::file, line) pairs.
+std::vector<std::pair<int, int>> gouging_lines(const DeviationRegion& region, const Mesh& mesh, const std::vector<double>& deviation,
                                const SimulationResult& r, double slack) {
   std::vector<std::uint32_t> probes = region.vertices;
   std::size_t keep = std::min(kProbesPerRegion, probes.size());
   std::partial_sort(probes.begin(), probes.begin() + static_cast<std::ptrdiff_t>(keep), probes.end(),
                     [&](std::uint32_t a, std::uint32_t b) { return deviation[a] < deviation[b]; });
   probes.resize(keep);
-  std::set<int> lines;
+  std::set<std::pair<int, int>> lines;
   for (const gcode::MoveGroup& group : r.groups) {
     std::vector<Vec3> local;
     for (std::uint32_t v : probes) local.push_back(group.frame.to_local(Vec3(mesh.positions[v])));
@@ -138,7 +139,7 @@ std::vector<int> gouging_lines(const DeviationRegion& region, const Mesh& mesh, 
           continue;
         detail::MoveGeometry::Lowest lowest = detail::MoveGeometry(cutter, tip).lowest(p.x, p.y);
         if (p.z + slack >= lowest.z && !(continues && lowest.t <= 1e-9)) {
-          lines.insert(m.line);
+          lines.insert({m.file, m.line});
           break;
         }
       }
@@ -300,10 +301,21 @@ int run_check(const CheckOptions& options) {
 
   // ---- which moves made the gouges ----------------------------------------------------------
   progress.stage("finding the moves that cut " + std::to_string(gouges.size()) + " gouge region(s)");
+  // A finding's file: the name of Move::file's entry, as --report's "files" and messages give it.
+  auto file_name = [&](int file) { return r.files.at(static_cast<std::size_t>(file)); };
   Json gouge_list = Json::array(), excess_list = Json::array();
   for (std::size_t k = 0; k < gouges.size() && k < kRegionsListed; ++k) {
     Json g = region_json(gouges[k], mesh, deviation);
-    if (k < kRegionsWithLines) g["lines"] = gouging_lines(gouges[k], mesh, deviation, r, spacing);
+    if (k < kRegionsWithLines) {
+      // "files"[i] is the file of "lines"[i]: a program with subprogram files repeats line numbers.
+      Json lines = Json::array(), files = Json::array();
+      for (const auto& [file, line] : gouging_lines(gouges[k], mesh, deviation, r, spacing)) {
+        lines.push_back(line);
+        files.push_back(file_name(file));
+      }
+      g["lines"] = lines;
+      g["files"] = files;
+    }
     gouge_list.push_back(g);
   }
   for (std::size_t k = 0; k < excesses.size() && k < kRegionsListed; ++k)
@@ -313,11 +325,11 @@ int run_check(const CheckOptions& options) {
   // ---- rapids and envelope ------------------------------------------------------------------
   Json rapid_list = Json::array();
   for (const RapidFinding& f : r.rapid_cuts)
-    rapid_list.push_back({{"line", f.line}, {"tool", f.tool}, {"axis", to_json(f.axis)},
+    rapid_list.push_back({{"file", file_name(f.file)}, {"line", f.line}, {"tool", f.tool}, {"axis", to_json(f.axis)},
                           {"depth_mm", f.depth_mm}, {"where", to_json(f.where)}});
   // ---- shanks and holders -------------------------------------------------------------------
   auto body_json = [&](const BodyFinding& f, const char* measure) {
-    return Json{{"line", f.line}, {"tool", f.tool}, {"part", f.part}, {measure, f.depth_mm},
+    return Json{{"file", file_name(f.file)}, {"line", f.line}, {"tool", f.tool}, {"part", f.part}, {measure, f.depth_mm},
                 {"point", to_json(f.where)}, {"axis", to_json(f.axis)}};
   };
   Json collision_list = Json::array(), near_list = Json::array();
@@ -341,20 +353,22 @@ int run_check(const CheckOptions& options) {
     // Positions "far along the tool axis" (home returns, reorientations) are tridex's stand-in for
     // where the machine takes the tool, not programmed points.
     const double far = 0.5 * gcode::MachineConfig::kDefaultFar;
-    std::vector<std::pair<int, Vec3>> outside;
+    std::vector<const gcode::Move*> outside;
     for (const gcode::MoveGroup& group : r.groups)
       for (const gcode::Move& m : group.moves)
-        if (glm::length(m.end) < far && !envelope->contains(m.end)) outside.emplace_back(m.line, m.end);
-    std::sort(outside.begin(), outside.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+        if (glm::length(m.end) < far && !envelope->contains(m.end)) outside.push_back(&m);
+    std::stable_sort(outside.begin(), outside.end(), [](const gcode::Move* a, const gcode::Move* b) {
+      return std::pair(a->file, a->line) < std::pair(b->file, b->line);
+    });
     envelope_outside = outside.size();
     for (std::size_t k = 0; k < outside.size() && k < kFindingsListed; ++k)
-      envelope_list.push_back({{"line", outside[k].first}, {"tip", to_json(outside[k].second)}});
+      envelope_list.push_back({{"file", file_name(outside[k]->file)}, {"line", outside[k]->line}, {"tip", to_json(outside[k]->end)}});
   }
 
   // Machine travel (the kinematics' "travel" and rotary limits): a finding per axis and move.
   Json travel_list = Json::array();
   for (const TravelFinding& f : r.travel)
-    travel_list.push_back({{"file", f.file}, {"line", f.line}, {"axis", std::string(1, f.axis)},
+    travel_list.push_back({{"file", file_name(f.file)}, {"line", f.line}, {"axis", std::string(1, f.axis)},
                            {"value", f.value}, {"limit", f.limit}});
 
   // ---- outputs ------------------------------------------------------------------------------
@@ -469,7 +483,7 @@ int run_check(const CheckOptions& options) {
       std::printf("  line %d: tool tip %s outside the envelope\n", envelope_list[k]["line"].get<int>(),
                   envelope_list[k]["tip"].dump().c_str());
     for (std::size_t k = 0; k < r.travel.size() && k < kFindingsPrinted; ++k)
-      std::printf("  %s:%d: %s\n", r.travel[k].file.c_str(), r.travel[k].line, travel_text(r.travel[k]).c_str());
+      std::printf("  %s:%d: %s\n", file_name(r.travel[k].file).c_str(), r.travel[k].line, travel_text(r.travel[k]).c_str());
     for (std::size_t k = 0; k < r.body.collisions.size() && k < kFindingsPrinted; ++k) {
       const BodyFinding& f = r.body.collisions[k];
       std::printf("  line %d: tool %d's %s is %.3f mm into the stock at (%.3f, %.3f, %.3f), spindle %s\n", f.line,

@@ -17,9 +17,9 @@ Segment raised(const Segment& tip, double by) {
   return Segment{tip.a + Vec3(0, 0, by), tip.b + Vec3(0, 0, by)};
 }
 
-// Keeps one finding per line and part: the deepest collision, the closest near miss.
+// Keeps one finding per source line and part: the deepest collision, the closest near miss.
 void record(std::vector<BodyFinding>& list, BodyFinding f, bool keep_larger) {
-  for (auto it = list.rbegin(); it != list.rend() && it->line == f.line; ++it)
+  for (auto it = list.rbegin(); it != list.rend() && it->line == f.line && it->file == f.file; ++it)
     if (it->part == f.part && it->tool == f.tool && it->group == f.group) {
       if (keep_larger ? f.depth_mm > it->depth_mm : f.depth_mm < it->depth_mm) *it = f;
       return;
@@ -137,7 +137,7 @@ void BodyCheck::check(const ZMap& map, const gcode::Move& move, const CutMove& c
       return frame.to_world(Vec3(map.grid.x(d.i), map.grid.y(d.j), map.height(d.i, d.j)));
     };
     if (plain.depth > kCollisionTolerance) {
-      record(found.collisions, BodyFinding{move.line, move.tool, part.name, plain.depth, located(plain), axis, group}, true);
+      record(found.collisions, BodyFinding{move.file, move.line, move.tool, part.name, plain.depth, located(plain), axis, group}, true);
       if (body.has_holder() && part.bottom >= body.stick_out) {
         double& deepest = found.holder_depth[{move.tool, group}];
         deepest = std::max(deepest, plain.depth);
@@ -158,7 +158,7 @@ void BodyCheck::check(const ZMap& map, const gcode::Move& move, const CutMove& c
         else lo = mid;
       }
     }
-    record(found.near_misses, BodyFinding{move.line, move.tool, part.name, hi, located(closest), axis, group}, false);
+    record(found.near_misses, BodyFinding{move.file, move.line, move.tool, part.name, hi, located(closest), axis, group}, false);
   }
   found.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }

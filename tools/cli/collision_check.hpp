@@ -40,6 +40,7 @@ namespace tridex::cli {
 constexpr double kCollisionTolerance = 0.005;
 
 struct BodyFinding {
+  int file = 0;            // Move::file: an index into the program's files (SimulationResult::files)
   int line = 0;
   int tool = 0;
   std::string part;        // "shank", "holder section k" (k = 1 at the holder's face)

@@ -68,35 +68,36 @@ double distance_to_segment(const glm::vec3& p, const glm::vec3& a, const glm::ve
   return glm::length(p - (a + t * ab));
 }
 
-// The source lines a listing needs: each finding's lines and `context` lines either side.
-std::set<int> listed_lines(const Json& report, int context) {
-  std::set<int> wanted;
-  auto add = [&](const Json& line) {
-    if (!line.is_number_integer()) return;
-    for (int k = line.get<int>() - context; k <= line.get<int>() + context; ++k) wanted.insert(k);
+// The source lines a listing needs, per file (by name, as the findings' "file" gives it): each
+// finding's lines and `context` lines either side.
+std::map<std::string, std::set<int>> listed_lines(const Json& report, int context) {
+  std::map<std::string, std::set<int>> wanted;
+  auto add = [&](const Json& file, const Json& line) {
+    if (!file.is_string() || !line.is_number_integer()) return;
+    std::set<int>& lines = wanted[file.get<std::string>()];
+    for (int k = line.get<int>() - context; k <= line.get<int>() + context; ++k) lines.insert(k);
   };
-  for (const char* kind : {"gouges", "excess", "rapid_cuts", "collisions"})
+  for (const char* kind : {"gouges", "rapid_cuts", "collisions"})
     if (report.contains(kind))
       for (const Json& f : report[kind]) {
-        if (f.contains("lines"))
-          for (const Json& line : f["lines"]) add(line);
-        if (f.contains("line")) add(f["line"]);
+        if (f.contains("lines"))  // a gouge's: "files"[i] is the file of "lines"[i]
+          for (std::size_t i = 0; i < f["lines"].size(); ++i) add(f["files"][i], f["lines"][i]);
+        if (f.contains("line")) add(f["file"], f["line"]);
       }
   for (const char* kind : {"envelope", "travel"})
     if (report.contains(kind))
-      for (const Json& v : report[kind]["violations"]) add(v["line"]);
+      for (const Json& v : report[kind]["violations"]) add(v["file"], v["line"]);
   if (report.contains("near_misses"))
-    for (const Json& v : report["near_misses"]["moves"]) add(v["line"]);
+    for (const Json& v : report["near_misses"]["moves"]) add(v["file"], v["line"]);
   return wanted;
 }
 
 // Each G-code file of the program (Move::file's table) with its text, line -> text: whole files
-// while their total stays within max_source_bytes, of the others only the lines around findings (a
-// report's line does not name its file: those lines are taken from every file).
+// while their total stays within max_source_bytes, of the others only the lines around findings.
 Json source_files(const HtmlPage& page, const HtmlLimits& limits) {
   Json files = Json::array();
   std::uintmax_t budget = limits.max_source_bytes;
-  std::optional<std::set<int>> wanted;
+  std::optional<std::map<std::string, std::set<int>>> wanted;
   for (const std::string& name : page.files) {
     Json file = {{"name", name}, {"source", Json::object()}, {"note", ""}};
     std::error_code error;
@@ -107,14 +108,18 @@ Json source_files(const HtmlPage& page, const HtmlLimits& limits) {
       files.push_back(std::move(file));
       continue;
     }
-    const bool everything = size <= budget;
-    if (everything) budget -= size;
-    else if (!wanted) wanted = listed_lines(page.report, limits.context);
-    if (!everything) file["note"] = "the program is large: only the lines around findings are included";
+    const std::set<int>* lines = nullptr;  // those included; null: all
+    if (size <= budget) {
+      budget -= size;
+    } else {
+      if (!wanted) wanted = listed_lines(page.report, limits.context);
+      lines = &(*wanted)[name];
+      file["note"] = "the program is large: only the lines around findings are included";
+    }
     Json& source = file["source"];
     std::string text;
     for (int line = 1; std::getline(in, text); ++line) {
-      if (!everything && !wanted->count(line)) continue;
+      if (lines && !lines->count(line)) continue;
       if (!text.empty() && text.back() == '\r') text.pop_back();
       source[std::to_string(line)] = text;
     }

@@ -100,7 +100,7 @@ void mill_in_program_order(ZMap& map, const gcode::MoveGroup& group, std::size_t
       CutDepth deepest = cut_depth(map, cutters[cut.cutter], cut.tip);
       if (deepest.depth > kRapidTolerance) {
         Vec3 local(map.grid.x(deepest.i), map.grid.y(deepest.j), map.height(deepest.i, deepest.j));
-        found.push_back(RapidFinding{m.line, m.tool, group.axis, deepest.depth, group.frame.to_world(local), g});
+        found.push_back(RapidFinding{m.file, m.line, m.tool, group.axis, deepest.depth, group.frame.to_world(local), g});
       }
     }
     if (bodies) bodies->check(map, m, cut, group.axis, group.frame, g, batch.empty(), flush, body_found);
@@ -274,7 +274,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
     if (kinematics && glm::length(m.end) < far)
       for (const gcode::TravelViolation& v : gcode::travel_violations(*kinematics, m.machine, m.rotary))
         if (r.travel_count++ < static_cast<long long>(kTravelListed))
-          r.travel.push_back({input.files[file].string(), m.line, v.axis, v.value, v.limit});
+          r.travel.push_back({m.file, m.line, v.axis, v.value, v.limit});
     if (m.kind != gcode::MoveKind::rapid) {
       // An approach from "far along the tool axis" is not where the work is.
       if (!m.from_far) cutting_bounds.extend(m.start);
@@ -435,7 +435,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
     for (const RapidCut& found : check_rapids ? rapid_cuts(maps.back(), cutters, rapids, kRapidTolerance)
                                               : std::vector<RapidCut>{}) {
       const gcode::Move& m = *rapid_moves[found.index];
-      r.rapid_cuts.push_back(RapidFinding{m.line, m.tool, group.axis, found.depth_mm, m.end, g});
+      r.rapid_cuts.push_back(RapidFinding{m.file, m.line, m.tool, group.axis, found.depth_mm, m.end, g});
     }
     backends::mill_with(zmap_backend, maps.back(), cutters, rapids, options.threads);
   }

@@ -75,6 +75,7 @@ struct PipelineRequest {
 
 // A rapid that cuts: `depth_mm` below the material along the spindle at `where` (work frame).
 struct RapidFinding {
+  int file = 0;  // Move::file: an index into SimulationResult::files
   int line = 0;
   int tool = 0;
   Vec3 axis{0, 0, 1};
@@ -86,7 +87,7 @@ struct RapidFinding {
 // A move that ends outside the machine's travel (the kinematics' "travel" in machine
 // coordinates, or a rotary axis's limits): `check` lists these as findings, `simulate` warns.
 struct TravelFinding {
-  std::string file;
+  int file = 0;      // Move::file: an index into SimulationResult::files
   int line = 0;
   char axis = 'X';
   double value = 0;  // mm (X Y Z, machine coordinates) or degrees (A B C)

@@ -41,8 +41,8 @@ int run_simulate(const SimulateOptions& options) {
   std::vector<std::string>& warnings = r.warnings;
   Json rapid_findings = Json::array();
   for (const RapidFinding& f : r.rapid_cuts)
-    rapid_findings.push_back({{"line", f.line}, {"tool", f.tool}, {"axis", to_json(f.axis)},
-                              {"depth_mm", f.depth_mm}});
+    rapid_findings.push_back({{"file", r.files.at(static_cast<std::size_t>(f.file))}, {"line", f.line}, {"tool", f.tool},
+                              {"axis", to_json(f.axis)}, {"depth_mm", f.depth_mm}, {"where", to_json(f.where)}});
   if (!rapid_findings.empty()) {
     std::string lines;
     for (std::size_t k = 0; k < rapid_findings.size() && k < 10; ++k)
@@ -54,7 +54,7 @@ int run_simulate(const SimulateOptions& options) {
   if (r.travel_count > 0) {
     const TravelFinding& f = r.travel.front();
     warnings.push_back(std::to_string(r.travel_count) + " position(s) outside the machine's travel (first " +
-                       f.file + ":" + std::to_string(f.line) + ": " + travel_text(f) +
+                       r.files.at(static_cast<std::size_t>(f.file)) + ":" + std::to_string(f.line) + ": " + travel_text(f) +
                        "; `tridex check` lists each)");
   }
 
