@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "tridex/dexel_ops.hpp"
+#include "tridex/geometry.hpp"
 #include "tridex/mill.hpp"
 #include "tridex/zmap.hpp"
 
@@ -45,15 +46,6 @@ inline bool is_steep_cell(const ZMap& map, int i, int j, double steep_slope) {
   auto top = [&](int a, int b) { return double(std::max(map.height(a, b), map.empty_height)); };
   const double a = top(i, j), b = top(i + 1, j), c = top(i, j + 1), d = top(i + 1, j + 1);
   return std::max({a, b, c, d}) - std::min({a, b, c, d}) > steep_slope * map.grid.cell;
-}
-
-// The distance in XY from (x, y) to the tip path's projection.
-inline double point_segment_distance_xy(double x, double y, const Segment& s) {
-  const double vx = s.b.x - s.a.x, vy = s.b.y - s.a.y, ux = x - s.a.x, uy = y - s.a.y;
-  const double vv = vx * vx + vy * vy;
-  const double t = vv > 0 ? std::clamp((ux * vx + uy * vy) / vv, 0.0, 1.0) : 0.0;
-  const double dx = ux - t * vx, dy = uy - t * vy;
-  return std::sqrt(dx * dx + dy * dy);
 }
 
 // Makes the steep cells of `map` fine, with sub-point heights from the moves it was milled with
@@ -147,7 +139,9 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
         for (std::size_t tx = tx0; tx <= tx1; ++tx) {
           if (!tile_walls[static_cast<std::size_t>(band) * tiles_x + tx]) continue;
           const double cx = g.x0 + (double(tx) + 0.5) * kTile * g.cell, cy = g.y0 + 0.5 * (j0 + j1) * g.cell;
-          if (point_segment_distance_xy(cx, cy, s) > r + tile_half_diagonal) continue;
+          if (distance2_point_segment(Vec2(cx, cy), Vec2(s.a.x, s.a.y), Vec2(s.b.x, s.b.y)) >
+              (r + tile_half_diagonal) * (r + tile_half_diagonal))
+            continue;
           first_tile = std::min(first_tile, tx), last_tile = tx;
         }
         if (first_tile > last_tile) continue;
@@ -168,7 +162,8 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
             // least the profile's height at `reach` above its lowest tip there (profiles rise
             // outward), less a rounding margin far below float heights.
             const double cx = g.x0 + (i + 0.5) * g.cell, cy = g.y0 + (j + 0.5) * g.cell;
-            const double reach = point_segment_distance_xy(cx, cy, s) - half_diagonal;
+            const double reach =
+                std::sqrt(distance2_point_segment(Vec2(cx, cy), Vec2(s.a.x, s.a.y), Vec2(s.b.x, s.b.y))) - half_diagonal;
             if (reach > r + tile_half_diagonal) continue;
             if (tip + move.cutter->lower_height(std::max(0.0, reach)) - 1e-6 >= double(cell_top[index])) continue;
             float* h = sub.data() + index * kPoints;
