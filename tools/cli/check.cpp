@@ -324,9 +324,7 @@ int run_check(const CheckOptions& options) {
 
   // ---- rapids and envelope ------------------------------------------------------------------
   Json rapid_list = Json::array();
-  for (const RapidFinding& f : r.rapid_cuts)
-    rapid_list.push_back({{"file", file_name(f.file)}, {"line", f.line}, {"tool", f.tool}, {"axis", to_json(f.axis)},
-                          {"depth_mm", f.depth_mm}, {"where", to_json(f.where)}});
+  for (const RapidFinding& f : r.rapid_cuts) rapid_list.push_back(rapid_finding_json(f, r.files));
   // ---- shanks and holders -------------------------------------------------------------------
   auto body_json = [&](const BodyFinding& f, const char* measure) {
     return Json{{"file", file_name(f.file)}, {"line", f.line}, {"tool", f.tool}, {"part", f.part}, {measure, f.depth_mm},

@@ -205,6 +205,11 @@ std::string travel_text(const TravelFinding& f) {
   return text;
 }
 
+Json rapid_finding_json(const RapidFinding& f, const std::vector<std::string>& files) {
+  return {{"file", files.at(static_cast<std::size_t>(f.file))}, {"line", f.line}, {"tool", f.tool},
+          {"axis", to_json(f.axis)}, {"depth_mm", f.depth_mm}, {"where", to_json(f.where)}};
+}
+
 std::string axis_label(const Vec3& axis) {
   static const char* names[] = {"x", "y", "z"};
   for (int a = 0; a < 3; ++a) {

@@ -159,6 +159,9 @@ double fine_cell_bytes(double cells, double rows, double moves, double bands_per
 std::string axis_label(const Vec3& axis);
 // "X 612.5 mm, past the travel's end 600" / "A -130°, past its limit -120".
 std::string travel_text(const TravelFinding& finding);
+
+// A rapid into the stock as simulate's and check's reports list it (`files`: SimulationResult::files).
+Json rapid_finding_json(const RapidFinding& finding, const std::vector<std::string>& files);
 void write_stl_file(const std::filesystem::path& path, const Mesh& mesh);
 
 }  // namespace tridex::cli

@@ -40,9 +40,7 @@ int run_simulate(const SimulateOptions& options) {
   const long long segments = r.segments;
   std::vector<std::string>& warnings = r.warnings;
   Json rapid_findings = Json::array();
-  for (const RapidFinding& f : r.rapid_cuts)
-    rapid_findings.push_back({{"file", r.files.at(static_cast<std::size_t>(f.file))}, {"line", f.line}, {"tool", f.tool},
-                              {"axis", to_json(f.axis)}, {"depth_mm", f.depth_mm}, {"where", to_json(f.where)}});
+  for (const RapidFinding& f : r.rapid_cuts) rapid_findings.push_back(rapid_finding_json(f, r.files));
   if (!rapid_findings.empty()) {
     std::string lines;
     for (std::size_t k = 0; k < rapid_findings.size() && k < 10; ++k)
