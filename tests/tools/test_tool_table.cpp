@@ -276,6 +276,22 @@ TEST_CASE("LinuxCNC .tbl tool tables: bad lines name file, line, column and the 
   CHECK(error_of_tbl("T1 D-0.1\n").find("must not be negative") != std::string::npos);
 }
 
+TEST_CASE("LinuxCNC .tbl tool tables: a missing file or a directory is an input error naming it") {
+  const fs::path dir = fs::temp_directory_path() / ("tridex-tbl-" + std::to_string(::getpid()));
+  fs::create_directories(dir / "folder.tbl");
+  auto error_of_read = [](const fs::path& path) {
+    try {
+      ToolTable::read(path);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  CHECK(error_of_read(dir / "folder.tbl").find("folder.tbl: is a directory, not a tool table") != std::string::npos);
+  CHECK(error_of_read(dir / "none.tbl").find("none.tbl: no such file") != std::string::npos);
+  fs::remove_all(dir);
+}
+
 TEST_CASE("LinuxCNC .tbl tool tables: the sample configurations' tables load") {
   // LinuxCNC's own tables (GPL: read where the package installed them, not copied here).
   const fs::path sim = "/usr/share/doc/linuxcnc/examples/sample-configs/sim/axis/simtcl/sim.tbl";

@@ -110,11 +110,11 @@ Json parse_json_text(const std::string& text, const std::string& source) {
   return result;
 }
 
-Json read_json_file(const fs::path& path) {
+std::string read_text_file(const fs::path& path, const std::string& kind) {
   std::error_code error;
   fs::file_status status = fs::status(path, error);
   if (!fs::exists(status)) input_error(path.string(), ": no such file");
-  if (fs::is_directory(status)) input_error(path.string(), ": is a directory, not a JSON file");
+  if (fs::is_directory(status)) input_error(path.string(), ": is a directory, not ", kind);
   if (!fs::is_regular_file(status)) input_error(path.string(), ": is not a regular file");
   std::string text;
   try {
@@ -127,8 +127,10 @@ Json read_json_file(const fs::path& path) {
   } catch (const std::exception&) {  // libstdc++'s filebuf throws on a read error
     input_error(path.string(), ": cannot read the file");
   }
-  return parse_json_text(text, path.string());
+  return text;
 }
+
+Json read_json_file(const fs::path& path) { return parse_json_text(read_text_file(path, "a JSON file"), path.string()); }
 
 std::string json_type_name(const Json& value) {
   switch (value.type()) {

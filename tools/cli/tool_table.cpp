@@ -4,8 +4,6 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
-#include <fstream>
-#include <iterator>
 #include <limits>
 #include <map>
 #include <vector>
@@ -363,12 +361,7 @@ ToolTable ToolTable::from_fusion_json(const nlohmann::json& library, const std::
 }
 
 ToolTable ToolTable::read(const std::filesystem::path& path) {
-  if (lower(path.extension().string()) == ".tbl") {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) input_error(path.string(), ": cannot open the tool table");
-    std::string text((std::istreambuf_iterator<char>(in)), {});
-    return from_tbl(text, path.string());
-  }
+  if (lower(path.extension().string()) == ".tbl") return from_tbl(read_text_file(path, "a tool table"), path.string());
   nlohmann::json json = read_json_file(path);
   if (json.is_object() && json.contains("data") && json["data"].is_array())
     return from_fusion_json(json, path.string());
