@@ -1,6 +1,8 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <random>
 
 #include "reference.hpp"
@@ -155,6 +157,51 @@ TEST_CASE("the flat end's and the bull nose's vector forms agree with the scalar
   }
   CHECK(covered[0] > 250 * detail::kLanes);
   CHECK(covered[1] > 500 * detail::kLanes);
+}
+
+TEST_CASE("the bull nose's root: extreme slopes and corners, and each point's value its own") {
+  // BullLanes finds the corner's contact reach by Halley's method with a guarded step, each lane
+  // stopping on its own. Against the scalar bracketed Newton (MoveGeometry::lowest) at slopes
+  // from 1e-6 to 1e3 and corner radii from 0.01R to 0.99R; and every lane's height is the same,
+  // to the bit, whether its neighbours are evaluated with it or not (so that the milled result
+  // cannot depend on which points of a row a move is tested on).
+  std::mt19937 rng(53);
+  std::uniform_real_distribution<double> u(-1, 1), unit(0, 1);
+  const double r = 2;
+  int inside = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const double corner = r * std::array{0.01, 0.1, 0.5, 0.9, 0.99}[static_cast<std::size_t>(trial % 5)];
+    const double slope = std::pow(10.0, -6 + 9 * unit(rng)), angle = 6.3 * unit(rng), length = 0.2 + 3 * unit(rng);
+    const Vec3 a(u(rng), u(rng), u(rng));
+    const Segment s{a, a + Vec3(length * std::cos(angle), length * std::sin(angle), (trial % 2 ? 1 : -1) * slope * length)};
+    const Cutter cutter = Cutter::bull_nose(r, corner);
+    detail::MoveGeometry m(cutter, s);
+    detail::BullLanes bull(m);
+    detail::DoubleN x{}, y{};
+    detail::MaskN all{};
+    for (int l = 0; l < detail::kLanes; ++l) {
+      // Most points beside the move, where the minimum is inside it.
+      const double along = unit(rng), across = r * u(rng);
+      x[l] = s.a.x + along * (s.b.x - s.a.x) - across * std::sin(angle);
+      y[l] = s.a.y + along * (s.b.y - s.a.y) + across * std::cos(angle);
+      all[l] = -1;
+    }
+    const detail::DoubleN ux = x - bull.ax, uy = y - bull.ay;
+    const detail::DoubleN together = bull.at(ux, uy, all);
+    for (int l = 0; l < detail::kLanes; ++l) {
+      CAPTURE(trial);
+      CAPTURE(l);
+      detail::MaskN one{};
+      one[l] = -1;
+      // The same point with no other lane wanted.
+      REQUIRE(bull.at(ux, uy, one)[l] == together[l]);
+      const detail::MoveGeometry::Lowest expected = m.lowest(x[l], y[l]);
+      if (!(expected.z < 1e300)) continue;
+      if (expected.t > 1e-9 && expected.t < 1 - 1e-9) ++inside;
+      REQUIRE(together[l] == doctest::Approx(expected.z).epsilon(0).scale(1).epsilon(1e-9));
+    }
+  }
+  CHECK(inside > 1000 * detail::kLanes);
 }
 
 TEST_CASE("the flat end's and the bull nose's vector supporting planes: the scalar ones, and below S everywhere") {
