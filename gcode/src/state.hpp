@@ -58,6 +58,7 @@ struct Interpreter::State : ParameterReader {
   Vec3 work_offset{0.0};
   std::map<int, Vec3> offsets;
   double feed = 0;
+  Vec2 spline_mirror{0.0};  // G5 without I J: P1 − P0, program units (−P, −Q of the last G5)
   double speed = 0;
   int spindle_direction = 0;
   int tool_selected = 0;
@@ -190,8 +191,19 @@ struct Interpreter::State : ParameterReader {
   }
 
   // ---- words ----
+  // G5.1 is LinuxCNC's quadratic spline (a motion), and on Fanuc AI contour control (G5.1 Q1, a
+  // smoothing mode): a spline under --machine linuxcnc, or wherever the block gives I or J.
+  bool g5_1_spline = false;  // of the block being gathered
+  bool g5_1_is_spline(const Block& block) const {
+    if (machine.dialect == Dialect::linuxcnc) return true;
+    for (const Word& word : block.words)
+      if (word.letter == 'I' || word.letter == 'J') return true;
+    return false;
+  }
+
   void gather(const Block& block) {
     w.present = w.used = 0;
+    g5_1_spline = g5_1_is_spline(block);
     w.g_count = w.m_count = 0;
     std::array<int, kGroupCount> g_seen{};
     std::array<int, kMGroupCount> m_seen{};
@@ -204,6 +216,7 @@ struct Interpreter::State : ParameterReader {
         int code = integral ? static_cast<int>(rounded) : -1;
         if (word.letter == 'M' && code % 10) integral = false;
         int group = !integral ? -1 : word.letter == 'G' ? g_group(code) : m_group(code / 10);
+        if (word.letter == 'G' && code == 51 && g5_1_spline) group = kMotion;
         if (group < 0 && integral && word.letter == 'M') {
           // An M-code moves no axis: accepted (once a warning per code unless the machine
           // declares it), an error where the machine forbids it.
@@ -235,13 +248,13 @@ struct Interpreter::State : ParameterReader {
           if (word.letter == 'G' && integral && machine.dialect == Dialect::linuxcnc) {
             // Never skipped, even lenient: each moves the tool. LinuxCNC's lathe codes (G7
             // diameter mode, G33 threading, G70-G72 turning cycles, G76 threading cycle) have no
-            // meaning on a mill; G5 and G5.2 are splines tridex does not follow.
+            // meaning on a mill; G5.2 is a NURBS tridex does not follow.
             static constexpr int kLathe[] = {70, 330, 700, 710, 711, 712, 720, 721, 722, 760};
             if (std::find(std::begin(kLathe), std::end(kLathe), code) != std::end(kLathe))
               error(word.column, name + " is a lathe code: tridex simulates milling machines");
-            if (code == 50 || code == 52)
-              error(word.column, name + " (LinuxCNC's " + (code == 50 ? "cubic spline" : "NURBS") +
-                                     ") is not supported: write the curve as G1 or G2/G3 moves");
+            if (code == 52)
+              error(word.column, name + " (LinuxCNC's NURBS) is not supported: write the curve as "
+                                        "G1 or G2/G3 moves");
           }
           unsupported(word.column, "unsupported code " + name, "code " + name, harmless && !coordinates);
           continue;
@@ -421,6 +434,10 @@ struct Interpreter::State : ParameterReader {
   void arc_chords(const Vec3& start, const Vec3& end, const Vec2& c, bool ccw, double sweep,
                   double move_feed);
   void cycle(int code);
+  // LinuxCNC's G5 / G5.1 splines as biarcs (spline.cpp).
+  void spline(bool quadratic);
+  void biarc(const Vec2& p0, const Vec2& t0, const Vec2& p4, const Vec2& t4, double z);
+  void spline_piece(const Vec2& from, const Vec2& to, const Vec2& tangent, double z);
   void machine_move(const Vec3& target, unsigned mask, MoveKind kind, double move_feed);
   void polar_words(bool axis_consumer, int nonmodal);  // LinuxCNC @ and ^ become X and Y (motion.cpp)
   void home_return(bool second);
