@@ -64,7 +64,7 @@ Flow Interpreter::State::execute(const Block& block) {
   int motion_code = -1, nonmodal = -1, tilt = -1, orient = -1;
   for (int i = 0; i < w.g_count; ++i) {
     const Code& g = w.g[static_cast<std::size_t>(i)];
-    int group = g.code == 51 && g5_1_spline ? kMotion : g_group(g.code);
+    int group = block_g_group(g.code);
     if (group == kMotion) {
       motion_code = g.code;
       motion_column = g.column;
@@ -292,6 +292,8 @@ Flow Interpreter::State::execute(const Block& block) {
     } else if (motion == 20 || motion == 30) {
       char cu = kCenterLetter[plane_axes(plane)[0]], cv = kCenterLetter[plane_axes(plane)[1]];
       if (axes || motion_code >= 0 || w.has(cu) || w.has(cv) || w.has('R')) arc(motion == 30);
+    } else if (motion >= 382 && motion <= 385) {
+      if (axes || motion_code >= 0) probe(motion);
     } else if (motion == 50 || motion == 51) {
       if (axes || motion_code >= 0 || w.has('I') || w.has('J') || w.has('P') || w.has('Q'))
         spline(motion == 51);

@@ -113,6 +113,8 @@ struct Interpreter::State : ParameterReader {
   bool warned_home = false;
   bool warned_reference2 = false;
   std::set<int> warned_m_codes;
+  bool warned_plain_rotary = false;  // A/B/C on a LinuxCNC machine without kinematics
+  bool warned_probe = false;         // G38.x read as rs274 standalone does
   Vec3 local_offset{0.0};  // G52 / G92 (one register, as LinuxCNC keeps it), machine axes
   Vec3 saved_local_offset{0.0};  // G92.2 suspends, G92.3 restores
   Vec3 world_origin{0.0};
@@ -194,6 +196,13 @@ struct Interpreter::State : ParameterReader {
   // G5.1 is LinuxCNC's quadratic spline (a motion), and on Fanuc AI contour control (G5.1 Q1, a
   // smoothing mode): a spline under --machine linuxcnc, or wherever the block gives I or J.
   bool g5_1_spline = false;  // of the block being gathered
+  // The modal group of a G code in this block: g_group, and the motions of the LinuxCNC dialect
+  // (G5.1 as a spline, G38.2–G38.5 straight probes).
+  int block_g_group(int code) const {
+    if (code == 51 && g5_1_spline) return kMotion;
+    if (code >= 382 && code <= 385 && machine.dialect == Dialect::linuxcnc) return kMotion;
+    return g_group(code);
+  }
   bool g5_1_is_spline(const Block& block) const {
     if (machine.dialect == Dialect::linuxcnc) return true;
     for (const Word& word : block.words)
@@ -215,8 +224,7 @@ struct Interpreter::State : ParameterReader {
         bool integral = std::abs(scaled - rounded) < 1e-6 && word.value >= 0 && word.value < 10000;
         int code = integral ? static_cast<int>(rounded) : -1;
         if (word.letter == 'M' && code % 10) integral = false;
-        int group = !integral ? -1 : word.letter == 'G' ? g_group(code) : m_group(code / 10);
-        if (word.letter == 'G' && code == 51 && g5_1_spline) group = kMotion;
+        int group = !integral ? -1 : word.letter == 'G' ? block_g_group(code) : m_group(code / 10);
         if (group < 0 && integral && word.letter == 'M') {
           // An M-code moves no axis: accepted (once a warning per code unless the machine
           // declares it), an error where the machine forbids it.
@@ -244,7 +252,8 @@ struct Interpreter::State : ParameterReader {
           if (word.letter == 'G' && code >= 382 && code <= 385)  // never skipped: it moves
             error(word.column, name + " (probing) is not simulated: where the probe touches, and so "
                                       "where the tool goes next, is known only on the machine; "
-                                      "leave the probing cycle out of the program tridex reads");
+                                      "leave the probing cycle out of the program tridex reads (or, "
+                                      "with --machine linuxcnc, read it as rs274 does)");
           if (word.letter == 'G' && integral && machine.dialect == Dialect::linuxcnc) {
             // Never skipped, even lenient: each moves the tool. LinuxCNC's lathe codes (G7
             // diameter mode, G33 threading, G70-G72 turning cycles, G76 threading cycle) have no
@@ -408,6 +417,18 @@ struct Interpreter::State : ParameterReader {
   Vec2 comp_endpoint{0.0};             // where the queued moves start (program frame)
   bool comp_endpoint_valid = false;
   bool comp_active() const { return comp_side != 0 && comp_radius > 0; }
+  // A program point's coordinates in the active plane, (u, v) of plane_axes (G17: X Y; G18: Z X,
+  // LinuxCNC's order for compensation), and a point with those replaced.
+  Vec2 plane_uv(const Vec3& p) const {
+    const std::array<int, 3> a = plane_axes(plane);
+    return Vec2(p[a[0]], p[a[1]]);
+  }
+  Vec3 with_plane_uv(Vec3 p, const Vec2& q) const {
+    const std::array<int, 3> a = plane_axes(plane);
+    p[a[0]] = q.x;
+    p[a[1]] = q.y;
+    return p;
+  }
   void cutter_comp_codes(int code, int column);  // G40, G41, G42, G41.1, G42.1
   void comp_forbid(int column, const std::string& what) const;
   void comp_straight(MoveKind kind, const Vec3& target, double move_feed);
@@ -415,7 +436,7 @@ struct Interpreter::State : ParameterReader {
   void comp_move_endpoint_and_flush(const Vec2& to);
   void comp_dequeue();
   void comp_finish() {  // at the end of the program: emit what waits
-    if (!comp_queue.empty()) comp_move_endpoint_and_flush(Vec2(comp_current));
+    if (!comp_queue.empty()) comp_move_endpoint_and_flush(plane_uv(comp_current));
   }
 
   // ---- motion (motion.cpp) ----
@@ -438,6 +459,7 @@ struct Interpreter::State : ParameterReader {
   void spline(bool quadratic);
   void biarc(const Vec2& p0, const Vec2& t0, const Vec2& p4, const Vec2& t4, double z);
   void spline_piece(const Vec2& from, const Vec2& to, const Vec2& tangent, double z);
+  void probe(int code);  // LinuxCNC's G38.2–G38.5 (motion.cpp)
   void machine_move(const Vec3& target, unsigned mask, MoveKind kind, double move_feed);
   void polar_words(bool axis_consumer, int nonmodal);  // LinuxCNC @ and ^ become X and Y (motion.cpp)
   void home_return(bool second);

@@ -131,7 +131,7 @@ TEST_CASE("cutter compensation errors, each at its block") {
       {start + "G41 D1 G1 X2 Y0\nM2\n", 4, "not longer than the tool radius"},
       {start + "G41 D1 G1 X20 Y0\nG3 X20 Y4 I0 J2\nM2\n", 5, "not less than the arc radius"},
       {start + "G41 D2 G1 X20 Y0\nG1 X20 Y5\nG1 X0 Y5\nM2\n", 6, "gouging"},
-      {start + "G18 G41 D1\nM2\n", 4, "XY plane"},
+      {start + "G19 G41 D1\nM2\n", 4, "XY (G17) or XZ (G18) plane"},
       {start + "G41 D1\nG42 D1\nM2\n", 5, "already on"},
       {start + "G41 D1 G1 X20 Y0\nG40\nG2 X40 Y0 R5\nM2\n", 6, "must be straight"},
       {start + "G41 D1 G1 X20 Y0\nT2 M6\nM2\n", 5, "tool change"},

@@ -124,9 +124,13 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log, const fs
       points.push_back(Point{Vec3(0.0), 0, record, false, true});
       continue;
     }
+    // rs274 standalone's probe reaches its point and stops 0.254 mm (0.01 in) back towards its
+    // start (saicanon.cc STRAIGHT_PROBE): two points.
+    bool probe = false;
     Vec3 p;
     if ((at = line.find("STRAIGHT_TRAVERSE(")) != std::string::npos ||
-        (at = line.find("STRAIGHT_FEED(")) != std::string::npos) {
+        (at = line.find("STRAIGHT_FEED(")) != std::string::npos ||
+        (probe = (at = line.find("STRAIGHT_PROBE(")) != std::string::npos)) {
       auto v = arguments(line, line.find('(', at));
       REQUIRE(v.size() >= 3);
       p = Vec3(v[0], v[1], v[2]);
@@ -144,9 +148,17 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log, const fs
     // rs274 prints a block with no axis words under G0 as a move to where it is: dropped here
     // by the printed point, which (unlike the tip) starts at the origin as tridex's first point.
     Vec3 controlled = p * scale + offset + local;
-    if (glm::length(controlled - last_controlled) <= 1e-9) continue;
-    last_controlled = controlled;
-    push(points, Point{controlled + Vec3(0, 0, length_offset - loaded_length), 0.5e-4 * scale + 1e-6, record});
+    Vec3 from = last_controlled;  // in mm, as saicanon keeps it across offset and unit changes
+    for (int piece = 0; piece < (probe ? 2 : 1); ++piece) {
+      if (piece == 1) {
+        double distance = glm::length(from - controlled);
+        if (distance == 0) break;
+        controlled += 0.254 * (from - controlled) / distance;  // 0.01 in = 0.254 mm
+      }
+      if (glm::length(controlled - last_controlled) <= 1e-9) continue;
+      last_controlled = controlled;
+      push(points, Point{controlled + Vec3(0, 0, length_offset - loaded_length), 0.5e-4 * scale + 1e-6, record});
+    }
   }
   fs::remove(out);
   fs::remove(out.string() + ".log");
@@ -201,9 +213,11 @@ std::vector<fs::path> corpus() {
     files.assign(1, fs::path(only));
     return files;
   }
-  for (const char* name : {"3D_Chips.ngc", "3dtest.ngc", "arcspiral.ngc", "cds.ngc", "flowsnake.ngc",
-                           "hole-circle.ngc", "lathe_pawn.ngc", "plasmatest.ngc", "polar.ngc",
-                           "spiral.ngc", "tort.ngc"})
+  // b-index turns B, a plain axis on LinuxCNC without kinematics: X/Y/Z agree (cone and daisy,
+  // which turn A/B/C too, then stop at W and at G93 inverse time, which tridex does not read).
+  for (const char* name : {"3D_Chips.ngc", "3dtest.ngc", "arcspiral.ngc", "b-index.ngc", "cds.ngc",
+                           "flowsnake.ngc", "hole-circle.ngc", "lathe_pawn.ngc",
+                           "plasmatest.ngc", "polar.ngc", "spiral.ngc", "tort.ngc"})
     files.push_back(fs::path("/usr/share/linuxcnc/ncfiles") / name);
   return files;
 }
