@@ -59,7 +59,7 @@ inline int g_group(int code) {
     case 40: case 100: case 280: case 300: case 530: case 520: case 650: case 920: case 921:
     case 922: case 923: return kNonModal;
     case 0: case 10: case 20: case 30: case 730: case 800: case 810: case 820: case 830:
-    case 850: case 860: case 890: case 50: return kMotion;  // G5: LinuxCNC's cubic spline
+    case 850: case 860: case 890: return kMotion;
     case 170: case 180: case 190: return kPlane;
     case 900: case 910: return kDistance;
     case 901: case 911: return kArcDistance;

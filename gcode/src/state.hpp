@@ -193,26 +193,30 @@ struct Interpreter::State : ParameterReader {
   }
 
   // ---- words ----
-  // G5.1 is LinuxCNC's quadratic spline (a motion), and on Fanuc AI contour control (G5.1 Q1, a
-  // smoothing mode): a spline under --machine linuxcnc, or wherever the block gives I or J.
-  bool g5_1_spline = false;  // of the block being gathered
+  // G5 and G5.1 are LinuxCNC's splines (motions). On Fanuc they are modes: G5 P10000 / G5 P0
+  // high-speed machining, G5.1 Q1 AI contour control (smoothing). So they are splines under the
+  // LinuxCNC dialect, and elsewhere where the block has a spline's words: G5 with X, Y, I, J or
+  // Q, G5.1 with I or J.
+  bool g5_spline = false, g5_1_spline = false;  // of the block being gathered
+  void find_splines(const Block& block) {
+    g5_spline = g5_1_spline = machine.dialect == Dialect::linuxcnc;
+    for (const Word& word : block.words) {
+      bool ij = word.letter == 'I' || word.letter == 'J';
+      g5_spline |= ij || word.letter == 'X' || word.letter == 'Y' || word.letter == 'Q';
+      g5_1_spline |= ij;
+    }
+  }
   // The modal group of a G code in this block: g_group, and the motions of the LinuxCNC dialect
-  // (G5.1 as a spline, G38.2–G38.5 straight probes).
+  // (G5 and G5.1 splines, G38.2–G38.5 straight probes).
   int block_g_group(int code) const {
-    if (code == 51 && g5_1_spline) return kMotion;
+    if ((code == 50 && g5_spline) || (code == 51 && g5_1_spline)) return kMotion;
     if (code >= 382 && code <= 385 && machine.dialect == Dialect::linuxcnc) return kMotion;
     return g_group(code);
-  }
-  bool g5_1_is_spline(const Block& block) const {
-    if (machine.dialect == Dialect::linuxcnc) return true;
-    for (const Word& word : block.words)
-      if (word.letter == 'I' || word.letter == 'J') return true;
-    return false;
   }
 
   void gather(const Block& block) {
     w.present = w.used = 0;
-    g5_1_spline = g5_1_is_spline(block);
+    find_splines(block);
     w.g_count = w.m_count = 0;
     std::array<int, kGroupCount> g_seen{};
     std::array<int, kMGroupCount> m_seen{};

@@ -83,6 +83,9 @@ TEST_CASE("G5.1: biarcs through the quadratic Bezier's points; Fanuc's G5.1 Q1 s
   Result fanuc = run_program("G21 G17 G90 F100\nG0 X0 Y0 Z-1\nG5.1 Q1\nG1 X5\n");
   REQUIRE(fanuc.moves.size() == 2);
   CHECK(fanuc.moves.back().kind == MoveKind::feed);
+  // Fanuc's G05 P10000 (high-speed machining on) stays an unsupported mode, not a spline.
+  CHECK(error_of("G21 G17 G90 F100\nG0 X0 Y0 Z-1\nG05 P10000\n").message.find("unsupported code G5") !=
+        std::string::npos);
   Result spline = run_program("G21 G17 G90 F100\nG0 X0 Y0 Z-1\nG5.1 I2 J4 X6 Y0\n");
   CHECK(moves_of_line(spline, 3).size() == moves_of_line(r, 3).size());
 }
