@@ -11,7 +11,8 @@
 //   cutting back would reverse a move or shorten an arc past its start ("gouging");
 // - compensated moves therefore wait in a queue until the next move decides where they end;
 //   G40, M2/M30 and the end of the program emit them.
-// Compensation works in the XY plane of the program frame (G17) only: the milling case.
+// Compensation works in the XY plane (G17) and, as in LinuxCNC, the XZ plane (G18), whose 2D
+// coordinates are (Z, X) there (interp_convert.cc comp_get_current): plane_uv of state.hpp.
 #include <cmath>
 
 #include "state.hpp"
@@ -24,7 +25,6 @@ constexpr double kConcaveCorner = 0.05;  // rad, LinuxCNC's TOLERANCE_CONCAVE_CO
 constexpr double kEqual = 1e-6;          // LinuxCNC's TOLERANCE_EQUAL
 constexpr double kHalfPi = kPi / 2;
 
-Vec2 xy(const Vec3& p) { return Vec2(p.x, p.y); }
 Vec2 polar(double angle) { return Vec2(std::cos(angle), std::sin(angle)); }
 double angle_of(const Vec2& d) { return std::atan2(d.y, d.x); }
 
@@ -54,7 +54,7 @@ void Interpreter::State::comp_forbid(int column, const std::string& what) const 
 void Interpreter::State::cutter_comp_codes(int code, int column) {
   if (code == 400) {
     if (comp_active() && !comp_first) {
-      comp_move_endpoint_and_flush(xy(comp_current));
+      comp_move_endpoint_and_flush(plane_uv(comp_current));
       comp_dequeue();
       comp_programmed_current = true;  // LinuxCNC: the current point is the programmed one
       comp_arc_forbidden = true;
@@ -64,15 +64,15 @@ void Interpreter::State::cutter_comp_codes(int code, int column) {
     return;
   }
   std::string name = code_name('G', code);
-  if (plane != 170)
+  if (plane != 170 && plane != 180)
     error(column, name + " in " + code_name('G', plane) +
-                      ": cutter compensation works in the XY plane (G17) only");
+                      ": cutter compensation works in the XY (G17) or XZ (G18) plane only");
   if (comp_side != 0) error(column, name + " while cutter compensation is already on (G40 first)");
   int side = code == 410 || code == 411 ? 1 : -1;
   double radius = 0;
   if (code == 411 || code == 421) {  // LinuxCNC: D is the diameter itself
     if (!w.has('D')) error(column, name + " needs D (the tool diameter)");
-    if (w.has('L')) error(w.col('L'), name + " L (a lathe tool orientation) needs G18, which tridex does not compensate in");
+    if (w.has('L')) error(w.col('L'), name + " L (a lathe tool's orientation) is not simulated: tridex simulates mills");
     radius = length('D') / 2;
   } else {
     int number = tool;
@@ -107,7 +107,7 @@ void Interpreter::State::comp_dequeue() {
     } else {
       Vec3 start = to_program(pos);
       bool ccw = q.turn > 0;
-      arc_chords(start, q.end, q.centre, ccw, std::abs(find_turn(xy(start), q.centre, q.turn, xy(q.end))),
+      arc_chords(start, q.end, q.centre, ccw, std::abs(find_turn(plane_uv(start), q.centre, q.turn, plane_uv(q.end))),
                  q.feed);
     }
   }
@@ -121,7 +121,7 @@ void Interpreter::State::comp_move_endpoint_and_flush(const Vec2& to) {
   if (comp_queue.empty()) return;
   for (CompMove& q : comp_queue) {
     if (q.kind == CompMove::arc) {
-      double r1 = glm::length(xy(q.end) - q.centre), r2 = glm::length(to - q.centre);
+      double r1 = glm::length(plane_uv(q.end) - q.centre), r2 = glm::length(to - q.centre);
       double l2 = find_turn(comp_endpoint, q.centre, q.turn, to);
       if (std::abs(r1 - r2) > 0.01 * unit)
         error(motion_column, "cutter compensation made an arc with mismatched radii " +
@@ -138,8 +138,7 @@ void Interpreter::State::comp_move_endpoint_and_flush(const Vec2& to) {
                                  "(cutter compensation: the corner is too small for the tool radius " +
                                  format_number(comp_radius) + " mm)");
     }
-    q.end.x = to.x;
-    q.end.y = to.y;
+    q.end = with_plane_uv(q.end, to);
   }
   comp_dequeue();
   comp_endpoint = to;
@@ -152,13 +151,13 @@ void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double
                          "is unknown; position it with X, Y and Z first");
   const double r = comp_radius;
   const int side = comp_side;
-  const Vec2 p = xy(target);
+  const Vec2 p = plane_uv(target);
   CompMove move;
   move.move_kind = kind;
   move.line = line;
   move.feed = move_feed;
   if (comp_first) {  // the entry move (convert_straight_comp1)
-    Vec2 c = xy(to_program(pos));
+    Vec2 c = plane_uv(to_program(pos));
     double distance = glm::length(p - c);
     if (distance <= r)
       error(motion_column, "cutter compensation entry move of length " + format_number(distance) +
@@ -168,7 +167,7 @@ void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double
     comp_endpoint = c;
     comp_endpoint_valid = true;
     move.direction = polar(alpha);  // as LinuxCNC records it
-    move.end = Vec3(end, target.z);
+    move.end = with_plane_uv(target, end);
     comp_queue.push_back(move);
     comp_first = false;
     comp_current = move.end;
@@ -177,10 +176,10 @@ void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double
     return;
   }
   // Later moves (convert_straight_comp2).
-  const Vec2 c = xy(comp_current);
-  const Vec2 op = xy(comp_programmed);
+  const Vec2 c = plane_uv(comp_current);
+  const Vec2 op = plane_uv(comp_programmed);
   Vec2 end = c;
-  if (p.x == op.x && p.y == op.y) {  // no XY motion: stays where the tool is, for now
+  if (p.x == op.x && p.y == op.y) {  // no motion in the plane: stays where the tool is, for now
     move.direction = Vec2(0.0);
   } else {
     double theta = angle_of(c - op);
@@ -208,7 +207,7 @@ void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double
     if (!concave && beta > kConcaveCorner) {  // convex corner: an arc about it (G0: a line)
       comp_move_endpoint_and_flush(c);
       CompMove corner = move;
-      corner.end = Vec3(mid, comp_current.z);
+      corner.end = with_plane_uv(comp_current, mid);
       if (kind == MoveKind::rapid) {
         corner.direction = Vec2(0.0);
       } else {
@@ -231,7 +230,7 @@ void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double
         meet = c + retreat * polar(theta + gamma);
       } else {  // arc to line: where the offset arc meets the offset line
         const CompMove& prev = *front;
-        double old_radius = glm::length(prev.centre - xy(prev.end));
+        double old_radius = glm::length(prev.centre - plane_uv(prev.end));
         double base = angle_of(p - op);
         double th = prev.turn > 0 ? base + kHalfPi : base - kHalfPi;
         double phi = angle_of(prev.centre - op);
@@ -254,7 +253,7 @@ void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double
     }
     move.direction = p - op;
   }
-  move.end = Vec3(end, target.z);
+  move.end = with_plane_uv(target, end);
   comp_queue.push_back(move);
   comp_current = move.end;
   comp_programmed = target;
@@ -279,9 +278,9 @@ void Interpreter::State::comp_arc(bool ccw) {
                                 " mm is not less than the arc radius (cutter compensation)";
   if (comp_first) {  // the entry arc (convert_arc_comp1)
     Vec3 current = to_program(pos);
-    Vec2 c = xy(current);
+    Vec2 c = plane_uv(current);
     ArcData a = arc_data(current, ccw);
-    Vec2 end = xy(a.end);
+    Vec2 end = plane_uv(a.end);
     if (glm::length(end - c) <= r)
       error(motion_column, "cutter compensation entry arc: its end is not farther than the tool "
                            "radius " + format_number(r) + " mm from its start");
@@ -298,7 +297,7 @@ void Interpreter::State::comp_arc(bool ccw) {
     double a_angle = angle_of(c - end) - ab;
     if (std::abs(std::cos(a_angle)) < kEqual) error(motion_column, too_small);
     Vec2 centre = end + (b_len / std::cos(a_angle)) * polar(ab);
-    move.end = Vec3(end, a.end.z);
+    move.end = with_plane_uv(a.end, end);
     move.centre = centre;
     move.original_sweep = find_turn(c, centre, turn, end);
     comp_queue.push_back(move);
@@ -307,10 +306,10 @@ void Interpreter::State::comp_arc(bool ccw) {
     return;
   }
   // Later arcs (convert_arc_comp2).
-  const Vec2 op = xy(comp_programmed);
-  const Vec2 c = xy(comp_current);
+  const Vec2 op = plane_uv(comp_programmed);
+  const Vec2 c = plane_uv(comp_current);
   ArcData a = arc_data(comp_programmed, ccw);
-  const Vec2 centre = a.centre, end = xy(a.end);
+  const Vec2 centre = a.centre, end = plane_uv(a.end);
   double arc_radius = glm::length(centre - end);
   double theta = angle_of(c - op) + (side > 0 ? -kHalfPi : kHalfPi);
   double delta = angle_of(centre - op);
@@ -327,7 +326,7 @@ void Interpreter::State::comp_arc(bool ccw) {
     delta += kPi;
   }
   Vec2 new_end = end + r * polar(gamma);
-  move.end = Vec3(new_end, a.end.z);
+  move.end = with_plane_uv(a.end, new_end);
   move.centre = centre;
   move.original_sweep = find_turn(op, centre, turn, end);
   const std::string gouge = "arc move in a concave corner cannot be reached by the tool without "
@@ -346,7 +345,7 @@ void Interpreter::State::comp_arc(bool ccw) {
       meet = centre + from_centre * polar(angle);
     } else {  // arc to arc: where the two offset circles cross
       const CompMove& prev = *front;
-      double old_radius = glm::length(prev.centre - xy(prev.end));
+      double old_radius = glm::length(prev.centre - plane_uv(prev.end));
       double new_radius = inside ? arc_radius - r : arc_radius + r;
       double centres = glm::length(prev.centre - centre);
       if (old_radius == 0 || centres == 0)
@@ -367,7 +366,7 @@ void Interpreter::State::comp_arc(bool ccw) {
     Vec2 mid = op + r * polar(delta);
     comp_dequeue();
     CompMove corner = move;
-    corner.end = Vec3(mid, comp_current.z);
+    corner.end = with_plane_uv(comp_current, mid);
     corner.centre = op;
     corner.turn = side > 0 ? -1 : 1;
     corner.original_sweep = 0;

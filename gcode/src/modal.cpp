@@ -64,7 +64,7 @@ Flow Interpreter::State::execute(const Block& block) {
   int motion_code = -1, nonmodal = -1, tilt = -1, orient = -1;
   for (int i = 0; i < w.g_count; ++i) {
     const Code& g = w.g[static_cast<std::size_t>(i)];
-    int group = g_group(g.code);
+    int group = block_g_group(g.code);
     if (group == kMotion) {
       motion_code = g.code;
       motion_column = g.column;
@@ -158,10 +158,7 @@ Flow Interpreter::State::execute(const Block& block) {
   tool_length_codes();
   tool_center_codes();  // G43.4/G43.5 TCP, G254/G255 DWO (rotary.cpp)
   // Look-ahead and smoothing modes change how the control follows the path, not the path.
-  if (w.find_g(51)) {
-    if (machine.dialect == Dialect::linuxcnc)  // LinuxCNC's G5.1 is a quadratic spline: a move
-      error(w.find_g(51), "G5.1 (LinuxCNC's quadratic B-spline) is not supported: write the curve as "
-                          "G1 or G2/G3 moves");
+  if (w.find_g(51) && motion_code != 51) {  // Fanuc's G5.1 Q (a spline G5.1 is a motion)
     for (char c : {'Q', 'R'})
       if (w.has(c)) w.take(c);
   }
@@ -295,13 +292,18 @@ Flow Interpreter::State::execute(const Block& block) {
     } else if (motion == 20 || motion == 30) {
       char cu = kCenterLetter[plane_axes(plane)[0]], cv = kCenterLetter[plane_axes(plane)[1]];
       if (axes || motion_code >= 0 || w.has(cu) || w.has(cv) || w.has('R')) arc(motion == 30);
+    } else if (motion >= 382 && motion <= 385) {
+      if (axes || motion_code >= 0) probe(motion);
+    } else if (motion == 50 || motion == 51) {
+      if (axes || motion_code >= 0 || w.has('I') || w.has('J') || w.has('P') || w.has('Q'))
+        spline(motion == 51);
     } else if (is_cycle(motion)) {
       if (axes || motion_code >= 0 || w.has('R')) {
         comp_forbid(motion_column, "a canned cycle");
         cycle(motion);
       }
     } else if (axes) {
-      error(motion_column, "X/Y/Z without an active motion mode (G0, G1, G2, G3 or a cycle)");
+      error(motion_column, "X/Y/Z without an active motion mode (G0, G1, G2, G3, G5, G5.1 or a cycle)");
     }
   }
 

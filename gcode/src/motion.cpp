@@ -219,6 +219,49 @@ void Interpreter::State::arc_chords(const Vec3& start, const Vec3& end, const Ve
   pos = to_machine(end);
 }
 
+// ---- straight probes ----
+// LinuxCNC's G38.2 / G38.3 (towards the part, G38.3 without error when nothing is touched) and
+// G38.4 / G38.5 (away from it), as its rs274 run standalone reads them (interp_convert.cc
+// convert_probe, the errors; sai/saicanon.cc STRAIGHT_PROBE, the position): the probe reaches the
+// programmed point and stops 0.254 mm (0.01 in) back towards where it started, and the next
+// block starts there. #5061–#5063 hold the programmed point, #5070 is 0 (standalone's "not
+// tripped"). Where a real probe touches is known only on the machine: said once in the warnings.
+void Interpreter::State::probe(int code) {
+  const std::string name = code_name('G', code);
+  if (comp_side != 0) error(motion_column, name + ": cannot probe with cutter radius compensation on");
+  if (!(feed > 0)) error(motion_column, name + ": cannot probe with zero feed rate");
+  Vec3 current = comp_programmed_current ? comp_programmed : to_program(pos);
+  Vec3 target = current;
+  std::array<bool, 3> set{};
+  for (int i = 0; i < 3; ++i) {
+    char c = kAxisLetter[i];
+    if (!w.has(c)) continue;
+    double v = length(c);
+    target[i] = incremental ? current[i] + v : v;
+    set[static_cast<std::size_t>(i)] = !incremental;
+  }
+  comp_programmed_current = false;
+  comp_arc_forbidden = false;
+  const bool must_move = code == 382 || code == 384;  // G38.3/G38.5 may stand still
+  if (must_move && target == current)
+    error(motion_column, name + ": start point too close to probe point (the probe does not move)");
+  if (!warned_probe) {
+    warned_probe = true;
+    warn(motion_column, name + " read as LinuxCNC's rs274 standalone does: the probe reaches the "
+                               "programmed point and backs off 0.254 mm; where it really touches is "
+                               "known only on the machine");
+  }
+  move_to(target, set, rotation, origin, MoveKind::feed, feed);
+  for (int i = 0; i < 3; ++i)
+    globals[5061 + i] = Value{target[i] / unit, false};
+  globals[5070] = Value{0, false};
+  double distance = glm::length(target - current);
+  if (far || !(distance > 0)) return;
+  Vec3 back = to_machine(target + 0.254 * (current - target) / distance);
+  emit(MoveKind::feed, pos, back, feed);
+  pos = back;
+}
+
 // ---- canned cycles ----
 void Interpreter::State::cycle(int code) {
   const std::array<int, 3> axes = plane_axes(plane);

@@ -53,7 +53,19 @@ void Interpreter::State::rotary_words() {
     if (unused && (!first || w.col(c) < first)) first = w.col(c);
   }
   if (!first) return;
-  if (!machine.kinematics) return;  // the unused-word check refuses them, naming the machine file
+  if (!machine.kinematics) {
+    // The unused-word check refuses them, naming the machine file, except on LinuxCNC: without
+    // kinematics (trivkins) A/B/C are axes of their own, as rs274 reads them, that turn nothing.
+    if (machine.dialect != Dialect::linuxcnc) return;
+    for (char c : {'A', 'B', 'C'})
+      if (w.has(c) && !((w.used >> letter_index(c)) & 1u)) w.take(c);
+    if (!warned_plain_rotary) {
+      warned_plain_rotary = true;
+      warn(first, "A/B/C read as plain axes, as LinuxCNC does on a machine without kinematics: the "
+                  "tool does not tilt (give the machine file \"kinematics\" to simulate them)");
+    }
+    return;
+  }
   const Kinematics& kin = *machine.kinematics;
   if (motion != 0 && motion != 10)
     error(first, "A/B/C words need G0 or G1 (a rotary word on an arc or a cycle is a 5-axis move)");

@@ -58,6 +58,7 @@ struct Interpreter::State : ParameterReader {
   Vec3 work_offset{0.0};
   std::map<int, Vec3> offsets;
   double feed = 0;
+  Vec2 spline_mirror{0.0};  // G5 without I J: P1 − P0, program units (−P, −Q of the last G5)
   double speed = 0;
   int spindle_direction = 0;
   int tool_selected = 0;
@@ -112,6 +113,8 @@ struct Interpreter::State : ParameterReader {
   bool warned_home = false;
   bool warned_reference2 = false;
   std::set<int> warned_m_codes;
+  bool warned_plain_rotary = false;  // A/B/C on a LinuxCNC machine without kinematics
+  bool warned_probe = false;         // G38.x read as rs274 standalone does
   Vec3 local_offset{0.0};  // G52 / G92 (one register, as LinuxCNC keeps it), machine axes
   Vec3 saved_local_offset{0.0};  // G92.2 suspends, G92.3 restores
   Vec3 world_origin{0.0};
@@ -190,8 +193,30 @@ struct Interpreter::State : ParameterReader {
   }
 
   // ---- words ----
+  // G5 and G5.1 are LinuxCNC's splines (motions). On Fanuc they are modes: G5 P10000 / G5 P0
+  // high-speed machining, G5.1 Q1 AI contour control (smoothing). So they are splines under the
+  // LinuxCNC dialect, and elsewhere where the block has a spline's words: G5 with X, Y, I, J or
+  // Q, G5.1 with I or J.
+  bool g5_spline = false, g5_1_spline = false;  // of the block being gathered
+  void find_splines(const Block& block) {
+    g5_spline = g5_1_spline = machine.dialect == Dialect::linuxcnc;
+    for (const Word& word : block.words) {
+      bool ij = word.letter == 'I' || word.letter == 'J';
+      g5_spline |= ij || word.letter == 'X' || word.letter == 'Y' || word.letter == 'Q';
+      g5_1_spline |= ij;
+    }
+  }
+  // The modal group of a G code in this block: g_group, and the motions of the LinuxCNC dialect
+  // (G5 and G5.1 splines, G38.2–G38.5 straight probes).
+  int block_g_group(int code) const {
+    if ((code == 50 && g5_spline) || (code == 51 && g5_1_spline)) return kMotion;
+    if (code >= 382 && code <= 385 && machine.dialect == Dialect::linuxcnc) return kMotion;
+    return g_group(code);
+  }
+
   void gather(const Block& block) {
     w.present = w.used = 0;
+    find_splines(block);
     w.g_count = w.m_count = 0;
     std::array<int, kGroupCount> g_seen{};
     std::array<int, kMGroupCount> m_seen{};
@@ -203,7 +228,7 @@ struct Interpreter::State : ParameterReader {
         bool integral = std::abs(scaled - rounded) < 1e-6 && word.value >= 0 && word.value < 10000;
         int code = integral ? static_cast<int>(rounded) : -1;
         if (word.letter == 'M' && code % 10) integral = false;
-        int group = !integral ? -1 : word.letter == 'G' ? g_group(code) : m_group(code / 10);
+        int group = !integral ? -1 : word.letter == 'G' ? block_g_group(code) : m_group(code / 10);
         if (group < 0 && integral && word.letter == 'M') {
           // An M-code moves no axis: accepted (once a warning per code unless the machine
           // declares it), an error where the machine forbids it.
@@ -231,17 +256,18 @@ struct Interpreter::State : ParameterReader {
           if (word.letter == 'G' && code >= 382 && code <= 385)  // never skipped: it moves
             error(word.column, name + " (probing) is not simulated: where the probe touches, and so "
                                       "where the tool goes next, is known only on the machine; "
-                                      "leave the probing cycle out of the program tridex reads");
+                                      "leave the probing cycle out of the program tridex reads (or, "
+                                      "with --machine linuxcnc, read it as rs274 does)");
           if (word.letter == 'G' && integral && machine.dialect == Dialect::linuxcnc) {
             // Never skipped, even lenient: each moves the tool. LinuxCNC's lathe codes (G7
             // diameter mode, G33 threading, G70-G72 turning cycles, G76 threading cycle) have no
-            // meaning on a mill; G5 and G5.2 are splines tridex does not follow.
+            // meaning on a mill; G5.2 is a NURBS tridex does not follow.
             static constexpr int kLathe[] = {70, 330, 700, 710, 711, 712, 720, 721, 722, 760};
             if (std::find(std::begin(kLathe), std::end(kLathe), code) != std::end(kLathe))
               error(word.column, name + " is a lathe code: tridex simulates milling machines");
-            if (code == 50 || code == 52)
-              error(word.column, name + " (LinuxCNC's " + (code == 50 ? "cubic spline" : "NURBS") +
-                                     ") is not supported: write the curve as G1 or G2/G3 moves");
+            if (code == 52)
+              error(word.column, name + " (LinuxCNC's NURBS) is not supported: write the curve as "
+                                        "G1 or G2/G3 moves");
           }
           unsupported(word.column, "unsupported code " + name, "code " + name, harmless && !coordinates);
           continue;
@@ -395,6 +421,18 @@ struct Interpreter::State : ParameterReader {
   Vec2 comp_endpoint{0.0};             // where the queued moves start (program frame)
   bool comp_endpoint_valid = false;
   bool comp_active() const { return comp_side != 0 && comp_radius > 0; }
+  // A program point's coordinates in the active plane, (u, v) of plane_axes (G17: X Y; G18: Z X,
+  // LinuxCNC's order for compensation), and a point with those replaced.
+  Vec2 plane_uv(const Vec3& p) const {
+    const std::array<int, 3> a = plane_axes(plane);
+    return Vec2(p[a[0]], p[a[1]]);
+  }
+  Vec3 with_plane_uv(Vec3 p, const Vec2& q) const {
+    const std::array<int, 3> a = plane_axes(plane);
+    p[a[0]] = q.x;
+    p[a[1]] = q.y;
+    return p;
+  }
   void cutter_comp_codes(int code, int column);  // G40, G41, G42, G41.1, G42.1
   void comp_forbid(int column, const std::string& what) const;
   void comp_straight(MoveKind kind, const Vec3& target, double move_feed);
@@ -402,7 +440,7 @@ struct Interpreter::State : ParameterReader {
   void comp_move_endpoint_and_flush(const Vec2& to);
   void comp_dequeue();
   void comp_finish() {  // at the end of the program: emit what waits
-    if (!comp_queue.empty()) comp_move_endpoint_and_flush(Vec2(comp_current));
+    if (!comp_queue.empty()) comp_move_endpoint_and_flush(plane_uv(comp_current));
   }
 
   // ---- motion (motion.cpp) ----
@@ -421,6 +459,11 @@ struct Interpreter::State : ParameterReader {
   void arc_chords(const Vec3& start, const Vec3& end, const Vec2& c, bool ccw, double sweep,
                   double move_feed);
   void cycle(int code);
+  // LinuxCNC's G5 / G5.1 splines as biarcs (spline.cpp).
+  void spline(bool quadratic);
+  void biarc(const Vec2& p0, const Vec2& t0, const Vec2& p4, const Vec2& t4, double z);
+  void spline_piece(const Vec2& from, const Vec2& to, const Vec2& tangent, double z);
+  void probe(int code);  // LinuxCNC's G38.2–G38.5 (motion.cpp)
   void machine_move(const Vec3& target, unsigned mask, MoveKind kind, double move_feed);
   void polar_words(bool axis_consumer, int nonmodal);  // LinuxCNC @ and ^ become X and Y (motion.cpp)
   void home_return(bool second);

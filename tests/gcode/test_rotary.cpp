@@ -237,3 +237,21 @@ TEST_CASE("rotary 3+2, lenient: every line read otherwise is counted, past the 1
                 "(lines 1504, 1505, 1506, 1507, 1508, …)") != "");
   CHECK(r.warnings.size() == 1000 + 3);  // capped per line; three summaries (A10, A20, the plane)
 }
+
+TEST_CASE("A/B/C on a LinuxCNC machine without kinematics are plain axes, as in rs274; elsewhere errors") {
+  MachineConfig linuxcnc = *MachineConfig::bundled("linuxcnc");
+  Result r = run_program("G21 G90 F100\nG0 X1 Y2 Z3 A90\nG1 X4 B45 C10\nG0 A0\nG2 X6 Y2 I1 J0 C5\nM2\n", {}, linuxcnc);
+  REQUIRE(r.moves.size() >= 3);
+  CHECK(near(r.moves[0].end, Vec3(1, 2, 3)));
+  CHECK(near(r.moves[1].end, Vec3(4, 2, 3)));
+  CHECK(near(r.moves.back().end, Vec3(6, 2, 3)));
+  for (const Move& m : r.moves) CHECK(near(m.axis, Vec3(0, 0, 1)));  // the tool never tilts
+  REQUIRE(r.warnings.size() == 1);
+  CHECK(r.warnings[0].line == 2);
+  CHECK(r.warnings[0].column == 13);
+  CHECK(r.warnings[0].message.find("does not tilt") != std::string::npos);
+  // Without --machine (and on a machine file without kinematics) they stay an error at the word.
+  Diagnostic d = error_of("G21 G90 F100\nG0 X1 Y2 Z3 A90\n", {}, at_origin());
+  CHECK(d.column == 13);
+  CHECK(d.message.find("kinematics") != std::string::npos);
+}

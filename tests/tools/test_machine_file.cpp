@@ -357,6 +357,20 @@ TEST_CASE("--tools with tool lengths: G43 H names the tip, G49 the gauge point (
     CHECK(m[2]["end"] == nlohmann::json::array({2, 1, -12.7}));
     CHECK(m[3]["end"] == nlohmann::json::array({2, 1, 5}));
   }
+  // A metric machine (LinuxCNC's LINEAR_UNITS = mm): the same .tbl written in mm.
+  write_text(dir / "mm.tbl", "T1 P1 D3.175 Z+12.7 ;1/8 end mill\n");
+  write_text(dir / "metric.json", R"({"base": "linuxcnc", "linear_units": "mm"})");
+  CommandResult metric = run_tridex({"moves", (dir / "p.ngc").string(), "--machine", (dir / "metric.json").string(),
+                                     "--tools", (dir / "mm.tbl").string()},
+                                    dir);
+  REQUIRE(metric.status == 0);
+  auto mm = moves_of(metric);
+  REQUIRE(mm.size() == 4);
+  CHECK(mm[1]["end"] == nlohmann::json::array({1, 1, -12.7}));
+  write_text(dir / "typo.json", R"({"base": "linuxcnc", "linear_units": "metric"})");
+  CommandResult typo = run_tridex({"moves", (dir / "p.ngc").string(), "--machine", (dir / "typo.json").string()}, dir);
+  CHECK(typo.status == 2);
+  CHECK(typo.err.find("\"linear_units\": \"mm\" or \"inch\", got \"metric\"") != std::string::npos);
   write_text(dir / "bad.tbl", "T1 P1 D0.125 Z+0.5\nT2 P2 Dx\n");
   CommandResult r = run_tridex({"moves", (dir / "p.ngc").string(), "--tools", (dir / "bad.tbl").string()}, dir);
   CHECK(r.status == 2);

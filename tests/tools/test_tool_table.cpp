@@ -258,6 +258,13 @@ TEST_CASE("LinuxCNC .tbl tool tables: diameters and lengths in inches, comments 
   CHECK(table.tool_lengths().at(98876) == doctest::Approx(2.54));
 }
 
+TEST_CASE("LinuxCNC .tbl tool tables in mm (a machine whose LINEAR_UNITS are mm)") {
+  ToolTable table = ToolTable::from_tbl("T1 P1 D6 Z+50.5 ;6 mm\n", "mm.tbl", 1.0);
+  REQUIRE(table.find(1) != nullptr);
+  CHECK(table.find(1)->diameter_mm == 6);
+  CHECK(table.tool_lengths().at(1) == 50.5);
+}
+
 TEST_CASE("LinuxCNC .tbl tool tables: bad lines name file, line, column and the word") {
   auto error_of_tbl = [](const std::string& text) {
     try {

@@ -132,6 +132,10 @@ gcode::MachineConfig parse(const json& doc, const std::string& file, MachineRate
       std::string u = string_value(value, where).get<std::string>();
       if (u != "mm" && u != "inch") input_error(where, ": \"mm\" or \"inch\", got \"", u, "\"");
       m.inch_at_start = u == "inch";
+    } else if (key == "linear_units") {  // LinuxCNC's [TRAJ]LINEAR_UNITS: a .tbl's units
+      std::string u = string_value(value, where).get<std::string>();
+      if (u != "mm" && u != "inch") input_error(where, ": \"mm\" or \"inch\", got \"", u, "\"");
+      m.tool_table_in_inches = u == "inch";
     } else if (key == "start") {
       if (value.is_string() && value.get<std::string>() == "far")
         m.start_position.reset();

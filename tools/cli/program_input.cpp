@@ -29,7 +29,8 @@ ProgramInput resolve_program(const CommonOptions& options) {
   } else {
     input.files.push_back(input.program);
   }
-  if (!options.tools.empty()) input.tools = ToolTable::read(options.tools);
+  if (!options.tools.empty())
+    input.tools = ToolTable::read(options.tools, input.machine.tool_table_in_inches ? 25.4 : 1.0);
   if (input.tools) {  // cutter compensation (G41/G42 D) offsets by half a tool's diameter
     for (const auto& [number, spec] : input.tools->tools()) input.machine.tool_diameters[number] = spec.diameter_mm;
     input.machine.tool_lengths = input.tools->tool_lengths();  // G43 H

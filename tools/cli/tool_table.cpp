@@ -200,7 +200,7 @@ ToolTable ToolTable::from_json(const nlohmann::json& table, const std::string& s
   return result;
 }
 
-ToolTable ToolTable::from_tbl(const std::string& text, const std::string& source) {
+ToolTable ToolTable::from_tbl(const std::string& text, const std::string& source, double unit_mm) {
   ToolTable result;
   std::map<int, int> line_of;  // tool number -> its line, to name both of a duplicate
   int line = 0;
@@ -250,8 +250,7 @@ ToolTable ToolTable::from_tbl(const std::string& text, const std::string& source
       if (auto it = words.find(c); it != words.end() && it->second.first != 0)
         input_error(source, ":", line, ":", it->second.second, ": tool ", number, " has a sideways offset ", c,
                     it->second.first, ", which tridex does not simulate");
-    constexpr double kInch = 25.4;  // rs274 standalone's units for a tool table
-    if (auto z = words.find('Z'); z != words.end()) result.tool_lengths_[number] = kInch * z->second.first;
+    if (auto z = words.find('Z'); z != words.end()) result.tool_lengths_[number] = unit_mm * z->second.first;
     auto d = words.find('D');
     if (d == words.end() || d->second.first == 0) continue;  // a length only: it cannot cut
     std::string where = source + ":" + std::to_string(line) + ": tool " + std::to_string(number);
@@ -259,7 +258,7 @@ ToolTable ToolTable::from_tbl(const std::string& text, const std::string& source
     ToolSpec spec;
     spec.number = number;
     spec.shape = "cylindrical";
-    spec.diameter_mm = kInch * d->second.first;
+    spec.diameter_mm = unit_mm * d->second.first;
     spec.description = description;
     spec.cutter = make_cutter(spec, where);
     spec.body = make_body(spec, where);
@@ -360,8 +359,9 @@ ToolTable ToolTable::from_fusion_json(const nlohmann::json& library, const std::
   return result;
 }
 
-ToolTable ToolTable::read(const std::filesystem::path& path) {
-  if (lower(path.extension().string()) == ".tbl") return from_tbl(read_text_file(path, "a tool table"), path.string());
+ToolTable ToolTable::read(const std::filesystem::path& path, double tbl_unit_mm) {
+  if (lower(path.extension().string()) == ".tbl")
+    return from_tbl(read_text_file(path, "a tool table"), path.string(), tbl_unit_mm);
   nlohmann::json json = read_json_file(path);
   if (json.is_object() && json.contains("data") && json["data"].is_array())
     return from_fusion_json(json, path.string());

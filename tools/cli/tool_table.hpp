@@ -26,7 +26,8 @@
 //
 // The third format, a LinuxCNC tool table (.tbl), is read by from_tbl: one tool a line,
 // `T1 P1 Z0.511 D0.125 ;comment`, T the tool number, Z its length, D its diameter (a flat end
-// mill), in inches, as rs274 run standalone reads them; the comment is its description. X/Y
+// mill), in the machine's units (LinuxCNC's [TRAJ]LINEAR_UNITS, the machine file's
+// "linear_units"): inches unless it says mm, as rs274 run standalone reads them; the comment is its description. X/Y
 // offsets other than 0 are an error (tridex does not simulate them); P, the pocket, and the
 // other axes' offsets and lathe entries (I J Q) are ignored. A tool without D keeps its length
 // (for G43) but cannot cut.
@@ -74,9 +75,11 @@ class ToolTable {
   // Parses a Fusion tool library (`{"data": [...]}`); throws InputError naming the tool and field.
   static ToolTable from_fusion_json(const nlohmann::json& library, const std::string& source);
   // Parses a LinuxCNC tool table; throws InputError naming source:line:column and the word.
-  static ToolTable from_tbl(const std::string& text, const std::string& source);
-  // Reads any format (a .tbl file name: LinuxCNC; a Fusion library is an object with a "data" list).
-  static ToolTable read(const std::filesystem::path& path);
+  // `unit_mm`: millimetres per table unit (25.4: inches).
+  static ToolTable from_tbl(const std::string& text, const std::string& source, double unit_mm = 25.4);
+  // Reads any format (a .tbl file name: LinuxCNC, in `tbl_unit_mm`; a Fusion library is an object
+  // with a "data" list).
+  static ToolTable read(const std::filesystem::path& path, double tbl_unit_mm = 25.4);
 
   const ToolSpec* find(int number) const {
     auto it = tools_.find(number);

@@ -112,6 +112,9 @@ struct MachineConfig {
   // tip); with some, G43 H / G43.1 / G44 H / G49 shift which point the program names (gcode/README.md,
   // "Tool length offsets").
   std::map<int, double> tool_lengths;
+  // The units of a LinuxCNC tool table (.tbl) for this machine: LinuxCNC reads it in machine
+  // units, its INI's [TRAJ]LINEAR_UNITS; rs274 run standalone, with no INI, in inches.
+  bool tool_table_in_inches = true;
 
   void set_home(const Vec3& p) {
     home = p;
