@@ -261,10 +261,10 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   progress.stage("parsing " + input.program.string());
   Clock::time_point t = Clock::now();
   gcode::DirectionGrouper grouper;
-  // simulate must hold every move: grouped by direction (a vector's capacity can be twice its
-  // size), then as one direction's cutter sweeps while it is milled. What the process already
-  // holds (the libraries, a design read) leaves that much less for them.
-  MoveBudget budget(max_memory, 2.0 * sizeof(gcode::Move) + sizeof(CutMove) + sizeof(void*));
+  // simulate must hold every move: grouped by direction (a MoveList holds no spare copies), then
+  // as one direction's cutter sweeps while it is milled. What the process already holds (the
+  // libraries, a design read) leaves that much less for them.
+  MoveBudget budget(max_memory, sizeof(gcode::Move) + sizeof(CutMove) + sizeof(void*));
   Aabb cutting_bounds;
   const std::optional<gcode::Kinematics>& kinematics = input.machine.kinematics;
   // Positions "far along the tool axis" stand in for where the machine takes the tool: no travel.
@@ -323,24 +323,25 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
     // The program order loses them too: each run keeps the count of its moves that stay.
     std::vector<std::size_t> next(groups.size(), 0);
     for (GroupRun& run : r.order) {
-      const std::vector<gcode::Move>& moves = groups[run.group].moves;
+      const gcode::MoveList& moves = groups[run.group].moves;
       const std::size_t end = next[run.group] + run.moves;
       run.moves = static_cast<std::uint64_t>(std::count_if(moves.begin() + static_cast<std::ptrdiff_t>(next[run.group]),
                                                            moves.begin() + static_cast<std::ptrdiff_t>(end),
                                                            [](const gcode::Move& m) { return m.tool != 0; }));
       next[run.group] = end;
     }
+    // In place: the groups hold every move of the program, and a copy would double that.
     for (gcode::MoveGroup& group : groups) {
-      std::vector<gcode::Move> kept;
-      kept.reserve(group.moves.size());
+      std::size_t toolless = 0;
       for (const gcode::Move& m : group.moves) {
-        if (m.tool != 0) kept.push_back(m);
-        else if (m.kind == gcode::MoveKind::rapid) ++toolless_rapids;
-        else
+        if (m.tool != 0) continue;
+        if (m.kind != gcode::MoveKind::rapid)
           input_error(input.files.size() == 1 ? input.files[0].string() : input.program.string(), ":",
                       m.line, ": a ", gcode::to_string(m.kind), " move with no tool loaded (T… M6)");
+        ++toolless;
       }
-      group.moves = std::move(kept);
+      if (toolless > 0) erase_if(group.moves, [](const gcode::Move& m) { return m.tool == 0; });
+      toolless_rapids += static_cast<long long>(toolless);
     }
   }
   if (toolless_rapids > 0)
