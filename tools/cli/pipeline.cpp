@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "batch_pipe.hpp"
 #include "errors.hpp"
 #include "output.hpp"
 #include "rapid_check.hpp"
@@ -270,12 +271,13 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   // Positions "far along the tool axis" stand in for where the machine takes the tool: no travel.
   const double far = 0.5 * input.machine.far_distance;
   r.machining = MachiningTimer(input.rates, kinematics);
-  InterpretResult parsed = interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t file) {
-    budget.keep(m, input.files[file].string());
+  // Grouping (and the checks that read each move once) runs on a second thread when there is one,
+  // overlapping the interpreter; the budget and the machining time stay on this thread, with the
+  // dwells the timer also reads.
+  BatchPipe<gcode::Move> grouping([&](const gcode::Move& m) {
     const auto group = static_cast<std::uint32_t>(grouper.add(m));
     if (r.order.empty() || r.order.back().group != group) r.order.push_back({group, 0});
     ++r.order.back().moves;
-    r.machining.add(m);
     if (kinematics && glm::length(m.end) < far)
       for (const gcode::TravelViolation& v : gcode::travel_violations(*kinematics, m.machine, m.rotary))
         if (r.travel_count++ < static_cast<long long>(kTravelListed))
@@ -285,7 +287,13 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
       if (!m.from_far) cutting_bounds.extend(m.start);
       cutting_bounds.extend(m.end);
     }
+  }, detail::resolve_threads(options.threads) > 1);
+  InterpretResult parsed = interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t file) {
+    budget.keep(m, input.files[file].string());
+    r.machining.add(m);
+    grouping.push(m);
   }, [&](const gcode::Dwell& d) { r.machining.add(d); });
+  grouping.finish();
   r.groups = grouper.take();
   std::vector<gcode::MoveGroup>& groups = r.groups;
   r.files = std::move(parsed.files);
