@@ -40,8 +40,10 @@ std::size_t DirectionGrouper::add(const Move& move) {
     group.frame = Frame::from_axis(axis);
     groups_.push_back(std::move(group));
   }
-  groups_[found].moves.push_back(move);
-  groups_[found].tools.insert(move.tool);
+  MoveGroup& group = groups_[found];
+  // Tools change rarely: the set is searched only when this move's differs from the last one's.
+  if (group.moves.empty() || group.moves.back().tool != move.tool) group.tools.insert(move.tool);
+  group.moves.push_back(move);
   last_ = found;
   return found;
 }

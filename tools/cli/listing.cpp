@@ -100,8 +100,8 @@ int run_moves(const ListOptions& options) {
 int run_groups(const ListOptions& options) {
   ProgramInput input = resolve_program(options);
   check_output(options.output, input);
-  // The groups hold every move (a vector's capacity can be twice its size).
-  MoveBudget budget(max_memory_bytes(options.max_memory), 2.0 * sizeof(gcode::Move));
+  // The groups hold every move, each once (MoveList).
+  MoveBudget budget(max_memory_bytes(options.max_memory), sizeof(gcode::Move));
   gcode::DirectionGrouper grouper;
   struct Extra {
     long long kinds[4] = {0, 0, 0, 0};

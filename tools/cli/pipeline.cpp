@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "batch_pipe.hpp"
 #include "errors.hpp"
 #include "output.hpp"
 #include "rapid_check.hpp"
@@ -261,21 +262,22 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   progress.stage("parsing " + input.program.string());
   Clock::time_point t = Clock::now();
   gcode::DirectionGrouper grouper;
-  // simulate must hold every move: grouped by direction (a vector's capacity can be twice its
-  // size), then as one direction's cutter sweeps while it is milled. What the process already
-  // holds (the libraries, a design read) leaves that much less for them.
-  MoveBudget budget(max_memory, 2.0 * sizeof(gcode::Move) + sizeof(CutMove) + sizeof(void*));
+  // simulate must hold every move: grouped by direction (a MoveList holds no spare copies), then
+  // as one direction's cutter sweeps while it is milled. What the process already holds (the
+  // libraries, a design read) leaves that much less for them.
+  MoveBudget budget(max_memory, sizeof(gcode::Move) + sizeof(CutMove) + sizeof(void*));
   Aabb cutting_bounds;
   const std::optional<gcode::Kinematics>& kinematics = input.machine.kinematics;
   // Positions "far along the tool axis" stand in for where the machine takes the tool: no travel.
   const double far = 0.5 * input.machine.far_distance;
   r.machining = MachiningTimer(input.rates, kinematics);
-  InterpretResult parsed = interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t file) {
-    budget.keep(m, input.files[file].string());
+  // Grouping (and the checks that read each move once) runs on a second thread when there is one,
+  // overlapping the interpreter; the budget and the machining time stay on this thread, with the
+  // dwells the timer also reads.
+  BatchPipe<gcode::Move> grouping([&](const gcode::Move& m) {
     const auto group = static_cast<std::uint32_t>(grouper.add(m));
     if (r.order.empty() || r.order.back().group != group) r.order.push_back({group, 0});
     ++r.order.back().moves;
-    r.machining.add(m);
     if (kinematics && glm::length(m.end) < far)
       for (const gcode::TravelViolation& v : gcode::travel_violations(*kinematics, m.machine, m.rotary))
         if (r.travel_count++ < static_cast<long long>(kTravelListed))
@@ -285,7 +287,13 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
       if (!m.from_far) cutting_bounds.extend(m.start);
       cutting_bounds.extend(m.end);
     }
+  }, detail::resolve_threads(options.threads) > 1);
+  InterpretResult parsed = interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t file) {
+    budget.keep(m, input.files[file].string());
+    r.machining.add(m);
+    grouping.push(m);
   }, [&](const gcode::Dwell& d) { r.machining.add(d); });
+  grouping.finish();
   r.groups = grouper.take();
   std::vector<gcode::MoveGroup>& groups = r.groups;
   r.files = std::move(parsed.files);
@@ -323,24 +331,25 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
     // The program order loses them too: each run keeps the count of its moves that stay.
     std::vector<std::size_t> next(groups.size(), 0);
     for (GroupRun& run : r.order) {
-      const std::vector<gcode::Move>& moves = groups[run.group].moves;
+      const gcode::MoveList& moves = groups[run.group].moves;
       const std::size_t end = next[run.group] + run.moves;
       run.moves = static_cast<std::uint64_t>(std::count_if(moves.begin() + static_cast<std::ptrdiff_t>(next[run.group]),
                                                            moves.begin() + static_cast<std::ptrdiff_t>(end),
                                                            [](const gcode::Move& m) { return m.tool != 0; }));
       next[run.group] = end;
     }
+    // In place: the groups hold every move of the program, and a copy would double that.
     for (gcode::MoveGroup& group : groups) {
-      std::vector<gcode::Move> kept;
-      kept.reserve(group.moves.size());
+      std::size_t toolless = 0;
       for (const gcode::Move& m : group.moves) {
-        if (m.tool != 0) kept.push_back(m);
-        else if (m.kind == gcode::MoveKind::rapid) ++toolless_rapids;
-        else
+        if (m.tool != 0) continue;
+        if (m.kind != gcode::MoveKind::rapid)
           input_error(input.files.size() == 1 ? input.files[0].string() : input.program.string(), ":",
                       m.line, ": a ", gcode::to_string(m.kind), " move with no tool loaded (T… M6)");
+        ++toolless;
       }
-      group.moves = std::move(kept);
+      if (toolless > 0) erase_if(group.moves, [](const gcode::Move& m) { return m.tool == 0; });
+      toolless_rapids += static_cast<long long>(toolless);
     }
   }
   if (toolless_rapids > 0)

@@ -11,7 +11,7 @@
 #include <span>
 #include <vector>
 
-#include "tridex/gcode/move.hpp"
+#include "tridex/gcode/move_list.hpp"
 #include "tridex/geometry.hpp"
 
 namespace tridex::gcode {
@@ -19,7 +19,7 @@ namespace tridex::gcode {
 struct MoveGroup {
   Vec3 axis{0.0, 0.0, 1.0};  // the direction of the group's first move
   Frame frame;               // Frame::from_axis(axis)
-  std::vector<Move> moves;   // in program order
+  MoveList moves;            // in program order
   std::set<int> tools;
 };
 
