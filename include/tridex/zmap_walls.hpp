@@ -48,11 +48,30 @@ inline bool is_steep_cell(const ZMap& map, int i, int j, double steep_slope) {
   return std::max({a, b, c, d}) - std::min({a, b, c, d}) > steep_slope * map.grid.cell;
 }
 
+// The steep cells of `map` (grid.index of their (i, j) corners), ascending. Rows are split
+// among `threads` threads (0: every hardware thread); the list is the same for any count.
+inline std::vector<std::uint32_t> steep_cells(const ZMap& map, double steep_slope, unsigned threads = 1) {
+  const ZMapGrid& g = map.grid;
+  const auto bands = static_cast<std::size_t>((g.ny - 1 + detail::kMapBandRows - 1) / detail::kMapBandRows);
+  std::vector<std::vector<std::uint32_t>> found(bands);
+  detail::for_each_chunk(bands, threads, [&](std::size_t band) {
+    const int j0 = static_cast<int>(band) * detail::kMapBandRows, j1 = std::min(g.ny - 1, j0 + detail::kMapBandRows);
+    for (int j = j0; j < j1; ++j)
+      for (int i = 0; i + 1 < g.nx; ++i)
+        if (is_steep_cell(map, i, j, steep_slope)) found[band].push_back(static_cast<std::uint32_t>(g.index(i, j)));
+  });
+  std::vector<std::uint32_t> cells;
+  for (const auto& part : found) cells.insert(cells.end(), part.begin(), part.end());
+  return cells;
+}
+
 // Makes the steep cells of `map` fine, with sub-point heights from the moves it was milled with
 // (the same cutters and moves, in its frame). Call it on a map prepared by raise_uncut, last:
-// it reads the map's heights. Throws tridex::Error for a move with a cutter out of range.
+// it reads the map's heights. `cells` are the map's steep cells as steep_cells gives them
+// (with options.steep_slope), for a caller that needed them beforehand. Throws tridex::Error
+// for a move with a cutter out of range.
 inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::span<const CutMove> moves,
-                               WallOptions options = {}) {
+                               std::vector<std::uint32_t> cells, WallOptions options = {}) {
   constexpr int kSteps = ZMapFineCells::kSteps, kSide = ZMapFineCells::kSide;
   constexpr auto kPoints = static_cast<std::size_t>(ZMapFineCells::kPoints);
   for (std::size_t k = 0; k < moves.size(); ++k)
@@ -62,10 +81,6 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
   const ZMapGrid& g = map.grid;
   float ceiling = map.empty_height;
   for (float h : map.heights) ceiling = std::max(ceiling, h);
-  std::vector<std::uint32_t> cells;
-  for (int j = 0; j + 1 < g.ny; ++j)
-    for (int i = 0; i + 1 < g.nx; ++i)
-      if (is_steep_cell(map, i, j, options.steep_slope)) cells.push_back(static_cast<std::uint32_t>(g.index(i, j)));
   if (cells.empty()) {
     map.fine = {};
     return;
@@ -188,6 +203,12 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
     for (std::thread& th : pool) th.join();
   }
   map.set_fine_cells(std::move(cells), std::move(sub));
+}
+
+// The same, finding the steep cells itself.
+inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::span<const CutMove> moves,
+                               WallOptions options = {}) {
+  refine_steep_cells(map, cutters, moves, steep_cells(map, options.steep_slope, options.threads), options);
 }
 
 }  // namespace tridex

@@ -182,13 +182,6 @@ void check_dump_names(const std::string& directory, const std::vector<gcode::Mov
 
 }  // namespace
 
-std::size_t count_steep_cells(const ZMap& map, double steep_slope) {
-  std::size_t cells = 0;
-  for (int j = 0; j + 1 < map.grid.ny; ++j)
-    for (int i = 0; i + 1 < map.grid.nx; ++i) cells += is_steep_cell(map, i, j, steep_slope) ? 1 : 0;
-  return cells;
-}
-
 double fine_cell_bytes(double cells, double rows, double moves, double bands_per_move) {
   constexpr double kSubHeights = 4.0 * ZMapFineCells::kPoints;
   const double per_cell = (kSubHeights + 2 * 4 + 4) + (kSubHeights + 4 + 4);
@@ -466,16 +459,19 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   if (request.keep_maps) kept_maps = maps;
   // Then walls parallel to a spindle are placed inside their cells: the steep cells take finer
   // heights from the moves (zmap_walls.hpp).
-  for (std::size_t g = 0; g < maps.size(); ++g)
-    raise_uncut(maps[g], stock.mesh ? ZMap::from_mesh(groups[g].frame, *stock.mesh, zmap_cell, limits)
-                                    : ZMap::from_box(groups[g].frame, stock.box, zmap_cell, limits));
+  for (std::size_t g = 0; g < maps.size(); ++g) {
+    if (stock.mesh) raise_uncut(maps[g], ZMap::from_mesh(groups[g].frame, *stock.mesh, zmap_cell, limits), options.threads);
+    else raise_uncut(maps[g], stock.box, options.threads);
+  }
   if (request.fine_cells) {
     // How many cells are steep is known only now: their sub-grids are checked against
     // --max-memory before any is allocated.
+    std::vector<std::vector<std::uint32_t>> steep(maps.size());
     std::size_t steep_cells = 0;
     double rows = 0, most_moves = 0;
     for (std::size_t g = 0; g < maps.size(); ++g) {
-      steep_cells += count_steep_cells(maps[g], WallOptions{}.steep_slope);
+      steep[g] = tridex::steep_cells(maps[g], WallOptions{}.steep_slope, options.threads);
+      steep_cells += steep[g].size();
       rows += maps[g].grid.ny;
       most_moves = std::max(most_moves, static_cast<double>(groups[g].moves.size()));
     }
@@ -490,11 +486,12 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
                   format_mib(r.memory.walls), " on top of ", format_mib(r.memory.total() - r.memory.walls),
                   ", more than --max-memory ", format_mib(static_cast<double>(max_memory)),
                   "; use a larger --zmap-cell or --dexel-cell, or a smaller --dexel-res");
+    std::vector<CutMove> moves;  // one buffer for every direction: its pages are touched once
+    moves.reserve(static_cast<std::size_t>(most_moves));
     for (std::size_t g = 0; g < maps.size(); ++g) {
-      std::vector<CutMove> moves;
-      moves.reserve(groups[g].moves.size());
+      moves.clear();
       for (const gcode::Move& m : groups[g].moves) moves.push_back(cut_move(groups[g], m, cutter_of_tool));
-      refine_steep_cells(maps[g], cutters, moves, {.threads = options.threads});
+      refine_steep_cells(maps[g], cutters, moves, std::move(steep[g]), {.threads = options.threads});
     }
   }
   progress.stage("dexelizing the stock");
