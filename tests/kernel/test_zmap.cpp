@@ -232,13 +232,13 @@ TEST_CASE("from_box and raise_uncut in row bands on any thread count match the o
   // than 64 rows, so that the bands' borders (and the rows each band reads beyond them) count.
   std::mt19937 rng(29);
   std::uniform_real_distribution<double> u(0, 1);
-  const Aabb stock{Vec3(0, 0, 0), Vec3(12, 9, 4)};
+  const Aabb stock{Vec3(0, 0, 0), Vec3(12, 9, 8)};
   const std::vector<Cutter> cutters{Cutter::ball(0.6), Cutter::flat(0.9), Cutter::bull_nose(1.0, 0.3)};
   for (int trial = 0; trial < 8; ++trial) {
     CAPTURE(trial);
     const Vec3 axis = trial == 0 ? Vec3(0, 0, 1) : glm::normalize(Vec3(2 * u(rng) - 1, 2 * u(rng) - 1, 0.2 + u(rng)));
     const Frame f = Frame::from_axis(axis);
-    const double cell = 0.05 + 0.05 * u(rng);
+    const double cell = 0.03 + 0.03 * u(rng);
     const ZMap initial = from_box_reference(f, stock, cell);
     for (unsigned threads : {1u, 2u, 3u}) CHECK(ZMap::from_box(f, stock, cell, {}, threads).heights == initial.heights);
     REQUIRE(initial.grid.ny > 2 * detail::kMapBandRows);
@@ -265,5 +265,5 @@ TEST_CASE("from_box and raise_uncut in row bands on any thread count match the o
   }
   // The box's grid must be the map's.
   ZMap other = ZMap::from_box(Frame{}, stock, 0.5);
-  CHECK_THROWS_AS(raise_uncut(other, Aabb{Vec3(0), Vec3(12, 9, 5)}), Error);
+  CHECK_THROWS_AS(raise_uncut(other, Aabb{Vec3(0), Vec3(12, 10, 8)}), Error);
 }

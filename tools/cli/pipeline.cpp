@@ -186,7 +186,7 @@ double fine_cell_bytes(double cells, double rows, double moves, double bands_per
   constexpr double kSubHeights = 4.0 * ZMapFineCells::kPoints;
   const double per_cell = (kSubHeights + 2 * 4 + 4) + (kSubHeights + 4 + 4);
   const double per_row = 8 + 4;  // refine's row starts, the map's
-  const double per_move = sizeof(CutMove) + sizeof(detail::MoveGeometry) + 4 * bands_per_move;
+  const double per_move = sizeof(CutMove) + 4 * bands_per_move;
   return per_cell * cells + per_row * rows + per_move * moves;
 }
 
@@ -407,7 +407,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
     progress.stage("milling direction " + std::to_string(g + 1) + "/" + std::to_string(groups.size()) +
                    " (" + axis_label(group.axis) + ", " + std::to_string(group.moves.size()) + " moves)");
     maps.push_back(stock.mesh ? ZMap::from_mesh(group.frame, *stock.mesh, zmap_cell, limits)
-                              : ZMap::from_box(group.frame, stock.box, zmap_cell, limits));
+                              : ZMap::from_box(group.frame, stock.box, zmap_cell, limits, options.threads));
     r.segments += static_cast<long long>(group.moves.size());
     if (request.rapid_check == RapidCheck::in_program_order) {
       std::optional<BodyCheck> bodies;
@@ -491,7 +491,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
     for (std::size_t g = 0; g < maps.size(); ++g) {
       moves.clear();
       for (const gcode::Move& m : groups[g].moves) moves.push_back(cut_move(groups[g], m, cutter_of_tool));
-      refine_steep_cells(maps[g], cutters, moves, std::move(steep[g]), {.threads = options.threads});
+      refine_steep_cells(maps[g], cutters, moves, {.threads = options.threads}, std::move(steep[g]));
     }
   }
   progress.stage("dexelizing the stock");

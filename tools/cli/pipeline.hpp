@@ -147,7 +147,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
 // all, while it holds `moves` moves of one direction, each listed in about `bands_per_move` of
 // its row bands: per cell the sub-heights, index and highest sub-point being built (108 bytes,
 // the index up to twice over while it grows), the sorted copy set_fine_cells makes of both
-// (108), and each move as a CutMove, its MoveGeometry and its places in the bands.
+// (108), and each move as a CutMove and its places in the bands.
 double fine_cell_bytes(double cells, double rows, double moves, double bands_per_move);
 
 std::string axis_label(const Vec3& axis);
