@@ -19,14 +19,11 @@
 
 #include "tridex/dexel.hpp"
 #include "tridex/error.hpp"
+#include "tridex/parallel.hpp"
 
 namespace tridex {
 
 namespace detail {
-
-inline unsigned resolve_threads(unsigned threads) {
-  return threads ? threads : std::max(1u, std::thread::hardware_concurrency());
-}
 
 // Builds grid `axis` of a triple dexel on `lattice` by calling per_ray(r, out) for every ray r
 // in order within a chunk; per_ray appends ray r's intervals to `out`. Chunks run on `threads`

@@ -12,11 +12,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "tridex/error.hpp"
 #include "tridex/geometry.hpp"
 #include "tridex/mesh.hpp"
+#include "tridex/parallel.hpp"
 
 namespace tridex {
 
@@ -103,8 +105,10 @@ class ZMap {
   bool is_empty(int i, int j) const { return height(i, j) <= empty_height; }
 
   // Step 1 initialisation from a box stock: each point holds the top of the (possibly tilted)
-  // box above it, exactly, or `empty_height` outside the box's projection.
-  static ZMap from_box(const Frame& frame, const Aabb& stock, double cell, ZMapLimits limits = {});
+  // box above it, exactly, or `empty_height` outside the box's projection. Rows are split
+  // among `threads` threads (0: every hardware thread); the map is the same for any count.
+  static ZMap from_box(const Frame& frame, const Aabb& stock, double cell, ZMapLimits limits = {},
+                       unsigned threads = 1);
 
   // Initialisation from the top surface of a closed mesh seen along the frame's z.
   static ZMap from_mesh(const Frame& frame, const Mesh& stock, double cell,
@@ -135,8 +139,14 @@ class ZMap {
 // surface extrapolated from them (the largest such value): between it and its neighbour the
 // polyhedron spans the strip of stock up to the footprint's edge, and a raised point there
 // would leave a fin of uncut stock in that strip, as thin as a cell and as tall as the cut
-// (seen by the dexel rays across the edge only). Throws if the grids differ.
-void raise_uncut(ZMap& milled, const ZMap& initial);
+// (seen by the dexel rays across the edge only). Throws if the grids differ. Rows are split
+// among `threads` threads (0: every hardware thread); the result is the same for any count.
+void raise_uncut(ZMap& milled, const ZMap& initial, unsigned threads = 1);
+
+// The same for a map that ZMap::from_box(milled.grid.frame, box_stock, milled.grid.cell) started:
+// its initial heights are computed again row by row where they are needed, never stored, so a
+// box stock costs no second map. Throws if that map's grid differs from `milled`'s.
+void raise_uncut(ZMap& milled, const Aabb& box_stock, unsigned threads = 1);
 
 // ---------------------------------------------------------------------------------------------
 
@@ -189,19 +199,40 @@ inline ZMapGrid ZMapGrid::covering(const Frame& frame, const Aabb& local_box, do
   return g;
 }
 
-inline ZMap ZMap::from_box(const Frame& frame, const Aabb& stock, double cell, ZMapLimits limits) {
-  Aabb local = local_bounds(frame, stock);
-  ZMapGrid g = ZMapGrid::covering(frame, local.inflated(detail::empty_margin(cell)), cell);
-  float empty = static_cast<float>(local.min.z - detail::empty_margin(cell));
+namespace detail {
+
+// Row j of ZMap::from_box's heights on `g`: the top of the box above each point, or `empty`
+// outside its projection. raise_uncut for a box computes the same rows again, so both must come
+// from here to agree bit for bit.
+inline void box_top_row(const ZMapGrid& g, const Aabb& stock, float empty, int j, float* row) {
+  const Vec3 up = g.frame.axis();
+  for (int i = 0; i < g.nx; ++i) {
+    double s0, s1;
+    const Vec3 p = g.frame.to_world(Vec3(g.x(i), g.y(j), 0));
+    row[i] = line_box_interval(p, up, stock, s0, s1) ? static_cast<float>(s1) : empty;
+  }
+}
+
+// The grid and empty height of ZMap::from_box's map.
+inline std::pair<ZMapGrid, float> box_map_grid(const Frame& frame, const Aabb& stock, double cell) {
+  const Aabb local = local_bounds(frame, stock);
+  return {ZMapGrid::covering(frame, local.inflated(empty_margin(cell)), cell),
+          static_cast<float>(local.min.z - empty_margin(cell))};
+}
+
+// Rows per chunk of work for the row-parallel passes over a map.
+inline constexpr int kMapBandRows = 64;
+
+}  // namespace detail
+
+inline ZMap ZMap::from_box(const Frame& frame, const Aabb& stock, double cell, ZMapLimits limits, unsigned threads) {
+  const auto [g, empty] = detail::box_map_grid(frame, stock, cell);
   ZMap map(g, empty, empty, limits);
-  const Vec3 up = frame.axis();
-  for (int j = 0; j < g.ny; ++j)
-    for (int i = 0; i < g.nx; ++i) {
-      double s0, s1;
-      Vec3 p = frame.to_world(Vec3(g.x(i), g.y(j), 0));
-      if (detail::line_box_interval(p, up, stock, s0, s1))
-        map.heights[g.index(i, j)] = static_cast<float>(s1);
-    }
+  const auto bands = static_cast<std::size_t>((g.ny + detail::kMapBandRows - 1) / detail::kMapBandRows);
+  detail::for_each_chunk(bands, threads, [&](std::size_t band) {
+    const int j0 = static_cast<int>(band) * detail::kMapBandRows, j1 = std::min(g.ny, j0 + detail::kMapBandRows);
+    for (int j = j0; j < j1; ++j) detail::box_top_row(g, stock, empty, j, map.heights.data() + g.index(0, j));
+  });
   return map;
 }
 
@@ -291,37 +322,82 @@ inline void ZMap::set_fine_cells(std::vector<std::uint32_t> cells, std::vector<f
   }
 }
 
-inline void raise_uncut(ZMap& milled, const ZMap& initial) {
+namespace detail {
+
+// raise_uncut on the initial heights that initial_row(j, row) writes, row j of them into `row`
+// (grid.nx floats), `initial_empty` being their empty height. The map is split into bands of
+// rows. A first pass reads only: each band computes its initial rows (and two more on each
+// side, which its points' neighbourhoods reach), marks the points still at their initial
+// height and lists the extrapolated points outside the footprint. The second writes, each band
+// its own rows: the marked points are raised, then the listed ones set, as before any band
+// had written.
+template <class InitialRow>
+void raise_uncut_rows(ZMap& milled, float initial_empty, InitialRow&& initial_row, unsigned threads) {
+  const ZMapGrid& a = milled.grid;
+  const std::size_t nx = static_cast<std::size_t>(a.nx);
+  const auto bands = static_cast<std::size_t>((a.ny + kMapBandRows - 1) / kMapBandRows);
+  std::vector<std::uint8_t> uncut(a.size());
+  std::vector<float> band_top(bands, milled.empty_height);
+  // Each outside point next to a cut: its index and the largest continued height (unclamped).
+  std::vector<std::vector<std::pair<std::size_t, float>>> continued(bands);
+  for_each_chunk(bands, threads, [&](std::size_t band) {
+    const int j0 = static_cast<int>(band) * kMapBandRows, j1 = std::min(a.ny, j0 + kMapBandRows);
+    const int w0 = std::max(0, j0 - 2), w1 = std::min(a.ny, j1 + 2);  // rows of the window
+    std::vector<float> window(static_cast<std::size_t>(w1 - w0) * nx);
+    for (int j = w0; j < w1; ++j) initial_row(j, window.data() + static_cast<std::size_t>(j - w0) * nx);
+    auto initial = [&](int i, int j) { return window[static_cast<std::size_t>(j - w0) * nx + static_cast<std::size_t>(i)]; };
+    auto inside = [&](int i, int j) { return i >= 0 && j >= 0 && i < a.nx && j < a.ny && initial(i, j) > initial_empty; };
+    auto cut = [&](int i, int j) { return inside(i, j) && milled.height(i, j) != initial(i, j); };
+    float top = band_top[band];
+    for (int j = j0; j < j1; ++j)
+      for (int i = 0; i < a.nx; ++i) {
+        const std::size_t p = a.index(i, j);
+        top = std::max(top, initial(i, j));
+        uncut[p] = milled.heights[p] == initial(i, j);
+        if (inside(i, j)) continue;
+        float best = -std::numeric_limits<float>::infinity();
+        for (int dj = -1; dj <= 1; ++dj)
+          for (int di = -1; di <= 1; ++di) {
+            if ((di == 0 && dj == 0) || !cut(i + di, j + dj)) continue;
+            const float near = milled.height(i + di, j + dj);
+            const float far = cut(i + 2 * di, j + 2 * dj) ? milled.height(i + 2 * di, j + 2 * dj) : near;
+            best = std::max(best, 2 * near - far);
+          }
+        if (best > -std::numeric_limits<float>::infinity()) continued[band].emplace_back(p, best);
+      }
+    band_top[band] = top;
+  });
+  const float top = *std::max_element(band_top.begin(), band_top.end());
+  const float above = static_cast<float>(top + empty_margin(a.cell));
+  milled.fine = {};  // the heights change under any fine cells
+  for_each_chunk(bands, threads, [&](std::size_t band) {
+    const std::size_t p0 = band * kMapBandRows * nx, p1 = std::min(a.size(), p0 + kMapBandRows * nx);
+    for (std::size_t p = p0; p < p1; ++p)
+      if (uncut[p]) milled.heights[p] = above;
+    for (const auto& [p, h] : continued[band]) milled.heights[p] = std::clamp(h, milled.empty_height, above);
+  });
+}
+
+}  // namespace detail
+
+inline void raise_uncut(ZMap& milled, const ZMap& initial, unsigned threads) {
   const ZMapGrid &a = milled.grid, &b = initial.grid;
   if (a.nx != b.nx || a.ny != b.ny || a.x0 != b.x0 || a.y0 != b.y0 || a.cell != b.cell ||
       milled.heights.size() != initial.heights.size())
     detail::fail("raise_uncut: the milled and initial Z-maps have different grids");
-  float top = milled.empty_height;
-  for (float h : initial.heights) top = std::max(top, h);
-  const float above = static_cast<float>(top + detail::empty_margin(a.cell));
-  // Points outside the footprint next to cut ones: the cut surface continued linearly from the
-  // two points inward along each of the 8 directions (constant where only one was cut).
-  auto inside = [&](int i, int j) { return i >= 0 && j >= 0 && i < a.nx && j < a.ny && initial.height(i, j) > initial.empty_height; };
-  auto cut = [&](int i, int j) { return inside(i, j) && milled.height(i, j) != initial.height(i, j); };
-  std::vector<std::pair<std::size_t, float>> continued;
-  for (int j = 0; j < a.ny; ++j)
-    for (int i = 0; i < a.nx; ++i) {
-      if (inside(i, j)) continue;
-      float best = -std::numeric_limits<float>::infinity();
-      for (int dj = -1; dj <= 1; ++dj)
-        for (int di = -1; di <= 1; ++di) {
-          if ((di == 0 && dj == 0) || !cut(i + di, j + dj)) continue;
-          const float near = milled.height(i + di, j + dj);
-          const float far = cut(i + 2 * di, j + 2 * dj) ? milled.height(i + 2 * di, j + 2 * dj) : near;
-          best = std::max(best, 2 * near - far);
-        }
-      if (best > -std::numeric_limits<float>::infinity())
-        continued.emplace_back(a.index(i, j), std::clamp(best, milled.empty_height, above));
-    }
-  milled.fine = {};  // the heights change under any fine cells
-  for (std::size_t p = 0; p < milled.heights.size(); ++p)
-    if (milled.heights[p] == initial.heights[p]) milled.heights[p] = above;
-  for (const auto& [p, h] : continued) milled.heights[p] = h;
+  detail::raise_uncut_rows(
+      milled, initial.empty_height,
+      [&](int j, float* row) { std::copy_n(initial.heights.data() + b.index(0, j), b.nx, row); }, threads);
+}
+
+inline void raise_uncut(ZMap& milled, const Aabb& box_stock, unsigned threads) {
+  const ZMapGrid& a = milled.grid;
+  const auto [b, empty] = detail::box_map_grid(a.frame, box_stock, a.cell);
+  if (a.nx != b.nx || a.ny != b.ny || a.x0 != b.x0 || a.y0 != b.y0 || a.cell != b.cell ||
+      milled.heights.size() != b.size())
+    detail::fail("raise_uncut: the milled Z-map's grid is not the box stock's");
+  detail::raise_uncut_rows(
+      milled, empty, [&](int j, float* row) { detail::box_top_row(b, box_stock, empty, j, row); }, threads);
 }
 
 }  // namespace tridex

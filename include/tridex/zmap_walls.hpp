@@ -48,11 +48,30 @@ inline bool is_steep_cell(const ZMap& map, int i, int j, double steep_slope) {
   return std::max({a, b, c, d}) - std::min({a, b, c, d}) > steep_slope * map.grid.cell;
 }
 
+// The steep cells of `map` (grid.index of their (i, j) corners), ascending. Rows are split
+// among `threads` threads (0: every hardware thread); the list is the same for any count.
+inline std::vector<std::uint32_t> steep_cells(const ZMap& map, double steep_slope, unsigned threads = 1) {
+  const ZMapGrid& g = map.grid;
+  const auto bands = static_cast<std::size_t>((g.ny - 1 + detail::kMapBandRows - 1) / detail::kMapBandRows);
+  std::vector<std::vector<std::uint32_t>> found(bands);
+  detail::for_each_chunk(bands, threads, [&](std::size_t band) {
+    const int j0 = static_cast<int>(band) * detail::kMapBandRows, j1 = std::min(g.ny - 1, j0 + detail::kMapBandRows);
+    for (int j = j0; j < j1; ++j)
+      for (int i = 0; i + 1 < g.nx; ++i)
+        if (is_steep_cell(map, i, j, steep_slope)) found[band].push_back(static_cast<std::uint32_t>(g.index(i, j)));
+  });
+  std::vector<std::uint32_t> cells;
+  for (const auto& part : found) cells.insert(cells.end(), part.begin(), part.end());
+  return cells;
+}
+
 // Makes the steep cells of `map` fine, with sub-point heights from the moves it was milled with
 // (the same cutters and moves, in its frame). Call it on a map prepared by raise_uncut, last:
-// it reads the map's heights. Throws tridex::Error for a move with a cutter out of range.
+// it reads the map's heights. `cells` are the map's steep cells as steep_cells gives them
+// (with options.steep_slope), for a caller that needed them beforehand. Throws tridex::Error
+// for a move with a cutter out of range.
 inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::span<const CutMove> moves,
-                               WallOptions options = {}) {
+                               WallOptions options, std::vector<std::uint32_t> cells) {
   constexpr int kSteps = ZMapFineCells::kSteps, kSide = ZMapFineCells::kSide;
   constexpr auto kPoints = static_cast<std::size_t>(ZMapFineCells::kPoints);
   for (std::size_t k = 0; k < moves.size(); ++k)
@@ -60,12 +79,14 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
       detail::fail("refine steep cells: move ", k, " uses cutter ", moves[k].cutter, " but only ", cutters.size(),
                    " are given");
   const ZMapGrid& g = map.grid;
-  float ceiling = map.empty_height;
-  for (float h : map.heights) ceiling = std::max(ceiling, h);
-  std::vector<std::uint32_t> cells;
-  for (int j = 0; j + 1 < g.ny; ++j)
-    for (int i = 0; i + 1 < g.nx; ++i)
-      if (is_steep_cell(map, i, j, options.steep_slope)) cells.push_back(static_cast<std::uint32_t>(g.index(i, j)));
+  const auto map_bands = static_cast<std::size_t>((g.ny + detail::kMapBandRows - 1) / detail::kMapBandRows);
+  std::vector<float> band_ceiling(map_bands, map.empty_height);
+  detail::for_each_chunk(map_bands, options.threads, [&](std::size_t band) {
+    const std::size_t p0 = band * detail::kMapBandRows * static_cast<std::size_t>(g.nx);
+    const std::size_t p1 = std::min(g.size(), p0 + detail::kMapBandRows * static_cast<std::size_t>(g.nx));
+    for (std::size_t p = p0; p < p1; ++p) band_ceiling[band] = std::max(band_ceiling[band], map.heights[p]);
+  });
+  const float ceiling = *std::max_element(band_ceiling.begin(), band_ceiling.end());
   if (cells.empty()) {
     map.fine = {};
     return;
@@ -76,9 +97,6 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
   for (std::size_t row = row_begin.size() - 1; row-- > 0;) row_begin[row] = std::min(row_begin[row], row_begin[row + 1]);
 
   std::vector<float> sub(cells.size() * kPoints, ceiling);
-  std::vector<detail::MoveGeometry> geometry;
-  geometry.reserve(moves.size());
-  for (const CutMove& m : moves) geometry.emplace_back(cutters[m.cutter], m.tip);
   const double step = g.cell / kSteps;  // exact: kSteps is a power of two
   // Bands of cell rows, one thread each at a time. Each band gets the moves whose swept box
   // reaches it, in program order (a counting sort: one pass to count, one to place), so that a
@@ -123,8 +141,7 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
            ++at) {
         const std::size_t m = band_moves[at];
         const Segment& s = moves[m].tip;
-        const detail::MoveGeometry& move = geometry[m];
-        const double r = move.radius;
+        const double r = cutters[moves[m].cutter].radius();
         const double lo_y = std::min(s.a.y, s.b.y) - r, hi_y = std::max(s.a.y, s.b.y) + r;
         const int row0 = std::max(j0, static_cast<int>(std::floor((lo_y - g.y0) / g.cell)));
         const int row1 = std::min(j1 - 1, static_cast<int>(std::floor((hi_y - g.y0) / g.cell)));
@@ -147,6 +164,9 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
         if (first_tile > last_tile) continue;
         i0 = std::max(i0, static_cast<std::uint32_t>(first_tile * kTile));
         i1 = std::min(i1, static_cast<std::uint32_t>(last_tile * kTile + kTile - 1));
+        // Built here, for the few (band, move) pairs that come this far: kept for every move up
+        // front, the program's geometry took longer to write than the bands take to read.
+        const detail::MoveGeometry move(cutters[moves[m].cutter], s);
         const double tip = move.lowest_tip();
         for (int j = row0; j <= row1; ++j) {
           const auto row = static_cast<std::size_t>(j), base = row * static_cast<std::size_t>(g.nx);
@@ -188,6 +208,12 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
     for (std::thread& th : pool) th.join();
   }
   map.set_fine_cells(std::move(cells), std::move(sub));
+}
+
+// The same, finding the steep cells itself.
+inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::span<const CutMove> moves,
+                               WallOptions options = {}) {
+  refine_steep_cells(map, cutters, moves, options, steep_cells(map, options.steep_slope, options.threads));
 }
 
 }  // namespace tridex

@@ -283,3 +283,24 @@ TEST_CASE("refine steep cells: every inner sub-point is the brute-force lowest p
   CHECK(compared > 10000);
   CHECK(wrong == 0);
 }
+
+TEST_CASE("steep cells: the row bands on any thread count list every steep cell, ascending, as a scan of all cells") {
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> unit(0, 1);
+  for (int trial = 0; trial < 4; ++trial) {
+    // Random heights, flat patches and empty points over more rows than a band, so that bands
+    // with no steep cell and cells on the bands' borders occur.
+    ZMapGrid g;
+    g.cell = 0.1, g.nx = 37 + 11 * trial, g.ny = 2 * detail::kMapBandRows + 17 * trial;
+    ZMap map(g, 0.0f, -0.5f);
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i)
+        if (j % 50 < 30) map.heights[g.index(i, j)] = unit(rng) < 0.1 ? -1.0f : static_cast<float>(0.4 * unit(rng));
+    std::vector<std::uint32_t> want;
+    for (int j = 0; j + 1 < g.ny; ++j)
+      for (int i = 0; i + 1 < g.nx; ++i)
+        if (is_steep_cell(map, i, j, 1.5)) want.push_back(static_cast<std::uint32_t>(g.index(i, j)));
+    REQUIRE(want.size() > 100);
+    for (unsigned threads : {1u, 2u, 3u}) CHECK(steep_cells(map, 1.5, threads) == want);
+  }
+}

@@ -156,3 +156,59 @@ TEST_CASE("weld_vertices: a triangle soup welds back to the closed solid") {
   signs.positions = {{0.0f, 1.0f, 2.0f}, {-0.0f, 1.0f, 2.0f}};
   CHECK(weld_vertices(signs).positions.size() == 1);
 }
+
+namespace {
+
+// check_mesh's edge counts the plain way: every directed edge with its undirected key, all
+// sorted, each key classified by how many uses it has and in which directions.
+MeshCheck sorted_edges_reference(const Mesh& m) {
+  std::vector<std::pair<std::pair<std::uint32_t, std::uint32_t>, bool>> edges;
+  for (const glm::uvec3& t : m.triangles)
+    for (int e = 0; e < 3; ++e) {
+      const std::uint32_t a = t[e], b = t[(e + 1) % 3];
+      if (a != b) edges.push_back({{std::min(a, b), std::max(a, b)}, a < b});
+    }
+  std::sort(edges.begin(), edges.end());
+  MeshCheck c;
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i, forward = 0;
+    for (; j < edges.size() && edges[j].first == edges[i].first; ++j) forward += edges[j].second ? 1 : 0;
+    if (j - i == 1) ++c.boundary_edges;
+    else if (j - i > 2) ++c.non_manifold_edges;
+    else if (forward != 1) ++c.misoriented_edges;
+    i = j;
+  }
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("check_mesh: random triangle sets (repeated, collapsed, both ways) counted as by sorting all edges") {
+  std::mt19937 rng(23);
+  for (int trial = 0; trial < 200; ++trial) {
+    // Few vertices for many triangles: edges used once, twice either way, and three or more times.
+    const auto vertices = std::uniform_int_distribution<std::uint32_t>(1, 12)(rng);
+    Mesh m;
+    for (std::uint32_t v = 0; v < vertices; ++v)
+      m.positions.emplace_back(std::uniform_real_distribution<float>(-1, 1)(rng), std::uniform_real_distribution<float>(-1, 1)(rng),
+                               std::uniform_real_distribution<float>(-1, 1)(rng));
+    std::uniform_int_distribution<std::uint32_t> pick(0, vertices - 1);
+    const int triangles = std::uniform_int_distribution<int>(0, 40)(rng);
+    for (int k = 0; k < triangles; ++k) m.triangles.emplace_back(pick(rng), pick(rng), pick(rng));
+    const MeshCheck got = check_mesh(m), want = sorted_edges_reference(m);
+    CHECK(got.boundary_edges == want.boundary_edges);
+    CHECK(got.non_manifold_edges == want.non_manifold_edges);
+    CHECK(got.misoriented_edges == want.misoriented_edges);
+  }
+  // A closed solid's check agrees too, and so does the same solid opened and flipped at random.
+  for (const Mesh& solid : closed_shapes()) {
+    Mesh m = shuffled(solid, rng);
+    for (glm::uvec3& t : m.triangles)
+      if (std::uniform_int_distribution<int>(0, 6)(rng) == 0) std::swap(t.y, t.z);
+    m.triangles.resize(m.triangles.size() - m.triangles.size() / 5);
+    const MeshCheck got = check_mesh(m), want = sorted_edges_reference(m);
+    CHECK(got.boundary_edges == want.boundary_edges);
+    CHECK(got.misoriented_edges == want.misoriented_edges);
+    CHECK(got.non_manifold_edges == want.non_manifold_edges);
+  }
+}

@@ -179,3 +179,91 @@ TEST_CASE("raise_uncut: an uncut direction keeps the whole stock; cuts stay cut"
   ZMap mismatched = ZMap::from_box(Frame{}, stock, 0.25);
   CHECK_THROWS_AS(raise_uncut(other, mismatched), Error);
 }
+
+namespace {
+
+// The old whole-map ZMap::from_box: every point's line against the box, one thread.
+ZMap from_box_reference(const Frame& frame, const Aabb& stock, double cell) {
+  const Aabb local = local_bounds(frame, stock);
+  const ZMapGrid g = ZMapGrid::covering(frame, local.inflated(detail::empty_margin(cell)), cell);
+  const auto empty = static_cast<float>(local.min.z - detail::empty_margin(cell));
+  ZMap map(g, empty, empty);
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) {
+      double s0, s1;
+      if (detail::line_box_interval(frame.to_world(Vec3(g.x(i), g.y(j), 0)), frame.axis(), stock, s0, s1))
+        map.heights[g.index(i, j)] = static_cast<float>(s1);
+    }
+  return map;
+}
+
+// The old raise_uncut, point by point over the whole map on one thread, reading `initial`.
+void raise_uncut_reference(ZMap& milled, const ZMap& initial) {
+  const ZMapGrid& a = milled.grid;
+  float top = milled.empty_height;
+  for (float h : initial.heights) top = std::max(top, h);
+  const float above = static_cast<float>(top + detail::empty_margin(a.cell));
+  auto inside = [&](int i, int j) { return i >= 0 && j >= 0 && i < a.nx && j < a.ny && initial.height(i, j) > initial.empty_height; };
+  auto cut = [&](int i, int j) { return inside(i, j) && milled.height(i, j) != initial.height(i, j); };
+  std::vector<std::pair<std::size_t, float>> continued;
+  for (int j = 0; j < a.ny; ++j)
+    for (int i = 0; i < a.nx; ++i) {
+      if (inside(i, j)) continue;
+      float best = -std::numeric_limits<float>::infinity();
+      for (int dj = -1; dj <= 1; ++dj)
+        for (int di = -1; di <= 1; ++di) {
+          if ((di == 0 && dj == 0) || !cut(i + di, j + dj)) continue;
+          const float near = milled.height(i + di, j + dj);
+          const float far = cut(i + 2 * di, j + 2 * dj) ? milled.height(i + 2 * di, j + 2 * dj) : near;
+          best = std::max(best, 2 * near - far);
+        }
+      if (best > -std::numeric_limits<float>::infinity())
+        continued.emplace_back(a.index(i, j), std::clamp(best, milled.empty_height, above));
+    }
+  for (std::size_t p = 0; p < milled.heights.size(); ++p)
+    if (milled.heights[p] == initial.heights[p]) milled.heights[p] = above;
+  for (const auto& [p, h] : continued) milled.heights[p] = h;
+}
+
+}  // namespace
+
+TEST_CASE("from_box and raise_uncut in row bands on any thread count match the old whole-map passes") {
+  // Random tilted directions and random cuts, some leaving the stock's footprint; maps of more
+  // than 64 rows, so that the bands' borders (and the rows each band reads beyond them) count.
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<double> u(0, 1);
+  const Aabb stock{Vec3(0, 0, 0), Vec3(12, 9, 8)};
+  const std::vector<Cutter> cutters{Cutter::ball(0.6), Cutter::flat(0.9), Cutter::bull_nose(1.0, 0.3)};
+  for (int trial = 0; trial < 8; ++trial) {
+    CAPTURE(trial);
+    const Vec3 axis = trial == 0 ? Vec3(0, 0, 1) : glm::normalize(Vec3(2 * u(rng) - 1, 2 * u(rng) - 1, 0.2 + u(rng)));
+    const Frame f = Frame::from_axis(axis);
+    const double cell = 0.03 + 0.03 * u(rng);
+    const ZMap initial = from_box_reference(f, stock, cell);
+    for (unsigned threads : {1u, 2u, 3u}) CHECK(ZMap::from_box(f, stock, cell, {}, threads).heights == initial.heights);
+    REQUIRE(initial.grid.ny > 2 * detail::kMapBandRows);
+    const Aabb local = local_bounds(f, stock);
+    auto at = [&](double depth) {
+      return Vec3(local.min.x - 1 + (local.size().x + 2) * u(rng), local.min.y - 1 + (local.size().y + 2) * u(rng),
+                  local.max.z - depth);
+    };
+    std::vector<CutMove> moves;
+    for (int k = 0; k < 12; ++k)
+      moves.push_back({Segment{at(3 * u(rng)), at(3 * u(rng))}, static_cast<std::uint32_t>(k % cutters.size())});
+    ZMap milled = initial;
+    mill(milled, cutters, moves, {.threads = 1});
+    ZMap want = milled;
+    raise_uncut_reference(want, initial);
+    for (unsigned threads : {1u, 2u, 3u}) {
+      CAPTURE(threads);
+      ZMap from_map = milled, from_box = milled;
+      raise_uncut(from_map, initial, threads);
+      raise_uncut(from_box, stock, threads);
+      CHECK(from_map.heights == want.heights);
+      CHECK(from_box.heights == want.heights);
+    }
+  }
+  // The box's grid must be the map's.
+  ZMap other = ZMap::from_box(Frame{}, stock, 0.5);
+  CHECK_THROWS_AS(raise_uncut(other, Aabb{Vec3(0), Vec3(12, 10, 8)}), Error);
+}

@@ -209,7 +209,7 @@ TEST_CASE("memory: the steep cells counted before refining are those refine_stee
                              Vec3(local.min.x + 6, local.min.y + 5, local.max.z - 1)}, 1});
     mill(map, cutters, moves, {.threads = 1});
     raise_uncut(map, initial);
-    const std::size_t counted = cli::count_steep_cells(map, WallOptions{}.steep_slope);
+    const std::size_t counted = steep_cells(map, WallOptions{}.steep_slope, 2).size();
     refine_steep_cells(map, cutters, moves, {.threads = 2});
     CHECK(counted > 100);
     CHECK(counted == map.fine.cells.size());

@@ -52,7 +52,8 @@ MemoryEstimate estimate_memory(double held_bytes, const MemoryShape& shape) {
   MemoryEstimate e;
   e.held = held_bytes;
   // Float heights and tile maxima (4.1 bytes a point, measured 6.1 with the milling's buffers);
-  // raise_uncut builds one stock map beside them; a kept copy adds to all. A dumped map's
+  // raise_uncut builds a mesh stock's map beside them (a box's heights it computes again row by
+  // row, marking a byte a point); a kept copy adds to all. A dumped map's
   // polyhedron (a vertex and two triangles a point) and its STL bytes (two 50-byte records a
   // point, and more at the walls) add to the largest: measured 340 bytes a point on the example.
   e.zmaps = 8.0 * shape.zmap_points + 4.0 * shape.largest_map;

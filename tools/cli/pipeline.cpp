@@ -183,18 +183,11 @@ void check_dump_names(const std::string& directory, const std::vector<gcode::Mov
 
 }  // namespace
 
-std::size_t count_steep_cells(const ZMap& map, double steep_slope) {
-  std::size_t cells = 0;
-  for (int j = 0; j + 1 < map.grid.ny; ++j)
-    for (int i = 0; i + 1 < map.grid.nx; ++i) cells += is_steep_cell(map, i, j, steep_slope) ? 1 : 0;
-  return cells;
-}
-
 double fine_cell_bytes(double cells, double rows, double moves, double bands_per_move) {
   constexpr double kSubHeights = 4.0 * ZMapFineCells::kPoints;
   const double per_cell = (kSubHeights + 2 * 4 + 4) + (kSubHeights + 4 + 4);
   const double per_row = 8 + 4;  // refine's row starts, the map's
-  const double per_move = sizeof(CutMove) + sizeof(detail::MoveGeometry) + 4 * bands_per_move;
+  const double per_move = sizeof(CutMove) + 4 * bands_per_move;
   return per_cell * cells + per_row * rows + per_move * moves;
 }
 
@@ -423,7 +416,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
     progress.stage("milling direction " + std::to_string(g + 1) + "/" + std::to_string(groups.size()) +
                    " (" + axis_label(group.axis) + ", " + std::to_string(group.moves.size()) + " moves)");
     maps.push_back(stock.mesh ? ZMap::from_mesh(group.frame, *stock.mesh, zmap_cell, limits)
-                              : ZMap::from_box(group.frame, stock.box, zmap_cell, limits));
+                              : ZMap::from_box(group.frame, stock.box, zmap_cell, limits, options.threads));
     r.segments += static_cast<long long>(group.moves.size());
     if (request.rapid_check == RapidCheck::in_program_order) {
       std::optional<BodyCheck> bodies;
@@ -475,16 +468,19 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   if (request.keep_maps) kept_maps = maps;
   // Then walls parallel to a spindle are placed inside their cells: the steep cells take finer
   // heights from the moves (zmap_walls.hpp).
-  for (std::size_t g = 0; g < maps.size(); ++g)
-    raise_uncut(maps[g], stock.mesh ? ZMap::from_mesh(groups[g].frame, *stock.mesh, zmap_cell, limits)
-                                    : ZMap::from_box(groups[g].frame, stock.box, zmap_cell, limits));
+  for (std::size_t g = 0; g < maps.size(); ++g) {
+    if (stock.mesh) raise_uncut(maps[g], ZMap::from_mesh(groups[g].frame, *stock.mesh, zmap_cell, limits), options.threads);
+    else raise_uncut(maps[g], stock.box, options.threads);
+  }
   if (request.fine_cells) {
     // How many cells are steep is known only now: their sub-grids are checked against
     // --max-memory before any is allocated.
+    std::vector<std::vector<std::uint32_t>> steep(maps.size());
     std::size_t steep_cells = 0;
     double rows = 0, most_moves = 0;
     for (std::size_t g = 0; g < maps.size(); ++g) {
-      steep_cells += count_steep_cells(maps[g], WallOptions{}.steep_slope);
+      steep[g] = tridex::steep_cells(maps[g], WallOptions{}.steep_slope, options.threads);
+      steep_cells += steep[g].size();
       rows += maps[g].grid.ny;
       most_moves = std::max(most_moves, static_cast<double>(groups[g].moves.size()));
     }
@@ -499,11 +495,12 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
                   format_mib(r.memory.walls), " on top of ", format_mib(r.memory.total() - r.memory.walls),
                   ", more than --max-memory ", format_mib(static_cast<double>(max_memory)),
                   "; use a larger --zmap-cell or --dexel-cell, or a smaller --dexel-res");
+    std::vector<CutMove> moves;  // one buffer for every direction: its pages are touched once
+    moves.reserve(static_cast<std::size_t>(most_moves));
     for (std::size_t g = 0; g < maps.size(); ++g) {
-      std::vector<CutMove> moves;
-      moves.reserve(groups[g].moves.size());
+      moves.clear();
       for (const gcode::Move& m : groups[g].moves) moves.push_back(cut_move(groups[g], m, cutter_of_tool));
-      refine_steep_cells(maps[g], cutters, moves, {.threads = options.threads});
+      refine_steep_cells(maps[g], cutters, moves, {.threads = options.threads}, std::move(steep[g]));
     }
   }
   progress.stage("dexelizing the stock");

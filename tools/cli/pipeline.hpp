@@ -143,17 +143,11 @@ constexpr double kRapidTolerance = 0.005;
 SimulationResult simulate_program(const SimulateOptions& options, Progress& progress,
                                   const PipelineRequest& request = {});
 
-// The cells refine_steep_cells (zmap_walls.hpp) will make fine in `map`, counted with its own
-// rule (is_steep_cell) so that their memory is known before any is allocated. How many there are depends on the walls the
-// program cuts (every cell along a pocket's side, or the whole map for a field of narrow slots),
-// so it is counted on the milled maps, not guessed up front.
-std::size_t count_steep_cells(const ZMap& map, double steep_slope);
-
 // Bytes at refine_steep_cells's peak for `cells` fine cells over maps with `rows` cell rows in
 // all, while it holds `moves` moves of one direction, each listed in about `bands_per_move` of
 // its row bands: per cell the sub-heights, index and highest sub-point being built (108 bytes,
 // the index up to twice over while it grows), the sorted copy set_fine_cells makes of both
-// (108), and each move as a CutMove, its MoveGeometry and its places in the bands.
+// (108), and each move as a CutMove and its places in the bands.
 double fine_cell_bytes(double cells, double rows, double moves, double bands_per_move);
 
 std::string axis_label(const Vec3& axis);
