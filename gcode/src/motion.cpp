@@ -45,19 +45,23 @@ void Interpreter::State::move_to(Vec3 target, const std::array<bool, 3>& set_abs
   far = false;
 }
 
-void Interpreter::State::linear(MoveKind kind, double move_feed) {
-  // Under cutter compensation the programmed point, not the offset tip, is where coordinates
-  // count from (and, just after G40, until the next move).
-  Vec3 current = comp_programmed_current ? comp_programmed : to_program(pos);
-  Vec3 target = current;
-  std::array<bool, 3> set{};
+Interpreter::State::Target Interpreter::State::axis_word_target(const Vec3& current) {
+  Target t{current, {}};
   for (int i = 0; i < 3; ++i) {
     char c = kAxisLetter[i];
     if (!w.has(c)) continue;
     double v = length(c);
-    target[i] = incremental ? current[i] + v : v;
-    set[static_cast<std::size_t>(i)] = !incremental;
+    t.point[i] = incremental ? current[i] + v : v;
+    t.set[static_cast<std::size_t>(i)] = !incremental;
   }
+  return t;
+}
+
+void Interpreter::State::linear(MoveKind kind, double move_feed) {
+  // Under cutter compensation the programmed point, not the offset tip, is where coordinates
+  // count from (and, just after G40, until the next move).
+  Vec3 current = comp_programmed_current ? comp_programmed : to_program(pos);
+  const auto [target, set] = axis_word_target(current);
   comp_programmed_current = false;
   if (comp_active()) {
     comp_straight(kind, target, move_feed);
@@ -231,15 +235,7 @@ void Interpreter::State::probe(int code) {
   if (comp_side != 0) error(motion_column, name + ": cannot probe with cutter radius compensation on");
   if (!(feed > 0)) error(motion_column, name + ": cannot probe with zero feed rate");
   Vec3 current = comp_programmed_current ? comp_programmed : to_program(pos);
-  Vec3 target = current;
-  std::array<bool, 3> set{};
-  for (int i = 0; i < 3; ++i) {
-    char c = kAxisLetter[i];
-    if (!w.has(c)) continue;
-    double v = length(c);
-    target[i] = incremental ? current[i] + v : v;
-    set[static_cast<std::size_t>(i)] = !incremental;
-  }
+  const auto [target, set] = axis_word_target(current);
   comp_programmed_current = false;
   comp_arc_forbidden = false;
   const bool must_move = code == 382 || code == 384;  // G38.3/G38.5 may stand still

@@ -446,6 +446,13 @@ struct Interpreter::State : ParameterReader {
   // ---- motion (motion.cpp) ----
   void move_to(Vec3 target, const std::array<bool, 3>& set_absolute, const Mat3& rot,
                const Vec3& org, MoveKind kind, double move_feed);
+  // The point the block's X Y Z words name, in the program frame, from `current`; set[i] says
+  // coordinate i was given absolutely (motion.cpp).
+  struct Target {
+    Vec3 point{0.0};
+    std::array<bool, 3> set{};
+  };
+  Target axis_word_target(const Vec3& current);  // takes the words
   void linear(MoveKind kind, double move_feed);
   void require_feed();
   void arc(bool ccw);
