@@ -525,7 +525,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   // ---- surface ------------------------------------------------------------------------------
   progress.stage("extracting the surface");
   t = Clock::now();
-  r.mesh = extract_surface(r.result);
+  r.mesh = extract_surface(r.result, {.threads = options.threads});
   r.mesh_check = check_mesh(r.mesh);
   r.timings.mesh = seconds_since(t);
   r.volume = r.mesh.signed_volume();
