@@ -220,6 +220,11 @@ inline std::pair<ZMapGrid, float> box_map_grid(const Frame& frame, const Aabb& s
           static_cast<float>(local.min.z - empty_margin(cell))};
 }
 
+// Whether two grids have the same points (their frames are the caller's to compare).
+inline bool same_points(const ZMapGrid& a, const ZMapGrid& b) {
+  return a.nx == b.nx && a.ny == b.ny && a.x0 == b.x0 && a.y0 == b.y0 && a.cell == b.cell;
+}
+
 // Rows per chunk of work for the row-parallel passes over a map.
 inline constexpr int kMapBandRows = 64;
 
@@ -382,8 +387,7 @@ void raise_uncut_rows(ZMap& milled, float initial_empty, InitialRow&& initial_ro
 
 inline void raise_uncut(ZMap& milled, const ZMap& initial, unsigned threads) {
   const ZMapGrid &a = milled.grid, &b = initial.grid;
-  if (a.nx != b.nx || a.ny != b.ny || a.x0 != b.x0 || a.y0 != b.y0 || a.cell != b.cell ||
-      milled.heights.size() != initial.heights.size())
+  if (!detail::same_points(a, b) || milled.heights.size() != initial.heights.size())
     detail::fail("raise_uncut: the milled and initial Z-maps have different grids");
   detail::raise_uncut_rows(
       milled, initial.empty_height,
@@ -393,8 +397,7 @@ inline void raise_uncut(ZMap& milled, const ZMap& initial, unsigned threads) {
 inline void raise_uncut(ZMap& milled, const Aabb& box_stock, unsigned threads) {
   const ZMapGrid& a = milled.grid;
   const auto [b, empty] = detail::box_map_grid(a.frame, box_stock, a.cell);
-  if (a.nx != b.nx || a.ny != b.ny || a.x0 != b.x0 || a.y0 != b.y0 || a.cell != b.cell ||
-      milled.heights.size() != b.size())
+  if (!detail::same_points(a, b) || milled.heights.size() != b.size())
     detail::fail("raise_uncut: the milled Z-map's grid is not the box stock's");
   detail::raise_uncut_rows(
       milled, empty, [&](int j, float* row) { detail::box_top_row(b, box_stock, empty, j, row); }, threads);
