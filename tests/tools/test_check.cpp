@@ -287,7 +287,7 @@ TEST_CASE("check: a plunge 0.3 mm too deep in a tilted direction is a gouge of 0
   const json& gouge = report["gouges"][0];
   CHECK(gouge["depth_mm"].get<double>() == doctest::Approx(0.3).epsilon(0.1 / 0.3));  // within a dexel cell
   CHECK(gouge["lines"] == json::array({13}));
-  CHECK(r.out.find("lines 13") != std::string::npos);
+  CHECK(r.out.find("p.nc:13") != std::string::npos);
   // The deepest point lies on the faulty hole's floor: in the feature frame within the tool's
   // radius of (0, 4) and about 2.3 deep; the region's centre near the floor's centre.
   Vec3 deepest(gouge["deepest_point"][0].get<double>(), gouge["deepest_point"][1].get<double>(),
@@ -357,7 +357,7 @@ TEST_CASE("check: rapids through material are reported with their line, in progr
   REQUIRE(report["rapid_cuts"].size() == 1);
   CHECK(report["rapid_cuts"][0]["line"] == 8);
   CHECK(report["rapid_cuts"][0]["depth_mm"].get<double>() > 0.3);
-  CHECK(r.out.find("rapid at line 8") != std::string::npos);
+  CHECK(r.out.find("p.nc:8: rapid cuts") != std::string::npos);
 
   // A rapid through material no move removes: a rapid and a gouge, both at line 8.
   r = f.check(program(-2, "G0 X5 Y-5\nG0 Z-1.5\nG0 Z5\n"));

@@ -239,7 +239,7 @@ TEST_CASE("check: a holder passing a boss and a shank on a pocket's floor are fo
   REQUIRE(run.report["stick_out"].size() == 1);
   CHECK(run.report["stick_out"][0]["tool"] == 1);
   CHECK(run.report["stick_out"][0]["needed_mm"].get<double>() == doctest::Approx(26.0).epsilon(0.001));
-  CHECK(run.result.out.find("line 16: tool 1's holder section 1 is 1.000 mm into the stock") != std::string::npos);
+  CHECK(run.result.out.find("p.nc:16: tool 1's holder section 1 is 1.000 mm into the stock") != std::string::npos);
   fs::remove_all(dir);
 }
 

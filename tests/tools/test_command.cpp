@@ -917,7 +917,8 @@ TEST_CASE("rapids that cut material no feed move removes are reported with their
                                dir);
   INFO(r.err);
   REQUIRE(r.status == 0);
-  CHECK(r.err.find("2 rapid move(s) cut material that no feed move removes (lines 6, 7;") != std::string::npos);
+  CHECK(r.err.find("2 rapid move(s) cut material that no feed move removes (at " + program.string() + ":6, " +
+                   program.string() + ":7;") != std::string::npos);
   json found = json::parse(slurp(report))["rapid_cuts"];
   REQUIRE(found.size() == 2);
   for (std::size_t k = 0; k < 2; ++k) {

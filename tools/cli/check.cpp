@@ -22,7 +22,6 @@
 #include <cstdio>
 #include <iostream>
 #include <set>
-#include <thread>
 
 #include "commands.hpp"
 #include "deviation.hpp"
@@ -37,6 +36,7 @@
 #include "tridex/dexel_ops.hpp"
 #include "tridex/dexelize.hpp"
 #include "tridex/mill.hpp"
+#include "tridex/parallel.hpp"
 #include "tridex/stl.hpp"
 
 namespace tridex::cli {
@@ -62,21 +62,13 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// Runs body(k) for k in [0, n) on `threads` threads (0: every hardware thread), in blocks.
+// Runs body(k) for k in [0, n) on `threads` threads (0: every hardware thread), in blocks of 4096.
 template <class Body>
 void parallel_for(std::size_t n, unsigned threads, const Body& body) {
-  unsigned t = threads ? threads : std::max(1u, std::thread::hardware_concurrency());
-  t = static_cast<unsigned>(std::min<std::size_t>(t, std::max<std::size_t>(1, n / 4096)));
-  if (t <= 1) {
-    for (std::size_t k = 0; k < n; ++k) body(k);
-    return;
-  }
-  std::vector<std::thread> workers;
-  for (unsigned w = 0; w < t; ++w)
-    workers.emplace_back([&, w] {
-      for (std::size_t k = n * w / t; k < n * (w + 1) / t; ++k) body(k);
-    });
-  for (std::thread& worker : workers) worker.join();
+  constexpr std::size_t kBlock = 4096;
+  detail::for_each_chunk((n + kBlock - 1) / kBlock, threads, [&](std::size_t c) {
+    for (std::size_t k = c * kBlock; k < std::min(n, (c + 1) * kBlock); ++k) body(k);
+  });
 }
 
 Json statistics(std::vector<double> values) {
@@ -467,24 +459,26 @@ int run_check(const CheckOptions& options) {
       if (g.contains("lines") && printed++ < kFindingsPrinted) {
         std::string lines;
         std::size_t count = 0;
-        for (int line : g["lines"])
-          if (count++ < 10) lines += (lines.empty() ? "" : ", ") + std::to_string(line);
+        for (std::size_t i = 0; i < g["lines"].size(); ++i)
+          if (count++ < 10)
+            lines += (lines.empty() ? "" : ", ") + g["files"][i].get<std::string>() + ":" + std::to_string(g["lines"][i].get<int>());
         if (count > 10) lines += ", … (" + std::to_string(count) + " in all)";
         const Json& c = g["centroid"];
         std::printf("  gouge %.3f mm around (%.3f, %.3f, %.3f), lines %s\n", g["depth_mm"].get<double>(),
                     c[0].get<double>(), c[1].get<double>(), c[2].get<double>(), lines.empty() ? "?" : lines.c_str());
       }
     for (std::size_t k = 0; k < rapid_list.size() && k < kFindingsPrinted; ++k)
-      std::printf("  rapid at line %d cuts %.3f mm of material\n", rapid_list[k]["line"].get<int>(),
-                  rapid_list[k]["depth_mm"].get<double>());
+      std::printf("  %s:%d: rapid cuts %.3f mm of material\n", rapid_list[k]["file"].get<std::string>().c_str(),
+                  rapid_list[k]["line"].get<int>(), rapid_list[k]["depth_mm"].get<double>());
     for (std::size_t k = 0; k < envelope_list.size() && k < kFindingsPrinted; ++k)
-      std::printf("  line %d: tool tip %s outside the envelope\n", envelope_list[k]["line"].get<int>(),
-                  envelope_list[k]["tip"].dump().c_str());
+      std::printf("  %s:%d: tool tip %s outside the envelope\n", envelope_list[k]["file"].get<std::string>().c_str(),
+                  envelope_list[k]["line"].get<int>(), envelope_list[k]["tip"].dump().c_str());
     for (std::size_t k = 0; k < r.travel.size() && k < kFindingsPrinted; ++k)
       std::printf("  %s:%d: %s\n", file_name(r.travel[k].file).c_str(), r.travel[k].line, travel_text(r.travel[k]).c_str());
     for (std::size_t k = 0; k < r.body.collisions.size() && k < kFindingsPrinted; ++k) {
       const BodyFinding& f = r.body.collisions[k];
-      std::printf("  line %d: tool %d's %s is %.3f mm into the stock at (%.3f, %.3f, %.3f), spindle %s\n", f.line,
+      std::printf("  %s:%d: tool %d's %s is %.3f mm into the stock at (%.3f, %.3f, %.3f), spindle %s\n",
+                  file_name(f.file).c_str(), f.line,
                   f.tool, f.part.c_str(), f.depth_mm, f.where.x, f.where.y, f.where.z, axis_label(f.axis).c_str());
     }
     for (const Json& s : stick_out)

@@ -373,7 +373,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
                                ? options.zmap_cell
                                : std::min(diagonal * kDefaultZmapCellFraction, kDefaultZmapCellOfSpacing * lattice.spacing);
   r.zmap_cell = zmap_cell;
-  MemoryShape shape{.keep_maps = request.keep_maps, .dump_maps = !options.dump_zmaps.empty()};
+  MemoryShape shape{.mesh_stock = stock.mesh.has_value(), .keep_maps = request.keep_maps, .dump_maps = !options.dump_zmaps.empty()};
   for (const gcode::MoveGroup& group : groups) {
     try {
       r.grids.push_back(ZMapGrid::covering(group.frame, local_bounds(group.frame, stock.box), zmap_cell));

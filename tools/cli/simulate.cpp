@@ -44,9 +44,10 @@ int run_simulate(const SimulateOptions& options) {
   if (!rapid_findings.empty()) {
     std::string lines;
     for (std::size_t k = 0; k < rapid_findings.size() && k < 10; ++k)
-      lines += (k ? ", " : "") + std::to_string(rapid_findings[k]["line"].get<int>());
+      lines += (k ? ", " : "") + rapid_findings[k]["file"].get<std::string>() + ":" +
+               std::to_string(rapid_findings[k]["line"].get<int>());
     warnings.push_back(std::to_string(rapid_findings.size()) +
-                       " rapid move(s) cut material that no feed move removes (lines " + lines +
+                       " rapid move(s) cut material that no feed move removes (at " + lines +
                        (rapid_findings.size() > 10 ? ", …" : "") + "; see \"rapid_cuts\" in the report)");
   }
   if (r.travel_count > 0) {
