@@ -148,6 +148,10 @@ void raise_uncut(ZMap& milled, const ZMap& initial, unsigned threads = 1);
 // box stock costs no second map. Throws if that map's grid differs from `milled`'s.
 void raise_uncut(ZMap& milled, const Aabb& box_stock, unsigned threads = 1);
 
+// And for a map that ZMap::from_mesh(milled.grid.frame, stock, milled.grid.cell) started, its rows
+// rasterised again from the triangles that cross them.
+void raise_uncut(ZMap& milled, const Mesh& stock, unsigned threads = 1);
+
 // ---------------------------------------------------------------------------------------------
 
 namespace detail {
@@ -241,47 +245,106 @@ inline ZMap ZMap::from_box(const Frame& frame, const Aabb& stock, double cell, Z
   return map;
 }
 
-inline ZMap ZMap::from_mesh(const Frame& frame, const Mesh& stock, double cell,
-                            ZMapLimits limits) {
-  if (stock.triangles.empty()) detail::fail("Z-map: stock mesh has no triangles");
-  std::vector<Vec3> local(stock.positions.size());
-  Aabb box;
-  for (std::size_t v = 0; v < local.size(); ++v) {
-    local[v] = frame.to_local(Vec3(stock.positions[v]));
-    if (!is_finite(local[v])) detail::fail("Z-map: stock mesh vertex ", v, " is not finite");
-    box.extend(local[v]);
+namespace detail {
+
+// A stock mesh seen along a frame's z, from which any row of ZMap::from_mesh's heights can be
+// computed on its own: the triangles are listed by the bands of kMapBandRows rows they cross.
+// ZMap::from_mesh and raise_uncut for a mesh stock both rasterise through raster_rows, so they
+// agree bit for bit (a point's height is the largest of its hits, in any order).
+class MeshTop {
+ public:
+  MeshTop(const Frame& frame, const Mesh& stock, double cell) : triangles_(stock.triangles) {
+    if (stock.triangles.empty()) fail("Z-map: stock mesh has no triangles");
+    local_.resize(stock.positions.size());
+    Aabb box;
+    for (std::size_t v = 0; v < local_.size(); ++v) {
+      local_[v] = frame.to_local(Vec3(stock.positions[v]));
+      if (!is_finite(local_[v])) fail("Z-map: stock mesh vertex ", v, " is not finite");
+      box.extend(local_[v]);
+    }
+    for (const glm::uvec3& t : stock.triangles)
+      if (t.x >= local_.size() || t.y >= local_.size() || t.z >= local_.size())
+        fail("Z-map: stock mesh triangle refers to a missing vertex");
+    grid_ = ZMapGrid::covering(frame, box.inflated(empty_margin(cell)), cell);
+    empty_ = static_cast<float>(box.min.z - empty_margin(cell));
   }
-  ZMapGrid g = ZMapGrid::covering(frame, box.inflated(detail::empty_margin(cell)), cell);
-  float empty = static_cast<float>(box.min.z - detail::empty_margin(cell));
-  ZMap map(g, empty, empty, limits);
-  // Rasterise each triangle's projection; the top surface above a point is the highest hit.
-  // Barycentric tests are inclusive with a small tolerance so that points on shared edges or
-  // vertices are never lost (a doubled hit does no harm to a maximum).
-  for (const glm::uvec3& t : stock.triangles) {
-    if (t.x >= local.size() || t.y >= local.size() || t.z >= local.size())
-      detail::fail("Z-map: stock mesh triangle refers to a missing vertex");
-    const Vec3 &a = local[t.x], &b = local[t.y], &c = local[t.z];
-    double det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
-    if (std::abs(det) < 1e-18) continue;  // seen edge-on: adds no height of its own
-    double lox = std::min({a.x, b.x, c.x}), hix = std::max({a.x, b.x, c.x});
-    double loy = std::min({a.y, b.y, c.y}), hiy = std::max({a.y, b.y, c.y});
-    int i0 = std::max(0, static_cast<int>(std::ceil((lox - g.x0) / cell - 1e-9)));
-    int i1 = std::min(g.nx - 1, static_cast<int>(std::floor((hix - g.x0) / cell + 1e-9)));
-    int j0 = std::max(0, static_cast<int>(std::ceil((loy - g.y0) / cell - 1e-9)));
-    int j1 = std::min(g.ny - 1, static_cast<int>(std::floor((hiy - g.y0) / cell + 1e-9)));
+
+  const ZMapGrid& grid() const { return grid_; }
+  float empty() const { return empty_; }
+
+  // Lists the triangles by band; needed before row(), not by raster_rows over the whole grid.
+  void index_bands() {
+    bands_.assign(static_cast<std::size_t>((grid_.ny + kMapBandRows - 1) / kMapBandRows), {});
+    for (std::size_t t = 0; t < triangles_.size(); ++t) {
+      const auto [j0, j1] = rows_of(t);
+      for (int b = j0 / kMapBandRows; j0 <= j1 && b <= j1 / kMapBandRows; ++b)
+        bands_[static_cast<std::size_t>(b)].push_back(static_cast<std::uint32_t>(t));
+    }
+  }
+
+  // Row j of the heights into `out` (grid().nx floats).
+  void row(int j, float* out) const {
+    std::fill_n(out, grid_.nx, empty_);
+    for (std::uint32_t t : bands_[static_cast<std::size_t>(j / kMapBandRows)])
+      raster_rows(t, j, j, [&](int i, int) -> float& { return out[i]; });
+  }
+
+  // Rasterises triangle t's projection over rows [row_lo, row_hi]; at(i, j) is the height of
+  // point (i, j), raised to each hit. Barycentric tests are inclusive with a small tolerance
+  // so that points on shared edges or vertices are never lost (a doubled hit does no harm to
+  // a maximum); a triangle seen edge-on adds no height of its own.
+  template <class At>
+  void raster_rows(std::size_t t, int row_lo, int row_hi, At&& at) const {
+    const glm::uvec3& tri = triangles_[t];
+    const Vec3 &a = local_[tri.x], &b = local_[tri.y], &c = local_[tri.z];
+    const double det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+    if (std::abs(det) < 1e-18) return;
+    const ZMapGrid& g = grid_;
+    const double lox = std::min({a.x, b.x, c.x}), hix = std::max({a.x, b.x, c.x});
+    const int i0 = std::max(0, static_cast<int>(std::ceil((lox - g.x0) / g.cell - 1e-9)));
+    const int i1 = std::min(g.nx - 1, static_cast<int>(std::floor((hix - g.x0) / g.cell + 1e-9)));
+    const auto [j0, j1] = rows_of(t);
     const double eps = 1e-9;
-    for (int j = j0; j <= j1; ++j)
+    for (int j = std::max(j0, row_lo); j <= std::min(j1, row_hi); ++j)
       for (int i = i0; i <= i1; ++i) {
-        double px = g.x(i), py = g.y(j);
-        double wb = ((px - a.x) * (c.y - a.y) - (c.x - a.x) * (py - a.y)) / det;
-        double wc = ((b.x - a.x) * (py - a.y) - (px - a.x) * (b.y - a.y)) / det;
-        double wa = 1 - wb - wc;
+        const double px = g.x(i), py = g.y(j);
+        const double wb = ((px - a.x) * (c.y - a.y) - (c.x - a.x) * (py - a.y)) / det;
+        const double wc = ((b.x - a.x) * (py - a.y) - (px - a.x) * (b.y - a.y)) / det;
+        const double wa = 1 - wb - wc;
         if (wa < -eps || wb < -eps || wc < -eps) continue;
-        float z = static_cast<float>(wa * a.z + wb * b.z + wc * c.z);
-        float& h = map.heights[g.index(i, j)];
-        h = std::max(h, z);
+        float& h = at(i, j);
+        h = std::max(h, static_cast<float>(wa * a.z + wb * b.z + wc * c.z));
       }
   }
+
+  std::size_t triangles() const { return triangles_.size(); }
+
+ private:
+  // The rows triangle t's projection spans (j0 > j1 when it misses the grid).
+  std::pair<int, int> rows_of(std::size_t t) const {
+    const glm::uvec3& tri = triangles_[t];
+    const double loy = std::min({local_[tri.x].y, local_[tri.y].y, local_[tri.z].y});
+    const double hiy = std::max({local_[tri.x].y, local_[tri.y].y, local_[tri.z].y});
+    return {std::max(0, static_cast<int>(std::ceil((loy - grid_.y0) / grid_.cell - 1e-9))),
+            std::min(grid_.ny - 1, static_cast<int>(std::floor((hiy - grid_.y0) / grid_.cell + 1e-9)))};
+  }
+
+  const std::vector<glm::uvec3>& triangles_;  // the stock's, which outlives this
+  std::vector<Vec3> local_;
+  ZMapGrid grid_;
+  float empty_ = 0;
+  std::vector<std::vector<std::uint32_t>> bands_;
+};
+
+}  // namespace detail
+
+inline ZMap ZMap::from_mesh(const Frame& frame, const Mesh& stock, double cell,
+                            ZMapLimits limits) {
+  const detail::MeshTop top(frame, stock, cell);
+  const ZMapGrid& g = top.grid();
+  ZMap map(g, top.empty(), top.empty(), limits);
+  for (std::size_t t = 0; t < top.triangles(); ++t)
+    top.raster_rows(t, 0, g.ny - 1, [&](int i, int j) -> float& { return map.heights[g.index(i, j)]; });
   return map;
 }
 
@@ -401,6 +464,15 @@ inline void raise_uncut(ZMap& milled, const Aabb& box_stock, unsigned threads) {
     detail::fail("raise_uncut: the milled Z-map's grid is not the box stock's");
   detail::raise_uncut_rows(
       milled, empty, [&](int j, float* row) { detail::box_top_row(b, box_stock, empty, j, row); }, threads);
+}
+
+inline void raise_uncut(ZMap& milled, const Mesh& stock, unsigned threads) {
+  const ZMapGrid& a = milled.grid;
+  detail::MeshTop top(a.frame, stock, a.cell);
+  if (!detail::same_points(a, top.grid()) || milled.heights.size() != top.grid().size())
+    detail::fail("raise_uncut: the milled Z-map's grid is not the stock mesh's");
+  top.index_bands();
+  detail::raise_uncut_rows(milled, top.empty(), [&](int j, float* row) { top.row(j, row); }, threads);
 }
 
 }  // namespace tridex

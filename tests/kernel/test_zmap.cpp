@@ -267,3 +267,47 @@ TEST_CASE("from_box and raise_uncut in row bands on any thread count match the o
   ZMap other = ZMap::from_box(Frame{}, stock, 0.5);
   CHECK_THROWS_AS(raise_uncut(other, Aabb{Vec3(0), Vec3(12, 10, 8)}), Error);
 }
+
+TEST_CASE("raise_uncut for a mesh stock, row by row on any thread count, matches it against the stored map") {
+  // A sphere and a tilted box as stocks, seen along random directions, with random cuts some of
+  // which leave the footprint; maps of more than 64 rows, so that triangles cross bands.
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> u(0, 1);
+  const std::vector<Cutter> cutters{Cutter::ball(0.6), Cutter::flat(0.9)};
+  const Frame tilt = Frame::from_axis(glm::normalize(Vec3(0.3, -0.2, 1)));
+  Mesh tilted_box = tridex_test::box_mesh(Vec3(0, 0, 0), Vec3(10, 7, 6));
+  for (glm::vec3& p : tilted_box.positions) p = glm::vec3(tilt.to_world(Vec3(p)));
+  const std::vector<Mesh> stocks{tridex_test::sphere_mesh(Vec3(5, 4, 3), 4.5), tilted_box};
+  for (int trial = 0; trial < 6; ++trial) {
+    CAPTURE(trial);
+    const Mesh& stock = stocks[static_cast<std::size_t>(trial % 2)];
+    const Vec3 axis = trial < 2 ? Vec3(0, 0, 1) : glm::normalize(Vec3(2 * u(rng) - 1, 2 * u(rng) - 1, 0.2 + u(rng)));
+    const Frame f = Frame::from_axis(axis);
+    const double cell = 0.04 + 0.03 * u(rng);
+    const ZMap initial = ZMap::from_mesh(f, stock, cell);
+    REQUIRE(initial.grid.ny > 2 * detail::kMapBandRows);
+    Aabb local;
+    for (const glm::vec3& p : stock.positions) local.extend(f.to_local(Vec3(p)));
+    auto at = [&](double depth) {
+      return Vec3(local.min.x - 1 + (local.size().x + 2) * u(rng), local.min.y - 1 + (local.size().y + 2) * u(rng),
+                  local.max.z - depth);
+    };
+    std::vector<CutMove> moves;
+    for (int k = 0; k < 12; ++k)
+      moves.push_back({Segment{at(4 * u(rng)), at(4 * u(rng))}, static_cast<std::uint32_t>(k % cutters.size())});
+    ZMap milled = initial;
+    mill(milled, cutters, moves, {.threads = 1});
+    ZMap want = milled;
+    raise_uncut(want, initial);
+    CHECK(want.heights != milled.heights);
+    for (unsigned threads : {1u, 2u, 3u}) {
+      CAPTURE(threads);
+      ZMap from_mesh = milled;
+      raise_uncut(from_mesh, stock, threads);
+      CHECK(from_mesh.heights == want.heights);
+    }
+  }
+  // The mesh's grid must be the map's.
+  ZMap other = ZMap::from_mesh(Frame{}, stocks[0], 0.5);
+  CHECK_THROWS_AS(raise_uncut(other, stocks[1]), Error);
+}

@@ -61,8 +61,7 @@ TEST_CASE("--max-memory units and the memory estimate") {
   CHECK(big.mesh == doctest::Approx(4 * small.mesh));
   CHECK(big.held == small.held);
   CHECK(big.total() > small.total());
-  // A mesh stock's map, and keeping or dumping the maps, cost more.
-  CHECK(estimate_memory(0, {.zmap_points = 1e6, .largest_map = 5e5, .mesh_stock = true}).zmaps > small.zmaps);
+  // Keeping or dumping the maps costs more.
   CHECK(estimate_memory(0, {.zmap_points = 1e6, .largest_map = 5e5, .keep_maps = true}).zmaps > small.zmaps);
   CHECK(estimate_memory(0, {.zmap_points = 1e6, .largest_map = 5e5, .dump_maps = true}).zmaps > small.zmaps);
   CHECK(physical_memory_bytes() > (64ull << 20));

@@ -52,11 +52,11 @@ MemoryEstimate estimate_memory(double held_bytes, const MemoryShape& shape) {
   MemoryEstimate e;
   e.held = held_bytes;
   // Float heights and tile maxima (4.1 bytes a point, measured 6.1 with the milling's buffers);
-  // raise_uncut builds a mesh stock's map beside the largest (a box's heights it computes again
-  // row by row, marking a byte a point); a kept copy adds to all. A dumped map's
+  // raise_uncut computes the stock's heights again row by row, marking a byte a point of the
+  // largest; a kept copy adds to all. A dumped map's
   // polyhedron (a vertex and two triangles a point) and its STL bytes (two 50-byte records a
   // point, and more at the walls) add to the largest: measured 340 bytes a point on the example.
-  e.zmaps = 8.0 * shape.zmap_points + (shape.mesh_stock ? 4.0 : 1.0) * shape.largest_map;
+  e.zmaps = 8.0 * shape.zmap_points + 1.0 * shape.largest_map;
   if (shape.keep_maps) e.zmaps += 4.0 * shape.zmap_points;
   if (shape.dump_maps) e.zmaps += 400.0 * shape.largest_map;
   // A ray costs a 4-byte offset and, typically, one or two 8-byte intervals, in the stock and

@@ -34,7 +34,6 @@ struct MemoryShape {
   double zmap_points = 0;     // the sum over directions of nx·ny
   double largest_map = 0;     // nx·ny of the largest direction's map
   double rays = 0;            // nx·ny + ny·nz + nz·nx of the triple dexel's lattice
-  bool mesh_stock = false;    // raise_uncut builds the stock mesh's map beside the largest
   bool keep_maps = false;     // the milled maps are copied and kept to the end
   bool dump_maps = false;     // --dump-zmaps: each map's polyhedron is built and written
 };

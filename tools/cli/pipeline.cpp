@@ -373,7 +373,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
                                ? options.zmap_cell
                                : std::min(diagonal * kDefaultZmapCellFraction, kDefaultZmapCellOfSpacing * lattice.spacing);
   r.zmap_cell = zmap_cell;
-  MemoryShape shape{.mesh_stock = stock.mesh.has_value(), .keep_maps = request.keep_maps, .dump_maps = !options.dump_zmaps.empty()};
+  MemoryShape shape{.keep_maps = request.keep_maps, .dump_maps = !options.dump_zmaps.empty()};
   for (const gcode::MoveGroup& group : groups) {
     try {
       r.grids.push_back(ZMapGrid::covering(group.frame, local_bounds(group.frame, stock.box), zmap_cell));
@@ -469,7 +469,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   // Then walls parallel to a spindle are placed inside their cells: the steep cells take finer
   // heights from the moves (zmap_walls.hpp).
   for (std::size_t g = 0; g < maps.size(); ++g) {
-    if (stock.mesh) raise_uncut(maps[g], ZMap::from_mesh(groups[g].frame, *stock.mesh, zmap_cell, limits), options.threads);
+    if (stock.mesh) raise_uncut(maps[g], *stock.mesh, options.threads);
     else raise_uncut(maps[g], stock.box, options.threads);
   }
   if (request.fine_cells) {
