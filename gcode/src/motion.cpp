@@ -499,9 +499,21 @@ void Interpreter::State::home_return(bool second) {
   unsigned mask = 0;
   for (int i = 0; i < 3; ++i)
     if (w.has(kAxisLetter[i])) mask |= 1u << i;
-  bool rotary = w.has('A') || w.has('B') || w.has('C');
+  const bool rotary = w.has('A') || w.has('B') || w.has('C');
   if (mask) linear(MoveKind::rapid, 0.0);  // the intermediate point
   if (!mask && !rotary) mask = 7;
+  // The named rotary axes go to their zero. With a kinematic model that moves the part or tilts
+  // the tool only when one of them was not at zero already; without one, only when the tool
+  // was oriented off +Z (G53.1 and the like), which the return brings back. Otherwise the
+  // linear axes return as if no rotary word were given (a 4-axis post's `G28 X0 Y0 A0`).
+  bool turns = rotary && !machine.kinematics && glm::dot(axis, Vec3(0, 0, 1)) < 1 - kSameDirection;
+  for (char c : {'A', 'B', 'C'})
+    if (w.has(c)) {
+      w.take(c);
+      double& angle = rotary_position[static_cast<std::size_t>(rotary_index(c))];
+      turns = turns || (machine.kinematics && angle != 0);
+      angle = 0;
+    }
   const Vec3& target = second ? machine.reference2 : machine.home;
   bool is_default = second ? machine.reference2_is_default : machine.home_is_default;
   bool& warned = second ? warned_reference2 : warned_home;
@@ -519,14 +531,14 @@ void Interpreter::State::home_return(bool second) {
   // With the tool along +Z, returning X/Y only is a plain rapid at the current height (on any
   // machine). Anything else is a retract: the tip goes far along the tool axis, the homed
   // axes' coordinates kept for the lateral position.
-  if (mask && !(mask & 4u) && !rotary && !far &&
+  if (mask && !(mask & 4u) && !turns && !far &&
       glm::dot(axis, Vec3(0, 0, 1)) >= 1 - kSameDirection) {
     machine_move(target, mask, MoveKind::rapid, 0.0);
     return;
   }
   // A machine file that sets the position makes the return a known rapid (tool along +Z: the
   // machine's axes are the work's).
-  if (!is_default && !rotary && glm::dot(axis, Vec3(0, 0, 1)) >= 1 - kSameDirection) {
+  if (!is_default && !turns && glm::dot(axis, Vec3(0, 0, 1)) >= 1 - kSameDirection) {
     Vec3 end = pos;
     for (int i = 0; i < 3; ++i)
       if ((mask >> i) & 1u) end[i] = tip_below(target)[i];
@@ -542,16 +554,9 @@ void Interpreter::State::home_return(bool second) {
   for (int i = 0; i < 3; ++i)
     if ((mask >> i) & 1u) pos[i] = target[i];
   far = true;
-  if (rotary) {
-    // Rotary axes home: the spindle returns to the machine's +Z, and the tip goes far.
-    // With a kinematic model the named axes go to their zero and the direction follows.
-    for (char c : {'A', 'B', 'C'})
-      if (w.has(c)) {
-        w.take(c);
-        rotary_position[static_cast<std::size_t>(rotary_index(c))] = 0;
-      }
+  if (turns) {
+    // The tip goes far while the axes turn; the direction follows the kinematic model.
     axis = machine.kinematics ? tool_direction(*machine.kinematics, rotary_position) : Vec3(0, 0, 1);
-    far = true;
     update_frame();
   }
 }

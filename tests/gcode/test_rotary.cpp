@@ -255,3 +255,27 @@ TEST_CASE("A/B/C on a LinuxCNC machine without kinematics are plain axes, as in 
   CHECK(d.column == 13);
   CHECK(d.message.find("kinematics") != std::string::npos);
 }
+
+TEST_CASE("G28/G30 with X Y and a rotary word at zero return X and Y too (a 4-axis post's G28 X0. Y0. A0.)") {
+  // LinuxCNC without kinematics (as rs274: STRAIGHT_TRAVERSE to the origin), in G90 and G91.
+  MachineConfig linuxcnc = *MachineConfig::bundled("linuxcnc");
+  Result r = run_program("G20 G90 G17\nG0 X1 Y1 Z.5 A0\nG91 G28 Z0\nG28 X0 Y0 A0\nM2\n", {}, linuxcnc);
+  REQUIRE(!r.moves.empty());
+  CHECK(near(r.moves.back().end, Vec3(0, 0, 0), 1e-9));
+  r = run_program("G21 G90\nG0 X10 Y10 Z5 A30\nG28 X4 Y4 A0\nG0 Z7\nM2\n", {}, linuxcnc);
+  REQUIRE(r.moves.size() >= 3);
+  CHECK(near(r.moves[1].end, Vec3(4, 4, 5), 1e-9));  // the intermediate point
+  CHECK(near(r.moves[2].end, Vec3(0, 0, 5), 1e-9));  // the named axes go home
+  // With a kinematic model and the axis already at zero, X and Y go to the machine file's home
+  // as without the word; turned away from zero, the tool turns back and the tip goes far.
+  MachineConfig ac = with_kinematics("ac-trunnion");
+  ac.home = Vec3(0, 0, 0);
+  ac.home_is_default = false;
+  r = run_program("G21 G90\nG0 X10 Y10 Z5 A0\nG91 G28 X0 Y0 A0\nG90\nM2\n", {}, ac);
+  REQUIRE(!r.moves.empty());
+  CHECK(near(r.moves.back().end, Vec3(0, 0, 5), 1e-9));
+  r = run_program("G21 G90\nG0 X10 Y10 Z5 A20\nG91 G28 X0 Y0 A0\nG90 G0 X1 Y1 Z1\nM2\n", {}, ac);
+  REQUIRE(!r.moves.empty());
+  CHECK(near(r.moves.back().axis, Vec3(0, 0, 1), 1e-9));
+  CHECK(r.moves.back().start.z > 1 + 100);  // from far above
+}
