@@ -28,6 +28,7 @@ struct Words {
   int g_count = 0;
   std::array<Code, 8> m{};
   int m_count = 0;
+  bool m_arguments = false;  // an accepted M-code that takes P Q E L R words is in the block
 
   bool has(char c) const { return (present >> letter_index(c)) & 1u; }
   int col(char c) const { return column[static_cast<std::size_t>(letter_index(c))]; }
@@ -68,13 +69,13 @@ inline int g_group(int code) {
     case 400: case 410: case 420: case 411: case 421: return kCutterComp;
     case 430: case 431: case 434: case 435: case 440: case 490: return kToolLength;
     case 980: case 990: return kReturn;
-    case 540: case 550: case 560: case 570: case 580: case 590: case 541: return kWork;
+    case 540: case 550: case 560: case 570: case 580: case 590: case 541: case 1540: return kWork;
     case 970: return kSpindleMode;
     case 150: return kPolar;
     case 610: case 640: return kPath;
     case 682: case 683: case 684: case 690: case 2680: case 2690: return kTilt;
     case 531: case 533: case 536: case 2530: return kOrient;
-    case 51: case 80: case 1870: return kSmoothing;  // Fanuc G5.1 Q / G8 P, Haas G187 P E
+    case 51: case 80: case 1030: case 1870: return kSmoothing;  // Fanuc G5.1 Q / G8 P, Haas G103 P, G187 P E
     case 2540: case 2550: return kDynamicOffset;     // Haas DWO
     default: return -1;
   }
@@ -84,7 +85,7 @@ enum MGroup { kStop, kToolChange, kSpindle, kCoolant, kMGroupCount };
 
 inline int m_group(int code) {
   switch (code) {
-    case 0: case 1: case 2: case 30: case 98: case 99: return kStop;
+    case 0: case 1: case 2: case 30: case 97: case 98: case 99: return kStop;
     case 6: case 61: return kToolChange;
     case 3: case 4: case 5: return kSpindle;
     case 7: case 8: case 9: return kCoolant;

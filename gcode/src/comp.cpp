@@ -75,8 +75,9 @@ void Interpreter::State::cutter_comp_codes(int code, int column) {
     if (w.has('L')) error(w.col('L'), name + " L (a lathe tool's orientation) is not simulated: tridex simulates mills");
     radius = length('D') / 2;
   } else {
-    int number = tool;
+    int number = offset_d >= 0 ? offset_d : tool;
     if (w.has('D')) number = static_cast<int>(integer('D', (name + " D (a tool number)").c_str(), 0, 99'999'999));
+    if (w.has('D') && machine.dialect == Dialect::fanuc) offset_d = number;
     if (number != 0) {
       auto it = machine.tool_diameters.find(number);
       if (it == machine.tool_diameters.end())

@@ -46,7 +46,7 @@ struct Position {
   int line = 0;  // the line number of the line before `offset`
 };
 
-enum class CallKind { m98, g65, o_call };
+enum class CallKind { m98, m97, g65, o_call };  // M97: Haas, a block N of this program
 
 struct Call {
   CallKind kind;
@@ -110,6 +110,7 @@ class ProgramFlow {
   void give_back(int column);
   void o_word(const Control& control);
   void loop_control(const Control& control);
+  Position find_sequence(long long number, const std::string& what, int column);
   void jump_to_sequence(long long number, int column);
   std::vector<Value> arguments(const Control& control);
   bool condition(const Control& control);
@@ -282,6 +283,7 @@ void ProgramFlow::call(CallKind kind, const std::string& label, long long repeat
   Call c{kind, label, here(), {}, repeats, loops_.size(), branches_.size(), false};
   std::optional<Position> body =
       kind == CallKind::o_call ? find_body(&Source::subroutines, label, label, true, column)
+      : kind == CallKind::m97  ? find_sequence(std::stoll(label), "M97 P" + label, column)
                                : find_body(&Source::programs, std::stoi(label), label, false, column);
   if (!body) {
     if (kind == CallKind::o_call)
@@ -294,7 +296,7 @@ void ProgramFlow::call(CallKind kind, const std::string& label, long long repeat
     return;
   }
   c.body = *body;
-  if (kind != CallKind::m98) {
+  if (kind == CallKind::g65 || kind == CallKind::o_call) {  // M98 and M97 share the caller's locals
     s_.scopes.emplace_back();
     c.scope = true;
     auto& locals = s_.scopes.back().locals;
@@ -342,6 +344,11 @@ bool ProgramFlow::condition(const Control& control) {
 }
 
 void ProgramFlow::jump_to_sequence(long long number, int column) {
+  jump(find_sequence(number, "GOTO " + std::to_string(number), column));
+}
+
+// Where block N`number` of the current file starts; `what` names the jump in the error.
+Position ProgramFlow::find_sequence(long long number, const std::string& what, int column) {
   Source& src = source();
   auto it = src.sequences.find(number);
   if (it == src.sequences.end()) {
@@ -367,11 +374,13 @@ void ProgramFlow::jump_to_sequence(long long number, int column) {
     if (!found) {
       jump(back);
       s_.line = from;
-      error(column, "GOTO " + std::to_string(number) + ": no block N" + std::to_string(number));
+      error(column, what + ": no block N" + std::to_string(number));
     }
+    jump(back);
+    s_.line = from;
     it = src.sequences.emplace(number, Source::Label{found->offset, found->line}).first;
   }
-  jump(Position{current_, it->second.body, it->second.line});
+  return Position{current_, it->second.body, it->second.line};
 }
 
 void ProgramFlow::loop_control(const Control& control) {
@@ -644,9 +653,10 @@ void ProgramFlow::run() {
       break;
     }
     if (flow == Flow::call || flow == Flow::macro) {
-      int column = flow == Flow::call ? s_.w.find_m(98) : s_.w.find_g(650);
-      call(flow == Flow::call ? CallKind::m98 : CallKind::g65, std::to_string(s_.call_label),
-           s_.call_repeats, column);
+      const int m97 = s_.w.find_m(97);
+      int column = flow == Flow::macro ? s_.w.find_g(650) : m97 ? m97 : s_.w.find_m(98);
+      call(flow == Flow::macro ? CallKind::g65 : m97 ? CallKind::m97 : CallKind::m98,
+           std::to_string(s_.call_label), s_.call_repeats, column);
       continue;
     }
     if (flow == Flow::ret) {

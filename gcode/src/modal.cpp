@@ -167,6 +167,7 @@ Flow Interpreter::State::execute(const Block& block) {
     for (char c : {'P', 'E'})
       if (w.has(c)) w.take(c);
   }
+  if (w.find_g(1030) && w.has('P')) w.take('P');  // Haas: blocks of look-ahead
   if (w.find_g(640)) {  // path blending tolerances (LinuxCNC G64 P Q): no effect on the path
     if (w.has('P')) w.take('P');
     if (w.has('Q')) w.take('Q');
@@ -175,13 +176,16 @@ Flow Interpreter::State::execute(const Block& block) {
   if (w.find_g(990)) retract_to_r = true;
 
   // Work coordinate system.
-  for (int code : {540, 550, 560, 570, 580, 590, 541}) {
+  for (int code : {540, 550, 560, 570, 580, 590, 541, 1540}) {
     int column = w.find_g(code);
     if (!column) continue;
-    int key = code == 541 ? 0 : (code - 540) / 10 + 1;
+    int key = (code - 540) / 10 + 1;
     if (code == 541) {
       if (!w.has('P')) error(column, "G54.1 needs P (1-300)");
       key = MachineConfig::g54_1_key(static_cast<int>(integer('P', "G54.1 number", 1, 300)));
+    } else if (code == 1540) {  // Haas: the same extra offsets as G54.1 P1-P99
+      if (!w.has('P')) error(column, "G154 needs P (1-99)");
+      key = MachineConfig::g54_1_key(static_cast<int>(integer('P', "G154 number", 1, 99)));
     }
     if (tilted && key != work_key)
       error(column, "work coordinates change while a tilted plane is active (cancel it first)");
@@ -313,20 +317,28 @@ Flow Interpreter::State::execute(const Block& block) {
     comp_finish();
     flow = Flow::end;
   }
-  if (int column = w.find_m(98)) {
-    if (!w.has('P')) error(column, "M98 needs P (the O number to call)");
-    call_label = static_cast<int>(integer('P', "M98 P", 0, 999'999'999));
+  for (int m : {98, 97}) {  // M97 P: Haas, a local subprogram at block N P of this program
+    const int column = w.find_m(m);
+    if (!column) continue;
+    const std::string name = m == 98 ? "M98" : "M97";
+    if (!w.has('P')) error(column, name + (m == 98 ? " needs P (the O number to call)" : " needs P (the N number to call)"));
+    call_label = static_cast<int>(integer('P', (name + " P").c_str(), 0, 999'999'999));
     if (w.has('L') && w.has('K')) error(w.col('K'), "repeat count given twice (L and K)");
     call_repeats = 1;
-    if (w.has('L')) call_repeats = integer('L', "M98 repeat count", 0, 9999);
-    if (w.has('K')) call_repeats = integer('K', "M98 repeat count", 0, 9999);
+    if (w.has('L')) call_repeats = integer('L', (name + " repeat count").c_str(), 0, 9999);
+    if (w.has('K')) call_repeats = integer('K', (name + " repeat count").c_str(), 0, 9999);
     flow = Flow::call;
   }
   if (w.find_m(99)) flow = Flow::ret;
 
+  // Fanuc keeps a D word for the next G41/G42 (`T4 D04 M06`); LinuxCNC refuses it, as rs274.
+  if (machine.dialect == Dialect::fanuc && w.has('D') && !((w.used >> letter_index('D')) & 1u))
+    offset_d = static_cast<int>(integer('D', "D (a cutter radius offset number)", 0, 99'999'999));
   // Every word must have been used by some code of the block: never a silent misreading.
   std::uint32_t free_words = w.present & ~w.used;
   for (char c : {'F', 'S', 'T', 'O'}) free_words &= ~(1u << letter_index(c));
+  if (w.m_arguments)
+    for (char c : {'P', 'Q', 'E', 'L', 'R'}) free_words &= ~(1u << letter_index(c));
   if (free_words) {
     for (int i = 0; i < 26; ++i) {
       if (!((free_words >> i) & 1u)) continue;
@@ -334,9 +346,19 @@ Flow Interpreter::State::execute(const Block& block) {
       std::size_t k = static_cast<std::size_t>(i);
       bool axis_letter = c == 'X' || c == 'Y' || c == 'Z';
       if (axis_letter) continue;  // axis words are consumed by construction or rejected above
-      if ((c == 'A' || c == 'B' || c == 'C') && !machine.kinematics)  // never dropped, even lenient
+      if ((c == 'A' || c == 'B' || c == 'C') && !machine.kinematics) {
+        // A 4-axis post writes A0. at every tool start: with the tool along +Z (no G53.1 has
+        // turned the axes) an axis that stays at zero turns nothing, whatever the machine. Any
+        // other angle is never dropped, even lenient.
+        if (w.value[k] == 0 && glm::dot(axis, Vec3(0, 0, 1)) >= 1 - kSameDirection) {
+          if (warned_rotary_at_zero.insert(c).second)
+            warn(w.column[k], std::string("rotary word ") + c + "0 read as the axis staying at zero (the "
+                              "tool stays along +Z); a machine file with \"kinematics\" models the axis");
+          continue;
+        }
         error(w.column[k], std::string("rotary word ") + c + format_number(w.value[k]) +
                                ": reading A/B/C needs a machine file with \"kinematics\" (--machine)");
+      }
       // Only words that never carry geometry may be dropped: E (an extruder), D and H (offset
       // numbers, which tridex does not apply).
       bool skippable = c == 'E' || c == 'D' || c == 'H';

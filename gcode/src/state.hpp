@@ -113,6 +113,7 @@ struct Interpreter::State : ParameterReader {
   bool warned_home = false;
   bool warned_reference2 = false;
   std::set<int> warned_m_codes;
+  std::set<char> warned_rotary_at_zero;  // A/B/C words of 0 read on a machine without kinematics
   bool warned_plain_rotary = false;  // A/B/C on a LinuxCNC machine without kinematics
   bool warned_probe = false;         // G38.x read as rs274 standalone does
   Vec3 local_offset{0.0};  // G52 / G92 (one register, as LinuxCNC keeps it), machine axes
@@ -218,6 +219,7 @@ struct Interpreter::State : ParameterReader {
     w.present = w.used = 0;
     find_splines(block);
     w.g_count = w.m_count = 0;
+    w.m_arguments = false;
     std::array<int, kGroupCount> g_seen{};
     std::array<int, kMGroupCount> m_seen{};
     for (const Word& word : block.words) {
@@ -239,6 +241,9 @@ struct Interpreter::State : ParameterReader {
             warn(word.column, code_name('M', code) +
                                   " has no effect on the tool path here (accepted; declare it in the "
                                   "machine file's m_codes to silence this)");
+          // Spindle orientation (M19 R Q P) and LinuxCNC's I/O codes (M62-M65 P, M66 P E L Q,
+          // M67/M68 E Q) and user codes (M100-M199 P Q) take arguments of their own.
+          w.m_arguments |= m == 19 || (m >= 62 && m <= 68) || (m >= 100 && m <= 199);
           continue;
         }
         if (group < 0) {
@@ -412,6 +417,7 @@ struct Interpreter::State : ParameterReader {
   };
   int comp_side = 0;
   double comp_radius = 0;              // mm, ≥ 0
+  int offset_d = -1;                   // Fanuc: the last D word, modal (#4107); -1: none yet
   bool comp_first = true;              // the next compensated move is the entry move
   bool comp_arc_forbidden = false;     // just after G40: the next move must be straight
   bool comp_programmed_current = false;  // coordinates count from comp_programmed, not the tip

@@ -236,11 +236,14 @@ void Interpreter::State::orient_to_plane(int code) {
   }
   update_frame();
   if (code != 533) return;
-  if (!(w.has('I') && w.has('J') && w.has('K')))
-    error(column, "G53.3 needs I, J and K: the point of the plane to go to");
-  Vec3 target(length('I'), length('J'), length('K'));
-  // I J K are a position here, not arc centre offsets: the motion stage must not see them.
-  for (char c : {'I', 'J', 'K'}) w.present &= ~(1u << letter_index(c));
+  // LinuxCNC's remap (g533remap.ngc) requires X, Y and Z, and hands them on to M530 as I J K.
+  for (char c : {'I', 'J', 'K'})
+    if (w.has(c)) error(w.col(c), "G53.3 takes the point of the plane to go to as X Y Z, not I J K");
+  if (!(w.has('X') && w.has('Y') && w.has('Z')))
+    error(column, "G53.3 needs X, Y and Z: the point of the plane to go to");
+  Vec3 target(length('X'), length('Y'), length('Z'));
+  // The point is G53.3's own rapid, made here: the motion stage must not move to it again.
+  for (char c : {'X', 'Y', 'Z'}) w.present &= ~(1u << letter_index(c));
   move_to(target, {true, true, true}, rotation, origin, MoveKind::rapid, 0.0);
 }
 

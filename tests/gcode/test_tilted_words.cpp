@@ -115,15 +115,18 @@ TEST_CASE("G68.4 composes with the active plane; G68.3 takes the tool axis") {
   CHECK(error_of("G68.3\n").message.find("retracted") != std::string::npos);
 }
 
-TEST_CASE("LinuxCNC G53.3 orients and rapids to I J K in the plane") {
-  Result r = run_program("G21 G90 T1 M6\nG68.2 X5 I0 J30 K0 Q313\nG53.3 P1 I1 J2 K3\nM30\n", {},
+TEST_CASE("LinuxCNC G53.3 orients and rapids to X Y Z in the plane (its remap's form)") {
+  Result r = run_program("G21 G90 T1 M6\nG68.2 X5 I0 J30 K0 Q313\nG53.3 P1 X1 Y2 Z3\nM30\n", {},
                          at_origin());
   REQUIRE(r.moves.size() == 1);
   Frame f = fanuc_euler(Vec3(5, 0, 0), 0, 30, 0);
   CHECK(near(r.moves[0].end, f.to_world(Vec3(1, 2, 3)), 1e-9));
   CHECK(r.moves[0].kind == MoveKind::rapid);
   CHECK(near(r.moves[0].axis, f.rotation[2], 1e-12));
-  CHECK(error_of("G68.2 J30\nG53.3 I1 J2\n").message.find("needs I, J and K") != std::string::npos);
+  CHECK(error_of("G68.2 J30\nG53.3 X1 Y2\n").message.find("needs X, Y and Z") != std::string::npos);
+  Diagnostic d = error_of("G68.2 J30\nG53.3 I1 J2 K3\n");
+  CHECK(d.column == 7);
+  CHECK(d.message.find("as X Y Z, not I J K") != std::string::npos);
 }
 
 TEST_CASE("tilted-plane words: bad combinations are errors with their column") {

@@ -1,0 +1,107 @@
+// Words that shop programs write and public programs showed tridex refusing: Haas M97 local
+// subprograms, G103 and G154, M-codes with arguments of their own (M19 R, LinuxCNC's I/O
+// codes), and Fanuc's modal D. Each is compared with the same program written without it.
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+#include "helpers.hpp"
+
+using namespace tridex;
+using namespace tridex::gcode;
+using namespace tridex::gcode::test;
+
+namespace {
+
+void same_moves(const Result& a, const Result& b) {
+  REQUIRE(a.moves.size() == b.moves.size());
+  for (std::size_t i = 0; i < a.moves.size(); ++i) {
+    CAPTURE(i);
+    CHECK(near(a.moves[i].start, b.moves[i].start));
+    CHECK(near(a.moves[i].end, b.moves[i].end));
+    CHECK(a.moves[i].kind == b.moves[i].kind);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("Haas M97 P L calls block N P of this program, L times, back at M99") {
+  const std::string sub = "N1000\nG91 G1 Z-0.5 F100\nG90 X10\nX0\nM99\n";
+  Result called = run_program("G21 G90 G17\nG0 X0 Y0 Z1\nM97 P1000 L2\nG0 Z5\nM97 P1000\nM30\n" + sub, {},
+                              at_origin());
+  const std::string body = "G91 G1 Z-0.5 F100\nG90 X10\nX0\n";
+  Result inline_ = run_program("G21 G90 G17\nG0 X0 Y0 Z1\n" + body + body + "G0 Z5\n" + body + "M30\n", {},
+                               at_origin());
+  same_moves(called, inline_);
+  // A local subprogram before the call, nested in an M98 subprogram's file position, and errors.
+  Result before = run_program("G21 G90\nG0 X0 Y0 Z1\nGOTO 5\nN7 G1 X3 F100\nM99\nN5 M97 P7\nM30\n", {},
+                              at_origin());
+  REQUIRE(before.moves.size() == 2);
+  CHECK(near(before.moves[1].end, Vec3(3, 0, 1)));
+  Diagnostic d = error_of("G0 X0 Y0 Z1\nM97 P12\nM30\n");
+  CHECK(d.line == 2);
+  CHECK(d.message.find("M97 P12: no block N12") != std::string::npos);
+  CHECK(error_of("M97\nM30\n").message.find("M97 needs P") != std::string::npos);
+}
+
+TEST_CASE("Haas G103 (look-ahead) and G154 P (extra work offsets, as G54.1 P)") {
+  MachineConfig machine = at_origin();
+  machine.work_offsets[MachineConfig::g54_1_key(7)] = Vec3(10, 20, 30);
+  Result haas = run_program("G21 G90\nG103 P1\nG154 P7 G0 X1 Y2 Z3\nG103\nG1 X4 F100\nM30\n", {}, machine);
+  Result fanuc = run_program("G21 G90\nG54.1 P7 G0 X1 Y2 Z3\nG1 X4 F100\nM30\n", {}, machine);
+  CHECK(haas.warnings.empty());
+  same_moves(haas, fanuc);
+  REQUIRE(!haas.moves.empty());
+  CHECK(near(haas.moves.back().end, Vec3(14, 22, 33)));
+  CHECK(error_of("G154\n").message.find("G154 needs P") != std::string::npos);
+  CHECK(error_of("G154 P100\n").message.find("G154 number") != std::string::npos);
+}
+
+TEST_CASE("M-codes with arguments of their own: M19 R, LinuxCNC's M62-M68, user M100-M199") {
+  MachineConfig linuxcnc = *MachineConfig::bundled("linuxcnc");
+  Result io = run_program("G21 G90\nM62 P0\nM65 P1\nM66 P0 L0 Q1\nM68 E0 Q0\nM19 R45\nG0 X1 Y2 Z3\nM2\n", {},
+                          linuxcnc);
+  Result plain = run_program("G21 G90\nG0 X1 Y2 Z3\nM2\n", {}, linuxcnc);
+  same_moves(io, plain);
+  // Each code is said once in the warnings.
+  CHECK(io.warnings.size() == 5);
+  // Other M-codes do not take them, and a word no code uses is still an error.
+  Diagnostic d = error_of("G21 G90\nM8 P1\n", {}, linuxcnc);
+  CHECK(d.message.find("word P1 is not used") != std::string::npos);
+  d = error_of("G21 G90\nM62 P0 G1 X1 I3 F100\n", {}, linuxcnc);
+  CHECK(d.message.find("word I3 is not used") != std::string::npos);
+}
+
+TEST_CASE("Fanuc keeps D for the next G41/G42 (T4 D04 M06); LinuxCNC refuses it as rs274 does") {
+  MachineConfig machine = at_origin();
+  machine.tool_diameters = {{1, 6.0}, {4, 10.0}};
+  const std::string path = "G0 X-20 Y0 Z1\nG1 Z-1 F100\nX0\nY20\nG40 X-20 Y30\nM30\n";
+  Result modal = run_program("G21 G90 G17\nT1 D4 M6\nG41\n" + path, {}, machine);
+  Result given = run_program("G21 G90 G17\nT1 M6\nG41 D4\n" + path, {}, machine);
+  Result loaded = run_program("G21 G90 G17\nT1 M6\nG41\n" + path, {}, machine);
+  same_moves(modal, given);
+  // D4 (radius 5) and the loaded tool (radius 3) offset the path differently: the cut along
+  // Y ends 5 mm to the left of X0.
+  bool at_minus_5 = false;
+  for (const Move& m : modal.moves) at_minus_5 |= m.kind == MoveKind::feed && std::abs(m.end.x + 5) < 1e-9 && m.end.y > 10;
+  CHECK(at_minus_5);
+  bool at_minus_3 = false;
+  for (const Move& m : loaded.moves) at_minus_3 |= m.kind == MoveKind::feed && std::abs(m.end.x + 3) < 1e-9 && m.end.y > 10;
+  CHECK(at_minus_3);
+  MachineConfig linuxcnc = *MachineConfig::bundled("linuxcnc");
+  linuxcnc.tool_diameters = machine.tool_diameters;
+  CHECK(error_of("G21 G90\nT1 D4 M6\n", {}, linuxcnc).message.find("word D4 is not used") != std::string::npos);
+}
+
+TEST_CASE("A0/B0/C0 on a machine without kinematics: the axis stays at zero (4-axis posts' tool starts)") {
+  Result with_a = run_program("G21 G90\nT1 M6\nG0 X1 Y2 Z5 A0.\nG1 Z-1 B0 F100\nG91 G0 A0\nM30\n", {}, at_origin());
+  Result without = run_program("G21 G90\nT1 M6\nG0 X1 Y2 Z5\nG1 Z-1 F100\nG91\nM30\n", {}, at_origin());
+  same_moves(with_a, without);
+  REQUIRE(with_a.warnings.size() == 2);  // once per letter
+  CHECK(with_a.warnings[0].message.find("rotary word A0 read as the axis staying at zero") != std::string::npos);
+  // Any other angle needs the kinematics, and so does A0 once G53.1 has turned the tool.
+  CHECK(error_of("G21 G90\nG0 X1 A10\n", {}, at_origin()).message.find("kinematics") != std::string::npos);
+  Diagnostic d = error_of("G21 G90\nG68.2 X0 Y0 Z0 I0 J30 K0\nG53.1\nG0 X1 A0\n", {}, at_origin());
+  CHECK(d.line == 4);
+  CHECK(d.message.find("kinematics") != std::string::npos);
+}
