@@ -235,6 +235,12 @@ Flow Interpreter::State::execute(const Block& block) {
         if (w.has(kAxisLetter[i]))
           value[i] = relative_to_position ? linear_axes()[i] - local_offset[i] - length(kAxisLetter[i])
                                           : length(kAxisLetter[i]);
+      // A rotary offset of 0 changes nothing, nor do LinuxCNC's plain A/B/C (no kinematics);
+      // any other would turn the part under the program, which tridex does not model.
+      for (char c : {'A', 'B', 'C'})
+        if (w.has(c) && w.take(c) != 0 && !(linuxcnc && !machine.kinematics))
+          error(w.col(c), std::string("G10 ") + c + format_number(w.value[static_cast<std::size_t>(letter_index(c))]) +
+                              ": a rotary work offset other than 0 is not simulated");
       if (key == work_key) comp_forbid(column, "G10 on the active work offset");
       offsets[key] = value;
       if (key == work_key) {

@@ -105,3 +105,18 @@ TEST_CASE("A0/B0/C0 on a machine without kinematics: the axis stays at zero (4-a
   CHECK(d.line == 4);
   CHECK(d.message.find("kinematics") != std::string::npos);
 }
+
+TEST_CASE("G10 L2/L20 with rotary words: 0 changes nothing; LinuxCNC's plain axes take any") {
+  const std::string after = "T1 M6\nG54 G0 X1 Y2 Z10\nG1 Z-1 F100\nM30\n";
+  Result with_b = run_program("G21 G90\nG10 L2 P1 X5 Y0 Z0 B0\n" + after, {}, at_origin());
+  Result without = run_program("G21 G90\nG10 L2 P1 X5 Y0 Z0\n" + after, {}, at_origin());
+  same_moves(with_b, without);
+  REQUIRE(!with_b.moves.empty());
+  CHECK(near(with_b.moves.back().end, Vec3(6, 2, -1)));
+  MachineConfig linuxcnc = *MachineConfig::bundled("linuxcnc");
+  same_moves(run_program("G21 G90\nG10 L20 P1 X0 A30 C5\n" + after, {}, linuxcnc),
+             run_program("G21 G90\nG10 L20 P1 X0\n" + after, {}, linuxcnc));
+  Diagnostic d = error_of("G21 G90\nG10 L2 P1 X0 B15\n", {}, at_origin());
+  CHECK(d.column == 14);
+  CHECK(d.message.find("G10 B15: a rotary work offset other than 0 is not simulated") != std::string::npos);
+}

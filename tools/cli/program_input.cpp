@@ -88,7 +88,8 @@ InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOpt
       if (options.max_blocks <= 0 || interpreter.blocks() <= options.max_blocks) throw;
       input_error(e.where.file, ":", e.where.line, ":", e.where.column, ": more than ", options.max_blocks,
                   " blocks executed (--max-blocks ", options.max_blocks,
-                  "; nested M98 ... L repeats?); raise --max-blocks if the program needs more");
+                  "; an endless GOTO or WHILE loop, or nested M98 ... L repeats?); raise --max-blocks if the "
+                  "program needs more");
     }
     for (const gcode::Diagnostic& d : interpreter.warnings()) result.warnings.push_back(d.to_string());
     for (const auto& [tool, line] : interpreter.tool_first_line())
