@@ -55,6 +55,35 @@ void Interpreter::State::tool_length_codes() {
   update_frame();
 }
 
+// The feed mode, F and S, in RS274/NGC's order (feed mode first). LinuxCNC's G94 and G95 set the
+// feed rate to 0 (interp_convert.cc convert_feed_mode), so a feed move after them needs a new F;
+// the other dialects clear it when the mode changes. Under G93, F is the block's 1/min (read in
+// require_feed, only from the block itself, as LinuxCNC does); under G95 the rate is F × S.
+void Interpreter::State::feed_mode_codes() {
+  for (int code : {930, 940, 950}) {
+    if (!w.find_g(code)) continue;
+    FeedMode next = code == 930 ? FeedMode::inverse_time
+                    : code == 940 ? FeedMode::per_minute
+                                  : FeedMode::per_revolution;
+    bool clears = machine.dialect == Dialect::linuxcnc ? code != 930 : next != feed_mode;
+    if (clears) feed = feed_per_rev = 0;
+    feed_mode = next;
+  }
+  if (w.has('F')) {
+    if (w.value[static_cast<std::size_t>(letter_index('F'))] < 0)
+      error(w.col('F'), "feed rate F must not be negative");
+    if (feed_mode == FeedMode::inverse_time) inverse_time = w.take('F');
+    else if (feed_mode == FeedMode::per_revolution) feed_per_rev = length('F');
+    else feed = length('F');
+  }
+  if (w.has('S')) {
+    double s = w.take('S');
+    if (s < 0) error(w.col('S'), "spindle speed S must not be negative");
+    speed = s;
+  }
+  if (feed_mode == FeedMode::per_revolution) feed = feed_per_rev * speed;
+}
+
 Flow Interpreter::State::execute(const Block& block) {
   gather(block);
   if (plane_blocks.code && !w.find_g(plane_blocks.code))  // a G68.2 P2/P3 plane is under way
@@ -95,16 +124,7 @@ Flow Interpreter::State::execute(const Block& block) {
     unit = next;
   }
 
-  if (w.has('F')) {
-    double f = length('F');
-    if (f < 0) error(w.col('F'), "feed rate F must not be negative");
-    feed = f;
-  }
-  if (w.has('S')) {
-    double s = w.take('S');
-    if (s < 0) error(w.col('S'), "spindle speed S must not be negative");
-    speed = s;
-  }
+  feed_mode_codes();
   if (w.has('T')) tool_selected = static_cast<int>(integer('T', "tool number", 0, 99'999'999));
 
   if (w.find_m(6) || (w.has('T') && machine.tool_loads_on_t)) {

@@ -57,7 +57,19 @@ struct Interpreter::State : ParameterReader {
   int work_key = 1;
   Vec3 work_offset{0.0};
   std::map<int, Vec3> offsets;
-  double feed = 0;
+  double feed = 0;  // mm/min of the next feed move (under G93 and G95, worked out per move)
+  // Feed modes (RS274/NGC group 5, NIST IR 6556 §3.5.19; LinuxCNC interp_inverse.cc): G94 F in
+  // units per minute; G93 inverse time, F in 1/min, every feed block takes 1/F minutes (its rate
+  // is its programmed length × F, set per move); G95 F in units per spindle revolution (× S).
+  enum class FeedMode { per_minute, inverse_time, per_revolution };
+  FeedMode feed_mode = FeedMode::per_minute;
+  double inverse_time = 0;  // G93: the block's F (1/min)
+  double feed_per_rev = 0;  // G95: mm per revolution
+  // The feed rate as LinuxCNC's #<_feed> reads it, in program units: per revolution under G95,
+  // under G93 the rate of the last feed move.
+  double programmed_feed() const { return (feed_mode == FeedMode::per_revolution ? feed_per_rev : feed) / unit; }
+  void feed_mode_codes();                 // G93, G94, G95, F and S (modal.cpp)
+  void inverse_time_rate(double length);  // G93: feed for a block `length` mm long (motion.cpp)
   Vec2 spline_mirror{0.0};  // G5 without I J: P1 − P0, program units (−P, −Q of the last G5)
   double speed = 0;
   int spindle_direction = 0;
@@ -245,7 +257,7 @@ struct Interpreter::State : ParameterReader {
           // Codes known to leave the path alone (feed and speed modes, exact stop, cancels of
           // modes tridex never enters) may be skipped in a block without coordinates; any other
           // unknown code could move the tool or change how later coordinates read.
-          static constexpr int kHarmless[] = {50, 90, 131, 500, 501, 611, 620, 630, 670, 930, 950, 960};
+          static constexpr int kHarmless[] = {50, 90, 131, 500, 501, 611, 620, 630, 670, 960};
           bool harmless = word.letter == 'G' && integral &&
                           std::find(std::begin(kHarmless), std::end(kHarmless), code) != std::end(kHarmless);
           bool coordinates = false;
@@ -463,6 +475,7 @@ struct Interpreter::State : ParameterReader {
   };
   ArcData arc_data(const Vec3& start, bool ccw);
   double arc_sweep(const Vec3& start, const Vec3& end, const Vec2& c, bool ccw) const;
+  double arc_length(const Vec3& start, const ArcData& a, bool ccw) const;
   void arc_chords(const Vec3& start, const Vec3& end, const Vec2& c, bool ccw, double sweep,
                   double move_feed);
   void cycle(int code);

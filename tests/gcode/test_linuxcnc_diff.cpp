@@ -466,3 +466,53 @@ TEST_CASE("differential: skeleton.ngc's tool length offset agrees with rs274") {
   CHECK(ours.front().p.z == doctest::Approx(-0.511 * 25.4));
   fs::remove(program);
 }
+
+// rs274 prints the rate of every feed move (SET_FEED_RATE, program units per minute, or per
+// revolution after SET_FEED_MODE(0, 1), times the SET_SPINDLE_SPEED); under G93 it is the rate
+// it works out for the block, its length × F. tridex's moves carry theirs in mm/min: the rates
+// of the feed blocks of feed_modes.ngc (one STRAIGHT_FEED or ARC_FEED each) are compared in order.
+TEST_CASE("differential: feed rates in G93, G94 and G95 agree with rs274") {
+  if (!rs274_available()) {
+    MESSAGE("SKIPPED: rs274 not found (install the Debian package linuxcnc-uspace); the LinuxCNC "
+            "differential test did not run");
+    return;
+  }
+  const fs::path program = fs::path(TRIDEX_TEST_DATA) / "gcode" / "linuxcnc" / "feed_modes.ngc";
+  const fs::path out = fs::temp_directory_path() / ("tridex_rs274_feeds_" + std::to_string(::getpid()));
+  std::string command = "rs274 -g '" + program.string() + "' '" + out.string() + "' < /dev/null > /dev/null 2>&1";
+  (void)std::system(command.c_str());
+  std::vector<std::pair<double, double>> theirs;  // mm/min, tolerance
+  {
+    std::ifstream in(out);
+    double scale = 1, rate = 0, speed = 0;
+    bool per_rev = false;
+    for (std::string line; std::getline(in, line);) {
+      std::size_t at;
+      if (line.find("USE_LENGTH_UNITS(CANON_UNITS_INCHES") != std::string::npos) scale = 25.4;
+      if (line.find("USE_LENGTH_UNITS(CANON_UNITS_MM") != std::string::npos) scale = 1;
+      if ((at = line.find("SET_FEED_MODE(")) != std::string::npos) per_rev = arguments(line, line.find('(', at)).at(1) == 1;
+      if ((at = line.find("SET_FEED_RATE(")) != std::string::npos) rate = arguments(line, line.find('(', at)).at(0);
+      if ((at = line.find("SET_SPINDLE_SPEED(")) != std::string::npos) speed = arguments(line, line.find('(', at)).at(1);
+      if (line.find("STRAIGHT_FEED(") != std::string::npos || line.find("ARC_FEED(") != std::string::npos)
+        theirs.emplace_back(rate * scale * (per_rev ? speed : 1), 0.5e-4 * scale * (per_rev ? speed : 1) + 1e-6);
+    }
+  }
+  fs::remove(out);
+  std::vector<double> ours;
+  {
+    std::ifstream in(program);
+    Interpreter interpreter({}, *MachineConfig::bundled("linuxcnc"));
+    int last_line = 0;
+    interpreter.run(in, program.string(), [&](const Move& m) {
+      if (m.kind == MoveKind::rapid || m.line == last_line) return;
+      last_line = m.line;
+      ours.push_back(m.feed);
+    });
+  }
+  REQUIRE(theirs.size() >= 10);
+  REQUIRE(ours.size() == theirs.size());
+  for (std::size_t i = 0; i < ours.size(); ++i) {
+    CAPTURE(i);
+    CHECK(std::abs(ours[i] - theirs[i].first) <= theirs[i].second);
+  }
+}
