@@ -85,6 +85,16 @@ struct Interpreter::State : ParameterReader {
     return it == machine.tool_lengths.end() ? 0.0 : it->second;
   }
   Vec3 length_shift() const { return (length_offset - loaded_length()) * axis; }
+  // The control's tool table as LinuxCNC's G10 L1/L10/L11 rewrite it (modal.cpp): the lengths
+  // G43 H reads (mm). The tool itself keeps the machine's length (loaded_length): a program that
+  // sets a wrong length moves the tip as the real machine would.
+  std::map<int, double> set_lengths;
+  std::optional<double> table_length(int number) const {
+    if (auto it = set_lengths.find(number); it != set_lengths.end()) return it->second;
+    if (auto it = machine.tool_lengths.find(number); it != machine.tool_lengths.end()) return it->second;
+    return std::nullopt;
+  }
+  void tool_table_entry(long long l, int column);  // G10 L1, L10, L11 (modal.cpp)
   // A machine position names the gauge point (G53, G28/G30, the tool-change position, with the
   // tool along +Z): the tip lies the loaded tool's length below it.
   Vec3 tip_below(const Vec3& gauge) const { return gauge - Vec3(0, 0, loaded_length()); }
