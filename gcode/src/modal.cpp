@@ -332,6 +332,7 @@ Flow Interpreter::State::execute(const Block& block) {
   if (w.has('A') || w.has('B') || w.has('C'))
     comp_forbid(w.col(w.has('A') ? 'A' : w.has('B') ? 'B' : 'C'), "a rotary axis word");
   if (!axis_consumer && nonmodal != 280 && nonmodal != 300) rotary_words();
+  extra_linear_words(!axis_consumer && nonmodal < 0);
   if (nonmodal == 280 || nonmodal == 300) {
     if (motion_code >= 0 && motion_code != 800)
       error(motion_column, "G28/G30 with a motion code in the same block");

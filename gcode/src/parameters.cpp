@@ -61,7 +61,8 @@ Value Interpreter::State::numbered(int n) {
     case 5220: return number(work_key >= 100 ? 0 : work_key);
     case 5400: return number(tool);
     case 5420: case 5421: case 5422: return number(program[n - 5420] / unit);
-    case 5423: case 5424: case 5425: case 5426: case 5427: case 5428: return number(0);
+    case 5423: case 5424: case 5425: return number(0);
+    case 5426: case 5427: case 5428: return number(uvw_position[n - 5426] / unit);
     default: break;
   }
   int component = 0;
@@ -80,6 +81,7 @@ std::optional<Value> Interpreter::State::named(std::string_view name) {
   if (!key.empty() && key[0] == '_') {
     Vec3 program = to_program(pos);
     if (key == "_x" || key == "_y" || key == "_z") return number(program[key[1] - 'x'] / unit);
+    if (key == "_u" || key == "_v" || key == "_w") return number(uvw_position[key[1] - 'u'] / unit);
     if (key == "_current_tool") return number(tool);
     if (key == "_selected_tool") return number(tool_selected);
     if (key == "_metric") return number(unit == 1.0 ? 1 : 0);

@@ -136,6 +136,8 @@ struct Interpreter::State : ParameterReader {
   bool warned_reference2 = false;
   std::set<int> warned_m_codes;
   bool warned_plain_rotary = false;  // A/B/C on a LinuxCNC machine without kinematics
+  bool warned_uvw = false;           // U/V/W on a LinuxCNC machine
+  Vec3 uvw_position{0.0};            // mm, where the U/V/W words put those axes
   bool warned_probe = false;         // G38.x read as rs274 standalone does
   Vec3 local_offset{0.0};  // G52 / G92 (one register, as LinuxCNC keeps it), machine axes
   Vec3 saved_local_offset{0.0};  // G92.2 suspends, G92.3 restores
@@ -506,6 +508,7 @@ struct Interpreter::State : ParameterReader {
   // ---- rotary axes, DWO and TCP (rotary.cpp) ----
   void tool_center_codes();
   void rotary_words();
+  void extra_linear_words(bool track);  // LinuxCNC's U/V/W
   void set_rotary(const RotaryPositions& next);
 
   // ---- tilted planes (tilt.cpp) ----
