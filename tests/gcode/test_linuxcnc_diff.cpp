@@ -116,7 +116,9 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log, const fs
       REQUIRE(v.size() >= 3);
       length_offset = v[2] * scale;
     }
-    if ((at = line.find("CHANGE_TOOL(")) != std::string::npos) {
+    // M6 prints CHANGE_TOOL, M61 Q CHANGE_TOOL_NUMBER: either way that tool is in the spindle.
+    if ((at = line.find("CHANGE_TOOL(")) != std::string::npos ||
+        (at = line.find("CHANGE_TOOL_NUMBER(")) != std::string::npos) {
       auto v = arguments(line, line.find('(', at));
       REQUIRE(v.size() >= 1);
       auto it = tool_lengths.find(static_cast<int>(v[0]));
