@@ -64,7 +64,7 @@ inline int g_group(int code) {
     case 170: case 180: case 190: return kPlane;
     case 900: case 910: return kDistance;
     case 901: case 911: return kArcDistance;
-    case 940: return kFeedMode;
+    case 930: case 940: case 950: return kFeedMode;
     case 200: case 210: return kUnits;
     case 400: case 410: case 420: case 411: case 421: return kCutterComp;
     case 430: case 431: case 434: case 435: case 440: case 490: return kToolLength;

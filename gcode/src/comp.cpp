@@ -281,6 +281,8 @@ void Interpreter::State::comp_arc(bool ccw) {
     Vec3 current = to_program(pos);
     Vec2 c = plane_uv(current);
     ArcData a = arc_data(current, ccw);
+    if (feed_mode == FeedMode::inverse_time) inverse_time_rate(arc_length(current, a, ccw));
+    move.feed = feed;
     Vec2 end = plane_uv(a.end);
     if (glm::length(end - c) <= r)
       error(motion_column, "cutter compensation entry arc: its end is not farther than the tool "
@@ -310,6 +312,8 @@ void Interpreter::State::comp_arc(bool ccw) {
   const Vec2 op = plane_uv(comp_programmed);
   const Vec2 c = plane_uv(comp_current);
   ArcData a = arc_data(comp_programmed, ccw);
+  if (feed_mode == FeedMode::inverse_time) inverse_time_rate(arc_length(comp_programmed, a, ccw));
+  move.feed = feed;
   const Vec2 centre = a.centre, end = plane_uv(a.end);
   double arc_radius = glm::length(centre - end);
   double theta = angle_of(c - op) + (side > 0 ? -kHalfPi : kHalfPi);

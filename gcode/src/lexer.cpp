@@ -125,13 +125,25 @@ class Parser {
     Reference ref;
     if (i_ < n_ && text_[i_] == '<') {
       std::size_t open = i_++;
+      std::string as_written;
       while (i_ < n_ && text_[i_] != '>') {
-        if (!is_space(text_[i_])) ref.name.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(text_[i_]))));
+        if (!is_space(text_[i_])) {
+          as_written.push_back(text_[i_]);
+          ref.name.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(text_[i_]))));
+        }
         ++i_;
       }
       if (i_ == n_) fail(open, "named parameter '<' is not closed by '>'");
       ++i_;
       if (ref.name.empty()) fail(open, "empty parameter name");
+      // LinuxCNC reads #<_hal[pin]> from the running HAL (with the INI's [RS274NGC]FEATURES bit
+      // HAL_PIN_VARS); rs274 run standalone has none and refuses it, "not defined".
+      if (ref.name.starts_with("_hal["))
+        fail(hash, "parameter #<" + as_written + "> reads HAL pin " +
+                           as_written.substr(5, as_written.find(']') == std::string::npos ? std::string::npos
+                                                                                          : as_written.find(']') - 5) +
+                           ", whose value is known only on the running machine (LinuxCNC's rs274 run "
+                           "standalone refuses it too): set the value in the program instead");
       return ref;
     }
     Value index = primary(hash);

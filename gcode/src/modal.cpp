@@ -40,9 +40,8 @@ void Interpreter::State::tool_length_codes() {
   } else if (code != 490) {
     int number = tool;
     if (w.has('H')) number = static_cast<int>(integer('H', "tool length offset number", 0, 99'999'999));
-    auto it = machine.tool_lengths.find(number);
-    if (it != machine.tool_lengths.end()) {
-      next = code == 440 ? -it->second : it->second;
+    if (std::optional<double> table = table_length(number)) {
+      next = code == 440 ? -*table : *table;
     } else if (number != 0 && !machine.tool_lengths.empty()) {
       error(w.has('H') ? w.col('H') : column,
             "H" + std::to_string(number) + ": tool " + std::to_string(number) +
@@ -53,6 +52,81 @@ void Interpreter::State::tool_length_codes() {
   if (next != length_offset) comp_forbid(column, "changing the tool length offset");
   length_offset = next;
   update_frame();
+}
+
+// The feed mode, F and S, in RS274/NGC's order (feed mode first). LinuxCNC's G94 and G95 set the
+// feed rate to 0 (interp_convert.cc convert_feed_mode), so a feed move after them needs a new F;
+// the other dialects clear it when the mode changes. Under G93, F is the block's 1/min (read in
+// require_feed, only from the block itself, as LinuxCNC does); under G95 the rate is F × S.
+void Interpreter::State::feed_mode_codes() {
+  for (int code : {930, 940, 950}) {
+    if (!w.find_g(code)) continue;
+    FeedMode next = code == 930 ? FeedMode::inverse_time
+                    : code == 940 ? FeedMode::per_minute
+                                  : FeedMode::per_revolution;
+    bool clears = machine.dialect == Dialect::linuxcnc ? code != 930 : next != feed_mode;
+    if (clears) feed = feed_per_rev = 0;
+    feed_mode = next;
+  }
+  if (w.has('F')) {
+    if (w.value[static_cast<std::size_t>(letter_index('F'))] < 0)
+      error(w.col('F'), "feed rate F must not be negative");
+    if (feed_mode == FeedMode::inverse_time) inverse_time = w.take('F');
+    else if (feed_mode == FeedMode::per_revolution) feed_per_rev = length('F');
+    else feed = length('F');
+  }
+  if (w.has('S')) {
+    double s = w.take('S');
+    if (s < 0) error(w.col('S'), "spindle speed S must not be negative");
+    speed = s;
+  }
+  if (feed_mode == FeedMode::per_revolution) feed = feed_per_rev * speed;
+}
+
+// LinuxCNC's G10 L1 / L10 / L11 P<tool> (interp_convert.cc convert_setup_tool): set the tool
+// table entry of tool P. L1: Z is its length and R its radius. L10: the length that makes the
+// current position read Z under G43 of that tool (the gauge point as the control knows it, in
+// the active work system, G52/G92 included, minus Z); L11: the same in G59.3 without G52/G92.
+// A later G43 H / G41 D reads the entry; nothing moves now. X/Y (sideways and lathe offsets) and
+// the other axes' offsets are not simulated: an error. I, J (lathe angles) and Q (orientation)
+// are read and leave the mill alone.
+void Interpreter::State::tool_table_entry(long long l, int column) {
+  const std::string name = "G10 L" + std::to_string(l);
+  if (!w.has('P')) error(column, name + " needs P (the tool number)");
+  int number = static_cast<int>(integer('P', (name + " P (a tool number)").c_str(), 0, 99'999'999));
+  bool any = false;
+  for (char c : {'X', 'Y', 'Z', 'A', 'B', 'C', 'U', 'V', 'W', 'R', 'Q', 'I', 'J'}) any |= w.has(c);
+  if (!any) error(column, name + " without offsets has no effect");
+  for (char c : {'X', 'Y', 'A', 'B', 'C', 'U', 'V', 'W'})
+    if (w.has(c))
+      error(w.col(c), name + " " + c + ": a tool offset along " + c + " is not simulated (tridex offsets tools along their axis only)");
+  if (w.has('Q')) {
+    double q = w.take('Q');
+    if (std::abs(q - std::round(q)) > 1e-9) error(w.col('Q'), "Q number in G10 is not an integer");
+    if (q > 9) error(w.col('Q'), "invalid tool orientation Q" + format_number(q));
+  }
+  for (char c : {'I', 'J'})
+    if (w.has(c)) w.take(c);
+  // The radius of compensation already on stays (LinuxCNC reads it at G41/G42).
+  if (w.has('R')) machine.tool_diameters[number] = 2 * length('R');
+  if (!w.has('Z')) return;
+  if (l == 1) {
+    set_lengths[number] = length('Z');
+    return;
+  }
+  if (far) error(column, name + " with the tool retracted far along its axis: its position is unknown");
+  if (tilted || machine.kinematics || glm::dot(axis, Vec3(0, 0, 1)) < 1 - kSameDirection)
+    error(column, name + " with a tilted frame or rotary axes is not simulated");
+  // linear_axes(): the controlled point in machine coordinates; the control puts the gauge point
+  // the active offset above it.
+  double gauge = linear_axes().z + length_offset;
+  double system = 0;
+  if (l == 10) {
+    system = work_offset.z + local_offset.z;
+  } else if (auto it = offsets.find(9); it != offsets.end()) {  // G59.3 (never set by tridex: 0)
+    system = it->second.z;
+  }
+  set_lengths[number] = gauge - system - length('Z');
 }
 
 Flow Interpreter::State::execute(const Block& block) {
@@ -95,16 +169,7 @@ Flow Interpreter::State::execute(const Block& block) {
     unit = next;
   }
 
-  if (w.has('F')) {
-    double f = length('F');
-    if (f < 0) error(w.col('F'), "feed rate F must not be negative");
-    feed = f;
-  }
-  if (w.has('S')) {
-    double s = w.take('S');
-    if (s < 0) error(w.col('S'), "spindle speed S must not be negative");
-    speed = s;
-  }
+  feed_mode_codes();
   if (w.has('T')) tool_selected = static_cast<int>(integer('T', "tool number", 0, 99'999'999));
 
   if (w.find_m(6) || (w.has('T') && machine.tool_loads_on_t)) {
@@ -205,10 +270,15 @@ Flow Interpreter::State::execute(const Block& block) {
   if (nonmodal == 100) {
     axis_consumer = true;
     int column = w.find_g(100);
-    if (!w.has('L')) error(column, "G10 needs L2 or L20");
+    bool linuxcnc_tools = machine.dialect == Dialect::linuxcnc;
+    if (!w.has('L')) error(column, linuxcnc_tools ? "G10 needs L1, L2, L10, L11 or L20" : "G10 needs L2 or L20");
     long long l = integer('L', "G10 L", 0, 99);
-    if (l != 2 && l != 20) {
-      unsupported(column, "G10 L" + std::to_string(l) + " is not supported (only L2 and L20)", "G10 L");
+    if (linuxcnc_tools && (l == 1 || l == 10 || l == 11)) {
+      tool_table_entry(l, column);
+    } else if (l != 2 && l != 20) {
+      unsupported(column, "G10 L" + std::to_string(l) + " is not supported (only L2 and L20" +
+                              (linuxcnc_tools ? ", and L1, L10, L11" : "; L1, L10, L11 under --machine linuxcnc") + ")",
+                  "G10 L");
     } else {
       if (!w.has('P')) error(column, "G10 L" + std::to_string(l) + " needs P");
       // Fanuc: L2 P1-6 sets G54-G59, L20 Pn sets G54.1 Pn. LinuxCNC: P1-6 are G54-G59 for both,
@@ -272,6 +342,7 @@ Flow Interpreter::State::execute(const Block& block) {
   if (w.has('A') || w.has('B') || w.has('C'))
     comp_forbid(w.col(w.has('A') ? 'A' : w.has('B') ? 'B' : 'C'), "a rotary axis word");
   if (!axis_consumer && nonmodal != 280 && nonmodal != 300) rotary_words();
+  extra_linear_words(!axis_consumer && nonmodal < 0);
   if (nonmodal == 280 || nonmodal == 300) {
     if (motion_code >= 0 && motion_code != 800)
       error(motion_column, "G28/G30 with a motion code in the same block");

@@ -63,6 +63,10 @@ void Interpreter::State::linear(MoveKind kind, double move_feed) {
   Vec3 current = comp_programmed_current ? comp_programmed : to_program(pos);
   const auto [target, set] = axis_word_target(current);
   comp_programmed_current = false;
+  if (kind == MoveKind::feed && feed_mode == FeedMode::inverse_time) {
+    inverse_time_rate(glm::length(target - current));
+    move_feed = feed;
+  }
   if (comp_active()) {
     comp_straight(kind, target, move_feed);
     return;
@@ -72,7 +76,35 @@ void Interpreter::State::linear(MoveKind kind, double move_feed) {
 }
 
 void Interpreter::State::require_feed() {
+  if (feed_mode == FeedMode::inverse_time) {  // LinuxCNC's checks (interp_convert.cc)
+    if (!w.has('F'))
+      error(motion_column, "F word missing with inverse time (G93) feed move: every G1, G2 and G3 "
+                           "block needs its own F");
+    if (!(inverse_time > 0)) error(w.col('F'), "inverse time (G93) F0: the move would never end");
+    return;
+  }
+  if (feed_mode == FeedMode::per_revolution) {
+    if (!(feed_per_rev > 0)) error(motion_column, "feed move with no feed per revolution (F) set (G95)");
+    if (!(speed > 0))
+      error(motion_column, "cannot feed with zero spindle speed in feed per revolution mode (G95)");
+    return;
+  }
   if (!(feed > 0)) error(motion_column, "feed move with no feed rate (F) set");
+}
+
+// G93: a block `length` mm long (its programmed path, as LinuxCNC's inverse_time_rate_straight
+// and _arc measure it) takes 1/F minutes, so it runs at length × F mm/min. A block that does not
+// move takes no time at any rate; LinuxCNC gives it 0.1 units/min.
+void Interpreter::State::inverse_time_rate(double length) {
+  feed = length > 0 ? length * inverse_time : 0.1 * unit;
+}
+
+// The length of the arc (a helix along the plane normal) from `start` (program frame) that
+// arc_data found, as LinuxCNC's find_arc_length: the start radius times the sweep, and the rise.
+double Interpreter::State::arc_length(const Vec3& start, const ArcData& a, bool ccw) const {
+  const std::array<int, 3> axes = plane_axes(plane);
+  double radius = glm::length(a.centre - Vec2(start[axes[0]], start[axes[1]]));
+  return std::hypot(radius * arc_sweep(start, a.end, a.centre, ccw), a.end[axes[2]] - start[axes[2]]);
 }
 
 // ---- arcs ----
@@ -106,6 +138,7 @@ void Interpreter::State::arc(bool ccw) {
   require_feed();
   Vec3 start = to_program(pos);
   ArcData a = arc_data(start, ccw);
+  if (feed_mode == FeedMode::inverse_time) inverse_time_rate(arc_length(start, a, ccw));
   arc_chords(start, a.end, a.centre, ccw, arc_sweep(start, a.end, a.centre, ccw), feed);
   pos = to_machine(a.end);
 }
@@ -233,6 +266,8 @@ void Interpreter::State::arc_chords(const Vec3& start, const Vec3& end, const Ve
 void Interpreter::State::probe(int code) {
   const std::string name = code_name('G', code);
   if (comp_side != 0) error(motion_column, name + ": cannot probe with cutter radius compensation on");
+  if (feed_mode == FeedMode::per_revolution)
+    error(motion_column, name + ": cannot probe in feed per revolution mode (G95)");
   if (!(feed > 0)) error(motion_column, name + ": cannot probe with zero feed rate");
   Vec3 current = comp_programmed_current ? comp_programmed : to_program(pos);
   const auto [target, set] = axis_word_target(current);
@@ -288,6 +323,9 @@ void Interpreter::State::cycle(int code) {
     if (p < 0) error(w.col('P'), "dwell P must not be negative");
     cycle_dwell = dwell_seconds(p);
   }
+  if (feed_mode == FeedMode::inverse_time)
+    error(motion_column, code_name('G', code) + ": canned cycles cannot run in inverse time feed "
+                                                "(G93), as LinuxCNC requires; G94 first");
   if (!has_cycle_r) error(motion_column, code_name('G', code) + " needs R (retract plane)");
   if (!has_cycle_z)
     error(motion_column, code_name('G', code) + " needs " + depth_letter + " (hole bottom)");
@@ -487,6 +525,10 @@ void Interpreter::State::machine_move(const Vec3& gauge, unsigned mask, MoveKind
   if (!along_z)
     error(motion_column, "G53 X/Y with a tilted tool depends on the machine's kinematics; "
                          "retract with G53 Z (or G28) first");
+  if (kind == MoveKind::feed && feed_mode == FeedMode::inverse_time) {
+    inverse_time_rate(glm::length(end - pos));
+    move_feed = feed;
+  }
   emit(kind, pos, end, move_feed);
   pos = end;
 }

@@ -44,14 +44,14 @@ Value Interpreter::State::numbered(int n) {
     case 4001: return number(motion < 0 ? 0 : motion / 10.0);
     case 4002: return number(plane / 10.0);
     case 4003: return number(incremental ? 91 : 90);
-    case 4005: return number(94);
+    case 4005: return number(feed_mode == FeedMode::inverse_time ? 93 : feed_mode == FeedMode::per_minute ? 94 : 95);
     case 4006: return number(unit == 1.0 ? 21 : 20);
     case 4007: return number(comp_side == 0 ? 40 : comp_side > 0 ? 41 : 42);
     case 4008: return number(49);
     case 4009: return number(is_cycle(motion) ? motion / 10.0 : 80);
     case 4010: return number(retract_to_r ? 99 : 98);
     case 4014: return number(work_key >= 100 ? 54.1 : 53 + work_key);
-    case 4109: return number(feed / unit);
+    case 4109: return number(programmed_feed());
     case 4119: return number(speed);
     case 4120: return number(tool);
     case 5001: case 5002: case 5003: return number(program[n - 5001] / unit);
@@ -61,7 +61,8 @@ Value Interpreter::State::numbered(int n) {
     case 5220: return number(work_key >= 100 ? 0 : work_key);
     case 5400: return number(tool);
     case 5420: case 5421: case 5422: return number(program[n - 5420] / unit);
-    case 5423: case 5424: case 5425: case 5426: case 5427: case 5428: return number(0);
+    case 5423: case 5424: case 5425: return number(0);
+    case 5426: case 5427: case 5428: return number(uvw_position[n - 5426] / unit);
     default: break;
   }
   int component = 0;
@@ -80,13 +81,17 @@ std::optional<Value> Interpreter::State::named(std::string_view name) {
   if (!key.empty() && key[0] == '_') {
     Vec3 program = to_program(pos);
     if (key == "_x" || key == "_y" || key == "_z") return number(program[key[1] - 'x'] / unit);
+    if (key == "_u" || key == "_v" || key == "_w") return number(uvw_position[key[1] - 'u'] / unit);
     if (key == "_current_tool") return number(tool);
     if (key == "_selected_tool") return number(tool_selected);
     if (key == "_metric") return number(unit == 1.0 ? 1 : 0);
     if (key == "_imperial") return number(unit == 1.0 ? 0 : 1);
     if (key == "_absolute") return number(incremental ? 0 : 1);
     if (key == "_incremental") return number(incremental ? 1 : 0);
-    if (key == "_feed") return number(feed / unit);
+    if (key == "_feed") return number(programmed_feed());
+    if (key == "_inverse_time") return number(feed_mode == FeedMode::inverse_time ? 1 : 0);
+    if (key == "_units_per_minute") return number(feed_mode == FeedMode::per_minute ? 1 : 0);
+    if (key == "_units_per_rev") return number(feed_mode == FeedMode::per_revolution ? 1 : 0);
     if (key == "_rpm") return number(speed);
     if (key == "_motion_mode") return number(motion < 0 ? 0 : motion);
     if (key == "_plane") return number(plane);

@@ -46,6 +46,30 @@ void Interpreter::State::tool_center_codes() {
 // far along its axis, except in raw form where the machine coordinates keep the tip known (the
 // sweep of the rotation itself is not simulated). Rotary motion during G1 is simultaneous
 // 5-axis: an error, or with lenient a warning and the move indexed at its end orientation.
+// LinuxCNC's U/V/W: linear axes of their own (a quill, a second carriage) that a LinuxCNC
+// machine may have and reads as plain axes (rs274 run standalone, with no INI, has none and
+// refuses them). They do not move the tool tridex simulates: read under the LinuxCNC dialect
+// with one warning, their positions kept (`track`: on moves) for #5426–#5428 and #<_u> #<_v>
+// #<_w>; on other machines an unused word, as before.
+void Interpreter::State::extra_linear_words(bool track) {
+  if (machine.dialect != Dialect::linuxcnc) return;
+  int first = 0;
+  for (char c : {'U', 'V', 'W'})
+    if (w.has(c) && (!first || w.col(c) < first)) first = w.col(c);
+  if (!first) return;
+  for (int i = 0; i < 3; ++i) {
+    char c = "UVW"[i];
+    if (!w.has(c)) continue;
+    double v = length(c);
+    if (track) uvw_position[i] = incremental ? uvw_position[i] + v : v;
+  }
+  if (!warned_uvw) {
+    warned_uvw = true;
+    warn(first, "U/V/W read as plain axes, as LinuxCNC does on a machine that has them: they do not move "
+                "the tool tridex simulates");
+  }
+}
+
 void Interpreter::State::rotary_words() {
   int first = 0;
   for (char c : {'A', 'B', 'C'}) {

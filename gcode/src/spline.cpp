@@ -83,6 +83,8 @@ void Interpreter::State::spline(bool quadratic) {
     error(motion_column, std::string(name) + " with cutter radius compensation on: LinuxCNC refuses "
                                              "it (G40 first)");
   require_feed();
+  if (feed_mode == FeedMode::inverse_time)  // its length is known only once its biarcs are made
+    error(motion_column, std::string(name) + " in inverse time feed (G93) is not supported: G94 first");
   if (plane != 170) error(motion_column, std::string(name) + " is a spline in the XY plane only (G17)");
   for (char c : {'Z', 'A', 'B', 'C'})
     if (w.has(c))

@@ -57,7 +57,19 @@ struct Interpreter::State : ParameterReader {
   int work_key = 1;
   Vec3 work_offset{0.0};
   std::map<int, Vec3> offsets;
-  double feed = 0;
+  double feed = 0;  // mm/min of the next feed move (under G93 and G95, worked out per move)
+  // Feed modes (RS274/NGC group 5, NIST IR 6556 §3.5.19; LinuxCNC interp_inverse.cc): G94 F in
+  // units per minute; G93 inverse time, F in 1/min, every feed block takes 1/F minutes (its rate
+  // is its programmed length × F, set per move); G95 F in units per spindle revolution (× S).
+  enum class FeedMode { per_minute, inverse_time, per_revolution };
+  FeedMode feed_mode = FeedMode::per_minute;
+  double inverse_time = 0;  // G93: the block's F (1/min)
+  double feed_per_rev = 0;  // G95: mm per revolution
+  // The feed rate as LinuxCNC's #<_feed> reads it, in program units: per revolution under G95,
+  // under G93 the rate of the last feed move.
+  double programmed_feed() const { return (feed_mode == FeedMode::per_revolution ? feed_per_rev : feed) / unit; }
+  void feed_mode_codes();                 // G93, G94, G95, F and S (modal.cpp)
+  void inverse_time_rate(double length);  // G93: feed for a block `length` mm long (motion.cpp)
   Vec2 spline_mirror{0.0};  // G5 without I J: P1 − P0, program units (−P, −Q of the last G5)
   double speed = 0;
   int spindle_direction = 0;
@@ -73,6 +85,16 @@ struct Interpreter::State : ParameterReader {
     return it == machine.tool_lengths.end() ? 0.0 : it->second;
   }
   Vec3 length_shift() const { return (length_offset - loaded_length()) * axis; }
+  // The control's tool table as LinuxCNC's G10 L1/L10/L11 rewrite it (modal.cpp): the lengths
+  // G43 H reads (mm). The tool itself keeps the machine's length (loaded_length): a program that
+  // sets a wrong length moves the tip as the real machine would.
+  std::map<int, double> set_lengths;
+  std::optional<double> table_length(int number) const {
+    if (auto it = set_lengths.find(number); it != set_lengths.end()) return it->second;
+    if (auto it = machine.tool_lengths.find(number); it != machine.tool_lengths.end()) return it->second;
+    return std::nullopt;
+  }
+  void tool_table_entry(long long l, int column);  // G10 L1, L10, L11 (modal.cpp)
   // A machine position names the gauge point (G53, G28/G30, the tool-change position, with the
   // tool along +Z): the tip lies the loaded tool's length below it.
   Vec3 tip_below(const Vec3& gauge) const { return gauge - Vec3(0, 0, loaded_length()); }
@@ -115,6 +137,8 @@ struct Interpreter::State : ParameterReader {
   std::set<int> warned_m_codes;
   std::set<char> warned_rotary_at_zero;  // A/B/C words of 0 read on a machine without kinematics
   bool warned_plain_rotary = false;  // A/B/C on a LinuxCNC machine without kinematics
+  bool warned_uvw = false;           // U/V/W on a LinuxCNC machine
+  Vec3 uvw_position{0.0};            // mm, where the U/V/W words put those axes
   bool warned_probe = false;         // G38.x read as rs274 standalone does
   Vec3 local_offset{0.0};  // G52 / G92 (one register, as LinuxCNC keeps it), machine axes
   Vec3 saved_local_offset{0.0};  // G92.2 suspends, G92.3 restores
@@ -250,7 +274,7 @@ struct Interpreter::State : ParameterReader {
           // Codes known to leave the path alone (feed and speed modes, exact stop, cancels of
           // modes tridex never enters) may be skipped in a block without coordinates; any other
           // unknown code could move the tool or change how later coordinates read.
-          static constexpr int kHarmless[] = {50, 90, 131, 500, 501, 611, 620, 630, 670, 930, 950, 960};
+          static constexpr int kHarmless[] = {50, 90, 131, 500, 501, 611, 620, 630, 670, 960};
           bool harmless = word.letter == 'G' && integral &&
                           std::find(std::begin(kHarmless), std::end(kHarmless), code) != std::end(kHarmless);
           bool coordinates = false;
@@ -469,6 +493,7 @@ struct Interpreter::State : ParameterReader {
   };
   ArcData arc_data(const Vec3& start, bool ccw);
   double arc_sweep(const Vec3& start, const Vec3& end, const Vec2& c, bool ccw) const;
+  double arc_length(const Vec3& start, const ArcData& a, bool ccw) const;
   void arc_chords(const Vec3& start, const Vec3& end, const Vec2& c, bool ccw, double sweep,
                   double move_feed);
   void cycle(int code);
@@ -489,6 +514,7 @@ struct Interpreter::State : ParameterReader {
   // ---- rotary axes, DWO and TCP (rotary.cpp) ----
   void tool_center_codes();
   void rotary_words();
+  void extra_linear_words(bool track);  // LinuxCNC's U/V/W
   void set_rotary(const RotaryPositions& next);
 
   // ---- tilted planes (tilt.cpp) ----

@@ -12,6 +12,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -88,6 +89,7 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log, const fs
   Vec3 local(0.0);   // mm, G92 / G52
   double length_offset = 0, loaded_length = 0;  // mm
   Vec3 last_controlled(0.0);
+  double last_length_offset = 0;  // at the last point printed
   char plane = 'Z';  // XY: Z, XZ: Y, YZ: X (the arc's axis)
   std::string line;
   int record = 0;
@@ -114,7 +116,9 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log, const fs
       REQUIRE(v.size() >= 3);
       length_offset = v[2] * scale;
     }
-    if ((at = line.find("CHANGE_TOOL(")) != std::string::npos) {
+    // M6 prints CHANGE_TOOL, M61 Q CHANGE_TOOL_NUMBER: either way that tool is in the spindle.
+    if ((at = line.find("CHANGE_TOOL(")) != std::string::npos ||
+        (at = line.find("CHANGE_TOOL_NUMBER(")) != std::string::npos) {
       auto v = arguments(line, line.find('(', at));
       REQUIRE(v.size() >= 1);
       auto it = tool_lengths.find(static_cast<int>(v[0]));
@@ -155,7 +159,11 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log, const fs
         if (distance == 0) break;
         controlled += 0.254 * (from - controlled) / distance;  // 0.01 in = 0.254 mm
       }
-      if (glm::length(controlled - last_controlled) <= 1e-9) continue;
+      // A move to where the controlled point is moves the axes when the tool length offset
+      // changed since (cone.ngc's `g43.1 z#1` then `g0 z0`); a tool change alone moves nothing.
+      bool offset_changed = length_offset != last_length_offset;
+      last_length_offset = length_offset;
+      if (glm::length(controlled - last_controlled) <= 1e-9 && !offset_changed) continue;
       last_controlled = controlled;
       push(points, Point{controlled + Vec3(0, 0, length_offset - loaded_length), 0.5e-4 * scale + 1e-6, record});
     }
@@ -213,10 +221,10 @@ std::vector<fs::path> corpus() {
     files.assign(1, fs::path(only));
     return files;
   }
-  // b-index turns B, a plain axis on LinuxCNC without kinematics: X/Y/Z agree (cone and daisy,
-  // which turn A/B/C too, then stop at W and at G93 inverse time, which tridex does not read).
+  // b-index and daisy turn B and A, plain axes on LinuxCNC without kinematics: X/Y/Z agree
+  // (daisy under G93 inverse time). cone.ngc has a test of its own (its W words).
   for (const char* name : {"3D_Chips.ngc", "3dtest.ngc", "arcspiral.ngc", "b-index.ngc", "cds.ngc",
-                           "flowsnake.ngc", "hole-circle.ngc", "lathe_pawn.ngc",
+                           "daisy.ngc", "flowsnake.ngc", "hole-circle.ngc", "lathe_pawn.ngc",
                            "plasmatest.ngc", "polar.ngc", "spiral.ngc", "tort.ngc"})
     files.push_back(fs::path("/usr/share/linuxcnc/ncfiles") / name);
   return files;
@@ -304,10 +312,11 @@ struct Comparison {
   bool agreed = true;
 };
 
-Comparison compare_with_rs274(const fs::path& program, int max_reports) {
+// `ours`: the program tridex reads, when it is not the same (an rs274 refuses words of it).
+Comparison compare_with_rs274(const fs::path& program, int max_reports, const fs::path& ours_program = {}) {
   std::string log;
   std::vector<Point> theirs = run_rs274(program, log);
-  std::vector<Point> ours = run_tridex(program);
+  std::vector<Point> ours = run_tridex(ours_program.empty() ? program : ours_program);
   INFO("rs274 log: " << log.substr(0, 600));
   CHECK_MESSAGE(!rs274_stopped(log), "rs274 stopped on an error");
   int reported = 0;
@@ -465,4 +474,95 @@ TEST_CASE("differential: skeleton.ngc's tool length offset agrees with rs274") {
   REQUIRE(!ours.empty());
   CHECK(ours.front().p.z == doctest::Approx(-0.511 * 25.4));
   fs::remove(program);
+}
+
+// rs274 prints the rate of every feed move (SET_FEED_RATE, program units per minute, or per
+// revolution after SET_FEED_MODE(0, 1), times the SET_SPINDLE_SPEED); under G93 it is the rate
+// it works out for the block, its length × F. tridex's moves carry theirs in mm/min: the rates
+// of the feed blocks of feed_modes.ngc (one STRAIGHT_FEED or ARC_FEED each) are compared in order.
+TEST_CASE("differential: feed rates in G93, G94 and G95 agree with rs274") {
+  if (!rs274_available()) {
+    MESSAGE("SKIPPED: rs274 not found (install the Debian package linuxcnc-uspace); the LinuxCNC "
+            "differential test did not run");
+    return;
+  }
+  const fs::path program = fs::path(TRIDEX_TEST_DATA) / "gcode" / "linuxcnc" / "feed_modes.ngc";
+  const fs::path out = fs::temp_directory_path() / ("tridex_rs274_feeds_" + std::to_string(::getpid()));
+  std::string command = "rs274 -g '" + program.string() + "' '" + out.string() + "' < /dev/null > /dev/null 2>&1";
+  (void)std::system(command.c_str());
+  std::vector<std::pair<double, double>> theirs;  // mm/min, tolerance
+  {
+    std::ifstream in(out);
+    double scale = 1, rate = 0, speed = 0;
+    bool per_rev = false;
+    for (std::string line; std::getline(in, line);) {
+      std::size_t at;
+      if (line.find("USE_LENGTH_UNITS(CANON_UNITS_INCHES") != std::string::npos) scale = 25.4;
+      if (line.find("USE_LENGTH_UNITS(CANON_UNITS_MM") != std::string::npos) scale = 1;
+      if ((at = line.find("SET_FEED_MODE(")) != std::string::npos) per_rev = arguments(line, line.find('(', at)).at(1) == 1;
+      if ((at = line.find("SET_FEED_RATE(")) != std::string::npos) rate = arguments(line, line.find('(', at)).at(0);
+      if ((at = line.find("SET_SPINDLE_SPEED(")) != std::string::npos) speed = arguments(line, line.find('(', at)).at(1);
+      if (line.find("STRAIGHT_FEED(") != std::string::npos || line.find("ARC_FEED(") != std::string::npos)
+        theirs.emplace_back(rate * scale * (per_rev ? speed : 1), 0.5e-4 * scale * (per_rev ? speed : 1) + 1e-6);
+    }
+  }
+  fs::remove(out);
+  std::vector<double> ours;
+  {
+    std::ifstream in(program);
+    Interpreter interpreter({}, *MachineConfig::bundled("linuxcnc"));
+    int last_line = 0;
+    interpreter.run(in, program.string(), [&](const Move& m) {
+      if (m.kind == MoveKind::rapid || m.line == last_line) return;
+      last_line = m.line;
+      ours.push_back(m.feed);
+    });
+  }
+  REQUIRE(theirs.size() >= 10);
+  REQUIRE(ours.size() == theirs.size());
+  for (std::size_t i = 0; i < ours.size(); ++i) {
+    CAPTURE(i);
+    CHECK(std::abs(ours[i] - theirs[i].first) <= theirs[i].second);
+  }
+}
+
+// LinuxCNC's cone.ngc, for its simulated 5-axis machine, drills with a W axis (`g1 w100`), which
+// rs274 run standalone refuses ("Bad character 'w' used": it has no U/V/W without an INI), while
+// a LinuxCNC machine with W reads it as a plain axis, as tridex does under --machine linuxcnc.
+// rs274 reads the installed program (GPL: not copied here) with its W words taken out; tridex
+// reads it whole, and its X/Y/Z must not move for them.
+TEST_CASE("differential: cone.ngc's W axis moves no X/Y/Z, as rs274 without its W words") {
+  if (!rs274_available()) {
+    MESSAGE("SKIPPED: rs274 not found (install the Debian package linuxcnc-uspace); the LinuxCNC "
+            "differential test did not run");
+    return;
+  }
+  const fs::path installed = "/usr/share/linuxcnc/ncfiles/cone.ngc";
+  REQUIRE_MESSAGE(fs::exists(installed), "corpus file missing");
+  std::ifstream in(installed);
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  std::size_t removed = 0;
+  for (std::size_t at = 0; (at = text.find_first_of("wW", at)) != std::string::npos;) {
+    std::size_t end = at + 1;
+    while (end < text.size() && (std::isdigit(static_cast<unsigned char>(text[end])) || text[end] == '.' ||
+                                 text[end] == '-'))
+      ++end;
+    bool word = end > at + 1 && (at == 0 || !std::isalpha(static_cast<unsigned char>(text[at - 1])));
+    if (!word) {
+      at = end;
+      continue;
+    }
+    text.erase(at, end - at);
+    ++removed;
+  }
+  REQUIRE(removed == 2);
+  fs::path stripped = fs::temp_directory_path() / ("tridex_cone_" + std::to_string(::getpid()) + ".ngc");
+  {
+    std::ofstream out(stripped);
+    out << text;
+  }
+  Comparison c = compare_with_rs274(stripped, 5, installed);
+  CHECK(c.agreed);
+  CHECK(c.compared >= 80);
+  fs::remove(stripped);
 }

@@ -7,8 +7,9 @@
 // linear axis at most at its rate: with one rate for all, length / rate; with one per axis, the
 // longest of |Δx|/x, |Δy|/y, |Δz|/z (a straight rapid as LinuxCNC plans it), along the work frame's
 // axes. Acceleration, tool changes and the approach from "far along the tool axis" (whose start
-// is a stand-in, docs/design.md) are not timed; the approaches are counted. G93 inverse-time
-// feeds are not read by the interpreter (an error), so every feed here is units per minute.
+// is a stand-in, docs/design.md) are not timed; the approaches are counted. The interpreter
+// gives every feed in mm/min: under G93 inverse time a block's moves run at its length × F, so
+// the block takes 1/F minutes; under G95 at F × S.
 #pragma once
 
 #include <array>

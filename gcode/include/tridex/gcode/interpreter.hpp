@@ -1,8 +1,8 @@
 // tridex::gcode — the modal interpreter: a milling program in, a stream of tool-tip moves out.
 //
 // Codes: G0 G1 G2 G3 (I/J/K and R, full circles, helices) in G17/G18/G19, G20/G21, G90/G91,
-// G90.1/G91.1, G54–G59 and G54.1 Pn, G10 L2/L20 (P0 the active system), G52, G92/G92.1/G92.2/
-// G92.3, G43/G44/G49 H and G43.1 (MachineConfig::tool_lengths), T, M6, M61 Q, F, S, M3/M4/M5, M0/M1/M2/M30, G28/G30/G53, canned cycles
+// G90.1/G91.1, G54–G59 and G54.1 Pn, G10 L2/L20 (P0 the active system), LinuxCNC's G10 L1/L10/L11 (tool table entries), G52, G92/G92.1/G92.2/
+// G92.3, G43/G44/G49 H and G43.1 (MachineConfig::tool_lengths), T, M6, M61 Q, F, S, M3/M4/M5, M0/M1/M2/M30, G93/G94/G95, G28/G30/G53, canned cycles
 // G73 G81 G82 G83 G85 G86 G89 with G98/G99 and repeats (L or K), cutter radius compensation
 // G41/G42 D (MachineConfig::tool_diameters), G41.1/G42.1 D and G40 as LinuxCNC computes it, M98 P L / M99 with O (or ':')
 // numbers, G65 macro calls, G4; tilted planes Fanuc G68.2 (Euler Z-X-Z), G53.1, G53.6, G69 and
@@ -10,7 +10,7 @@
 // machine coordinates), Haas DWO G254/G255 and Fanuc TCP G43.4/G43.5 I J K (part coordinates),
 // rotary limits and G53.1 reachability (gcode/README.md, "Rotary words, DWO and TCP"); Fanuc
 // Macro B and LinuxCNC parameters, expressions and o-word control flow (lexer.hpp). Accepted without effect on the tool path: G15 G61 G64 (P Q)
-// G80 G94 G97, look-ahead/smoothing G5.1 (Q R), G8 (P), G187 (P E), M7 M8 M9 and any other
+// G80 G97, look-ahead/smoothing G5.1 (Q R), G8 (P), G187 (P E), M7 M8 M9 and any other
 // M-code (one warning per code unless the MachineConfig declares it). Anything else is an error
 // naming file, line, column and word (a warning in lenient mode, which then skips the word).
 //
