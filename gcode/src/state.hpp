@@ -271,10 +271,10 @@ struct Interpreter::State : ParameterReader {
           if (word.letter == 'G' && (code == 52 || code == 53))
             error(word.column, name + " (LinuxCNC's NURBS) is read with --machine linuxcnc only");
           if (word.letter == 'G' && integral && machine.dialect == Dialect::linuxcnc) {
-            // Never skipped, even lenient: each moves the tool. LinuxCNC's lathe codes (G7
-            // diameter mode, G33 threading, G70-G72 turning cycles, G76 threading cycle) have no
-            // meaning on a mill.
-            static constexpr int kLathe[] = {70, 330, 700, 710, 711, 712, 720, 721, 722, 760};
+            // Never skipped, even lenient: each moves the tool or sets how it moves. LinuxCNC's
+            // lathe codes (G7 diameter mode, G33 threading, G70-G72 turning cycles, G76 threading
+            // cycle, G96 constant surface speed) have no meaning on a mill.
+            static constexpr int kLathe[] = {70, 330, 700, 710, 711, 712, 720, 721, 722, 760, 960};
             if (std::find(std::begin(kLathe), std::end(kLathe), code) != std::end(kLathe))
               error(word.column, name + " is a lathe code: tridex simulates milling machines");
           }
