@@ -44,14 +44,16 @@ class Nurbs {
   double u_max() const { return count() - order_ + 1; }
   Vec2 first() const { return points_.front().p; }
 
-  // The rational form: Σ N_i w_i P_i / Σ N_i w_i (The NURBS Book, eq. 4.2).
+  // The rational form: Σ N_i w_i P_i / Σ N_i w_i (The NURBS Book, eq. 4.2), over the N_i that
+  // are not zero at u.
   Vec2 point(double u) const {
-    basis(u);
+    const std::size_t lo = basis(u);
     Vec2 sum(0.0);
     double weight = 0;
-    for (std::size_t i = 0; i < points_.size(); ++i) {
-      sum += basis_[i] * points_[i].weight * points_[i].p;
-      weight += basis_[i] * points_[i].weight;
+    for (std::size_t j = 0; j < basis_.size() && lo + j < points_.size(); ++j) {
+      const Interpreter::State::NurbsPoint& c = points_[lo + j];
+      sum += basis_[j] * c.weight * c.p;
+      weight += basis_[j] * c.weight;
     }
     return sum / weight;
   }
@@ -65,21 +67,31 @@ class Nurbs {
   }
 
  private:
-  // Cox–de Boor (The NURBS Book, eq. 2.5) for every i at once, raising the order from 1, with
-  // LinuxCNC's closed spans [u_i, u_i+1] at order 1 and 0/0 read as 0: basis_[i] = N_i,order(u).
-  // The same sums as LinuxCNC's recursive Nmix, in O(order × knots) instead of O(2^order).
-  void basis(double u) const {
+  // Cox–de Boor (The NURBS Book, eq. 2.5), raising the order from 1, with LinuxCNC's closed
+  // spans [u_i, u_i+1] at order 1 and 0/0 read as 0: the same sums as LinuxCNC's recursive Nmix.
+  // Only N_i with u_i <= u <= u_i+order can be non-zero: the spans holding u, [first, last] (two
+  // or more where u is on a knot), and the order − 1 before them. So the work per point is
+  // O(order²), whatever the number of control points. basis_[j] = N_lo+j,order(u); returns lo.
+  std::size_t basis(double u) const {
     auto t = [&](std::size_t j) { return knots_[j]; };
-    basis_.assign(knots_.size() - 1, 0.0);
-    for (std::size_t i = 0; i + 1 < knots_.size(); ++i) basis_[i] = u >= t(i) && u <= t(i + 1) ? 1.0 : 0.0;
-    for (std::size_t k = 2; k <= static_cast<std::size_t>(order_); ++k)
-      for (std::size_t i = 0; i + k < knots_.size(); ++i) {
+    const auto index = [&](auto it) { return static_cast<std::size_t>(it - knots_.begin()); };
+    std::size_t first = index(std::lower_bound(knots_.begin(), knots_.end(), u));  // t(first) >= u
+    first = first == 0 ? 0 : first - 1;                                           // t(first + 1) >= u
+    std::size_t last = index(std::upper_bound(knots_.begin(), knots_.end(), u));   // t(last) > u
+    last = std::min(last == 0 ? 0 : last - 1, knots_.size() - 2);                  // t(last) <= u
+    const std::size_t k_max = static_cast<std::size_t>(order_);
+    const std::size_t lo = first >= k_max - 1 ? first - (k_max - 1) : 0;
+    basis_.assign(last + 2 - lo, 0.0);  // i in [lo, last + 1]; N_last+1 stays 0 at every order
+    for (std::size_t i = first; i <= last; ++i) basis_[i - lo] = 1.0;
+    for (std::size_t k = 2; k <= k_max; ++k)
+      for (std::size_t i = lo; i <= last && i + k < knots_.size(); ++i) {
         double left = t(i + k - 1) - t(i), right = t(i + k) - t(i + 1);
         double value = 0;
-        if (left != 0) value += (u - t(i)) * basis_[i] / left;
-        if (right != 0) value += (t(i + k) - u) * basis_[i + 1] / right;
-        basis_[i] = value;  // basis_[i + 1] is still of order k − 1 for the next i
+        if (left != 0) value += (u - t(i)) * basis_[i - lo] / left;
+        if (right != 0) value += (t(i + k) - u) * basis_[i + 1 - lo] / right;
+        basis_[i - lo] = value;  // basis_[i + 1 − lo] is still of order k − 1 for the next i
       }
+    return lo;
   }
 
   std::vector<Interpreter::State::NurbsPoint> points_;
