@@ -75,8 +75,13 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log, const fs
   fs::path out = fs::temp_directory_path() /
                  ("tridex_rs274_" + std::to_string(::getpid()) + "_" + program.filename().string());
   std::string tools = tool_table.empty() ? "" : "-t '" + tool_table.string() + "' ";
-  std::string command = "rs274 " + tools + "-g '" + program.string() + "' '" + out.string() +
-                        "' < /dev/null > '" + out.string() + ".log' 2>&1";
+  // rs274 keeps its tool table in $HOME/.tool.mmap (LinuxCNC 2.9 tooldata_mmap.cc): two runs at
+  // once under one HOME read each other's tools or die of a bus error, so each test process
+  // gives it a HOME of its own.
+  fs::path home = fs::temp_directory_path() / ("tridex_rs274_home_" + std::to_string(::getpid()));
+  fs::create_directories(home);
+  std::string command = "HOME='" + home.string() + "' rs274 " + tools + "-g '" + program.string() +
+                        "' '" + out.string() + "' < /dev/null > '" + out.string() + ".log' 2>&1";
   int status = std::system(command.c_str());
   (void)status;  // rs274 exits 0 even on interpreter errors; its log is checked instead
   std::ifstream log_in(out.string() + ".log");
@@ -162,6 +167,7 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log, const fs
   }
   fs::remove(out);
   fs::remove(out.string() + ".log");
+  fs::remove_all(home);
   return points;
 }
 
