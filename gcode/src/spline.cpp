@@ -158,8 +158,8 @@ void Interpreter::State::spline(bool quadratic) {
 // A G5.2 block: one control point (X Y, weight P) of the NURBS that G5.3 cuts. As LinuxCNC 2.9's
 // convert_nurbs: the first block puts the current point first (weight 1, or the P of a block
 // without X and Y); X and Y are read against the current point, which stays where it is until
-// G5.3 (G91: increments from it, not from the previous control point); L (from 4) sets the order,
-// 3 by default.
+// G5.3 (G91: increments from it, not from the previous control point); L sets the order, 3 by
+// default (LinuxCNC takes L only from 4 on).
 void Interpreter::State::nurbs_point() {
   if (comp_side != 0)
     error(motion_column, "G5.2 with cutter radius compensation on: its curve is not offset (G40 first)");
