@@ -336,6 +336,10 @@ Flow Interpreter::State::execute(const Block& block) {
                                " in a block whose X/Y/Z belong to another code");
     if (motion_code == 800 || !is_cycle(motion_code)) cycle_active = false;
     if (is_cycle(motion_code) && motion != motion_code) cycle_active = false;
+    if (motion == 52 && motion_code != 52 && !nurbs_points.empty())
+      warn(motion_column, "the G5.2 control points before this " + code_name('G', motion_code) +
+                              " are dropped: no G5.3 ended them (LinuxCNC drops them too)");
+    if (motion_code == 52 && motion != 52) nurbs_points.clear();  // a new curve starts
     motion = motion_code;
   }
   if (w.has('@') || w.has('^')) polar_words(axis_consumer, nonmodal);
@@ -363,6 +367,10 @@ Flow Interpreter::State::execute(const Block& block) {
     if (mask)
       machine_move(target, mask, motion == 0 ? MoveKind::rapid : MoveKind::feed,
                    motion == 0 ? 0.0 : feed);
+  } else if (nonmodal == 53) {  // G5.3: the NURBS of the G5.2 blocks before it (spline.cpp)
+    if (motion_code >= 0 || has_axis_words())
+      error(motion_column, "G5.3 ends a G5.2 NURBS: no motion code or coordinates in its block");
+    nurbs_end(motion_column);
   } else if (!axis_consumer) {
     bool axes = has_axis_words();
     if (motion == 0 || motion == 10) {
@@ -378,13 +386,15 @@ Flow Interpreter::State::execute(const Block& block) {
     } else if (motion == 50 || motion == 51) {
       if (axes || motion_code >= 0 || w.has('I') || w.has('J') || w.has('P') || w.has('Q'))
         spline(motion == 51);
+    } else if (motion == 52) {
+      if (axes || motion_code >= 0 || w.has('P') || w.has('L')) nurbs_point();
     } else if (is_cycle(motion)) {
       if (axes || motion_code >= 0 || w.has('R')) {
         comp_forbid(motion_column, "a canned cycle");
         cycle(motion);
       }
     } else if (axes) {
-      error(motion_column, "X/Y/Z without an active motion mode (G0, G1, G2, G3, G5, G5.1 or a cycle)");
+      error(motion_column, "X/Y/Z without an active motion mode (G0, G1, G2, G3, G5, G5.1, G5.2 or a cycle)");
     }
   }
 

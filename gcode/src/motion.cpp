@@ -176,10 +176,20 @@ Interpreter::State::ArcData Interpreter::State::arc_data(const Vec3& start, bool
     double r1 = glm::length(e - c);
     if (!(r0 > 1e-9)) error(motion_column, "zero-radius arc: the centre is the start point");
     if (!(r1 > 1e-9)) error(motion_column, "zero-radius arc: the centre is the end point");
-    if (std::abs(r1 - r0) > options.arc_radius_tolerance)
+    double err = std::abs(r1 - r0);
+    if (machine.dialect == Dialect::linuxcnc) {
+      // LinuxCNC 2.9 (interp_arc.cc arc_data_ijk) cuts a spiral where the radii differ by up to
+      // 0.002·√2 in (0.02·√2 mm under G21), or by 100 times that within 0.1 % of the radius.
+      double spiral = (unit == 1.0 ? 0.02 : 0.002 * 25.4) * std::numbers::sqrt2;
+      if (err > 100 * spiral || (err / std::max(r0, r1) > 0.001 && err > spiral))
+        error(motion_column, "arc end radius " + format_number(r1) + " differs from start radius " +
+                                 format_number(r0) + " by more than LinuxCNC's spiral tolerance (" +
+                                 format_number(spiral) + " mm, or 0.1 % of the radius)");
+    } else if (err > options.arc_radius_tolerance) {
       error(motion_column, "arc end radius " + format_number(r1) + " differs from start radius " +
                                format_number(r0) + " by more than " +
                                format_number(options.arc_radius_tolerance) + " mm");
+    }
   } else {
     double r = length('R');
     double d = glm::length(e - s);

@@ -1,22 +1,27 @@
-// tridex::gcode — LinuxCNC's splines in the XY plane: G5 (cubic) and G5.1 (quadratic B-spline),
-// turned into the arcs LinuxCNC's controller moves along.
+// tridex::gcode — LinuxCNC's splines in the XY plane: G5 (cubic), G5.1 (quadratic B-spline) and
+// G5.2/G5.3 (NURBS), turned into the arcs LinuxCNC's controller moves along.
 //
 // As LinuxCNC 2.9 computes them (GPL sources read, not copied; the formulas are re-written here):
 // - src/emc/rs274ngc/interp_convert.cc, convert_spline: the control points and the errors.
 //   G5 from the current point P0 to the end P3: P1 = P0 + (I, J), P2 = P3 + (P, Q); without I and
 //   J, P1 mirrors the previous G5's end tangent, P0 − (P, Q) of that block (zero before any G5).
 //   G5.1: P1 = P0 + (I, J), end P2. I, J, P and Q are increments in program units.
-// - src/emc/rs274ngc/nurbs_additional_functions.cc: the curve, a NURBS of order 4 (G5) or 3 (G5.1)
-//   with unit weights and a clamped knot vector, evaluated by the Cox–de Boor recursion
-//   (Piegl & Tiller, The NURBS Book, eq. 2.5), and its tangent by a difference over ±1e-5 of u.
+// - interp_convert.cc, convert_nurbs: G5.2 blocks gather control points X Y with weights P and the
+//   order L; G5.3 hands them to the controller.
+// - src/emc/rs274ngc/nurbs_additional_functions.cc: the curve, a NURBS of order 4 (G5), 3 (G5.1)
+//   or L (G5.2) with a clamped uniform knot vector, evaluated by the Cox–de Boor recursion
+//   (Piegl & Tiller, The NURBS Book, eq. 2.5) in rational form (eq. 4.2), and its tangent by a
+//   difference over ±1e-5 of u.
 // - src/emc/task/emccanon.cc, NURBS_FEED / biarc / arc: the curve is cut at 4 × (control points)
 //   equal steps of u, and each step becomes a biarc (two tangent arcs matching the curve's ends and
 //   end tangents; Bolton, "Biarc curves", CAD 7(2) 1975), an arc degenerating to a line when its
-//   chord runs along its start tangent.
+//   chord runs along its start tangent. tridex cuts those arcs into chords within
+//   InterpreterOptions::arc_tolerance, as every arc.
 // Standalone rs274 prints only NURBS_FEED for these blocks; the pieces are what the machine cuts.
 #include <algorithm>
-#include <array>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "state.hpp"
 
@@ -24,44 +29,31 @@ namespace tridex::gcode {
 
 namespace {
 
-constexpr int kMaxControlPoints = 4;
-
-// A clamped NURBS of `order` over `count` control points with unit weights (the only kind G5 and
-// G5.1 make), parameter u in [0, count − order + 1].
-struct Nurbs {
-  int count = 0;
-  int order = 0;
-  std::array<Vec2, kMaxControlPoints> points{};
-  std::array<double, 2 * kMaxControlPoints> knots{};
-
-  Nurbs(const std::array<Vec2, kMaxControlPoints>& control, int n_points, int k)
-      : count(n_points), order(k), points(control) {
+// A clamped NURBS of `order` over its control points (LinuxCNC's G5 and G5.1 make unit weights,
+// G5.2 the block's P), parameter u in [0, count − order + 1].
+class Nurbs {
+ public:
+  Nurbs(std::vector<Interpreter::State::NurbsPoint> control, int k)
+      : points_(std::move(control)), order_(k) {
     // LinuxCNC's knot_vector_creator: `order` zeros, then 1, 2, …, then u_max repeated.
-    const int n = count - 1;
-    for (int i = 0; i <= n + order; ++i)
-      knots[static_cast<std::size_t>(i)] = i < order ? 0.0 : i <= n ? i - order + 1 : n - order + 2;
+    const int n = count() - 1;
+    for (int i = 0; i <= n + order_; ++i)
+      knots_.push_back(i < order_ ? 0.0 : i <= n ? i - order_ + 1 : n - order_ + 2);
   }
-  double u_max() const { return count - order + 1; }
+  int count() const { return static_cast<int>(points_.size()); }
+  double u_max() const { return count() - order_ + 1; }
+  Vec2 first() const { return points_.front().p; }
 
-  // Cox–de Boor, with LinuxCNC's closed spans [u_i, u_i+1] at order 1 and 0/0 read as 0.
-  double basis(int i, int k, double u) const {
-    auto t = [&](int j) { return knots[static_cast<std::size_t>(j)]; };
-    if (k == 1) return u >= t(i) && u <= t(i + 1) ? 1.0 : 0.0;
-    double left = t(i + k - 1) - t(i), right = t(i + k) - t(i + 1);
-    double value = 0;
-    if (left != 0) value += (u - t(i)) * basis(i, k - 1, u) / left;
-    if (right != 0) value += (t(i + k) - u) * basis(i + 1, k - 1, u) / right;
-    return value;
-  }
-
-  // The rational form, as LinuxCNC divides by the sum of the weighted basis functions.
+  // The rational form: Σ N_i w_i P_i / Σ N_i w_i (The NURBS Book, eq. 4.2), over the N_i that
+  // are not zero at u.
   Vec2 point(double u) const {
+    const std::size_t lo = basis(u);
     Vec2 sum(0.0);
     double weight = 0;
-    for (int i = 0; i < count; ++i) {
-      double b = basis(i, order, u);
-      sum += b * points[static_cast<std::size_t>(i)];
-      weight += b;
+    for (std::size_t j = 0; j < basis_.size() && lo + j < points_.size(); ++j) {
+      const Interpreter::State::NurbsPoint& c = points_[lo + j];
+      sum += basis_[j] * c.weight * c.p;
+      weight += basis_[j] * c.weight;
     }
     return sum / weight;
   }
@@ -73,6 +65,39 @@ struct Nurbs {
     double h = glm::length(d);
     return h != 0 ? d / h : d;
   }
+
+ private:
+  // Cox–de Boor (The NURBS Book, eq. 2.5), raising the order from 1, with LinuxCNC's closed
+  // spans [u_i, u_i+1] at order 1 and 0/0 read as 0: the same sums as LinuxCNC's recursive Nmix.
+  // Only N_i with u_i <= u <= u_i+order can be non-zero: the spans holding u, [first, last] (two
+  // or more where u is on a knot), and the order − 1 before them. So the work per point is
+  // O(order²), whatever the number of control points. basis_[j] = N_lo+j,order(u); returns lo.
+  std::size_t basis(double u) const {
+    auto t = [&](std::size_t j) { return knots_[j]; };
+    const auto index = [&](auto it) { return static_cast<std::size_t>(it - knots_.begin()); };
+    std::size_t first = index(std::lower_bound(knots_.begin(), knots_.end(), u));  // t(first) >= u
+    first = first == 0 ? 0 : first - 1;                                           // t(first + 1) >= u
+    std::size_t last = index(std::upper_bound(knots_.begin(), knots_.end(), u));   // t(last) > u
+    last = std::min(last == 0 ? 0 : last - 1, knots_.size() - 2);                  // t(last) <= u
+    const std::size_t k_max = static_cast<std::size_t>(order_);
+    const std::size_t lo = first >= k_max - 1 ? first - (k_max - 1) : 0;
+    basis_.assign(last + 2 - lo, 0.0);  // i in [lo, last + 1]; N_last+1 stays 0 at every order
+    for (std::size_t i = first; i <= last; ++i) basis_[i - lo] = 1.0;
+    for (std::size_t k = 2; k <= k_max; ++k)
+      for (std::size_t i = lo; i <= last && i + k < knots_.size(); ++i) {
+        double left = t(i + k - 1) - t(i), right = t(i + k) - t(i + 1);
+        double value = 0;
+        if (left != 0) value += (u - t(i)) * basis_[i - lo] / left;
+        if (right != 0) value += (t(i + k) - u) * basis_[i + 1 - lo] / right;
+        basis_[i - lo] = value;  // basis_[i + 1 − lo] is still of order k − 1 for the next i
+      }
+    return lo;
+  }
+
+  std::vector<Interpreter::State::NurbsPoint> points_;
+  int order_;
+  std::vector<double> knots_;
+  mutable std::vector<double> basis_;
 };
 
 }  // namespace
@@ -92,8 +117,8 @@ void Interpreter::State::spline(bool quadratic) {
 
   Vec3 start = comp_programmed_current ? comp_programmed : to_program(pos);
   comp_programmed_current = false;
-  std::array<Vec2, kMaxControlPoints> control{};
-  control[0] = Vec2(start);
+  std::vector<NurbsPoint> control(quadratic ? 3 : 4);
+  control[0].p = Vec2(start);
   Vec2 first(0.0);  // P1 − P0
   if (quadratic) {
     if (!w.has('I') || !w.has('J')) error(motion_column, "G5.1 needs both I and J");
@@ -111,17 +136,15 @@ void Interpreter::State::spline(bool quadratic) {
     char c = kAxisLetter[i];
     if (w.has(c)) end[i] = incremental ? start[i] + length(c) : length(c);
   }
-  control[1] = control[0] + first;
-  int count = 3;
+  control[1].p = control[0].p + first;
   if (quadratic) {
-    control[2] = Vec2(end);
+    control[2].p = Vec2(end);
   } else {
     if (!w.has('P') || !w.has('Q')) error(motion_column, "G5 needs both P and Q (the end tangent)");
     double p = w.take('P'), q = w.take('Q');
-    control[2] = Vec2(end) + Vec2(p, q) * unit;
-    control[3] = Vec2(end);
+    control[2].p = Vec2(end) + Vec2(p, q) * unit;
+    control[3].p = Vec2(end);
     spline_mirror = Vec2(-p, -q);
-    count = 4;
   }
 
   if (far) {  // the far rule, as for arcs: only the lateral position changes
@@ -129,19 +152,79 @@ void Interpreter::State::spline(bool quadratic) {
     return;
   }
 
-  // emccanon's NURBS_FEED: 4 × (control points) equal steps of u, a biarc each.
-  Nurbs curve(control, count, count);
-  const int steps = 4 * count;
-  Vec2 p0 = control[0], t0 = curve.tangent(0);
+  const int order = quadratic ? 3 : 4;
+  nurbs_feed(std::move(control), order, Vec2(end), start[2]);
+  pos = to_machine(end);
+}
+
+// A G5.2 block: one control point (X Y, weight P) of the NURBS that G5.3 cuts. As LinuxCNC 2.9's
+// convert_nurbs: the first block puts the current point first (weight 1, or the P of a block
+// without X and Y); X and Y are read against the current point, which stays where it is until
+// G5.3 (G91: increments from it, not from the previous control point); L sets the order, 3 by
+// default (LinuxCNC takes L only from 4 on).
+void Interpreter::State::nurbs_point() {
+  if (comp_side != 0)
+    error(motion_column, "G5.2 with cutter radius compensation on: its curve is not offset (G40 first)");
+  if (plane != 170) error(motion_column, "G5.2 is a NURBS in the XY plane only (G17)");
+  for (char c : {'Z', 'A', 'B', 'C'})
+    if (w.has(c)) error(w.col(c), std::string("G5.2 may not move ") + c + " (its control points are in XY)");
+  if (w.has('X') != w.has('Y'))
+    error(w.col(w.has('X') ? 'X' : 'Y'), "a G5.2 control point needs both X and Y");
+  require_feed();
+  bool point = w.has('X');
+  double weight = 0;
+  if (w.has('P')) {
+    weight = w.take('P');
+    if (!(weight > 0)) error(w.col('P'), "G5.2 weight P" + format_number(weight) + " must be positive");
+  }
+  if (nurbs_points.empty()) {
+    Vec3 start = comp_programmed_current ? comp_programmed : to_program(pos);
+    nurbs_points.push_back({Vec2(start), !point && weight > 0 ? weight : 1.0});
+    nurbs_order = 3;
+  } else if (!point) {
+    error(motion_column, "G5.2 needs X and Y (a control point): P alone weighs only the first point");
+  }
+  if (w.has('L')) {
+    // LinuxCNC ignores L below 4 (order 3 stays): an L1 or L2 is refused rather than misread.
+    nurbs_order = static_cast<int>(integer('L', "G5.2 order L", 3, kMaxNurbsOrder));
+  }
+  if (!point) return;
+  if (!w.has('P')) error(motion_column, "a G5.2 control point needs its weight P (positive)");
+  Vec3 start = to_program(pos);
+  Vec2 at(length('X'), length('Y'));
+  if (incremental) at += Vec2(start);
+  nurbs_points.push_back({at, weight});
+}
+
+// G5.3: the NURBS of the G5.2 blocks before it is cut, as LinuxCNC's NURBS_FEED does, and the
+// tool stands at its last control point (Z unchanged). No motion mode is left active.
+void Interpreter::State::nurbs_end(int column) {
+  if (motion != 52) error(column, "G5.3 without G5.2 before it (LinuxCNC refuses it)");
+  if (static_cast<int>(nurbs_points.size()) < nurbs_order)
+    error(column, "G5.3: " + std::to_string(nurbs_points.size()) + " control points, fewer than the order L = " +
+                      std::to_string(nurbs_order));
+  Vec3 start = to_program(pos);
+  Vec3 end(nurbs_points.back().p, start[2]);
+  if (!far) nurbs_feed(std::move(nurbs_points), nurbs_order, Vec2(end), start[2]);
+  nurbs_points.clear();
+  pos = to_machine(end);
+  motion = -1;
+}
+
+// emccanon's NURBS_FEED: 4 × (control points) equal steps of u, a biarc each, the last ending
+// exactly on `end` (the last control point).
+void Interpreter::State::nurbs_feed(std::vector<NurbsPoint> control, int order, const Vec2& end, double z) {
+  Nurbs curve(std::move(control), order);
+  const int steps = 4 * curve.count();
+  Vec2 p0 = curve.first(), t0 = curve.tangent(0);  // where the tool stands, exactly
   for (int i = 1; i <= steps; ++i) {
     double u = curve.u_max() * i / steps;
-    Vec2 p1 = i == steps ? Vec2(end) : curve.point(u);
+    Vec2 p1 = i == steps ? end : curve.point(u);
     Vec2 t1 = curve.tangent(u);
-    biarc(p0, t0, p1, t1, start[2]);
+    biarc(p0, t0, p1, t1, z);
     p0 = p1;
     t0 = t1;
   }
-  pos = to_machine(end);
 }
 
 // Two arcs from `p0` (tangent `t0`) to `p4` (tangent `t4`) meeting tangentially, with equal

@@ -27,6 +27,7 @@ inline constexpr double kPi = std::numbers::pi;
 inline constexpr double kAxisEps = 1e-9;        // a frame axis "has a component" along the tool axis
 inline constexpr double kSameDirection = 1e-12;  // 1 − cos of the angle below which axes are equal
 inline constexpr long long kMaxArcPieces = 10'000'000;
+inline constexpr long long kMaxNurbsOrder = 100;  // G5.2 L: far above any CAM output
 
 // ---- the interpreter's state ----------------------------------------------------------------
 struct Interpreter::State : ParameterReader {
@@ -71,6 +72,13 @@ struct Interpreter::State : ParameterReader {
   void feed_mode_codes();                 // G93, G94, G95, F and S (modal.cpp)
   void inverse_time_rate(double length);  // G93: feed for a block `length` mm long (motion.cpp)
   Vec2 spline_mirror{0.0};  // G5 without I J: P1 − P0, program units (−P, −Q of the last G5)
+  // G5.2 control points gathered for G5.3 (program units, XY) and the curve's order (L).
+  struct NurbsPoint {
+    Vec2 p{0.0};
+    double weight = 1;
+  };
+  std::vector<NurbsPoint> nurbs_points;
+  int nurbs_order = 3;
   double speed = 0;
   int spindle_direction = 0;
   int tool_selected = 0;
@@ -232,9 +240,11 @@ struct Interpreter::State : ParameterReader {
     }
   }
   // The modal group of a G code in this block: g_group, and the motions of the LinuxCNC dialect
-  // (G5 and G5.1 splines, G38.2–G38.5 straight probes).
+  // (G5 and G5.1 splines, G5.2 NURBS and its G5.3 end, G38.2–G38.5 straight probes).
   int block_g_group(int code) const {
     if ((code == 50 && g5_spline) || (code == 51 && g5_1_spline)) return kMotion;
+    if (machine.dialect == Dialect::linuxcnc && (code == 52 || code == 53))
+      return code == 52 ? kMotion : kNonModal;
     if (code >= 382 && code <= 385 && machine.dialect == Dialect::linuxcnc) return kMotion;
     return g_group(code);
   }
@@ -287,16 +297,15 @@ struct Interpreter::State : ParameterReader {
                                       "where the tool goes next, is known only on the machine; "
                                       "leave the probing cycle out of the program tridex reads (or, "
                                       "with --machine linuxcnc, read it as rs274 does)");
+          if (word.letter == 'G' && (code == 52 || code == 53))
+            error(word.column, name + " (LinuxCNC's NURBS) is read with --machine linuxcnc only");
           if (word.letter == 'G' && integral && machine.dialect == Dialect::linuxcnc) {
-            // Never skipped, even lenient: each moves the tool. LinuxCNC's lathe codes (G7
-            // diameter mode, G33 threading, G70-G72 turning cycles, G76 threading cycle) have no
-            // meaning on a mill; G5.2 is a NURBS tridex does not follow.
-            static constexpr int kLathe[] = {70, 330, 700, 710, 711, 712, 720, 721, 722, 760};
+            // Never skipped, even lenient: each moves the tool or sets how it moves. LinuxCNC's
+            // lathe codes (G7 diameter mode, G33 threading, G70-G72 turning cycles, G76 threading
+            // cycle, G96 constant surface speed) have no meaning on a mill.
+            static constexpr int kLathe[] = {70, 330, 700, 710, 711, 712, 720, 721, 722, 760, 960};
             if (std::find(std::begin(kLathe), std::end(kLathe), code) != std::end(kLathe))
               error(word.column, name + " is a lathe code: tridex simulates milling machines");
-            if (code == 52)
-              error(word.column, name + " (LinuxCNC's NURBS) is not supported: write the curve as "
-                                        "G1 or G2/G3 moves");
           }
           unsupported(word.column, "unsupported code " + name, "code " + name, harmless && !coordinates);
           continue;
@@ -501,6 +510,10 @@ struct Interpreter::State : ParameterReader {
   void spline(bool quadratic);
   void biarc(const Vec2& p0, const Vec2& t0, const Vec2& p4, const Vec2& t4, double z);
   void spline_piece(const Vec2& from, const Vec2& to, const Vec2& tangent, double z);
+  // LinuxCNC's G5.2/G5.3 NURBS (spline.cpp): a control point per G5.2 block, the cut at G5.3.
+  void nurbs_point();
+  void nurbs_end(int column);
+  void nurbs_feed(std::vector<NurbsPoint> control, int order, const Vec2& end, double z);
   void probe(int code);  // LinuxCNC's G38.2–G38.5 (motion.cpp)
   void machine_move(const Vec3& target, unsigned mask, MoveKind kind, double move_feed);
   void polar_words(bool axis_consumer, int nonmodal);  // LinuxCNC @ and ^ become X and Y (motion.cpp)

@@ -178,3 +178,25 @@ TEST_CASE("arcs: bad arcs are errors with their position") {
   d = error_of("G17 G90 F100\nG0 X10 Y0\nG2 X0 Y0 Z-1 I-5\n");
   CHECK(d.message.find("retracted") != std::string::npos);
 }
+
+// LinuxCNC 2.9 (interp_arc.cc; each case checked with rs274) cuts an I/J/K arc whose end radius differs from its start radius
+// as a spiral up to 0.02·√2 mm (G21) or 0.002·√2 in (G20), and up to 100 times that within 0.1 %
+// of the radius; tridex's own rule (arc_radius_tolerance, 0.002 mm) stays for other machines.
+TEST_CASE("arcs: LinuxCNC's spiral tolerance on --machine linuxcnc") {
+  const MachineConfig linuxcnc = *MachineConfig::bundled("linuxcnc");
+  // Radius 10 → 10.02 mm: within 0.02·√2 mm.
+  const std::string small = "G21 G17 G90 F100\nG0 X10 Y0 Z0\nG3 X0 Y10.02 I-10 J0\n";
+  Result r = run_program(small, {}, linuxcnc);
+  REQUIRE(!r.moves.empty());
+  CHECK(near(r.moves.back().end, Vec3(0, 10.02, 0)));
+  CHECK(error_of(small).message.find("0.002 mm") != std::string::npos);
+  // 10 → 10.03 mm: over 0.0283 mm and over 0.1 % of the radius.
+  Diagnostic d = error_of("G21 G17 G90 F100\nG0 X10 Y0 Z0\nG3 X0 Y10.03 I-10 J0\n", {}, linuxcnc);
+  CHECK(d.message.find("spiral tolerance") != std::string::npos);
+  // Radius 100 → 100.05 mm: over 0.0283 mm but within 0.1 %.
+  CHECK(!run_program("G21 G17 G90 F100\nG0 X100 Y0 Z0\nG3 X0 Y100.05 I-100 J0\n", {}, linuxcnc).moves.empty());
+  // In inches the bound is 0.002·√2 in: 1 → 1.0025 in is within, 1 → 1.003 in is not.
+  CHECK(!run_program("G20 G17 G90 F10\nG0 X1 Y0 Z0\nG3 X0 Y1.0025 I-1 J0\n", {}, linuxcnc).moves.empty());
+  CHECK(error_of("G20 G17 G90 F10\nG0 X1 Y0 Z0\nG3 X0 Y1.003 I-1 J0\n", {}, linuxcnc).message.find("spiral") !=
+        std::string::npos);
+}

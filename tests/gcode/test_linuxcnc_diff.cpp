@@ -76,8 +76,13 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log, const fs
   fs::path out = fs::temp_directory_path() /
                  ("tridex_rs274_" + std::to_string(::getpid()) + "_" + program.filename().string());
   std::string tools = tool_table.empty() ? "" : "-t '" + tool_table.string() + "' ";
-  std::string command = "rs274 " + tools + "-g '" + program.string() + "' '" + out.string() +
-                        "' < /dev/null > '" + out.string() + ".log' 2>&1";
+  // rs274 keeps its tool table in $HOME/.tool.mmap (LinuxCNC 2.9 tooldata_mmap.cc): two runs at
+  // once under one HOME read each other's tools or die of a bus error, so each test process
+  // gives it a HOME of its own.
+  fs::path home = fs::temp_directory_path() / ("tridex_rs274_home_" + std::to_string(::getpid()));
+  fs::create_directories(home);
+  std::string command = "HOME='" + home.string() + "' rs274 " + tools + "-g '" + program.string() +
+                        "' '" + out.string() + "' < /dev/null > '" + out.string() + ".log' 2>&1";
   int status = std::system(command.c_str());
   (void)status;  // rs274 exits 0 even on interpreter errors; its log is checked instead
   std::ifstream log_in(out.string() + ".log");
@@ -170,6 +175,7 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log, const fs
   }
   fs::remove(out);
   fs::remove(out.string() + ".log");
+  fs::remove_all(home);
   return points;
 }
 
@@ -382,7 +388,53 @@ void compare_paths(const fs::path& program, const fs::path& tool_table,
   MESSAGE(program.filename().string() << ": " << theirs.size() << " rs274 end points met");
 }
 
+// The diameters of a LinuxCNC tool table (`T<n> ... D<d>` a line, inches as rs274 standalone
+// reads it), in mm: what tridex's --tools reads from the same file.
+std::map<int, double> tbl_diameters(const fs::path& table) {
+  std::map<int, double> diameters;
+  std::ifstream in(table);
+  REQUIRE(in);
+  std::string line;
+  while (std::getline(in, line)) {
+    line = line.substr(0, line.find(';'));
+    std::size_t t = line.find('T'), d = line.find(" D");
+    if (t == std::string::npos || d == std::string::npos) continue;
+    diameters[std::stoi(line.substr(t + 1))] = std::stod(line.substr(d + 2)) * 25.4;
+  }
+  return diameters;
+}
+
 }  // namespace
+
+// LinuxCNC's sample programs with G41/G42, read in place (GPL: not copied), with a tool table of
+// ours (sweep_tools.tbl) that both interpreters read: rs274 through -t, tridex as --tools would.
+// TRIDEX_DIFF_COMP_ONLY=FILE runs one program this way (ad hoc).
+TEST_CASE("differential: LinuxCNC's G41/G42 samples agree with rs274 given a tool table") {
+  if (!rs274_available()) {
+    MESSAGE("SKIPPED: rs274 not found (install the Debian package linuxcnc-uspace); the LinuxCNC "
+            "differential test did not run");
+    return;
+  }
+  const fs::path table = fs::path(TRIDEX_TEST_DATA) / "gcode" / "linuxcnc" / "sweep_tools.tbl";
+  std::vector<fs::path> programs;
+  if (const char* only = std::getenv("TRIDEX_DIFF_COMP_ONLY")) {
+    programs.assign(1, fs::path(only));
+  } else {
+    // lathecomp.ngc is a lathe's program, but its codes are a mill's (G18, G41/G42): with this
+    // table's mill tools both interpreters offset the path in XZ alike.
+    for (const char* name : {"comp.ngc", "comp-g1.ngc", "comp311.ngc", "comp311_2.ngc",
+                             "gmoccapy_2_tools_with_cutter_radius_compensation.ngc", "lathecomp.ngc",
+                             "useful-subroutines.ngc"})
+      programs.push_back(fs::path("/usr/share/linuxcnc/ncfiles") / name);
+  }
+  const std::map<int, double> diameters = tbl_diameters(table);
+  REQUIRE(diameters.at(4) == doctest::Approx(0.2 * 25.4));
+  for (const fs::path& program : programs) {
+    CAPTURE(program.string());
+    REQUIRE_MESSAGE(fs::exists(program), "corpus file missing");
+    compare_paths(program, table, diameters);
+  }
+}
 
 TEST_CASE("differential: cutter compensation (G41/G42) agrees with rs274") {
   if (!rs274_available()) {

@@ -1,9 +1,10 @@
 // LinuxCNC's polar words (@ radius, ^ angle) against the same points written as X and Y, their
-// errors, and the codes tridex refuses by name (lathe codes, LinuxCNC's splines). The rs274
-// differential corpus (tests/data/gcode/linuxcnc/polar_words.ngc) checks them against LinuxCNC.
+// errors, and the codes tridex refuses by name (lathe codes). The rs274 differential corpus
+// (tests/data/gcode/linuxcnc/polar_words.ngc) checks them against LinuxCNC.
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <fstream>
 
 #include "helpers.hpp"
 
@@ -67,17 +68,28 @@ TEST_CASE("polar: errors name the word and the rule") {
   CHECK(error_of("G0 X0 Y0 Z1\nG91 G0 ^10\n", {}, m).message.find("origin") != std::string::npos);
 }
 
-TEST_CASE("lathe codes and LinuxCNC's NURBS (G5.2) are errors that name them, even lenient") {
+TEST_CASE("lathe codes are errors that name them, even lenient") {
   InterpreterOptions lenient;
   lenient.lenient = true;
   for (const char* code : {"G7", "G33 Z-1 K0.1", "G76 P0.05 Z-1 I-0.01 J0.01 K0.03", "G70 Q1", "G71 Q1",
-                           "G72 Q1"}) {
+                           "G72 Q1", "G96 D2500 S200"}) {
     Diagnostic d = error_of(std::string("G0 X0 Y0 Z0\n") + code + "\nM2\n", lenient, linuxcnc());
     CHECK(d.line == 2);
     CHECK_MESSAGE(d.message.find("is a lathe code") != std::string::npos, d.message);
   }
-  Diagnostic d = error_of("G0 X0 Y0 Z0\nG5.2 X1 Y1 P1 L3\nM2\n", lenient, linuxcnc());
-  CHECK_MESSAGE(d.message.find("is not supported") != std::string::npos, d.message);
+  // LinuxCNC's installed lathe demo (read in place, GPL): refused at its first turning cycle.
+  const char* demo = "/usr/share/linuxcnc/ncfiles/lathe_g70_71_demo.ngc";
+  if (std::ifstream in{demo}; in) {
+    Interpreter interpreter({}, linuxcnc());
+    try {
+      interpreter.run(in, demo, [](const Move&) {});
+      FAIL("lathe_g70_71_demo.ngc was accepted");
+    } catch (const GcodeError& e) {
+      CHECK(e.where.line == 28);
+      CHECK(e.where.column == 1);
+      CHECK(e.where.message == "G71.1 is a lathe code: tridex simulates milling machines");
+    }
+  }
   // Fanuc's G76 is a mill's fine boring cycle: not called a lathe code there.
   CHECK(error_of("G0 X0 Y0 Z0\nG76 X1 Z-1 R1 Q0.1\n", {}, at_origin()).message.find("lathe") == std::string::npos);
 }
