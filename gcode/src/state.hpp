@@ -275,9 +275,10 @@ struct Interpreter::State : ParameterReader {
             warn(word.column, code_name('M', code) +
                                   " has no effect on the tool path here (accepted; declare it in the "
                                   "machine file's m_codes to silence this)");
-          // Spindle orientation (M19 R Q P) and LinuxCNC's I/O codes (M62-M65 P, M66 P E L Q,
-          // M67/M68 E Q) and user codes (M100-M199 P Q) take arguments of their own.
-          w.m_arguments |= m == 19 || (m >= 62 && m <= 68) || (m >= 100 && m <= 199);
+          // Spindle orientation (M19 R Q P), LinuxCNC's override switches (M50-M53 P), I/O
+          // codes (M62-M65 P, M66 P E L Q, M67/M68 E Q) and user codes (M100-M199 P Q) take
+          // arguments of their own.
+          w.m_arguments |= m == 19 || (m >= 50 && m <= 53) || (m >= 62 && m <= 68) || (m >= 100 && m <= 199);
           continue;
         }
         if (group < 0) {

@@ -59,12 +59,12 @@ TEST_CASE("Haas G103 (look-ahead) and G154 P (extra work offsets, as G54.1 P)") 
 
 TEST_CASE("M-codes with arguments of their own: M19 R, LinuxCNC's M62-M68, user M100-M199") {
   MachineConfig linuxcnc = *MachineConfig::bundled("linuxcnc");
-  Result io = run_program("G21 G90\nM62 P0\nM65 P1\nM66 P0 L0 Q1\nM68 E0 Q0\nM19 R45\nG0 X1 Y2 Z3\nM2\n", {},
+  Result io = run_program("G21 G90\nM62 P0\nM65 P1\nM66 P0 L0 Q1\nM68 E0 Q0\nM19 R45\nM52 P1\nG0 X1 Y2 Z3\nM2\n", {},
                           linuxcnc);
   Result plain = run_program("G21 G90\nG0 X1 Y2 Z3\nM2\n", {}, linuxcnc);
   same_moves(io, plain);
   // Each code is said once in the warnings.
-  CHECK(io.warnings.size() == 5);
+  CHECK(io.warnings.size() == 6);
   // Other M-codes do not take them, and a word no code uses is still an error.
   Diagnostic d = error_of("G21 G90\nM8 P1\n", {}, linuxcnc);
   CHECK(d.message.find("word P1 is not used") != std::string::npos);
