@@ -21,7 +21,7 @@ constexpr double kDegree = std::numbers::pi / 180.0;
 // LinuxCNC compares for equality within this (rs274ngc's TOLERANCE_EQUAL), so that a loop
 // counter built from decimal steps still meets its bound.
 constexpr double kEqualTolerance = 1e-4;
-constexpr int kMaxParameter = 99999;
+constexpr int kMaxParameter = 999999;  // Fanuc: six digits (#901001 in pallet programs)
 constexpr int kMaxDepth = 64;  // nested brackets and parameter references
 
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
@@ -149,7 +149,7 @@ class Parser {
     Value index = primary(hash);
     double v = index.number;
     if (std::abs(v - std::round(v)) > 1e-6 || v < 0 || v > kMaxParameter)
-      fail(hash, "parameter number " + format(v) + " must be an integer in [0, 99999]");
+      fail(hash, "parameter number " + format(v) + " must be an integer in [0, 999999]");
     ref.number = static_cast<int>(std::lround(v));
     return ref;
   }

@@ -120,3 +120,16 @@ TEST_CASE("G10 L2/L20 with rotary words: 0 changes nothing; LinuxCNC's plain axe
   CHECK(d.column == 14);
   CHECK(d.message.find("G10 B15: a rotary work offset other than 0 is not simulated") != std::string::npos);
 }
+
+TEST_CASE("six-digit variables (#901001 in pallet programs); machine presets for the rest") {
+  Result r = run_program("G21 G90\n#901001 = 7\nG0 X#901001 Y0 Z1\nM30\n", {}, at_origin());
+  REQUIRE(r.moves.size() == 1);
+  CHECK(near(r.moves[0].end, Vec3(7, 0, 1)));
+  CHECK(error_of("#1000000 = 1\n").message.find("[0, 999999]") != std::string::npos);
+  MachineConfig machine = at_origin();
+  machine.variables = {{650, 2000}, {901001, 4}};
+  r = run_program("G21 G90\nG0 X0 Y0 Z1\nG1 X#901001 F#650\nM30\n", {}, machine);
+  REQUIRE(r.moves.size() == 2);
+  CHECK(r.moves[1].feed == 2000);
+  CHECK(near(r.moves[1].end, Vec3(4, 0, 1)));
+}

@@ -81,6 +81,30 @@ TEST_CASE("machine files: each key changes what the program means") {
   fs::remove_all(dir);
 }
 
+TEST_CASE("machine files: \"variables\" are what the control holds when the program starts") {
+  // A production program's feed in a persistent common, and an input it branches on.
+  fs::path dir = scratch("machine-variables");
+  write_text(dir / "p.nc", "G21 G90\nT1 M6\nG0 X0 Y0 Z5\nIF [#1000 EQ 1] GOTO 9\nG1 Z-1 F#650\nN9 G0 Z5\n"
+                           "#901001 = 3\nG0 X#901001\nM30\n");
+  CommandResult r = run_tridex({"moves", (dir / "p.nc").string()}, dir);
+  CHECK(r.status == 2);  // #650 is vacant: no feed rate
+  CHECK(r.err.find("p.nc:5:") != std::string::npos);
+  write_text(dir / "m.json", R"({"variables": {"#650": 2000, "1000": 0}})");
+  r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "m.json").string()}, dir);
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  std::vector<nlohmann::json> m = moves_of(r);
+  REQUIRE(m.size() == 4);
+  CHECK(m[1]["feed"] == 2000.0);
+  CHECK(m[3]["end"][0] == 3.0);
+  // The input set: the cut is skipped.
+  write_text(dir / "m.json", R"({"variables": {"#650": 2000, "#1000": 1}})");
+  r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "m.json").string()}, dir);
+  REQUIRE(r.status == 0);
+  CHECK(moves_of(r).size() == 3);
+  fs::remove_all(dir);
+}
+
 TEST_CASE("machine files: T alone loads the tool where the control does so") {
   fs::path dir = scratch("machine-t");
   write_text(dir / "p.nc", "T3\nG0 X0 Y0 Z5\nG1 Z0 F100\nM30\n");
@@ -287,6 +311,10 @@ TEST_CASE("machine files: bad files name the file, the key and the value") {
       {"{\"work_offsets\": {\"G54.1 P301\": [0, 0, 0]}}", "G54.1 P301"},
       {"{\"m_codes\": [1.5]}", "\"m_codes\""},
       {"{\"m_codes\": [10], \"forbidden_m_codes\": [10]}", "M10"},
+      {"{\"variables\": [650]}", "\"variables\""},
+      {"{\"variables\": {\"#x\": 1}}", "\"#x\" is not a variable number"},
+      {"{\"variables\": {\"#1000000\": 1}}", "\"#1000000\" is not a variable number"},
+      {"{\"variables\": {\"#650\": \"fast\"}}", "must be a number"},
       {"{\"far_distance\": -1}", "\"far_distance\""},
       {"{\"units\": \"cm\"}", "\"units\""},
       {"{\"base\": \"haas\"}", "\"base\""},

@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <optional>
 #include <sstream>
@@ -171,6 +172,18 @@ gcode::MachineConfig parse(const json& doc, const std::string& file, MachineRate
       m.m_codes = m_code_list(value, where);
     } else if (key == "forbidden_m_codes") {
       m.forbidden_m_codes = m_code_list(value, where);
+    } else if (key == "variables") {  // {"#650": 2000, "#1000": 0}: what the control holds
+      if (!value.is_object()) input_error(where, ": must be an object such as {\"#650\": 2000}");
+      for (const auto& [name, number] : value.items()) {
+        std::string digits = name.starts_with("#") ? name.substr(1) : name;
+        char* end = nullptr;
+        const long n = digits.empty() ? -1 : std::strtol(digits.c_str(), &end, 10);
+        if (n < 1 || n > 999999 || *end != '\0')
+          input_error(where, ": \"", name, "\" is not a variable number (#1 to #999999)");
+        if (!number.is_number() || !std::isfinite(number.get<double>()))
+          input_error(where, ": \"", name, "\": must be a number, got ", number.dump());
+        m.variables[static_cast<int>(n)] = number.get<double>();
+      }
     } else if (key == "kinematics") {
       try {
         m.kinematics = gcode::kinematics_from_json(value, cat(file, ": kinematics"));
@@ -211,7 +224,7 @@ gcode::MachineConfig parse(const json& doc, const std::string& file, MachineRate
     } else {
       input_error(where, ": unknown key (known: name, description, base, dialect, units, start, "
                          "tool_change, tool_loads_on_t, home, reference2, work_offsets, m_codes, "
-                         "forbidden_m_codes, far_distance, subprograms, kinematics, "
+                         "forbidden_m_codes, variables, far_distance, subprograms, kinematics, "
                          "rapid_rate_mm_per_min, rapid_rate_deg_per_min, max_feed_mm_per_min)");
     }
   }

@@ -97,6 +97,11 @@ struct MachineConfig {
   std::set<int> m_codes;
   std::set<int> forbidden_m_codes;
 
+  // Numbered variables as the program finds them when it starts: the control's persistent
+  // commons (Fanuc #500-#999, kept across power-off) and the inputs a program reads (#1000...),
+  // which the program alone cannot know. Any other starts vacant (0 under LinuxCNC).
+  std::map<int, double> variables;
+
   // Where M98 / G65 / o<name> call look for programs the file does not contain: O1234.nc-style
   // files (and name.ngc for LinuxCNC) in these folders, in order.
   std::vector<std::string> subprogram_dirs;

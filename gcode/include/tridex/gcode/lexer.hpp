@@ -54,7 +54,7 @@ struct Value {
 class ParameterReader {
  public:
   virtual ~ParameterReader() = default;
-  // #n, n in [0, 99999]; may throw tridex::Error for a variable that cannot be read.
+  // #n, n in [0, 999999]; may throw tridex::Error for a variable that cannot be read.
   virtual Value numbered(int n) = 0;
   // #<name>, the name lower case without spaces; nullopt when it is not defined.
   virtual std::optional<Value> named(std::string_view name) = 0;
