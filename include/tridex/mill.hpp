@@ -685,12 +685,14 @@ struct BullLanes : RisingMove {
     all = all == 0;
     Plane p{splat(kInf), splat(0), splat(0), MaskN{}};
     if (!lowest<1>({ux}, uy, {all}, t, d)) return p;
-    const DoubleN px = ux - t[0] * vx, py = uy - t[0] * vy, d2 = px * px + py * py;
-    p.has_plane = (d[0] < kInf) & (d2 < r2 * (1 - 1e-7));
-    const DoubleN dist = sqrt_n(d2), reach = max_n(dist - flat, splat(0));
-    const DoubleN root = sqrt_n(max_n(corner2 - reach * reach, splat(corner2 * 1e-14)));
-    const DoubleN factor = p.has_plane & (reach > 0) ? reach / (root * dist) : splat(0);
-    p.z = d[0] < kInf ? low + t[0] * w + height(d[0]) : splat(kInf);
+    // d* = |q − C(t*)| (up to rounding: t* is clamped to the move only by rounding), so h and
+    // h' share one square root, and dividing by d* needs no other.
+    const DoubleN px = ux - t[0] * vx, py = uy - t[0] * vy, dist = min_n(d[0], splat(radius));
+    p.has_plane = (d[0] < kInf) & (px * px + py * py < r2 * (1 - 1e-7));
+    const DoubleN reach = max_n(dist - flat, splat(0)), root2 = max_n(corner2 - reach * reach, splat(0));
+    const DoubleN root = sqrt_n(root2);
+    const DoubleN factor = p.has_plane & (reach > 0) ? reach / (max_n(root, splat(corner * 1e-7)) * dist) : splat(0);
+    p.z = d[0] < kInf ? low + t[0] * w + (corner - root) : splat(kInf);
     p.gx = factor * px, p.gy = factor * py;
     return p;
   }
