@@ -639,6 +639,7 @@ struct FlatLanes : RisingMove {
 // exactly when t⊥ ≥ 1 and Q(|u − v| − R0) ≥ 0. There S is the still cutter at that end.
 struct BullLanes : RisingMove {
   double radius = 0, flat = 0, corner = 0, corner2 = 0, m2 = 0, start = 0;
+  double reach_scale = 0;  // 1/(R + R0)
 
   BullLanes() = default;
   explicit BullLanes(const MoveGeometry& m) : RisingMove(m) {
@@ -647,6 +648,7 @@ struct BullLanes : RisingMove {
     flat = m.radius - corner;
     m2 = w * w * inv_vv;
     start = corner * std::sqrt(m2 / (1 + m2));  // the root for e = 0
+    reach_scale = 1 / (radius + flat);
   }
 
   // The corner's height h at distance d from the axis (0 under the flat bottom).
@@ -744,7 +746,7 @@ struct BullLanes : RisingMove {
       DoubleN least[G];  // the lower bounds: the root for e = 0, ρ_b past the end, and e − R0 (e ≤ d)
       MaskN moving[G];
       for (int g = 0; g < G; ++g) {
-        least[g] = reach[g] = max_n(reach[g], sqrt_n(e2[g]) - flat);
+        least[g] = reach[g] = max_n(reach[g], (e2[g] - flat * flat) * reach_scale);
         moving[g] = inside[g];
       }
       for (int step = 0; step < 30; ++step) {
