@@ -405,7 +405,9 @@ struct MoveGeometry {
     if (closed) {
       const double side = std::sqrt(std::max(0.0, root_d * root_d - e2)) * inv_len;
       const double t = std::clamp(w > 0 ? t_foot - side : t_foot + side, lo, hi), s = t - t_foot;
-      return {az + t * w + cutter->lower_height(std::sqrt(e2 + s * s * vv)), t};
+      // Where φ < m up to the rim (a steep move), d(t*) = R, which rounding may put past the rim
+      // (where lower_height is +infinity, as if q were not covered).
+      return {az + t * w + cutter->lower_height(std::min(radius, std::sqrt(e2 + s * s * vv))), t};
     }
     return convex_regula_falsi(e2, t_foot, lo, hi);
   }
