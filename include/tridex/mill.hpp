@@ -31,7 +31,8 @@
 // Ball end moves are bounded kLanes tiles at a time and evaluated kLanes points at a time, with
 // one square root per point (BallLanes); flat end and bull nose moves are bounded and evaluated
 // kLanes at a time too (FlatLanes: a closed form; BullLanes: the still cutter where the minimum is
-// at an end of the move, else Halley steps with no square root). The moves
+// at an end of the move, else Halley steps with no square root), and the other cutters' moves
+// are evaluated kLanes at a time (ProfileLanes: a closed form per profile piece). The moves
 // left for a tile in pass 2 are cut lowest bound first, a run of one cutter at a time, each run
 // checked against what the tile holds by then: so a tile first cut by any cutter, or roughed
 // deeper by another cutter, still rejects the moves that cut air. Runs of flat end and bull nose
