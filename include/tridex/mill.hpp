@@ -31,7 +31,8 @@
 // Ball end moves are bounded kLanes tiles at a time and evaluated kLanes points at a time, with
 // one square root per point (BallLanes); flat end and bull nose moves are bounded and evaluated
 // kLanes at a time too (FlatLanes: a closed form; BullLanes: the still cutter where the minimum is
-// at an end of the move, else Halley steps with no square root). The moves
+// at an end of the move, else Halley steps with no square root), and the other cutters' moves
+// are evaluated kLanes at a time (ProfileLanes: a closed form per profile piece). The moves
 // left for a tile in pass 2 are cut lowest bound first, a run of one cutter at a time, each run
 // checked against what the tile holds by then: so a tile first cut by any cutter, or roughed
 // deeper by another cutter, still rejects the moves that cut air. Runs of flat end and bull nose
@@ -405,7 +406,9 @@ struct MoveGeometry {
     if (closed) {
       const double side = std::sqrt(std::max(0.0, root_d * root_d - e2)) * inv_len;
       const double t = std::clamp(w > 0 ? t_foot - side : t_foot + side, lo, hi), s = t - t_foot;
-      return {az + t * w + cutter->lower_height(std::sqrt(e2 + s * s * vv)), t};
+      // Where φ < m up to the rim (a steep move), d(t*) = R, which rounding may put past the rim
+      // (where lower_height is +infinity, as if q were not covered).
+      return {az + t * w + cutter->lower_height(std::min(radius, std::sqrt(e2 + s * s * vv))), t};
     }
     return convex_regula_falsi(e2, t_foot, lo, hi);
   }
@@ -639,6 +642,7 @@ struct FlatLanes : RisingMove {
 // exactly when t⊥ ≥ 1 and Q(|u − v| − R0) ≥ 0. There S is the still cutter at that end.
 struct BullLanes : RisingMove {
   double radius = 0, flat = 0, corner = 0, corner2 = 0, m2 = 0, start = 0;
+  double reach_scale = 0;  // 1/(R + R0)
 
   BullLanes() = default;
   explicit BullLanes(const MoveGeometry& m) : RisingMove(m) {
@@ -647,6 +651,7 @@ struct BullLanes : RisingMove {
     flat = m.radius - corner;
     m2 = w * w * inv_vv;
     start = corner * std::sqrt(m2 / (1 + m2));  // the root for e = 0
+    reach_scale = 1 / (radius + flat);
   }
 
   // The corner's height h at distance d from the axis (0 under the flat bottom).
@@ -685,12 +690,14 @@ struct BullLanes : RisingMove {
     all = all == 0;
     Plane p{splat(kInf), splat(0), splat(0), MaskN{}};
     if (!lowest<1>({ux}, uy, {all}, t, d)) return p;
-    const DoubleN px = ux - t[0] * vx, py = uy - t[0] * vy, d2 = px * px + py * py;
-    p.has_plane = (d[0] < kInf) & (d2 < r2 * (1 - 1e-7));
-    const DoubleN dist = sqrt_n(d2), reach = max_n(dist - flat, splat(0));
-    const DoubleN root = sqrt_n(max_n(corner2 - reach * reach, splat(corner2 * 1e-14)));
-    const DoubleN factor = p.has_plane & (reach > 0) ? reach / (root * dist) : splat(0);
-    p.z = d[0] < kInf ? low + t[0] * w + height(d[0]) : splat(kInf);
+    // d* = |q − C(t*)| (up to rounding: t* is clamped to the move only by rounding), so h and
+    // h' share one square root, and dividing by d* needs no other.
+    const DoubleN px = ux - t[0] * vx, py = uy - t[0] * vy, dist = min_n(d[0], splat(radius));
+    p.has_plane = (d[0] < kInf) & (px * px + py * py < r2 * (1 - 1e-7));
+    const DoubleN reach = max_n(dist - flat, splat(0)), root2 = max_n(corner2 - reach * reach, splat(0));
+    const DoubleN root = sqrt_n(root2);
+    const DoubleN factor = p.has_plane & (reach > 0) ? reach / (max_n(root, splat(corner * 1e-7)) * dist) : splat(0);
+    p.z = d[0] < kInf ? low + t[0] * w + (corner - root) : splat(kInf);
     p.gx = factor * px, p.gy = factor * py;
     return p;
   }
@@ -742,7 +749,7 @@ struct BullLanes : RisingMove {
       DoubleN least[G];  // the lower bounds: the root for e = 0, ρ_b past the end, and e − R0 (e ≤ d)
       MaskN moving[G];
       for (int g = 0; g < G; ++g) {
-        least[g] = reach[g] = max_n(reach[g], sqrt_n(e2[g]) - flat);
+        least[g] = reach[g] = max_n(reach[g], (e2[g] - flat * flat) * reach_scale);
         moving[g] = inside[g];
       }
       for (int step = 0; step < 30; ++step) {
@@ -775,6 +782,85 @@ struct BullLanes : RisingMove {
       }
     }
     return true;
+  }
+};
+
+// The swept surface S of a cutter made of lines and arcs centred on the axis (cone, chamfer,
+// tapered ball, from_profile), kLanes points at a time: MoveGeometry::convex_minimum's closed
+// form per profile piece, with its tests squared so that they need no square root. For a rising
+// move (slope m = w/|v| > 0) the minimiser lies behind the foot at the distance d* where
+// φ(d) = h'(d)·√(d² − e²)/d reaches m, found on the first piece (from the axis out) where it
+// does: φ(from) ≥ m puts d* on the piece's inner end (a kink, or e itself); else φ(to) ≥ m puts it
+// inside, where a line of slope k has φ ≥ m ⟺ k²(d² − e²) ≥ m²d², d*² = e²k²/(k² − m²), and an
+// arc of radius a centred on the axis (h' = d/√(a² − d²)) has φ ≥ m ⟺ d² − e² ≥ m²(a² − d²),
+// d*² = (e² + m²a²)/(1 + m²). Then t* = t⊥ − √(d*² − e²)/|v| clamped to the covering interval,
+// and S = low + t*·w + h(d(t*)). Three square roots a point (one more per arc), where the scalar
+// form spent four to five and a call through the piece list per piece.
+struct ProfileLanes : RisingMove {
+  const Cutter* cutter = nullptr;
+  double m2 = 0, radius = 0;
+
+  ProfileLanes() = default;
+  explicit ProfileLanes(const MoveGeometry& m)
+      : RisingMove(m), cutter(m.cutter), m2(w * w * inv_vv), radius(m.radius) {}
+
+  // Whether the cutter's pieces all have this closed form (an arc off the axis has not).
+  static bool closed_form(const Cutter& c) {
+    for (const ProfilePiece& piece : c.pieces())
+      if (piece.is_arc && piece.centre_d != 0) return false;
+    return true;
+  }
+
+  // h at distance d (d ≤ R): the piece holding d, as Cutter::lower_height.
+  DoubleN height(DoubleN d) const {
+    DoubleN h = splat(0);
+    for (const ProfilePiece& piece : cutter->pieces()) {
+      const MaskN on = d >= piece.d0;
+      if (!any_n(on)) break;
+      const DoubleN z = piece.is_arc ? piece.centre_h - sqrt_n(max_n(piece.radius * piece.radius - d * d, splat(0)))
+                                     : piece.h0 + piece.slope * (d - piece.d0);
+      h = on ? z : h;
+    }
+    return h;
+  }
+
+  // φ(d) ≥ m for the piece, from d² (e² = the points' squared distance to the move's line).
+  MaskN reaches(const ProfilePiece& piece, DoubleN d2, DoubleN e2) const {
+    if (piece.is_arc) {
+      const DoubleN a2 = splat(piece.radius * piece.radius);
+      return (d2 >= a2) | (d2 - e2 >= m2 * (a2 - d2));
+    }
+    const double k2 = piece.slope * piece.slope;
+    // On the axis φ = h'(0), the piece's slope.
+    const MaskN on_axis = d2 <= 0, sloped = k2 * (d2 - e2) >= m2 * d2;
+    return k2 >= m2 ? on_axis | sloped : ~on_axis & sloped;
+  }
+
+  // S at the points where `wanted` (+infinity elsewhere and where the cutter does not pass).
+  DoubleN at(DoubleN ux, DoubleN uy, MaskN wanted) const {
+    const Cover c = cover(ux, uy);
+    const MaskN covered = c.covered & wanted;
+    if (!any_n(covered)) return splat(kInf);
+    DoubleN t = min_n(max_n(c.t_foot, c.lo), c.hi);  // a level move: where the axis comes closest
+    if (w > 0) {
+      DoubleN root2 = splat(r2);  // φ < m up to the rim: the minimiser leaves the footprint
+      MaskN found = ~covered;
+      for (const ProfilePiece& piece : cutter->pieces()) {
+        const MaskN here = ~found & (c.e2 <= piece.d1 * piece.d1);
+        if (!any_n(here)) continue;
+        const DoubleN from2 = max_n(splat(piece.d0 * piece.d0), c.e2), to2 = splat(std::min(piece.d1 * piece.d1, r2));
+        const MaskN at_from = here & reaches(piece, from2, c.e2);
+        const MaskN inside = here & ~at_from & reaches(piece, to2, c.e2);
+        const DoubleN explicit2 = piece.is_arc ? (c.e2 + m2 * piece.radius * piece.radius) / (1 + m2)
+                                               : c.e2 * (piece.slope * piece.slope) / (piece.slope * piece.slope - m2);
+        root2 = at_from ? from2 : inside ? min_n(max_n(explicit2, from2), to2) : root2;
+        found |= at_from | inside;
+        if (all_n(found)) break;
+      }
+      t = min_n(max_n(c.t_foot - sqrt_n(max_n(root2 - c.e2, splat(0))) * inv_len, c.lo), c.hi);
+    }
+    const DoubleN s = t - c.t_foot, d = min_n(sqrt_n(c.e2 + s * s * vv), splat(radius));
+    return covered ? low + t * w + height(d) : splat(kInf);
   }
 };
 
@@ -889,9 +975,9 @@ class Miller {
   };
 
   // How a move's swept surface is evaluated on a tile's points: kLanes at a time by the ball
-  // end's, the flat end's or the bull nose's vector form, or one point at a time
-  // (MoveGeometry::lowest: plunges and the other cutters).
-  enum class LaneKind : unsigned char { scalar, ball, flat, bull_nose };
+  // end's, the flat end's, the bull nose's or the other profiles' vector form, or one point at a
+  // time (MoveGeometry::lowest: plunges, and profiles with an arc off the axis).
+  enum class LaneKind : unsigned char { scalar, ball, flat, bull_nose, profile };
 
   static LaneKind lane_kind(const MoveGeometry& m) {
     if (m.vertical) return LaneKind::scalar;
@@ -899,7 +985,7 @@ class Miller {
       case CutterShape::ball: return LaneKind::ball;
       case CutterShape::flat: return LaneKind::flat;
       case CutterShape::bull_nose: return LaneKind::bull_nose;
-      default: return LaneKind::scalar;
+      default: return ProfileLanes::closed_form(*m.cutter) ? LaneKind::profile : LaneKind::scalar;
     }
   }
 
@@ -914,6 +1000,7 @@ class Miller {
     std::vector<BallLanes> balls;
     std::vector<FlatLanes> flats;
     std::vector<BullLanes> bulls;
+    std::vector<ProfileLanes> profiles;
     std::vector<IndexBox> boxes;
     TileRow row;
   };
@@ -964,6 +1051,7 @@ class Miller {
     scratch.balls.clear();
     scratch.flats.clear();
     scratch.bulls.clear();
+    scratch.profiles.clear();
     scratch.boxes.clear();
     for (std::size_t k = bin_start_[bin]; k < bin_start_[bin + 1]; ++k) {
       const CutMove& move = moves_[bin_moves_[k]];
@@ -973,6 +1061,7 @@ class Miller {
       scratch.balls.push_back(kind == LaneKind::ball ? BallLanes(m) : BallLanes{});
       scratch.flats.push_back(kind == LaneKind::flat ? FlatLanes(m) : FlatLanes{});
       scratch.bulls.push_back(kind == LaneKind::bull_nose ? BullLanes(m) : BullLanes{});
+      scratch.profiles.push_back(kind == LaneKind::profile ? ProfileLanes(m) : ProfileLanes{});
       scratch.boxes.emplace_back();
       footprint_box(move, scratch.boxes.back());
     }
@@ -1443,6 +1532,12 @@ class Miller {
           }
           bull.at<kGroups>(ux, splat(uy), above, z);
           for (int g = 0; g < kGroups; ++g) h[g] = min_n(h[g], z[g]);
+        } else if (kind == LaneKind::profile) {
+          // As the bull nose: only the points above the move's plane.
+          const ProfileLanes& profile = scratch.profiles[c.move];
+          const double move_row = (c.has_plane ? c.centre_z : -kInf) + c.gradient.y * dy, uy = y - profile.ay;
+          for (int g = 0; g < kGroups; ++g)
+            h[g] = min_n(h[g], profile.at(x[g] - profile.ax, splat(uy), move_row + c.gradient.x * dx[g] < h[g]));
         } else {
           const double move_row = (c.has_plane ? c.centre_z : -kInf) + c.gradient.y * dy;
           for (int g = 0; g < kGroups; ++g)

@@ -159,6 +159,57 @@ TEST_CASE("the flat end's and the bull nose's vector forms agree with the scalar
   CHECK(covered[1] > 500 * detail::kLanes);
 }
 
+TEST_CASE("the other profiles' vector form agrees with the scalar one") {
+  // ProfileLanes (a closed form per line or arc piece, its tests squared) against
+  // MoveGeometry::lowest (convex_minimum): the cone (a kink on the axis), the chamfer (a kink
+  // between its flat tip and its cone), the tapered ball (an arc on the axis, then a line) and a
+  // polyline profile, on rising, falling, level, steep and nearly level moves; only wanted lanes.
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const std::array<Cutter, 4> cutters{Cutter::cone(1.7, 35), Cutter::chamfer(1.7, 0.6, 50),
+                                      Cutter::tapered_ball(1.7, 0.8, 12),
+                                      Cutter::from_profile({Vec2(0.4, 0), Vec2(0.9, 0.1), Vec2(1.4, 0.5), Vec2(1.7, 1.2)})};
+  std::array<int, 4> covered{};
+  std::array<int, 4> inside{};  // minimiser strictly inside the move
+  for (int trial = 0; trial < 8000; ++trial) {
+    const std::size_t kind = static_cast<std::size_t>(trial % 4);
+    const Cutter& cutter = cutters[kind];
+    REQUIRE(detail::ProfileLanes::closed_form(cutter));
+    Segment s{Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng))};
+    if (trial % 5 == 0) s.b.z = s.a.z;                                                  // level
+    if (trial % 7 == 0) s.b = s.a + Vec3(0.01 * u(rng), 0.01 * u(rng), 2 * u(rng));  // steep
+    if (trial % 11 == 0) s.b = s.a + Vec3(2 * u(rng), 2 * u(rng), 1e-4 * u(rng));    // nearly level
+    detail::MoveGeometry m(cutter, s);
+    if (m.vertical) continue;
+    detail::ProfileLanes lanes(m);
+    detail::DoubleN x{}, y{};
+    detail::MaskN wanted{};
+    for (int l = 0; l < detail::kLanes; ++l) x[l] = 3 * u(rng), y[l] = 3 * u(rng), wanted[l] = l % 5 == 4 ? 0 : -1;
+    const detail::DoubleN z = lanes.at(x - lanes.ax, y - lanes.ay, wanted);
+    for (int l = 0; l < detail::kLanes; ++l) {
+      CAPTURE(trial);
+      CAPTURE(l);
+      if (!wanted[l]) {
+        CHECK(z[l] > 1e300);
+        continue;
+      }
+      const detail::MoveGeometry::Lowest expected = m.lowest(x[l], y[l]);
+      if (!(expected.z < 1e300)) {
+        const double rim_gap = std::sqrt(distance2_point_segment(Vec2(x[l], y[l]), Vec2(s.a), Vec2(s.b))) - 1.7;
+        CHECK((z[l] > 1e300 || std::abs(rim_gap) < 1e-9));
+        continue;
+      }
+      ++covered[kind];
+      if (expected.t > 1e-9 && expected.t < 1 - 1e-9) ++inside[kind];
+      REQUIRE(z[l] == doctest::Approx(expected.z).epsilon(0).scale(1).epsilon(1e-9));
+    }
+  }
+  for (std::size_t kind = 0; kind < 4; ++kind) {
+    CHECK(covered[kind] > 400 * detail::kLanes);
+    CHECK(inside[kind] > 100 * detail::kLanes);
+  }
+}
+
 TEST_CASE("the bull nose's root: extreme slopes and corners, and each point's value its own") {
   // BullLanes finds the corner's contact reach by Halley's method with a guarded step, each lane
   // stopping on its own. Against the scalar bracketed Newton (MoveGeometry::lowest) at slopes
