@@ -62,6 +62,13 @@ inline MachineConfig at_origin(MachineConfig machine = {}) {
   return machine;
 }
 
+// The LinuxCNC dialect on such a machine.
+inline MachineConfig linuxcnc_at_origin() {
+  MachineConfig machine = at_origin();
+  machine.dialect = Dialect::linuxcnc;
+  return machine;
+}
+
 // Rotation by `degrees` about a unit axis (Rodrigues): a reference independent of the library's
 // rotation helpers.
 inline Mat3 about(const Vec3& k, double degrees) {

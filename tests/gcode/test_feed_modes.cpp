@@ -14,12 +14,6 @@ using namespace tridex::gcode::test;
 
 namespace {
 
-MachineConfig linuxcnc() {
-  MachineConfig machine = at_origin();
-  machine.dialect = Dialect::linuxcnc;
-  return machine;
-}
-
 // Minutes each source line takes at its moves' feeds (feed moves only).
 std::map<int, double> minutes_by_line(const std::vector<Move>& moves) {
   std::map<int, double> minutes;
@@ -39,7 +33,7 @@ double feed_on(const std::vector<Move>& moves, int line) {
 }  // namespace
 
 TEST_CASE("feed modes: G93 inverse time takes 1/F minutes per block, lines and arcs; G94 back") {
-  for (const MachineConfig& machine : {at_origin(), linuxcnc()}) {
+  for (const MachineConfig& machine : {at_origin(), linuxcnc_at_origin()}) {
     Result r = run_program("G21 G0 X0 Y0 Z0\n"
                            "G93 G1 X30 Y40 F2\n"          // 50 mm in 1/2 min: 100 mm/min
                            "G1 X0 Y40 F0.25\n"            // 30 mm in 4 min
@@ -72,7 +66,7 @@ TEST_CASE("feed modes: the path does not depend on the feed mode") {
       next = path.find('\n', at);
       text += (at == 0 ? "G1 " : "") + path.substr(at, next - at) + " F" + f + "\n";
     }
-    return run_program(text, {}, linuxcnc()).moves;
+    return run_program(text, {}, linuxcnc_at_origin()).moves;
   };
   std::vector<Move> per_minute = with("G94", "200"), inverse = with("G93", "3"), per_rev = with("G95", "0.2");
   REQUIRE(per_minute.size() == inverse.size());
@@ -85,7 +79,7 @@ TEST_CASE("feed modes: the path does not depend on the feed mode") {
 }
 
 TEST_CASE("feed modes: G95 feeds F per revolution at the spindle speed S, in program units") {
-  Result r = run_program("G0 X0 Y0 Z0\nG95 G1 X10 F0.1 S1200\nS600 X20\nG20 X1 F0.01\n", {}, linuxcnc());
+  Result r = run_program("G0 X0 Y0 Z0\nG95 G1 X10 F0.1 S1200\nS600 X20\nG20 X1 F0.01\n", {}, linuxcnc_at_origin());
   CHECK(feed_on(r.moves, 2) == doctest::Approx(120));
   CHECK(feed_on(r.moves, 3) == doctest::Approx(60));
   CHECK(feed_on(r.moves, 4) == doctest::Approx(0.01 * 25.4 * 600));
@@ -93,37 +87,37 @@ TEST_CASE("feed modes: G95 feeds F per revolution at the spindle speed S, in pro
 
 TEST_CASE("feed modes: G94 and G95 clear the feed rate under LinuxCNC; elsewhere a change of mode does") {
   // rs274: G94 sets the feed rate to 0 (interp_convert.cc convert_feed_mode), even when already in G94.
-  Diagnostic d = error_of("F100\nG94\nG1 X1\n", {}, linuxcnc());
+  Diagnostic d = error_of("F100\nG94\nG1 X1\n", {}, linuxcnc_at_origin());
   CHECK(d.line == 3);
   CHECK(d.message.find("no feed rate") != std::string::npos);
   CHECK_NOTHROW(run_program("F100\nG94\nG0 X0 Y0 Z0\nG1 X1\n", {}, at_origin()));
   d = error_of("G0 X0 Y0 Z0\nF100\nG93 G1 X1 F1\nG94\nG1 X2\n", {}, at_origin());
   CHECK(d.line == 5);
   // F on the G94 block itself counts (the mode is set first).
-  CHECK_NOTHROW(run_program("G0 X0 Y0 Z0\nG94 F100\nG1 X1\n", {}, linuxcnc()));
+  CHECK_NOTHROW(run_program("G0 X0 Y0 Z0\nG94 F100\nG1 X1\n", {}, linuxcnc_at_origin()));
 }
 
 TEST_CASE("feed modes: LinuxCNC's errors, with line and column") {
   // Every G1/G2/G3 block in G93 needs its own F (NCE_F_WORD_MISSING_WITH_INVERSE_TIME_*).
-  Diagnostic d = error_of("G0 X0 Y0 Z0\nG93 G1 X1 F2\nG1 X2\n", {}, linuxcnc());
+  Diagnostic d = error_of("G0 X0 Y0 Z0\nG93 G1 X1 F2\nG1 X2\n", {}, linuxcnc_at_origin());
   CHECK(d.line == 3);
   CHECK(d.column == 1);
   CHECK(d.message.find("F word missing with inverse time") != std::string::npos);
-  d = error_of("G0 X0 Y0 Z0\nG93 G1 X1 F2\n  G2 X3 I1 J0\n", {}, linuxcnc());
+  d = error_of("G0 X0 Y0 Z0\nG93 G1 X1 F2\n  G2 X3 I1 J0\n", {}, linuxcnc_at_origin());
   CHECK(d.line == 3);
   CHECK(d.column == 3);
   CHECK(d.message.find("F word missing with inverse time") != std::string::npos);
-  d = error_of("G0 X0 Y0 Z0\nG93 G1 X1 F0\n", {}, linuxcnc());
+  d = error_of("G0 X0 Y0 Z0\nG93 G1 X1 F0\n", {}, linuxcnc_at_origin());
   CHECK(d.column == 11);
   CHECK(d.message.find("F0") != std::string::npos);
-  d = error_of("G0 X0 Y0 Z5\nG93 G81 X1 Z-1 R1 F2\n", {}, linuxcnc());
+  d = error_of("G0 X0 Y0 Z5\nG93 G81 X1 Z-1 R1 F2\n", {}, linuxcnc_at_origin());
   CHECK(d.message.find("canned cycles cannot run in inverse time") != std::string::npos);
-  d = error_of("G0 X0 Y0 Z0\nG95 G1 X1 F0.1\n", {}, linuxcnc());
+  d = error_of("G0 X0 Y0 Z0\nG95 G1 X1 F0.1\n", {}, linuxcnc_at_origin());
   CHECK(d.message.find("zero spindle speed") != std::string::npos);
-  d = error_of("G0 X0 Y0 Z0\nS100 G95 F0.1\nG38.2 X1\n", {}, linuxcnc());
+  d = error_of("G0 X0 Y0 Z0\nS100 G95 F0.1\nG38.2 X1\n", {}, linuxcnc_at_origin());
   CHECK(d.message.find("feed per revolution") != std::string::npos);
   // A G0 in G93 needs no F; G93 alone is no move.
-  CHECK_NOTHROW(run_program("G93\nG0 X0 Y0 Z0\nG0 X5\n", {}, linuxcnc()));
+  CHECK_NOTHROW(run_program("G93\nG0 X0 Y0 Z0\nG0 X5\n", {}, linuxcnc_at_origin()));
 }
 
 TEST_CASE("feed modes: Fanuc's #4005 and #4109 read the mode and F of the block before") {
