@@ -9,7 +9,6 @@ using namespace tridex;
 using namespace tridex::gcode;
 using namespace tridex::gcode::test;
 
-
 TEST_CASE("U/V/W: plain axes under LinuxCNC, the tool path as without them, one warning") {
   const std::string with = "G0 X1 Y2 Z3 W5\nG1 W100 F200\nG0 W0\nG1 X4 U1 V2 F100\nG2 X6 I1 J0 W3\n";
   const std::string without = "G0 X1 Y2 Z3\nG1 F200\nG0\nG1 X4 F100\nG2 X6 I1 J0\n";
