@@ -488,7 +488,7 @@ Flow Interpreter::State::macro_call(int column) {
 // position reads X Y Z; G92.1 clears it, G92.2 suspends it, G92.3 restores it. LinuxCNC keeps G52
 // and G92 in one register; Fanuc's G52 and G92 change the same program origin.
 void Interpreter::State::local_offsets(int code, int column) {
-  if (tilted) error(column, code_name('G', code) + " under a tilted plane (cancel it first)");
+  const Vec3 before = local_offset;
   if (code == 921 || code == 922) {
     saved_local_offset = code == 922 ? local_offset : Vec3(0.0);
     local_offset = Vec3(0.0);
@@ -516,6 +516,10 @@ void Interpreter::State::local_offsets(int code, int column) {
     if (!any) error(column, code_name('G', code) + " needs X, Y or Z");
     saved_local_offset = local_offset;
   }
+  // Under a tilted plane only a code that leaves the offset as it is (LinuxCNC's tilted-plane
+  // demos clear G52 to zero in a subroutine) is read: a shift there has no agreed meaning.
+  if (tilted && local_offset != before)
+    error(column, code_name('G', code) + " changes the local offset under a tilted plane (cancel it first)");
   update_frame();
 }
 

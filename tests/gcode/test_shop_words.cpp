@@ -133,3 +133,13 @@ TEST_CASE("six-digit variables (#901001 in pallet programs); machine presets for
   CHECK(r.moves[1].feed == 2000);
   CHECK(near(r.moves[1].end, Vec3(4, 0, 1)));
 }
+
+TEST_CASE("G52 under a tilted plane: read when it leaves the offset as it is (LinuxCNC's TWP demo)") {
+  const std::string tilt = "G21 G90\nT1 M6\nG68.2 X50 Y50 Z-50 I0 J30 K0\nG53.1\nG0 X0 Y0 Z100\nG0 X-50\n";
+  Result cleared = run_program(tilt + "G52 X0 Y0 Z0\nG0 X0\nG69\nM30\n", {}, at_origin());
+  Result plain = run_program(tilt + "G0 X0\nG69\nM30\n", {}, at_origin());
+  same_moves(cleared, plain);
+  Diagnostic d = error_of(tilt + "G52 X5\n", {}, at_origin());
+  CHECK(d.line == 7);
+  CHECK(d.message.find("G52 changes the local offset under a tilted plane") != std::string::npos);
+}
