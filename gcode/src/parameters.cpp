@@ -98,6 +98,16 @@ std::optional<Value> Interpreter::State::named(std::string_view name) {
     if (key == "_coord_system") return number(work_key >= 100 ? 0 : 530 + 10 * work_key);
     if (key == "_call_level") return number(static_cast<double>(scopes.size() - 1));
     if (key == "_line") return number(line);
+    if (key == "_ccomp") return number(comp_side == 0 ? 400 : comp_side > 0 ? 410 : 420);
+    if (key == "_spindle_on") return number(spindle_direction != 0 ? 1 : 0);
+    if (key == "_spindle_cw") return number(spindle_direction > 0 ? 1 : 0);
+    if (key == "_ijk_absolute_mode") return number(arc_absolute ? 1 : 0);
+    // As LinuxCNC 2.9's interpreter run outside its task (a preview, rs274 standalone) reads
+    // them: no remap under way, overrides at 100 %, a mill.
+    if (key == "_task" || key == "_remap_level" || key == "_lathe_diameter_mode") return number(0);
+    if (key == "_speed_override" || key == "_feed_override") return number(1);
+    if (key == "_vmajor") return number(2.9);
+    if (key == "_vminor") return number(0);
     auto it = named_globals.find(key);
     if (it == named_globals.end()) return std::nullopt;
     return it->second;
