@@ -293,7 +293,7 @@ struct Interpreter::State : ParameterReader {
             coordinates |= other.letter == 'X' || other.letter == 'Y' || other.letter == 'Z';
           std::string name = integral ? code_name(word.letter, code)
                                       : std::string(1, word.letter) + format_number(word.value);
-          if (word.letter == 'G' && code >= 382 && code <= 385)  // never skipped: it moves
+          if (word.letter == 'G' && ((code >= 382 && code <= 385) || code == 310))  // never skipped: it moves
             error(word.column, name + " (probing) is not simulated: where the probe touches, and so "
                                       "where the tool goes next, is known only on the machine; "
                                       "leave the probing cycle out of the program tridex reads (or, "

@@ -164,10 +164,10 @@ TEST_CASE("lenient mode runs G41/G42 like strict mode; #4007 reads the mode") {
   CHECK(at_41);
 }
 
-TEST_CASE("probing (G38.x) is an error that names it, even lenient") {
+TEST_CASE("probing (G38.x, Fanuc's G31 skip) is an error that names it, even lenient") {
   InterpreterOptions lenient;
   lenient.lenient = true;
-  for (const char* code : {"G38.2", "G38.3", "G38.4", "G38.5"}) {
+  for (const char* code : {"G38.2", "G38.3", "G38.4", "G38.5", "G31"}) {
     Diagnostic d = error_of(std::string("G0 X0 Y0 Z0\n") + code + " Z-10 F100\nM2\n", lenient, at_origin());
     CHECK(d.line == 2);
     CHECK_MESSAGE(d.message.find(std::string(code) + " (probing) is not simulated") != std::string::npos, d.message);
