@@ -73,7 +73,7 @@ inline int g_group(int code) {
     case 970: return kSpindleMode;
     case 150: return kPolar;
     case 610: case 640: return kPath;
-    case 682: case 683: case 684: case 690: case 2680: case 2690: return kTilt;
+    case 680: case 682: case 683: case 684: case 690: case 2680: case 2690: return kTilt;
     case 531: case 533: case 536: case 2530: return kOrient;
     case 51: case 80: case 1030: case 1870: return kSmoothing;  // Fanuc G5.1 Q / G8 P, Haas G103 P, G187 P E
     case 2540: case 2550: return kDynamicOffset;     // Haas DWO

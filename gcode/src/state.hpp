@@ -246,6 +246,7 @@ struct Interpreter::State : ParameterReader {
     if (machine.dialect == Dialect::linuxcnc && (code == 52 || code == 53))
       return code == 52 ? kMotion : kNonModal;
     if (code >= 382 && code <= 385 && machine.dialect == Dialect::linuxcnc) return kMotion;
+    if (code == 680 && machine.dialect == Dialect::linuxcnc) return -1;  // no G68 in LinuxCNC
     return g_group(code);
   }
 

@@ -175,7 +175,24 @@ void Interpreter::State::tilted_plane(int code) {
   int column = w.find_g(code);
   if (incremental) error(column, code_name('G', code) + " under G91 is not supported; use G90");
   Frame feature;
-  if (code == 683) {
+  if (code == 680) {
+    // Fanuc's coordinate rotation G68 X Y R (G17; Fanuc 0i-MF operator's manual, "Coordinate
+    // system rotation"): the program's points turn by R degrees, counter-clockwise, about the
+    // centre X Y (where either is left out, the current point's): p = C + Rz(R)·(p' − C).
+    if (tilted) error(column, "G68 while a rotation or tilted plane is active (G69 first)");
+    if (plane != 170) error(column, "G68 (coordinate rotation) is read in the XY plane (G17) only");
+    if (w.has('Z')) error(w.col('Z'), "G68 Z: the rotation in G17 is about an axis along Z through X Y");
+    if (!w.has('R')) error(column, "G68 needs R (the angle of rotation, degrees)");
+    if ((!w.has('X') || !w.has('Y')) && far)
+      error(column, "G68 without X and Y turns about the current point, but the tool is retracted "
+                    "far along its axis: give X and Y");
+    Vec3 centre = far ? Vec3(0.0) : to_program(pos);
+    if (w.has('X')) centre.x = length('X');
+    if (w.has('Y')) centre.y = length('Y');
+    centre.z = 0;
+    const Mat3 turn = rotation_z(w.take('R'));
+    feature = Frame{turn, centre - turn * centre + work_offset + local_offset};
+  } else if (code == 683) {
     // G68.3 X Y Z R (Fanuc B-79976E): Z along the tool; the origin is X Y Z, all three or none
     // (none: the tool tip where it stands).
     int given = int(w.has('X')) + int(w.has('Y')) + int(w.has('Z'));

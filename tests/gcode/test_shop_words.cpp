@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "helpers.hpp"
 
@@ -142,4 +143,44 @@ TEST_CASE("G52 under a tilted plane: read when it leaves the offset as it is (Li
   Diagnostic d = error_of(tilt + "G52 X5\n", {}, at_origin());
   CHECK(d.line == 7);
   CHECK(d.message.find("G52 changes the local offset under a tilted plane") != std::string::npos);
+}
+
+TEST_CASE("Fanuc G68 X Y R turns the program's XY about a centre; G69 ends it") {
+  // A slot, an arc and a drilled hole, written once under G68 and once with every point turned
+  // by hand about the centre (the arc's centre offsets turned as vectors).
+  const double cx = 10, cy = 5, degrees = 30;
+  const double c = std::cos(degrees * std::acos(-1.0) / 180), s = std::sin(degrees * std::acos(-1.0) / 180);
+  auto exact = [](double v) {
+    char text[40];
+    std::snprintf(text, sizeof text, "%.10f", v);
+    return std::string(text);
+  };
+  auto turned = [&](double x, double y) {
+    return cat(" X", exact(cx + c * (x - cx) - s * (y - cy)), " Y", exact(cy + s * (x - cx) + c * (y - cy)));
+  };
+  auto turned_offset = [&](double i, double j) { return cat(" I", exact(c * i - s * j), " J", exact(s * i + c * j)); };
+  const std::string head = "G21 G90 G17\nT1 M6\nG0 X0 Y0 Z5\n";
+  const std::string tail = "G69\nG0 X0 Y0\nM30\n";
+  Result rotated = run_program(head + "G68 X10 Y5 R30\nG0 X20 Y5\nG1 Z-1 F100\nX30 Y8\n"
+                                      "G3 X30 Y18 I0 J5\nG81 X25 Y0 Z-3 R2\nG80\n" + tail,
+                               {}, at_origin());
+  Result by_hand = run_program(head + "G0" + turned(20, 5) + "\nG1 Z-1 F100\nG1" + turned(30, 8) + "\nG3" +
+                                   turned(30, 18) + turned_offset(0, 5) + "\nG81" + turned(25, 0) +
+                                   " Z-3 R2\nG80\n" + tail,
+                               {}, at_origin());
+  REQUIRE(rotated.moves.size() == by_hand.moves.size());
+  for (std::size_t i = 0; i < rotated.moves.size(); ++i) {
+    CAPTURE(i);
+    CHECK(near(rotated.moves[i].end, by_hand.moves[i].end, 1e-6));
+    CHECK(near(rotated.moves[i].axis, Vec3(0, 0, 1)));
+  }
+  // Without X Y the centre is the current point; errors at their word.
+  Result here = run_program("G21 G90\nG0 X10 Y5 Z5\nG68 R90\nG0 X11 Y5\nG69\nM30\n", {}, at_origin());
+  REQUIRE(!here.moves.empty());
+  CHECK(near(here.moves.back().end, Vec3(10, 6, 5), 1e-9));
+  CHECK(error_of("G21 G90\nG0 X0 Y0 Z5\nG68 X1 Y1\n", {}, at_origin()).message.find("G68 needs R") != std::string::npos);
+  CHECK(error_of("G21 G90\nG18\nG68 X1 Y1 R5\n", {}, at_origin()).message.find("G17") != std::string::npos);
+  CHECK(error_of("G21 G90\nG68 X1 Y1 R5\nG68 X0 Y0 R5\n", {}, at_origin()).message.find("G69 first") != std::string::npos);
+  // LinuxCNC has no G68.
+  CHECK(error_of("G21 G90\nG68 X1 Y1 R5\n", {}, linuxcnc_at_origin()).message.find("G68") != std::string::npos);
 }
