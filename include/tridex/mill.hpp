@@ -45,6 +45,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <atomic>
 #include <cmath>
 #include <cstddef>
@@ -145,6 +146,18 @@ inline bool all_n(MaskN m) {
   return _mm_movemask_pd(reinterpret_cast<__m128d>(m)) == (1 << kLanes) - 1;
 #else
   return (m[0] & m[1]) != 0;
+#endif
+}
+// Bit l set where lane l of m is set.
+inline std::uint32_t lane_bits(MaskN m) {
+#if defined(__AVX512F__)
+  return _mm512_test_epi64_mask(reinterpret_cast<__m512i>(m), reinterpret_cast<__m512i>(m));
+#elif defined(__AVX__)
+  return static_cast<std::uint32_t>(_mm256_movemask_pd(reinterpret_cast<__m256d>(m)));
+#elif defined(__SSE2__)
+  return static_cast<std::uint32_t>(_mm_movemask_pd(reinterpret_cast<__m128d>(m)));
+#else
+  return (m[0] != 0 ? 1u : 0u) | (m[1] != 0 ? 2u : 0u);
 #endif
 }
 inline double max_lane(DoubleN a) {
@@ -967,12 +980,13 @@ class Miller {
     double distance;
   };
 
-  // A move of another cutter left out of pass 1 over one tile (its lowest tip is not below the
-  // lowest centre height found there so far).
+  // A move of another cutter left out of pass 1 over some tiles of the row (its lowest tip is not
+  // below the lowest centre height found there so far): bit `col` of `tiles` for each.
   struct DeferredMove {
     std::uint32_t move;
-    int col;
+    std::uint32_t tiles;
   };
+  static_assert(kBinTiles <= 32);
 
   // How a move's swept surface is evaluated on a tile's points: kLanes at a time by the ball
   // end's, the flat end's, the bull nose's or the other profiles' vector form, or one point at a
@@ -1214,17 +1228,27 @@ class Miller {
       int col0, col1;
       if (!columns(row, scratch.boxes[k], col0, col1)) continue;
       const MoveGeometry& m = scratch.moves[k];
+      // Which tiles the move can reach below their top, and which of those it is deferred on,
+      // kLanes tiles at a time (a move spans most of a row: one test per tile cost more than
+      // the bounds, on bench_mill's bull nose raster). Each tile's test reads only its own first
+      // cut, so testing them together before any is updated changes nothing.
+      std::uint32_t bounded = 0, deferred = 0;
+      const DoubleN tip = splat(m.lowest_tip());
+      for (int lane0 = col0 / kLanes * kLanes; lane0 <= col1; lane0 += kLanes) {
+        const DoubleN col = lane_index() + lane0;
+        const MaskN below = (col >= col0) & (col <= col1) & (tip < load_n(&lanes.top[lane0]));
+        const MaskN defer = below & (load_n(&lanes.first_covers[lane0]) != 0) & (tip >= load_n(&lanes.first_z[lane0]));
+        bounded |= lane_bits(below & ~defer) << lane0;
+        deferred |= lane_bits(defer) << lane0;
+      }
+      if (deferred != 0) scratch.deferred.push_back({k, deferred});
       // A flat end's and a bull nose's bounds are found kLanes tiles at a time (as the ball
       // end's), the others' one tile at a time.
       MoveBounds bounds;
-      for (int col = col0; col <= col1; ++col) {
+      for (; bounded != 0; bounded &= bounded - 1) {
+        const int col = std::countr_zero(bounded);
         Tile& tile = row.tiles[static_cast<std::size_t>(col)];
-        if (m.lowest_tip() >= tile.state.top) continue;
         const bool first_covers = lanes.first_covers[col] != 0;
-        if (first_covers && m.lowest_tip() >= lanes.first_z[col]) {
-          scratch.deferred.push_back({k, col});
-          continue;
-        }
         Candidate c = bounds.at(scratch, row, k, col);
         if (c.bound >= tile.state.top) continue;
         tile.candidates.push_back(c);
@@ -1283,14 +1307,21 @@ class Miller {
       std::erase_if(tile.candidates,
                     [&](const Candidate& c) { return (has_first && c.move == first) || !can_cut(c, tile); });
     }
-    // A move's deferred tiles are consecutive: bounds are found kLanes tiles at a time.
+    // A deferred move is bounded only over the tiles whose first cut left their top above its
+    // lowest tip (most are not, the upper levels of a Z-level roughing, for instance), kLanes
+    // tiles at a time.
     MoveBounds bounds;
     for (const DeferredMove& d : scratch.deferred) {
-      Tile& tile = row.tiles[static_cast<std::size_t>(d.col)];
-      const MoveGeometry& m = scratch.moves[d.move];
-      if (m.lowest_tip() >= tile.state.top || static_cast<double>(d.move) == lanes.first[d.col]) continue;
-      const Candidate c = bounds.at(scratch, row, d.move, d.col);
-      if (can_cut(c, tile)) tile.candidates.push_back(c);
+      const DoubleN tip = splat(scratch.moves[d.move].lowest_tip()), move = splat(static_cast<double>(d.move));
+      std::uint32_t tiles = 0;
+      for (int lane0 = 0; lane0 < row.count; lane0 += kLanes)
+        tiles |= lane_bits((tip < load_n(&lanes.top[lane0])) & (load_n(&lanes.first[lane0]) != move)) << lane0;
+      for (tiles &= d.tiles; tiles != 0; tiles &= tiles - 1) {
+        const int col = std::countr_zero(tiles);
+        Tile& tile = row.tiles[static_cast<std::size_t>(col)];
+        const Candidate c = bounds.at(scratch, row, d.move, col);
+        if (can_cut(c, tile)) tile.candidates.push_back(c);
+      }
     }
     for (const BallBounds& b : scratch.ball_bounds) keep_other_cuts(row, b);
     double row_top = -kInf;
