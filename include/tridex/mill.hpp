@@ -31,8 +31,8 @@
 // Ball end moves are bounded kLanes tiles at a time and evaluated kLanes points at a time, with
 // one square root per point (BallLanes); flat end and bull nose moves are bounded and evaluated
 // kLanes at a time too (FlatLanes: a closed form; BullLanes: the still cutter where the minimum is
-// at an end of the move, else Halley steps with no square root), and the other cutters' moves
-// are evaluated kLanes at a time (ProfileLanes: a closed form per profile piece). The moves
+// at an end of the move, else Halley steps with no square root), and so are the other cutters'
+// moves (ProfileLanes: a closed form per profile piece). The moves
 // left for a tile in pass 2 are cut lowest bound first, a run of one cutter at a time, each run
 // checked against what the tile holds by then: so a tile first cut by any cutter, or roughed
 // deeper by another cutter, still rejects the moves that cut air. Runs of flat end and bull nose
@@ -849,12 +849,57 @@ struct ProfileLanes : RisingMove {
     return k2 >= m2 ? on_axis | sloped : ~on_axis & sloped;
   }
 
+  // h' at distance d (d ≤ R): the piece holding d, as Cutter::lower_slope.
+  DoubleN slope(DoubleN d) const {
+    DoubleN k = splat(0);
+    for (const ProfilePiece& piece : cutter->pieces()) {
+      const MaskN on = d >= piece.d0;
+      if (!any_n(on)) break;
+      const DoubleN z = piece.is_arc ? d / sqrt_n(max_n(piece.radius * piece.radius - d * d, splat(0)))
+                                     : splat(piece.slope);
+      k = on ? z : k;
+    }
+    return k;
+  }
+
   // S at the points where `wanted` (+infinity elsewhere and where the cutter does not pass).
   DoubleN at(DoubleN ux, DoubleN uy, MaskN wanted) const {
+    DoubleN t, d;
+    const MaskN covered = lowest(ux, uy, wanted, t, d);
+    return covered ? low + t * w + height(d) : splat(kInf);
+  }
+
+  // S and its supporting plane's slope at the points (MoveGeometry::supporting_plane): h'(d)/d
+  // times q − C(t*). No plane where the cutter does not pass, where q is within 1e-7·R² (in d²)
+  // of the rim, or where d is within 1e-8·R of a kink of the profile (MoveGeometry::near_kink:
+  // a joint of two pieces, or the axis of a profile that starts sloped).
+  using Plane = FlatLanes::Plane;
+  Plane plane_at(DoubleN ux, DoubleN uy) const {
+    MaskN all{};
+    all = all == 0;
+    DoubleN t, d;
+    const MaskN covered = lowest(ux, uy, all, t, d);
+    const DoubleN px = ux - t * vx, py = uy - t * vy, d2 = px * px + py * py;
+    const double tolerance = 1e-8 * radius;
+    MaskN kink = d <= tolerance;
+    if (cutter->pieces().front().derivative(0) == 0) kink = MaskN{};
+    for (std::size_t k = 1; k < cutter->pieces().size(); ++k) kink |= abs_n(d - cutter->pieces()[k].d0) <= tolerance;
+    Plane p;
+    p.z = covered ? low + t * w + height(d) : splat(kInf);
+    p.has_plane = covered & (d2 < r2 * (1 - 1e-7)) & ~kink;
+    const DoubleN factor = p.has_plane & (d > 0) ? slope(d) / d : splat(0);
+    p.gx = factor * px, p.gy = factor * py;
+    return p;
+  }
+
+  // Where S is reached, t* and d(t*) (at most R), at the points where `wanted`; the mask of
+  // those the cutter passes over.
+  MaskN lowest(DoubleN ux, DoubleN uy, MaskN wanted, DoubleN& t, DoubleN& d) const {
     const Cover c = cover(ux, uy);
     const MaskN covered = c.covered & wanted;
-    if (!any_n(covered)) return splat(kInf);
-    DoubleN t = min_n(max_n(c.t_foot, c.lo), c.hi);  // a level move: where the axis comes closest
+    t = d = splat(0);
+    if (!any_n(covered)) return covered;
+    t = min_n(max_n(c.t_foot, c.lo), c.hi);  // a level move: where the axis comes closest
     if (w > 0) {
       DoubleN root2 = splat(r2);  // φ < m up to the rim: the minimiser leaves the footprint
       MaskN found = ~covered;
@@ -872,8 +917,9 @@ struct ProfileLanes : RisingMove {
       }
       t = min_n(max_n(c.t_foot - sqrt_n(max_n(root2 - c.e2, splat(0))) * inv_len, c.lo), c.hi);
     }
-    const DoubleN s = t - c.t_foot, d = min_n(sqrt_n(c.e2 + s * s * vv), splat(radius));
-    return covered ? low + t * w + height(d) : splat(kInf);
+    const DoubleN s = t - c.t_foot;
+    d = min_n(sqrt_n(c.e2 + s * s * vv), splat(radius));
+    return covered;
   }
 };
 
@@ -1391,9 +1437,9 @@ class Miller {
     }
   }
 
-  // bound_at_centre for a flat end's or a bull nose's move, from FlatLanes::plane_at or
-  // BullLanes::plane_at at the centres of kLanes tiles of a row at once (`at` computes them for
-  // the tiles around column col when needed).
+  // bound_at_centre for a flat end's, a bull nose's or a profile's move, from the plane_at of
+  // FlatLanes, BullLanes or ProfileLanes at the centres of kLanes tiles of a row at once (`at`
+  // computes them for the tiles around column col when needed).
   template <class Lanes>
   struct LaneBounds {
     FlatLanes::Plane plane;
@@ -1419,12 +1465,14 @@ class Miller {
   struct MoveBounds {
     LaneBounds<FlatLanes> flat;
     LaneBounds<BullLanes> bull;
+    LaneBounds<ProfileLanes> profile;
 
     Candidate at(const BlockScratch& scratch, const TileRow& row, std::uint32_t k, int col) {
       const MoveGeometry& m = scratch.moves[k];
       switch (scratch.kind[k]) {
         case LaneKind::flat: return flat.at(scratch.flats[k], m, row, k, col);
         case LaneKind::bull_nose: return bull.at(scratch.bulls[k], m, row, k, col);
+        case LaneKind::profile: return profile.at(scratch.profiles[k], m, row, k, col);
         default: return bound_at_centre(m, row.tiles[static_cast<std::size_t>(col)], k);
       }
     }
