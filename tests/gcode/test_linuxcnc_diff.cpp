@@ -200,6 +200,10 @@ std::vector<Point> run_tridex(const fs::path& program, const std::map<int, doubl
     in_arc = false;
   };
   interpreter.run(in, program.string(), [&](const Move& m) {
+    // A move that leaves the tip where it is (`G0 Z#1` back to where it is, after a tool change
+    // that moved the tip to the new tool's length) is dropped, as rs274's to where it is: the
+    // tip's last point before it belongs to the previous tool (tcdemo.ngc's `T3 M6`).
+    if (m.start == m.end) return;
     if (chords) {
       push(points, Point{m.end, 0, m.line, m.kind == MoveKind::arc});
       return;
@@ -233,6 +237,12 @@ std::vector<fs::path> corpus() {
                            "daisy.ngc", "flowsnake.ngc", "hole-circle.ngc", "lathe_pawn.ngc",
                            "plasmatest.ngc", "polar.ngc", "spiral.ngc", "tort.ngc"})
     files.push_back(fs::path("/usr/share/linuxcnc/ncfiles") / name);
+  // Text engraved with G5.1 splines, two tools of different lengths changed between rapids. It
+  // is one of linuxcnc-uspace's documentation examples, which an image that leaves out
+  // /usr/share/doc does not have.
+  const fs::path tcdemo = "/usr/share/doc/linuxcnc/examples/sample-configs/sim/axis/remap/"
+                          "manual-toolchange-with-tool-length-switch/nc_files/tcdemo.ngc";
+  if (fs::exists(tcdemo)) files.push_back(tcdemo);
   return files;
 }
 
