@@ -563,6 +563,28 @@ class LineLexer : public Parser {
       finish();
       return true;
     }
+    // External output (Fanuc 0i-MF operator's manual, "External output commands"; Haas the same
+    // on its serial port or a file): POPEN, DPRNT[...] or BPRNT[...], PCLOS. It sends text and
+    // values to a device and moves nothing, so it is read and does nothing. DPRNT's text (letters,
+    // digits, '*' for a space, #n[ab] for a value of a integer and b decimal digits) is not an
+    // expression: only its brackets are checked.
+    if (keyword("POPEN") || keyword("PCLOS")) {
+      finish();
+      return true;
+    }
+    if (keyword("DPRNT") || keyword("BPRNT")) {
+      spaces();
+      if (i_ == n_ || text_[i_] != '[') fail(i_, "DPRNT and BPRNT need their text in [ ]");
+      const std::size_t open = i_;
+      int depth = 0;
+      do {
+        depth += text_[i_] == '[' ? 1 : text_[i_] == ']' ? -1 : 0;
+        ++i_;
+      } while (i_ < n_ && depth > 0);
+      if (depth > 0) fail(open, "'[' of the output text is not closed on this line");
+      finish();
+      return true;
+    }
     return false;
   }
 

@@ -184,3 +184,22 @@ TEST_CASE("Fanuc G68 X Y R turns the program's XY about a centre; G69 ends it") 
   // LinuxCNC has no G68.
   CHECK(error_of("G21 G90\nG68 X1 Y1 R5\n", {}, linuxcnc_at_origin()).message.find("G68") != std::string::npos);
 }
+
+TEST_CASE("Fanuc/Haas external output (POPEN, DPRNT, BPRNT, PCLOS) moves nothing") {
+  // A probing report as Haas and Fanuc programs write it: the same moves as without it.
+  const std::string moves = "G0 X10 Y10 Z5\nG1 Z-1 F100\nX20\n";
+  Result with = run_program("G21 G90 G17\nPOPEN\n" + moves +
+                                "DPRNT[MEASURED*X#5021[44]*Y#5022[44]]\nN20 BPRNT[TOOL#4120[20]]\n"
+                                "dprnt [**LINE*2*]  (spaces and a comment after)\nPCLOS\nM30\n",
+                            {}, at_origin());
+  Result without = run_program("G21 G90 G17\n" + moves + "M30\n", {}, at_origin());
+  same_moves(with, without);
+  CHECK(with.warnings.empty());
+  // Errors at the statement: no text, brackets not closed, words after it.
+  CHECK(error_of("DPRNT X1\n").message.find("DPRNT and BPRNT need their text in [ ]") != std::string::npos);
+  const Diagnostic open = error_of("G21\nDPRNT[X#5021[44]\n");
+  CHECK(open.line == 2);
+  CHECK(open.column == 6);
+  CHECK(open.message.find("not closed") != std::string::npos);
+  CHECK(error_of("POPEN G1 X1\n").message.find("after the statement") != std::string::npos);
+}
