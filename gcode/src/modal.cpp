@@ -129,6 +129,36 @@ void Interpreter::State::tool_table_entry(long long l, int column) {
   set_lengths[number] = gauge - system - length('Z');
 }
 
+// Fanuc's and Haas's G10 L10 / L11 P<offset> R<value> (Fanuc 0i-MF operator's manual, "Tool
+// compensation values input by program", memory C; Haas's G10): the tool length geometry (L10)
+// or wear (L11) of H offset P, set to R under G90 and changed by R under G91. G43 H reads geometry
+// plus wear; a geometry never set is the machine's length of tool P. Their cutter radius offsets
+// (L12, L13) hold a radius on Fanuc and a diameter on Haas (its setting 40): they are read, and a
+// G41/G42 that uses one is refused rather than guessed (comp.cpp; tool setting and probing
+// programs write them and never compensate).
+void Interpreter::State::tool_length_entry(long long l, int column) {
+  if (l == 12 || l == 13) {
+    if (!w.has('P')) error(column, "G10 L" + std::to_string(l) + " needs P (the cutter radius offset number)");
+    if (!w.has('R')) error(column, "G10 L" + std::to_string(l) + " needs R (the offset's value)");
+    d_set_at[static_cast<int>(integer('P', "G10 P (a cutter radius offset number)", 0, 99'999'999))] = line;
+    w.take('R');
+    return;
+  }
+  const std::string name = "G10 L" + std::to_string(l);
+  if (!w.has('P')) error(column, name + " needs P (the tool length offset number)");
+  if (!w.has('R')) error(column, name + " needs R (the offset's value)");
+  int number = static_cast<int>(integer('P', (name + " P (a tool length offset number)").c_str(), 0, 99'999'999));
+  for (char c : {'X', 'Y', 'Z', 'A', 'B', 'C'})
+    if (w.has(c)) error(w.col(c), name + " " + c + ": a tool length offset takes R only");
+  double value = length('R');
+  if (l == 10) {
+    set_lengths[number] = (incremental ? length_geometry(number).value_or(0) : 0) + value;
+  } else {
+    double& wear = length_wear[number];
+    wear = (incremental ? wear : 0) + value;
+  }
+}
+
 Flow Interpreter::State::execute(const Block& block) {
   gather(block);
   if (plane_blocks.code && !w.find_g(plane_blocks.code))  // a G68.2 P2/P3 plane is under way
@@ -271,13 +301,16 @@ Flow Interpreter::State::execute(const Block& block) {
     axis_consumer = true;
     int column = w.find_g(100);
     bool linuxcnc_tools = machine.dialect == Dialect::linuxcnc;
-    if (!w.has('L')) error(column, linuxcnc_tools ? "G10 needs L1, L2, L10, L11 or L20" : "G10 needs L2 or L20");
+    if (!w.has('L'))
+      error(column, linuxcnc_tools ? "G10 needs L1, L2, L10, L11 or L20" : "G10 needs L2, L10-L13 or L20");
     long long l = integer('L', "G10 L", 0, 99);
     if (linuxcnc_tools && (l == 1 || l == 10 || l == 11)) {
       tool_table_entry(l, column);
+    } else if (!linuxcnc_tools && l >= 10 && l <= 13) {
+      tool_length_entry(l, column);
     } else if (l != 2 && l != 20) {
       unsupported(column, "G10 L" + std::to_string(l) + " is not supported (only L2 and L20" +
-                              (linuxcnc_tools ? ", and L1, L10, L11" : "; L1, L10, L11 under --machine linuxcnc") + ")",
+                              (linuxcnc_tools ? ", and L1, L10, L11" : ", and L10-L13 for tool offsets") + ")",
                   "G10 L");
     } else {
       if (!w.has('P')) error(column, "G10 L" + std::to_string(l) + " needs P");

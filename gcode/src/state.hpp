@@ -93,16 +93,24 @@ struct Interpreter::State : ParameterReader {
     return it == machine.tool_lengths.end() ? 0.0 : it->second;
   }
   Vec3 length_shift() const { return (length_offset - loaded_length()) * axis; }
-  // The control's tool table as LinuxCNC's G10 L1/L10/L11 rewrite it (modal.cpp): the lengths
-  // G43 H reads (mm). The tool itself keeps the machine's length (loaded_length): a program that
-  // sets a wrong length moves the tip as the real machine would.
-  std::map<int, double> set_lengths;
-  std::optional<double> table_length(int number) const {
+  // The control's tool table as LinuxCNC's G10 L1/L10/L11 or Fanuc's G10 L10/L11 rewrite it
+  // (modal.cpp): the lengths G43 H reads (mm), geometry plus Fanuc's wear. The tool itself keeps
+  // the machine's length (loaded_length): a program that sets a wrong length moves the tip as the
+  // real machine would.
+  std::map<int, double> set_lengths, length_wear;
+  std::optional<double> length_geometry(int number) const {
     if (auto it = set_lengths.find(number); it != set_lengths.end()) return it->second;
     if (auto it = machine.tool_lengths.find(number); it != machine.tool_lengths.end()) return it->second;
     return std::nullopt;
   }
-  void tool_table_entry(long long l, int column);  // G10 L1, L10, L11 (modal.cpp)
+  std::optional<double> table_length(int number) const {
+    std::optional<double> geometry = length_geometry(number);
+    auto wear = length_wear.find(number);
+    if (geometry && wear != length_wear.end()) return *geometry + wear->second;
+    return geometry;
+  }
+  void tool_table_entry(long long l, int column);   // LinuxCNC's G10 L1, L10, L11 (modal.cpp)
+  void tool_length_entry(long long l, int column);  // Fanuc's G10 L10-L13 (modal.cpp)
   // A machine position names the gauge point (G53, G28/G30, the tool-change position, with the
   // tool along +Z): the tip lies the loaded tool's length below it.
   Vec3 tip_below(const Vec3& gauge) const { return gauge - Vec3(0, 0, loaded_length()); }
@@ -453,6 +461,7 @@ struct Interpreter::State : ParameterReader {
   int comp_side = 0;
   double comp_radius = 0;              // mm, ≥ 0
   int offset_d = -1;                   // Fanuc: the last D word, modal (#4107); -1: none yet
+  std::map<int, int> d_set_at;         // Fanuc: D offsets a G10 L12/L13 wrote, and its line
   bool comp_first = true;              // the next compensated move is the entry move
   bool comp_arc_forbidden = false;     // just after G40: the next move must be straight
   bool comp_programmed_current = false;  // coordinates count from comp_programmed, not the tip

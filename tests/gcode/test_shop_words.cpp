@@ -203,3 +203,38 @@ TEST_CASE("Fanuc/Haas external output (POPEN, DPRNT, BPRNT, PCLOS) moves nothing
   CHECK(open.message.find("not closed") != std::string::npos);
   CHECK(error_of("POPEN G1 X1\n").message.find("after the statement") != std::string::npos);
 }
+
+TEST_CASE("Fanuc/Haas G10 L10/L11 set H's length geometry and wear (G91: by R); L12/L13 refused at their G41") {
+  MachineConfig machine = at_origin();
+  machine.tool_lengths = {{1, 100.0}, {2, 80.0}};
+  machine.tool_diameters = {{1, 6.0}};
+  // Geometry 102 for a tool 100 long puts the tip 2 above the programmed point; wear −0.5 and then
+  // −0.25 more (G91) 1.5 and 1.25 above it; offset 2 untouched.
+  const std::string cut = "G43 H1 G0 Z5\nG1 Z-1 F100\n";
+  Result set = run_program("G21 G90 G17\nT1 M6\nG0 X0 Y0\n" + cut + "G10 L10 P1 R102.\n" + cut +
+                               "G10 L11 P1 R-0.5\n" + cut + "G91 G10 L11 P1 R-0.25\nG90\n" + cut +
+                               "G91 G10 L10 P1 R-2.\nG90\n" + cut + "G10 L10 P2 R81.\n" + cut + "M30\n",
+                           {}, machine);
+  auto shifted = [](double dz) {
+    return "G43 H1 G0 Z" + std::to_string(5 + dz) + "\nG1 Z" + std::to_string(-1 + dz) + " F100\n";
+  };
+  Result moved = run_program("G21 G90 G17\nT1 M6\nG0 X0 Y0\n" + shifted(0) + shifted(2) + shifted(1.5) +
+                                 shifted(1.25) + shifted(-0.75) + shifted(-0.75) + "M30\n",
+                             {}, machine);
+  same_moves(set, moved);
+  // Inches: R is in program units.
+  Result inches = run_program("G20 G90 G17\nT1 M6\nG0 X0 Y0\nG10 L10 P1 R4.\nG43 H1 G0 Z1\nM30\n", {}, machine);
+  REQUIRE(!inches.moves.empty());
+  CHECK(inches.moves.back().end.z == doctest::Approx(25.4 + (4 * 25.4 - 100)));
+  // Cutter radius offsets: a radius on Fanuc, a diameter on Haas. Read where no G41/G42 uses them.
+  Result probing = run_program("G21 G90 G17\nT1 M6\nG10 L12 P1 R3.\nG10 L13 P1 R-0.01\nG0 X0 Y0 Z5\nM30\n", {}, machine);
+  CHECK(probing.moves.size() == 1);
+  const Diagnostic used = error_of("G21 G90 G17\nT1 M6\nG10 L12 P1 R3.\nG0 X0 Y0 Z5\nG41 D1 G1 X5 F100\n", {}, machine);
+  CHECK(used.line == 5);
+  CHECK(used.message.find("G10 L12/L13 at line 3") != std::string::npos);
+  // Errors: no P, no R, axis words; LinuxCNC keeps its own meaning of L10 (a tool table entry).
+  CHECK(error_of("G10 L10 R5.\n").message.find("needs P") != std::string::npos);
+  CHECK(error_of("G10 L11 P1\n").message.find("needs R") != std::string::npos);
+  CHECK(error_of("G10 L10 P1 R5. Z1.\n").message.find("takes R only") != std::string::npos);
+  CHECK(error_of("G10 L14 P1 R5.\n").message.find("L10-L13 for tool offsets") != std::string::npos);
+}
