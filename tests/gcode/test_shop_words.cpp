@@ -232,7 +232,7 @@ TEST_CASE("Fanuc/Haas G10 L10/L11 set H's length geometry and wear (G91: by R); 
   const Diagnostic used = error_of("G21 G90 G17\nT1 M6\nG10 L12 P1 R3.\nG0 X0 Y0 Z5\nG41 D1 G1 X5 F100\n", {}, machine);
   CHECK(used.line == 5);
   CHECK(used.message.find("G10 L12/L13 at line 3") != std::string::npos);
-  // Errors: no P, no R, axis words; LinuxCNC keeps its own meaning of L10 (a tool table entry).
+  // Errors: no P, no R, axis words, an L that is no tool offset.
   CHECK(error_of("G10 L10 R5.\n").message.find("needs P") != std::string::npos);
   CHECK(error_of("G10 L11 P1\n").message.find("needs R") != std::string::npos);
   CHECK(error_of("G10 L10 P1 R5. Z1.\n").message.find("takes R only") != std::string::npos);
