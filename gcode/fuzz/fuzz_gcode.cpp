@@ -34,13 +34,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     rest = newline == std::string_view::npos ? std::string_view() : rest.substr(newline + 1);
   }
 
-  for (bool lenient : {false, true}) {
+  // Fanuc and Haas strict (they read the offset registers #2001… differently), LinuxCNC lenient.
+  for (Dialect dialect : {Dialect::fanuc, Dialect::haas, Dialect::linuxcnc}) {
+    const bool lenient = dialect == Dialect::linuxcnc;
     InterpreterOptions options;
     options.lenient = lenient;
     options.arc_tolerance = 0.01;  // keeps huge arcs cheap
     options.max_blocks = 20000;    // keeps M98 L loops bounded
     MachineConfig machine;  // no subprogram folders: calls stay inside the input
-    machine.dialect = lenient ? Dialect::linuxcnc : Dialect::fanuc;
+    machine.dialect = dialect;
     Interpreter interpreter(options, machine);
     DirectionGrouper grouper;
     std::istringstream in(text);

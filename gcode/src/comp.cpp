@@ -77,13 +77,13 @@ void Interpreter::State::cutter_comp_codes(int code, int column) {
   } else {
     int number = offset_d >= 0 ? offset_d : tool;
     if (w.has('D')) number = static_cast<int>(integer('D', (name + " D (a tool number)").c_str(), 0, 99'999'999));
-    if (w.has('D') && machine.dialect == Dialect::fanuc) offset_d = number;
+    if (w.has('D') && machine.dialect != Dialect::linuxcnc) offset_d = number;
     if (auto set = d_set_at.find(number); set != d_set_at.end())
       error(w.has('D') ? w.col('D') : column,
-            name + " D" + std::to_string(number) + ": offset " + std::to_string(number) +
-                " was written by G10 L12/L13 at line " + std::to_string(set->second) +
-                ", a radius on Fanuc and a diameter on Haas; give the tool's diameter with --tools and leave "
-                "that G10 out");
+            name + " D" + std::to_string(number) + ": offset " + std::to_string(number) + " was written by " +
+                set->second.by + " at line " + std::to_string(set->second.line) +
+                ", a radius on Fanuc and a diameter or a radius on Haas (its setting 40); give the tool's "
+                "diameter with --tools and leave that write out");
     if (number != 0) {
       auto it = machine.tool_diameters.find(number);
       if (it == machine.tool_diameters.end())

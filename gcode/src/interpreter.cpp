@@ -110,6 +110,11 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
 
 std::optional<MachineConfig> MachineConfig::bundled(const std::string& name) {
   if (name == "default") return MachineConfig{};
+  if (name == "haas") {  // the default machine, reading Haas's tool offset registers
+    MachineConfig m;
+    m.dialect = Dialect::haas;
+    return m;
+  }
   if (name == "linuxcnc") {  // rs274 run standalone (its default configuration)
     MachineConfig m;
     m.dialect = Dialect::linuxcnc;

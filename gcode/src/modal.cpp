@@ -130,18 +130,21 @@ void Interpreter::State::tool_table_entry(long long l, int column) {
 }
 
 // Fanuc's and Haas's G10 L10 / L11 P<offset> R<value> (Fanuc 0i-MF operator's manual, "Tool
-// compensation values input by program", memory C; Haas's G10): the tool length geometry (L10)
-// or wear (L11) of H offset P, set to R under G90 and changed by R under G91. G43 H reads geometry
-// plus wear; a geometry never set is the machine's length of tool P. Their cutter radius offsets
-// (L12, L13) hold a radius on Fanuc and a diameter on Haas (its setting 40): they are read, and a
-// G41/G42 that uses one is refused rather than guessed (comp.cpp; tool setting and probing
-// programs write them and never compensate).
+// compensation values input by program", memory C; Haas's G10, where L1 is L11): the tool length
+// geometry (L10) or wear (L11) of H offset P, set to R under G90 and changed by R under G91. G43 H
+// reads geometry plus wear; a geometry never set is the machine's length of tool P. Their cutter
+// radius offsets (L12, L13) hold a radius on Fanuc and a diameter or a radius on Haas (its setting
+// 40): they are kept for the macro variables that read them (parameters.cpp), and a G41/G42 that
+// uses one is refused rather than guessed (comp.cpp; tool setting and probing programs write them
+// and never compensate).
 void Interpreter::State::tool_length_entry(long long l, int column) {
   if (l == 12 || l == 13) {
     if (!w.has('P')) error(column, "G10 L" + std::to_string(l) + " needs P (the cutter radius offset number)");
     if (!w.has('R')) error(column, "G10 L" + std::to_string(l) + " needs R (the offset's value)");
-    d_set_at[static_cast<int>(integer('P', "G10 P (a cutter radius offset number)", 0, 99'999'999))] = line;
-    w.take('R');
+    const int number = static_cast<int>(integer('P', "G10 P (a cutter radius offset number)", 0, 99'999'999));
+    d_set_at[number] = {line, "G10 L" + std::to_string(l)};
+    double& value = (l == 12 ? d_geometry : d_wear)[number];
+    value = (incremental ? value : 0) + length('R');
     return;
   }
   const std::string name = "G10 L" + std::to_string(l);
@@ -302,11 +305,13 @@ Flow Interpreter::State::execute(const Block& block) {
     int column = w.find_g(100);
     bool linuxcnc_tools = machine.dialect == Dialect::linuxcnc;
     if (!w.has('L'))
-      error(column, linuxcnc_tools ? "G10 needs L1, L2, L10, L11 or L20" : "G10 needs L2, L10-L13 or L20");
+      error(column, linuxcnc_tools ? "G10 needs L1, L2, L10, L11 or L20"
+                                   : machine.dialect == Dialect::haas ? "G10 needs L1, L2, L10-L13 or L20"
+                                                                      : "G10 needs L2, L10-L13 or L20");
     long long l = integer('L', "G10 L", 0, 99);
     if (linuxcnc_tools && (l == 1 || l == 10 || l == 11)) {
       tool_table_entry(l, column);
-    } else if (!linuxcnc_tools && l >= 10 && l <= 13) {
+    } else if (!linuxcnc_tools && ((l >= 10 && l <= 13) || (l == 1 && machine.dialect == Dialect::haas))) {
       tool_length_entry(l, column);
     } else if (l != 2 && l != 20) {
       unsupported(column, "G10 L" + std::to_string(l) + " is not supported (only L2 and L20" +
@@ -452,7 +457,7 @@ Flow Interpreter::State::execute(const Block& block) {
   if (w.find_m(99)) flow = Flow::ret;
 
   // Fanuc keeps a D word for the next G41/G42 (`T4 D04 M06`); LinuxCNC refuses it, as rs274.
-  if (machine.dialect == Dialect::fanuc && w.has('D') && !((w.used >> letter_index('D')) & 1u))
+  if (machine.dialect != Dialect::linuxcnc && w.has('D') && !((w.used >> letter_index('D')) & 1u))
     offset_d = static_cast<int>(integer('D', "D (a cutter radius offset number)", 0, 99'999'999));
   // Every word must have been used by some code of the block: never a silent misreading.
   std::uint32_t free_words = w.present & ~w.used;

@@ -3,9 +3,14 @@
 // global, #<name> local to a call, #<_name> global), with the system variables that posts and
 // probing macros read: modal state (Fanuc #4001–#4120), positions (Fanuc #5001–#5043, LinuxCNC
 // #5420–#5428, #<_x> …) and work offsets (#5221 + 20·(n−1) for G54…G59 in both dialects,
-// Fanuc #7001 + 20·(p−1) for G54.1 Pp). Sources: Fanuc 0i-MF operator's manual, "Custom
-// macro: system variables"; LinuxCNC's "Numbered parameters" and "Predefined named parameters".
+// Fanuc #7001 + 20·(p−1) for G54.1 Pp up to P48, #14001 + 20·(p−1) up to P300) and tool offsets
+// (below). Sources: Fanuc 0i-MF operator's manual, "Custom macro: system variables"; Haas's mill
+// operator's manual, "Macros: system variables"; LinuxCNC's "Numbered parameters" and "Predefined
+// named parameters".
 #include <cmath>
+#include <optional>
+#include <string>
+#include <utility>
 
 #include "state.hpp"
 
@@ -21,8 +26,10 @@ int offset_variable(int n, int& axis) {
       return k + 1;
     }
   }
-  if (n >= 7001 && n < 7001 + 300 * 20) {
-    int k = (n - 7001) / 20, a = (n - 7001) % 20;
+  // G54.1 P1–P48 at #7001 (up to #7960), and P1–P300 at #14001: #10001–#13999 are tool offsets.
+  for (auto [first, count] : {std::pair{7001, 48}, std::pair{14001, 300}}) {
+    if (n < first || n >= first + count * 20) continue;
+    int k = (n - first) / 20, a = (n - first) % 20;
     if (a < 3) {
       axis = a;
       return MachineConfig::g54_1_key(k + 1);
@@ -32,6 +39,32 @@ int offset_variable(int n, int& axis) {
 }
 
 Value number(double v) { return Value{v, false}; }
+
+// A tool offset register named by a system variable: Fanuc's tool compensation memory C (#10001…
+// H wear, #11001… H geometry, #12001… D wear, #13001… D geometry, 999 each, and for offsets 1–200
+// #2001… H wear, #2201… H geometry) or Haas's (#2001… H geometry, #2201… H wear, #2401… D
+// geometry, #2601… D wear, 200 each; Haas's #10000s are general-purpose variables). The two
+// controls swap #2001 and #2201: the machine's dialect says which.
+struct OffsetRegister {
+  int number;   // the H or D offset
+  bool length;  // H (else D)
+  bool wear;    // wear (else geometry)
+};
+
+std::optional<OffsetRegister> offset_register(int n, Dialect dialect) {
+  if (dialect == Dialect::linuxcnc) return std::nullopt;
+  if (dialect == Dialect::haas) {
+    if (n < 2001 || n > 2800) return std::nullopt;
+    const int bank = (n - 2001) / 200;  // H geometry, H wear, D geometry, D wear
+    return OffsetRegister{(n - 2001) % 200 + 1, bank < 2, bank % 2 == 1};
+  }
+  if (n >= 2001 && n <= 2400) return OffsetRegister{(n - 2001) % 200 + 1, true, n <= 2200};
+  if (n >= 10001 && n <= 13999 && n % 1000 != 0) {
+    const int bank = n / 1000 - 10;  // H wear, H geometry, D wear, D geometry
+    return OffsetRegister{n % 1000, bank < 2, bank % 2 == 0};
+  }
+  return std::nullopt;
+}
 
 }  // namespace
 
@@ -69,6 +102,23 @@ Value Interpreter::State::numbered(int n) {
   if (int key = offset_variable(n, component); key >= 0) {
     auto it = offsets.find(key);
     return number(it == offsets.end() ? 0.0 : it->second[component] / unit);
+  }
+  if (auto r = offset_register(n, machine.dialect)) {
+    // H: what G43 reads (a geometry never set is the machine's length of that tool). D: what the
+    // program wrote, else Fanuc's radius from the tool table; Haas's depends on its setting 40.
+    if (r->length) {
+      auto wear = length_wear.find(r->number);
+      return number((r->wear ? (wear == length_wear.end() ? 0.0 : wear->second)
+                             : length_geometry(r->number).value_or(0.0)) / unit);
+    }
+    const std::map<int, double>& written = r->wear ? d_wear : d_geometry;
+    if (auto it = written.find(r->number); it != written.end()) return number(it->second / unit);
+    if (r->wear) return number(0);
+    if (machine.dialect == Dialect::haas)
+      detail::fail("#", n, " (D", r->number, "'s geometry) holds a diameter or a radius after Haas's setting 40, ",
+                   "which tridex does not know; set it in the program before reading it");  // placed by the lexer
+    auto diameter = machine.tool_diameters.find(r->number);
+    return number(diameter == machine.tool_diameters.end() ? 0.0 : diameter->second / 2 / unit);
   }
   auto it = globals.find(n);
   if (it != globals.end()) return it->second;
@@ -148,6 +198,16 @@ void Interpreter::State::assign(const Assignment& a) {
     if (key == work_key) {
       work_offset = value;
       update_frame();
+    }
+    return;
+  }
+  if (auto r = offset_register(n, machine.dialect)) {  // tool setting and probing macros
+    const double value = a.value.vacant ? 0.0 : a.value.number;
+    if (r->length) {
+      (r->wear ? length_wear : set_lengths)[r->number] = value * unit;
+    } else {  // read back as written; a G41/G42 using it is refused (comp.cpp)
+      (r->wear ? d_wear : d_geometry)[r->number] = value * unit;
+      d_set_at[r->number] = {line, std::string(1, '#').append(std::to_string(n))};
     }
     return;
   }

@@ -461,7 +461,14 @@ struct Interpreter::State : ParameterReader {
   int comp_side = 0;
   double comp_radius = 0;              // mm, ≥ 0
   int offset_d = -1;                   // Fanuc: the last D word, modal (#4107); -1: none yet
-  std::map<int, int> d_set_at;         // Fanuc: D offsets a G10 L12/L13 wrote, and its line
+  // Fanuc/Haas: the D offsets a program wrote (G10 L12/L13, or a macro variable such as #13001),
+  // with the line and what wrote them, and their geometry and wear as written (mm).
+  struct DWrite {
+    int line;
+    std::string by;
+  };
+  std::map<int, DWrite> d_set_at;
+  std::map<int, double> d_geometry, d_wear;
   bool comp_first = true;              // the next compensated move is the entry move
   bool comp_arc_forbidden = false;     // just after G40: the next move must be straight
   bool comp_programmed_current = false;  // coordinates count from comp_programmed, not the tip

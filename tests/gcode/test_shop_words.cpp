@@ -231,10 +231,76 @@ TEST_CASE("Fanuc/Haas G10 L10/L11 set H's length geometry and wear (G91: by R); 
   CHECK(probing.moves.size() == 1);
   const Diagnostic used = error_of("G21 G90 G17\nT1 M6\nG10 L12 P1 R3.\nG0 X0 Y0 Z5\nG41 D1 G1 X5 F100\n", {}, machine);
   CHECK(used.line == 5);
-  CHECK(used.message.find("G10 L12/L13 at line 3") != std::string::npos);
+  CHECK(used.message.find("written by G10 L12 at line 3") != std::string::npos);
   // Errors: no P, no R, axis words, an L that is no tool offset.
   CHECK(error_of("G10 L10 R5.\n").message.find("needs P") != std::string::npos);
   CHECK(error_of("G10 L11 P1\n").message.find("needs R") != std::string::npos);
   CHECK(error_of("G10 L10 P1 R5. Z1.\n").message.find("takes R only") != std::string::npos);
   CHECK(error_of("G10 L14 P1 R5.\n").message.find("L10-L13 for tool offsets") != std::string::npos);
+}
+
+TEST_CASE("Fanuc/Haas tool offset variables are the registers G10 L10-L13 write, by dialect") {
+  MachineConfig fanuc = at_origin();
+  fanuc.tool_lengths = {{1, 100.0}, {2, 80.0}};
+  fanuc.tool_diameters = {{1, 6.0}};
+  MachineConfig haas = fanuc;
+  haas.dialect = Dialect::haas;
+  const std::string no_tool = "G21 G90 G17\nG0 X0 Y0\n", head = no_tool + "T1 M6\n", cut = "G43 H1 G0 Z5\nG1 Z-1 F100\n";
+  auto program = [&](const std::string& setting) { return head + setting + cut + "M30\n"; };
+  // Each write against the G10 that sets the same register: geometry 102, then wear −0.5 (the
+  // read-modify-write of a tool-wear macro through #4120, the tool's number).
+  const std::string g10 = program("G10 L10 P1 R102.\nG10 L11 P1 R-0.25\nG91 G10 L11 P1 R-0.25\nG90\n");
+  Result by_g10 = run_program(g10, {}, fanuc);
+  same_moves(run_program(program("#11001 = 102.\n#10001 = -0.25\n#[10000 + #4120] = #[10000 + #4120] - 0.25\n"),
+                         {}, fanuc),
+             by_g10);
+  same_moves(run_program(program("#2201 = 102.\n#2001 = -0.5\n"), {}, fanuc), by_g10);  // memory C, 1-200
+  same_moves(run_program(program("#2001 = 102.\n#2201 = -0.5\n"), {}, haas), by_g10);   // Haas swaps them
+  same_moves(run_program(program("G10 L10 P1 R102.\nG10 L1 P1 R-0.5\n"), {}, haas), by_g10);  // Haas's L1: wear
+  same_moves(run_program(g10, {}, haas), by_g10);
+  // The same text on the other control: #2001 = 102. is a wear there, 102 more than the geometry.
+  Result wear = run_program(program("#2001 = 102.\n"), {}, fanuc);
+  REQUIRE(!wear.moves.empty());
+  CHECK(wear.moves.back().end.z == doctest::Approx(-1 + 102));
+  // Reads (no tool in the spindle: the tip is the programmed point): the machine's length until written, then what was written; wear 0; in program units.
+  Result read = run_program(no_tool + "G0 Z[#11001 / 10]\n#11001 = 102.\n#10001 = 0.5\nG0 Z[#11001 + #10001 - 100]\n"
+                                   "G20\nG0 Z#10001\nM30\n",
+                            {}, fanuc);
+  REQUIRE(read.moves.size() >= 3);
+  CHECK(read.moves[read.moves.size() - 3].end.z == doctest::Approx(10));
+  CHECK(read.moves[read.moves.size() - 2].end.z == doctest::Approx(2.5));
+  CHECK(read.moves.back().end.z == doctest::Approx(0.5));
+  Result haas_read = run_program(no_tool + "G0 Z[#2001 - #2201 - 90]\nM30\n", {}, haas);
+  REQUIRE(!haas_read.moves.empty());
+  CHECK(haas_read.moves.back().end.z == doctest::Approx(10));
+  // Haas's #10000s are general-purpose variables: they move no tool.
+  Result general = run_program(no_tool + "#10001 = 7.\nG0 Z#10001\nM30\n", {}, haas);
+  REQUIRE(!general.moves.empty());
+  CHECK(general.moves.back().end.z == doctest::Approx(7));
+  // D registers: read back as written; Fanuc's unwritten geometry is the tool's radius; a G41/G42
+  // using a written one is refused at its D, naming the write; Haas's unwritten one is unknown.
+  Result d = run_program(no_tool + "G0 Z#13001\n#13001 = 2.5\n#12001 = -0.1\nG0 Z[#13001 + #12001]\nM30\n", {}, fanuc);
+  REQUIRE(d.moves.size() >= 2);
+  CHECK(d.moves[d.moves.size() - 2].end.z == doctest::Approx(3));
+  CHECK(d.moves.back().end.z == doctest::Approx(2.4));
+  Result by_g10_d = run_program(no_tool + "G10 L12 P2 R1.5\nG10 L13 P2 R-0.05\nG0 Z[#13002 + #12002]\nM30\n", {}, fanuc);
+  REQUIRE(!by_g10_d.moves.empty());
+  CHECK(by_g10_d.moves.back().end.z == doctest::Approx(1.45));
+  const Diagnostic used = error_of(head + "#2401 = 6.\nG41 D1 G1 X5 F100\n", {}, haas);
+  CHECK(used.line == 5);
+  CHECK(used.message.find("#2401 at line 4") != std::string::npos);
+  const Diagnostic unknown = error_of(head + "G0 Z#2401\n", {}, haas);
+  CHECK(unknown.line == 4);
+  CHECK(unknown.message.find("setting 40") != std::string::npos);
+  // G54.1 P1's Z: #7003 (P1-P48) and #14003 (P1-P300); #11001 is no work offset.
+  Result extended = run_program(no_tool + "#14003 = -5.\n#11003 = 9.\nG54.1 P1\nG0 Z0\nG0 Z#7003\nM30\n", {}, fanuc);
+  REQUIRE(extended.moves.size() >= 2);
+  CHECK(extended.moves[extended.moves.size() - 2].end.z == doctest::Approx(-5));
+  CHECK(extended.moves.back().end.z == doctest::Approx(-10));
+  // LinuxCNC's #2001 is a plain parameter.
+  MachineConfig linuxcnc = linuxcnc_at_origin();
+  linuxcnc.tool_lengths = fanuc.tool_lengths;
+  Result plain = run_program(head + "#2001 = 102.\nG43 H1 G0 Z5\nG0 Z#2001\nM30\n", {}, linuxcnc);
+  REQUIRE(plain.moves.size() >= 2);
+  CHECK(plain.moves.back().end.z == doctest::Approx(102));
 }

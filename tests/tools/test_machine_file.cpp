@@ -317,7 +317,7 @@ TEST_CASE("machine files: bad files name the file, the key and the value") {
       {"{\"variables\": {\"#650\": \"fast\"}}", "must be a number"},
       {"{\"far_distance\": -1}", "\"far_distance\""},
       {"{\"units\": \"cm\"}", "\"units\""},
-      {"{\"base\": \"haas\"}", "\"base\""},
+      {"{\"base\": \"okuma\"}", "\"base\""},
       {"{\"kinematic\": {}}", "unknown key"},
       {"{\"kinematics\": \"xyz-trunnion\"}", "kinematics: is not a bundled profile"},
       {"{\"kinematics\": 5}", "kinematics"},
@@ -365,6 +365,21 @@ TEST_CASE("tools: G41/G42 D take the tool's diameter from --tools or the project
   for (const nlohmann::json& m : moves_of(r))
     side |= m["line"] == 5 && m["end"][0] == -4 && m["end"][1] == 20;
   CHECK(side);
+}
+
+TEST_CASE("machine files: the Haas dialect (\"dialect\": \"haas\", --machine haas) reads Haas's offset registers") {
+  fs::path dir = scratch("haas-dialect");
+  // #2001 is H1's geometry on Haas and its wear on Fanuc: the alarm says what the program read.
+  write_text(dir / "p.nc", "G21 G90\n#2001 = 50.\n#3000 = #2001 + #2201\n");
+  write_text(dir / "t.json", R"({"1": {"shape": "cylindrical", "diameter": 6, "tool-length": 80}})");
+  write_text(dir / "haas.json", R"({"dialect": "haas"})");
+  for (const std::string& machine : {std::string("haas"), (dir / "haas.json").string(), std::string("default")}) {
+    CAPTURE(machine);
+    CommandResult r =
+        run_tridex({"moves", (dir / "p.nc").string(), "--machine", machine, "--tools", (dir / "t.json").string()}, dir);
+    CHECK(r.status == 2);
+    CHECK(r.err.find(machine == "default" ? "#3000 = 130" : "#3000 = 50") != std::string::npos);
+  }
 }
 
 TEST_CASE("--tools with tool lengths: G43 H names the tip, G49 the gauge point (.tbl and JSON)") {

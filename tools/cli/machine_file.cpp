@@ -99,7 +99,7 @@ std::array<double, 3> rotary_rates(const json& value, const std::string& where) 
   return rates;
 }
 
-// A bundled machine: MachineConfig's own ("default", "linuxcnc"), or a bundled kinematics
+// A bundled machine: MachineConfig's own ("default", "haas", "linuxcnc"), or a bundled kinematics
 // profile by name (the default machine with that profile's rotary axes), so that
 // `--machine bc-trunnion` reads rotary words as `{"kinematics": "bc-trunnion"}` does.
 std::optional<gcode::MachineConfig> bundled_machine(const std::string& name) {
@@ -127,8 +127,9 @@ gcode::MachineConfig parse(const json& doc, const std::string& file, MachineRate
     } else if (key == "dialect") {
       std::string d = string_value(value, where).get<std::string>();
       if (d == "fanuc") m.dialect = gcode::Dialect::fanuc;
+      else if (d == "haas") m.dialect = gcode::Dialect::haas;
       else if (d == "linuxcnc") m.dialect = gcode::Dialect::linuxcnc;
-      else input_error(where, ": \"fanuc\" or \"linuxcnc\", got \"", d, "\"");
+      else input_error(where, ": \"fanuc\", \"haas\" or \"linuxcnc\", got \"", d, "\"");
     } else if (key == "units") {
       std::string u = string_value(value, where).get<std::string>();
       if (u != "mm" && u != "inch") input_error(where, ": \"mm\" or \"inch\", got \"", u, "\"");

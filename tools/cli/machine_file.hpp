@@ -14,7 +14,7 @@ namespace tridex::cli {
 
 // The bundled kinematics profiles are machines too: the default machine with those rotary axes.
 inline constexpr const char* kBundledMachines =
-    "default, linuxcnc, ac-trunnion, bc-trunnion, b-head-c-table, head-head";
+    "default, haas, linuxcnc, ac-trunnion, bc-trunnion, b-head-c-table, head-head";
 
 // An empty name is the default machine. `subprogram_dirs` (--subprograms) are searched before
 // the machine file's own. Throws InputError naming the file, the key and the value.

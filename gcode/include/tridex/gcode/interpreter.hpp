@@ -45,8 +45,9 @@ namespace tridex::gcode {
 // The controller dialect: where Fanuc (and Haas, Mazak, most Fanuc-like controls) and LinuxCNC
 // read the same program differently. Fanuc: a word whose value is vacant (#0, an unset local) is
 // left out, FIX/FUP round toward/away from zero. LinuxCNC: unset numbered parameters read 0, FIX
-// and FUP are floor and ceiling.
-enum class Dialect { fanuc, linuxcnc };
+// and FUP are floor and ceiling. Haas: Fanuc's, with Haas's tool offset registers (macro
+// variables #2001–#2800, G10 L1 as wear; parameters.cpp, modal.cpp).
+enum class Dialect { fanuc, haas, linuxcnc };
 
 // What M6 does with the tool tip.
 enum class ToolChange {
@@ -132,9 +133,9 @@ struct MachineConfig {
   static int g54_key(int n) { return n; }          // n = 1..6 for G54..G59
   static int g54_1_key(int p) { return 100 + p; }  // G54.1 Pp
 
-  // The bundled machines: "default" (the far rule) and "linuxcnc" (rs274 run standalone: start
-  // at the origin, M6 in place, G28/G30 at the origin, G53 literal, G99, LinuxCNC's dialect);
-  // nullopt otherwise.
+  // The bundled machines: "default" (the far rule), "haas" (the default with Haas's dialect) and
+  // "linuxcnc" (rs274 run standalone: start at the origin, M6 in place, G28/G30 at the origin,
+  // G53 literal, G99, LinuxCNC's dialect); nullopt otherwise.
   static std::optional<MachineConfig> bundled(const std::string& name);
 };
 
