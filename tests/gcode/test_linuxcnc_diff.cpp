@@ -225,6 +225,9 @@ std::vector<fs::path> corpus() {
   std::vector<fs::path> files;
   for (const auto& entry : fs::directory_iterator(fs::path(TRIDEX_TEST_DATA) / "gcode" / "linuxcnc"))
     if (entry.path().extension() == ".ngc") files.push_back(entry.path());
+  // Programs written by others (tests/data/gcode/public: a hobby mill's Fusion 360 output).
+  for (const auto& entry : fs::recursive_directory_iterator(fs::path(TRIDEX_TEST_DATA) / "gcode" / "public"))
+    if (entry.path().extension() == ".nc") files.push_back(entry.path());
   std::sort(files.begin(), files.end());
   // LinuxCNC's own sample programs that use only codes both interpreters support.
   if (const char* only = std::getenv("TRIDEX_DIFF_ONLY")) {  // ad-hoc: one program
