@@ -364,6 +364,31 @@ TEST_CASE("bad tool tables, missing tools and bad stocks exit 2 naming the probl
   fs::remove_all(dir);
 }
 
+// A hobby mill's Fusion 360 output (tests/data/gcode/public): `T1` and no M6, Z zero touched off
+// on the tip. Without the machine that loads tools on T the first feed is refused, saying how to
+// describe such a machine; with it the program mills a watertight solid.
+TEST_CASE("simulate: a public hobby program that loads its tool with T alone") {
+  fs::path dir = scratch("public-hobby");
+  const fs::path program = fs::path(TRIDEX_TEST_DATA) / "gcode" / "public" / "led_floor" / "1101_bore_tests.nc";
+  write_text(dir / "tools.json", R"({"1": {"shape": "cylindrical", "diameter": 2}})");
+  write_text(dir / "hobby.json", R"({"tool_loads_on_t": true})");
+  std::vector<std::string> args{"simulate", program.string(), "--tools", (dir / "tools.json").string(),
+                                "--stock", "box:-5,-5,-13,35,95,0", "--dexel-res", "128", "-o",
+                                (dir / "out.stl").string()};
+  CommandResult refused = run_tridex(args, dir);
+  CHECK(refused.status == 2);
+  CHECK(refused.err.find("1101_bore_tests.nc:17") != std::string::npos);
+  CHECK(refused.err.find("\"tool_loads_on_t\": true") != std::string::npos);
+  CHECK(!fs::exists(dir / "out.stl"));
+  args.insert(args.end(), {"--machine", (dir / "hobby.json").string()});
+  CommandResult r = run_tridex(args, dir);
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  CHECK(r.out.find("watertight") != std::string::npos);
+  CHECK(fs::exists(dir / "out.stl"));
+  fs::remove_all(dir);
+}
+
 TEST_CASE("unwritable outputs and inputs named as outputs are refused before any work") {
   fs::path dir = scratch("outputs");
   fs::path program = dir / "p.nc", tools = dir / "tools.json";

@@ -338,7 +338,9 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
         if (m.tool != 0) continue;
         if (m.kind != gcode::MoveKind::rapid)
           input_error(input.files.size() == 1 ? input.files[0].string() : input.program.string(), ":",
-                      m.line, ": a ", gcode::to_string(m.kind), " move with no tool loaded (T… M6)");
+                      m.line, ": a ", gcode::to_string(m.kind),
+                      " move with no tool loaded (T… M6; on a machine that loads the tool on T alone, give "
+                      "--machine a file with \"tool_loads_on_t\": true)");
         ++toolless;
       }
       if (toolless > 0) erase_if(group.moves, [](const gcode::Move& m) { return m.tool == 0; });
