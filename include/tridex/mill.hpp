@@ -1606,8 +1606,6 @@ class Miller {
           for (int g = 0; g < kGroups; ++g) h[g] = load_heights(row + g * kLanes, count - g * kLanes);
           loaded = true;
         }
-        DoubleN before[kGroups];
-        for (int g = 0; g < kGroups; ++g) before[g] = h[g];
         if (ball) {
           // Every point of the row: a test per group costs more in mispredicted branches and
           // in the chain through h than the evaluations it saves (measured).
@@ -1649,13 +1647,10 @@ class Miller {
                 h[g][l] = std::min(h[g][l], std::max(static_cast<double>(static_cast<float>(z)), empty));
               }
         }
-        MaskN lowered = h[0] < before[0];
-        for (int g = 1; g < kGroups; ++g) lowered |= h[g] < before[g];
-        if (!ball && !every_row && any_n(lowered)) {
+        if (!ball && !every_row) {
           // The other cutters' near-equal surfaces (a flat end's neighbouring passes) leave a
           // row's first cut far from its final shape, often not covering it all: measured again
-          // after each move that lowered it (most lower nothing), the row rejects the moves that
-          // it has become lower than.
+          // after each move, the row rejects the moves that it has become lower than.
           DoubleN top = h[0], excess = h[0] - (tile_row + plane.gradient.x * dx[0]);
           for (int g = 1; g < kGroups; ++g) {
             top = max_n(top, h[g]);
