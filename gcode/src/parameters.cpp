@@ -188,12 +188,19 @@ void Interpreter::State::assign(const Assignment& a) {
     warn(a.column, "#3006 = " + format_number(a.value.number) + ": the program stops for the operator here");
     return;
   }
+  // An offset moves the tool as a word does, and is held to a word's range.
+  auto offset_value = [&] {
+    const double value = a.value.vacant ? 0.0 : a.value.number;
+    if (!std::isfinite(value) || std::abs(value) > kMaxWordValue)
+      error(a.column, "#" + std::to_string(n) + " = " + format_number(value) + ": out of range (limit 1e9)");
+    return value;
+  };
   int component = 0;
   if (int key = offset_variable(n, component); key >= 0) {  // probing macros set work offsets this way
     if (tilted && key == work_key)
       error(a.column, "the active work offset changes under a tilted plane");
     Vec3 value = offsets.count(key) ? offsets[key] : Vec3(0.0);
-    value[component] = (a.value.vacant ? 0.0 : a.value.number) * unit;
+    value[component] = offset_value() * unit;
     offsets[key] = value;
     if (key == work_key) {
       work_offset = value;
@@ -202,7 +209,7 @@ void Interpreter::State::assign(const Assignment& a) {
     return;
   }
   if (auto r = offset_register(n, machine.dialect)) {  // tool setting and probing macros
-    const double value = a.value.vacant ? 0.0 : a.value.number;
+    const double value = offset_value();
     if (r->length) {
       (r->wear ? length_wear : set_lengths)[r->number] = value * unit;
     } else {  // read back as written; a G41/G42 using it is refused (comp.cpp)

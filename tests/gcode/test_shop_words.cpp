@@ -297,6 +297,11 @@ TEST_CASE("Fanuc/Haas tool offset variables are the registers G10 L10-L13 write,
   REQUIRE(extended.moves.size() >= 2);
   CHECK(extended.moves[extended.moves.size() - 2].end.z == doctest::Approx(-5));
   CHECK(extended.moves.back().end.z == doctest::Approx(-10));
+  // Offsets are held to a word's range, as G10 R is.
+  const Diagnostic huge = error_of(no_tool + "#11001 = [100000 * 100000]\n", {}, fanuc);
+  CHECK(huge.line == 3);
+  CHECK(huge.message.find("#11001 = 1e+10: out of range") != std::string::npos);
+  CHECK(error_of(no_tool + "#5223 = [100000 * 100000]\n", {}, fanuc).message.find("out of range") != std::string::npos);
   // LinuxCNC's #2001 is a plain parameter.
   MachineConfig linuxcnc = linuxcnc_at_origin();
   linuxcnc.tool_lengths = fanuc.tool_lengths;
