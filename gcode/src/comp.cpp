@@ -81,8 +81,7 @@ void Interpreter::State::cutter_comp_codes(int code, int column) {
     if (auto set = d_set_at.find(number); set != d_set_at.end())
       error(w.has('D') ? w.col('D') : column,
             name + " D" + std::to_string(number) + ": offset " + std::to_string(number) + " was written by " +
-                set->second.by + " at line " + std::to_string(set->second.line) +
-                ", a radius on Fanuc and a diameter or a radius on Haas (its setting 40); give the tool's "
+                set->second + ", a radius on Fanuc and a diameter or a radius on Haas (its setting 40); give the tool's "
                 "diameter with --tools and leave that write out");
     if (number != 0) {
       auto it = machine.tool_diameters.find(number);

@@ -142,7 +142,7 @@ void Interpreter::State::tool_length_entry(long long l, int column) {
     if (!w.has('P')) error(column, "G10 L" + std::to_string(l) + " needs P (the cutter radius offset number)");
     if (!w.has('R')) error(column, "G10 L" + std::to_string(l) + " needs R (the offset's value)");
     const int number = static_cast<int>(integer('P', "G10 P (a cutter radius offset number)", 0, 99'999'999));
-    d_set_at[number] = {line, "G10 L" + std::to_string(l)};
+    d_set_at[number] = "G10 L" + std::to_string(l) + " at line " + std::to_string(line);
     double& value = (l == 12 ? d_geometry : d_wear)[number];
     value = (incremental ? value : 0) + length('R');
     return;

@@ -214,13 +214,26 @@ void Interpreter::State::assign(const Assignment& a) {
       (r->wear ? length_wear : set_lengths)[r->number] = value * unit;
     } else {  // read back as written; a G41/G42 using it is refused (comp.cpp)
       (r->wear ? d_wear : d_geometry)[r->number] = value * unit;
-      d_set_at[r->number] = {line, std::string(1, '#').append(std::to_string(n))};
+      std::string by(1, '#');
+      by += std::to_string(n);
+      by += line > 0 ? " at line " + std::to_string(line) : " in the machine file's \"variables\"";
+      d_set_at[r->number] = std::move(by);
     }
     return;
   }
   if ((n >= 4001 && n <= 4400) || (n >= 5001 && n <= 5043) || (n >= 5420 && n <= 5428))
     error(a.column, "#" + std::to_string(n) + " is a read-only system variable");
   globals[n] = a.value;
+}
+
+// Offsets the control holds at the start are its registers, set as a program would set them
+// (read back through them, and G43 H reads them); other variables are kept as they are.
+void Interpreter::State::preset(int n, double value) {
+  int component = 0;
+  if (offset_variable(n, component) >= 0 || offset_register(n, machine.dialect))
+    assign(Assignment{n, {}, Value{value, false}, 0});
+  else
+    globals[n] = Value{value, false};
 }
 
 }  // namespace tridex::gcode

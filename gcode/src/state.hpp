@@ -188,6 +188,7 @@ struct Interpreter::State : ParameterReader {
   std::optional<Value> named(std::string_view name) override;
   bool vacant_words_omitted() const override { return machine.dialect != Dialect::linuxcnc; }
   void assign(const Assignment& a);  // #n = v or #<name> = v, system variables included
+  void preset(int n, double value);  // the machine file's "variables"
 
   Words w;
 
@@ -461,13 +462,9 @@ struct Interpreter::State : ParameterReader {
   int comp_side = 0;
   double comp_radius = 0;              // mm, ≥ 0
   int offset_d = -1;                   // Fanuc: the last D word, modal (#4107); -1: none yet
-  // Fanuc/Haas: the D offsets a program wrote (G10 L12/L13, or a macro variable such as #13001),
-  // with the line and what wrote them, and their geometry and wear as written (mm).
-  struct DWrite {
-    int line;
-    std::string by;
-  };
-  std::map<int, DWrite> d_set_at;
+  // Fanuc/Haas: the D offsets a program wrote (G10 L12/L13, or a macro variable such as #13001)
+  // and what wrote them ("G10 L12 at line 3"), and their geometry and wear as written (mm).
+  std::map<int, std::string> d_set_at;
   std::map<int, double> d_geometry, d_wear;
   bool comp_first = true;              // the next compensated move is the entry move
   bool comp_arc_forbidden = false;     // just after G40: the next move must be straight

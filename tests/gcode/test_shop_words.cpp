@@ -289,6 +289,11 @@ TEST_CASE("Fanuc/Haas tool offset variables are the registers G10 L10-L13 write,
   const Diagnostic used = error_of(head + "#2401 = 6.\nG41 D1 G1 X5 F100\n", {}, haas);
   CHECK(used.line == 5);
   CHECK(used.message.find("#2401 at line 4") != std::string::npos);
+  // What the control holds at the start (the machine file's "variables") is its registers.
+  MachineConfig preset = haas;
+  preset.variables = {{2001, 102.0}, {2201, -0.5}, {2401, 6.0}};
+  same_moves(run_program(program(""), {}, preset), by_g10);
+  CHECK(error_of(head + "G41 D1 G1 X5 F100\n", {}, preset).message.find("#2401 in the machine file") != std::string::npos);
   const Diagnostic unknown = error_of(head + "G0 Z#2401\n", {}, haas);
   CHECK(unknown.line == 4);
   CHECK(unknown.message.find("setting 40") != std::string::npos);
