@@ -138,19 +138,17 @@ void Interpreter::State::tool_table_entry(long long l, int column) {
 // uses one is refused rather than guessed (comp.cpp; tool setting and probing programs write them
 // and never compensate).
 void Interpreter::State::tool_length_entry(long long l, int column) {
-  if (l == 12 || l == 13) {
-    if (!w.has('P')) error(column, "G10 L" + std::to_string(l) + " needs P (the cutter radius offset number)");
-    if (!w.has('R')) error(column, "G10 L" + std::to_string(l) + " needs R (the offset's value)");
-    const int number = static_cast<int>(integer('P', "G10 P (a cutter radius offset number)", 0, 99'999'999));
-    d_set_at[number] = "G10 L" + std::to_string(l) + " at line " + std::to_string(line);
+  const bool radius = l == 12 || l == 13;
+  const std::string name = "G10 L" + std::to_string(l), offset = radius ? "cutter radius" : "tool length";
+  if (!w.has('P')) error(column, name + " needs P (the " + offset + " offset number)");
+  if (!w.has('R')) error(column, name + " needs R (the offset's value)");
+  const int number = static_cast<int>(integer('P', (name + " P (a " + offset + " offset number)").c_str(), 0, 99'999'999));
+  if (radius) {
+    d_set_at[number] = name + " at line " + std::to_string(line);
     double& value = (l == 12 ? d_geometry : d_wear)[number];
     value = (incremental ? value : 0) + length('R');
     return;
   }
-  const std::string name = "G10 L" + std::to_string(l);
-  if (!w.has('P')) error(column, name + " needs P (the tool length offset number)");
-  if (!w.has('R')) error(column, name + " needs R (the offset's value)");
-  int number = static_cast<int>(integer('P', (name + " P (a tool length offset number)").c_str(), 0, 99'999'999));
   for (char c : {'X', 'Y', 'Z', 'A', 'B', 'C'})
     if (w.has(c)) error(w.col(c), name + " " + c + ": a tool length offset takes R only");
   double value = length('R');

@@ -106,11 +106,7 @@ Value Interpreter::State::numbered(int n) {
   if (auto r = offset_register(n, machine.dialect)) {
     // H: what G43 reads (a geometry never set is the machine's length of that tool). D: what the
     // program wrote, else Fanuc's radius from the tool table; Haas's depends on its setting 40.
-    if (r->length) {
-      auto wear = length_wear.find(r->number);
-      return number((r->wear ? (wear == length_wear.end() ? 0.0 : wear->second)
-                             : length_geometry(r->number).value_or(0.0)) / unit);
-    }
+    if (r->length) return number((r->wear ? wear_of(r->number) : length_geometry(r->number).value_or(0.0)) / unit);
     const std::map<int, double>& written = r->wear ? d_wear : d_geometry;
     if (auto it = written.find(r->number); it != written.end()) return number(it->second / unit);
     if (r->wear) return number(0);

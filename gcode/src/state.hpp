@@ -103,10 +103,13 @@ struct Interpreter::State : ParameterReader {
     if (auto it = machine.tool_lengths.find(number); it != machine.tool_lengths.end()) return it->second;
     return std::nullopt;
   }
+  double wear_of(int number) const {
+    auto it = length_wear.find(number);
+    return it == length_wear.end() ? 0.0 : it->second;
+  }
   std::optional<double> table_length(int number) const {
     std::optional<double> geometry = length_geometry(number);
-    auto wear = length_wear.find(number);
-    if (geometry && wear != length_wear.end()) return *geometry + wear->second;
+    if (geometry) return *geometry + wear_of(number);
     return geometry;
   }
   void tool_table_entry(long long l, int column);   // LinuxCNC's G10 L1, L10, L11 (modal.cpp)
