@@ -78,20 +78,7 @@ void Interpreter::State::cutter_comp_codes(int code, int column) {
     int number = offset_d >= 0 ? offset_d : tool;
     if (w.has('D')) number = static_cast<int>(integer('D', (name + " D (a tool number)").c_str(), 0, 99'999'999));
     if (w.has('D') && machine.dialect != Dialect::linuxcnc) offset_d = number;
-    if (auto set = d_set_at.find(number); set != d_set_at.end())
-      error(w.has('D') ? w.col('D') : column,
-            name + " D" + std::to_string(number) + ": offset " + std::to_string(number) + " was written by " +
-                set->second + ", a radius on Fanuc and a diameter or a radius on Haas (its setting 40); give the tool's "
-                "diameter with --tools and leave that write out");
-    if (number != 0) {
-      auto it = machine.tool_diameters.find(number);
-      if (it == machine.tool_diameters.end())
-        error(w.has('D') ? w.col('D') : column,
-              name + ": tool " + std::to_string(number) +
-                  " is not in the tool table (its diameter sets the offset; give the tools with "
-                  "--tools or a project)");
-      radius = it->second / 2;
-    }
+    radius = d_offset_radius(number, w.has('D') ? w.col('D') : column, name);
   }
   if (radius < 0) {  // a negative radius offsets to the other side (LinuxCNC)
     radius = -radius;
@@ -99,6 +86,42 @@ void Interpreter::State::cutter_comp_codes(int code, int column) {
   }
   comp_side = side;
   comp_radius = radius;
+}
+
+// The radius G41/G42 D<number> offsets by. Where the program (or the machine file) wrote that
+// offset's geometry or wear (G10 L12/L13, #13001…, Haas #2401…), what the control would read:
+// geometry plus wear, a radius or a diameter as the machine's D registers hold
+// (MachineConfig::d_offsets), a geometry never written being the tool table's. Else half the tool
+// table's diameter of tool <number>. D0 offsets by nothing.
+double Interpreter::State::d_offset_radius(int number, int column, const std::string& code) {
+  if (number == 0) return 0;
+  const std::string d = code + " D" + std::to_string(number);
+  auto diameter = machine.tool_diameters.find(number);
+  auto set = d_set_at.find(number);
+  if (set == d_set_at.end()) {
+    if (diameter == machine.tool_diameters.end())
+      error(column, code + ": tool " + std::to_string(number) +
+                        " is not in the tool table (its diameter sets the offset; give the tools with "
+                        "--tools or a project)");
+    return diameter->second / 2;
+  }
+  const std::optional<double> scale = d_register_scale();
+  if (!scale)
+    error(column, d + ": offset " + std::to_string(number) + " was written by " + set->second +
+                      ", a diameter or a radius after Haas's setting 40; say which with \"d_offsets\": "
+                      "\"radius\" or \"diameter\" in the machine file (README: Machine files)");
+  double geometry = 0;
+  if (auto it = d_geometry.find(number); it != d_geometry.end()) {
+    geometry = it->second;
+  } else if (diameter != machine.tool_diameters.end()) {
+    geometry = diameter->second / 2 / *scale;
+  } else {
+    error(column, d + ": offset " + std::to_string(number) + " has a wear written by " + set->second +
+                      " but no geometry: its geometry is tool " + std::to_string(number) +
+                      "'s diameter, and that tool is not in the tool table (give the tools with --tools)");
+  }
+  auto wear = d_wear.find(number);
+  return (geometry + (wear == d_wear.end() ? 0.0 : wear->second)) * *scale;
 }
 
 void Interpreter::State::comp_dequeue() {

@@ -134,9 +134,8 @@ void Interpreter::State::tool_table_entry(long long l, int column) {
 // geometry (L10) or wear (L11) of H offset P, set to R under G90 and changed by R under G91. G43 H
 // reads geometry plus wear; a geometry never set is the machine's length of tool P. Their cutter
 // radius offsets (L12, L13) hold a radius on Fanuc and a diameter or a radius on Haas (its setting
-// 40): they are kept for the macro variables that read them (parameters.cpp), and a G41/G42 that
-// uses one is refused rather than guessed (comp.cpp; tool setting and probing programs write them
-// and never compensate).
+// 40, the machine file's "d_offsets"): G41/G42 D and the macro variables read them (comp.cpp,
+// parameters.cpp).
 void Interpreter::State::tool_length_entry(long long l, int column) {
   const bool radius = l == 12 || l == 13;
   const std::string name = "G10 L" + std::to_string(l), offset = radius ? "cutter radius" : "tool length";

@@ -105,16 +105,17 @@ Value Interpreter::State::numbered(int n) {
   }
   if (auto r = offset_register(n, machine.dialect)) {
     // H: what G43 reads (a geometry never set is the machine's length of that tool). D: what the
-    // program wrote, else Fanuc's radius from the tool table; Haas's depends on its setting 40.
+    // program wrote, else the tool table's radius or diameter, as the machine's D registers hold.
     if (r->length) return number((r->wear ? wear_of(r->number) : length_geometry(r->number).value_or(0.0)) / unit);
     const std::map<int, double>& written = r->wear ? d_wear : d_geometry;
     if (auto it = written.find(r->number); it != written.end()) return number(it->second / unit);
     if (r->wear) return number(0);
-    if (machine.dialect == Dialect::haas)
-      detail::fail("#", n, " (D", r->number, "'s geometry) holds a diameter or a radius after Haas's setting 40, ",
-                   "which tridex does not know; set it in the program before reading it");  // placed by the lexer
+    const std::optional<double> scale = d_register_scale();
+    if (!scale)
+      detail::fail("#", n, " (D", r->number, "'s geometry) holds a diameter or a radius after Haas's setting 40: ",
+                   "say which with \"d_offsets\" in the machine file, or set it in the program before reading it");
     auto diameter = machine.tool_diameters.find(r->number);
-    return number(diameter == machine.tool_diameters.end() ? 0.0 : diameter->second / 2 / unit);
+    return number(diameter == machine.tool_diameters.end() ? 0.0 : diameter->second / 2 / *scale / unit);
   }
   auto it = globals.find(n);
   if (it != globals.end()) return it->second;
@@ -208,7 +209,7 @@ void Interpreter::State::assign(const Assignment& a) {
     const double value = offset_value();
     if (r->length) {
       (r->wear ? length_wear : set_lengths)[r->number] = value * unit;
-    } else {  // read back as written; a G41/G42 using it is refused (comp.cpp)
+    } else {  // read back as written, and by a G41/G42 using it (comp.cpp)
       (r->wear ? d_wear : d_geometry)[r->number] = value * unit;
       std::string by(1, '#');
       by += std::to_string(n);

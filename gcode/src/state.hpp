@@ -469,6 +469,14 @@ struct Interpreter::State : ParameterReader {
   // and what wrote them ("G10 L12 at line 3"), and their geometry and wear as written (mm).
   std::map<int, std::string> d_set_at;
   std::map<int, double> d_geometry, d_wear;
+  // Radius per unit of a D register: 1 (it holds a radius), 0.5 (a diameter), none where the
+  // machine does not say (Haas, whose setting 40 decides).
+  std::optional<double> d_register_scale() const {
+    if (machine.d_offsets == DOffsets::diameter) return 0.5;
+    if (machine.d_offsets == DOffsets::radius || machine.dialect != Dialect::haas) return 1.0;
+    return std::nullopt;
+  }
+  double d_offset_radius(int number, int column, const std::string& code);  // comp.cpp
   bool comp_first = true;              // the next compensated move is the entry move
   bool comp_arc_forbidden = false;     // just after G40: the next move must be straight
   bool comp_programmed_current = false;  // coordinates count from comp_programmed, not the tip

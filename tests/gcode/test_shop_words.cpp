@@ -204,7 +204,7 @@ TEST_CASE("Fanuc/Haas external output (POPEN, DPRNT, BPRNT, PCLOS) moves nothing
   CHECK(error_of("POPEN G1 X1\n").message.find("after the statement") != std::string::npos);
 }
 
-TEST_CASE("Fanuc/Haas G10 L10/L11 set H's length geometry and wear (G91: by R); L12/L13 refused at their G41") {
+TEST_CASE("Fanuc/Haas G10 L10/L11 set H's length geometry and wear (G91: by R); L12/L13 D's, read by G41/G42") {
   MachineConfig machine = at_origin();
   machine.tool_lengths = {{1, 100.0}, {2, 80.0}};
   machine.tool_diameters = {{1, 6.0}};
@@ -226,12 +226,24 @@ TEST_CASE("Fanuc/Haas G10 L10/L11 set H's length geometry and wear (G91: by R); 
   Result inches = run_program("G20 G90 G17\nT1 M6\nG0 X0 Y0\nG10 L10 P1 R4.\nG43 H1 G0 Z1\nM30\n", {}, machine);
   REQUIRE(!inches.moves.empty());
   CHECK(inches.moves.back().end.z == doctest::Approx(25.4 + (4 * 25.4 - 100)));
-  // Cutter radius offsets: a radius on Fanuc, a diameter on Haas. Read where no G41/G42 uses them.
-  Result probing = run_program("G21 G90 G17\nT1 M6\nG10 L12 P1 R3.\nG10 L13 P1 R-0.01\nG0 X0 Y0 Z5\nM30\n", {}, machine);
-  CHECK(probing.moves.size() == 1);
-  const Diagnostic used = error_of("G21 G90 G17\nT1 M6\nG10 L12 P1 R3.\nG0 X0 Y0 Z5\nG41 D1 G1 X5 F100\n", {}, machine);
-  CHECK(used.line == 5);
-  CHECK(used.message.find("written by G10 L12 at line 3") != std::string::npos);
+  // Cutter radius offsets (a radius on Fanuc): G41 D1 offsets by geometry + wear, a geometry
+  // never written being the tool table's radius; the same cut as a tool table saying so.
+  const std::string contour = "G0 X-5 Y-5 Z5\nG1 Z-1 F100\nG41 D1 G1 X0 Y0\nY10\nX10\nG40 G1 X15 Y15\nM30\n";
+  auto with_diameter = [&](double diameter) {
+    MachineConfig table = machine;
+    table.tool_diameters = {{1, diameter}};
+    return run_program("G21 G90 G17\nT1 M6\n" + contour, {}, table);
+  };
+  same_moves(run_program("G21 G90 G17\nT1 M6\nG10 L12 P1 R3.5\nG10 L13 P1 R-0.01\n" + contour, {}, machine),
+             with_diameter(6.98));
+  same_moves(run_program("G21 G90 G17\nT1 M6\nG10 L13 P1 R-0.1\n" + contour, {}, machine), with_diameter(5.8));
+  same_moves(run_program("G21 G90 G17\nT1 M6\nG10 L12 P1 R2.\nG91 G10 L12 P1 R0.5\nG90\n" + contour, {}, machine),
+             with_diameter(5));
+  // A wear with no geometry needs the tool's diameter.
+  const Diagnostic no_tool = error_of("G21 G90 G17\nT1 M6\nG10 L13 P2 R-0.1\nG0 X0 Y0 Z5\nG41 D2 G1 X5 F100\n", {}, machine);
+  CHECK(no_tool.line == 5);
+  CHECK(no_tool.message.find("G10 L13 at line 3") != std::string::npos);
+  CHECK(no_tool.message.find("not in the tool table") != std::string::npos);
   // Errors: no P, no R, axis words, an L that is no tool offset.
   CHECK(error_of("G10 L10 R5.\n").message.find("needs P") != std::string::npos);
   CHECK(error_of("G10 L11 P1\n").message.find("needs R") != std::string::npos);
@@ -286,9 +298,29 @@ TEST_CASE("Fanuc/Haas tool offset variables are the registers G10 L10-L13 write,
   Result by_g10_d = run_program(no_tool + "G10 L12 P2 R1.5\nG10 L13 P2 R-0.05\nG0 Z[#13002 + #12002]\nM30\n", {}, fanuc);
   REQUIRE(!by_g10_d.moves.empty());
   CHECK(by_g10_d.moves.back().end.z == doctest::Approx(1.45));
+  // Haas's D registers hold a diameter or a radius after its setting 40: unknown, a G41/G42 using a
+  // written one is refused at its D, naming the write; the machine file's "d_offsets" tells.
   const Diagnostic used = error_of(head + "#2401 = 6.\nG41 D1 G1 X5 F100\n", {}, haas);
   CHECK(used.line == 5);
   CHECK(used.message.find("#2401 at line 4") != std::string::npos);
+  CHECK(used.message.find("\"d_offsets\"") != std::string::npos);
+  const std::string contour = "G0 X-5 Y-5 Z5\nG1 Z-1 F100\nG41 D1 G1 X0 Y0\nY10\nX10\nG40 G1 X15 Y15\nM30\n";
+  MachineConfig haas_diameter = haas, haas_radius = haas;
+  haas_diameter.d_offsets = DOffsets::diameter;
+  haas_radius.d_offsets = DOffsets::radius;
+  same_moves(run_program(head + "#2401 = 6.\n#2601 = -0.2\n" + contour, {}, haas_diameter),
+             run_program(head + "G10 L12 P1 R2.9\n" + contour, {}, fanuc));
+  same_moves(run_program(head + "#2401 = 6.\n" + contour, {}, haas_radius),
+             run_program(head + "G10 L12 P1 R6.\n" + contour, {}, fanuc));
+  // An unwritten D geometry reads as the table's diameter or radius, as the machine's hold.
+  Result as_diameter = run_program(no_tool + "G0 Z[#2401 + #13001]\nM30\n", {}, haas_diameter);
+  REQUIRE(!as_diameter.moves.empty());
+  CHECK(as_diameter.moves.back().end.z == doctest::Approx(6));
+  MachineConfig fanuc_diameter = fanuc;
+  fanuc_diameter.d_offsets = DOffsets::diameter;
+  Result fanuc_read = run_program(no_tool + "G0 Z#13001\nM30\n", {}, fanuc_diameter);
+  REQUIRE(!fanuc_read.moves.empty());
+  CHECK(fanuc_read.moves.back().end.z == doctest::Approx(6));
   // What the control holds at the start (the machine file's "variables") is its registers.
   MachineConfig preset = haas;
   preset.variables = {{2001, 102.0}, {2201, -0.5}, {2401, 6.0}};

@@ -367,7 +367,7 @@ TEST_CASE("tools: G41/G42 D take the tool's diameter from --tools or the project
   CHECK(side);
 }
 
-TEST_CASE("machine files: the Haas dialect (\"dialect\": \"haas\", --machine haas) reads Haas's offset registers") {
+TEST_CASE("machine files: the Haas dialect (\"dialect\": \"haas\", --machine haas) reads Haas's offset registers; \"d_offsets\"") {
   fs::path dir = scratch("haas-dialect");
   // #2001 is H1's geometry on Haas and its wear on Fanuc: the alarm says what the program read.
   write_text(dir / "p.nc", "G21 G90\n#2001 = 50.\n#3000 = #2001 + #2201\n");
@@ -379,6 +379,22 @@ TEST_CASE("machine files: the Haas dialect (\"dialect\": \"haas\", --machine haa
         run_tridex({"moves", (dir / "p.nc").string(), "--machine", machine, "--tools", (dir / "t.json").string()}, dir);
     CHECK(r.status == 2);
     CHECK(r.err.find(machine == "default" ? "#3000 = 130" : "#3000 = 50") != std::string::npos);
+  }
+  // Its D registers (#2401) hold a diameter or a radius after its setting 40: "d_offsets" says
+  // which, and an unwritten one then reads as the tool table's (6 or 3); without it, refused.
+  write_text(dir / "d.nc", "G21 G90\n#3000 = #2401\n");
+  write_text(dir / "diameter.json", R"({"dialect": "haas", "d_offsets": "diameter"})");
+  write_text(dir / "radius.json", R"({"base": "haas", "d_offsets": "radius"})");
+  write_text(dir / "bad.json", R"({"base": "haas", "d_offsets": "diametre"})");
+  for (const auto& [machine, expected] : {std::pair<std::string, std::string>{"diameter.json", "#3000 = 6"},
+                                          {"radius.json", "#3000 = 3"},
+                                          {"haas", "\"d_offsets\""},
+                                          {"bad.json", "\"d_offsets\": \"radius\" or \"diameter\", got \"diametre\""}}) {
+    CAPTURE(machine);
+    const std::string path = machine == "haas" ? machine : (dir / machine).string();
+    CommandResult r = run_tridex({"moves", (dir / "d.nc").string(), "--machine", path, "--tools", (dir / "t.json").string()}, dir);
+    CHECK(r.status == 2);
+    CHECK(r.err.find(expected) != std::string::npos);
   }
 }
 

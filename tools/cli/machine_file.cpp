@@ -157,6 +157,10 @@ gcode::MachineConfig parse(const json& doc, const std::string& file, MachineRate
     } else if (key == "tool_loads_on_t") {
       if (!value.is_boolean()) input_error(where, ": must be true or false, got ", value.dump());
       m.tool_loads_on_t = value.get<bool>();
+    } else if (key == "d_offsets") {  // what the D registers hold (Haas: its setting 40)
+      std::string d = string_value(value, where).get<std::string>();
+      if (d != "radius" && d != "diameter") input_error(where, ": \"radius\" or \"diameter\", got \"", d, "\"");
+      m.d_offsets = d == "radius" ? gcode::DOffsets::radius : gcode::DOffsets::diameter;
     } else if (key == "g53") {
       std::string g = string_value(value, where).get<std::string>();
       if (g != "far" && g != "literal") input_error(where, ": \"far\" or \"literal\", got \"", g, "\"");
@@ -224,7 +228,7 @@ gcode::MachineConfig parse(const json& doc, const std::string& file, MachineRate
         m.subprogram_dirs.push_back((base / string_value(dir, where).get<std::string>()).string());
     } else {
       input_error(where, ": unknown key (known: name, description, base, dialect, units, start, "
-                         "tool_change, tool_loads_on_t, home, reference2, work_offsets, m_codes, "
+                         "tool_change, tool_loads_on_t, d_offsets, home, reference2, work_offsets, m_codes, "
                          "forbidden_m_codes, variables, far_distance, subprograms, kinematics, "
                          "rapid_rate_mm_per_min, rapid_rate_deg_per_min, max_feed_mm_per_min)");
     }

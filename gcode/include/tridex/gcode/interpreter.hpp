@@ -56,6 +56,11 @@ enum class ToolChange {
   to_position,  // moves it (a rapid, machine coordinates) to tool_change_position
 };
 
+// What a Fanuc/Haas control's D (cutter compensation) offset registers hold, where a program or
+// the machine file writes them (G10 L12/L13, #13001… or #2401…): Fanuc's a radius; Haas's a
+// diameter or a radius after its setting 40. `dialect`: a radius on Fanuc, unknown on Haas.
+enum class DOffsets { dialect, radius, diameter };
+
 // What the interpreter needs to know of the machine (tridex's machine file, tools/cli/machine.*,
 // fills it; the defaults are the "far along the tool axis" rule of docs/design.md).
 struct MachineConfig {
@@ -83,6 +88,7 @@ struct MachineConfig {
   ToolChange tool_change = ToolChange::retract_far;
   Vec3 tool_change_position{0.0};  // machine coordinates, for ToolChange::to_position
   bool tool_loads_on_t = false;    // the control loads a tool on T alone (no M6 needed)
+  DOffsets d_offsets = DOffsets::dialect;
   bool inch_at_start = false;      // units before any G20/G21: inch (true) or mm
   // G53 with the tool along +Z: false, a G53 Z is a retract (the tip goes far along the tool, as
   // G28 with the default position); true, G53 goes to the machine coordinates it names, because
