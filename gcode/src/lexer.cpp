@@ -306,7 +306,10 @@ class Parser {
       case Op::minus: return finite(x - y, at);
       case Op::eq:
       case Op::ne: {
-        bool equal = a.vacant || b.vacant ? a.vacant == b.vacant : std::abs(x - y) < kEqualTolerance;
+        // Fanuc: vacant equals only vacant (#1 EQ 0 is false for an unset #1). LinuxCNC has no
+        // vacant value: an unset numbered parameter is 0 and compares as 0.
+        const bool by_vacancy = (a.vacant || b.vacant) && parameters_->vacant_words_omitted();
+        bool equal = by_vacancy ? a.vacant == b.vacant : std::abs(x - y) < kEqualTolerance;
         return Value{(op == Op::eq) == equal ? 1.0 : 0.0, false};
       }
       case Op::gt: return Value{x > y ? 1.0 : 0.0, false};
