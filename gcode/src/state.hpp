@@ -269,8 +269,12 @@ struct Interpreter::State : ParameterReader {
     w.m_arguments = false;
     std::array<int, kGroupCount> g_seen{};
     std::array<int, kMGroupCount> m_seen{};
+    // In a G65 block M is an argument (#13), not an M-code (Fanuc's argument specification I).
+    const bool macro_call = machine.dialect != Dialect::linuxcnc &&
+                            std::any_of(block.words.begin(), block.words.end(),
+                                        [](const Word& word) { return word.letter == 'G' && word.value == 65; });
     for (const Word& word : block.words) {
-      if (word.letter == 'G' || word.letter == 'M') {
+      if (word.letter == 'G' || (word.letter == 'M' && !macro_call)) {
         // Codes are small; anything else is unsupported before it reaches an int (fuzz finding).
         double scaled = word.value * 10;
         double rounded = std::round(scaled);

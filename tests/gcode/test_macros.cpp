@@ -203,6 +203,8 @@ TEST_CASE("macros: Fanuc control flow gives the moves of the same program writte
   // G65: arguments become locals of a new level; the caller's locals are untouched.
   same_moves("#1 = 100\nG65 P9000 A1 B2 X3 L2\nG0 X#1 Y0 Z0\nM30\nO9000\nG0 X[#1 + #2] Y#24 Z#3\n#1 = 50\nM99\n",
              "G0 X3 Y3 Z0\nG0 X3 Y3 Z0\nG0 X100 Y0 Z0\nM30\n");
+  // M, S and T are arguments in a G65 block (#13, #19, #20), not codes.
+  same_moves("G65 P9100 M0.07 T13.16 S5.\nM30\nO9100\nG0 X#13 Y#20 Z#19\nM99\n", "G0 X0.07 Y13.16 Z5\nM30\n");
 }
 
 TEST_CASE("macros: LinuxCNC o-words give the moves of the same program written out") {
