@@ -59,8 +59,8 @@ inline int g_group(int code) {
   switch (code) {
     case 40: case 100: case 280: case 300: case 530: case 520: case 650: case 920: case 921:
     case 922: case 923: return kNonModal;
-    case 0: case 10: case 20: case 30: case 730: case 800: case 810: case 820: case 830:
-    case 850: case 860: case 890: return kMotion;
+    case 0: case 10: case 20: case 30: case 730: case 740: case 800: case 810: case 820: case 830:
+    case 840: case 850: case 860: case 890: return kMotion;
     case 170: case 180: case 190: return kPlane;
     case 900: case 910: return kDistance;
     case 901: case 911: return kArcDistance;
@@ -109,8 +109,8 @@ inline std::string format_number(double v) {
 }
 
 inline bool is_cycle(int motion) {
-  return motion == 730 || motion == 810 || motion == 820 || motion == 830 || motion == 850 ||
-         motion == 860 || motion == 890;
+  return motion == 730 || motion == 740 || motion == 810 || motion == 820 || motion == 830 ||
+         motion == 840 || motion == 850 || motion == 860 || motion == 890;
 }
 
 // Plane axes (u, v) and normal w as coordinate indices: G17 XY, G18 ZX, G19 YZ.

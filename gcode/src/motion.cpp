@@ -328,7 +328,10 @@ void Interpreter::State::cycle(int code) {
     if (!has_cycle_q || !(cycle_q > 0))
       error(motion_column, code_name('G', code) + " needs a positive peck depth Q");
   }
-  if ((code == 820 || code == 860 || code == 890) && w.has('P')) {
+  // The cycles that dwell at the bottom read P. Fanuc and Haas keep P as modal cycle data in any
+  // cycle (a post writes it on G81 too), for a later one that dwells.
+  const bool dwells = code == 740 || code == 820 || code == 840 || code == 860 || code == 890;
+  if ((dwells || machine.dialect != Dialect::linuxcnc) && w.has('P')) {
     double p = w.take('P');
     if (p < 0) error(w.col('P'), "dwell P must not be negative");
     cycle_dwell = dwell_seconds(p);
@@ -341,6 +344,8 @@ void Interpreter::State::cycle(int code) {
     error(motion_column, code_name('G', code) + " needs " + depth_letter + " (hole bottom)");
   require_feed();
   if (w.has('L') && w.has('K')) error(w.col('K'), "repeat count given twice (L and K)");
+  if (w.has('L') && (code == 740 || code == 840) && machine.dialect == Dialect::linuxcnc)
+    error(w.col('L'), code_name('G', code) + " L: LinuxCNC's rs274 takes no repeats on a tapping cycle");
   long long repeats = 1;
   if (w.has('L')) repeats = integer('L', "repeat count", 0, 9999);
   if (w.has('K')) repeats = integer('K', "repeat count", 0, 9999);
@@ -446,8 +451,12 @@ void Interpreter::State::cycle(int code) {
         cut(at(hole_u, hole_v, bottom));
         break;
     }
-    if (code == 820 || code == 860 || code == 890) emit_dwell(cycle_dwell);  // at the bottom
+    if (dwells) emit_dwell(cycle_dwell);  // at the bottom
     switch (code) {  // the way out: at feed for these, at rapid for the others (below)
+      case 740:  // tapping (G74 left hand, G84 right hand): the spindle reverses and the tap
+      case 840:  // backs out at feed: to R on Fanuc and Haas, as G85; LinuxCNC's to the clear level
+        cut(at(hole_u, hole_v, machine.dialect == Dialect::linuxcnc && !clear_far ? clear : r_level));
+        break;
       case 850:  // to R (then rapid to the clear level)
         cut(at(hole_u, hole_v, r_level));
         break;

@@ -83,6 +83,44 @@ TEST_CASE("G85/G89 feed out, G86 rapids out; L repeats step under G91") {
   CHECK(near(k.moves.back().end, Vec3(2, 0, 5)));
 }
 
+TEST_CASE("G84/G74 tapping back out at feed: to R on Fanuc, to the clear level on LinuxCNC; P kept on any Fanuc cycle") {
+  const std::string program = "G90 F100 S500 M3\nG0 X0 Y0 Z10\nG98 G84 X1 Y1 Z-3 R2 P200\nG80\nM30\n";
+  for (const Dialect dialect : {Dialect::fanuc, Dialect::haas, Dialect::linuxcnc}) {
+    CAPTURE(static_cast<int>(dialect));
+    MachineConfig machine = at_origin();
+    machine.dialect = dialect;
+    Result r = run_program(program, {}, machine);
+    std::vector<Move> cycle;
+    for (const Move& m : r.moves)
+      if (m.kind == MoveKind::cycle) cycle.push_back(m);
+    // XY at the initial level, down to R, down at feed, up at feed, then (Fanuc) a rapid to 10.
+    const bool linuxcnc = dialect == Dialect::linuxcnc;
+    REQUIRE(cycle.size() == (linuxcnc ? 4u : 5u));
+    CHECK(cycle[2].feed > 0);
+    CHECK(near(cycle[2].end, Vec3(1, 1, -3)));
+    CHECK(cycle[3].feed > 0);
+    CHECK(near(cycle[3].end, Vec3(1, 1, linuxcnc ? 10 : 2)));
+    if (!linuxcnc) {
+      CHECK(cycle[4].feed == 0);
+      CHECK(near(cycle[4].end, Vec3(1, 1, 10)));
+    }
+  }
+  // G74 (left hand) goes the same way; LinuxCNC's rs274 takes no L on either.
+  auto same_ends = [](const Result& a, const Result& b) {
+    REQUIRE(a.moves.size() == b.moves.size());
+    for (std::size_t i = 0; i < a.moves.size(); ++i) CHECK(near(a.moves[i].end, b.moves[i].end));
+  };
+  same_ends(run_program("G90 F100 S500 M4\nG0 X0 Y0 Z10\nG99 G74 X1 Y1 Z-3 R2\nX2\nG80\nM30\n", {}, at_origin()),
+            run_program("G90 F100 S500 M4\nG0 X0 Y0 Z10\nG99 G85 X1 Y1 Z-3 R2\nX2\nG80\nM30\n", {}, at_origin()));
+  CHECK(error_of("G90 F100\nG0 X0 Y0 Z10\nG84 X1 Z-3 R2 L2\n", {}, linuxcnc_at_origin()).message.find("no repeats") !=
+        std::string::npos);
+  // A P written on G81 (a post's habit): modal cycle data on Fanuc, an unused word on LinuxCNC.
+  same_ends(run_program("G90 F100\nG0 X0 Y0 Z10\nG81 X1 Z-3 R2 P500\nG80\nM30\n", {}, at_origin()),
+            run_program("G90 F100\nG0 X0 Y0 Z10\nG81 X1 Z-3 R2\nG80\nM30\n", {}, at_origin()));
+  CHECK(error_of("G90 F100\nG0 X0 Y0 Z10\nG81 X1 Z-3 R2 P500\n", {}, linuxcnc_at_origin()).message.find("P500") !=
+        std::string::npos);
+}
+
 TEST_CASE("cycle errors: missing words, bottom above R, wrong axis, retracted incremental") {
   CHECK(error_of("G0 X0 Y0 Z5\nG81 X1 Z-1 F10\n").message.find("needs R") != std::string::npos);
   CHECK(error_of("G0 X0 Y0 Z5\nG83 X1 Z-1 R1 F10\n").message.find("Q") != std::string::npos);
