@@ -73,6 +73,7 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
   s.dwell_sink = &dwell_sink;
   s.offsets = s.machine.work_offsets;
   for (const auto& [n, value] : s.machine.variables) s.preset(n, value);
+  for (const auto& [name, value] : s.machine.named_variables) s.named_globals[name] = Value{value, false};
   if (auto it = s.offsets.find(1); it != s.offsets.end()) s.work_offset = it->second;
   s.world_origin = s.work_offset;
   s.unit = s.machine.inch_at_start ? 25.4 : 1.0;

@@ -102,6 +102,18 @@ TEST_CASE("machine files: \"variables\" are what the control holds when the prog
   r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "m.json").string()}, dir);
   REQUIRE(r.status == 0);
   CHECK(moves_of(r).size() == 3);
+  // LinuxCNC's global named parameters, as the operator sets them by MDI (case and spaces as
+  // LinuxCNC reads names); a local name cannot be preset.
+  write_text(dir / "n.ngc", "G21 G90\nG0 X0 Y0 Z1\nG1 X#<_td> Y#<_Tool_Dia> F100\nM2\n");
+  write_text(dir / "n.json", R"({"base": "linuxcnc", "variables": {"#<_td>": 6.35, "#<_tool_ dia>": 3}})");
+  r = run_tridex({"moves", (dir / "n.ngc").string(), "--machine", (dir / "n.json").string()}, dir);
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  CHECK(moves_of(r).back()["end"] == nlohmann::json::array({6.35, 3, 1}));
+  write_text(dir / "n.json", R"({"base": "linuxcnc", "variables": {"#<td>": 6.35}})");
+  r = run_tridex({"moves", (dir / "n.ngc").string(), "--machine", (dir / "n.json").string()}, dir);
+  CHECK(r.status == 2);
+  CHECK(r.err.find("\"#<td>\" is not a global named parameter") != std::string::npos);
   fs::remove_all(dir);
 }
 

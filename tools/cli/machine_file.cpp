@@ -1,6 +1,7 @@
 #include "machine_file.hpp"
 
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -180,13 +181,22 @@ gcode::MachineConfig parse(const json& doc, const std::string& file, MachineRate
     } else if (key == "variables") {  // {"#650": 2000, "#1000": 0}: what the control holds
       if (!value.is_object()) input_error(where, ": must be an object such as {\"#650\": 2000}");
       for (const auto& [name, number] : value.items()) {
+        if (!number.is_number() || !std::isfinite(number.get<double>()))
+          input_error(where, ": \"", name, "\": must be a number, got ", number.dump());
+        if (name.starts_with("#<")) {  // LinuxCNC's named global, case and spaces as it reads them
+          std::string global;
+          for (char c : name.substr(2, name.size() > 3 ? name.size() - 3 : 0))
+            if (c != ' ' && c != '\t') global.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(c))));
+          if (!name.ends_with(">") || global.size() < 2 || global[0] != '_')
+            input_error(where, ": \"", name, "\" is not a global named parameter (#<_name>)");
+          m.named_variables[global] = number.get<double>();
+          continue;
+        }
         std::string digits = name.starts_with("#") ? name.substr(1) : name;
         char* end = nullptr;
         const long n = digits.empty() ? -1 : std::strtol(digits.c_str(), &end, 10);
         if (n < 1 || n > 999999 || *end != '\0')
-          input_error(where, ": \"", name, "\" is not a variable number (#1 to #999999)");
-        if (!number.is_number() || !std::isfinite(number.get<double>()))
-          input_error(where, ": \"", name, "\": must be a number, got ", number.dump());
+          input_error(where, ": \"", name, "\" is not a variable number (#1 to #999999) or #<_name>");
         m.variables[static_cast<int>(n)] = number.get<double>();
       }
     } else if (key == "kinematics") {

@@ -108,6 +108,9 @@ struct MachineConfig {
   // commons (Fanuc #500-#999, kept across power-off) and the inputs a program reads (#1000...),
   // which the program alone cannot know. Any other starts vacant (0 under LinuxCNC).
   std::map<int, double> variables;
+  // LinuxCNC's global named parameters the same way (#<_name>, the name lower case without its
+  // #< >), such as a value the operator sets by MDI before running the program.
+  std::map<std::string, double> named_variables;
 
   // Where M98 / G65 / o<name> call look for programs the file does not contain: O1234.nc-style
   // files (and name.ngc for LinuxCNC) in these folders, in order.
