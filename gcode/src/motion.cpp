@@ -185,10 +185,10 @@ Interpreter::State::ArcData Interpreter::State::arc_data(const Vec3& start, bool
         error(motion_column, "arc end radius " + format_number(r1) + " differs from start radius " +
                                  format_number(r0) + " by more than LinuxCNC's spiral tolerance (" +
                                  format_number(spiral) + " mm, or 0.1 % of the radius)");
-    } else if (err > options.arc_radius_tolerance) {
+    } else if (err > machine.arc_radius_tolerance) {
       error(motion_column, "arc end radius " + format_number(r1) + " differs from start radius " +
                                format_number(r0) + " by more than " +
-                               format_number(options.arc_radius_tolerance) + " mm");
+                               format_number(machine.arc_radius_tolerance) + " mm");
     }
   } else {
     double r = length('R');
@@ -196,7 +196,7 @@ Interpreter::State::ArcData Interpreter::State::arc_data(const Vec3& start, bool
     if (!(std::abs(r) > 1e-9)) error(w.col('R'), "zero-radius arc (R0)");
     if (!(d > 1e-9))
       error(w.col('R'), "R-form arc with the same start and end point (a full circle needs I/J/K)");
-    if (d > 2 * std::abs(r) + options.arc_radius_tolerance)
+    if (d > 2 * std::abs(r) + machine.arc_radius_tolerance)
       error(w.col('R'), "arc radius " + format_number(std::abs(r)) +
                             " is too small for its chord of " + format_number(d));
     result.programmed_radius = std::abs(r);

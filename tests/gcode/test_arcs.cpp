@@ -181,7 +181,7 @@ TEST_CASE("arcs: bad arcs are errors with their position") {
 
 // LinuxCNC 2.9 (interp_arc.cc; each case checked with rs274) cuts an I/J/K arc whose end radius differs from its start radius
 // as a spiral up to 0.02·√2 mm (G21) or 0.002·√2 in (G20), and up to 100 times that within 0.1 %
-// of the radius; tridex's own rule (arc_radius_tolerance, 0.002 mm) stays for other machines.
+// of the radius; the machine's arc_radius_tolerance (0.02 mm unless set) stays for other machines.
 TEST_CASE("arcs: LinuxCNC's spiral tolerance on --machine linuxcnc") {
   const MachineConfig linuxcnc = *MachineConfig::bundled("linuxcnc");
   // Radius 10 → 10.02 mm: within 0.02·√2 mm.
@@ -189,7 +189,17 @@ TEST_CASE("arcs: LinuxCNC's spiral tolerance on --machine linuxcnc") {
   Result r = run_program(small, {}, linuxcnc);
   REQUIRE(!r.moves.empty());
   CHECK(near(r.moves.back().end, Vec3(0, 10.02, 0)));
-  CHECK(error_of(small).message.find("0.002 mm") != std::string::npos);
+  // Fanuc's rule: a spiral up to the machine's arc_radius_tolerance (0.02 mm unless set), an
+  // alarm beyond; a program posted to 4 decimals of an inch is 0.00254 mm off.
+  const std::string inch4 = "G20 G17 G90 F10\nG0 X21.5179 Y2. Z0.1\nG3 X19.6618 I-0.928 J0.\n";
+  Result fanuc = run_program(inch4);
+  REQUIRE(!fanuc.moves.empty());
+  CHECK(near(fanuc.moves.back().end, Vec3(19.6618, 2, 0.1) * 25.4));
+  MachineConfig tight;
+  tight.arc_radius_tolerance = 0.002;
+  CHECK(error_of(inch4, {}, tight).message.find("by more than 0.002 mm") != std::string::npos);
+  CHECK(error_of("G21 G17 G90 F100\nG0 X10 Y0 Z0\nG3 X0 Y10.03 I-10 J0\n").message.find("by more than 0.02 mm") !=
+        std::string::npos);
   // 10 → 10.03 mm: over 0.0283 mm and over 0.1 % of the radius.
   Diagnostic d = error_of("G21 G17 G90 F100\nG0 X10 Y0 Z0\nG3 X0 Y10.03 I-10 J0\n", {}, linuxcnc);
   CHECK(d.message.find("spiral tolerance") != std::string::npos);

@@ -117,6 +117,22 @@ TEST_CASE("machine files: \"variables\" are what the control holds when the prog
   fs::remove_all(dir);
 }
 
+TEST_CASE("machine files: \"arc_radius_tolerance_mm\" is how far an arc's end may lie off its circle") {
+  fs::path dir = scratch("machine-arc");
+  // 0.00254 mm off (an inch program posted to 4 decimals): within the default 0.02 mm.
+  write_text(dir / "p.nc", "G20 G17 G90\nG0 X21.5179 Y2. Z0.1\nG3 X19.6618 I-0.928 J0. F10.\nM30\n");
+  write_text(dir / "tight.json", R"({"arc_radius_tolerance_mm": 0.002})");
+  write_text(dir / "bad.json", R"({"arc_radius_tolerance_mm": 0})");
+  CHECK(run_tridex({"moves", (dir / "p.nc").string()}, dir).status == 0);
+  CommandResult r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "tight.json").string()}, dir);
+  CHECK(r.status == 2);
+  CHECK(r.err.find("p.nc:3:") != std::string::npos);
+  r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "bad.json").string()}, dir);
+  CHECK(r.status == 2);
+  CHECK(r.err.find("\"arc_radius_tolerance_mm\": must be a positive number") != std::string::npos);
+  fs::remove_all(dir);
+}
+
 TEST_CASE("machine files: T alone loads the tool where the control does so") {
   fs::path dir = scratch("machine-t");
   write_text(dir / "p.nc", "T3\nG0 X0 Y0 Z5\nG1 Z0 F100\nM30\n");

@@ -158,6 +158,10 @@ gcode::MachineConfig parse(const json& doc, const std::string& file, MachineRate
     } else if (key == "tool_loads_on_t") {
       if (!value.is_boolean()) input_error(where, ": must be true or false, got ", value.dump());
       m.tool_loads_on_t = value.get<bool>();
+    } else if (key == "arc_radius_tolerance_mm") {  // Fanuc's parameter 3410
+      if (!value.is_number() || !(value.get<double>() > 0) || !std::isfinite(value.get<double>()))
+        input_error(where, ": must be a positive number of mm, got ", value.dump());
+      m.arc_radius_tolerance = value.get<double>();
     } else if (key == "d_offsets") {  // what the D registers hold (Haas: its setting 40)
       std::string d = string_value(value, where).get<std::string>();
       if (d != "radius" && d != "diameter") input_error(where, ": \"radius\" or \"diameter\", got \"", d, "\"");
@@ -238,7 +242,7 @@ gcode::MachineConfig parse(const json& doc, const std::string& file, MachineRate
         m.subprogram_dirs.push_back((base / string_value(dir, where).get<std::string>()).string());
     } else {
       input_error(where, ": unknown key (known: name, description, base, dialect, units, start, "
-                         "tool_change, tool_loads_on_t, d_offsets, home, reference2, work_offsets, m_codes, "
+                         "tool_change, tool_loads_on_t, arc_radius_tolerance_mm, d_offsets, home, reference2, work_offsets, m_codes, "
                          "forbidden_m_codes, variables, far_distance, subprograms, kinematics, "
                          "rapid_rate_mm_per_min, rapid_rate_deg_per_min, max_feed_mm_per_min)");
     }

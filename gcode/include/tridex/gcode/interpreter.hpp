@@ -88,6 +88,11 @@ struct MachineConfig {
   ToolChange tool_change = ToolChange::retract_far;
   Vec3 tool_change_position{0.0};  // machine coordinates, for ToolChange::to_position
   bool tool_loads_on_t = false;    // the control loads a tool on T alone (no M6 needed)
+  // Fanuc and Haas: how far an I/J/K arc's end may lie off its circle (mm; Fanuc's parameter
+  // 3410) before the control alarms; within it the arc is cut as a spiral. The default passes a
+  // program posted to 4 decimals of an inch (0.0001 in = 0.00254 mm off). LinuxCNC's own rule
+  // replaces it under its dialect.
+  double arc_radius_tolerance = 0.02;
   DOffsets d_offsets = DOffsets::dialect;
   bool inch_at_start = false;      // units before any G20/G21: inch (true) or mm
   // G53 with the tool along +Z: false, a G53 Z is a retract (the tip goes far along the tool, as
@@ -150,7 +155,6 @@ struct MachineConfig {
 
 struct InterpreterOptions {
   double arc_tolerance = 0.001;         // mm, largest chord error of a linearised arc
-  double arc_radius_tolerance = 0.002;  // mm, allowed |end radius − start radius| of I/J/K arcs
   bool lenient = false;        // unsupported words become warnings and are skipped
   bool block_delete = true;    // skip blocks that start with '/' (the switch on)
   int max_call_depth = 16;     // nested M98 / G65 / o-word calls
