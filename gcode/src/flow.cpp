@@ -8,8 +8,12 @@
 // subroutines and GOTO targets met, and a stack of calls, loops and branches. A GOTO or a call to
 // a label not seen yet reads ahead (without executing) noting labels on the way, as M98 always
 // did; a WHILE whose condition is false skips to its END the same way.
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <set>
 
 #include "line_reader.hpp"
 #include "state.hpp"
@@ -101,6 +105,7 @@ class ProgramFlow {
   bool scan_for(const std::function<bool()>& found);
   std::optional<std::pair<std::size_t, Source::Label>> find_external(const std::string& label,
                                                                      bool o_word);
+  std::optional<std::filesystem::path> find_by_o_number(const std::filesystem::path& dir, int number);
   template <class Key>
   std::optional<Position> find_body(std::map<Key, Source::Label> Source::*table, const Key& key,
                                     const std::string& label, bool o_word, int column);
@@ -128,6 +133,8 @@ class ProgramFlow {
   std::uint64_t statement_offset_ = 0;  // where the line being executed starts
   std::string_view skipped_;            // the line skip_until stopped at (until the next read)
   std::vector<Value> o_arguments_;      // an o-word call's arguments
+  // Per subprogram folder, its files by the O number they start with (find_by_o_number).
+  std::map<std::filesystem::path, std::map<int, std::filesystem::path>> o_numbers_;
 };
 
 bool ProgramFlow::read(std::string_view& out) {
@@ -195,7 +202,8 @@ bool ProgramFlow::scan_for(const std::function<bool()>& found) {
 }
 
 // A subprogram file: `O1234.nc`-style names for an O number, `name.ngc` for a LinuxCNC o-word,
-// in the machine's subprogram folders and the program's own folder.
+// in the machine's subprogram folders and the program's own folder; failing a name, for an O
+// number, the file of those folders that starts with it (a control keeps programs by number).
 std::optional<std::pair<std::size_t, Source::Label>> ProgramFlow::find_external(
     const std::string& label, bool o_word) {
   std::vector<std::string> names;
@@ -206,7 +214,7 @@ std::optional<std::pair<std::size_t, Source::Label>> ProgramFlow::find_external(
     std::string padded = label;
     while (padded.size() < 4) padded = "0" + padded;
     for (const std::string& stem : {"O" + padded, "O" + label, "o" + padded, "o" + label, label})
-      for (const char* ext : {".nc", ".NC", ".ngc", ".NGC", ".tap", ".txt", ""})
+      for (const char* ext : {".nc", ".NC", ".ngc", ".NGC", ".tap", ".txt", ".cnc", ""})
         names.push_back(stem + ext);
   }
   std::vector<std::filesystem::path> dirs;
@@ -214,24 +222,75 @@ std::optional<std::pair<std::size_t, Source::Label>> ProgramFlow::find_external(
   dirs.push_back(std::filesystem::path(sources_[0]->name).parent_path());
   for (std::size_t k = 0; k < sources_.size(); ++k)
     if (sources_[k]->name == label) return std::pair{k, Source::Label{sources_[k]->start, 0}};
+  auto open = [&](const std::filesystem::path& path) -> std::optional<std::pair<std::size_t, Source::Label>> {
+    std::string shown = path.string();
+    for (std::size_t k = 0; k < sources_.size(); ++k)
+      if (sources_[k]->name == shown) return std::pair{k, Source::Label{sources_[k]->start, 0}};
+    auto file = std::make_unique<std::ifstream>(path, std::ios::binary);
+    if (!*file) return std::nullopt;
+    auto src = std::make_unique<Source>(shown, *file);
+    src->owned = std::move(file);
+    sources_.push_back(std::move(src));
+    s_.files.push_back(shown);
+    return std::pair{sources_.size() - 1, Source::Label{sources_.back()->start, 0}};
+  };
   for (const auto& dir : dirs) {
     for (const std::string& name : names) {
-      std::filesystem::path path = dir / name;
       std::error_code ec;
-      if (!std::filesystem::is_regular_file(path, ec)) continue;
-      std::string shown = path.string();
-      for (std::size_t k = 0; k < sources_.size(); ++k)
-        if (sources_[k]->name == shown) return std::pair{k, Source::Label{sources_[k]->start, 0}};
-      auto file = std::make_unique<std::ifstream>(path, std::ios::binary);
-      if (!*file) continue;
-      auto src = std::make_unique<Source>(shown, *file);
-      src->owned = std::move(file);
-      sources_.push_back(std::move(src));
-      s_.files.push_back(shown);
-      return std::pair{sources_.size() - 1, Source::Label{sources_.back()->start, 0}};
+      if (!std::filesystem::is_regular_file(dir / name, ec)) continue;
+      if (auto found = open(dir / name)) return found;
     }
   }
+  if (o_word) return std::nullopt;
+  for (const auto& dir : dirs)
+    if (auto path = find_by_o_number(dir, std::stoi(label)))
+      if (auto found = open(*path)) return found;
   return std::nullopt;
+}
+
+// The file of `dir` whose program starts with O<number> (or Fanuc's `:<number>`) on its first line
+// after `%`, blank lines and comments, whatever its name. The folder's files with a G-code
+// extension (or none) are read once, their first kilobyte each.
+std::optional<std::filesystem::path> ProgramFlow::find_by_o_number(const std::filesystem::path& dir, int number) {
+  auto [index, fresh] = o_numbers_.try_emplace(dir);
+  if (fresh) {
+    static const std::set<std::string> kExtensions = {"", ".nc", ".ngc", ".tap", ".txt", ".cnc", ".eia",
+                                                      ".min", ".mpf", ".spf", ".ptp", ".gcode", ".iso"};
+    std::error_code ec;
+    std::vector<std::filesystem::path> files;
+    for (std::filesystem::directory_iterator it(dir.empty() ? "." : dir, ec), end; !ec && it != end; it.increment(ec)) {
+      std::string ext = it->path().extension().string();
+      for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      if (it->is_regular_file(ec) && kExtensions.count(ext)) files.push_back(it->path());
+    }
+    std::sort(files.begin(), files.end());  // the first in name order wins a number two files start with
+    for (const auto& path : files) {
+      std::ifstream in(path, std::ios::binary);
+      std::string head(1024, '\0');
+      in.read(head.data(), static_cast<std::streamsize>(head.size()));
+      head.resize(static_cast<std::size_t>(in.gcount()));
+      std::size_t i = 0;
+      while (i < head.size()) {  // past %, blank lines and whole-line comments
+        const char c = head[i];
+        if (c == '%' || c == ' ' || c == '\t' || c == '\r' || c == '\n') {
+          ++i;
+        } else if (c == '(' || c == ';') {
+          i = head.find('\n', i);
+          if (i == std::string::npos) i = head.size();
+        } else {
+          break;
+        }
+      }
+      if (i >= head.size() || (head[i] != 'O' && head[i] != 'o' && head[i] != ':')) continue;
+      std::size_t digits = i + 1;
+      while (digits < head.size() && digits - i <= 9 && std::isdigit(static_cast<unsigned char>(head[digits]))) ++digits;
+      if (digits == i + 1 || digits - i > 9) continue;
+      index->second.try_emplace(std::stoi(head.substr(i + 1, digits - i - 1)), path);
+    }
+  }
+  auto it = index->second.find(number);
+  if (it == index->second.end()) return std::nullopt;
+  return it->second;
 }
 
 void ProgramFlow::skip_until(const std::function<bool(const Skim&)>& stop, const std::string& what,

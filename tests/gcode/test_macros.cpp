@@ -227,7 +227,7 @@ TEST_CASE("macros: LinuxCNC o-words give the moves of the same program written o
              "G0 X1 Y8 Z0\nM2\n", l);
 }
 
-TEST_CASE("macros: subprogram files are found by name") {
+TEST_CASE("macros: subprogram files are found by name, or by the O number they start with") {
   namespace fs = std::filesystem;
   fs::path dir = fs::temp_directory_path() / ("tridex_subs_" + std::to_string(::getpid()));
   fs::create_directories(dir);
@@ -259,6 +259,16 @@ TEST_CASE("macros: subprogram files are found by name") {
   r = run_program("G65 P9999\nG0 X1 Y1 Z1\nM30\n", lenient, m);
   CHECK(r.moves.size() == 1);
   CHECK(!r.warnings.empty());
+  // Failing a name, by the O number a file starts with (after %, blank lines and comments), as a
+  // control keeps them; Fanuc's ':' spelling too. A file that starts otherwise is not taken.
+  std::ofstream(dir / "gauge_tool.cnc") << "%\n(TOOL GAUGE)\n\nO1002 (SUB)\nG0 X7 Y8 Z3\nM99\n%\n";
+  std::ofstream(dir / "second.txt") << ":1003\nG0 X9 Y9 Z9\nM99\n";
+  std::ofstream(dir / "notes.txt") << "G0 X1\nO1004\nM99\n";
+  r = run_program("M98 P1002\nM98 P1003\nM30\n", {}, m);
+  REQUIRE(r.moves.size() == 2);
+  CHECK(near(r.moves[0].end, Vec3(7, 8, 3)));
+  CHECK(near(r.moves[1].end, Vec3(9, 9, 9)));
+  CHECK(error_of("M98 P1004\nM30\n", {}, m).message.find("O1004") != std::string::npos);
   fs::remove_all(dir);
 }
 
