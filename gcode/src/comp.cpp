@@ -4,7 +4,10 @@
 // convert_cutter_compensation_on/off; interp_queue.cc: move_endpoint_and_flush), so that tridex
 // and `rs274` agree move for move, errors included:
 // - the entry move (the first after G41/G42) ends one radius to the side of its programmed end,
-//   perpendicular to itself; an entry no longer than the radius is an error;
+//   perpendicular to itself; an entry no longer than the radius is an error. Fanuc and Haas
+//   (their start-up of type A, Fanuc's default) end it perpendicular to the start of the next
+//   move instead, of any length; so a hole's "line from the centre, then G3 I" needs no room
+//   for a corner (comp_resolve_entry);
 // - later moves end one radius to the side of their programmed ends; a convex corner gets an arc
 //   about the programmed corner (a G0 gets a straight piece instead); at a concave corner the
 //   moves still waiting in the queue are cut back to where the offset paths meet, an error when
@@ -61,13 +64,16 @@ void Interpreter::State::cutter_comp_codes(int code, int column) {
     }
     comp_side = 0;
     comp_first = true;
+    comp_entry_pending = false;
     return;
   }
   std::string name = code_name('G', code);
   if (plane != 170 && plane != 180)
     error(column, name + " in " + code_name('G', plane) +
                       ": cutter compensation works in the XY (G17) or XZ (G18) plane only");
-  if (comp_side != 0) error(column, name + " while cutter compensation is already on (G40 first)");
+  const bool was_on = comp_side != 0;
+  if (was_on && (machine.dialect == Dialect::linuxcnc || code == 411 || code == 421))
+    error(column, name + " while cutter compensation is already on (G40 first)");
   int side = code == 410 || code == 411 ? 1 : -1;
   double radius = 0;
   if (code == 411 || code == 421) {  // LinuxCNC: D is the diameter itself
@@ -83,6 +89,12 @@ void Interpreter::State::cutter_comp_codes(int code, int column) {
   if (radius < 0) {  // a negative radius offsets to the other side (LinuxCNC)
     radius = -radius;
     side = -side;
+  }
+  if (was_on) {  // Fanuc and Haas: the mode given again, which changes nothing if side and radius stay
+    if (side != comp_side || std::abs(radius - comp_radius) > 1e-9)
+      error(column, name + " changes the side or the radius of cutter compensation while it is on: "
+                           "tridex needs G40 between (the control's transition is not simulated)");
+    return;
   }
   comp_side = side;
   comp_radius = radius;
@@ -188,9 +200,12 @@ void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double
   if (comp_first) {  // the entry move (convert_straight_comp1)
     Vec2 c = plane_uv(to_program(pos));
     double distance = glm::length(p - c);
-    if (distance <= r)
+    const bool fanuc_start = machine.dialect != Dialect::linuxcnc;
+    if (fanuc_start ? !(distance > kEqual) : distance <= r)
       error(motion_column, "cutter compensation entry move of length " + format_number(distance) +
-                               " mm is not longer than the tool radius " + format_number(r) + " mm");
+                               (fanuc_start ? " mm: it must move in the plane"
+                                            : " mm is not longer than the tool radius " + format_number(r) + " mm"));
+    comp_entry_pending = fanuc_start;
     double alpha = angle_of(p - c) + (side > 0 ? kHalfPi : -kHalfPi);
     Vec2 end = p + r * polar(alpha);
     comp_endpoint = c;
@@ -205,6 +220,7 @@ void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double
     return;
   }
   // Later moves (convert_straight_comp2).
+  if (comp_entry_pending) comp_resolve_entry(p - plane_uv(comp_programmed));
   const Vec2 c = plane_uv(comp_current);
   const Vec2 op = plane_uv(comp_programmed);
   Vec2 end = c;
@@ -289,6 +305,22 @@ void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double
   comp_programmed_current = true;
 }
 
+// Fanuc's and Haas's start-up (Fanuc's type A): the entry move, queued ending perpendicular to
+// itself, ends one radius to the side of its programmed end perpendicular to the next move's
+// start instead; the next move then starts straight on from it, with no corner. A next move with
+// no motion in the plane leaves the entry as it was.
+void Interpreter::State::comp_resolve_entry(const Vec2& next_direction) {
+  comp_entry_pending = false;
+  const double length = glm::length(next_direction);
+  if (!(length > kEqual) || comp_queue.size() != 1) return;
+  const Vec2 unit_direction = next_direction / length;
+  const Vec2 side = comp_side > 0 ? Vec2(-unit_direction.y, unit_direction.x) : Vec2(unit_direction.y, -unit_direction.x);
+  CompMove& entry = comp_queue.front();
+  entry.end = with_plane_uv(entry.end, plane_uv(comp_programmed) + comp_radius * side);
+  entry.direction = plane_uv(entry.end) - comp_endpoint;  // from where the entry starts
+  comp_current = entry.end;
+}
+
 void Interpreter::State::comp_arc(bool ccw) {
   if (far)
     error(motion_column, "cutter compensation from a retracted (far) position: the tool's position "
@@ -337,9 +369,13 @@ void Interpreter::State::comp_arc(bool ccw) {
     return;
   }
   // Later arcs (convert_arc_comp2).
+  ArcData a = arc_data(comp_programmed, ccw);
+  if (comp_entry_pending) {  // the arc's tangent at its start
+    const Vec2 radial = plane_uv(comp_programmed) - a.centre;
+    comp_resolve_entry(ccw ? Vec2(-radial.y, radial.x) : Vec2(radial.y, -radial.x));
+  }
   const Vec2 op = plane_uv(comp_programmed);
   const Vec2 c = plane_uv(comp_current);
-  ArcData a = arc_data(comp_programmed, ccw);
   if (feed_mode == FeedMode::inverse_time) inverse_time_rate(arc_length(comp_programmed, a, ccw));
   move.feed = feed;
   const Vec2 centre = a.centre, end = plane_uv(a.end);

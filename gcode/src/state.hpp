@@ -482,6 +482,9 @@ struct Interpreter::State : ParameterReader {
   }
   double d_offset_radius(int number, int column, const std::string& code);  // comp.cpp
   bool comp_first = true;              // the next compensated move is the entry move
+  // Fanuc/Haas: the entry move's end waits for the next move's start direction (comp.cpp).
+  bool comp_entry_pending = false;
+  void comp_resolve_entry(const Vec2& next_direction);
   bool comp_arc_forbidden = false;     // just after G40: the next move must be straight
   bool comp_programmed_current = false;  // coordinates count from comp_programmed, not the tip
   Vec3 comp_programmed{0.0};           // the last programmed point (program frame)

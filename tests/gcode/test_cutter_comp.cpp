@@ -183,3 +183,48 @@ TEST_CASE("after G40 the next move counts from the programmed point, after a too
   Result changed = run_program(head + "T2 M6\nG0 Z10\nM2\n", {}, with_tools());
   CHECK(near(changed.moves.back().end, Vec3(20, 3, 10), 1e-9));
 }
+
+TEST_CASE("Fanuc and Haas start-up (type A): the entry ends perpendicular to the next move's start") {
+  for (const Dialect dialect : {Dialect::fanuc, Dialect::haas}) {
+    CAPTURE(static_cast<int>(dialect));
+    MachineConfig m = with_tools();
+    m.dialect = dialect;
+    // A hole of radius 8 milled from its centre with a D6 (r = 3): the entry ends at (-5, 0),
+    // perpendicular to the circle's start, and the tool runs round at radius 5 (LinuxCNC finds no
+    // corner there: the entry's offset line y = -3 meets that circle only for r <= 2.5).
+    Result hole = run_program("G21 G17 G90 F300\nT1 M6\nG0 X0 Y0 Z5\nG1 Z-2\nG41 D1 G1 X-8 Y0\nG3 I8 J0\n"
+                              "G40 G1 X0 Y0\nM30\n",
+                              {}, m);
+    int on_circle = 0;
+    for (const Move& move : hole.moves) {
+      if (move.line == 5) CHECK(near(move.end, Vec3(-5, 0, -2)));
+      if (move.line != 6) continue;
+      CHECK(std::abs(std::hypot(move.end.x, move.end.y) - 5) < 1e-9);
+      ++on_circle;
+    }
+    CHECK(on_circle > 20);
+    CHECK(near(hole.moves.back().end, Vec3(0, 0, -2)));
+    // Line to line, turning left under G41: the entry ends at (7, 0), beside the next move's
+    // start, with no corner to cut back; an entry shorter than the radius is fine.
+    Result corner = run_program("G21 G17 G90 F300\nT1 M6\nG0 X0 Y0 Z-1\nG41 D1 G1 X10 Y0\nG1 Y10\nG40 G1 X20\nM30\n",
+                                {}, m);
+    REQUIRE(corner.moves.size() >= 3);
+    CHECK(near(corner.moves[1].end, Vec3(7, 0, -1)));
+    CHECK(near(corner.moves[2].end, Vec3(7, 10, -1)));
+    Result short_entry = run_program("G21 G17 G90 F300\nT1 M6\nG0 X0 Y0 Z-1\nG41 D1 G1 X1 Y0\nG1 X20\nG40 G1 Y-10\nM30\n",
+                                     {}, m);
+    REQUIRE(short_entry.moves.size() >= 3);
+    CHECK(near(short_entry.moves[1].end, Vec3(1, 3, -1)));
+    CHECK(near(short_entry.moves[2].end, Vec3(20, 3, -1)));
+    // G41 given again with the same side and radius changes nothing; another radius is refused.
+    Result again = run_program("G21 G17 G90 F300\nT1 M6\nG0 X0 Y0 Z-1\nG41 D1 G1 X1 Y0\nG41 G1 X20\nG40 G1 Y-10\nM30\n",
+                               {}, m);
+    REQUIRE(again.moves.size() == short_entry.moves.size());
+    for (std::size_t i = 0; i < again.moves.size(); ++i) CHECK(near(again.moves[i].end, short_entry.moves[i].end));
+    CHECK(error_of("G21 G17 G90 F300\nT1 M6\nG0 X0 Y0 Z-1\nG41 D1 G1 X1 Y0\nG41 D2 G1 X20\n", {}, m)
+              .message.find("changes the side or the radius") != std::string::npos);
+  }
+  // LinuxCNC keeps its own rule: the same short entry is refused.
+  CHECK(error_of("G21 G17 G90 F300\nT1 M6\nG0 X0 Y0 Z-1\nG41 D1 G1 X1 Y0\nG1 X20\n", {}, with_tools())
+            .message.find("not longer than the tool radius") != std::string::npos);
+}
