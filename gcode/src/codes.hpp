@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 namespace tridex::gcode {
 
@@ -29,6 +30,7 @@ struct Words {
   std::array<Code, 8> m{};
   int m_count = 0;
   bool m_arguments = false;  // an accepted M-code that takes P Q E L R words is in the block
+  const std::vector<std::string>* vacant_words = nullptr;  // the block's (Block::vacant_words)
 
   bool has(char c) const { return (present >> letter_index(c)) & 1u; }
   int col(char c) const { return column[static_cast<std::size_t>(letter_index(c))]; }

@@ -462,7 +462,13 @@ class LineLexer : public Parser {
         fail(i_, std::string("word ") + letter + ": parameters and expressions are not supported");
       v = primary(start);
       if (v.vacant) {
-        if (parameters_->vacant_words_omitted()) return;  // Fanuc: as if not written
+        if (parameters_->vacant_words_omitted()) {  // Fanuc: as if not written
+          std::string written(1, letter);
+          for (std::size_t k = start + 1; k < i_; ++k)
+            if (!is_space(text_[k])) written.push_back(text_[k]);
+          block_.vacant_words.push_back(std::move(written));
+          return;
+        }
         v = Value{0, false};
       }
     } else {

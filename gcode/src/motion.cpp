@@ -89,7 +89,15 @@ void Interpreter::State::require_feed() {
       error(motion_column, "cannot feed with zero spindle speed in feed per revolution mode (G95)");
     return;
   }
-  if (!(feed > 0)) error(motion_column, "feed move with no feed rate (F) set");
+  if (!(feed > 0)) {
+    std::string left_out;
+    if (w.vacant_words)
+      for (const std::string& word : *w.vacant_words)
+        if (word[0] == 'F')
+          left_out = ": this block's " + word + " was left out, its value vacant (a variable the control keeps, such "
+                     "as #500-#999, is set at the start by the machine file's \"variables\")";
+    error(motion_column, "feed move with no feed rate (F) set" + left_out);
+  }
 }
 
 // G93: a block `length` mm long (its programmed path, as LinuxCNC's inverse_time_rate_straight

@@ -267,6 +267,7 @@ struct Interpreter::State : ParameterReader {
     find_splines(block);
     w.g_count = w.m_count = 0;
     w.m_arguments = false;
+    w.vacant_words = &block.vacant_words;
     std::array<int, kGroupCount> g_seen{};
     std::array<int, kMGroupCount> m_seen{};
     // In a G65 block M is an argument (#13), not an M-code (Fanuc's argument specification I).

@@ -102,8 +102,11 @@ struct Block {
   Control control;
   bool block_delete = false;  // the block starts with '/'
   bool percent = false;       // the line is a '%' tape delimiter
+  // Fanuc: words left out because their value was vacant, as written ("F#650"), for messages.
+  std::vector<std::string> vacant_words;
   void clear() {
     words.clear();
+    vacant_words.clear();
     assignments.clear();
     control = Control{};
     block_delete = false;
