@@ -100,7 +100,7 @@ TEST_CASE("macros: parameters, indirection, named parameters and the vacant valu
   CHECK(near(r.moves[1].end, Vec3(1, 4, 1)));
   CHECK(value_of("0 EQ #0") == 0);
   // A feed left out for a vacant value (a persistent common the machine holds) is named.
-  CHECK(error_of("G0 X0 Y0 Z5\nG1 Z0 F[#650 * 2]\n").message.find("F[#650*2] was left out") != std::string::npos);
+  CHECK(error_of("G0 X0 Y0 Z5\nG1 Z0 F#650\n").message.find("F#650 was left out") != std::string::npos);
   // LinuxCNC reads the same word as 0.
   r = run_program("G0 X1 Y2 Z3\nG0 X#5\nM30\n", {}, dialect(Dialect::linuxcnc));
   CHECK(near(r.moves[1].end, Vec3(0, 2, 3)));
