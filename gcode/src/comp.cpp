@@ -81,9 +81,18 @@ void Interpreter::State::cutter_comp_codes(int code, int column) {
     if (w.has('L')) error(w.col('L'), name + " L (a lathe tool's orientation) is not simulated: tridex simulates mills");
     radius = length('D') / 2;
   } else {
-    int number = offset_d >= 0 ? offset_d : tool;
+    // LinuxCNC: D names a tool, the loaded one without D. Fanuc and Haas: D names an offset and
+    // is modal; before any D the control holds D0, no offset (Haas: "a nonzero D code must be
+    // specified" to compensate).
+    const bool fanuc = machine.dialect != Dialect::linuxcnc;
+    int number = offset_d >= 0 ? offset_d : fanuc ? 0 : tool;
     if (w.has('D')) number = static_cast<int>(integer('D', (name + " D (a tool number)").c_str(), 0, 99'999'999));
-    if (w.has('D') && machine.dialect != Dialect::linuxcnc) offset_d = number;
+    if (w.has('D') && fanuc) offset_d = number;
+    if (fanuc && number == 0 && !w.has('D') && !warned_comp_without_d) {
+      warned_comp_without_d = true;
+      warn(column, name + " with no D word and none before: the control compensates by D0, nothing; "
+                          "write " + name + " D<n> for the tool's radius");
+    }
     radius = d_offset_radius(number, w.has('D') ? w.col('D') : column, name);
   }
   if (radius < 0) {  // a negative radius offsets to the other side (LinuxCNC)

@@ -159,6 +159,7 @@ struct Interpreter::State : ParameterReader {
   bool warned_uvw = false;           // U/V/W on a LinuxCNC machine
   Vec3 uvw_position{0.0};            // mm, where the U/V/W words put those axes
   bool warned_probe = false;         // G38.x read as rs274 standalone does
+  bool warned_comp_without_d = false;  // Fanuc/Haas G41/G42 with no D yet: D0
   Vec3 local_offset{0.0};  // G52 / G92 (one register, as LinuxCNC keeps it), machine axes
   Vec3 saved_local_offset{0.0};  // G92.2 suspends, G92.3 restores
   Vec3 world_origin{0.0};

@@ -73,22 +73,24 @@ TEST_CASE("M-codes with arguments of their own: M19 R, LinuxCNC's M62-M68, user 
   CHECK(d.message.find("word I3 is not used") != std::string::npos);
 }
 
-TEST_CASE("Fanuc keeps D for the next G41/G42 (T4 D04 M06); LinuxCNC refuses it as rs274 does") {
+TEST_CASE("Fanuc keeps D for the next G41/G42 (T4 D04 M06), D0 before any; LinuxCNC refuses it as rs274 does") {
   MachineConfig machine = at_origin();
   machine.tool_diameters = {{1, 6.0}, {4, 10.0}};
   const std::string path = "G0 X-20 Y0 Z1\nG1 Z-1 F100\nX0\nY20\nG40 X-20 Y30\nM30\n";
   Result modal = run_program("G21 G90 G17\nT1 D4 M6\nG41\n" + path, {}, machine);
   Result given = run_program("G21 G90 G17\nT1 M6\nG41 D4\n" + path, {}, machine);
-  Result loaded = run_program("G21 G90 G17\nT1 M6\nG41\n" + path, {}, machine);
+  Result no_d = run_program("G21 G90 G17\nT1 M6\nG41\n" + path, {}, machine);
   same_moves(modal, given);
-  // D4 (radius 5) and the loaded tool (radius 3) offset the path differently: the cut along
-  // Y ends 5 mm to the left of X0.
+  // D4 (radius 5) offsets the cut along Y 5 mm to the left of X0; with no D yet the control holds
+  // D0 and does not offset (Haas: "a nonzero D code must be specified"), with a warning.
   bool at_minus_5 = false;
   for (const Move& m : modal.moves) at_minus_5 |= m.kind == MoveKind::feed && std::abs(m.end.x + 5) < 1e-9 && m.end.y > 10;
   CHECK(at_minus_5);
-  bool at_minus_3 = false;
-  for (const Move& m : loaded.moves) at_minus_3 |= m.kind == MoveKind::feed && std::abs(m.end.x + 3) < 1e-9 && m.end.y > 10;
-  CHECK(at_minus_3);
+  bool at_zero = false;
+  for (const Move& m : no_d.moves) at_zero |= m.kind == MoveKind::feed && std::abs(m.end.x) < 1e-9 && m.end.y > 10;
+  CHECK(at_zero);
+  REQUIRE(!no_d.warnings.empty());
+  CHECK(no_d.warnings.front().message.find("D0") != std::string::npos);
   MachineConfig linuxcnc = *MachineConfig::bundled("linuxcnc");
   linuxcnc.tool_diameters = machine.tool_diameters;
   CHECK(error_of("G21 G90\nT1 D4 M6\n", {}, linuxcnc).message.find("word D4 is not used") != std::string::npos);
