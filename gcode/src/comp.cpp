@@ -210,10 +210,18 @@ void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double
     Vec2 c = plane_uv(to_program(pos));
     double distance = glm::length(p - c);
     const bool fanuc_start = machine.dialect != Dialect::linuxcnc;
-    if (fanuc_start ? !(distance > kEqual) : distance <= r)
+    if (fanuc_start && !(distance > kEqual)) {
+      // Haas: "If cutter compensation is turned on ... in a block without any X-Y move, there is
+      // no change made to cutter compensation until the next X or Y move": a plunge goes as
+      // programmed, and the next move in the plane is the entry.
+      const Vec3 end = to_machine(target);
+      emit(kind, pos, end, move_feed);
+      pos = end;
+      return;
+    }
+    if (!fanuc_start && distance <= r)
       error(motion_column, "cutter compensation entry move of length " + format_number(distance) +
-                               (fanuc_start ? " mm: it must move in the plane"
-                                            : " mm is not longer than the tool radius " + format_number(r) + " mm"));
+                               " mm is not longer than the tool radius " + format_number(r) + " mm");
     comp_entry_pending = fanuc_start;
     double alpha = angle_of(p - c) + (side > 0 ? kHalfPi : -kHalfPi);
     Vec2 end = p + r * polar(alpha);

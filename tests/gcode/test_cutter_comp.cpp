@@ -216,6 +216,12 @@ TEST_CASE("Fanuc and Haas start-up (type A): the entry ends perpendicular to the
     REQUIRE(short_entry.moves.size() >= 3);
     CHECK(near(short_entry.moves[1].end, Vec3(1, 3, -1)));
     CHECK(near(short_entry.moves[2].end, Vec3(20, 3, -1)));
+    // A move with no motion in the plane after G41 goes as programmed; the next one is the entry.
+    Result plunge = run_program("G21 G17 G90 F300\nT1 M6\nG0 X0 Y0 Z5\nG41 D1\nG1 Z-1\nG1 X1 Y0\nG1 X20\nG40 G1 Y-10\nM30\n",
+                                {}, m);
+    REQUIRE(plunge.moves.size() == short_entry.moves.size() + 1);
+    CHECK(near(plunge.moves[1].end, Vec3(0, 0, -1)));
+    for (std::size_t i = 1; i < short_entry.moves.size(); ++i) CHECK(near(plunge.moves[i + 1].end, short_entry.moves[i].end));
     // G41 given again with the same side and radius changes nothing; another radius is refused.
     Result again = run_program("G21 G17 G90 F300\nT1 M6\nG0 X0 Y0 Z-1\nG41 D1 G1 X1 Y0\nG41 G1 X20\nG40 G1 Y-10\nM30\n",
                                {}, m);
