@@ -72,12 +72,13 @@ int work_offset_key(const std::string& name, const std::string& where) {
   input_error(where, ": unknown work offset \"", name, "\" (G54..G59 or \"G54.1 P1\"..\"G54.1 P300\")");
 }
 
-// A positive, finite number of mm/min.
-double rate(const json& value, const std::string& where) {
+// A positive, finite number of `unit` (mm, mm/min).
+double positive(const json& value, const std::string& where, const char* unit) {
   if (!value.is_number() || !(value.get<double>() > 0) || !std::isfinite(value.get<double>()))
-    input_error(where, ": must be a positive number of mm/min, got ", value.dump());
+    input_error(where, ": must be a positive number of ", unit, ", got ", value.dump());
   return value.get<double>();
 }
+double rate(const json& value, const std::string& where) { return positive(value, where, "mm/min"); }
 
 // Rotary rapid rates, degrees per minute, indexed A, B, C (0 where not given): one number for
 // every rotary axis, or {"A": …, "B": …, "C": …}.
@@ -159,9 +160,7 @@ gcode::MachineConfig parse(const json& doc, const std::string& file, MachineRate
       if (!value.is_boolean()) input_error(where, ": must be true or false, got ", value.dump());
       m.tool_loads_on_t = value.get<bool>();
     } else if (key == "arc_radius_tolerance_mm") {  // Fanuc's parameter 3410
-      if (!value.is_number() || !(value.get<double>() > 0) || !std::isfinite(value.get<double>()))
-        input_error(where, ": must be a positive number of mm, got ", value.dump());
-      m.arc_radius_tolerance = value.get<double>();
+      m.arc_radius_tolerance = positive(value, where, "mm");
     } else if (key == "d_offsets") {  // what the D registers hold (Haas: its setting 40)
       std::string d = string_value(value, where).get<std::string>();
       if (d != "radius" && d != "diameter") input_error(where, ": \"radius\" or \"diameter\", got \"", d, "\"");
@@ -212,9 +211,7 @@ gcode::MachineConfig parse(const json& doc, const std::string& file, MachineRate
         input_error(e.what());
       }
     } else if (key == "far_distance") {
-      if (!value.is_number() || !(value.get<double>() > 0) || !std::isfinite(value.get<double>()))
-        input_error(where, ": must be a positive number of mm, got ", value.dump());
-      m.far_distance = value.get<double>();
+      m.far_distance = positive(value, where, "mm");
     } else if (key == "rapid_rate_mm_per_min") {
       MachineRates r;
       if (value.is_array()) {
