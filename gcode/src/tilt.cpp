@@ -234,7 +234,9 @@ void Interpreter::State::tilted_plane(int code) {
 
 // G53.1 / G53.6 / G253 turn the tool to the feature Z; LinuxCNC's G53.1, G53.3 and G53.6 take P
 // (0 shortest, 1 positive, 2 negative turn of the rotaries: which pose, not which direction),
-// and G53.3 I J K then rapids to that point of the plane (remap.py's g53n_core).
+// and G53.3 I J K then rapids to that point of the plane (remap.py's g53n_core). That remap turns
+// the rotaries, or makes G53.3's move, with a G0 block of its own, which leaves G0 the motion
+// mode: LinuxCNC's TWP demos (incremental_repetition_g533.ngc) move with bare X Y Z after G53.6.
 void Interpreter::State::orient_to_plane(int code) {
   int column = w.find_g(code);
   if (!tilted) error(column, code_name('G', code) + " without an active tilted plane");
@@ -252,6 +254,7 @@ void Interpreter::State::orient_to_plane(int code) {
     go_far();  // the machine turns the tool: where the tip ends is the kinematics' business
   }
   update_frame();
+  if (machine.dialect == Dialect::linuxcnc) motion = 0;
   if (code != 533) return;
   // LinuxCNC's remap (g533remap.ngc) requires X, Y and Z, and hands them on to M530 as I J K.
   for (char c : {'I', 'J', 'K'})

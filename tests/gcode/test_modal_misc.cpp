@@ -48,6 +48,28 @@ TEST_CASE("G53.6 orients like G53.1; G269 cancels G268; G69 cancels G68.2") {
   CHECK(near(r.moves[3].start, r.moves[2].end, 1e-9));
 }
 
+TEST_CASE("LinuxCNC: G53.1, G53.3 and G53.6 leave G0 the motion mode; Fanuc's keep it") {
+  // LinuxCNC's TWP remap turns the rotaries with a G0 block of its own (remap.py, g53n_core), and
+  // its demos then move with bare X Y Z (incremental_repetition_g533.ngc).
+  MachineConfig linuxcnc;
+  linuxcnc.dialect = Dialect::linuxcnc;
+  for (const char* orient : {"G53.1", "G53.6", "G53.3 X0 Y0 Z30"}) {
+    CAPTURE(orient);
+    Result r = run_program(std::string("G21 G90 G0 X0 Y0 Z50\nG1 X1 F100\nG68.2 X10 Y0 Z0 Q121 I0 J90\n") + orient +
+                               "\nX5 Y5 Z20\nG1 X6\nM2\n",
+                           InterpreterOptions{}, linuxcnc);
+    const Move& bare = r.moves[r.moves.size() - 2];
+    CHECK(bare.kind == MoveKind::rapid);
+    CHECK(near(bare.axis, Vec3(1, 0, 0), 1e-12));       // Q121 J90: the tool along +X
+    // Ry(90°) takes the plane's x, y, z to −Z, +Y, +X: (5, 5, 20) lands at (10, 0, 0) + (20, 5, −5).
+    CHECK(near(bare.end, Vec3(30, 5, -5), 1e-9));
+    CHECK(r.moves.back().kind == MoveKind::feed);
+  }
+  // Fanuc's G53.1 is no motion code: the G1 before it goes on.
+  Result fanuc = run_program("G21 G90 G0 X0 Y0 Z50\nG1 X1 F100\nG68.2 X10 Y0 Z0 I0 J90 K0\nG53.1\nX5 Y5 Z20\nM30\n");
+  CHECK(fanuc.moves.back().kind == MoveKind::feed);
+}
+
 TEST_CASE("G30 P2 is the second reference; P3 is rejected") {
   MachineConfig machine;
   machine.set_reference2(Vec3(7, 8, 0));
