@@ -8,10 +8,15 @@
 //   * mixed cutters in one map: that ball raster plus a coarse roughing raster (2 mm stepover,
 //     1 mm segments, 5,100 segments) with a flat end D10 or a bull nose D8 r1, either 0.4 mm
 //     below the finishing surface (the ball ends then cut air, the case of issue 13) or 0.3 mm
-//     above it (roughing leaves stock for the ball), and each roughing raster alone.
+//     above it (roughing leaves stock for the ball), and each roughing raster alone;
+//   * the finishing raster placed for the ball, the flat end and the bull nose to touch the surface
+//     (drop-cutter), as a CAM system writes it: the tips of the raster above follow the surface, so
+//     that a flat bottom cuts below it wherever it slopes.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "tridex/mill.hpp"
@@ -24,15 +29,40 @@ constexpr double kSide = 100, kCell = 0.02;
 
 double wavy(double x, double y) { return 20 + 3 * std::sin(x / 8) * std::cos(y / 11) + 0.01 * x; }
 
-// A zig-zag raster over the wavy surface raised by `lift`, cut with cutter `cutter`.
-std::vector<CutMove> raster(double stepover, double step, double lift, std::uint32_t cutter) {
+// The lowest tip at (x, y) from which `shape` stays on or above the wavy surface: the surface
+// sampled every 0.1 mm over the footprint (drop-cutter), as a CAM system places a finishing tool.
+// Sampling leaves the tip at most a few µm low, which does not matter to a timing.
+double touching_tip(const Cutter& shape, double x, double y) {
+  const double radius = shape.radius(), step = 0.1;
+  double tip = -std::numeric_limits<double>::infinity();
+  for (double dy = -radius; dy <= radius; dy += step)
+    for (double dx = -radius; dx <= radius; dx += step) {
+      const double d = std::sqrt(dx * dx + dy * dy);
+      if (d <= radius) tip = std::max(tip, wavy(x + dx, y + dy) - shape.lower_height(d));
+    }
+  return tip;
+}
+
+// A zig-zag raster over the wavy surface raised by `lift`, cut with cutter `cutter`; with
+// `touching`, the tips are placed so that that cutter touches the surface instead of its tip
+// following it (which makes a flat end or a bull nose cut below the surface on a slope).
+std::vector<CutMove> raster(double stepover, double step, double lift, std::uint32_t cutter,
+                            const Cutter* touching = nullptr) {
   std::vector<CutMove> moves;
   int lines = static_cast<int>(kSide / stepover) + 1, steps = static_cast<int>(kSide / step);
+  std::vector<double> tips(static_cast<std::size_t>(lines) * static_cast<std::size_t>(steps + 1));
+  for (int l = 0; l < lines; ++l)
+    for (int s = 0; s <= steps; ++s) {
+      const double x = s * step, y = l * stepover;
+      tips[static_cast<std::size_t>(l * (steps + 1) + s)] = touching ? touching_tip(*touching, x, y) : wavy(x, y);
+    }
   for (int l = 0; l < lines; ++l) {
     double y = l * stepover;
     for (int s = 0; s < steps; ++s) {
-      double x0 = (l % 2 ? steps - s : s) * step, x1 = x0 + (l % 2 ? -step : step);
-      moves.push_back({Segment{Vec3(x0, y, wavy(x0, y) + lift), Vec3(x1, y, wavy(x1, y) + lift)}, cutter});
+      int s0 = l % 2 ? steps - s : s, s1 = s0 + (l % 2 ? -1 : 1);
+      double z0 = tips[static_cast<std::size_t>(l * (steps + 1) + s0)] + lift;
+      double z1 = tips[static_cast<std::size_t>(l * (steps + 1) + s1)] + lift;
+      moves.push_back({Segment{Vec3(s0 * step, y, z0), Vec3(s1 * step, y, z1)}, cutter});
     }
   }
   return moves;
@@ -71,6 +101,25 @@ void profile_d6(benchmark::State& s) {
   one_cutter(s, Cutter::from_profile({Vec2(0.5, 0), Vec2(1.5, 0.2), Vec2(2.5, 0.8), Vec2(3, 1.5)}));
 }
 
+// The finishing raster placed for a cutter to touch the surface (see `raster`), made once (it
+// takes seconds) however often the benchmark library calls the benchmark.
+void touching(benchmark::State& state, const Cutter& cutter, std::vector<CutMove>& moves) {
+  if (moves.empty()) moves = raster(0.5, 0.5, 0, 0, &cutter);
+  mill_moves(state, {cutter}, moves);
+}
+void ball_d6_touching(benchmark::State& s) {
+  static std::vector<CutMove> moves;
+  touching(s, Cutter::ball(3), moves);
+}
+void flat_d6_touching(benchmark::State& s) {
+  static std::vector<CutMove> moves;
+  touching(s, Cutter::flat(3), moves);
+}
+void bull_d6_r1_touching(benchmark::State& s) {
+  static std::vector<CutMove> moves;
+  touching(s, Cutter::bull_nose(3, 1), moves);
+}
+
 // Roughing (cutter 1) `lift` above the finishing surface, alone or with the ball raster (cutter 0).
 void roughing(benchmark::State& state, Cutter rough, double lift, bool with_ball) {
   std::vector<CutMove> moves = raster(2, 1, lift, 1);
@@ -93,6 +142,9 @@ BENCHMARK(cone_d6_45)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTim
 BENCHMARK(chamfer_d6_tip1_45)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(tapered_d6_r1_10)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(profile_d6)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(ball_d6_touching)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(flat_d6_touching)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(bull_d6_r1_touching)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(flat_d10_rough_below)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(ball_and_flat_d10_below)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(bull_d8_rough_below)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
