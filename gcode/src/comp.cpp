@@ -157,8 +157,8 @@ void Interpreter::State::comp_dequeue() {
     } else {
       Vec3 start = to_program(pos);
       bool ccw = q.turn > 0;
-      arc_chords(start, q.end, q.centre, ccw, std::abs(find_turn(plane_uv(start), q.centre, q.turn, plane_uv(q.end))),
-                 q.feed);
+      double sweep = std::abs(find_turn(plane_uv(start), q.centre, q.turn, plane_uv(q.end)));
+      arc_chords(start, q.end, q.centre, ccw, sweep + 2 * kPi * q.extra_turns, q.feed);
     }
   }
   line = saved_line;
@@ -352,13 +352,14 @@ void Interpreter::State::comp_arc(bool ccw) {
   move.line = line;
   move.feed = feed;
   move.turn = turn;
+  move.extra_turns = arc_extra_turns();
   const std::string too_small = "the tool radius " + format_number(r) +
                                 " mm is not less than the arc radius (cutter compensation)";
   if (comp_first) {  // the entry arc (convert_arc_comp1)
     Vec3 current = to_program(pos);
     Vec2 c = plane_uv(current);
     ArcData a = arc_data(current, ccw);
-    if (feed_mode == FeedMode::inverse_time) inverse_time_rate(arc_length(current, a, ccw));
+    if (feed_mode == FeedMode::inverse_time) inverse_time_rate(arc_length(current, a, ccw, move.extra_turns));
     move.feed = feed;
     Vec2 end = plane_uv(a.end);
     if (glm::length(end - c) <= r)
@@ -393,7 +394,7 @@ void Interpreter::State::comp_arc(bool ccw) {
   }
   const Vec2 op = plane_uv(comp_programmed);
   const Vec2 c = plane_uv(comp_current);
-  if (feed_mode == FeedMode::inverse_time) inverse_time_rate(arc_length(comp_programmed, a, ccw));
+  if (feed_mode == FeedMode::inverse_time) inverse_time_rate(arc_length(comp_programmed, a, ccw, move.extra_turns));
   move.feed = feed;
   const Vec2 centre = a.centre, end = plane_uv(a.end);
   double arc_radius = glm::length(centre - end);

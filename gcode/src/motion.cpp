@@ -109,10 +109,22 @@ void Interpreter::State::inverse_time_rate(double length) {
 
 // The length of the arc (a helix along the plane normal) from `start` (program frame) that
 // arc_data found, as LinuxCNC's find_arc_length: the start radius times the sweep, and the rise.
-double Interpreter::State::arc_length(const Vec3& start, const ArcData& a, bool ccw) const {
+double Interpreter::State::arc_length(const Vec3& start, const ArcData& a, bool ccw, int extra_turns) const {
   const std::array<int, 3> axes = plane_axes(plane);
   double radius = glm::length(a.centre - Vec2(start[axes[0]], start[axes[1]]));
-  return std::hypot(radius * arc_sweep(start, a.end, a.centre, ccw), a.end[axes[2]] - start[axes[2]]);
+  double sweep = arc_sweep(start, a.end, a.centre, ccw) + 2 * kPi * extra_turns;
+  return std::hypot(radius * sweep, a.end[axes[2]] - start[axes[2]]);
+}
+
+// LinuxCNC's P on G2/G3, the number of turns (a helix that winds P times down a bore): the arc
+// goes round P − 1 full circles before its end, the rise shared over all of them (rs274 prints
+// `G3 … P3` as ARC_FEED(…, 3, …), the rotation that LinuxCNC 2.9 interp_find.cc find_turn turns
+// into the arc plus (P − 1)·2π). P must be an integer of 1 or more, as rs274 requires ("P value
+// not an integer with M19 G2 or G3", "P value should be 1 or greater with G2 or G3"). Returns
+// P − 1; 0 without P. On Fanuc and Haas P stays a word no code of the block uses.
+int Interpreter::State::arc_extra_turns() {
+  if (machine.dialect != Dialect::linuxcnc || !w.has('P')) return 0;
+  return static_cast<int>(integer('P', "G2/G3 P (the number of turns)", 1, 1'000'000)) - 1;
 }
 
 // ---- arcs ----
@@ -140,14 +152,16 @@ void Interpreter::State::arc(bool ccw) {
     }
     for (char c : {'I', 'J', 'K', 'R'})
       if (w.has(c)) w.take(c);
+    arc_extra_turns();
     pos = to_machine(target);
     return;
   }
   require_feed();
   Vec3 start = to_program(pos);
   ArcData a = arc_data(start, ccw);
-  if (feed_mode == FeedMode::inverse_time) inverse_time_rate(arc_length(start, a, ccw));
-  arc_chords(start, a.end, a.centre, ccw, arc_sweep(start, a.end, a.centre, ccw), feed);
+  const int extra_turns = arc_extra_turns();
+  if (feed_mode == FeedMode::inverse_time) inverse_time_rate(arc_length(start, a, ccw, extra_turns));
+  arc_chords(start, a.end, a.centre, ccw, arc_sweep(start, a.end, a.centre, ccw) + 2 * kPi * extra_turns, feed);
   pos = to_machine(a.end);
 }
 

@@ -466,6 +466,7 @@ struct Interpreter::State : ParameterReader {
     Vec3 end{0.0};        // program frame
     Vec2 centre{0.0};     // arc
     int turn = 0;         // arc: +1 counter-clockwise, −1 clockwise
+    int extra_turns = 0;  // arc: full circles before its end (LinuxCNC's P − 1)
     double original_sweep = 0;  // arc: signed radians when queued (0: never checked)
   };
   int comp_side = 0;
@@ -537,7 +538,8 @@ struct Interpreter::State : ParameterReader {
   };
   ArcData arc_data(const Vec3& start, bool ccw);
   double arc_sweep(const Vec3& start, const Vec3& end, const Vec2& c, bool ccw) const;
-  double arc_length(const Vec3& start, const ArcData& a, bool ccw) const;
+  double arc_length(const Vec3& start, const ArcData& a, bool ccw, int extra_turns = 0) const;
+  int arc_extra_turns();
   void arc_chords(const Vec3& start, const Vec3& end, const Vec2& c, bool ccw, double sweep,
                   double move_feed);
   void cycle(int code);

@@ -210,3 +210,67 @@ TEST_CASE("arcs: LinuxCNC's spiral tolerance on --machine linuxcnc") {
   CHECK(error_of("G20 G17 G90 F10\nG0 X1 Y0 Z0\nG3 X0 Y1.003 I-1 J0\n", {}, linuxcnc).message.find("spiral") !=
         std::string::npos);
 }
+
+// LinuxCNC's G2/G3 P: the number of turns. rs274 prints `G3 X10 Y0 I-10 J0 Z-6 P3` as
+// ARC_FEED(…, 3, -6, …): three full circles about (0, 0) while Z falls 6 mm (interp_find.cc
+// find_turn: the arc plus (P − 1)·2π). Before, P was refused as a word no code used, and
+// lagun-linuxcnc's pocket_circ.ngc (a helical plunge `G3 … Z… P1`) stopped there.
+TEST_CASE("arcs: LinuxCNC's P on G2/G3 winds P − 1 full circles before the end") {
+  const MachineConfig linuxcnc = linuxcnc_at_origin();
+  // The angle turned about `centre` in XY, signed (counter-clockwise positive), and the Z the
+  // tool reaches when it has turned half of it.
+  auto turned = [](const Result& r, int line, const Vec2& centre, double& z_halfway) {
+    double total = 0, half = 0;
+    for (const Move& m : r.moves)
+      if (m.line == line) {
+        Vec2 a = Vec2(m.start) - centre, b = Vec2(m.end) - centre;
+        total += std::atan2(a.x * b.y - a.y * b.x, glm::dot(a, b));
+      }
+    z_halfway = std::nan("");
+    for (const Move& m : r.moves)
+      if (m.line == line) {
+        Vec2 a = Vec2(m.start) - centre, b = Vec2(m.end) - centre;
+        half += std::atan2(a.x * b.y - a.y * b.x, glm::dot(a, b));
+        if (std::abs(half) >= std::abs(total) / 2 - 1e-12) {
+          z_halfway = m.end.z;
+          break;
+        }
+      }
+    return total;
+  };
+  const double pi = std::numbers::pi;
+  double z_half = 0;
+  Result r = run_program("G21 G17 G90 F100\nG0 X10 Y0 Z0\nG3 X10 Y0 I-10 J0 Z-6 P3\n"
+                         "G2 X0 Y10 I-10 J0 Z-8 P2\nG3 X-10 Y0 R10 P2\nM2\n",
+                         {}, linuxcnc);
+  CHECK(turned(r, 3, Vec2(0, 0), z_half) == doctest::Approx(6 * pi));
+  CHECK(z_half == doctest::Approx(-3).epsilon(0.01));  // the rise shared over all three turns
+  CHECK(near(r.moves.back().end, Vec3(-10, 0, -8)));
+  // Clockwise from 0° to 90°: 270°, and one more circle.
+  CHECK(turned(r, 4, Vec2(0, 0), z_half) == doctest::Approx(-3.5 * pi));
+  CHECK(turned(r, 5, Vec2(0, 0), z_half) == doctest::Approx(2.5 * pi));  // the R form too
+  // P1 is the plain arc.
+  r = run_program("G21 G17 G90 F100\nG0 X10 Y0 Z0\nG3 X0 Y10 I-10 J0 P1\nM2\n", {}, linuxcnc);
+  CHECK(turned(r, 3, Vec2(0, 0), z_half) == doctest::Approx(pi / 2));
+  // Inverse time: the block takes 1/F minutes over its whole length (find_arc_length).
+  r = run_program("G21 G17 G90 G93\nG0 X10 Y0 Z0\nG3 X10 Y0 I-10 J0 P2 F2\nM2\n", {}, linuxcnc);
+  CHECK(r.moves.back().feed == doctest::Approx(2 * (4 * pi * 10)));
+  // Under cutter compensation (rs274: G41.1 D2 then this arc prints ARC_FEED(…, 2, …)).
+  MachineConfig comp = linuxcnc;
+  r = run_program("G21 G17 G90 F100\nG0 X20 Y0 Z0\nG41.1 D2\nG1 X10 Y0\nG3 X10 Y0 I-10 J0 P2\n"
+                  "G1 X10 Y-5\nG40\nG0 X30\nM2\n",
+                  {}, comp);
+  double around = 0;  // the chords on the offset circle (radius 9), not the corner arcs at X10 Y0
+  for (const Move& m : r.moves)
+    if (m.line == 5 && std::abs(glm::length(Vec2(m.start)) - 9) < 1e-6 && std::abs(glm::length(Vec2(m.end)) - 9) < 1e-6)
+      around += std::atan2(m.start.x * m.end.y - m.start.y * m.end.x, glm::dot(Vec2(m.start), Vec2(m.end)));
+  CHECK(around == doctest::Approx(4 * pi));
+  // rs274's errors: P an integer of 1 or more.
+  CHECK(error_of("G21 G17 F100\nG0 X10 Y0 Z0\nG3 X10 Y0 I-10 P1.5\n", {}, linuxcnc).message.find("integer") !=
+        std::string::npos);
+  CHECK(error_of("G21 G17 F100\nG0 X10 Y0 Z0\nG3 X10 Y0 I-10 P0\n", {}, linuxcnc).message.find("integer in [1") !=
+        std::string::npos);
+  // Fanuc has no such word: P on an arc is still a word no code of the block uses.
+  CHECK(error_of("G21 G17 F100\nG0 X10 Y0 Z0\nG3 X10 Y0 I-10 P2\n", {}, at_origin()).message.find("P2") !=
+        std::string::npos);
+}
