@@ -389,6 +389,31 @@ TEST_CASE("simulate: a public hobby program that loads its tool with T alone") {
   fs::remove_all(dir);
 }
 
+// A feed with no tool loaded is named by the file that holds it: a project's file (CAMotics'
+// heart example, whose heart.ngc loads its tool with T alone, was refused as
+// "heart.camotics:15"), or the subprogram a program called (it was named by the main program).
+TEST_CASE("simulate: a feed move with no tool loaded is named by the file that holds it") {
+  fs::path dir = scratch("toolless-file");
+  write_text(dir / "tools.json", R"({"1": {"shape": "cylindrical", "diameter": 2}})");
+  write_text(dir / "first.nc", "G21 G90\nT1 M6\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X10\nM30\n");
+  write_text(dir / "second.nc", "G21 G90\nG0 X0 Y0 Z5\nG0 X5\nG1 Z-1 F100\nM30\n");
+  // The project's first file feeds at its line 4 before any tool is loaded.
+  write_text(dir / "bare.camotics", R"({"files": ["second.nc", "first.nc"], "tools": {"1": {"shape": "cylindrical", "diameter": 2}}})");
+  CommandResult project = run_tridex({"simulate", (dir / "bare.camotics").string(), "-o", (dir / "out.stl").string()}, dir);
+  CHECK(project.status == 2);
+  CHECK(project.err.find("second.nc:4:") != std::string::npos);
+  CHECK(project.err.find("bare.camotics:4") == std::string::npos);
+  // A subprogram (O1000.nc, found in the program's folder) that feeds before any tool change.
+  write_text(dir / "O1000.nc", "O1000\nG0 X0 Y0 Z5\nG1 Z-1 F100\nM99\n");
+  write_text(dir / "main.nc", "G21 G90\nM98 P1000\nT1 M6\nM30\n");
+  CommandResult called = run_tridex({"simulate", (dir / "main.nc").string(), "--tools", (dir / "tools.json").string(),
+                                     "-o", (dir / "out.stl").string()}, dir);
+  CHECK(called.status == 2);
+  CHECK(called.err.find("O1000.nc:3:") != std::string::npos);
+  CHECK(!fs::exists(dir / "out.stl"));
+  fs::remove_all(dir);
+}
+
 TEST_CASE("unwritable outputs and inputs named as outputs are refused before any work") {
   fs::path dir = scratch("outputs");
   fs::path program = dir / "p.nc", tools = dir / "tools.json";

@@ -337,8 +337,9 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
       for (const gcode::Move& m : group.moves) {
         if (m.tool != 0) continue;
         if (m.kind != gcode::MoveKind::rapid)
-          input_error(input.files.size() == 1 ? input.files[0].string() : input.program.string(), ":",
-                      m.line, ": a ", gcode::to_string(m.kind),
+          // The file that holds the move (one of a project's files, or a called subprogram), not
+          // the project or the main program.
+          input_error(r.files.at(static_cast<std::size_t>(m.file)), ":", m.line, ": a ", gcode::to_string(m.kind),
                       " move with no tool loaded (T… M6; on a machine that loads the tool on T alone, give "
                       "--machine a file with \"tool_loads_on_t\": true)");
         ++toolless;
