@@ -97,6 +97,10 @@ inline bool parse_label(std::string_view text, int& number) {
     ++digits;
   }
   if (digits == 0 || value > 999'999'999) return false;
+  // Only a comment may follow: `o100 sub`, `o100 call` and the like are LinuxCNC o-words, and a
+  // numbered subroutine noted as program 100 could not be called before its definition.
+  while (i < n && (text[i] == ' ' || text[i] == '\t' || text[i] == '\r')) ++i;
+  if (i < n && text[i] != '(' && text[i] != ';') return false;
   number = static_cast<int>(value);
   return true;
 }

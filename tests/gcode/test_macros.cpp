@@ -224,6 +224,12 @@ TEST_CASE("macros: LinuxCNC o-words give the moves of the same program written o
              "G0 X1 Y0 Z0\nX3\nM2\n", l);
   same_moves("o<twice> sub\no<twice> return [#1 * 2]\no<twice> endsub\no<twice> call [21]\nG0 X#<_value> Y0 Z0\nM2\n",
              "G0 X42 Y0 Z0\nM2\n", l);
+  // A numbered subroutine defined after its call, read ahead as rs274 finds it (interp_o_word.cc
+  // control_back_to: "skip to the o_word"); `o100 sub` was taken for a Fanuc program number O100,
+  // so the call found no subroutine.
+  same_moves("o100 call [5]\nM2\no100 sub\nG0 X#1 Y0 Z0\no100 endsub\n", "G0 X5 Y0 Z0\nM2\n", l);
+  same_moves("o100 call\nG0 X3 Y0 Z0\nM2\no100 sub (a comment)\nG0 X2 Y0 Z0\no100 endsub\n",
+             "G0 X2 Y0 Z0\nX3\nM2\n", l);
   // Named locals belong to the call; globals are shared.
   same_moves("o10 sub\n#<a> = 7\n#<_g> = 8\no10 endsub\n#<a> = 1\no10 call\nG0 X#<a> Y#<_g> Z0\nM2\n",
              "G0 X1 Y8 Z0\nM2\n", l);
