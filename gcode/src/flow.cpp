@@ -114,6 +114,7 @@ class ProgramFlow {
   void call(CallKind kind, const std::string& label, long long repeats, int column);
   void give_back(int column);
   void o_word(const Control& control);
+  void linuxcnc_program_number(const Word& label);
   void loop_control(const Control& control);
   Position find_sequence(long long number, const std::string& what, int column);
   void jump_to_sequence(long long number, int column);
@@ -482,6 +483,20 @@ void ProgramFlow::loop_control(const Control& control) {
   jump(it->start);
 }
 
+// LinuxCNC reads a bare O number met in the flow as a Fanuc-style program number and goes on into
+// the blocks after it (LinuxCNC 2.9 interp_o_word.cc, convert_control_functions, case O_:
+// "continue executing into Fanuc-style programs w/o skipping"), in the main program and in an M98
+// subprogram alike: pcb2gcode's Mach3 output runs from its main program into "O200" and ends at
+// that subprogram's M99, and rs274 cuts it so. Only inside an o-word call is it an error, as
+// rs274 reports it.
+void ProgramFlow::linuxcnc_program_number(const Word& label) {
+  if (!calls_.empty() && calls_.back().kind == CallKind::o_call)
+    error(label.column, "O" + format_number(label.value) +
+                            " inside an o-word call: a Fanuc-style program must be called with M98 "
+                            "(as LinuxCNC refuses it)");
+  started_ = true;
+}
+
 void ProgramFlow::o_word(const Control& control) {
   const std::string& label = control.label;
   auto find_loop = [&]() {
@@ -685,6 +700,10 @@ void ProgramFlow::run() {
       if (!calls_.empty() && calls_.back().body.source == current_ && current_ != 0 &&
           calls_.back().body.offset == sources_[current_]->start)
         continue;  // a subprogram file's own O number, run from its top
+      if (s_.machine.dialect == Dialect::linuxcnc) {
+        linuxcnc_program_number(label);
+        continue;
+      }
       if (!calls_.empty())
         error(label.column, "subprogram " + calls_.back().label + " runs into O" +
                                 format_number(label.value) + " without M99");

@@ -212,3 +212,33 @@ TEST_CASE("subprogram errors and flow") {
   Interpreter interpreter;
   CHECK_THROWS_AS(interpreter.run(in, "pipe", [](const Move&) {}), GcodeError);
 }
+
+// LinuxCNC goes on through a bare O number met in the flow (interp_o_word.cc, case O_), in the
+// main program and in an M98 subprogram; each case as rs274 prints it. pcb2gcode's Mach3 output
+// (main program, then "O200" ... M99, then M2) was refused as running into O200.
+TEST_CASE("LinuxCNC: the flow goes on through a bare O number, as rs274 does") {
+  const MachineConfig linuxcnc = linuxcnc_at_origin();
+  auto ends = [](const Result& r) {
+    std::vector<double> x;
+    for (const Move& m : r.moves) x.push_back(m.end.x);
+    return x;
+  };
+  // rs274: X1, X2, then M99 in the main program ends it (X3 never runs).
+  Result r = run_program("G21 G90\nG0 X1\nO100\nG0 X2\nM99\nG0 X3\nM2\n", {}, linuxcnc);
+  CHECK(ends(r) == std::vector<double>{1, 2});
+  // rs274: a first O number after other blocks is passed over too.
+  r = run_program("G21 G90\nO1\nG0 X1\nO2\nG0 X2\nM30\n", {}, linuxcnc);
+  CHECK(ends(r) == std::vector<double>{1, 2});
+  // rs274: X1, the subprogram's X2 and, through O200, X3 before its M99, then X5.
+  r = run_program("G21 G90\nG0 X1\nM98 P100\nG0 X5\nM30\nO100\nG0 X2\nO200\nG0 X3\nM99\nM2\n", {},
+                  linuxcnc);
+  CHECK(ends(r) == std::vector<double>{1, 2, 3, 5});
+  // Inside an o-word call it is an error (rs274: "Fanuc 'O....' subroutine must be called with
+  // 'M98'").
+  Diagnostic d = error_of("G21 G90\no100 call\nM2\no100 sub\nO5\nG0 X2\no100 endsub\n", {}, linuxcnc);
+  CHECK(d.line == 5);
+  CHECK(d.message.find("M98") != std::string::npos);
+  // Fanuc and Haas keep refusing a main program that runs into the next O number.
+  CHECK(error_of("G21 G90\nG0 X1 Y0 Z0\nO100\nG0 X2\nM99\n", {}, at_origin()).message.find("M2/M30") !=
+        std::string::npos);
+}
