@@ -93,6 +93,15 @@ Value Interpreter::State::numbered(int n) {
     // LinuxCNC: the active coordinate system (1 = G54), the tool, the current position.
     case 5220: return number(work_key >= 100 ? 0 : work_key);
     case 5400: return number(tool);
+    // The loaded tool's diameter as LinuxCNC's tool table holds it (rs274ngc_pre.cc,
+    // set_tool_parameters: parameters[5410] = tool_table[0].diameter): in the table's units, the
+    // machine's (inches for rs274 run standalone), not the program's; 0 with no tool or one the
+    // table lacks. ngcgui's subroutines size their entry moves from it (#<tooldiam> = #5410).
+    case 5410:
+      if (machine.dialect != Dialect::linuxcnc) break;
+      if (auto d = machine.tool_diameters.find(tool); d != machine.tool_diameters.end())
+        return number(d->second / (machine.tool_table_in_inches ? 25.4 : 1.0));
+      return number(0);
     case 5420: case 5421: case 5422: return number(program[n - 5420] / unit);
     case 5423: case 5424: case 5425: return number(0);
     case 5426: case 5427: case 5428: return number(uvw_position[n - 5426] / unit);

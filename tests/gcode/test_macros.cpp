@@ -235,6 +235,35 @@ TEST_CASE("macros: LinuxCNC o-words give the moves of the same program written o
              "G0 X1 Y8 Z0\nM2\n", l);
 }
 
+// LinuxCNC's #5410: the loaded tool's diameter as its tool table holds it, in the table's units
+// (inches for rs274 run standalone) whatever the program's; 0 with no tool (rs274ngc_pre.cc
+// set_tool_parameters; rs274 -t with T1 D0.125: G21 ... T1 M6 G0 X#5410 goes to X0.125). It read
+// 0, and ngcgui's helix.ngc, ihex.ngc and the like, which size their compensated entry from it,
+// were refused as entries too short for the tool.
+TEST_CASE("macros: LinuxCNC's #5410 is the loaded tool's diameter in the tool table's units") {
+  MachineConfig m = linuxcnc_at_origin();
+  m.tool_diameters = {{1, 0.125 * 25.4}, {2, 6.0}};
+  auto x_of = [&](const std::string& text) {
+    Result r = run_program(text, {}, m);
+    REQUIRE(!r.moves.empty());
+    return r.moves.back().end.x;
+  };
+  CHECK(x_of("G21 G90\nG0 X#5410 Y0 Z0\nM2\n") == doctest::Approx(0));  // no tool yet
+  CHECK(x_of("G21 G90\nT1 M6\nG0 X#5410 Y0 Z0\nM2\n") == doctest::Approx(0.125));
+  CHECK(x_of("G20 G90\nT1 M6\nG0 X#5410 Y0 Z0\nM2\n") == doctest::Approx(0.125 * 25.4));
+  // G10 L1 rewrites the loaded tool's entry, and #5410 with it (rs274: R0.5 mm, 0.0394 in).
+  CHECK(x_of("G21 G90\nT1 M6\nG10 L1 P1 R0.5\nG0 X#5410 Y0 Z0\nM2\n") == doctest::Approx(1.0 / 25.4));
+  // A machine whose table is in mm (LinuxCNC's LINEAR_UNITS = mm) holds millimetres.
+  m.tool_table_in_inches = false;
+  CHECK(x_of("G21 G90\nT2 M6\nG0 X#5410 Y0 Z0\nM2\n") == doctest::Approx(6.0));
+  // Fanuc has no such variable: it stays vacant and the word is left out.
+  MachineConfig fanuc = at_origin();
+  fanuc.tool_diameters = {{1, 6.0}};
+  Result r = run_program("G21 G90\nT1 M6\nG0 X5 Y0 Z0\nG0 X#5410 Y1\nM30\n", {}, fanuc);
+  REQUIRE(!r.moves.empty());
+  CHECK(r.moves.back().end.x == doctest::Approx(5));
+}
+
 TEST_CASE("macros: subprogram files are found by name, or by the O number they start with") {
   namespace fs = std::filesystem;
   fs::path dir = fs::temp_directory_path() / ("tridex_subs_" + std::to_string(::getpid()));
