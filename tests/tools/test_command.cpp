@@ -565,6 +565,30 @@ TEST_CASE("moves: JSON Lines in the work frame under random G68.2 planes") {
   fs::remove_all(dir);
 }
 
+TEST_CASE("--block-delete: on (the default) skips the blocks that start with '/', off runs them") {
+  fs::path dir = scratch("block_delete");
+  fs::path program = dir / "p.nc";
+  write_text(program, "G21 G90\nG0 X0 Y0 Z5\n/G0 X10\nG0 Y20\nM30\n");
+  // The end of the last move, for the command's extra options.
+  auto last_end = [&](std::vector<std::string> args) {
+    args.insert(args.begin(), {"moves", program.string()});
+    CommandResult r = run_tridex(args, dir);
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    std::istringstream lines(r.out);
+    std::string line, last;
+    while (std::getline(lines, line)) last = line;
+    return vec(json::parse(last)["end"]);
+  };
+  CHECK(glm::length(last_end({}) - Vec3(0, 20, 5)) < 1e-12);
+  CHECK(glm::length(last_end({"--block-delete", "on"}) - Vec3(0, 20, 5)) < 1e-12);
+  CHECK(glm::length(last_end({"--block-delete", "off"}) - Vec3(10, 20, 5)) < 1e-12);
+  CommandResult bad = run_tridex({"moves", program.string(), "--block-delete", "yes"}, dir);
+  CHECK(bad.status == 2);
+  CHECK(bad.err.find("--block-delete") != std::string::npos);
+  fs::remove_all(dir);
+}
+
 TEST_CASE("groups: one group per spindle direction with its moves and tools") {
   fs::path dir = scratch("groups");
   fs::path program = dir / "five.nc", out = dir / "groups.json";

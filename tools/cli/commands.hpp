@@ -16,6 +16,7 @@ struct CommonOptions {
   std::string program;          // G-code file or CAMotics project
   double arc_tolerance = 0.001;  // mm
   bool lenient = false;
+  std::string block_delete = "on";        // --block-delete on|off: the operator's switch
   std::string machine;                    // --machine FILE|NAME (empty: the default machine)
   std::vector<std::string> subprograms;   // --subprograms DIR (repeatable)
   std::string tools;            // --tools FILE (overrides a project's table; G41/G42 D read it)

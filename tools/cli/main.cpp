@@ -60,6 +60,10 @@ void add_common(CLI::App& command, CommonOptions& options) {
       ->check(CLI::PositiveNumber);
   command.add_flag("--lenient", options.lenient,
                    "unsupported G-code words become warnings and are skipped");
+  command.add_option("--block-delete", options.block_delete,
+                     "the control's block delete switch: on skips the blocks that start with '/', off runs them\n"
+                     "(default on)")
+      ->check(CLI::IsMember({"on", "off"}));
   command.add_option("--machine", options.machine,
                      std::string("machine file (JSON) or bundled machine: ") + kBundledMachines +
                          " (README: Machine files)");

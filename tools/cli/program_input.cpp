@@ -42,6 +42,7 @@ gcode::InterpreterOptions interpreter_options(const CommonOptions& options) {
   gcode::InterpreterOptions o;
   o.arc_tolerance = options.arc_tolerance;
   o.lenient = options.lenient;
+  o.block_delete = options.block_delete == "on";
   o.max_blocks = options.max_blocks;
   return o;
 }

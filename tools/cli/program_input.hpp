@@ -44,7 +44,8 @@ struct InterpretResult {
                                    // the subprogram files they called, each once
 };
 
-// The interpreter's options from the command's: arc tolerance, --lenient and --max-blocks.
+// The interpreter's options from the command's: arc tolerance, --lenient, --block-delete and
+// --max-blocks.
 gcode::InterpreterOptions interpreter_options(const CommonOptions& options);
 
 // Counts the moves a command keeps in memory against its --max-memory, so that a program that
