@@ -125,9 +125,10 @@ int run_simulate(const SimulateOptions& options) {
     std::string written;
     for (const std::string& path : {options.output, options.png, options.report, options.html})
       if (!path.empty()) written += (written.empty() ? " -> " : ", ") + path;
-    std::printf("%s: %lld segments in %zu directions, %d x %d x %d dexels; %.1f mm^3 left, %.1f mm^3 "
+    std::printf("%s: %lld segment%s in %zu direction%s, %d x %d x %d dexels; %.1f mm^3 left, %.1f mm^3 "
                 "removed, %zu triangles, %s%s; %.2f s\n",
-                input.program.filename().string().c_str(), segments, groups.size(), lattice.n.x,
+                input.program.filename().string().c_str(), segments, segments == 1 ? "" : "s", groups.size(),
+                groups.size() == 1 ? "" : "s", lattice.n.x,
                 lattice.n.y, lattice.n.z, volume, stock.volume - volume, mesh.triangles.size(),
                 check.closed() ? "watertight" : "NOT watertight", written.c_str(), total_s);
     std::printf("  %s\n", machining_time_text(r.machining).c_str());
