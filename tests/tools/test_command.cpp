@@ -414,6 +414,21 @@ TEST_CASE("simulate: a feed move with no tool loaded is named by the file that h
   fs::remove_all(dir);
 }
 
+// CAMotics ships TPL programs (JavaScript that writes G-code) beside its G-code examples, and
+// its projects name them as they name G-code files.
+TEST_CASE("a CAMotics TPL program, given or named by a project, is refused as not G-code") {
+  fs::path dir = scratch("tpl");
+  write_text(dir / "gear.tpl", "var teeth = 12;\nfunction gear() {}\n");
+  write_text(dir / "gear.camotics", R"({"files": ["gear.tpl"], "tools": {"1": {"shape": "cylindrical", "diameter": 2}}})");
+  for (const char* program : {"gear.tpl", "gear.camotics"}) {
+    CAPTURE(program);
+    CommandResult r = run_tridex({"moves", (dir / program).string()}, dir);
+    CHECK(r.status == 2);
+    CHECK(r.err.find("gear.tpl: a CAMotics TPL program") != std::string::npos);
+  }
+  fs::remove_all(dir);
+}
+
 TEST_CASE("unwritable outputs and inputs named as outputs are refused before any work") {
   fs::path dir = scratch("outputs");
   fs::path program = dir / "p.nc", tools = dir / "tools.json";

@@ -1,6 +1,7 @@
 #include "program_input.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <fstream>
 
 #include "errors.hpp"
@@ -28,6 +29,16 @@ ProgramInput resolve_program(const CommonOptions& options) {
     input.stock = project.stock;
   } else {
     input.files.push_back(input.program);
+  }
+  // CAMotics' .tpl files are TPL, JavaScript that writes G-code when CAMotics runs it: read as
+  // G-code, the first "var" would be refused as a word 'v' with no number.
+  for (const fs::path& file : input.files) {
+    std::string extension = file.extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (extension == ".tpl")
+      input_error(file.string(), ": a CAMotics TPL program (JavaScript that writes G-code), not ",
+                  "G-code; run it with CAMotics' tplang and give tridex the G-code it writes");
   }
   if (!options.tools.empty())
     input.tools = ToolTable::read(options.tools, input.machine.tool_table_in_inches ? 25.4 : 1.0);
