@@ -1464,10 +1464,7 @@ class Miller {
           // bound_without_plane at once (on bench_mill's bull nose raster, half the tiles a move
           // is bounded over in pass 1 have no plane at their centre: the passes at the edge of
           // the footprint).
-          const DoubleN distance = sqrt_n(path_distance2(ux, uy, lanes.vx, lanes.vy, lanes.inv_vv));
-          const DoubleN gap = max_n(distance - load_n(&row.lanes.half_diagonal[lane0]), splat(0));
-          const DoubleN far = gap > m.radius ? splat(kInf) : lanes.low + lanes.height(min_n(gap, splat(m.radius)));
-          bound = plane.has_plane ? bound : far;
+          bound = plane.has_plane ? bound : off_path_bound(lanes, m, row, lane0, ux, uy);
         }
       }
       const int l = col - lane0;
@@ -1506,10 +1503,18 @@ class Miller {
     if (scratch.kind[k] != LaneKind::profile) return splat(m.lowest_tip());
     const ProfileLanes& move = scratch.profiles[k];
     const DoubleN ux = load_n(&row.lanes.xc[lane0]) - move.ax, uy = splat(row.tiles[0].yc - move.ay);
+    return off_path_bound(move, m, row, lane0, ux, uy);
+  }
+
+  // The lowest tip plus the cutter's height at the distance of the row's tiles (lanes lane0 …, at
+  // offsets (ux, uy) from the move's start) from its path: +infinity where the footprint misses a
+  // tile. For a move of FlatLanes, BullLanes or ProfileLanes.
+  template <class Lanes>
+  static DoubleN off_path_bound(const Lanes& move, const MoveGeometry& m, const TileRow& row, int lane0, DoubleN ux,
+                                DoubleN uy) {
     const DoubleN distance = sqrt_n(path_distance2(ux, uy, move.vx, move.vy, move.inv_vv));
     const DoubleN gap = max_n(distance - load_n(&row.lanes.half_diagonal[lane0]), splat(0));
-    const DoubleN reach = min_n(gap, splat(m.radius));
-    return gap > m.radius ? splat(kInf) : m.lowest_tip() + move.height(reach);
+    return gap > m.radius ? splat(kInf) : move.low + move.height(min_n(gap, splat(m.radius)));
   }
 
   // A lower bound of a move's swept surface over a tile where it has no plane at the centre: the
