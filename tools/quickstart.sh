@@ -42,21 +42,45 @@ if [ "$mode" = demo ]; then
   exec bash tools/demo.sh
 fi
 
+# The house rules first: they take seconds and name the file and line of every breach.
+echo "== house rules: lengths, one thread pool, one machine registry (tools/check_structure.py)"
+python3 tools/check_structure.py
+echo "== formatting (.clang-format, clang-format $(clang-format --version | grep -o '[0-9][0-9.]*' | head -1))"
+{ git ls-files -z '*.hpp' '*.cpp' '*.h' 2> /dev/null ||
+  find include gcode tools tests bench \( -name '*.hpp' -o -name '*.cpp' -o -name '*.h' \) -print0; } |
+  xargs -0 -r clang-format --dry-run --Werror
+
+# -DTRIDEX_BUILD_TESTS=ON even where build/ was configured by the demo without tests, and
+# --no-tests=error: a build with no tests must not pass.
 echo "== release build and tests"
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DTRIDEX_BUILD_TESTS=ON -DTRIDEX_BUILD_BENCH=ON
 cmake --build build -j "$jobs"
-ctest --test-dir build --output-on-failure -j "$jobs" | tee build/ctest.log
+ctest --test-dir build --output-on-failure --no-tests=error -j "$jobs" | tee build/ctest.log
 
-echo "== ASan+UBSan build and tests"
-cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTRIDEX_SANITIZE=ON -DTRIDEX_BUILD_BENCH=OFF
+echo "== ASan+UBSan build"
+cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTRIDEX_SANITIZE=ON \
+  -DTRIDEX_BUILD_TESTS=ON -DTRIDEX_BUILD_BENCH=OFF
 cmake --build build-asan -j "$jobs"
-ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 LSAN_OPTIONS=suppressions=$PWD/tools/lsan.supp \
-  ctest --test-dir build-asan --output-on-failure -j "$jobs" | tee build-asan/ctest.log
+echo "== the fuzzers' build (clang, libFuzzer)"
+bash tools/fuzz/build.sh build-fuzz
 
-echo "== fuzzing the G-code front end (bounded)"
-bash gcode/fuzz/run.sh 60 build-fuzz
-echo "== fuzzing the command's input formats: STL, tool table, project, options (bounded)"
-bash tools/fuzz/run.sh 60 build-fuzz
+# The fuzzers are bounded in time, not in work: they run on one core beside the sanitizer
+# suites, which leave a core idle while their longest suite finishes.
+echo "== ASan+UBSan tests, beside the bounded fuzzers (G-code front end; STL, tool table, project, options, machine file)"
+( bash gcode/fuzz/run.sh 60 build-fuzz > build-fuzz/gcode.log 2>&1 && bash tools/fuzz/run.sh 60 build-fuzz > build-fuzz/inputs.log 2>&1 ) &
+fuzzers=$!
+status=0
+ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 LSAN_OPTIONS=suppressions=$PWD/tools/lsan.supp \
+  ctest --test-dir build-asan --output-on-failure --no-tests=error -j "$jobs" | tee build-asan/ctest.log || status=$?
+fuzz_status=0
+wait "$fuzzers" || fuzz_status=$?
+cat build-fuzz/gcode.log build-fuzz/inputs.log 2> /dev/null | grep -E '^(==|stat::|#[0-9]+ +DONE|Done)|crash|ERROR' || true
+if [ "$fuzz_status" -ne 0 ]; then
+  tail -n 60 build-fuzz/gcode.log build-fuzz/inputs.log 2> /dev/null >&2
+  echo "a fuzzer failed (its log above; its input under build-fuzz/)" >&2
+  exit 1
+fi
+[ "$status" -eq 0 ] || exit "$status"
 
 # One closing line for both suites (ctest's own summaries are further up).
 total=$(( $(cat build/ctest.log build-asan/ctest.log | sed -n 's/.*tests failed out of \([0-9]*\).*/\1/p' | paste -sd+) ))
