@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer harness of the G-code front end with clang and runs it for a bounded time.
+# Runs the libFuzzer harness of the G-code front end for a bounded time (tools/fuzz/build.sh builds
+# it with clang, with the other harnesses, compiling only what changed).
 #   gcode/fuzz/run.sh [SECONDS=60] [BUILD_DIR=build-fuzz]
 # Exit status 0: no crash in that time. A crash leaves its input as BUILD_DIR/crash-* (and the
 # status is non-zero); turn it into a named case in tests/gcode/test_bad_input.cpp.
@@ -8,8 +9,7 @@ cd "$(dirname "$0")/../.."
 seconds=${1:-60}
 build=${2:-build-fuzz}
 mkdir -p "$build/fuzz_corpus"
-clang++ -std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
-  -Iinclude -Igcode/include gcode/fuzz/fuzz_gcode.cpp gcode/src/*.cpp -o "$build/fuzz_gcode"
+bash tools/fuzz/build.sh "$build"
 # A fixed seed (FUZZ_SEED, default 1) makes CI explore the same inputs in the same order.
 exec "$build/fuzz_gcode" -seed="${FUZZ_SEED:-1}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=4096 \
   -dict=gcode/fuzz/gcode.dict -artifact_prefix="$build/" -print_final_stats=1 \
