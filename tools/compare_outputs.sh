@@ -21,7 +21,7 @@ strip_volatile() {
 import json, re, sys
 path = sys.argv[1]
 text = open(path, encoding="utf-8", errors="surrogateescape").read()
-VOLATILE = {"timings_s", "peak_memory_mib", "memory", "elapsed_s", "threads", "generated"}
+VOLATILE = {"timings_s", "peak_memory_mib", "peak_rss_mib", "memory_estimate_mib", "memory", "elapsed_s", "threads", "generated"}
 def scrub(v):
     if isinstance(v, dict):
         return {k: scrub(x) for k, x in v.items() if k not in VOLATILE}
@@ -31,7 +31,8 @@ def scrub(v):
 try:
     out = json.dumps(scrub(json.loads(text)), sort_keys=True)
 except ValueError:  # a page: the same keys inside its embedded JSON
-    out = re.sub(r'"(timings_s|peak_memory_mib|memory|elapsed_s|threads|generated)":\s*(\{[^{}]*\}|[^,}]*)', '"\\1":_', text)
+    out = re.sub(r'"(timings_s|peak_memory_mib|peak_rss_mib|memory_estimate_mib|memory|elapsed_s|threads|generated)":\s*(\{[^{}]*\}|[^,}]*)', '"\\1":_', text)
+out = re.sub(r"/(old|new)/", "/SIDE/", out)  # each side writes to its own folder
 open(path, "w", encoding="utf-8", errors="surrogateescape").write(out)
 EOF
 }
@@ -43,7 +44,7 @@ run_both() {  # NAME ARGS... (each "@OUT" in ARGS becomes the side's output fold
     local args=("${@//@OUT/$work/$side}")
     "$bin" "${args[@]}" > "$work/$side/$name.stdout" 2> "$work/$side/$name.stderr"
     echo "exit $?" >> "$work/$side/$name.stdout"
-    sed -i -E 's/[0-9]+(\.[0-9]+)? ?(s|ms|MiB|GiB)\b/#/g' "$work/$side/$name.stdout" "$work/$side/$name.stderr"
+    sed -i -E "s|$work/$side/|@OUT/|g; s/[0-9]+(\.[0-9]+)? ?(s|ms|MiB|GiB)\b/#/g" "$work/$side/$name.stdout" "$work/$side/$name.stderr"
   done
 }
 
