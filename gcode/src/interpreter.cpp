@@ -109,27 +109,6 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
   summarize(s.read_as, "read");
 }
 
-std::optional<MachineConfig> MachineConfig::bundled(const std::string& name) {
-  if (name == "default") return MachineConfig{};
-  if (name == "haas") {  // the default machine, reading Haas's tool offset registers
-    MachineConfig m;
-    m.dialect = Dialect::haas;
-    return m;
-  }
-  if (name == "linuxcnc") {  // rs274 run standalone (its default configuration)
-    MachineConfig m;
-    m.dialect = Dialect::linuxcnc;
-    m.start_position = Vec3(0.0);
-    m.tool_change = ToolChange::in_place;
-    m.set_home(Vec3(0.0));
-    m.set_reference2(Vec3(0.0));
-    m.g53_literal = true;
-    m.g99_at_start = true;
-    return m;
-  }
-  return std::nullopt;
-}
-
 std::vector<Move> read_moves(const std::string& path, InterpreterOptions options,
                              MachineConfig machine) {
   std::ifstream in(path, std::ios::binary);

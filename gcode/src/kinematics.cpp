@@ -1,12 +1,10 @@
-// tridex::gcode — rotary kinematics: forward maps, the two-axis inverse (Paden–Kahan subproblems
-// 1 and 2, Murray, Li and Sastry 1994, §3.2.2), bundled profiles and the machine file's
-// "kinematics" object. See kinematics.hpp for the model.
+// tridex::gcode — rotary kinematics: forward maps and the two-axis inverse (Paden–Kahan
+// subproblems 1 and 2, Murray, Li and Sastry 1994, §3.2.2). See kinematics.hpp for the model.
 #include "tridex/gcode/kinematics.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "tridex/error.hpp"
@@ -99,109 +97,6 @@ std::optional<double> nearest_turn(const RotaryAxis& axis, double angle, double 
 
 double clamp_to_limits(const RotaryAxis& axis, double angle) {
   return axis.limits ? std::clamp(angle, (*axis.limits)[0], (*axis.limits)[1]) : angle;
-}
-
-// ---- JSON -------------------------------------------------------------------------------------
-
-[[noreturn]] void json_fail(const std::string& path, const std::string& what,
-                            const nlohmann::json& value) {
-  detail::fail(path, ": ", what, ", got ", value.dump());
-}
-
-double json_number(const nlohmann::json& j, const std::string& path) {
-  if (!j.is_number()) json_fail(path, "must be a number", j);
-  double v = j.get<double>();
-  if (!std::isfinite(v)) json_fail(path, "must be finite", j);
-  return v;
-}
-
-Vec3 json_vec3(const nlohmann::json& j, const std::string& path) {
-  if (!j.is_array() || j.size() != 3) json_fail(path, "must be an array of 3 numbers", j);
-  Vec3 v;
-  for (int i = 0; i < 3; ++i) v[i] = json_number(j[std::size_t(i)], path + "[" + std::to_string(i) + "]");
-  return v;
-}
-
-const nlohmann::json& json_key(const nlohmann::json& object, const char* key,
-                               const std::string& path) {
-  auto it = object.find(key);
-  if (it == object.end()) detail::fail(path, ": the key \"", key, "\" is missing");
-  return *it;
-}
-
-void json_known_keys(const nlohmann::json& object, std::initializer_list<const char*> keys,
-                     const std::string& path) {
-  for (auto it = object.begin(); it != object.end(); ++it)
-    if (std::none_of(keys.begin(), keys.end(), [&](const char* k) { return it.key() == k; }))
-      detail::fail(path, ".", it.key(), ": unknown key (known: ", [&] {
-        std::string list;
-        for (const char* k : keys) list += (list.empty() ? "" : ", ") + std::string(k);
-        return list;
-      }(), ")");
-}
-
-// "travel": {"X": [min, max], ...}, each letter optional.
-std::array<std::optional<std::array<double, 2>>, 3> travel_from_json(const nlohmann::json& j,
-                                                                     const std::string& path) {
-  if (!j.is_object()) json_fail(path, "must be an object such as {\"X\": [-300, 300]}", j);
-  json_known_keys(j, {"X", "Y", "Z"}, path);
-  std::array<std::optional<std::array<double, 2>>, 3> travel;
-  for (int i = 0; i < 3; ++i) {
-    std::string letter(1, char('X' + i));
-    if (!j.contains(letter)) continue;
-    const nlohmann::json& range = j[letter];
-    std::string at = path + "." + letter;
-    if (!range.is_array() || range.size() != 2) json_fail(at, "must be [min, max] in mm", range);
-    double lo = json_number(range[0], at + "[0]"), hi = json_number(range[1], at + "[1]");
-    if (!(lo < hi)) json_fail(at, "min must be less than max", range);
-    travel[std::size_t(i)] = std::array<double, 2>{lo, hi};
-  }
-  return travel;
-}
-
-RotaryAxis axis_from_json(const nlohmann::json& j, const std::string& path) {
-  if (!j.is_object()) json_fail(path, "must be an object", j);
-  json_known_keys(j, {"letter", "on", "direction", "sense", "pivot", "limits"}, path);
-  RotaryAxis axis;
-  const nlohmann::json& letter = json_key(j, "letter", path);
-  if (!letter.is_string() || letter.get<std::string>().size() != 1 ||
-      rotary_index(letter.get<std::string>()[0]) < 0)
-    json_fail(path + ".letter", "must be \"A\", \"B\" or \"C\"", letter);
-  axis.letter = char(std::toupper(static_cast<unsigned char>(letter.get<std::string>()[0])));
-  const nlohmann::json& on = json_key(j, "on", path);
-  if (on != "table" && on != "head") json_fail(path + ".on", "must be \"table\" or \"head\"", on);
-  axis.on_head = on == "head";
-  Vec3 direction = json_vec3(json_key(j, "direction", path), path + ".direction");
-  if (!(glm::length(direction) > 1e-12))
-    json_fail(path + ".direction", "must not be the zero vector", j["direction"]);
-  double sense = 1;
-  if (j.contains("sense")) {
-    sense = json_number(j["sense"], path + ".sense");
-    if (sense != 1 && sense != -1) json_fail(path + ".sense", "must be 1 or -1", j["sense"]);
-  }
-  axis.direction = sense * glm::normalize(direction);
-  axis.pivot = json_vec3(json_key(j, "pivot", path), path + ".pivot");
-  if (j.contains("limits")) {
-    const nlohmann::json& limits = j["limits"];
-    if (!limits.is_array() || limits.size() != 2)
-      json_fail(path + ".limits", "must be [min, max] in degrees", limits);
-    double lo = json_number(limits[0], path + ".limits[0]");
-    double hi = json_number(limits[1], path + ".limits[1]");
-    if (!(lo < hi)) json_fail(path + ".limits", "min must be less than max", limits);
-    axis.limits = std::array<double, 2>{lo, hi};
-  }
-  return axis;
-}
-
-RotaryAxis make_axis(char letter, bool on_head, Vec3 direction, Vec3 pivot,
-                     std::optional<std::array<double, 2>> limits) {
-  RotaryAxis axis;
-  axis.letter = letter;
-  axis.on_head = on_head;
-  axis.direction = direction;
-  axis.pivot = pivot;
-  axis.limits = limits;
-  return axis;
 }
 
 }  // namespace
@@ -404,91 +299,6 @@ RotaryPositions orient_tool(const Kinematics& kin, const Vec3& part_direction,
                  "cannot turn the tool there");
   }
   return *best;
-}
-
-// Bundled profiles. Machine coordinates are tool-tip coordinates with every rotary at 0; the
-// pivots put the table-face centre (or the tip, for head axes) at the origin, as a machine file
-// written against a machine's own zero would after subtracting it.
-//   ac-trunnion   table-table, A tilts the trunnion about X through (0, 0, −75) (the C face
-//                 75 mm above the tilt axis), −120°…120°; C turns the platter on it about Z
-//                 through the origin, endless. LinuxCNC's xyzac-trt kinematics with its default
-//                 directions (part_to_machine = Rx(A)·Rz(C) about the pivots).
-//   bc-trunnion   table-table, Haas UMC-style: B tilts about Y through (0, 0, −50), −35°…110°
-//                 (a UMC-750's published tilt range); C turns about Z through the origin,
-//                 endless.
-//   b-head-c-table head-table: B turns the head about Y through (0, 0, 150) (pivot 150 mm above
-//                 the tip), −110°…110°; C turns the table about Z through the origin, endless.
-//   head-head     head-head: C turns the head about Z through the spindle line, −360°…360°;
-//                 A, carried by C, tilts the spindle about X through (0, 0, 150), −100°…100°.
-std::optional<Kinematics> kinematics_profile(std::string_view name) {
-  using Limits = std::optional<std::array<double, 2>>;
-  const Limits endless;
-  Kinematics kin;
-  if (name == "ac-trunnion") {
-    kin.type = MachineType::table_table;
-    kin.axes = {make_axis('A', false, {1, 0, 0}, {0, 0, -75}, std::array<double, 2>{-120, 120}),
-                make_axis('C', false, {0, 0, 1}, {0, 0, 0}, endless)};
-  } else if (name == "bc-trunnion") {
-    kin.type = MachineType::table_table;
-    kin.axes = {make_axis('B', false, {0, 1, 0}, {0, 0, -50}, std::array<double, 2>{-35, 110}),
-                make_axis('C', false, {0, 0, 1}, {0, 0, 0}, endless)};
-  } else if (name == "b-head-c-table") {
-    kin.type = MachineType::head_table;
-    kin.axes = {make_axis('B', true, {0, 1, 0}, {0, 0, 150}, std::array<double, 2>{-110, 110}),
-                make_axis('C', false, {0, 0, 1}, {0, 0, 0}, endless)};
-  } else if (name == "head-head") {
-    kin.type = MachineType::head_head;
-    kin.axes = {make_axis('C', true, {0, 0, 1}, {0, 0, 0}, std::array<double, 2>{-360, 360}),
-                make_axis('A', true, {1, 0, 0}, {0, 0, 150}, std::array<double, 2>{-100, 100})};
-  } else {
-    return std::nullopt;
-  }
-  return kin;
-}
-
-std::vector<std::string> kinematics_profile_names() {
-  return {"ac-trunnion", "bc-trunnion", "b-head-c-table", "head-head"};
-}
-
-Kinematics kinematics_from_json(const nlohmann::json& value, const std::string& path) {
-  if (value.is_string()) {
-    std::optional<Kinematics> profile = kinematics_profile(value.get<std::string>());
-    if (!profile) {
-      std::string names;
-      for (const std::string& n : kinematics_profile_names()) names += (names.empty() ? "" : ", ") + n;
-      json_fail(path, "is not a bundled profile (" + names + ")", value);
-    }
-    return *profile;
-  }
-  if (!value.is_object()) json_fail(path, "must be a profile name or an object", value);
-  if (value.contains("profile")) {  // a bundled profile with the machine's own travel
-    json_known_keys(value, {"profile", "travel"}, path);
-    Kinematics kin = kinematics_from_json(value["profile"], path + ".profile");
-    if (value.contains("travel")) kin.travel = travel_from_json(value["travel"], path + ".travel");
-    return kin;
-  }
-  json_known_keys(value, {"type", "axes", "travel"}, path);
-  Kinematics kin;
-  if (value.contains("travel")) kin.travel = travel_from_json(value["travel"], path + ".travel");
-  const nlohmann::json& type = json_key(value, "type", path);
-  if (type == "table-table") kin.type = MachineType::table_table;
-  else if (type == "head-table") kin.type = MachineType::head_table;
-  else if (type == "head-head") kin.type = MachineType::head_head;
-  else json_fail(path + ".type", "must be \"table-table\", \"head-table\" or \"head-head\"", type);
-  const nlohmann::json& axes = json_key(value, "axes", path);
-  if (!axes.is_array() || axes.empty() || axes.size() > 2)
-    json_fail(path + ".axes", "must be an array of one or two axes", axes);
-  for (std::size_t i = 0; i < axes.size(); ++i)
-    kin.axes.push_back(axis_from_json(axes[i], path + ".axes[" + std::to_string(i) + "]"));
-  try {
-    kin.validate();
-  } catch (const Error& e) {
-    // validate() speaks of "kinematics"; name the machine file's path and the axes instead.
-    std::string message = e.what();
-    if (message.rfind("kinematics: ", 0) == 0) message = message.substr(12);
-    detail::fail(path, ": ", message, " (", value.dump(), ")");
-  }
-  return kin;
 }
 
 }  // namespace tridex::gcode

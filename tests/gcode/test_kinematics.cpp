@@ -1,5 +1,5 @@
-// Rotary kinematics (kinematics.hpp): each bundled profile against poses worked out by hand and
-// against the chain composed independently; random round trips (rotary positions → tool
+// Rotary kinematics (kinematics.hpp): each bundled profile (machine.hpp) against poses worked out
+// by hand and against the chain composed independently; random round trips (rotary positions → tool
 // direction → inverse → the same direction; machine ↔ part maps invert each other; TCP/DWO
 // positions agree with the raw machine-coordinate map); reachability, limits and the machine
 // file's "kinematics" object with its errors.
@@ -13,6 +13,7 @@
 #include "helpers.hpp"
 #include "tridex/error.hpp"
 #include "tridex/gcode/kinematics.hpp"
+#include "tridex/gcode/machine.hpp"
 #include "tridex/gcode/tilted_plane.hpp"
 
 using namespace tridex;

@@ -8,6 +8,7 @@
 
 #include "helpers.hpp"
 #include "tridex/gcode/kinematics.hpp"
+#include "tridex/gcode/machine.hpp"
 #include "tridex/gcode/tilted_plane.hpp"
 
 using namespace tridex;

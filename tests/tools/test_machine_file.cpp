@@ -7,7 +7,8 @@
 
 #include "command_harness.hpp"
 #include "errors.hpp"
-#include "machine_file.hpp"
+#include "program_input.hpp"
+#include "tridex/gcode/machine.hpp"
 
 using namespace tridex;
 using namespace tridex::test;
@@ -242,7 +243,7 @@ TEST_CASE("machine files: a bundled kinematics profile is a --machine name on ev
   write_text(dir / "tools.json", R"({"1": {"units": "mm", "shape": "ballnose", "diameter": 6, "length": 30}})");
   for (const std::string& name : gcode::kinematics_profile_names()) {
     INFO(name);
-    CHECK(std::string(cli::kBundledMachines).find(name) != std::string::npos);  // --help lists it
+    CHECK(gcode::bundled_machine_names().find(name) != std::string::npos);  // --help lists it
     // The name is the default machine with that profile: as {"kinematics": NAME}.
     write_text(dir / "m.json", "{\"kinematics\": \"" + name + "\"}");
     gcode::MachineConfig by_name = cli::load_machine(name), by_file = cli::load_machine((dir / "m.json").string());

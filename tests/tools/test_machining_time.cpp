@@ -11,9 +11,10 @@
 
 #include "command_harness.hpp"
 #include "errors.hpp"
-#include "machine_file.hpp"
 #include "machining_time.hpp"
+#include "program_input.hpp"
 #include "tridex/gcode/interpreter.hpp"
+#include "tridex/gcode/machine.hpp"
 
 using namespace tridex;
 using namespace tridex::test;
@@ -23,20 +24,21 @@ namespace {
 
 // The program's time as tridex reads it, with the tool starting at the origin.
 cli::MachiningTime time_of(const std::string& program, gcode::Dialect dialect = gcode::Dialect::linuxcnc,
-                           cli::MachineRates rates = {}) {
+                           gcode::MachineRates rates = {}) {
   gcode::MachineConfig machine;
   machine.dialect = dialect;
   machine.start_position = Vec3(0.0);
   machine.tool_change = gcode::ToolChange::in_place;
+  machine.rates = rates;
   gcode::Interpreter interpreter({}, machine);
-  cli::MachiningTimer timer(rates);
+  cli::MachiningTimer timer(machine);
   std::istringstream in(program);
   interpreter.run(
       in, "t.nc", [&](const gcode::Move& m) { timer.add(m); }, [&](const gcode::Dwell& d) { timer.add(d); });
   return timer.time();
 }
 
-constexpr double kRapid = cli::MachineRates::kDefaultRapid;
+constexpr double kRapid = gcode::MachineRates::kDefaultRapid;
 
 }  // namespace
 
@@ -96,11 +98,12 @@ TEST_CASE("machining time: dwell words by dialect") {
 }
 
 TEST_CASE("machining time: rapids per axis, a max feed, per tool and per direction") {
-  cli::MachineRates rates;
+  gcode::MachineConfig machine;
+  gcode::MachineRates& rates = machine.rates;
   rates.rapid_mm_per_min = Vec3(6000, 2000, 1000);
   rates.rapid_per_axis = true;
   rates.max_feed_mm_per_min = 500;
-  cli::MachiningTimer timer(rates);
+  cli::MachiningTimer timer(machine);
   gcode::Move m;
   m.kind = gcode::MoveKind::rapid;
   m.tool = 1;
@@ -138,8 +141,7 @@ TEST_CASE("machining time: the machine file's rates, refused when bad, in the re
   fs::path dir = scratch("machining-time");
   write_text(dir / "p.nc", "G21 G90\nG0 X0 Y0 Z5\nT1 M6\nG1 Z-1 F60\nG1 X20 F1200\nG4 P2\nG0 Z25\nM30\n");
   write_text(dir / "m.json", R"({"base": "linuxcnc", "rapid_rate_mm_per_min": 3000, "max_feed_mm_per_min": 600})");
-  cli::MachineRates rates;
-  cli::load_machine((dir / "m.json").string(), {}, &rates);
+  gcode::MachineRates rates = cli::load_machine((dir / "m.json").string()).rates;
   CHECK(rates.rapid_mm_per_min == Vec3(3000));
   CHECK(rates.max_feed_mm_per_min == 600);
   CHECK(rates.source == (dir / "m.json").string());
@@ -200,10 +202,9 @@ namespace {
 
 // The program's time on the machine a machine file describes (its kinematics and rates).
 cli::MachiningTime time_on(const std::string& machine_file, const std::string& program) {
-  cli::MachineRates rates;
-  gcode::MachineConfig machine = cli::machine_from_json(json::parse(machine_file), "m.json", &rates);
+  gcode::MachineConfig machine = gcode::machine_from_json(json::parse(machine_file), "m.json");
   gcode::Interpreter interpreter({}, machine);
-  cli::MachiningTimer timer(rates, machine.kinematics);
+  cli::MachiningTimer timer(machine);
   std::istringstream in(program);
   interpreter.run(in, "t.nc", [&](const gcode::Move& m) { timer.add(m); });
   return timer.time();
@@ -259,22 +260,22 @@ TEST_CASE("machining time: rapids in raw rotary form, with the turn at the rotar
 }
 
 TEST_CASE("machining time: the rotary rates in the machine file") {
-  cli::MachineRates rates;
-  cli::machine_from_json(json::parse(R"({"rapid_rate_deg_per_min": 5400})"), "m.json", &rates);
+  gcode::MachineRates rates =
+      gcode::machine_from_json(json::parse(R"({"rapid_rate_deg_per_min": 5400})"), "m.json").rates;
   CHECK(rates.rapid_deg_per_min == std::array<double, 3>{5400, 5400, 5400});
   // Read in either order with the linear rates (a JSON object's keys are unordered).
-  cli::machine_from_json(json::parse(R"({"rapid_rate_mm_per_min": 8000, "rapid_rate_deg_per_min": {"B": 900}})"),
-                         "m.json", &rates);
-  CHECK(rates.rapid_deg_per_min == std::array<double, 3>{0, 900, 0});
-  CHECK(rates.rapid_mm_per_min == Vec3(8000));
-  cli::MachiningTimer timer(rates);
+  gcode::MachineConfig machine = gcode::machine_from_json(
+      json::parse(R"({"rapid_rate_mm_per_min": 8000, "rapid_rate_deg_per_min": {"B": 900}})"), "m.json");
+  CHECK(machine.rates.rapid_deg_per_min == std::array<double, 3>{0, 900, 0});
+  CHECK(machine.rates.rapid_mm_per_min == Vec3(8000));
+  cli::MachiningTimer timer(machine);
   CHECK(cli::machining_time_json(timer)["rapid_rate_deg_per_min"] == json{{"B", 900.0}});
   for (const char* bad : {R"({"rapid_rate_deg_per_min": 0})", R"({"rapid_rate_deg_per_min": {"X": 100}})",
                           R"({"rapid_rate_deg_per_min": {"A": -5}})", R"({"rapid_rate_deg_per_min": [1, 2]})"}) {
     try {
-      cli::machine_from_json(json::parse(bad), "bad.json", &rates);
+      gcode::machine_from_json(json::parse(bad), "bad.json");
       FAIL(bad);
-    } catch (const cli::InputError& e) {
+    } catch (const gcode::MachineError& e) {
       std::string message = e.what();
       CHECK(message.find("bad.json: \"rapid_rate_deg_per_min\"") != std::string::npos);
     }

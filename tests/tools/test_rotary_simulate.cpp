@@ -16,6 +16,7 @@
 
 #include "command_harness.hpp"
 #include "tridex/gcode/kinematics.hpp"
+#include "tridex/gcode/machine.hpp"
 #include "tridex/gcode/tilted_plane.hpp"
 
 using namespace tridex;

@@ -110,7 +110,7 @@ int run_groups(const ListOptions& options) {
     std::vector<std::array<double, 3>> rotary;  // the distinct rotary positions (kinematics)
   };
   std::vector<Extra> extras;
-  MachiningTimer timer(input.rates, input.machine.kinematics);
+  MachiningTimer timer(input.machine);
   InterpretResult result = interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t file) {
     budget.keep(m, input.files[file].string());
     timer.add(m);

@@ -16,8 +16,8 @@ const double kSameDirection = std::cos(glm::radians(1e-3));
 
 }  // namespace
 
-MachiningTimer::MachiningTimer(MachineRates rates, std::optional<gcode::Kinematics> kinematics)
-    : rates_(std::move(rates)), kinematics_(std::move(kinematics)) {}
+MachiningTimer::MachiningTimer(const gcode::MachineConfig& machine)
+    : rates_(machine.rates), kinematics_(machine.kinematics) {}
 
 void MachiningTimer::charge(int tool, const Vec3& axis, double seconds) {
   time_.by_tool[tool] += seconds;
@@ -103,7 +103,7 @@ void MachiningTimer::add(const gcode::Dwell& dwell) {
 
 Json machining_time_json(const MachiningTimer& timer) {
   const MachiningTime& t = timer.time();
-  const MachineRates& rates = timer.rates();
+  const gcode::MachineRates& rates = timer.rates();
   Json by_tool = Json::array();
   for (const auto& [tool, s] : t.by_tool) by_tool.push_back({{"tool", tool}, {"s", s}});
   Json by_direction = Json::array();
@@ -137,7 +137,7 @@ std::string duration_text(double seconds) {
 
 std::string machining_time_text(const MachiningTimer& timer) {
   const MachiningTime& t = timer.time();
-  const MachineRates& rates = timer.rates();
+  const gcode::MachineRates& rates = timer.rates();
   char rate[96];
   if (rates.rapid_per_axis)
     std::snprintf(rate, sizeof rate, "[%g, %g, %g]", rates.rapid_mm_per_min.x, rates.rapid_mm_per_min.y,

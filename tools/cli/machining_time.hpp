@@ -19,24 +19,11 @@
 #include <vector>
 
 #include "json_text.hpp"
-#include "tridex/gcode/kinematics.hpp"
+#include "tridex/gcode/machine.hpp"
 #include "tridex/gcode/move.hpp"
 #include "tridex/geometry.hpp"
 
 namespace tridex::cli {
-
-// The machine file's speeds (README "Machine files"): "rapid_rate_mm_per_min" (a number, or
-// [x, y, z]), "rapid_rate_deg_per_min" (a number for every rotary axis, or {"A": …, "C": …}) and
-// "max_feed_mm_per_min" (feeds above it run at it).
-struct MachineRates {
-  static constexpr double kDefaultRapid = 10000;  // mm/min, when the machine file gives none
-
-  Vec3 rapid_mm_per_min{kDefaultRapid};
-  bool rapid_per_axis = false;
-  std::array<double, 3> rapid_deg_per_min{};  // A, B, C; 0: not given (such turns are not timed)
-  std::optional<double> max_feed_mm_per_min;
-  std::string source = "default";  // where the rapid rate came from: "default" or the file
-};
 
 struct MachiningTime {
   double feed_s = 0, rapid_s = 0, dwell_s = 0;
@@ -51,18 +38,18 @@ struct MachiningTime {
 class MachiningTimer {
  public:
   MachiningTimer() = default;
-  // `kinematics`: the machine's model, where it has one (MachineConfig::kinematics).
-  explicit MachiningTimer(MachineRates rates, std::optional<gcode::Kinematics> kinematics = std::nullopt);
+  // The machine's speeds and, where it has them, its rotary axes.
+  explicit MachiningTimer(const gcode::MachineConfig& machine);
   void add(const gcode::Move& move);
   void add(const gcode::Dwell& dwell);
   const MachiningTime& time() const { return time_; }
-  const MachineRates& rates() const { return rates_; }
+  const gcode::MachineRates& rates() const { return rates_; }
 
  private:
   void charge(int tool, const Vec3& axis, double seconds);
   double rapid_minutes(const gcode::Move& move);
 
-  MachineRates rates_;
+  gcode::MachineRates rates_;
   std::optional<gcode::Kinematics> kinematics_;
   MachiningTime time_;
   std::size_t last_direction_ = 0;

@@ -11,9 +11,9 @@
 
 #include "commands.hpp"
 #include "errors.hpp"
-#include "machine_file.hpp"
 #include "output.hpp"
 #include "tridex/gcode/diagnostic.hpp"
+#include "tridex/gcode/machine.hpp"
 
 #ifndef TRIDEX_VERSION
 #define TRIDEX_VERSION "unknown"
@@ -65,7 +65,7 @@ void add_common(CLI::App& command, CommonOptions& options) {
                      "(default on)")
       ->check(CLI::IsMember({"on", "off"}));
   command.add_option("--machine", options.machine,
-                     std::string("machine file (JSON) or bundled machine: ") + kBundledMachines +
+                     std::string("machine file (JSON) or bundled machine: ") + tridex::gcode::bundled_machine_names() +
                          " (README: Machine files)");
   command.add_option("--subprograms", options.subprograms,
                      "folder of subprogram files (O9810.nc, name.ngc) that M98/G65/o-call may "

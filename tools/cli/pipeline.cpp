@@ -263,7 +263,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   const std::optional<gcode::Kinematics>& kinematics = input.machine.kinematics;
   // Positions "far along the tool axis" stand in for where the machine takes the tool: no travel.
   const double far = 0.5 * input.machine.far_distance;
-  r.machining = MachiningTimer(input.rates, kinematics);
+  r.machining = MachiningTimer(input.machine);
   // Grouping (and the checks that read each move once) runs on a second thread when there is one,
   // overlapping the interpreter; the budget and the machining time stay on this thread, with the
   // dwells the timer also reads.

@@ -5,7 +5,7 @@
 #include <fstream>
 
 #include "errors.hpp"
-#include "machine_file.hpp"
+#include "json_input.hpp"
 #include "memory.hpp"
 #include "project.hpp"
 
@@ -13,10 +13,37 @@ namespace tridex::cli {
 
 namespace fs = std::filesystem;
 
+gcode::MachineConfig load_machine(const std::string& name_or_file,
+                                  const std::vector<std::string>& subprogram_dirs) {
+  gcode::MachineConfig machine;
+  if (name_or_file.empty()) {
+    machine = *gcode::MachineConfig::bundled("default");
+  } else if (auto bundled = gcode::MachineConfig::bundled(name_or_file)) {
+    machine = *bundled;
+  } else {
+    std::error_code error;
+    if (!fs::is_regular_file(name_or_file, error))
+      input_error("--machine ", name_or_file, ": neither a bundled machine (", gcode::bundled_machine_names(),
+                  ") nor a machine file");
+    nlohmann::json doc = read_json_file(name_or_file);
+    try {
+      machine = gcode::machine_from_json(doc, name_or_file);
+    } catch (const gcode::MachineError& e) {
+      throw InputError(e.what());  // bad input: exit status 2, as the command's other files
+    }
+  }
+  for (const std::string& dir : subprogram_dirs) {
+    std::error_code error;
+    if (!fs::is_directory(dir, error)) input_error("--subprograms ", dir, ": not a folder");
+    machine.subprogram_dirs.insert(machine.subprogram_dirs.begin(), dir);
+  }
+  return machine;
+}
+
 ProgramInput resolve_program(const CommonOptions& options) {
   const std::string& program = options.program;
   ProgramInput input;
-  input.machine = load_machine(options.machine, options.subprograms, &input.rates);
+  input.machine = load_machine(options.machine, options.subprograms);
   input.program = program;
   std::error_code error;
   if (fs::is_directory(input.program, error)) input_error(program, ": is a directory, not a program file");

@@ -24,8 +24,13 @@ struct ProgramInput {
   std::optional<ToolTable> tools;             // --tools, else from a project
   std::optional<StockSpec> stock;             // from a project
   gcode::MachineConfig machine;               // --machine, --subprograms
-  MachineRates rates;                         // the machine file's speeds, for the machining time
 };
+
+// --machine NAME|FILE and --subprograms: a bundled machine (tridex/gcode/machine.hpp's registry)
+// or a machine file; an empty name is the default machine. `subprogram_dirs` are searched before
+// the machine file's own. Throws InputError naming the option, or the file, the key and the value.
+gcode::MachineConfig load_machine(const std::string& name_or_file,
+                                  const std::vector<std::string>& subprogram_dirs = {});
 
 // Throws InputError if the file is missing, the project is malformed or the machine unknown.
 ProgramInput resolve_program(const CommonOptions& options);

@@ -6,7 +6,7 @@
 #   tool_table  the tool table, CAMotics schema (tools/cli/tool_table.cpp, json_input.cpp)
 #   project     the .camotics project (tools/cli/project.cpp)
 #   options     --stock, --envelope and --max-memory (tools/cli/stock.cpp, memory.cpp)
-#   machine     the machine file, kinematics included (tools/cli/machine_file.cpp)
+#   machine     the machine file, kinematics included (gcode/src/machine_file.cpp, machine.cpp)
 # Exit status 0: no crash in that time. A crash leaves its input as BUILD_DIR/<harness>-crash-*
 # and stops the script with a non-zero status; turn it into a named case in
 # tests/tools/test_bad_input.cpp with the input under tests/data/.
@@ -23,7 +23,7 @@ flags=(-std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recov
 mkdir -p "$build/inputs"
 # The command's parsers, compiled once (-fsanitize=fuzzer-no-link: instrumented, no main).
 objects=()
-for source in json_input machine_file memory numbers project stock tool_table; do
+for source in json_input memory numbers project stock tool_table; do
   object="$build/inputs/$source.o"
   if [ ! -f "$object" ] || [ "tools/cli/$source.cpp" -nt "$object" ]; then
     clang++ "${flags[@]/-fsanitize=fuzzer,address,undefined/-fsanitize=fuzzer-no-link,address,undefined}" \
@@ -31,7 +31,7 @@ for source in json_input machine_file memory numbers project stock tool_table; d
   fi
   objects+=("$object")
 done
-# The machine file's kinematics and bundled profiles come from the G-code front end.
+# The machine file, its kinematics and the bundled machines come from the G-code front end.
 for source in gcode/src/*.cpp; do
   object="$build/inputs/gcode_$(basename "$source" .cpp).o"
   if [ ! -f "$object" ] || [ "$source" -nt "$object" ]; then

@@ -20,30 +20,13 @@
 // (Paden–Kahan subproblem 2; Murray, Li and Sastry, "A Mathematical Introduction to Robotic
 // Manipulation", CRC 1994, §3.2.2): the common vector lies on two cones, at most two solutions.
 //
-// Machine file, key "kinematics" (issue 11's machine file; see gcode/README.md, "Machine
-// kinematics"): either the name of a bundled profile, or an object:
-//   "kinematics": {
-//     "type": "table-table",              // or "head-table", "head-head"
-//     "axes": [                           // chain order, each side from the machine outward
-//       {"letter": "A",                   // A, B or C; each at most once
-//        "on": "table",                   // "table" or "head"
-//        "direction": [1, 0, 0],          // the axis line's direction (any length but zero)
-//        "sense": 1,                      // optional, 1 or -1: which way a positive angle turns
-//        "pivot": [0, 0, -75],            // a point on the line, mm, every rotary at 0
-//        "limits": [-110, 110]},          // optional, degrees; absent: turns without end
-//       {"letter": "C", "on": "table", "direction": [0, 0, 1], "pivot": [0, 0, 0]}],
-//     "travel": {"X": [-300, 300], "Y": [-250, 250], "Z": [-400, 0]}}  // optional, see below
-// or a bundled profile with the machine's travel: {"profile": "bc-trunnion", "travel": {...}}.
-// One or two axes; "table-table" has them all on the table, "head-head" all on the head,
-// "head-table" one of each. Errors name the key path and the value
-// (`kinematics.axes[1].direction: ...`).
+// The machine file's "kinematics" key and the bundled profiles are the machine module's
+// (machine.hpp).
 #pragma once
 
 #include <array>
-#include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <string>
-#include <string_view>
 #include <vector>
 
 #include "tridex/geometry.hpp"
@@ -132,16 +115,5 @@ struct TravelViolation {
 // elsewhere.)
 std::vector<TravelViolation> travel_violations(const Kinematics& kin, const Vec3& machine_xyz,
                                                const RotaryPositions& rotary);
-
-// ---- profiles and the machine file ------------------------------------------------------------
-
-// A bundled profile by name: "ac-trunnion", "bc-trunnion", "b-head-c-table", "head-head"
-// (documented in kinematics.cpp and gcode/README.md); std::nullopt for another name.
-std::optional<Kinematics> kinematics_profile(std::string_view name);
-std::vector<std::string> kinematics_profile_names();
-
-// The "kinematics" value of a machine file (a profile name or an object, schema above); `path`
-// prefixes the key paths in error messages.
-Kinematics kinematics_from_json(const nlohmann::json& value, const std::string& path = "kinematics");
 
 }  // namespace tridex::gcode

@@ -1,0 +1,287 @@
+// tridex::gcode — the machine file: a machine described in JSON (machine.hpp lists the keys,
+// README "Machine files" documents them), read into a MachineConfig, its kinematics and its
+// speeds. Every fault is a MachineError naming the file, the key and the value.
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+
+#include "tridex/error.hpp"
+#include "tridex/gcode/machine.hpp"
+
+namespace tridex::gcode {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+template <class... Parts>
+[[noreturn]] void machine_error(const Parts&... parts) {
+  std::ostringstream message;
+  (message << ... << parts);
+  throw MachineError(message.str());
+}
+
+// Concatenation through a stream (GCC 12 warns falsely on "literal" + std::string chains).
+template <class... Parts>
+std::string cat(const Parts&... parts) {
+  std::ostringstream out;
+  (out << ... << parts);
+  return out.str();
+}
+
+Vec3 point(const json& value, const std::string& where) {
+  if (!value.is_array() || value.size() != 3)
+    machine_error(where, ": must be [x, y, z] in mm, got ", value.dump());
+  Vec3 p;
+  for (int i = 0; i < 3; ++i) {
+    const json& c = value[static_cast<std::size_t>(i)];
+    if (!c.is_number() || !std::isfinite(c.get<double>()))
+      machine_error(where, ": must be [x, y, z] of finite numbers, got ", value.dump());
+    p[i] = c.get<double>();
+  }
+  return p;
+}
+
+std::set<int> m_code_list(const json& value, const std::string& where) {
+  if (!value.is_array())
+    machine_error(where, ": must be a list of M-code numbers, got ", value.dump());
+  std::set<int> codes;
+  for (const json& c : value) {
+    if (!c.is_number_integer() || c.get<long long>() < 0 || c.get<long long>() > 9999)
+      machine_error(where, ": M-code numbers are integers in [0, 9999], got ", c.dump());
+    codes.insert(static_cast<int>(c.get<long long>()));
+  }
+  return codes;
+}
+
+const json& string_value(const json& value, const std::string& where) {
+  if (!value.is_string()) machine_error(where, ": must be a string, got ", value.dump());
+  return value;
+}
+
+// "G54".."G59" -> 1..6; "G54.1 P<n>" -> 100 + n.
+int work_offset_key(const std::string& name, const std::string& where) {
+  for (int n = 1; n <= 6; ++n)
+    if (name == cat("G", 53 + n)) return MachineConfig::g54_key(n);
+  if (name.rfind("G54.1 P", 0) == 0) {
+    std::string number = name.substr(7);
+    if (!number.empty() && number.size() <= 3 &&
+        number.find_first_not_of("0123456789") == std::string::npos) {
+      int p = std::stoi(number);
+      if (p >= 1 && p <= 300) return MachineConfig::g54_1_key(p);
+    }
+  }
+  machine_error(where, ": unknown work offset \"", name,
+                "\" (G54..G59 or \"G54.1 P1\"..\"G54.1 P300\")");
+}
+
+// A positive, finite number of `unit` (mm, mm/min).
+double positive(const json& value, const std::string& where, const char* unit) {
+  if (!value.is_number() || !(value.get<double>() > 0) || !std::isfinite(value.get<double>()))
+    machine_error(where, ": must be a positive number of ", unit, ", got ", value.dump());
+  return value.get<double>();
+}
+double rate(const json& value, const std::string& where) {
+  return positive(value, where, "mm/min");
+}
+
+// "rapid_rate_mm_per_min": one rate for every linear axis, or [x, y, z].
+void linear_rates(const json& value, const std::string& where, const std::string& file,
+                  MachineRates& rates) {
+  MachineRates r;
+  if (value.is_array()) {
+    if (value.size() != 3)
+      machine_error(where, ": one rate, or [x, y, z] in mm/min, got ", value.dump());
+    for (int a = 0; a < 3; ++a)
+      r.rapid_mm_per_min[a] = rate(value[static_cast<std::size_t>(a)], where);
+    r.rapid_per_axis = true;
+  } else {
+    r.rapid_mm_per_min = Vec3(rate(value, where));
+  }
+  rates.rapid_mm_per_min = r.rapid_mm_per_min;
+  rates.rapid_per_axis = r.rapid_per_axis;
+  rates.source = file;
+}
+
+// Rotary rapid rates, degrees per minute, indexed A, B, C (0 where not given): one number for
+// every rotary axis, or {"A": …, "B": …, "C": …}.
+std::array<double, 3> rotary_rates(const json& value, const std::string& where) {
+  std::array<double, 3> rates{};
+  if (value.is_object()) {
+    for (const auto& [letter, r] : value.items()) {
+      if (letter != "A" && letter != "B" && letter != "C")
+        machine_error(where, ": \"", letter, "\" is not a rotary axis (A, B or C)");
+      if (!r.is_number() || !(r.get<double>() > 0) || !std::isfinite(r.get<double>()))
+        machine_error(where, ": \"", letter,
+                      "\" must be a positive number of degrees per minute, got ", r.dump());
+      rates[static_cast<std::size_t>(letter[0] - 'A')] = r.get<double>();
+    }
+  } else if (value.is_number() && value.get<double>() > 0 && std::isfinite(value.get<double>())) {
+    rates.fill(value.get<double>());
+  } else {
+    machine_error(
+        where,
+        ": one rate for every rotary axis, or {\"A\": …, \"C\": …}, in degrees per minute, got ",
+        value.dump());
+  }
+  return rates;
+}
+
+// "variables": {"#650": 2000, "#<_name>": 1}: what the control holds when the program starts.
+void read_variables(const json& value, const std::string& where, MachineConfig& m) {
+  if (!value.is_object()) machine_error(where, ": must be an object such as {\"#650\": 2000}");
+  for (const auto& [name, number] : value.items()) {
+    if (!number.is_number() || !std::isfinite(number.get<double>()))
+      machine_error(where, ": \"", name, "\": must be a number, got ", number.dump());
+    if (name.starts_with("#<")) {  // LinuxCNC's named global, case and spaces as it reads them
+      std::string global;
+      for (char c : name.substr(2, name.size() > 3 ? name.size() - 3 : 0))
+        if (c != ' ' && c != '\t')
+          global.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(c))));
+      if (!name.ends_with(">") || global.size() < 2 || global[0] != '_')
+        machine_error(where, ": \"", name, "\" is not a global named parameter (#<_name>)");
+      m.named_variables[global] = number.get<double>();
+      continue;
+    }
+    std::string digits = name.starts_with("#") ? name.substr(1) : name;
+    char* end = nullptr;
+    const long n = digits.empty() ? -1 : std::strtol(digits.c_str(), &end, 10);
+    if (n < 1 || n > 999999 || *end != '\0')
+      machine_error(where, ": \"", name, "\" is not a variable number (#1 to #999999) or #<_name>");
+    m.variables[static_cast<int>(n)] = number.get<double>();
+  }
+}
+
+MachineConfig parse(const json& doc, const std::string& file) {
+  if (!doc.is_object()) machine_error(file, ": a machine file is a JSON object");
+  MachineConfig m;
+  if (auto base = doc.find("base"); base != doc.end()) {
+    std::string name = string_value(*base, cat(file, ": \"base\"")).get<std::string>();
+    auto bundled = MachineConfig::bundled(name);
+    if (!bundled)
+      machine_error(file, ": \"base\": no bundled machine \"", name, "\" (",
+                    bundled_machine_names(), ")");
+    m = *bundled;
+  }
+  for (const auto& [key, value] : doc.items()) {
+    std::string where = cat(file, ": \"", key, "\"");
+    if (key == "name" || key == "description" || key == "base") {
+      string_value(value, where);
+    } else if (key == "dialect") {
+      std::string d = string_value(value, where).get<std::string>();
+      if (d == "fanuc")
+        m.dialect = Dialect::fanuc;
+      else if (d == "haas")
+        m.dialect = Dialect::haas;
+      else if (d == "linuxcnc")
+        m.dialect = Dialect::linuxcnc;
+      else
+        machine_error(where, ": \"fanuc\", \"haas\" or \"linuxcnc\", got \"", d, "\"");
+    } else if (key == "units") {
+      std::string u = string_value(value, where).get<std::string>();
+      if (u != "mm" && u != "inch") machine_error(where, ": \"mm\" or \"inch\", got \"", u, "\"");
+      m.inch_at_start = u == "inch";
+    } else if (key == "linear_units") {  // LinuxCNC's [TRAJ]LINEAR_UNITS: a .tbl's units
+      std::string u = string_value(value, where).get<std::string>();
+      if (u != "mm" && u != "inch") machine_error(where, ": \"mm\" or \"inch\", got \"", u, "\"");
+      m.tool_table_in_inches = u == "inch";
+    } else if (key == "start") {
+      if (value.is_string() && value.get<std::string>() == "far")
+        m.start_position.reset();
+      else
+        m.start_position = point(value, where);
+    } else if (key == "tool_change") {
+      if (value.is_string() && value.get<std::string>() == "far") {
+        m.tool_change = ToolChange::retract_far;
+      } else if (value.is_string() && value.get<std::string>() == "in_place") {
+        m.tool_change = ToolChange::in_place;
+      } else if (value.is_array()) {
+        m.tool_change = ToolChange::to_position;
+        m.tool_change_position = point(value, where);
+      } else {
+        machine_error(where, ": \"far\", \"in_place\" or [x, y, z], got ", value.dump());
+      }
+    } else if (key == "tool_loads_on_t") {
+      if (!value.is_boolean()) machine_error(where, ": must be true or false, got ", value.dump());
+      m.tool_loads_on_t = value.get<bool>();
+    } else if (key == "arc_radius_tolerance_mm") {  // Fanuc's parameter 3410
+      m.arc_radius_tolerance = positive(value, where, "mm");
+    } else if (key == "d_offsets") {  // what the D registers hold (Haas: its setting 40)
+      std::string d = string_value(value, where).get<std::string>();
+      if (d != "radius" && d != "diameter")
+        machine_error(where, ": \"radius\" or \"diameter\", got \"", d, "\"");
+      m.d_offsets = d == "radius" ? DOffsets::radius : DOffsets::diameter;
+    } else if (key == "g53") {
+      std::string g = string_value(value, where).get<std::string>();
+      if (g != "far" && g != "literal")
+        machine_error(where, ": \"far\" or \"literal\", got \"", g, "\"");
+      m.g53_literal = g == "literal";
+    } else if (key == "home") {
+      m.set_home(point(value, where));
+    } else if (key == "reference2") {
+      m.set_reference2(point(value, where));
+    } else if (key == "work_offsets") {
+      if (!value.is_object())
+        machine_error(where, ": must be an object such as {\"G54\": [x, y, z]}");
+      for (const auto& [name, offset] : value.items())
+        m.work_offsets[work_offset_key(name, where)] =
+            point(offset, cat(where, ": \"", name, "\""));
+    } else if (key == "m_codes") {
+      m.m_codes = m_code_list(value, where);
+    } else if (key == "forbidden_m_codes") {
+      m.forbidden_m_codes = m_code_list(value, where);
+    } else if (key == "variables") {  // {"#650": 2000, "#1000": 0}: what the control holds
+      read_variables(value, where, m);
+    } else if (key == "kinematics") {
+      try {
+        m.kinematics = kinematics_from_json(value, cat(file, ": kinematics"));
+      } catch (const MachineError&) {
+        throw;
+      } catch (const Error& e) {
+        machine_error(e.what());
+      }
+    } else if (key == "far_distance") {
+      m.far_distance = positive(value, where, "mm");
+    } else if (key == "rapid_rate_mm_per_min") {
+      linear_rates(value, where, file, m.rates);
+    } else if (key == "rapid_rate_deg_per_min") {
+      m.rates.rapid_deg_per_min = rotary_rates(value, where);
+    } else if (key == "max_feed_mm_per_min") {
+      m.rates.max_feed_mm_per_min = rate(value, where);
+    } else if (key == "subprograms") {
+      if (!value.is_array()) machine_error(where, ": must be a list of folders");
+      fs::path base = fs::path(file).parent_path();
+      for (const json& dir : value)
+        m.subprogram_dirs.push_back((base / string_value(dir, where).get<std::string>()).string());
+    } else {
+      machine_error(where,
+                    ": unknown key (known: name, description, base, dialect, units, start, "
+                    "tool_change, tool_loads_on_t, arc_radius_tolerance_mm, d_offsets, home, "
+                    "reference2, work_offsets, m_codes, "
+                    "forbidden_m_codes, variables, far_distance, subprograms, kinematics, "
+                    "rapid_rate_mm_per_min, rapid_rate_deg_per_min, max_feed_mm_per_min)");
+    }
+  }
+  for (int code : m.m_codes)
+    if (m.forbidden_m_codes.count(code))
+      machine_error(file, ": M", code, " is both in \"m_codes\" and in \"forbidden_m_codes\"");
+  return m;
+}
+
+}  // namespace
+
+MachineConfig machine_from_json(const json& doc, const std::string& file) {
+  try {
+    return parse(doc, file);
+  } catch (const json::exception& e) {
+    machine_error(file, ": ", e.what());
+  }
+}
+
+}  // namespace tridex::gcode
