@@ -12,7 +12,7 @@
 #include "commands.hpp"
 #include "errors.hpp"
 #include "machine_file.hpp"
-#include "output.hpp"
+#include "outputs/output.hpp"
 #include "tridex/gcode/diagnostic.hpp"
 
 #ifndef TRIDEX_VERSION

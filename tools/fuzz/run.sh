@@ -3,9 +3,9 @@
 # share of a bounded total time, with a fixed seed:
 #   tools/fuzz/run.sh [SECONDS=60] [BUILD_DIR=build-fuzz]
 #   stl         the STL reader, binary and ASCII (include/tridex/stl.hpp)
-#   tool_table  the tool table, CAMotics schema (tools/cli/tool_table.cpp, json_input.cpp)
-#   project     the .camotics project (tools/cli/project.cpp)
-#   options     --stock, --envelope and --max-memory (tools/cli/stock.cpp, memory.cpp)
+#   tool_table  the tool table, CAMotics schema (tools/cli/inputs/tool_table.cpp, json_input.cpp)
+#   project     the .camotics project (tools/cli/inputs/project.cpp)
+#   options     --stock, --envelope and --max-memory (tools/cli/inputs/stock.cpp, pipeline/memory.cpp)
 #   machine     the machine file, kinematics included (tools/cli/machine_file.cpp)
 # Exit status 0: no crash in that time. A crash leaves its input as BUILD_DIR/<harness>-crash-*
 # and stops the script with a non-zero status; turn it into a named case in
@@ -23,8 +23,8 @@ flags=(-std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recov
 mkdir -p "$build/inputs"
 # The command's parsers, compiled once (-fsanitize=fuzzer-no-link: instrumented, no main).
 objects=()
-for source in json_input machine_file memory numbers project stock tool_table; do
-  object="$build/inputs/$source.o"
+for source in json_input machine_file pipeline/memory inputs/numbers inputs/project inputs/stock inputs/tool_table; do
+  object="$build/inputs/$(basename "$source").o"
   if [ ! -f "$object" ] || [ "tools/cli/$source.cpp" -nt "$object" ]; then
     clang++ "${flags[@]/-fsanitize=fuzzer,address,undefined/-fsanitize=fuzzer-no-link,address,undefined}" \
       -c "tools/cli/$source.cpp" -o "$object"

@@ -1,4 +1,4 @@
-#include "pipeline.hpp"
+#include "pipeline/pipeline.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -6,10 +6,10 @@
 #include <cstdio>
 #include <limits>
 
-#include "batch_pipe.hpp"
+#include "checks/rapid_check.hpp"
 #include "errors.hpp"
-#include "output.hpp"
-#include "rapid_check.hpp"
+#include "outputs/output.hpp"
+#include "pipeline/batch_pipe.hpp"
 #include "render.hpp"
 #include "tridex/backends/backends.hpp"
 #include "tridex/dexel_ops.hpp"

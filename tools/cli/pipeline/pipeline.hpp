@@ -15,13 +15,13 @@
 #include <utility>
 #include <vector>
 
-#include "collision_check.hpp"
+#include "checks/collision_check.hpp"
 #include "commands.hpp"
+#include "inputs/program_input.hpp"
 #include "json_text.hpp"
 #include "machining_time.hpp"
-#include "memory.hpp"
-#include "program_input.hpp"
-#include "progress.hpp"
+#include "pipeline/memory.hpp"
+#include "pipeline/progress.hpp"
 #include "tridex/cutter.hpp"
 #include "tridex/dexel.hpp"
 #include "tridex/gcode/grouping.hpp"

@@ -23,16 +23,16 @@
 #include <iostream>
 #include <set>
 
+#include "checks/deviation.hpp"
 #include "commands.hpp"
-#include "deviation.hpp"
 #include "errors.hpp"
-#include "html_report.hpp"
-#include "memory.hpp"
-#include "numbers.hpp"
-#include "output.hpp"
-#include "pipeline.hpp"
+#include "inputs/numbers.hpp"
+#include "inputs/stock.hpp"
+#include "outputs/html_report.hpp"
+#include "outputs/output.hpp"
+#include "pipeline/memory.hpp"
+#include "pipeline/pipeline.hpp"
 #include "render.hpp"
-#include "stock.hpp"
 #include "tridex/dexel_ops.hpp"
 #include "tridex/dexelize.hpp"
 #include "tridex/mill.hpp"
