@@ -30,6 +30,7 @@
 #include "inputs/stock.hpp"
 #include "outputs/html_report.hpp"
 #include "outputs/output.hpp"
+#include "outputs/result_files.hpp"
 #include "pipeline/memory.hpp"
 #include "pipeline/pipeline.hpp"
 #include "render.hpp"
@@ -150,39 +151,7 @@ Json region_json(const DeviationRegion& region, const Mesh& mesh, const std::vec
           {"vertices", region.vertices.size()}};
 }
 
-// Binary little-endian PLY: float x y z and uchar red green blue per vertex, uchar-counted int
-// index lists per face.
-void write_ply(const fs::path& path, const Mesh& mesh, const std::vector<glm::vec3>& colours) {
-  AtomicOutput out(path);
-  std::ostream& s = out.stream();
-  s << "ply\nformat binary_little_endian 1.0\ncomment tridex check: red gouge, grey within tolerance, blue excess\n"
-    << "element vertex " << mesh.positions.size()
-    << "\nproperty float x\nproperty float y\nproperty float z\n"
-    << "property uchar red\nproperty uchar green\nproperty uchar blue\n"
-    << "element face " << mesh.triangles.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
-  std::string bytes;
-  bytes.reserve(mesh.positions.size() * 15 + mesh.triangles.size() * 13);
-  auto put = [&](const void* data, std::size_t size) { bytes.append(static_cast<const char*>(data), size); };
-  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
-    put(&mesh.positions[v], 12);
-    for (int c = 0; c < 3; ++c) {
-      auto byte = static_cast<std::uint8_t>(std::clamp(colours[v][c], 0.0f, 1.0f) * 255.0f + 0.5f);
-      put(&byte, 1);
-    }
-  }
-  for (const glm::uvec3& t : mesh.triangles) {
-    std::uint8_t three = 3;
-    put(&three, 1);
-    for (int k = 0; k < 3; ++k) {
-      auto index = static_cast<std::int32_t>(t[k]);
-      put(&index, 4);
-    }
-  }
-  s.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  out.commit();
-}
-
-// ---- run_check's stages, in the order it runs them ----------------------------------------------
+// ---- run_check's stages, in the order it runs them -----------------------------------------
 
 // What check reads besides what the pipeline reads: the design and the envelope.
 struct CheckInputs {
@@ -210,8 +179,8 @@ CheckInputs read_check_inputs(const CheckOptions& options, Progress& progress) {
     input_error("--design: ", e.what());
   }
   if (!(design.signed_volume() > 0))
-    input_error("--design ", options.design, ": the mesh encloses no volume (", design.signed_volume(),
-                " mm^3); are its triangles inside out?");
+    input_error("--design ", options.design, ": the mesh encloses no volume (",
+                design.signed_volume(), " mm^3); are its triangles inside out?");
   return in;
 }
 
@@ -219,8 +188,11 @@ CheckInputs read_check_inputs(const CheckOptions& options, Progress& progress) {
 // bounds on the lattice, and the comparison's memory counted up front.
 PipelineRequest check_request(const CheckOptions& options, const Mesh& design) {
   PipelineRequest request;
-  request.outputs = {{"-o", options.output}, {"--report", options.report}, {"--png", options.png},
-                     {"--ply", options.ply}, {"--html", options.html}};
+  request.outputs = {{"-o", options.output},
+                     {"--report", options.report},
+                     {"--png", options.png},
+                     {"--ply", options.ply},
+                     {"--html", options.html}};
   request.extra_inputs = {options.design};
   request.extra_bounds = {{"--design " + options.design, design.bounds()}};
   request.rapid_check = RapidCheck::in_program_order;
@@ -258,7 +230,9 @@ struct CheckFindings {
 };
 
 // A finding's file: the name of Move::file's entry, as --report's "files" and messages give it.
-std::string file_name(const SimulationResult& r, int file) { return r.files.at(static_cast<std::size_t>(file)); }
+std::string file_name(const SimulationResult& r, int file) {
+  return r.files.at(static_cast<std::size_t>(file));
+}
 
 // The deviation of the machined surface from the design, its colours and its regions.
 void measure_deviation(const CheckOptions& options, const SimulationResult& r, const Mesh& design,
@@ -266,13 +240,14 @@ void measure_deviation(const CheckOptions& options, const SimulationResult& r, c
   const Mesh& mesh = r.mesh;
   progress.stage("dexelizing the design");
   TripleDexel design_dexel = dexelize(design, r.lattice, DexelizeOptions{options.threads});
-  progress.stage("measuring " + std::to_string(mesh.positions.size()) + " vertices against the design");
+  progress.stage("measuring " + std::to_string(mesh.positions.size()) +
+                 " vertices against the design");
   DistanceTree design_tree(design);
   std::vector<double>& deviation = f.deviation;
   deviation.resize(mesh.positions.size());
   parallel_for(mesh.positions.size(), options.threads, [&](std::size_t v) {
-    deviation[v] = design_tree.signed_distance(Vec3(mesh.positions[v]),
-                                               [&](const Vec3& p) { return contains(design_dexel, p); });
+    deviation[v] = design_tree.signed_distance(
+        Vec3(mesh.positions[v]), [&](const Vec3& p) { return contains(design_dexel, p); });
   });
   std::vector<char> gouge(deviation.size()), excess(deviation.size());
   f.colours.assign(deviation.size(), kOkColour);
@@ -300,7 +275,9 @@ void measure_design_side(const CheckOptions& options, const SimulationResult& r,
     // Positive where the machined solid holds the design sample (material left outside the
     // design there), negative where it does not (material missing).
     parallel_for(samples.size(), options.threads, [&](std::size_t k) {
-      design_deviation[k] = 0.0 - result_tree.signed_distance(samples[k], [&](const Vec3& p) { return contains(r.result, p); });
+      design_deviation[k] = 0.0 - result_tree.signed_distance(samples[k], [&](const Vec3& p) {
+        return contains(r.result, p);
+      });
     });
   }
   Json& design_side = f.design_side;
@@ -308,27 +285,36 @@ void measure_design_side(const CheckOptions& options, const SimulationResult& r,
   long long missing = 0, left = 0;
   double missing_depth = 0, left_depth = 0;
   for (std::size_t k = 0; k < design_deviation.size(); ++k) {
-    if (design_deviation[k] < -f.gouge_tol) ++missing, missing_box.extend(samples[k]), missing_depth = std::max(missing_depth, -design_deviation[k]);
-    if (design_deviation[k] > f.excess_tol) ++left, left_box.extend(samples[k]), left_depth = std::max(left_depth, design_deviation[k]);
+    if (design_deviation[k] < -f.gouge_tol)
+      ++missing, missing_box.extend(samples[k]),
+          missing_depth = std::max(missing_depth, -design_deviation[k]);
+    if (design_deviation[k] > f.excess_tol)
+      ++left, left_box.extend(samples[k]), left_depth = std::max(left_depth, design_deviation[k]);
   }
-  if (mesh.triangles.empty()) missing = static_cast<long long>(samples.size()), missing_box = design.bounds();
+  if (mesh.triangles.empty())
+    missing = static_cast<long long>(samples.size()), missing_box = design.bounds();
   design_side["deviation"] = statistics(design_deviation);
   design_side["missing"] = {{"samples", missing}, {"depth_mm", missing_depth}};
-  if (missing) design_side["missing"]["bbox"] = {{"min", to_json(missing_box.min)}, {"max", to_json(missing_box.max)}};
+  if (missing)
+    design_side["missing"]["bbox"] = {{"min", to_json(missing_box.min)},
+                                      {"max", to_json(missing_box.max)}};
   design_side["left"] = {{"samples", left}, {"depth_mm", left_depth}};
-  if (left) design_side["left"]["bbox"] = {{"min", to_json(left_box.min)}, {"max", to_json(left_box.max)}};
+  if (left)
+    design_side["left"]["bbox"] = {{"min", to_json(left_box.min)}, {"max", to_json(left_box.max)}};
 }
 
 // The regions as the report lists them, each of the deepest gouges with the moves that made it.
 void list_regions(const SimulationResult& r, Progress& progress, CheckFindings& f) {
   const Mesh& mesh = r.mesh;
-  progress.stage("finding the moves that cut " + std::to_string(f.gouges.size()) + " gouge region(s)");
+  progress.stage("finding the moves that cut " + std::to_string(f.gouges.size()) +
+                 " gouge region(s)");
   for (std::size_t k = 0; k < f.gouges.size() && k < kRegionsListed; ++k) {
     Json g = region_json(f.gouges[k], mesh, f.deviation);
     if (k < kRegionsWithLines) {
       // "files"[i] is the file of "lines"[i]: a program with subprogram files repeats line numbers.
       Json lines = Json::array(), files = Json::array();
-      for (const auto& [file, line] : gouging_lines(f.gouges[k], mesh, f.deviation, r, r.lattice.spacing)) {
+      for (const auto& [file, line] :
+           gouging_lines(f.gouges[k], mesh, f.deviation, r, r.lattice.spacing)) {
         lines.push_back(line);
         files.push_back(file_name(r, file));
       }
@@ -343,12 +329,18 @@ void list_regions(const SimulationResult& r, Progress& progress, CheckFindings& 
 
 // The program's own findings: rapids that cut, shanks and holders in the material or near it, the
 // stick-out each tool needs, moves outside the envelope or the machine's travel.
-void list_program_findings(const SimulationResult& r, const std::optional<Aabb>& envelope, CheckFindings& f) {
-  for (const RapidFinding& finding : r.rapid_cuts) f.rapid_list.push_back(rapid_finding_json(finding, r.files));
+void list_program_findings(const SimulationResult& r, const std::optional<Aabb>& envelope,
+                           CheckFindings& f) {
+  for (const RapidFinding& finding : r.rapid_cuts)
+    f.rapid_list.push_back(rapid_finding_json(finding, r.files));
   // ---- shanks and holders -------------------------------------------------------------------
   auto body_json = [&](const BodyFinding& finding, const char* measure) {
-    return Json{{"file", file_name(r, finding.file)}, {"line", finding.line}, {"tool", finding.tool},
-                {"part", finding.part}, {measure, finding.depth_mm}, {"point", to_json(finding.where)},
+    return Json{{"file", file_name(r, finding.file)},
+                {"line", finding.line},
+                {"tool", finding.tool},
+                {"part", finding.part},
+                {measure, finding.depth_mm},
+                {"point", to_json(finding.where)},
                 {"axis", to_json(finding.axis)}};
   };
   for (std::size_t k = 0; k < r.body.collisions.size() && k < kFindingsListed; ++k)
@@ -360,7 +352,9 @@ void list_program_findings(const SimulationResult& r, const std::optional<Aabb>&
   for (const auto& [key, depth] : r.body.holder_depth) {
     const auto& [tool, group] = key;
     const ToolBody& body = r.bodies[r.cutter_of_tool.at(tool)];
-    f.stick_out.push_back({{"tool", tool}, {"axis", to_json(r.groups[group].axis)}, {"stick_out_mm", body.stick_out},
+    f.stick_out.push_back({{"tool", tool},
+                           {"axis", to_json(r.groups[group].axis)},
+                           {"stick_out_mm", body.stick_out},
                            {"needed_mm", body.stick_out + depth + kCollisionTolerance}});
   }
 
@@ -372,19 +366,23 @@ void list_program_findings(const SimulationResult& r, const std::optional<Aabb>&
     for (const gcode::MoveGroup& group : r.groups)
       for (const gcode::Move& m : group.moves)
         if (glm::length(m.end) < far && !envelope->contains(m.end)) outside.push_back(&m);
-    std::stable_sort(outside.begin(), outside.end(), [](const gcode::Move* a, const gcode::Move* b) {
-      return std::pair(a->file, a->line) < std::pair(b->file, b->line);
-    });
+    std::stable_sort(outside.begin(), outside.end(),
+                     [](const gcode::Move* a, const gcode::Move* b) {
+                       return std::pair(a->file, a->line) < std::pair(b->file, b->line);
+                     });
     f.envelope_outside = outside.size();
     for (std::size_t k = 0; k < outside.size() && k < kFindingsListed; ++k)
-      f.envelope_list.push_back({{"file", file_name(r, outside[k]->file)}, {"line", outside[k]->line},
+      f.envelope_list.push_back({{"file", file_name(r, outside[k]->file)},
+                                 {"line", outside[k]->line},
                                  {"tip", to_json(outside[k]->end)}});
   }
 
   // Machine travel (the kinematics' "travel" and rotary limits): a finding per axis and move.
   for (const TravelFinding& finding : r.travel)
-    f.travel_list.push_back({{"file", file_name(r, finding.file)}, {"line", finding.line},
-                             {"axis", std::string(1, finding.axis)}, {"value", finding.value},
+    f.travel_list.push_back({{"file", file_name(r, finding.file)},
+                             {"line", finding.line},
+                             {"axis", std::string(1, finding.axis)},
+                             {"value", finding.value},
                              {"limit", finding.limit}});
 }
 
@@ -419,15 +417,18 @@ void write_result_files(const CheckOptions& options, SimulationResult& r, const 
       std::snprintf(gouge_label, sizeof gouge_label, "gouge < -%.3g mm", f.gouge_tol);
       std::snprintf(ok_label, sizeof ok_label, "within tolerance");
       std::snprintf(excess_label, sizeof excess_label, "excess > +%.3g mm", f.excess_tol);
-      render::draw_legend(image, {{kGougeColour, gouge_label}, {kOkColour, ok_label}, {kExcessColour, excess_label}});
+      render::draw_legend(
+          image,
+          {{kGougeColour, gouge_label}, {kOkColour, ok_label}, {kExcessColour, excess_label}});
       write_file_atomically(options.png, render::encode_png(image));
     }
   }
 }
 
 // --report's JSON (and the --html page's figures).
-Json check_report(const CheckOptions& options, const SimulationResult& r, const std::optional<Aabb>& envelope,
-                  const CheckFindings& f, bool failed, double deviation_s, double total_s) {
+Json check_report(const CheckOptions& options, const SimulationResult& r,
+                  const std::optional<Aabb>& envelope, const CheckFindings& f, bool failed,
+                  double deviation_s, double total_s) {
   const Mesh& mesh = r.mesh;
   Json report;
   report["program"] = r.input.program.string();
@@ -436,7 +437,8 @@ Json check_report(const CheckOptions& options, const SimulationResult& r, const 
   report["tolerances_mm"] = {{"gouge", f.gouge_tol}, {"excess", f.excess_tol}};
   report["stock"] = r.stock.description;
   report["segments"] = r.segments;
-  report["dexel"] = {{"cell_mm", r.lattice.spacing}, {"res", {r.lattice.n.x, r.lattice.n.y, r.lattice.n.z}}};
+  report["dexel"] = {{"cell_mm", r.lattice.spacing},
+                     {"res", {r.lattice.n.x, r.lattice.n.y, r.lattice.n.z}}};
   report["backends"] = {{"zmap", options.zmap_backend}, {"dexel", options.dexel_backend}};
   report["deviation"] = statistics(f.deviation);
   report["gouges"] = f.gouge_list;
@@ -445,19 +447,25 @@ Json check_report(const CheckOptions& options, const SimulationResult& r, const 
   report["rapid_cuts"] = f.rapid_list;
   report["collisions"] = f.collision_list;
   report["collisions_count"] = r.body.collisions.size();
-  report["near_misses"] = {{"clearance_mm", options.clearance}, {"count", r.body.near_misses.size()},
+  report["near_misses"] = {{"clearance_mm", options.clearance},
+                           {"count", r.body.near_misses.size()},
                            {"moves", f.near_list}};
   report["stick_out"] = f.stick_out;
   report["machining_time"] = machining_time_json(r.machining);
   if (envelope)
-    report["envelope"] = {{"box", {{"min", to_json(envelope->min)}, {"max", to_json(envelope->max)}}},
-                          {"outside", f.envelope_outside}, {"violations", f.envelope_list}};
-  if (r.input.machine.kinematics) report["travel"] = {{"outside", r.travel_count}, {"violations", f.travel_list}};
-  report["result"] = {{"volume_mm3", r.volume}, {"triangles", mesh.triangles.size()},
+    report["envelope"] = {
+        {"box", {{"min", to_json(envelope->min)}, {"max", to_json(envelope->max)}}},
+        {"outside", f.envelope_outside},
+        {"violations", f.envelope_list}};
+  if (r.input.machine.kinematics)
+    report["travel"] = {{"outside", r.travel_count}, {"violations", f.travel_list}};
+  report["result"] = {{"volume_mm3", r.volume},
+                      {"triangles", mesh.triangles.size()},
                       {"watertight", r.mesh_check.closed()}};
-  report["timings_s"] = {{"parse", r.timings.parse}, {"zmap", r.timings.zmap}, {"dexelize", r.timings.dexelize},
-                         {"intersect", r.timings.intersect}, {"mesh", r.timings.mesh},
-                         {"collisions", r.body.seconds}, {"deviation", deviation_s}, {"total", total_s}};
+  report["timings_s"] = {{"parse", r.timings.parse},       {"zmap", r.timings.zmap},
+                         {"dexelize", r.timings.dexelize}, {"intersect", r.timings.intersect},
+                         {"mesh", r.timings.mesh},         {"collisions", r.body.seconds},
+                         {"deviation", deviation_s},       {"total", total_s}};
   report["memory_estimate_mib"] = r.memory.total() / (1 << 20);
   report["memory_walls_mib"] = r.memory.walls / (1 << 20);
   report["peak_rss_mib"] = peak_rss_mib();
@@ -466,18 +474,24 @@ Json check_report(const CheckOptions& options, const SimulationResult& r, const 
 }
 
 // --report and --html.
-void write_reports(const CheckOptions& options, const SimulationResult& r, const Mesh& design, const Json& report,
-                   const CheckFindings& f, Progress& progress) {
+void write_reports(const CheckOptions& options, const SimulationResult& r, const Mesh& design,
+                   const Json& report, const CheckFindings& f, Progress& progress) {
   if (!options.report.empty()) {
     progress.stage("writing " + options.report);
     write_file_atomically(options.report, report.dump(2) + "\n");
   }
   if (!options.html.empty()) {
     progress.stage("writing " + options.html);
-    write_html_report(options.html, {.title = "tridex check: " + r.input.program.filename().string() + " against " +
-                                              fs::path(options.design).filename().string(),
-                                     .report = report, .mesh = &r.mesh, .deviation = f.deviation, .design = &design,
-                                     .groups = &r.groups, .order = r.order, .files = r.files});
+    write_html_report(options.html,
+                      {.title = "tridex check: " + r.input.program.filename().string() +
+                                " against " + fs::path(options.design).filename().string(),
+                       .report = report,
+                       .mesh = &r.mesh,
+                       .deviation = f.deviation,
+                       .design = &design,
+                       .groups = &r.groups,
+                       .order = r.order,
+                       .files = r.files});
   }
 }
 
@@ -488,15 +502,20 @@ void print_summary(const CheckOptions& options, const SimulationResult& r, const
   const Json& d = report["deviation"];
   char range[96] = "not measured (no material left)";
   if (d.contains("min_mm"))
-    std::snprintf(range, sizeof range, "%.4g .. %.4g mm", d["min_mm"].get<double>(), d["max_mm"].get<double>());
-  std::printf("%s vs %s: deviation %s; %zu gouge and %zu excess region(s) beyond -%g/+%g mm, design "
-              "samples %lld missing and %lld left, %zu rapid(s) cutting material, %zu move(s) outside the "
-              "envelope, %lld outside the machine's travel, %zu shank/holder collision(s), %zu near miss(es) within %g mm: %s; %.2f s\n",
-              r.input.program.filename().string().c_str(), fs::path(options.design).filename().string().c_str(),
-              range, f.gouges.size(), f.excesses.size(), f.gouge_tol, f.excess_tol,
-              f.design_side["missing"]["samples"].get<long long>(), f.design_side["left"]["samples"].get<long long>(),
-              f.rapid_list.size(), f.envelope_outside, r.travel_count, r.body.collisions.size(), r.body.near_misses.size(),
-              options.clearance, failed ? "FAIL" : "pass", total_s);
+    std::snprintf(range, sizeof range, "%.4g .. %.4g mm", d["min_mm"].get<double>(),
+                  d["max_mm"].get<double>());
+  std::printf(
+      "%s vs %s: deviation %s; %zu gouge and %zu excess region(s) beyond -%g/+%g mm, design "
+      "samples %lld missing and %lld left, %zu rapid(s) cutting material, %zu move(s) outside the "
+      "envelope, %lld outside the machine's travel, %zu shank/holder collision(s), %zu near "
+      "miss(es) within %g mm: %s; %.2f s\n",
+      r.input.program.filename().string().c_str(),
+      fs::path(options.design).filename().string().c_str(), range, f.gouges.size(),
+      f.excesses.size(), f.gouge_tol, f.excess_tol,
+      f.design_side["missing"]["samples"].get<long long>(),
+      f.design_side["left"]["samples"].get<long long>(), f.rapid_list.size(), f.envelope_outside,
+      r.travel_count, r.body.collisions.size(), r.body.near_misses.size(), options.clearance,
+      failed ? "FAIL" : "pass", total_s);
   std::printf("  %s\n", machining_time_text(r.machining).c_str());
   std::size_t printed = 0;
   for (const Json& g : f.gouge_list)
@@ -505,33 +524,41 @@ void print_summary(const CheckOptions& options, const SimulationResult& r, const
       std::size_t count = 0;
       for (std::size_t i = 0; i < g["lines"].size(); ++i)
         if (count++ < 10)
-          lines += (lines.empty() ? "" : ", ") + g["files"][i].get<std::string>() + ":" + std::to_string(g["lines"][i].get<int>());
+          lines += (lines.empty() ? "" : ", ") + g["files"][i].get<std::string>() + ":" +
+                   std::to_string(g["lines"][i].get<int>());
       if (count > 10) lines += ", … (" + std::to_string(count) + " in all)";
       const Json& c = g["centroid"];
-      std::printf("  gouge %.3f mm around (%.3f, %.3f, %.3f), lines %s\n", g["depth_mm"].get<double>(),
-                  c[0].get<double>(), c[1].get<double>(), c[2].get<double>(), lines.empty() ? "?" : lines.c_str());
+      std::printf("  gouge %.3f mm around (%.3f, %.3f, %.3f), lines %s\n",
+                  g["depth_mm"].get<double>(), c[0].get<double>(), c[1].get<double>(),
+                  c[2].get<double>(), lines.empty() ? "?" : lines.c_str());
     }
   const Json& rapid_list = f.rapid_list;
   for (std::size_t k = 0; k < rapid_list.size() && k < kFindingsPrinted; ++k)
-    std::printf("  %s:%d: rapid cuts %.3f mm of material\n", rapid_list[k]["file"].get<std::string>().c_str(),
-                rapid_list[k]["line"].get<int>(), rapid_list[k]["depth_mm"].get<double>());
+    std::printf("  %s:%d: rapid cuts %.3f mm of material\n",
+                rapid_list[k]["file"].get<std::string>().c_str(), rapid_list[k]["line"].get<int>(),
+                rapid_list[k]["depth_mm"].get<double>());
   const Json& envelope_list = f.envelope_list;
   for (std::size_t k = 0; k < envelope_list.size() && k < kFindingsPrinted; ++k)
-    std::printf("  %s:%d: tool tip %s outside the envelope\n", envelope_list[k]["file"].get<std::string>().c_str(),
+    std::printf("  %s:%d: tool tip %s outside the envelope\n",
+                envelope_list[k]["file"].get<std::string>().c_str(),
                 envelope_list[k]["line"].get<int>(), envelope_list[k]["tip"].dump().c_str());
   for (std::size_t k = 0; k < r.travel.size() && k < kFindingsPrinted; ++k)
-    std::printf("  %s:%d: %s\n", file_name(r, r.travel[k].file).c_str(), r.travel[k].line, travel_text(r.travel[k]).c_str());
+    std::printf("  %s:%d: %s\n", file_name(r, r.travel[k].file).c_str(), r.travel[k].line,
+                travel_text(r.travel[k]).c_str());
   for (std::size_t k = 0; k < r.body.collisions.size() && k < kFindingsPrinted; ++k) {
     const BodyFinding& b = r.body.collisions[k];
-    std::printf("  %s:%d: tool %d's %s is %.3f mm into the stock at (%.3f, %.3f, %.3f), spindle %s\n",
-                file_name(r, b.file).c_str(), b.line,
-                b.tool, b.part.c_str(), b.depth_mm, b.where.x, b.where.y, b.where.z, axis_label(b.axis).c_str());
+    std::printf(
+        "  %s:%d: tool %d's %s is %.3f mm into the stock at (%.3f, %.3f, %.3f), spindle %s\n",
+        file_name(r, b.file).c_str(), b.line, b.tool, b.part.c_str(), b.depth_mm, b.where.x,
+        b.where.y, b.where.z, axis_label(b.axis).c_str());
   }
   for (const Json& s : f.stick_out)
-    std::printf("  tool %d along %s needs a stick-out of %.3f mm (it has %.3f)\n", s["tool"].get<int>(),
-                s["axis"].dump().c_str(), s["needed_mm"].get<double>(), s["stick_out_mm"].get<double>());
+    std::printf("  tool %d along %s needs a stick-out of %.3f mm (it has %.3f)\n",
+                s["tool"].get<int>(), s["axis"].dump().c_str(), s["needed_mm"].get<double>(),
+                s["stick_out_mm"].get<double>());
   if (rapid_list.size() > kFindingsPrinted || f.envelope_outside > kFindingsPrinted ||
-      r.travel_count > static_cast<long long>(kFindingsPrinted) || r.body.collisions.size() > kFindingsPrinted)
+      r.travel_count > static_cast<long long>(kFindingsPrinted) ||
+      r.body.collisions.size() > kFindingsPrinted)
     std::printf("  (more in the report)\n");
 }
 
@@ -544,8 +571,12 @@ int run_check(const CheckOptions& options) {
   SimulationResult r = simulate_program(options, progress, check_request(options, in.design));
   const double spacing = r.lattice.spacing;
   CheckFindings f;
-  f.gouge_tol = options.gouge_tol > 0 ? options.gouge_tol : options.tolerance > 0 ? options.tolerance : spacing;
-  f.excess_tol = options.excess_tol > 0 ? options.excess_tol : options.tolerance > 0 ? options.tolerance : spacing;
+  f.gouge_tol = options.gouge_tol > 0   ? options.gouge_tol
+                : options.tolerance > 0 ? options.tolerance
+                                        : spacing;
+  f.excess_tol = options.excess_tol > 0  ? options.excess_tol
+                 : options.tolerance > 0 ? options.tolerance
+                                         : spacing;
 
   const Clock::time_point t = Clock::now();
   measure_deviation(options, r, in.design, progress, f);
@@ -556,8 +587,9 @@ int run_check(const CheckOptions& options) {
 
   write_result_files(options, r, f, progress);
   if (!r.mesh_check.closed())
-    r.warnings.push_back("the result mesh is not watertight (" + std::to_string(r.mesh_check.boundary_edges) +
-                         " boundary, " + std::to_string(r.mesh_check.non_manifold_edges) + " non-manifold edges)");
+    r.warnings.push_back("the result mesh is not watertight (" +
+                         std::to_string(r.mesh_check.boundary_edges) + " boundary, " +
+                         std::to_string(r.mesh_check.non_manifold_edges) + " non-manifold edges)");
   const bool failed = check_failed(r, f);
   const double total_s = seconds_since(start);
   const Json report = check_report(options, r, in.envelope, f, failed, deviation_s, total_s);

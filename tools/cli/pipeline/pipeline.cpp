@@ -9,6 +9,7 @@
 #include "checks/rapid_check.hpp"
 #include "errors.hpp"
 #include "outputs/output.hpp"
+#include "outputs/result_files.hpp"
 #include "pipeline/batch_pipe.hpp"
 #include "render.hpp"
 #include "tridex/backends/backends.hpp"
@@ -63,10 +64,6 @@ Stock load_stock(const StockSpec& spec, const Aabb& cutting_bounds, std::uint64_
     }
   }
   return stock;
-}
-
-void write_png_file(const fs::path& path, const render::Image& image) {
-  write_file_atomically(path, render::encode_png(image));
 }
 
 // A move of `group` as the kernel mills it: the tool tip in the group's frame.
@@ -217,12 +214,6 @@ std::string axis_label(const Vec3& axis) {
   return text;
 }
 
-void write_stl_file(const fs::path& path, const Mesh& mesh) {
-  AtomicOutput out(path);
-  write_stl(out.stream(), mesh);
-  out.commit();
-}
-
 namespace {
 
 // The pipeline's stages, in the order simulate_program runs them. Each fills its part of the
@@ -246,8 +237,10 @@ RunInputs check_inputs_and_outputs(const SimulateOptions& options, const Pipelin
   r.input = resolve_program(options);
   const ProgramInput& input = r.input;
   if (r.input.tools) run.table = std::move(r.input.tools);  // --tools, else the project's
-  if (!options.stock.empty()) run.stock_spec = parse_stock(options.stock);
-  else if (input.stock) run.stock_spec = *input.stock;
+  if (!options.stock.empty())
+    run.stock_spec = parse_stock(options.stock);
+  else if (input.stock)
+    run.stock_spec = *input.stock;
   run.max_memory = max_memory_bytes(options.max_memory);
 
   std::vector<fs::path>& inputs = run.inputs;
@@ -297,25 +290,31 @@ ParsedProgram parse_grouped(const SimulateOptions& options, std::uint64_t max_me
   // Grouping (and the checks that read each move once) runs on a second thread when there is one,
   // overlapping the interpreter; the budget and the machining time stay on this thread, with the
   // dwells the timer also reads.
-  BatchPipe<gcode::Move> grouping([&](const gcode::Move& m) {
-    const auto group = static_cast<std::uint32_t>(grouper.add(m));
-    if (r.order.empty() || r.order.back().group != group) r.order.push_back({group, 0});
-    ++r.order.back().moves;
-    if (kinematics && glm::length(m.end) < far)
-      for (const gcode::TravelViolation& v : gcode::travel_violations(*kinematics, m.machine, m.rotary))
-        if (r.travel_count++ < static_cast<long long>(kTravelListed))
-          r.travel.push_back({m.file, m.line, v.axis, v.value, v.limit});
-    if (m.kind != gcode::MoveKind::rapid) {
-      // An approach from "far along the tool axis" is not where the work is.
-      if (!m.from_far) cutting_bounds.extend(m.start);
-      cutting_bounds.extend(m.end);
-    }
-  }, detail::resolve_threads(options.threads) > 1);
-  parsed.interpreted = interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t file) {
-    budget.keep(m, input.files[file].string());
-    r.machining.add(m);
-    grouping.push(m);
-  }, [&](const gcode::Dwell& d) { r.machining.add(d); });
+  BatchPipe<gcode::Move> grouping(
+      [&](const gcode::Move& m) {
+        const auto group = static_cast<std::uint32_t>(grouper.add(m));
+        if (r.order.empty() || r.order.back().group != group) r.order.push_back({group, 0});
+        ++r.order.back().moves;
+        if (kinematics && glm::length(m.end) < far)
+          for (const gcode::TravelViolation& v :
+               gcode::travel_violations(*kinematics, m.machine, m.rotary))
+            if (r.travel_count++ < static_cast<long long>(kTravelListed))
+              r.travel.push_back({m.file, m.line, v.axis, v.value, v.limit});
+        if (m.kind != gcode::MoveKind::rapid) {
+          // An approach from "far along the tool axis" is not where the work is.
+          if (!m.from_far) cutting_bounds.extend(m.start);
+          cutting_bounds.extend(m.end);
+        }
+      },
+      detail::resolve_threads(options.threads) > 1);
+  parsed.interpreted = interpret(
+      input, interpreter_options(options),
+      [&](const gcode::Move& m, std::size_t file) {
+        budget.keep(m, input.files[file].string());
+        r.machining.add(m);
+        grouping.push(m);
+      },
+      [&](const gcode::Dwell& d) { r.machining.add(d); });
   grouping.finish();
   r.groups = grouper.take();
   r.files = std::move(parsed.interpreted.files);
@@ -348,7 +347,8 @@ void load_cutters(const SimulateOptions& options, const std::optional<ToolTable>
                                  ? input.program.string()
                                  : where->second.file + ":" + std::to_string(where->second.line);
       if (!table)
-        input_error(location, ": tool ", tool, " is used but there is no tool table (give --tools FILE)");
+        input_error(location, ": tool ", tool,
+                    " is used but there is no tool table (give --tools FILE)");
       input_error(location, ": tool ", tool, " is used but missing from the tool table ",
                   options.tools.empty() ? input.program.string() : options.tools);
     }
@@ -365,9 +365,10 @@ void drop_toolless_moves(SimulationResult& r) {
     for (GroupRun& run : r.order) {
       const gcode::MoveList& moves = groups[run.group].moves;
       const std::size_t end = next[run.group] + run.moves;
-      run.moves = static_cast<std::uint64_t>(std::count_if(moves.begin() + static_cast<std::ptrdiff_t>(next[run.group]),
-                                                           moves.begin() + static_cast<std::ptrdiff_t>(end),
-                                                           [](const gcode::Move& m) { return m.tool != 0; }));
+      run.moves = static_cast<std::uint64_t>(
+          std::count_if(moves.begin() + static_cast<std::ptrdiff_t>(next[run.group]),
+                        moves.begin() + static_cast<std::ptrdiff_t>(end),
+                        [](const gcode::Move& m) { return m.tool != 0; }));
       next[run.group] = end;
     }
     // In place: the groups hold every move of the program, and a copy would double that.
@@ -378,9 +379,11 @@ void drop_toolless_moves(SimulationResult& r) {
         if (m.kind != gcode::MoveKind::rapid)
           // The file that holds the move (one of a project's files, or a called subprogram), not
           // the project or the main program.
-          input_error(r.files.at(static_cast<std::size_t>(m.file)), ":", m.line, ": a ", gcode::to_string(m.kind),
-                      " move with no tool loaded (T… M6; on a machine that loads the tool on T alone, give "
-                      "--machine a file with \"tool_loads_on_t\": true)");
+          input_error(
+              r.files.at(static_cast<std::size_t>(m.file)), ":", m.line, ": a ",
+              gcode::to_string(m.kind),
+              " move with no tool loaded (T… M6; on a machine that loads the tool on T alone, give "
+              "--machine a file with \"tool_loads_on_t\": true)");
         ++toolless;
       }
       if (toolless > 0) erase_if(group.moves, [](const gcode::Move& m) { return m.tool == 0; });
@@ -388,14 +391,15 @@ void drop_toolless_moves(SimulationResult& r) {
     }
   }
   if (toolless_rapids > 0)
-    r.warnings.push_back(std::to_string(toolless_rapids) +
-                         " rapid move(s) before the first tool change were not simulated (no tool)");
+    r.warnings.push_back(
+        std::to_string(toolless_rapids) +
+        " rapid move(s) before the first tool change were not simulated (no tool)");
 }
 
 // The stock, the resolutions (the dexel lattice, the Z-map cell and grids), and the memory they
 // need, checked against --max-memory before anything big is allocated.
-void size_the_run(const SimulateOptions& options, const PipelineRequest& request, const RunInputs& run,
-                  const ParsedProgram& parsed, SimulationResult& r) {
+void size_the_run(const SimulateOptions& options, const PipelineRequest& request,
+                  const RunInputs& run, const ParsedProgram& parsed, SimulationResult& r) {
   const StockSpec& stock_spec = run.stock_spec;
   const std::uint64_t max_memory = run.max_memory;
   r.stock = load_stock(stock_spec, parsed.cutting_bounds, max_memory);
@@ -404,27 +408,33 @@ void size_the_run(const SimulateOptions& options, const PipelineRequest& request
   try {
     r.lattice = options.dexel_cell > 0
                     ? DexelLattice::covering(stock.box, options.dexel_cell)
-                    : DexelLattice::covering_resolution(stock.box, options.dexel_res > 0 ? options.dexel_res : kDefaultDexelRes);
+                    : DexelLattice::covering_resolution(
+                          stock.box, options.dexel_res > 0 ? options.dexel_res : kDefaultDexelRes);
   } catch (const tridex::Error& e) {
     input_error("dexel resolution: ", e.what());
   }
   const DexelLattice& lattice = r.lattice;
   // Where no move cuts, the stock's faces are all there is to represent (a wider range).
-  check_reach(stock_spec.kind == StockSpec::Kind::mesh ? "--stock " + stock_spec.mesh_path.string() : "the stock",
-              stock.box, lattice.spacing,
-              no_move_reaches(r.groups, r.cutters, stock.box) ? kMaxUncutReachSpacings : kMaxReachSpacings);
-  for (const auto& [what, bounds] : request.extra_bounds) check_reach(what, bounds, lattice.spacing);
+  check_reach(
+      stock_spec.kind == StockSpec::Kind::mesh ? "--stock " + stock_spec.mesh_path.string()
+                                               : "the stock",
+      stock.box, lattice.spacing,
+      no_move_reaches(r.groups, r.cutters, stock.box) ? kMaxUncutReachSpacings : kMaxReachSpacings);
+  for (const auto& [what, bounds] : request.extra_bounds)
+    check_reach(what, bounds, lattice.spacing);
   // A Z-map's polyhedron ramps across the cell where a wall parallel to its spindle drops, and
   // is off by up to a cell at the wall's rims, where it meets the other directions' cuts
   // (docs/design.md, "Known errors"); at most half a dexel spacing keeps those edges within h/2.
   const double zmap_cell = options.zmap_cell > 0
                                ? options.zmap_cell
-                               : std::min(diagonal * kDefaultZmapCellFraction, kDefaultZmapCellOfSpacing * lattice.spacing);
+                               : std::min(diagonal * kDefaultZmapCellFraction,
+                                          kDefaultZmapCellOfSpacing * lattice.spacing);
   r.zmap_cell = zmap_cell;
   MemoryShape shape{.keep_maps = request.keep_maps, .dump_maps = !options.dump_zmaps.empty()};
   for (const gcode::MoveGroup& group : r.groups) {
     try {
-      r.grids.push_back(ZMapGrid::covering(group.frame, local_bounds(group.frame, stock.box), zmap_cell));
+      r.grids.push_back(
+          ZMapGrid::covering(group.frame, local_bounds(group.frame, stock.box), zmap_cell));
     } catch (const tridex::Error& e) {
       input_error("--zmap-cell ", zmap_cell, ": ", e.what());
     }
@@ -436,21 +446,25 @@ void size_the_run(const SimulateOptions& options, const PipelineRequest& request
   shape.rays = n.x * n.y + n.y * n.z + n.z * n.x;
   // The peak so far holds the libraries, every move kept and the meshes read: all alive to the end.
   r.memory = estimate_memory(peak_rss_bytes(), shape);
-  if (request.memory_after) r.memory.after = request.memory_after(lattice.spacing, kTrianglesPerRay * shape.rays);
+  if (request.memory_after)
+    r.memory.after = request.memory_after(lattice.spacing, kTrianglesPerRay * shape.rays);
   const MemoryEstimate& need = r.memory;
   if (need.total() > static_cast<double>(max_memory))
-    input_error("the resolution needs an estimated ", format_mib(need.total()), " (in use before milling ",
-                format_mib(need.held), " with ", parsed.moves_kept, " moves kept, Z-maps ", format_mib(need.zmaps),
-                ", dexels ", format_mib(need.dexels), ", surface ", format_mib(need.mesh),
-                need.after > 0 ? ", the comparison with the design " + format_mib(need.after) : std::string(),
+    input_error("the resolution needs an estimated ", format_mib(need.total()),
+                " (in use before milling ", format_mib(need.held), " with ", parsed.moves_kept,
+                " moves kept, Z-maps ", format_mib(need.zmaps), ", dexels ",
+                format_mib(need.dexels), ", surface ", format_mib(need.mesh),
+                need.after > 0 ? ", the comparison with the design " + format_mib(need.after)
+                               : std::string(),
                 "), more than --max-memory ", format_mib(static_cast<double>(max_memory)),
                 "; use a larger --zmap-cell or --dexel-cell, or a smaller --dexel-res");
 }
 
 // Mills one group's moves into `map` feed moves first (RapidCheck::against_feeds): the rapids are
 // checked against what the feeds leave (when `check_rapids`), then milled too.
-void mill_against_feeds(ZMap& map, const gcode::MoveGroup& group, std::size_t g, backends::ZMapBackend zmap_backend,
-                        bool check_rapids, unsigned threads, SimulationResult& r) {
+void mill_against_feeds(ZMap& map, const gcode::MoveGroup& group, std::size_t g,
+                        backends::ZMapBackend zmap_backend, bool check_rapids, unsigned threads,
+                        SimulationResult& r) {
   const std::vector<Cutter>& cutters = r.cutters;
   std::vector<CutMove> feeds, rapids;
   std::vector<const gcode::Move*> rapid_moves;
@@ -465,17 +479,18 @@ void mill_against_feeds(ZMap& map, const gcode::MoveGroup& group, std::size_t g,
     }
   }
   backends::mill_with(zmap_backend, map, cutters, feeds, threads);
-  for (const RapidCut& found : check_rapids ? rapid_cuts(map, cutters, rapids, kRapidTolerance)
-                                            : std::vector<RapidCut>{}) {
+  for (const RapidCut& found :
+       check_rapids ? rapid_cuts(map, cutters, rapids, kRapidTolerance) : std::vector<RapidCut>{}) {
     const gcode::Move& m = *rapid_moves[found.index];
-    r.rapid_cuts.push_back(RapidFinding{m.file, m.line, m.tool, group.axis, found.depth_mm, m.end, g});
+    r.rapid_cuts.push_back(
+        RapidFinding{m.file, m.line, m.tool, group.axis, found.depth_mm, m.end, g});
   }
   backends::mill_with(zmap_backend, map, cutters, rapids, threads);
 }
 
 // Step 1: one milled Z-map per direction (r.maps), its rapids checked as the request asks.
-void mill_directions(const SimulateOptions& options, const PipelineRequest& request, Progress& progress,
-                     SimulationResult& r) {
+void mill_directions(const SimulateOptions& options, const PipelineRequest& request,
+                     Progress& progress, SimulationResult& r) {
   const Clock::time_point t = Clock::now();
   const std::vector<gcode::MoveGroup>& groups = r.groups;
   const Stock& stock = r.stock;
@@ -487,21 +502,24 @@ void mill_directions(const SimulateOptions& options, const PipelineRequest& requ
   // check needs the exact milling.
   const bool check_rapids = zmap_backend == backends::ZMapBackend::cpu;
   if (!check_rapids)
-    r.warnings.push_back("rapid moves were not checked for cutting stock: that check needs --zmap-backend cpu");
+    r.warnings.push_back(
+        "rapid moves were not checked for cutting stock: that check needs --zmap-backend cpu");
   ZMapLimits limits;
   limits.max_points = std::numeric_limits<std::size_t>::max();  // the memory check above rules
   for (std::size_t g = 0; g < groups.size(); ++g) {
     const gcode::MoveGroup& group = groups[g];
-    progress.stage("milling direction " + std::to_string(g + 1) + "/" + std::to_string(groups.size()) +
-                   " (" + axis_label(group.axis) + ", " + std::to_string(group.moves.size()) + " moves)");
-    maps.push_back(stock.mesh ? ZMap::from_mesh(group.frame, *stock.mesh, r.zmap_cell, limits)
-                              : ZMap::from_box(group.frame, stock.box, r.zmap_cell, limits, options.threads));
+    progress.stage("milling direction " + std::to_string(g + 1) + "/" +
+                   std::to_string(groups.size()) + " (" + axis_label(group.axis) + ", " +
+                   std::to_string(group.moves.size()) + " moves)");
+    maps.push_back(
+        stock.mesh ? ZMap::from_mesh(group.frame, *stock.mesh, r.zmap_cell, limits)
+                   : ZMap::from_box(group.frame, stock.box, r.zmap_cell, limits, options.threads));
     r.segments += static_cast<long long>(group.moves.size());
     if (request.rapid_check == RapidCheck::in_program_order) {
       std::optional<BodyCheck> bodies;
       if (request.body_clearance) bodies.emplace(maps.back(), r.bodies, *request.body_clearance);
-      mill_in_program_order(maps.back(), group, g, r.cutters, r.cutter_of_tool, zmap_backend, options.threads,
-                            r.rapid_cuts, bodies ? &*bodies : nullptr, r.body);
+      mill_in_program_order(maps.back(), group, g, r.cutters, r.cutter_of_tool, zmap_backend,
+                            options.threads, r.rapid_cuts, bodies ? &*bodies : nullptr, r.body);
       continue;
     }
     mill_against_feeds(maps.back(), group, g, zmap_backend, check_rapids, options.threads, r);
@@ -539,18 +557,22 @@ void refine_walls(const SimulateOptions& options, std::uint64_t max_memory, Simu
   double widest = 0;
   for (const Cutter& c : r.cutters) widest = std::max(widest, 2 * c.radius());
   const double bands_per_move = 2 + widest / (kWallBandRows * r.zmap_cell);
-  r.memory.walls = fine_cell_bytes(static_cast<double>(steep_cells), rows, most_moves, bands_per_move);
+  r.memory.walls =
+      fine_cell_bytes(static_cast<double>(steep_cells), rows, most_moves, bands_per_move);
   if (r.memory.total() > static_cast<double>(max_memory))
-    input_error("the walls need finer heights in ", steep_cells, " steep Z-map cells: an estimated ",
-                format_mib(r.memory.walls), " on top of ", format_mib(r.memory.total() - r.memory.walls),
-                ", more than --max-memory ", format_mib(static_cast<double>(max_memory)),
+    input_error("the walls need finer heights in ", steep_cells,
+                " steep Z-map cells: an estimated ", format_mib(r.memory.walls), " on top of ",
+                format_mib(r.memory.total() - r.memory.walls), ", more than --max-memory ",
+                format_mib(static_cast<double>(max_memory)),
                 "; use a larger --zmap-cell or --dexel-cell, or a smaller --dexel-res");
   std::vector<CutMove> moves;  // one buffer for every direction: its pages are touched once
   moves.reserve(static_cast<std::size_t>(most_moves));
   for (std::size_t g = 0; g < maps.size(); ++g) {
     moves.clear();
-    for (const gcode::Move& m : groups[g].moves) moves.push_back(cut_move(groups[g], m, r.cutter_of_tool));
-    refine_steep_cells(maps[g], r.cutters, moves, {.threads = options.threads}, std::move(steep[g]));
+    for (const gcode::Move& m : groups[g].moves)
+      moves.push_back(cut_move(groups[g], m, r.cutter_of_tool));
+    refine_steep_cells(maps[g], r.cutters, moves, {.threads = options.threads},
+                       std::move(steep[g]));
   }
 }
 
@@ -568,18 +590,21 @@ void intersect_directions(const SimulateOptions& options, const PipelineRequest&
   std::vector<ZMap> kept_maps;
   if (request.keep_maps) kept_maps = maps;
   for (std::size_t g = 0; g < maps.size(); ++g) {
-    if (stock.mesh) raise_uncut(maps[g], *stock.mesh, options.threads);
-    else raise_uncut(maps[g], stock.box, options.threads);
+    if (stock.mesh)
+      raise_uncut(maps[g], *stock.mesh, options.threads);
+    else
+      raise_uncut(maps[g], stock.box, options.threads);
   }
   if (request.fine_cells) refine_walls(options, max_memory, r);
   progress.stage("dexelizing the stock");
-  TripleDexel stock_dexel = stock.mesh ? dexelize(*stock.mesh, r.lattice, DexelizeOptions{options.threads})
-                                       : TripleDexel::box(r.lattice, stock.box);
+  TripleDexel stock_dexel = stock.mesh
+                                ? dexelize(*stock.mesh, r.lattice, DexelizeOptions{options.threads})
+                                : TripleDexel::box(r.lattice, stock.box);
   r.timings.dexelize = seconds_since(t);
   progress.stage("dexelizing and intersecting " + std::to_string(maps.size()) + " Z-maps");
   t = Clock::now();
-  r.result = backends::machine_with(backends::parse_dexel_backend(options.dexel_backend), stock_dexel, maps,
-                                    options.threads);
+  r.result = backends::machine_with(backends::parse_dexel_backend(options.dexel_backend),
+                                    stock_dexel, maps, options.threads);
   r.timings.intersect = seconds_since(t);
   // The result is the stock less the cuts: the same volume means no move reached the stock (a
   // stock given far from where the program works, say). Not an error, but surely not meant.
@@ -593,7 +618,8 @@ void intersect_directions(const SimulateOptions& options, const PipelineRequest&
 }
 
 // The surface of the result (r.mesh), checked for watertightness, and its volume.
-void extract_result_surface(const SimulateOptions& options, Progress& progress, SimulationResult& r) {
+void extract_result_surface(const SimulateOptions& options, Progress& progress,
+                            SimulationResult& r) {
   progress.stage("extracting the surface");
   const Clock::time_point t = Clock::now();
   r.mesh = extract_surface(r.result, {.threads = options.threads});
@@ -610,7 +636,8 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   const RunInputs run = check_inputs_and_outputs(options, request, r);
   ParsedProgram parsed = parse_grouped(options, run.max_memory, progress, r);
   // The dump files are named by the directions, known only now.
-  if (!options.dump_zmaps.empty()) check_dump_names(options.dump_zmaps, r.groups, request.outputs, run.inputs);
+  if (!options.dump_zmaps.empty())
+    check_dump_names(options.dump_zmaps, r.groups, request.outputs, run.inputs);
   load_cutters(options, run.table, parsed.interpreted.tool_first_line, r);
   drop_toolless_moves(r);
   size_the_run(options, request, run, parsed, r);

@@ -156,6 +156,5 @@ std::string travel_text(const TravelFinding& finding);
 
 // A rapid into the stock as simulate's and check's reports list it (`files`: SimulationResult::files).
 Json rapid_finding_json(const RapidFinding& finding, const std::vector<std::string>& files);
-void write_stl_file(const std::filesystem::path& path, const Mesh& mesh);
 
 }  // namespace tridex::cli

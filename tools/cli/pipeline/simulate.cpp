@@ -13,6 +13,7 @@
 #include "json_text.hpp"
 #include "outputs/html_report.hpp"
 #include "outputs/output.hpp"
+#include "outputs/result_files.hpp"
 #include "pipeline/memory.hpp"
 #include "pipeline/pipeline.hpp"
 #include "pipeline/progress.hpp"
