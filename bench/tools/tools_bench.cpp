@@ -12,9 +12,9 @@
 
 #include "../backends/workload.hpp"
 #include "commands.hpp"
+#include "inputs/program_input.hpp"
 #include "json_text.hpp"
-#include "pipeline.hpp"
-#include "program_input.hpp"
+#include "pipeline/pipeline.hpp"
 #include "render.hpp"
 
 using namespace tridex;

@@ -18,7 +18,7 @@
 
 #include "../kernel/edge_sampling.hpp"
 #include "command_harness.hpp"
-#include "tool_table.hpp"
+#include "inputs/tool_table.hpp"
 #include "tridex/gcode/interpreter.hpp"
 #include "tridex/mesh_check.hpp"
 #include "tridex/mill.hpp"

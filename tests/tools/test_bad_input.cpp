@@ -16,7 +16,7 @@
 #include <thread>
 
 #include "command_harness.hpp"
-#include "output.hpp"
+#include "outputs/output.hpp"
 
 using namespace tridex;
 using namespace tridex::test;

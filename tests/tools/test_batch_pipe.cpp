@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "batch_pipe.hpp"
+#include "pipeline/batch_pipe.hpp"
 
 using tridex::cli::BatchPipe;
 

@@ -13,8 +13,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "checks/deviation.hpp"
 #include "command_harness.hpp"
-#include "deviation.hpp"
 #include "tridex/geometry.hpp"
 
 using namespace tridex;

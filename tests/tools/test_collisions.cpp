@@ -10,7 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "collision_check.hpp"
+#include "checks/collision_check.hpp"
 #include "command_harness.hpp"
 #include "tridex/zmap.hpp"
 

@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "deviation.hpp"
+#include "checks/deviation.hpp"
 
 using namespace tridex;
 using namespace tridex::cli;

@@ -12,9 +12,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "checks/deviation.hpp"
 #include "command_harness.hpp"
-#include "deviation.hpp"
-#include "html_report.hpp"
+#include "outputs/html_report.hpp"
 #include "tridex/gcode/interpreter.hpp"
 
 using namespace tridex;

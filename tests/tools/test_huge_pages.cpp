@@ -9,7 +9,7 @@
 #include <sstream>
 #include <string>
 
-#include "huge_pages.hpp"
+#include "pipeline/huge_pages.hpp"
 
 namespace {
 

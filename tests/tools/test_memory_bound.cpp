@@ -16,7 +16,7 @@
 #include <numbers>
 
 #include "command_harness.hpp"
-#include "pipeline.hpp"
+#include "pipeline/pipeline.hpp"
 #include "tridex/gcode/move.hpp"
 #include "tridex/mill.hpp"
 #include "tridex/stl.hpp"

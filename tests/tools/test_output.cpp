@@ -8,7 +8,7 @@
 #include <unistd.h>
 
 #include "errors.hpp"
-#include "output.hpp"
+#include "outputs/output.hpp"
 
 using namespace tridex;
 using namespace tridex::cli;

@@ -4,8 +4,8 @@
 #include <random>
 
 #include "errors.hpp"
-#include "memory.hpp"
-#include "stock.hpp"
+#include "inputs/stock.hpp"
+#include "pipeline/memory.hpp"
 
 using namespace tridex;
 using namespace tridex::cli;

@@ -13,7 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "errors.hpp"
-#include "tool_table.hpp"
+#include "inputs/tool_table.hpp"
 
 using namespace tridex;
 using namespace tridex::cli;

@@ -11,7 +11,7 @@
 
 #include "commands.hpp"
 #include "errors.hpp"
-#include "output.hpp"
+#include "outputs/output.hpp"
 #include "tridex/gcode/diagnostic.hpp"
 #include "tridex/gcode/machine.hpp"
 

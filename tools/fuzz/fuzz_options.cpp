@@ -7,8 +7,8 @@
 #include <string>
 
 #include "errors.hpp"
-#include "memory.hpp"
-#include "stock.hpp"
+#include "inputs/stock.hpp"
+#include "pipeline/memory.hpp"
 
 namespace {
 

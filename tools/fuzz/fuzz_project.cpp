@@ -5,8 +5,8 @@
 #include <string>
 
 #include "errors.hpp"
+#include "inputs/project.hpp"
 #include "json_input.hpp"
-#include "project.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   std::string text(reinterpret_cast<const char*>(data), size);

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer harnesses of the command's input formats with clang and runs each for a
-# share of a bounded total time, with a fixed seed:
+# Runs the libFuzzer harnesses of the command's input formats (built by tools/fuzz/build.sh) each
+# for a share of a bounded total time, with a fixed seed:
 #   tools/fuzz/run.sh [SECONDS=60] [BUILD_DIR=build-fuzz]
 #   stl         the STL reader, binary and ASCII (include/tridex/stl.hpp)
-#   tool_table  the tool table, CAMotics schema (tools/cli/tool_table.cpp, json_input.cpp)
-#   project     the .camotics project (tools/cli/project.cpp)
-#   options     --stock, --envelope and --max-memory (tools/cli/stock.cpp, memory.cpp)
+#   tool_table  the tool table, CAMotics schema (tools/cli/inputs/tool_table.cpp, json_input.cpp)
+#   project     the .camotics project (tools/cli/inputs/project.cpp)
+#   options     --stock, --envelope and --max-memory (tools/cli/inputs/stock.cpp, pipeline/memory.cpp)
 #   machine     the machine file, kinematics included (gcode/src/machine_file.cpp, machine.cpp)
 # Exit status 0: no crash in that time. A crash leaves its input as BUILD_DIR/<harness>-crash-*
 # and stops the script with a non-zero status; turn it into a named case in
@@ -18,31 +18,7 @@ build=${2:-build-fuzz}
 harnesses=(stl tool_table project options machine)
 share=$(( seconds / ${#harnesses[@]} ))
 [ "$share" -ge 1 ] || share=1
-flags=(-std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined
-       -Iinclude -Igcode/include -Itools/cli)
-mkdir -p "$build/inputs"
-# The command's parsers, compiled once (-fsanitize=fuzzer-no-link: instrumented, no main).
-objects=()
-for source in json_input memory numbers project stock tool_table; do
-  object="$build/inputs/$source.o"
-  if [ ! -f "$object" ] || [ "tools/cli/$source.cpp" -nt "$object" ]; then
-    clang++ "${flags[@]/-fsanitize=fuzzer,address,undefined/-fsanitize=fuzzer-no-link,address,undefined}" \
-      -c "tools/cli/$source.cpp" -o "$object"
-  fi
-  objects+=("$object")
-done
-# The machine file, its kinematics and the bundled machines come from the G-code front end.
-for source in gcode/src/*.cpp; do
-  object="$build/inputs/gcode_$(basename "$source" .cpp).o"
-  if [ ! -f "$object" ] || [ "$source" -nt "$object" ]; then
-    clang++ "${flags[@]/-fsanitize=fuzzer,address,undefined/-fsanitize=fuzzer-no-link,address,undefined}" \
-      -c "$source" -o "$object"
-  fi
-  objects+=("$object")
-done
-for h in "${harnesses[@]}"; do
-  clang++ "${flags[@]}" "tools/fuzz/fuzz_$h.cpp" "${objects[@]}" -o "$build/inputs/fuzz_$h"
-done
+bash tools/fuzz/build.sh "$build"
 # A fixed seed (FUZZ_SEED, default 1) makes CI explore the same inputs in the same order.
 for h in "${harnesses[@]}"; do
   mkdir -p "$build/inputs/corpus_$h"

@@ -1,4 +1,4 @@
-#include "tool_table.hpp"
+#include "inputs/tool_table.hpp"
 
 #include <algorithm>
 #include <cctype>

@@ -1,4 +1,4 @@
-#include "deviation.hpp"
+#include "checks/deviation.hpp"
 
 #include <algorithm>
 #include <cmath>

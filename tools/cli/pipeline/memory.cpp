@@ -1,4 +1,4 @@
-#include "memory.hpp"
+#include "pipeline/memory.hpp"
 
 #include <sys/resource.h>
 #include <unistd.h>
@@ -8,7 +8,7 @@
 #include <cstdio>
 
 #include "errors.hpp"
-#include "numbers.hpp"
+#include "inputs/numbers.hpp"
 
 namespace tridex::cli {
 

@@ -1,4 +1,4 @@
-#include "collision_check.hpp"
+#include "checks/collision_check.hpp"
 
 #include <algorithm>
 #include <chrono>

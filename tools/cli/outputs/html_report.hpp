@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "json_text.hpp"
-#include "pipeline.hpp"
+#include "pipeline/pipeline.hpp"
 #include "tridex/gcode/grouping.hpp"
 #include "tridex/mesh.hpp"
 

@@ -1,4 +1,4 @@
-#include "rapid_check.hpp"
+#include "checks/rapid_check.hpp"
 
 #include <algorithm>
 #include <limits>

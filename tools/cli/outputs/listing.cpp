@@ -8,10 +8,10 @@
 
 #include "commands.hpp"
 #include "errors.hpp"
+#include "inputs/program_input.hpp"
 #include "json_text.hpp"
-#include "memory.hpp"
-#include "output.hpp"
-#include "program_input.hpp"
+#include "outputs/output.hpp"
+#include "pipeline/memory.hpp"
 #include "tridex/gcode/grouping.hpp"
 
 namespace tridex::cli {

@@ -8,7 +8,7 @@
 #include <cstdlib>
 #include <new>
 
-#include "huge_pages.hpp"
+#include "pipeline/huge_pages.hpp"
 
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 #define TRIDEX_SANITIZED_ALLOCATOR 1

@@ -1,11 +1,11 @@
-#include "stock.hpp"
+#include "inputs/stock.hpp"
 
 #include <cmath>
 #include <sstream>
 #include <vector>
 
 #include "errors.hpp"
-#include "numbers.hpp"
+#include "inputs/numbers.hpp"
 
 namespace tridex::cli {
 

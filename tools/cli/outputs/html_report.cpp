@@ -1,7 +1,7 @@
 // tridex command — the interactive HTML report; see html_report.hpp. Mesh simplification:
 // meshoptimizer's meshopt_simplify (A. Kapoulkine, after Garland and Heckbert, "Surface
 // Simplification Using Quadric Error Metrics", SIGGRAPH 1997).
-#include "html_report.hpp"
+#include "outputs/html_report.hpp"
 
 #include <meshoptimizer.h>
 
@@ -15,8 +15,8 @@
 #include <stdexcept>
 #include <string_view>
 
-#include "output.hpp"
-#include "pipeline.hpp"
+#include "outputs/output.hpp"
+#include "pipeline/pipeline.hpp"
 #include "tridex/gcode/interpreter.hpp"
 
 // The page template and libjs-three's files, embedded at build time (cmake/embed_text.cmake).

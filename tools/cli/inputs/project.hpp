@@ -13,8 +13,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "stock.hpp"
-#include "tool_table.hpp"
+#include "inputs/stock.hpp"
+#include "inputs/tool_table.hpp"
 
 namespace tridex::cli {
 

@@ -10,12 +10,13 @@
 
 #include "commands.hpp"
 #include "errors.hpp"
-#include "html_report.hpp"
 #include "json_text.hpp"
-#include "memory.hpp"
-#include "output.hpp"
-#include "pipeline.hpp"
-#include "progress.hpp"
+#include "outputs/html_report.hpp"
+#include "outputs/output.hpp"
+#include "outputs/result_files.hpp"
+#include "pipeline/memory.hpp"
+#include "pipeline/pipeline.hpp"
+#include "pipeline/progress.hpp"
 #include "render.hpp"
 #include "tridex/dexel_ops.hpp"
 

@@ -1,4 +1,4 @@
-#include "project.hpp"
+#include "inputs/project.hpp"
 
 #include <fstream>
 

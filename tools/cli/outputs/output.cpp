@@ -1,4 +1,4 @@
-#include "output.hpp"
+#include "outputs/output.hpp"
 
 #include <fcntl.h>
 #include <pthread.h>

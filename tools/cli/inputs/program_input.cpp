@@ -1,13 +1,13 @@
-#include "program_input.hpp"
+#include "inputs/program_input.hpp"
 
 #include <algorithm>
 #include <cctype>
 #include <fstream>
 
 #include "errors.hpp"
+#include "inputs/project.hpp"
 #include "json_input.hpp"
-#include "memory.hpp"
-#include "project.hpp"
+#include "pipeline/memory.hpp"
 
 namespace tridex::cli {
 

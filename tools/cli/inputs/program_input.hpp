@@ -10,10 +10,10 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "inputs/stock.hpp"
+#include "inputs/tool_table.hpp"
 #include "machining_time.hpp"
-#include "memory.hpp"
-#include "stock.hpp"
-#include "tool_table.hpp"
+#include "pipeline/memory.hpp"
 #include "tridex/gcode/interpreter.hpp"
 
 namespace tridex::cli {

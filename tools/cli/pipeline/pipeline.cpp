@@ -1,4 +1,4 @@
-#include "pipeline.hpp"
+#include "pipeline/pipeline.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -6,10 +6,11 @@
 #include <cstdio>
 #include <limits>
 
-#include "batch_pipe.hpp"
+#include "checks/rapid_check.hpp"
 #include "errors.hpp"
-#include "output.hpp"
-#include "rapid_check.hpp"
+#include "outputs/output.hpp"
+#include "outputs/result_files.hpp"
+#include "pipeline/batch_pipe.hpp"
 #include "render.hpp"
 #include "tridex/backends/backends.hpp"
 #include "tridex/dexel_ops.hpp"
@@ -63,10 +64,6 @@ Stock load_stock(const StockSpec& spec, const Aabb& cutting_bounds, std::uint64_
     }
   }
   return stock;
-}
-
-void write_png_file(const fs::path& path, const render::Image& image) {
-  write_file_atomically(path, render::encode_png(image));
 }
 
 // A move of `group` as the kernel mills it: the tool tip in the group's frame.
@@ -217,29 +214,40 @@ std::string axis_label(const Vec3& axis) {
   return text;
 }
 
-void write_stl_file(const fs::path& path, const Mesh& mesh) {
-  AtomicOutput out(path);
-  write_stl(out.stream(), mesh);
-  out.commit();
-}
+namespace {
 
-SimulationResult simulate_program(const SimulateOptions& options, Progress& progress,
-                                  const PipelineRequest& request) {
-  SimulationResult r;
-  // ---- inputs and outputs, checked before any work ---------------------------------------
+// The pipeline's stages, in the order simulate_program runs them. Each fills its part of the
+// SimulationResult; what one stage hands to a later one and the result does not keep travels in
+// RunInputs and ParsedProgram.
+
+// What the first stage settles besides r.input: the tool table (--tools, else the project's), the
+// stock to load, the memory limit, and every input path that no output may name.
+struct RunInputs {
+  std::optional<ToolTable> table;
+  StockSpec stock_spec;
+  std::uint64_t max_memory = 0;
+  std::vector<fs::path> inputs;
+};
+
+// Inputs and outputs, checked before any work: the program, the stock and the memory limit read,
+// every output path writable and naming no input, --dump-zmaps's directory created.
+RunInputs check_inputs_and_outputs(const SimulateOptions& options, const PipelineRequest& request,
+                                   SimulationResult& r) {
+  RunInputs run;
   r.input = resolve_program(options);
   const ProgramInput& input = r.input;
-  std::optional<ToolTable> table;
-  if (r.input.tools) table = std::move(r.input.tools);  // --tools, else the project's
-  StockSpec stock_spec;
-  if (!options.stock.empty()) stock_spec = parse_stock(options.stock);
-  else if (input.stock) stock_spec = *input.stock;
-  const std::uint64_t max_memory = max_memory_bytes(options.max_memory);
+  if (r.input.tools) run.table = std::move(r.input.tools);  // --tools, else the project's
+  if (!options.stock.empty())
+    run.stock_spec = parse_stock(options.stock);
+  else if (input.stock)
+    run.stock_spec = *input.stock;
+  run.max_memory = max_memory_bytes(options.max_memory);
 
-  std::vector<fs::path> inputs(input.files.begin(), input.files.end());
+  std::vector<fs::path>& inputs = run.inputs;
+  inputs.assign(input.files.begin(), input.files.end());
   inputs.push_back(input.program);
   if (!options.tools.empty()) inputs.push_back(options.tools);
-  if (stock_spec.kind == StockSpec::Kind::mesh) inputs.push_back(stock_spec.mesh_path);
+  if (run.stock_spec.kind == StockSpec::Kind::mesh) inputs.push_back(run.stock_spec.mesh_path);
   inputs.insert(inputs.end(), request.extra_inputs.begin(), request.extra_inputs.end());
   for (const auto& [option, path] : request.outputs)
     if (!path.empty()) check_output_path(option, path, inputs);
@@ -250,16 +258,31 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
     if (!fs::is_directory(options.dump_zmaps, error))
       input_error("--dump-zmaps ", options.dump_zmaps, ": cannot create the directory");
   }
+  return run;
+}
 
-  // ---- parse, grouped by spindle direction ------------------------------------------------
+// What parsing leaves besides the groups, the program order, the files, the travel findings and
+// the machining time in the result: the box of the cutting moves (an automatic stock's), where
+// each tool was first selected (for messages) and how many moves are kept (for the memory check).
+struct ParsedProgram {
+  InterpretResult interpreted;  // its files moved into SimulationResult::files
+  Aabb cutting_bounds;
+  long long moves_kept = 0;
+};
+
+// Parses the program and groups its moves by spindle direction.
+ParsedProgram parse_grouped(const SimulateOptions& options, std::uint64_t max_memory,
+                            Progress& progress, SimulationResult& r) {
+  ParsedProgram parsed;
+  const ProgramInput& input = r.input;
   progress.stage("parsing " + input.program.string());
-  Clock::time_point t = Clock::now();
+  const Clock::time_point t = Clock::now();
   gcode::DirectionGrouper grouper;
   // simulate must hold every move: grouped by direction (a MoveList holds no spare copies), then
   // as one direction's cutter sweeps while it is milled. What the process already holds (the
   // libraries, a design read) leaves that much less for them.
   MoveBudget budget(max_memory, sizeof(gcode::Move) + sizeof(CutMove) + sizeof(void*));
-  Aabb cutting_bounds;
+  Aabb& cutting_bounds = parsed.cutting_bounds;
   const std::optional<gcode::Kinematics>& kinematics = input.machine.kinematics;
   // Positions "far along the tool axis" stand in for where the machine takes the tool: no travel.
   const double far = 0.5 * input.machine.far_distance;
@@ -267,38 +290,48 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   // Grouping (and the checks that read each move once) runs on a second thread when there is one,
   // overlapping the interpreter; the budget and the machining time stay on this thread, with the
   // dwells the timer also reads.
-  BatchPipe<gcode::Move> grouping([&](const gcode::Move& m) {
-    const auto group = static_cast<std::uint32_t>(grouper.add(m));
-    if (r.order.empty() || r.order.back().group != group) r.order.push_back({group, 0});
-    ++r.order.back().moves;
-    if (kinematics && glm::length(m.end) < far)
-      for (const gcode::TravelViolation& v : gcode::travel_violations(*kinematics, m.machine, m.rotary))
-        if (r.travel_count++ < static_cast<long long>(kTravelListed))
-          r.travel.push_back({m.file, m.line, v.axis, v.value, v.limit});
-    if (m.kind != gcode::MoveKind::rapid) {
-      // An approach from "far along the tool axis" is not where the work is.
-      if (!m.from_far) cutting_bounds.extend(m.start);
-      cutting_bounds.extend(m.end);
-    }
-  }, detail::resolve_threads(options.threads) > 1);
-  InterpretResult parsed = interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t file) {
-    budget.keep(m, input.files[file].string());
-    r.machining.add(m);
-    grouping.push(m);
-  }, [&](const gcode::Dwell& d) { r.machining.add(d); });
+  BatchPipe<gcode::Move> grouping(
+      [&](const gcode::Move& m) {
+        const auto group = static_cast<std::uint32_t>(grouper.add(m));
+        if (r.order.empty() || r.order.back().group != group) r.order.push_back({group, 0});
+        ++r.order.back().moves;
+        if (kinematics && glm::length(m.end) < far)
+          for (const gcode::TravelViolation& v :
+               gcode::travel_violations(*kinematics, m.machine, m.rotary))
+            if (r.travel_count++ < static_cast<long long>(kTravelListed))
+              r.travel.push_back({m.file, m.line, v.axis, v.value, v.limit});
+        if (m.kind != gcode::MoveKind::rapid) {
+          // An approach from "far along the tool axis" is not where the work is.
+          if (!m.from_far) cutting_bounds.extend(m.start);
+          cutting_bounds.extend(m.end);
+        }
+      },
+      detail::resolve_threads(options.threads) > 1);
+  parsed.interpreted = interpret(
+      input, interpreter_options(options),
+      [&](const gcode::Move& m, std::size_t file) {
+        budget.keep(m, input.files[file].string());
+        r.machining.add(m);
+        grouping.push(m);
+      },
+      [&](const gcode::Dwell& d) { r.machining.add(d); });
   grouping.finish();
   r.groups = grouper.take();
-  std::vector<gcode::MoveGroup>& groups = r.groups;
-  r.files = std::move(parsed.files);
-  r.warnings = parsed.warnings;
+  r.files = std::move(parsed.interpreted.files);
+  r.warnings = parsed.interpreted.warnings;
   r.timings.parse = seconds_since(t);
-  if (!options.dump_zmaps.empty()) check_dump_names(options.dump_zmaps, groups, request.outputs, inputs);
+  parsed.moves_kept = budget.kept();
+  return parsed;
+}
 
-  // ---- cutters: every tool used must be in the table --------------------------------------
+// Cutters: every tool used must be in the table. Fills r.cutters, r.bodies and r.cutter_of_tool;
+// a tool missing is an InputError at the line that first selected it.
+void load_cutters(const SimulateOptions& options, const std::optional<ToolTable>& table,
+                  const std::map<int, ToolSelection>& tool_first_line, SimulationResult& r) {
+  const ProgramInput& input = r.input;
   std::vector<Cutter>& cutters = r.cutters;
   std::map<int, std::uint32_t>& cutter_of_tool = r.cutter_of_tool;
-  long long toolless_rapids = 0;
-  for (const gcode::MoveGroup& group : groups)
+  for (const gcode::MoveGroup& group : r.groups)
     for (int tool : group.tools) {
       if (cutter_of_tool.count(tool)) continue;
       const ToolSpec* spec = table ? table->find(tool) : nullptr;
@@ -309,26 +342,33 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
         continue;
       }
       if (tool == 0) continue;  // moves before the first tool change; checked below
-      auto where = parsed.tool_first_line.find(tool);
-      std::string location = where == parsed.tool_first_line.end()
+      auto where = tool_first_line.find(tool);
+      std::string location = where == tool_first_line.end()
                                  ? input.program.string()
                                  : where->second.file + ":" + std::to_string(where->second.line);
       if (!table)
-        input_error(location, ": tool ", tool, " is used but there is no tool table (give --tools FILE)");
+        input_error(location, ": tool ", tool,
+                    " is used but there is no tool table (give --tools FILE)");
       input_error(location, ": tool ", tool, " is used but missing from the tool table ",
                   options.tools.empty() ? input.program.string() : options.tools);
     }
-  // Without a tool in the spindle nothing cuts; rapids before the first tool change are only
-  // positioning and are skipped, but a feed move then is an error.
-  if (!cutter_of_tool.count(0)) {
+}
+
+// Without a tool in the spindle nothing cuts; rapids before the first tool change are only
+// positioning and are dropped (with a warning), but a feed move then is an error.
+void drop_toolless_moves(SimulationResult& r) {
+  std::vector<gcode::MoveGroup>& groups = r.groups;
+  long long toolless_rapids = 0;
+  if (!r.cutter_of_tool.count(0)) {
     // The program order loses them too: each run keeps the count of its moves that stay.
     std::vector<std::size_t> next(groups.size(), 0);
     for (GroupRun& run : r.order) {
       const gcode::MoveList& moves = groups[run.group].moves;
       const std::size_t end = next[run.group] + run.moves;
-      run.moves = static_cast<std::uint64_t>(std::count_if(moves.begin() + static_cast<std::ptrdiff_t>(next[run.group]),
-                                                           moves.begin() + static_cast<std::ptrdiff_t>(end),
-                                                           [](const gcode::Move& m) { return m.tool != 0; }));
+      run.moves = static_cast<std::uint64_t>(
+          std::count_if(moves.begin() + static_cast<std::ptrdiff_t>(next[run.group]),
+                        moves.begin() + static_cast<std::ptrdiff_t>(end),
+                        [](const gcode::Move& m) { return m.tool != 0; }));
       next[run.group] = end;
     }
     // In place: the groups hold every move of the program, and a copy would double that.
@@ -339,9 +379,11 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
         if (m.kind != gcode::MoveKind::rapid)
           // The file that holds the move (one of a project's files, or a called subprogram), not
           // the project or the main program.
-          input_error(r.files.at(static_cast<std::size_t>(m.file)), ":", m.line, ": a ", gcode::to_string(m.kind),
-                      " move with no tool loaded (T… M6; on a machine that loads the tool on T alone, give "
-                      "--machine a file with \"tool_loads_on_t\": true)");
+          input_error(
+              r.files.at(static_cast<std::size_t>(m.file)), ":", m.line, ": a ",
+              gcode::to_string(m.kind),
+              " move with no tool loaded (T… M6; on a machine that loads the tool on T alone, give "
+              "--machine a file with \"tool_loads_on_t\": true)");
         ++toolless;
       }
       if (toolless > 0) erase_if(group.moves, [](const gcode::Move& m) { return m.tool == 0; });
@@ -349,37 +391,50 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
     }
   }
   if (toolless_rapids > 0)
-    r.warnings.push_back(std::to_string(toolless_rapids) +
-                         " rapid move(s) before the first tool change were not simulated (no tool)");
+    r.warnings.push_back(
+        std::to_string(toolless_rapids) +
+        " rapid move(s) before the first tool change were not simulated (no tool)");
+}
 
-  // ---- stock, resolutions, and the memory they need ---------------------------------------
-  r.stock = load_stock(stock_spec, cutting_bounds, max_memory);
+// The stock, the resolutions (the dexel lattice, the Z-map cell and grids), and the memory they
+// need, checked against --max-memory before anything big is allocated.
+void size_the_run(const SimulateOptions& options, const PipelineRequest& request,
+                  const RunInputs& run, const ParsedProgram& parsed, SimulationResult& r) {
+  const StockSpec& stock_spec = run.stock_spec;
+  const std::uint64_t max_memory = run.max_memory;
+  r.stock = load_stock(stock_spec, parsed.cutting_bounds, max_memory);
   const Stock& stock = r.stock;
   const double diagonal = glm::length(stock.box.size());
   try {
     r.lattice = options.dexel_cell > 0
                     ? DexelLattice::covering(stock.box, options.dexel_cell)
-                    : DexelLattice::covering_resolution(stock.box, options.dexel_res > 0 ? options.dexel_res : kDefaultDexelRes);
+                    : DexelLattice::covering_resolution(
+                          stock.box, options.dexel_res > 0 ? options.dexel_res : kDefaultDexelRes);
   } catch (const tridex::Error& e) {
     input_error("dexel resolution: ", e.what());
   }
   const DexelLattice& lattice = r.lattice;
   // Where no move cuts, the stock's faces are all there is to represent (a wider range).
-  check_reach(stock_spec.kind == StockSpec::Kind::mesh ? "--stock " + stock_spec.mesh_path.string() : "the stock",
-              stock.box, lattice.spacing,
-              no_move_reaches(groups, cutters, stock.box) ? kMaxUncutReachSpacings : kMaxReachSpacings);
-  for (const auto& [what, bounds] : request.extra_bounds) check_reach(what, bounds, lattice.spacing);
+  check_reach(
+      stock_spec.kind == StockSpec::Kind::mesh ? "--stock " + stock_spec.mesh_path.string()
+                                               : "the stock",
+      stock.box, lattice.spacing,
+      no_move_reaches(r.groups, r.cutters, stock.box) ? kMaxUncutReachSpacings : kMaxReachSpacings);
+  for (const auto& [what, bounds] : request.extra_bounds)
+    check_reach(what, bounds, lattice.spacing);
   // A Z-map's polyhedron ramps across the cell where a wall parallel to its spindle drops, and
   // is off by up to a cell at the wall's rims, where it meets the other directions' cuts
   // (docs/design.md, "Known errors"); at most half a dexel spacing keeps those edges within h/2.
   const double zmap_cell = options.zmap_cell > 0
                                ? options.zmap_cell
-                               : std::min(diagonal * kDefaultZmapCellFraction, kDefaultZmapCellOfSpacing * lattice.spacing);
+                               : std::min(diagonal * kDefaultZmapCellFraction,
+                                          kDefaultZmapCellOfSpacing * lattice.spacing);
   r.zmap_cell = zmap_cell;
   MemoryShape shape{.keep_maps = request.keep_maps, .dump_maps = !options.dump_zmaps.empty()};
-  for (const gcode::MoveGroup& group : groups) {
+  for (const gcode::MoveGroup& group : r.groups) {
     try {
-      r.grids.push_back(ZMapGrid::covering(group.frame, local_bounds(group.frame, stock.box), zmap_cell));
+      r.grids.push_back(
+          ZMapGrid::covering(group.frame, local_bounds(group.frame, stock.box), zmap_cell));
     } catch (const tridex::Error& e) {
       input_error("--zmap-cell ", zmap_cell, ": ", e.what());
     }
@@ -391,18 +446,54 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   shape.rays = n.x * n.y + n.y * n.z + n.z * n.x;
   // The peak so far holds the libraries, every move kept and the meshes read: all alive to the end.
   r.memory = estimate_memory(peak_rss_bytes(), shape);
-  if (request.memory_after) r.memory.after = request.memory_after(lattice.spacing, kTrianglesPerRay * shape.rays);
+  if (request.memory_after)
+    r.memory.after = request.memory_after(lattice.spacing, kTrianglesPerRay * shape.rays);
   const MemoryEstimate& need = r.memory;
   if (need.total() > static_cast<double>(max_memory))
-    input_error("the resolution needs an estimated ", format_mib(need.total()), " (in use before milling ",
-                format_mib(need.held), " with ", budget.kept(), " moves kept, Z-maps ", format_mib(need.zmaps),
-                ", dexels ", format_mib(need.dexels), ", surface ", format_mib(need.mesh),
-                need.after > 0 ? ", the comparison with the design " + format_mib(need.after) : std::string(),
+    input_error("the resolution needs an estimated ", format_mib(need.total()),
+                " (in use before milling ", format_mib(need.held), " with ", parsed.moves_kept,
+                " moves kept, Z-maps ", format_mib(need.zmaps), ", dexels ",
+                format_mib(need.dexels), ", surface ", format_mib(need.mesh),
+                need.after > 0 ? ", the comparison with the design " + format_mib(need.after)
+                               : std::string(),
                 "), more than --max-memory ", format_mib(static_cast<double>(max_memory)),
                 "; use a larger --zmap-cell or --dexel-cell, or a smaller --dexel-res");
+}
 
-  // ---- Step 1: one milled Z-map per direction ---------------------------------------------
-  t = Clock::now();
+// Mills one group's moves into `map` feed moves first (RapidCheck::against_feeds): the rapids are
+// checked against what the feeds leave (when `check_rapids`), then milled too.
+void mill_against_feeds(ZMap& map, const gcode::MoveGroup& group, std::size_t g,
+                        backends::ZMapBackend zmap_backend, bool check_rapids, unsigned threads,
+                        SimulationResult& r) {
+  const std::vector<Cutter>& cutters = r.cutters;
+  std::vector<CutMove> feeds, rapids;
+  std::vector<const gcode::Move*> rapid_moves;
+  feeds.reserve(group.moves.size());
+  for (const gcode::Move& m : group.moves) {
+    CutMove cut = cut_move(group, m, r.cutter_of_tool);
+    if (m.kind == gcode::MoveKind::rapid) {
+      rapids.push_back(cut);
+      rapid_moves.push_back(&m);
+    } else {
+      feeds.push_back(cut);
+    }
+  }
+  backends::mill_with(zmap_backend, map, cutters, feeds, threads);
+  for (const RapidCut& found :
+       check_rapids ? rapid_cuts(map, cutters, rapids, kRapidTolerance) : std::vector<RapidCut>{}) {
+    const gcode::Move& m = *rapid_moves[found.index];
+    r.rapid_cuts.push_back(
+        RapidFinding{m.file, m.line, m.tool, group.axis, found.depth_mm, m.end, g});
+  }
+  backends::mill_with(zmap_backend, map, cutters, rapids, threads);
+}
+
+// Step 1: one milled Z-map per direction (r.maps), its rapids checked as the request asks.
+void mill_directions(const SimulateOptions& options, const PipelineRequest& request,
+                     Progress& progress, SimulationResult& r) {
+  const Clock::time_point t = Clock::now();
+  const std::vector<gcode::MoveGroup>& groups = r.groups;
+  const Stock& stock = r.stock;
   std::vector<ZMap>& maps = r.maps;
   maps.reserve(groups.size());
   const backends::ZMapBackend zmap_backend = backends::parse_zmap_backend(options.zmap_backend);
@@ -411,109 +502,109 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   // check needs the exact milling.
   const bool check_rapids = zmap_backend == backends::ZMapBackend::cpu;
   if (!check_rapids)
-    r.warnings.push_back("rapid moves were not checked for cutting stock: that check needs --zmap-backend cpu");
+    r.warnings.push_back(
+        "rapid moves were not checked for cutting stock: that check needs --zmap-backend cpu");
   ZMapLimits limits;
   limits.max_points = std::numeric_limits<std::size_t>::max();  // the memory check above rules
   for (std::size_t g = 0; g < groups.size(); ++g) {
     const gcode::MoveGroup& group = groups[g];
-    progress.stage("milling direction " + std::to_string(g + 1) + "/" + std::to_string(groups.size()) +
-                   " (" + axis_label(group.axis) + ", " + std::to_string(group.moves.size()) + " moves)");
-    maps.push_back(stock.mesh ? ZMap::from_mesh(group.frame, *stock.mesh, zmap_cell, limits)
-                              : ZMap::from_box(group.frame, stock.box, zmap_cell, limits, options.threads));
+    progress.stage("milling direction " + std::to_string(g + 1) + "/" +
+                   std::to_string(groups.size()) + " (" + axis_label(group.axis) + ", " +
+                   std::to_string(group.moves.size()) + " moves)");
+    maps.push_back(
+        stock.mesh ? ZMap::from_mesh(group.frame, *stock.mesh, r.zmap_cell, limits)
+                   : ZMap::from_box(group.frame, stock.box, r.zmap_cell, limits, options.threads));
     r.segments += static_cast<long long>(group.moves.size());
     if (request.rapid_check == RapidCheck::in_program_order) {
       std::optional<BodyCheck> bodies;
       if (request.body_clearance) bodies.emplace(maps.back(), r.bodies, *request.body_clearance);
-      mill_in_program_order(maps.back(), group, g, cutters, cutter_of_tool, zmap_backend, options.threads,
-                            r.rapid_cuts, bodies ? &*bodies : nullptr, r.body);
+      mill_in_program_order(maps.back(), group, g, r.cutters, r.cutter_of_tool, zmap_backend,
+                            options.threads, r.rapid_cuts, bodies ? &*bodies : nullptr, r.body);
       continue;
     }
-    // Feed moves first; the rapids are checked against what the feeds leave, then milled too.
-    std::vector<CutMove> feeds, rapids;
-    std::vector<const gcode::Move*> rapid_moves;
-    feeds.reserve(group.moves.size());
-    for (const gcode::Move& m : group.moves) {
-      CutMove cut = cut_move(group, m, cutter_of_tool);
-      if (m.kind == gcode::MoveKind::rapid) {
-        rapids.push_back(cut);
-        rapid_moves.push_back(&m);
-      } else {
-        feeds.push_back(cut);
-      }
-    }
-    backends::mill_with(zmap_backend, maps.back(), cutters, feeds, options.threads);
-    for (const RapidCut& found : check_rapids ? rapid_cuts(maps.back(), cutters, rapids, kRapidTolerance)
-                                              : std::vector<RapidCut>{}) {
-      const gcode::Move& m = *rapid_moves[found.index];
-      r.rapid_cuts.push_back(RapidFinding{m.file, m.line, m.tool, group.axis, found.depth_mm, m.end, g});
-    }
-    backends::mill_with(zmap_backend, maps.back(), cutters, rapids, options.threads);
+    mill_against_feeds(maps.back(), group, g, zmap_backend, check_rapids, options.threads, r);
   }
   r.timings.zmap = seconds_since(t);
+}
 
-  if (!options.dump_zmaps.empty()) {
-    const std::vector<fs::path> names = dump_names(options.dump_zmaps, groups);
-    for (std::size_t g = 0; g < maps.size(); ++g) {
-      progress.stage("writing Z-map " + std::to_string(g + 1) + " to " + options.dump_zmaps);
-      write_stl_file(names[2 * g], polyhedrize(maps[g]));
-      write_png_file(names[2 * g + 1], render::render_heights(maps[g]));
-    }
+// --dump-zmaps: each direction's milled Z-map as STL and as a height picture.
+void dump_zmaps(const std::string& directory, const SimulationResult& r, Progress& progress) {
+  const std::vector<fs::path> names = dump_names(directory, r.groups);
+  for (std::size_t g = 0; g < r.maps.size(); ++g) {
+    progress.stage("writing Z-map " + std::to_string(g + 1) + " to " + directory);
+    write_stl_file(names[2 * g], polyhedrize(r.maps[g]));
+    write_png_file(names[2 * g + 1], render::render_heights(r.maps[g]));
   }
+}
 
-  // ---- Steps 2 and 3: the stock as a triple dexel, cut by every direction's Z-map ---------
-  // machine() fuses the two steps ray by ray (each ray of the stock clipped by each Z-map's
-  // polyhedron in turn, never storing M_i), so "intersect" times them together.
-  t = Clock::now();
+// Walls parallel to a spindle are placed inside their cells: the steep cells take finer heights
+// from the moves (zmap_walls.hpp). How many cells are steep is known only now: their sub-grids
+// are checked against --max-memory before any is allocated.
+void refine_walls(const SimulateOptions& options, std::uint64_t max_memory, SimulationResult& r) {
+  std::vector<ZMap>& maps = r.maps;
+  const std::vector<gcode::MoveGroup>& groups = r.groups;
+  std::vector<std::vector<std::uint32_t>> steep(maps.size());
+  std::size_t steep_cells = 0;
+  double rows = 0, most_moves = 0;
+  for (std::size_t g = 0; g < maps.size(); ++g) {
+    steep[g] = tridex::steep_cells(maps[g], WallOptions{}.steep_slope, options.threads);
+    steep_cells += steep[g].size();
+    rows += maps[g].grid.ny;
+    most_moves = std::max(most_moves, static_cast<double>(groups[g].moves.size()));
+  }
+  // A move is listed in the bands its swept box spans: its width plus one band at each end
+  // for the short moves of most programs.
+  double widest = 0;
+  for (const Cutter& c : r.cutters) widest = std::max(widest, 2 * c.radius());
+  const double bands_per_move = 2 + widest / (kWallBandRows * r.zmap_cell);
+  r.memory.walls =
+      fine_cell_bytes(static_cast<double>(steep_cells), rows, most_moves, bands_per_move);
+  if (r.memory.total() > static_cast<double>(max_memory))
+    input_error("the walls need finer heights in ", steep_cells,
+                " steep Z-map cells: an estimated ", format_mib(r.memory.walls), " on top of ",
+                format_mib(r.memory.total() - r.memory.walls), ", more than --max-memory ",
+                format_mib(static_cast<double>(max_memory)),
+                "; use a larger --zmap-cell or --dexel-cell, or a smaller --dexel-res");
+  std::vector<CutMove> moves;  // one buffer for every direction: its pages are touched once
+  moves.reserve(static_cast<std::size_t>(most_moves));
+  for (std::size_t g = 0; g < maps.size(); ++g) {
+    moves.clear();
+    for (const gcode::Move& m : groups[g].moves)
+      moves.push_back(cut_move(groups[g], m, r.cutter_of_tool));
+    refine_steep_cells(maps[g], r.cutters, moves, {.threads = options.threads},
+                       std::move(steep[g]));
+  }
+}
+
+// Steps 2 and 3: the stock as a triple dexel, cut by every direction's Z-map (r.result).
+// machine() fuses the two steps ray by ray (each ray of the stock clipped by each Z-map's
+// polyhedron in turn, never storing M_i), so "intersect" times them together.
+void intersect_directions(const SimulateOptions& options, const PipelineRequest& request,
+                          std::uint64_t max_memory, Progress& progress, SimulationResult& r) {
+  Clock::time_point t = Clock::now();
+  const Stock& stock = r.stock;
+  std::vector<ZMap>& maps = r.maps;
   // The intersection needs only the cuts: what a direction left uncut is raised above the stock,
   // so that the stock's faces and silhouette come from W0 exactly (see raise_uncut). A kept map
   // stays as milled; the raised copy is the one intersected.
   std::vector<ZMap> kept_maps;
   if (request.keep_maps) kept_maps = maps;
-  // Then walls parallel to a spindle are placed inside their cells: the steep cells take finer
-  // heights from the moves (zmap_walls.hpp).
   for (std::size_t g = 0; g < maps.size(); ++g) {
-    if (stock.mesh) raise_uncut(maps[g], *stock.mesh, options.threads);
-    else raise_uncut(maps[g], stock.box, options.threads);
+    if (stock.mesh)
+      raise_uncut(maps[g], *stock.mesh, options.threads);
+    else
+      raise_uncut(maps[g], stock.box, options.threads);
   }
-  if (request.fine_cells) {
-    // How many cells are steep is known only now: their sub-grids are checked against
-    // --max-memory before any is allocated.
-    std::vector<std::vector<std::uint32_t>> steep(maps.size());
-    std::size_t steep_cells = 0;
-    double rows = 0, most_moves = 0;
-    for (std::size_t g = 0; g < maps.size(); ++g) {
-      steep[g] = tridex::steep_cells(maps[g], WallOptions{}.steep_slope, options.threads);
-      steep_cells += steep[g].size();
-      rows += maps[g].grid.ny;
-      most_moves = std::max(most_moves, static_cast<double>(groups[g].moves.size()));
-    }
-    // A move is listed in the bands its swept box spans: its width plus one band at each end
-    // for the short moves of most programs.
-    double widest = 0;
-    for (const Cutter& c : cutters) widest = std::max(widest, 2 * c.radius());
-    const double bands_per_move = 2 + widest / (kWallBandRows * zmap_cell);
-    r.memory.walls = fine_cell_bytes(static_cast<double>(steep_cells), rows, most_moves, bands_per_move);
-    if (r.memory.total() > static_cast<double>(max_memory))
-      input_error("the walls need finer heights in ", steep_cells, " steep Z-map cells: an estimated ",
-                  format_mib(r.memory.walls), " on top of ", format_mib(r.memory.total() - r.memory.walls),
-                  ", more than --max-memory ", format_mib(static_cast<double>(max_memory)),
-                  "; use a larger --zmap-cell or --dexel-cell, or a smaller --dexel-res");
-    std::vector<CutMove> moves;  // one buffer for every direction: its pages are touched once
-    moves.reserve(static_cast<std::size_t>(most_moves));
-    for (std::size_t g = 0; g < maps.size(); ++g) {
-      moves.clear();
-      for (const gcode::Move& m : groups[g].moves) moves.push_back(cut_move(groups[g], m, cutter_of_tool));
-      refine_steep_cells(maps[g], cutters, moves, {.threads = options.threads}, std::move(steep[g]));
-    }
-  }
+  if (request.fine_cells) refine_walls(options, max_memory, r);
   progress.stage("dexelizing the stock");
-  TripleDexel stock_dexel = stock.mesh ? dexelize(*stock.mesh, lattice, DexelizeOptions{options.threads})
-                                       : TripleDexel::box(lattice, stock.box);
+  TripleDexel stock_dexel = stock.mesh
+                                ? dexelize(*stock.mesh, r.lattice, DexelizeOptions{options.threads})
+                                : TripleDexel::box(r.lattice, stock.box);
   r.timings.dexelize = seconds_since(t);
   progress.stage("dexelizing and intersecting " + std::to_string(maps.size()) + " Z-maps");
   t = Clock::now();
-  r.result = backends::machine_with(backends::parse_dexel_backend(options.dexel_backend), stock_dexel, maps,
-                                    options.threads);
+  r.result = backends::machine_with(backends::parse_dexel_backend(options.dexel_backend),
+                                    stock_dexel, maps, options.threads);
   r.timings.intersect = seconds_since(t);
   // The result is the stock less the cuts: the same volume means no move reached the stock (a
   // stock given far from where the program works, say). Not an error, but surely not meant.
@@ -524,14 +615,36 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   stock_dexel = TripleDexel{};
   maps = std::move(kept_maps);
   maps.shrink_to_fit();
+}
 
-  // ---- surface ------------------------------------------------------------------------------
+// The surface of the result (r.mesh), checked for watertightness, and its volume.
+void extract_result_surface(const SimulateOptions& options, Progress& progress,
+                            SimulationResult& r) {
   progress.stage("extracting the surface");
-  t = Clock::now();
+  const Clock::time_point t = Clock::now();
   r.mesh = extract_surface(r.result, {.threads = options.threads});
   r.mesh_check = check_mesh(r.mesh);
   r.timings.mesh = seconds_since(t);
   r.volume = r.mesh.signed_volume();
+}
+
+}  // namespace
+
+SimulationResult simulate_program(const SimulateOptions& options, Progress& progress,
+                                  const PipelineRequest& request) {
+  SimulationResult r;
+  const RunInputs run = check_inputs_and_outputs(options, request, r);
+  ParsedProgram parsed = parse_grouped(options, run.max_memory, progress, r);
+  // The dump files are named by the directions, known only now.
+  if (!options.dump_zmaps.empty())
+    check_dump_names(options.dump_zmaps, r.groups, request.outputs, run.inputs);
+  load_cutters(options, run.table, parsed.interpreted.tool_first_line, r);
+  drop_toolless_moves(r);
+  size_the_run(options, request, run, parsed, r);
+  mill_directions(options, request, progress, r);
+  if (!options.dump_zmaps.empty()) dump_zmaps(options.dump_zmaps, r, progress);
+  intersect_directions(options, request, run.max_memory, progress, r);
+  extract_result_surface(options, progress, r);
   return r;
 }
 

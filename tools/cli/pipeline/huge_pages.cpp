@@ -1,5 +1,5 @@
 // tridex command — transparent huge pages for the big arrays (see huge_pages.hpp).
-#include "huge_pages.hpp"
+#include "pipeline/huge_pages.hpp"
 
 #include <cstdint>
 #include <cstdlib>

@@ -15,13 +15,13 @@
 #include <utility>
 #include <vector>
 
-#include "collision_check.hpp"
+#include "checks/collision_check.hpp"
 #include "commands.hpp"
+#include "inputs/program_input.hpp"
 #include "json_text.hpp"
 #include "machining_time.hpp"
-#include "memory.hpp"
-#include "program_input.hpp"
-#include "progress.hpp"
+#include "pipeline/memory.hpp"
+#include "pipeline/progress.hpp"
 #include "tridex/cutter.hpp"
 #include "tridex/dexel.hpp"
 #include "tridex/gcode/grouping.hpp"
@@ -156,6 +156,5 @@ std::string travel_text(const TravelFinding& finding);
 
 // A rapid into the stock as simulate's and check's reports list it (`files`: SimulationResult::files).
 Json rapid_finding_json(const RapidFinding& finding, const std::vector<std::string>& files);
-void write_stl_file(const std::filesystem::path& path, const Mesh& mesh);
 
 }  // namespace tridex::cli

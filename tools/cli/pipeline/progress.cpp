@@ -1,4 +1,4 @@
-#include "progress.hpp"
+#include "pipeline/progress.hpp"
 
 #include <unistd.h>
 

@@ -1,4 +1,4 @@
-#include "numbers.hpp"
+#include "inputs/numbers.hpp"
 
 #include <cmath>
 
