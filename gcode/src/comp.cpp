@@ -55,7 +55,7 @@ void Interpreter::State::comp_forbid(int column, const std::string& what) const 
 }
 
 void Interpreter::State::cutter_comp_codes(int code, int column) {
-  if (code == 400) {
+  if (code == kG40) {
     if (comp_active() && !comp_first) {
       comp_move_endpoint_and_flush(plane_uv(comp_current));
       comp_dequeue();
@@ -68,15 +68,15 @@ void Interpreter::State::cutter_comp_codes(int code, int column) {
     return;
   }
   std::string name = code_name('G', code);
-  if (plane != 170 && plane != 180)
+  if (plane != kG17 && plane != kG18)
     error(column, name + " in " + code_name('G', plane) +
                       ": cutter compensation works in the XY (G17) or XZ (G18) plane only");
   const bool was_on = comp_side != 0;
-  if (was_on && (machine.dialect == Dialect::linuxcnc || code == 411 || code == 421))
+  if (was_on && (machine.dialect == Dialect::linuxcnc || code == kG41_1 || code == kG42_1))
     error(column, name + " while cutter compensation is already on (G40 first)");
-  int side = code == 410 || code == 411 ? 1 : -1;
+  int side = code == kG41 || code == kG41_1 ? 1 : -1;
   double radius = 0;
-  if (code == 411 || code == 421) {  // LinuxCNC: D is the diameter itself
+  if (code == kG41_1 || code == kG42_1) {  // LinuxCNC: D is the diameter itself
     if (!w.has('D')) error(column, name + " needs D (the tool diameter)");
     if (w.has('L')) error(w.col('L'), name + " L (a lathe tool's orientation) is not simulated: tridex simulates mills");
     radius = length('D') / 2;
@@ -195,6 +195,40 @@ void Interpreter::State::comp_move_endpoint_and_flush(const Vec2& to) {
   comp_endpoint_valid = true;
 }
 
+// The entry move (convert_straight_comp1): it ends one radius to the side of its programmed end.
+void Interpreter::State::comp_straight_entry(CompMove& move, const Vec3& target) {
+  const double r = comp_radius;
+  const int side = comp_side;
+  const Vec2 p = plane_uv(target);
+  Vec2 c = plane_uv(to_program(pos));
+  double distance = glm::length(p - c);
+  const bool fanuc_start = machine.dialect != Dialect::linuxcnc;
+  if (fanuc_start && !(distance > kEqual)) {
+    // Haas: "If cutter compensation is turned on ... in a block without any X-Y move, there is
+    // no change made to cutter compensation until the next X or Y move": a plunge goes as
+    // programmed, and the next move in the plane is the entry.
+    const Vec3 end = to_machine(target);
+    emit(move.move_kind, pos, end, move.feed);
+    pos = end;
+    return;
+  }
+  if (!fanuc_start && distance <= r)
+    error(motion_column, "cutter compensation entry move of length " + format_number(distance) +
+                             " mm is not longer than the tool radius " + format_number(r) + " mm");
+  comp_entry_pending = fanuc_start;
+  double alpha = angle_of(p - c) + (side > 0 ? kHalfPi : -kHalfPi);
+  Vec2 end = p + r * polar(alpha);
+  comp_endpoint = c;
+  comp_endpoint_valid = true;
+  move.direction = polar(alpha);  // as LinuxCNC records it
+  move.end = with_plane_uv(target, end);
+  comp_queue.push_back(move);
+  comp_first = false;
+  comp_current = move.end;
+  comp_programmed = target;
+  comp_programmed_current = true;
+}
+
 void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double move_feed) {
   if (far)
     error(motion_column, "cutter compensation from a retracted (far) position: the tool's position "
@@ -206,34 +240,8 @@ void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double
   move.move_kind = kind;
   move.line = line;
   move.feed = move_feed;
-  if (comp_first) {  // the entry move (convert_straight_comp1)
-    Vec2 c = plane_uv(to_program(pos));
-    double distance = glm::length(p - c);
-    const bool fanuc_start = machine.dialect != Dialect::linuxcnc;
-    if (fanuc_start && !(distance > kEqual)) {
-      // Haas: "If cutter compensation is turned on ... in a block without any X-Y move, there is
-      // no change made to cutter compensation until the next X or Y move": a plunge goes as
-      // programmed, and the next move in the plane is the entry.
-      const Vec3 end = to_machine(target);
-      emit(kind, pos, end, move_feed);
-      pos = end;
-      return;
-    }
-    if (!fanuc_start && distance <= r)
-      error(motion_column, "cutter compensation entry move of length " + format_number(distance) +
-                               " mm is not longer than the tool radius " + format_number(r) + " mm");
-    comp_entry_pending = fanuc_start;
-    double alpha = angle_of(p - c) + (side > 0 ? kHalfPi : -kHalfPi);
-    Vec2 end = p + r * polar(alpha);
-    comp_endpoint = c;
-    comp_endpoint_valid = true;
-    move.direction = polar(alpha);  // as LinuxCNC records it
-    move.end = with_plane_uv(target, end);
-    comp_queue.push_back(move);
-    comp_first = false;
-    comp_current = move.end;
-    comp_programmed = target;
-    comp_programmed_current = true;
+  if (comp_first) {
+    comp_straight_entry(move, target);
     return;
   }
   // Later moves (convert_straight_comp2).
@@ -338,6 +346,41 @@ void Interpreter::State::comp_resolve_entry(const Vec2& next_direction) {
   comp_current = entry.end;
 }
 
+// The entry arc (convert_arc_comp1): it keeps its start and ends one radius from its programmed
+// end.
+void Interpreter::State::comp_arc_entry(CompMove& move, bool ccw, bool inside, const std::string& too_small) {
+  const double r = comp_radius;
+  const int turn = move.turn;
+  Vec3 current = to_program(pos);
+  Vec2 c = plane_uv(current);
+  ArcData a = arc_data(current, ccw);
+  if (feed_mode == FeedMode::inverse_time) inverse_time_rate(arc_length(current, a, ccw, move.extra_turns));
+  move.feed = feed;
+  Vec2 end = plane_uv(a.end);
+  if (glm::length(end - c) <= r)
+    error(motion_column, "cutter compensation entry arc: its end is not farther than the tool "
+                         "radius " + format_number(r) + " mm from its start");
+  double arc_radius = a.programmed_radius > 0 ? a.programmed_radius : glm::length(a.centre - c);
+  if (arc_radius <= r && inside) error(motion_column, too_small);
+  double gamma = inside ? angle_of(a.centre - end) : angle_of(end - a.centre);
+  comp_first = false;
+  comp_programmed = a.end;
+  end += r * polar(gamma);
+  // The compensated arc keeps its start and passes through the new end: its centre lies on
+  // the line from the end through the programmed centre, equally far from both.
+  double b_len = glm::length(c - end) / 2;
+  double ab = angle_of(a.centre - end);
+  double a_angle = angle_of(c - end) - ab;
+  if (std::abs(std::cos(a_angle)) < kEqual) error(motion_column, too_small);
+  Vec2 centre = end + (b_len / std::cos(a_angle)) * polar(ab);
+  move.end = with_plane_uv(a.end, end);
+  move.centre = centre;
+  move.original_sweep = find_turn(c, centre, turn, end);
+  comp_queue.push_back(move);
+  comp_current = move.end;
+  comp_programmed_current = true;
+}
+
 void Interpreter::State::comp_arc(bool ccw) {
   if (far)
     error(motion_column, "cutter compensation from a retracted (far) position: the tool's position "
@@ -355,35 +398,8 @@ void Interpreter::State::comp_arc(bool ccw) {
   move.extra_turns = arc_extra_turns();
   const std::string too_small = "the tool radius " + format_number(r) +
                                 " mm is not less than the arc radius (cutter compensation)";
-  if (comp_first) {  // the entry arc (convert_arc_comp1)
-    Vec3 current = to_program(pos);
-    Vec2 c = plane_uv(current);
-    ArcData a = arc_data(current, ccw);
-    if (feed_mode == FeedMode::inverse_time) inverse_time_rate(arc_length(current, a, ccw, move.extra_turns));
-    move.feed = feed;
-    Vec2 end = plane_uv(a.end);
-    if (glm::length(end - c) <= r)
-      error(motion_column, "cutter compensation entry arc: its end is not farther than the tool "
-                           "radius " + format_number(r) + " mm from its start");
-    double arc_radius = a.programmed_radius > 0 ? a.programmed_radius : glm::length(a.centre - c);
-    if (arc_radius <= r && inside) error(motion_column, too_small);
-    double gamma = inside ? angle_of(a.centre - end) : angle_of(end - a.centre);
-    comp_first = false;
-    comp_programmed = a.end;
-    end += r * polar(gamma);
-    // The compensated arc keeps its start and passes through the new end: its centre lies on
-    // the line from the end through the programmed centre, equally far from both.
-    double b_len = glm::length(c - end) / 2;
-    double ab = angle_of(a.centre - end);
-    double a_angle = angle_of(c - end) - ab;
-    if (std::abs(std::cos(a_angle)) < kEqual) error(motion_column, too_small);
-    Vec2 centre = end + (b_len / std::cos(a_angle)) * polar(ab);
-    move.end = with_plane_uv(a.end, end);
-    move.centre = centre;
-    move.original_sweep = find_turn(c, centre, turn, end);
-    comp_queue.push_back(move);
-    comp_current = move.end;
-    comp_programmed_current = true;
+  if (comp_first) {
+    comp_arc_entry(move, ccw, inside, too_small);
     return;
   }
   // Later arcs (convert_arc_comp2).

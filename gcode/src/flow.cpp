@@ -12,6 +12,7 @@
 #include <cctype>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <map>
 #include <set>
 
@@ -114,6 +115,14 @@ class ProgramFlow {
   void call(CallKind kind, const std::string& label, long long repeats, int column);
   void give_back(int column);
   void o_word(const Control& control);
+  std::vector<Loop>::reverse_iterator find_o_loop(const std::string& label);
+  OKeyword skip_to(const Control& control, std::initializer_list<OKeyword> keywords, const std::string& what);
+  void o_return(const Control& control);
+  void o_if(const Control& control);
+  void o_while(const Control& control);
+  void o_repeat(const Control& control);
+  void o_loop_end(const Control& control);
+  void o_break(const Control& control);
   void linuxcnc_program_number(const Word& label);
   void loop_control(const Control& control);
   Position find_sequence(long long number, const std::string& what, int column);
@@ -497,78 +506,56 @@ void ProgramFlow::linuxcnc_program_number(const Word& label) {
   started_ = true;
 }
 
+// The innermost o-word loop labelled `label` (rend(): none).
+std::vector<Loop>::reverse_iterator ProgramFlow::find_o_loop(const std::string& label) {
+  return std::find_if(loops_.rbegin(), loops_.rend(), [&](const Loop& l) {
+    return l.kind != LoopKind::fanuc && l.label == label;
+  });
+}
+
+// Skips to the next o-word of `control`'s label with one of `keywords`, and says which it met.
+OKeyword ProgramFlow::skip_to(const Control& control, std::initializer_list<OKeyword> keywords,
+                              const std::string& what) {
+  const std::string& label = control.label;
+  OKeyword hit = OKeyword::sub;
+  skip_until(
+      [&](const Skim& k) {
+        if (k.kind != ControlKind::o_word || k.label != label) return false;
+        for (OKeyword kw : keywords)
+          if (k.keyword == kw) {
+            hit = kw;
+            return true;
+          }
+        return false;
+      },
+      what, control.column);
+  return hit;
+}
+
+// LinuxCNC's o-words: a statement per keyword (subroutines, branches, loops).
 void ProgramFlow::o_word(const Control& control) {
   const std::string& label = control.label;
-  auto find_loop = [&]() {
-    return std::find_if(loops_.rbegin(), loops_.rend(), [&](const Loop& l) {
-      return l.kind != LoopKind::fanuc && l.label == label;
-    });
-  };
-  auto skip_to = [&](std::initializer_list<OKeyword> keywords, const std::string& what) {
-    OKeyword hit = OKeyword::sub;
-    skip_until(
-        [&](const Skim& k) {
-          if (k.kind != ControlKind::o_word || k.label != label) return false;
-          for (OKeyword kw : keywords)
-            if (k.keyword == kw) {
-              hit = kw;
-              return true;
-            }
-          return false;
-        },
-        what, control.column);
-    return hit;
-  };
-  Position start{current_, statement_offset_, line_ - 1};
   switch (control.keyword) {
     case OKeyword::sub:  // a definition met in the flow of the program: note it, skip it
       source().subroutines.emplace(label, Source::Label{here().offset, line_});
-      skip_to({OKeyword::endsub}, "o" + label + " endsub");
+      skip_to(control, {OKeyword::endsub}, "o" + label + " endsub");
       return;
     case OKeyword::endsub:
-    case OKeyword::return_: {
-      if (calls_.empty() || calls_.back().kind != CallKind::o_call)
-        error(control.column, "o" + label + " " + to_string(control.keyword) + " outside a call");
-      std::vector<Value> values = arguments(control);
-      if (!values.empty()) {
-        s_.named_globals["_value"] = values[0];
-        s_.named_globals["_value_returned"] = Value{1, false};
-      } else {
-        s_.named_globals["_value_returned"] = Value{0, false};
-      }
-      give_back(control.column);
+    case OKeyword::return_:
+      o_return(control);
       return;
-    }
     case OKeyword::call:
       o_arguments_ = arguments(control);
       call(CallKind::o_call, label, 1, control.column);
       return;
-    case OKeyword::if_: {
-      bool taken = condition(control);
-      if (branches_.size() >= kMaxControlDepth) error(control.column, "if nested too deeply");
-      branches_.push_back(Branch{label, taken});
-      while (!branches_.back().taken) {
-        OKeyword hit = skip_to({OKeyword::elseif, OKeyword::else_, OKeyword::endif}, "o" + label + " endif");
-        if (hit == OKeyword::endif) {
-          branches_.pop_back();
-          return;
-        }
-        if (hit == OKeyword::else_) {
-          branches_.back().taken = true;
-        } else {  // elseif: skimmed, so its condition is evaluated now
-          Block b;
-          if (!lex_line(skipped_, b, lex_error_, &s_))
-            throw SyntaxError(Diagnostic{source().name, line_, lex_error_.column, lex_error_.message});
-          branches_.back().taken = condition(b.control);
-        }
-      }
+    case OKeyword::if_:
+      o_if(control);
       return;
-    }
     case OKeyword::elseif:
     case OKeyword::else_:
       if (branches_.empty() || branches_.back().label != label)
         error(control.column, "o" + label + " " + to_string(control.keyword) + " without o" + label + " if");
-      skip_to({OKeyword::endif}, "o" + label + " endif");
+      skip_to(control, {OKeyword::endif}, "o" + label + " endif");
       branches_.pop_back();
       return;
     case OKeyword::endif:
@@ -576,78 +563,135 @@ void ProgramFlow::o_word(const Control& control) {
         error(control.column, "o" + label + " endif without o" + label + " if");
       branches_.pop_back();
       return;
-    case OKeyword::while_: {
-      auto loop = find_loop();
-      if (loop != loops_.rend() && loop->kind == LoopKind::o_do) {  // the end of a do … while
-        if (condition(control)) {
-          jump(loop->start);
-        } else {
-          loops_.erase(std::prev(loop.base()), loops_.end());
-        }
-        return;
-      }
-      bool running = loop != loops_.rend() && loop->start.offset == start.offset;
-      if (condition(control)) {
-        if (!running) {
-          if (loops_.size() >= kMaxControlDepth) error(control.column, "loops nested too deeply");
-          loops_.push_back(Loop{LoopKind::o_while, 0, label, start, 0});
-        }
-        return;
-      }
-      if (running) loops_.erase(std::prev(loop.base()), loops_.end());
-      skip_to({OKeyword::endwhile}, "o" + label + " endwhile");
+    case OKeyword::while_:
+      o_while(control);
       return;
-    }
     case OKeyword::do_:
       if (loops_.size() >= kMaxControlDepth) error(control.column, "loops nested too deeply");
       loops_.push_back(Loop{LoopKind::o_do, 0, label, here(), 0});
       return;
-    case OKeyword::repeat: {
-      std::vector<Value> values = arguments(control);
-      if (values.size() != 1) error(control.arguments_column, "o" + label + " repeat needs a count in [ ]");
-      long long count = std::llround(values[0].number);
-      if (count <= 0) {
-        skip_to({OKeyword::endrepeat}, "o" + label + " endrepeat");
-        return;
-      }
-      if (loops_.size() >= kMaxControlDepth) error(control.column, "loops nested too deeply");
-      loops_.push_back(Loop{LoopKind::o_repeat, 0, label, here(), count});
+    case OKeyword::repeat:
+      o_repeat(control);
       return;
-    }
     case OKeyword::endwhile:
     case OKeyword::endrepeat:
-    case OKeyword::continue_: {
-      auto loop = find_loop();
-      if (loop == loops_.rend())
-        error(control.column, "o" + label + " " + to_string(control.keyword) + " outside its loop");
-      loops_.erase(loop.base(), loops_.end());  // loops opened inside it end here
-      if (loop->kind == LoopKind::o_repeat) {
-        if (--loop->remaining > 0) {
-          jump(loop->start);
-        } else {
-          bool at_end = control.keyword == OKeyword::endrepeat;
-          loops_.pop_back();
-          if (!at_end) skip_to({OKeyword::endrepeat}, "o" + label + " endrepeat");
-        }
-        return;
-      }
-      jump(loop->start);  // while: its condition again; do: its first line
+    case OKeyword::continue_:
+      o_loop_end(control);
+      return;
+    case OKeyword::break_:
+      o_break(control);
+      return;
+  }
+}
+
+// o endsub / o return [value]: back to the caller, the value in #<_value>.
+void ProgramFlow::o_return(const Control& control) {
+  const std::string& label = control.label;
+  if (calls_.empty() || calls_.back().kind != CallKind::o_call)
+    error(control.column, "o" + label + " " + to_string(control.keyword) + " outside a call");
+  std::vector<Value> values = arguments(control);
+  if (!values.empty()) {
+    s_.named_globals["_value"] = values[0];
+    s_.named_globals["_value_returned"] = Value{1, false};
+  } else {
+    s_.named_globals["_value_returned"] = Value{0, false};
+  }
+  give_back(control.column);
+}
+
+// o if: skips to the branch taken (an elseif's condition is evaluated when it is reached).
+void ProgramFlow::o_if(const Control& control) {
+  const std::string& label = control.label;
+  bool taken = condition(control);
+  if (branches_.size() >= kMaxControlDepth) error(control.column, "if nested too deeply");
+  branches_.push_back(Branch{label, taken});
+  while (!branches_.back().taken) {
+    OKeyword hit = skip_to(control, {OKeyword::elseif, OKeyword::else_, OKeyword::endif}, "o" + label + " endif");
+    if (hit == OKeyword::endif) {
+      branches_.pop_back();
       return;
     }
-    case OKeyword::break_: {
-      auto loop = find_loop();
-      if (loop == loops_.rend()) error(control.column, "o" + label + " break outside its loop");
-      LoopKind kind = loop->kind;
-      loops_.erase(std::prev(loop.base()), loops_.end());
-      if (kind == LoopKind::o_repeat)
-        skip_to({OKeyword::endrepeat}, "o" + label + " endrepeat");
-      else if (kind == LoopKind::o_do)
-        skip_to({OKeyword::while_}, "o" + label + " while");
-      else
-        skip_to({OKeyword::endwhile}, "o" + label + " endwhile");
-      return;
+    if (hit == OKeyword::else_) {
+      branches_.back().taken = true;
+    } else {  // elseif: skimmed, so its condition is evaluated now
+      Block b;
+      if (!lex_line(skipped_, b, lex_error_, &s_))
+        throw SyntaxError(Diagnostic{source().name, line_, lex_error_.column, lex_error_.message});
+      branches_.back().taken = condition(b.control);
     }
   }
+}
+
+// o while: the start of a while loop (its condition read at each turn), or the end of a do loop.
+void ProgramFlow::o_while(const Control& control) {
+  const std::string& label = control.label;
+  Position start{current_, statement_offset_, line_ - 1};
+  auto loop = find_o_loop(label);
+  if (loop != loops_.rend() && loop->kind == LoopKind::o_do) {  // the end of a do … while
+    if (condition(control)) {
+      jump(loop->start);
+    } else {
+      loops_.erase(std::prev(loop.base()), loops_.end());
+    }
+    return;
+  }
+  bool running = loop != loops_.rend() && loop->start.offset == start.offset;
+  if (condition(control)) {
+    if (!running) {
+      if (loops_.size() >= kMaxControlDepth) error(control.column, "loops nested too deeply");
+      loops_.push_back(Loop{LoopKind::o_while, 0, label, start, 0});
+    }
+    return;
+  }
+  if (running) loops_.erase(std::prev(loop.base()), loops_.end());
+  skip_to(control, {OKeyword::endwhile}, "o" + label + " endwhile");
+}
+
+void ProgramFlow::o_repeat(const Control& control) {
+  const std::string& label = control.label;
+  std::vector<Value> values = arguments(control);
+  if (values.size() != 1) error(control.arguments_column, "o" + label + " repeat needs a count in [ ]");
+  long long count = std::llround(values[0].number);
+  if (count <= 0) {
+    skip_to(control, {OKeyword::endrepeat}, "o" + label + " endrepeat");
+    return;
+  }
+  if (loops_.size() >= kMaxControlDepth) error(control.column, "loops nested too deeply");
+  loops_.push_back(Loop{LoopKind::o_repeat, 0, label, here(), count});
+}
+
+// o endwhile, o endrepeat, o continue: the loop's next turn, or its end.
+void ProgramFlow::o_loop_end(const Control& control) {
+  const std::string& label = control.label;
+  auto loop = find_o_loop(label);
+  if (loop == loops_.rend())
+    error(control.column, "o" + label + " " + to_string(control.keyword) + " outside its loop");
+  loops_.erase(loop.base(), loops_.end());  // loops opened inside it end here
+  if (loop->kind == LoopKind::o_repeat) {
+    if (--loop->remaining > 0) {
+      jump(loop->start);
+    } else {
+      bool at_end = control.keyword == OKeyword::endrepeat;
+      loops_.pop_back();
+      if (!at_end) skip_to(control, {OKeyword::endrepeat}, "o" + label + " endrepeat");
+    }
+    return;
+  }
+  jump(loop->start);  // while: its condition again; do: its first line
+}
+
+void ProgramFlow::o_break(const Control& control) {
+  const std::string& label = control.label;
+  auto loop = find_o_loop(label);
+  if (loop == loops_.rend()) error(control.column, "o" + label + " break outside its loop");
+  LoopKind kind = loop->kind;
+  loops_.erase(std::prev(loop.base()), loops_.end());
+  if (kind == LoopKind::o_repeat)
+    skip_to(control, {OKeyword::endrepeat}, "o" + label + " endrepeat");
+  else if (kind == LoopKind::o_do)
+    skip_to(control, {OKeyword::while_}, "o" + label + " while");
+  else
+    skip_to(control, {OKeyword::endwhile}, "o" + label + " endwhile");
 }
 
 void ProgramFlow::run() {
@@ -731,21 +775,21 @@ void ProgramFlow::run() {
       break;
     }
     if (flow == Flow::call || flow == Flow::macro) {
-      const int m97 = s_.w.find_m(97);
-      int column = flow == Flow::macro ? s_.w.find_g(650) : m97 ? m97 : s_.w.find_m(98);
+      const int m97 = s_.w.find_m(kM97);
+      int column = flow == Flow::macro ? s_.w.find_g(kG65) : m97 ? m97 : s_.w.find_m(kM98);
       call(flow == Flow::macro ? CallKind::g65 : m97 ? CallKind::m97 : CallKind::m98,
            std::to_string(s_.call_label), s_.call_repeats, column);
       continue;
     }
     if (flow == Flow::ret) {
       if (calls_.empty()) {
-        s_.warn(s_.w.find_m(99), "M99 in the main program: treated as the end of the program");
+        s_.warn(s_.w.find_m(kM99), "M99 in the main program: treated as the end of the program");
         ended_ = true;
         break;
       }
       if (calls_.back().kind == CallKind::o_call)
-        error(s_.w.find_m(99), "M99 inside o" + calls_.back().label + " sub (use endsub or return)");
-      give_back(s_.w.find_m(99));
+        error(s_.w.find_m(kM99), "M99 inside o" + calls_.back().label + " sub (use endsub or return)");
+      give_back(s_.w.find_m(kM99));
     }
   }
   if (!ended_) {

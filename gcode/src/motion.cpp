@@ -305,7 +305,7 @@ void Interpreter::State::probe(int code) {
   const auto [target, set] = axis_word_target(current);
   comp_programmed_current = false;
   comp_arc_forbidden = false;
-  const bool must_move = code == 382 || code == 384;  // G38.3/G38.5 may stand still
+  const bool must_move = code == kG38_2 || code == kG38_4;  // G38.3/G38.5 may stand still
   if (must_move && target == current)
     error(motion_column, name + ": start point too close to probe point (the probe does not move)");
   if (!warned_probe) {
@@ -326,6 +326,15 @@ void Interpreter::State::probe(int code) {
 }
 
 // ---- canned cycles ----
+namespace {
+// The cycles that dwell at the bottom of the hole.
+bool cycle_dwells(int code) {
+  return code == kG74 || code == kG82 || code == kG84 || code == kG86 || code == kG89;
+}
+}  // namespace
+
+// A canned cycle's block: its sticky words, the levels along its axis, then each hole (L or K
+// repeats) in turn.
 void Interpreter::State::cycle(int code) {
   const std::array<int, 3> axes = plane_axes(plane);
   const int u = axes[0], v = axes[1], n = axes[2];
@@ -333,74 +342,10 @@ void Interpreter::State::cycle(int code) {
   if (glm::dot(drill, axis) < 1 - 1e-9)
     error(motion_column, code_name('G', code) + " drills along the " + code_name('G', plane) +
                              " plane normal, which is not the spindle direction");
-  char depth_letter = kAxisLetter[n];
-  if (w.has('R')) {
-    cycle_r = length('R');
-    has_cycle_r = true;
-  }
-  if (w.has(depth_letter)) {
-    cycle_z = length(depth_letter);
-    has_cycle_z = true;
-  }
-  if (code == 730 || code == 830) {
-    if (w.has('Q')) {
-      cycle_q = length('Q');
-      has_cycle_q = true;
-    }
-    if (!has_cycle_q || !(cycle_q > 0))
-      error(motion_column, code_name('G', code) + " needs a positive peck depth Q");
-  }
-  // The cycles that dwell at the bottom read P. Fanuc and Haas keep P as modal cycle data in any
-  // cycle (a post writes it on G81 too), for a later one that dwells.
-  const bool dwells = code == 740 || code == 820 || code == 840 || code == 860 || code == 890;
-  if ((dwells || machine.dialect != Dialect::linuxcnc) && w.has('P')) {
-    double p = w.take('P');
-    if (p < 0) error(w.col('P'), "dwell P must not be negative");
-    cycle_dwell = dwell_seconds(p);
-  }
-  if (feed_mode == FeedMode::inverse_time)
-    error(motion_column, code_name('G', code) + ": canned cycles cannot run in inverse time feed "
-                                                "(G93), as LinuxCNC requires; G94 first");
-  if (!has_cycle_r) error(motion_column, code_name('G', code) + " needs R (retract plane)");
-  if (!has_cycle_z)
-    error(motion_column, code_name('G', code) + " needs " + depth_letter + " (hole bottom)");
-  require_feed();
-  if (w.has('L') && w.has('K')) error(w.col('K'), "repeat count given twice (L and K)");
-  if (w.has('L') && (code == 740 || code == 840) && machine.dialect == Dialect::linuxcnc)
-    error(w.col('L'), code_name('G', code) + " L: LinuxCNC's rs274 takes no repeats on a tapping cycle");
-  long long repeats = 1;
-  if (w.has('L')) repeats = integer('L', "repeat count", 0, 9999);
-  if (w.has('K')) repeats = integer('K', "repeat count", 0, 9999);
+  const long long repeats = cycle_words(code, kAxisLetter[n]);
 
   Vec3 current = to_program(pos);
-  if (!cycle_active) {
-    cycle_active = true;
-    cycle_initial_far = far;
-    cycle_initial = current[n];
-  }
-  if (far && incremental)
-    error(motion_column, "incremental canned cycle from a retracted (far) position");
-  // G91: R counts from the initial level of the cycle (kept while the cycle mode lasts, as
-  // LinuxCNC's cycle_il and Fanuc's initial point), not from where the last hole left the tool.
-  double incremental_base = cycle_initial_far ? current[n] : cycle_initial;
-  double r_level = incremental ? incremental_base + cycle_r : cycle_r;
-  double bottom = incremental ? r_level + cycle_z : cycle_z;
-  if (bottom > r_level)
-    error(motion_column, "hole bottom " + format_number(bottom) + " is above the R plane " +
-                             format_number(r_level));
-  if (code == 730 || code == 830) {
-    // A real control pecks a hole a few hundred times at most; a tiny Q against a deep hole
-    // (or a far R plane) would emit moves without end, and below one ulp would never finish.
-    constexpr double kMaxPecks = 100000;
-    double pecks = (r_level - bottom) / cycle_q;
-    if (!(pecks <= kMaxPecks))
-      error(motion_column, code_name('G', code) + " would peck " + format_number(pecks) +
-                               " times (R " + format_number(r_level) + " to " + format_number(bottom) +
-                               " by Q " + format_number(cycle_q) + "); at most 100000 per hole");
-  }
-  bool clear_far = !retract_to_r && cycle_initial_far;
-  double clear = retract_to_r ? r_level : std::max(cycle_initial, r_level);
-  if (clear_far) clear = r_level;
+  const CycleLevels levels = cycle_levels(code, current[n]);
 
   // Lateral target of the first hole; increments repeat under G91.
   double du = w.has(kAxisLetter[u]) ? length(kAxisLetter[u]) : 0.0;
@@ -412,22 +357,8 @@ void Interpreter::State::cycle(int code) {
   double step_radius = w.has('@') ? length('@') : 0.0;
   double step_angle = w.has('^') ? glm::radians(w.take('^')) : 0.0;
 
-  auto at = [&](double uu, double vv, double depth) {
-    Vec3 p;
-    p[u] = uu;
-    p[v] = vv;
-    p[n] = depth;
-    return to_machine(p);
-  };
-  auto rapid = [&](const Vec3& to) {
-    emit(MoveKind::cycle, pos, to, 0.0);
-    pos = to;
-  };
-  auto cut = [&](const Vec3& to) {
-    emit(MoveKind::cycle, pos, to, feed);
-    pos = to;
-  };
-  if (!far && current[n] < r_level - 1e-9) rapid(at(current[u], current[v], r_level));
+  if (!far && current[n] < levels.r_level - 1e-9)
+    cycle_rapid(cycle_point(current[u], current[v], levels.r_level));
   for (long long k = 0; k < repeats; ++k) {
     if (incremental) {
       hole_u += du;
@@ -441,57 +372,163 @@ void Interpreter::State::cycle(int code) {
       hole_u = radius * std::cos(angle);
       hole_v = radius * std::sin(angle);
     }
-    if (far) {
-      // Come back from far straight down the axis onto the R plane of the hole.
-      Vec3 r_point = at(hole_u, hole_v, r_level);
-      emit(MoveKind::cycle, r_point + machine.far_distance * axis, r_point, 0.0, true);
-      pos = r_point;
-      far = false;
-    } else {
-      Vec3 level = to_program(pos);
-      rapid(at(hole_u, hole_v, level[n]));
-      rapid(at(hole_u, hole_v, r_level));
-    }
-    double d = options.peck_clearance;
-    switch (code) {
-      case 730:
-        for (double depth = r_level - cycle_q; depth > bottom; depth -= cycle_q) {
-          cut(at(hole_u, hole_v, depth));
-          rapid(at(hole_u, hole_v, depth + d));
-        }
-        cut(at(hole_u, hole_v, bottom));
-        break;
-      case 830:
-        for (double depth = r_level - cycle_q; depth > bottom; depth -= cycle_q) {
-          cut(at(hole_u, hole_v, depth));
-          rapid(at(hole_u, hole_v, r_level));
-          rapid(at(hole_u, hole_v, depth + d));
-        }
-        cut(at(hole_u, hole_v, bottom));
-        break;
-      default:  // the others go down at feed in one piece
-        cut(at(hole_u, hole_v, bottom));
-        break;
-    }
-    if (dwells) emit_dwell(cycle_dwell);  // at the bottom
-    switch (code) {  // the way out: at feed for these, at rapid for the others (below)
-      case 740:  // tapping (G74 left hand, G84 right hand): the spindle reverses and the tap
-      case 840:  // backs out at feed: to R on Fanuc and Haas, as G85; LinuxCNC's to the clear level
-        cut(at(hole_u, hole_v, machine.dialect == Dialect::linuxcnc && !clear_far ? clear : r_level));
-        break;
-      case 850:  // to R (then rapid to the clear level)
-        cut(at(hole_u, hole_v, r_level));
-        break;
-      case 890:  // all the way to the clear level, as LinuxCNC does
-        cut(at(hole_u, hole_v, clear_far ? r_level : clear));
-        break;
-      default:
-        break;
-    }
-    Vec3 out = at(hole_u, hole_v, clear);
-    if (out != pos) rapid(out);
-    if (clear_far) far = true;
+    cycle_hole(code, hole_u, hole_v, levels);
   }
+}
+
+// The cycle's words: R, the depth along the plane's normal and Q stay from block to block (the
+// cycle's sticky data), P where the cycle reads it; the repeat count (L or K) is returned.
+long long Interpreter::State::cycle_words(int code, char depth_letter) {
+  if (w.has('R')) {
+    cycle_r = length('R');
+    has_cycle_r = true;
+  }
+  if (w.has(depth_letter)) {
+    cycle_z = length(depth_letter);
+    has_cycle_z = true;
+  }
+  if (code == kG73 || code == kG83) {
+    if (w.has('Q')) {
+      cycle_q = length('Q');
+      has_cycle_q = true;
+    }
+    if (!has_cycle_q || !(cycle_q > 0))
+      error(motion_column, code_name('G', code) + " needs a positive peck depth Q");
+  }
+  // The cycles that dwell at the bottom read P. Fanuc and Haas keep P as modal cycle data in any
+  // cycle (a post writes it on G81 too), for a later one that dwells.
+  if ((cycle_dwells(code) || machine.dialect != Dialect::linuxcnc) && w.has('P')) {
+    double p = w.take('P');
+    if (p < 0) error(w.col('P'), "dwell P must not be negative");
+    cycle_dwell = dwell_seconds(p);
+  }
+  if (feed_mode == FeedMode::inverse_time)
+    error(motion_column, code_name('G', code) + ": canned cycles cannot run in inverse time feed "
+                                                "(G93), as LinuxCNC requires; G94 first");
+  if (!has_cycle_r) error(motion_column, code_name('G', code) + " needs R (retract plane)");
+  if (!has_cycle_z)
+    error(motion_column, code_name('G', code) + " needs " + depth_letter + " (hole bottom)");
+  require_feed();
+  if (w.has('L') && w.has('K')) error(w.col('K'), "repeat count given twice (L and K)");
+  if (w.has('L') && (code == kG74 || code == kG84) && machine.dialect == Dialect::linuxcnc)
+    error(w.col('L'), code_name('G', code) + " L: LinuxCNC's rs274 takes no repeats on a tapping cycle");
+  long long repeats = 1;
+  if (w.has('L')) repeats = integer('L', "repeat count", 0, 9999);
+  if (w.has('K')) repeats = integer('K', "repeat count", 0, 9999);
+  return repeats;
+}
+
+// The R plane, the bottom and the clear level along the cycle's axis, from `current` (the tool's
+// place along it); the cycle's initial level is kept while the cycle mode lasts.
+Interpreter::State::CycleLevels Interpreter::State::cycle_levels(int code, double current) {
+  if (!cycle_active) {
+    cycle_active = true;
+    cycle_initial_far = far;
+    cycle_initial = current;
+  }
+  if (far && incremental)
+    error(motion_column, "incremental canned cycle from a retracted (far) position");
+  // G91: R counts from the initial level of the cycle (kept while the cycle mode lasts, as
+  // LinuxCNC's cycle_il and Fanuc's initial point), not from where the last hole left the tool.
+  double incremental_base = cycle_initial_far ? current : cycle_initial;
+  double r_level = incremental ? incremental_base + cycle_r : cycle_r;
+  double bottom = incremental ? r_level + cycle_z : cycle_z;
+  if (bottom > r_level)
+    error(motion_column, "hole bottom " + format_number(bottom) + " is above the R plane " +
+                             format_number(r_level));
+  if (code == kG73 || code == kG83) {
+    // A real control pecks a hole a few hundred times at most; a tiny Q against a deep hole
+    // (or a far R plane) would emit moves without end, and below one ulp would never finish.
+    constexpr double kMaxPecks = 100000;
+    double pecks = (r_level - bottom) / cycle_q;
+    if (!(pecks <= kMaxPecks))
+      error(motion_column, code_name('G', code) + " would peck " + format_number(pecks) +
+                               " times (R " + format_number(r_level) + " to " + format_number(bottom) +
+                               " by Q " + format_number(cycle_q) + "); at most 100000 per hole");
+  }
+  bool clear_far = !retract_to_r && cycle_initial_far;
+  double clear = retract_to_r ? r_level : std::max(cycle_initial, r_level);
+  if (clear_far) clear = r_level;
+  return CycleLevels{r_level, bottom, clear, clear_far};
+}
+
+// A point of the cycle: (u, v) in the plane and `depth` along its normal, program frame.
+Vec3 Interpreter::State::cycle_point(double u_coordinate, double v_coordinate, double depth) const {
+  const std::array<int, 3> axes = plane_axes(plane);
+  Vec3 p;
+  p[axes[0]] = u_coordinate;
+  p[axes[1]] = v_coordinate;
+  p[axes[2]] = depth;
+  return to_machine(p);
+}
+
+void Interpreter::State::cycle_rapid(const Vec3& to) {
+  emit(MoveKind::cycle, pos, to, 0.0);
+  pos = to;
+}
+
+void Interpreter::State::cycle_cut(const Vec3& to) {
+  emit(MoveKind::cycle, pos, to, feed);
+  pos = to;
+}
+
+// One hole: onto its R plane, down (pecking for G73 and G83), the dwell, and out to the clear
+// level.
+void Interpreter::State::cycle_hole(int code, double hole_u, double hole_v, const CycleLevels& levels) {
+  const int n = plane_axes(plane)[2];
+  const double r_level = levels.r_level, bottom = levels.bottom, clear = levels.clear;
+  const bool clear_far = levels.clear_far;
+  auto at = [&](double uu, double vv, double depth) { return cycle_point(uu, vv, depth); };
+  if (far) {
+    // Come back from far straight down the axis onto the R plane of the hole.
+    Vec3 r_point = at(hole_u, hole_v, r_level);
+    emit(MoveKind::cycle, r_point + machine.far_distance * axis, r_point, 0.0, true);
+    pos = r_point;
+    far = false;
+  } else {
+    Vec3 level = to_program(pos);
+    cycle_rapid(at(hole_u, hole_v, level[n]));
+    cycle_rapid(at(hole_u, hole_v, r_level));
+  }
+  double d = options.peck_clearance;
+  switch (code) {
+    case kG73:
+      for (double depth = r_level - cycle_q; depth > bottom; depth -= cycle_q) {
+        cycle_cut(at(hole_u, hole_v, depth));
+        cycle_rapid(at(hole_u, hole_v, depth + d));
+      }
+      cycle_cut(at(hole_u, hole_v, bottom));
+      break;
+    case kG83:
+      for (double depth = r_level - cycle_q; depth > bottom; depth -= cycle_q) {
+        cycle_cut(at(hole_u, hole_v, depth));
+        cycle_rapid(at(hole_u, hole_v, r_level));
+        cycle_rapid(at(hole_u, hole_v, depth + d));
+      }
+      cycle_cut(at(hole_u, hole_v, bottom));
+      break;
+    default:  // the others go down at feed in one piece
+      cycle_cut(at(hole_u, hole_v, bottom));
+      break;
+  }
+  if (cycle_dwells(code)) emit_dwell(cycle_dwell);  // at the bottom
+  switch (code) {  // the way out: at feed for these, at rapid for the others (below)
+    case kG74:  // tapping (G74 left hand, G84 right hand): the spindle reverses and the tap
+    case kG84:  // backs out at feed: to R on Fanuc and Haas, as G85; LinuxCNC's to the clear level
+      cycle_cut(at(hole_u, hole_v, machine.dialect == Dialect::linuxcnc && !clear_far ? clear : r_level));
+      break;
+    case kG85:  // to R (then rapid to the clear level)
+      cycle_cut(at(hole_u, hole_v, r_level));
+      break;
+    case kG89:  // all the way to the clear level, as LinuxCNC does
+      cycle_cut(at(hole_u, hole_v, clear_far ? r_level : clear));
+      break;
+    default:
+      break;
+  }
+  Vec3 out = at(hole_u, hole_v, clear);
+  if (out != pos) cycle_rapid(out);
+  if (clear_far) far = true;
 }
 
 // ---- LinuxCNC polar coordinates ----
@@ -505,11 +542,11 @@ void Interpreter::State::polar_words(bool axis_consumer, int nonmodal) {
   int column = w.col(w.has('@') ? '@' : '^');
   if (machine.dialect != Dialect::linuxcnc)
     error(column, "'@' and '^' (polar coordinates) are LinuxCNC's words: use --machine linuxcnc");
-  if (nonmodal == 530) error(column, "polar coordinates cannot be used with G53");
-  bool moving = motion == 0 || motion == 10 || motion == 20 || motion == 30 || is_cycle(motion);
-  if (axis_consumer || nonmodal == 280 || nonmodal == 300 || !moving)
+  if (nonmodal == kG53) error(column, "polar coordinates cannot be used with G53");
+  bool moving = motion == kG0 || motion == kG1 || motion == kG2 || motion == kG3 || is_cycle(motion);
+  if (axis_consumer || nonmodal == kG28 || nonmodal == kG30 || !moving)
     error(column, "polar coordinates can only be used for motion (G0, G1, G2, G3 or a cycle)");
-  if (plane != 170) error(column, "polar coordinates need the XY plane (G17)");
+  if (plane != kG17) error(column, "polar coordinates need the XY plane (G17)");
   for (char c : {'X', 'Y'})
     if (w.has(c)) error(w.col(c), std::string("polar coordinates and an ") + c + " word in the same block");
   bool cycle_block = is_cycle(motion);
@@ -575,7 +612,7 @@ void Interpreter::State::machine_move(const Vec3& gauge, unsigned mask, MoveKind
 }
 
 void Interpreter::State::home_return(bool second) {
-  int column = w.find_g(second ? 300 : 280);
+  int column = w.find_g(second ? kG30 : kG28);
   if (second && w.has('P')) {
     if (integer('P', "G30 reference number", 2, 2) != 2) error(w.col('P'), "only G30 P2");
   }

@@ -151,10 +151,10 @@ std::optional<Value> Interpreter::State::named(std::string_view name) {
     if (key == "_rpm") return number(speed);
     if (key == "_motion_mode") return number(motion < 0 ? 0 : motion);
     if (key == "_plane") return number(plane);
-    if (key == "_coord_system") return number(work_key >= 100 ? 0 : 530 + 10 * work_key);
+    if (key == "_coord_system") return number(work_key >= 100 ? 0 : kG53 + 10 * work_key);
     if (key == "_call_level") return number(static_cast<double>(scopes.size() - 1));
     if (key == "_line") return number(line);
-    if (key == "_ccomp") return number(comp_side == 0 ? 400 : comp_side > 0 ? 410 : 420);
+    if (key == "_ccomp") return number(comp_side == 0 ? kG40 : comp_side > 0 ? kG41 : kG42);
     if (key == "_spindle_on") return number(spindle_direction != 0 ? 1 : 0);
     if (key == "_spindle_cw") return number(spindle_direction > 0 ? 1 : 0);
     if (key == "_ijk_absolute_mode") return number(arc_absolute ? 1 : 0);

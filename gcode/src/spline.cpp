@@ -110,7 +110,7 @@ void Interpreter::State::spline(bool quadratic) {
   require_feed();
   if (feed_mode == FeedMode::inverse_time)  // its length is known only once its biarcs are made
     error(motion_column, std::string(name) + " in inverse time feed (G93) is not supported: G94 first");
-  if (plane != 170) error(motion_column, std::string(name) + " is a spline in the XY plane only (G17)");
+  if (plane != kG17) error(motion_column, std::string(name) + " is a spline in the XY plane only (G17)");
   for (char c : {'Z', 'A', 'B', 'C'})
     if (w.has(c))
       error(w.col(c), std::string(name) + " may not move " + c + " (LinuxCNC's splines stay in XY)");
@@ -165,7 +165,7 @@ void Interpreter::State::spline(bool quadratic) {
 void Interpreter::State::nurbs_point() {
   if (comp_side != 0)
     error(motion_column, "G5.2 with cutter radius compensation on: its curve is not offset (G40 first)");
-  if (plane != 170) error(motion_column, "G5.2 is a NURBS in the XY plane only (G17)");
+  if (plane != kG17) error(motion_column, "G5.2 is a NURBS in the XY plane only (G17)");
   for (char c : {'Z', 'A', 'B', 'C'})
     if (w.has(c)) error(w.col(c), std::string("G5.2 may not move ") + c + " (its control points are in XY)");
   if (w.has('X') != w.has('Y'))
@@ -199,7 +199,7 @@ void Interpreter::State::nurbs_point() {
 // G5.3: the NURBS of the G5.2 blocks before it is cut, as LinuxCNC's NURBS_FEED does, and the
 // tool stands at its last control point (Z unchanged). No motion mode is left active.
 void Interpreter::State::nurbs_end(int column) {
-  if (motion != 52) error(column, "G5.3 without G5.2 before it (LinuxCNC refuses it)");
+  if (motion != kG5_2) error(column, "G5.3 without G5.2 before it (LinuxCNC refuses it)");
   if (static_cast<int>(nurbs_points.size()) < nurbs_order)
     error(column, "G5.3: " + std::to_string(nurbs_points.size()) + " control points, fewer than the order L = " +
                       std::to_string(nurbs_order));

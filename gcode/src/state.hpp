@@ -52,7 +52,7 @@ struct Interpreter::State : ParameterReader {
   double unit = 1.0;  // mm per program unit
   bool incremental = false;
   bool arc_absolute = false;
-  int plane = 170;
+  int plane = kG17;
   int motion = -1;  // -1: none yet
   bool retract_to_r = false;
   int work_key = 1;
@@ -127,9 +127,9 @@ struct Interpreter::State : ParameterReader {
   Mat3 rotation{1.0};
   Vec3 origin{0.0};
   // G68.2 / G68.4 P2 (three points) and P3 (two vectors) are written over consecutive blocks,
-  // one Q each (tilt.cpp); their words are gathered here until the last one completes the plane.
+  // one Q each (tilted_plane_codes.cpp); their words are gathered here until the last one completes the plane.
   struct PlaneBlocks {
-    int code = 0;  // 682 or 684 while a plane is under way; 0 otherwise
+    int code = 0;  // kG68_2 or kG68_4 while a plane is under way; 0 otherwise
     int p = 0;
     int first_line = 0;
     unsigned given = 0;  // bit q: the Q block has been read
@@ -255,11 +255,11 @@ struct Interpreter::State : ParameterReader {
   // The modal group of a G code in this block: g_group, and the motions of the LinuxCNC dialect
   // (G5 and G5.1 splines, G5.2 NURBS and its G5.3 end, G38.2–G38.5 straight probes).
   int block_g_group(int code) const {
-    if ((code == 50 && g5_spline) || (code == 51 && g5_1_spline)) return kMotion;
-    if (machine.dialect == Dialect::linuxcnc && (code == 52 || code == 53))
-      return code == 52 ? kMotion : kNonModal;
-    if (code >= 382 && code <= 385 && machine.dialect == Dialect::linuxcnc) return kMotion;
-    if (code == 680 && machine.dialect == Dialect::linuxcnc) return -1;  // no G68 in LinuxCNC
+    if ((code == kG5 && g5_spline) || (code == kG5_1 && g5_1_spline)) return kMotion;
+    if (machine.dialect == Dialect::linuxcnc && (code == kG5_2 || code == kG5_3))
+      return code == kG5_2 ? kMotion : kNonModal;
+    if (code >= kG38_2 && code <= kG38_5 && machine.dialect == Dialect::linuxcnc) return kMotion;
+    if (code == kG68 && machine.dialect == Dialect::linuxcnc) return -1;  // no G68 in LinuxCNC
     return g_group(code);
   }
 
@@ -304,7 +304,8 @@ struct Interpreter::State : ParameterReader {
           // Codes known to leave the path alone (feed and speed modes, exact stop, cancels of
           // modes tridex never enters) may be skipped in a block without coordinates; any other
           // unknown code could move the tool or change how later coordinates read.
-          static constexpr int kHarmless[] = {50, 90, 131, 500, 501, 611, 620, 630, 670, 960};
+          static constexpr int kHarmless[] = {kG5,  kG9,    kG13_1, kG50, kG50_1,
+                                              kG61_1, kG62, kG63, kG67, kG96};
           bool harmless = word.letter == 'G' && integral &&
                           std::find(std::begin(kHarmless), std::end(kHarmless), code) != std::end(kHarmless);
           bool coordinates = false;
@@ -312,18 +313,19 @@ struct Interpreter::State : ParameterReader {
             coordinates |= other.letter == 'X' || other.letter == 'Y' || other.letter == 'Z';
           std::string name = integral ? code_name(word.letter, code)
                                       : std::string(1, word.letter) + format_number(word.value);
-          if (word.letter == 'G' && ((code >= 382 && code <= 385) || code == 310))  // never skipped: it moves
+          if (word.letter == 'G' && ((code >= kG38_2 && code <= kG38_5) || code == kG31))  // never skipped: it moves
             error(word.column, name + " (probing) is not simulated: where the probe touches, and so "
                                       "where the tool goes next, is known only on the machine; "
                                       "leave the probing cycle out of the program tridex reads (or, "
                                       "with --machine linuxcnc, read it as rs274 does)");
-          if (word.letter == 'G' && (code == 52 || code == 53))
+          if (word.letter == 'G' && (code == kG5_2 || code == kG5_3))
             error(word.column, name + " (LinuxCNC's NURBS) is read with --machine linuxcnc only");
           if (word.letter == 'G' && integral && machine.dialect == Dialect::linuxcnc) {
             // Never skipped, even lenient: each moves the tool or sets how it moves. LinuxCNC's
             // lathe codes (G7 diameter mode, G33 threading, G70-G72 turning cycles, G76 threading
             // cycle, G96 constant surface speed) have no meaning on a mill.
-            static constexpr int kLathe[] = {70, 330, 700, 710, 711, 712, 720, 721, 722, 760, 960};
+            static constexpr int kLathe[] = {kG7,  kG33,   kG70,   kG71,   kG71_1, kG71_2,
+                                            kG72, kG72_1, kG72_2, kG76,   kG96};
             if (std::find(std::begin(kLathe), std::end(kLathe), code) != std::end(kLathe))
               error(word.column, name + " is a lathe code: tridex simulates milling machines");
           }
@@ -332,10 +334,10 @@ struct Interpreter::State : ParameterReader {
         }
         if (word.letter == 'G') {
           int& seen = g_seen[static_cast<std::size_t>(group)];
-          if (seen && group == kMotion && (code == 800 || w.g[static_cast<std::size_t>(seen - 1)].code == 800)) {
+          if (seen && group == kMotion && (code == kG80 || w.g[static_cast<std::size_t>(seen - 1)].code == kG80)) {
             // G80 beside another motion code (the safe-start line `G0 G17 G40 G49 G80 G90`):
             // rs274, Fanuc and Haas read it as the other code, which ends any cycle anyway.
-            if (code != 800) w.g[static_cast<std::size_t>(seen - 1)] = Code{code, word.column};
+            if (code != kG80) w.g[static_cast<std::size_t>(seen - 1)] = Code{code, word.column};
             continue;
           }
           if (seen)
@@ -511,7 +513,9 @@ struct Interpreter::State : ParameterReader {
   void cutter_comp_codes(int code, int column);  // G40, G41, G42, G41.1, G42.1
   void comp_forbid(int column, const std::string& what) const;
   void comp_straight(MoveKind kind, const Vec3& target, double move_feed);
+  void comp_straight_entry(CompMove& move, const Vec3& target);
   void comp_arc(bool ccw);
+  void comp_arc_entry(CompMove& move, bool ccw, bool inside, const std::string& too_small);
   void comp_move_endpoint_and_flush(const Vec2& to);
   void comp_dequeue();
   void comp_finish() {  // at the end of the program: emit what waits
@@ -543,6 +547,17 @@ struct Interpreter::State : ParameterReader {
   void arc_chords(const Vec3& start, const Vec3& end, const Vec2& c, bool ccw, double sweep,
                   double move_feed);
   void cycle(int code);
+  // A canned cycle's levels along its axis (program frame), and whether it clears far.
+  struct CycleLevels {
+    double r_level = 0, bottom = 0, clear = 0;
+    bool clear_far = false;
+  };
+  long long cycle_words(int code, char depth_letter);
+  CycleLevels cycle_levels(int code, double current);
+  Vec3 cycle_point(double u_coordinate, double v_coordinate, double depth) const;
+  void cycle_rapid(const Vec3& to);
+  void cycle_cut(const Vec3& to);
+  void cycle_hole(int code, double hole_u, double hole_v, const CycleLevels& levels);
   // LinuxCNC's G5 / G5.1 splines as biarcs (spline.cpp).
   void spline(bool quadratic);
   void biarc(const Vec2& p0, const Vec2& t0, const Vec2& p4, const Vec2& t4, double z);
@@ -567,15 +582,44 @@ struct Interpreter::State : ParameterReader {
   void extra_linear_words(bool track);  // LinuxCNC's U/V/W
   void set_rotary(const RotaryPositions& next);
 
-  // ---- tilted planes (tilt.cpp) ----
+  // ---- tilted planes (tilted_plane_codes.cpp) ----
   std::optional<Frame> plane_words(int code);  // nullopt: a several-block form awaits more blocks
   std::optional<Frame> several_block_plane(int code, int p);
   std::string incomplete_plane() const;
   void tilted_plane(int code);
   void orient_to_plane(int code);
 
-  // ---- one block ----
+  // ---- one block (modal.cpp): execute calls a stage per modal group, in RS274/NGC's order ----
   Flow execute(const Block& block);
+  // The block's codes that decide the later stages (-1: none), and whether a code other than the
+  // motion takes its X/Y/Z (G10, G52, G92, a tilted plane).
+  struct BlockCodes {
+    int motion = -1;
+    int nonmodal = -1;
+    int tilt = -1;
+    int orient = -1;
+    bool axis_consumer = false;
+  };
+  BlockCodes block_codes();
+  void units_codes();
+  void tool_change_codes();  // T, M6, M61
+  void spindle_codes();
+  void dwell_code(const BlockCodes& codes);
+  void plane_codes();
+  void distance_mode_codes();
+  void smoothing_codes(const BlockCodes& codes);
+  void return_mode_codes();
+  void work_system_codes();
+  void offset_codes(BlockCodes& codes);  // G52, G92, G10
+  void work_offset_entry(long long l, int column);  // G10 L2, L20
+  void tilted_plane_group(BlockCodes& codes);
+  void motion_mode_codes(const BlockCodes& codes);
+  void axis_words(const BlockCodes& codes);
+  void block_move(const BlockCodes& codes);
+  void machine_coordinate_move();  // G53
+  void motion_mode_move(bool new_code);
+  Flow flow_codes();
+  void check_words_used();
 };
 
 // Runs a whole program through `state` (flow.cpp).
