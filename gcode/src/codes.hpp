@@ -15,6 +15,7 @@ namespace tridex::gcode {
 inline int letter_index(char c) { return c == '@' ? 26 : c - 'A'; }
 inline constexpr std::size_t kWordSlots = 30;
 
+// clang-format off
 // The G codes by name, as Code::code holds them (times ten: G53.1 is kG53_1 = 531). Every code the
 // interpreter reads is named here; a bare number in gcode/src is a parameter, a count or a length.
 inline constexpr int kG0 = 0, kG1 = 10, kG2 = 20, kG3 = 30, kG4 = 40;
@@ -46,8 +47,10 @@ inline constexpr int kG253 = 2530, kG254 = 2540, kG255 = 2550, kG268 = 2680, kG2
 inline constexpr int kM0 = 0, kM1 = 1, kM2 = 2, kM3 = 3, kM4 = 4, kM5 = 5, kM6 = 6;
 inline constexpr int kM7 = 7, kM8 = 8, kM9 = 9, kM30 = 30, kM61 = 61, kM97 = 97, kM98 = 98, kM99 = 99;
 
+// clang-format on
+
 struct Code {
-  int code;    // G codes times ten: G53.1 -> 531 (kG53_1), G1 -> 10 (kG1); M codes as written
+  int code;  // G codes times ten: G53.1 -> 531 (kG53_1), G1 -> 10 (kG1); M codes as written
   int column;
 };
 
@@ -81,6 +84,8 @@ struct Words {
   }
 };
 
+// The codes and their groups read as tables.
+// clang-format off
 // Modal groups (RS274/NGC table 4, plus the tilted-plane codes); -1: not supported.
 enum Group {
   kNonModal, kMotion, kPlane, kDistance, kArcDistance, kFeedMode, kUnits, kCutterComp,
@@ -127,6 +132,8 @@ inline int m_group(int code) {
     default: return -1;
   }
 }
+
+// clang-format on
 
 inline std::string code_name(char letter, int code10) {
   char text[32];

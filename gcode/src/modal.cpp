@@ -31,15 +31,18 @@ void Interpreter::State::tool_length_codes() {
   double next = 0;
   if (code == kG43_1) {
     if (machine.dialect != Dialect::linuxcnc)
-      unsupported(column, "G43.1 (LinuxCNC's dynamic tool length offset) needs --machine linuxcnc", "G43.1", false);
+      unsupported(column, "G43.1 (LinuxCNC's dynamic tool length offset) needs --machine linuxcnc",
+                  "G43.1", false);
     for (char c : {'X', 'Y'})
-      if (w.has(c)) error(w.col(c), std::string("G43.1 ") + c + ": a sideways tool offset is not simulated");
+      if (w.has(c))
+        error(w.col(c), std::string("G43.1 ") + c + ": a sideways tool offset is not simulated");
     if (!w.has('Z')) error(column, "G43.1 needs Z (the tool length offset)");
     next = length('Z');
     w.present &= ~(1u << letter_index('Z'));  // an offset here, not a coordinate
   } else if (code != kG49) {
     int number = tool;
-    if (w.has('H')) number = static_cast<int>(integer('H', "tool length offset number", 0, 99'999'999));
+    if (w.has('H'))
+      number = static_cast<int>(integer('H', "tool length offset number", 0, 99'999'999));
     if (std::optional<double> table = table_length(number)) {
       next = code == kG44 ? -*table : *table;
     } else if (number != 0 && !machine.tool_lengths.empty()) {
@@ -61,9 +64,9 @@ void Interpreter::State::tool_length_codes() {
 void Interpreter::State::feed_mode_codes() {
   for (int code : {kG93, kG94, kG95}) {
     if (!w.find_g(code)) continue;
-    FeedMode next = code == kG93 ? FeedMode::inverse_time
+    FeedMode next = code == kG93   ? FeedMode::inverse_time
                     : code == kG94 ? FeedMode::per_minute
-                                  : FeedMode::per_revolution;
+                                   : FeedMode::per_revolution;
     bool clears = machine.dialect == Dialect::linuxcnc ? code != kG93 : next != feed_mode;
     if (clears) feed = feed_per_rev = 0;
     feed_mode = next;
@@ -71,9 +74,12 @@ void Interpreter::State::feed_mode_codes() {
   if (w.has('F')) {
     if (w.value[static_cast<std::size_t>(letter_index('F'))] < 0)
       error(w.col('F'), "feed rate F must not be negative");
-    if (feed_mode == FeedMode::inverse_time) inverse_time = w.take('F');
-    else if (feed_mode == FeedMode::per_revolution) feed_per_rev = length('F');
-    else feed = length('F');
+    if (feed_mode == FeedMode::inverse_time)
+      inverse_time = w.take('F');
+    else if (feed_mode == FeedMode::per_revolution)
+      feed_per_rev = length('F');
+    else
+      feed = length('F');
   }
   if (w.has('S')) {
     double s = w.take('S');
@@ -99,7 +105,8 @@ void Interpreter::State::tool_table_entry(long long l, int column) {
   if (!any) error(column, name + " without offsets has no effect");
   for (char c : {'X', 'Y', 'A', 'B', 'C', 'U', 'V', 'W'})
     if (w.has(c))
-      error(w.col(c), name + " " + c + ": a tool offset along " + c + " is not simulated (tridex offsets tools along their axis only)");
+      error(w.col(c), name + " " + c + ": a tool offset along " + c +
+                          " is not simulated (tridex offsets tools along their axis only)");
   if (w.has('Q')) {
     double q = w.take('Q');
     if (std::abs(q - std::round(q)) > 1e-9) error(w.col('Q'), "Q number in G10 is not an integer");
@@ -111,10 +118,11 @@ void Interpreter::State::tool_table_entry(long long l, int column) {
   if (w.has('R')) machine.tool_diameters[number] = 2 * length('R');
   if (!w.has('Z')) return;
   if (l == 1) {
-    set_lengths[number] = length('Z');
+    tool_table.lengths[number] = length('Z');
     return;
   }
-  if (far) error(column, name + " with the tool retracted far along its axis: its position is unknown");
+  if (far)
+    error(column, name + " with the tool retracted far along its axis: its position is unknown");
   if (tilted || machine.kinematics || glm::dot(axis, Vec3(0, 0, 1)) < 1 - kSameDirection)
     error(column, name + " with a tilted frame or rotary axes is not simulated");
   // linear_axes(): the controlled point in machine coordinates; the control puts the gauge point
@@ -126,7 +134,7 @@ void Interpreter::State::tool_table_entry(long long l, int column) {
   } else if (auto it = offsets.find(9); it != offsets.end()) {  // G59.3 (never set by tridex: 0)
     system = it->second.z;
   }
-  set_lengths[number] = gauge - system - length('Z');
+  tool_table.lengths[number] = gauge - system - length('Z');
 }
 
 // Fanuc's and Haas's G10 L10 / L11 P<offset> R<value> (Fanuc 0i-MF operator's manual, "Tool
@@ -138,13 +146,15 @@ void Interpreter::State::tool_table_entry(long long l, int column) {
 // parameters.cpp).
 void Interpreter::State::tool_length_entry(long long l, int column) {
   const bool radius = l == 12 || l == 13;
-  const std::string name = "G10 L" + std::to_string(l), offset = radius ? "cutter radius" : "tool length";
+  const std::string name = "G10 L" + std::to_string(l),
+                    offset = radius ? "cutter radius" : "tool length";
   if (!w.has('P')) error(column, name + " needs P (the " + offset + " offset number)");
   if (!w.has('R')) error(column, name + " needs R (the offset's value)");
-  const int number = static_cast<int>(integer('P', (name + " P (a " + offset + " offset number)").c_str(), 0, 99'999'999));
+  const int number = static_cast<int>(
+      integer('P', (name + " P (a " + offset + " offset number)").c_str(), 0, 99'999'999));
   if (radius) {
-    d_set_at[number] = name + " at line " + std::to_string(line);
-    double& value = (l == 12 ? d_geometry : d_wear)[number];
+    comp.d_set_at[number] = name + " at line " + std::to_string(line);
+    double& value = (l == 12 ? comp.d_geometry : comp.d_wear)[number];
     value = (incremental ? value : 0) + length('R');
     return;
   }
@@ -152,9 +162,9 @@ void Interpreter::State::tool_length_entry(long long l, int column) {
     if (w.has(c)) error(w.col(c), name + " " + c + ": a tool length offset takes R only");
   double value = length('R');
   if (l == 10) {
-    set_lengths[number] = (incremental ? length_geometry(number).value_or(0) : 0) + value;
+    tool_table.lengths[number] = (incremental ? length_geometry(number).value_or(0) : 0) + value;
   } else {
-    double& wear = length_wear[number];
+    double& wear = tool_table.wear[number];
     wear = (incremental ? wear : 0) + value;
   }
 }
@@ -173,7 +183,8 @@ void Interpreter::State::tool_length_entry(long long l, int column) {
 // Last, every word of the block must have been read by some code.
 Flow Interpreter::State::execute(const Block& block) {
   gather(block);
-  if (plane_blocks.code && !w.find_g(plane_blocks.code))  // a G68.2 P2/P3 plane is under way
+  if (tilt.plane_blocks.code &&
+      !w.find_g(tilt.plane_blocks.code))  // a G68.2 P2/P3 plane is under way
     error(block.words.front().column, incomplete_plane());
   if (int column = w.find_g(kG65)) return macro_call(column);
   BlockCodes codes = block_codes();
@@ -251,7 +262,7 @@ void Interpreter::State::tool_change_codes() {
 
   if (w.find_m(kM6) || (w.has('T') && machine.tool_loads_on_t)) {
     comp_forbid(w.find_m(kM6) ? w.find_m(kM6) : w.col('T'), "a tool change");
-    comp_programmed_current = false;  // LinuxCNC resynchronises with where the tool really is
+    comp.programmed_current = false;  // LinuxCNC resynchronises with where the tool really is
     load_tool(tool_selected);
     tool_first_line.emplace(tool, line);
     if (machine.tool_change == ToolChange::retract_far) go_far();
@@ -366,17 +377,20 @@ void Interpreter::State::offset_codes(BlockCodes& codes) {
     int column = w.find_g(kG10);
     bool linuxcnc_tools = machine.dialect == Dialect::linuxcnc;
     if (!w.has('L'))
-      error(column, linuxcnc_tools ? "G10 needs L1, L2, L10, L11 or L20"
-                                   : machine.dialect == Dialect::haas ? "G10 needs L1, L2, L10-L13 or L20"
-                                                                      : "G10 needs L2, L10-L13 or L20");
+      error(column, linuxcnc_tools                     ? "G10 needs L1, L2, L10, L11 or L20"
+                    : machine.dialect == Dialect::haas ? "G10 needs L1, L2, L10-L13 or L20"
+                                                       : "G10 needs L2, L10-L13 or L20");
     long long l = integer('L', "G10 L", 0, 99);
     if (linuxcnc_tools && (l == 1 || l == 10 || l == 11)) {
       tool_table_entry(l, column);
-    } else if (!linuxcnc_tools && ((l >= 10 && l <= 13) || (l == 1 && machine.dialect == Dialect::haas))) {
+    } else if (!linuxcnc_tools &&
+               ((l >= 10 && l <= 13) || (l == 1 && machine.dialect == Dialect::haas))) {
       tool_length_entry(l, column);
     } else if (l != 2 && l != 20) {
-      unsupported(column, "G10 L" + std::to_string(l) + " is not supported (only L2 and L20" +
-                              (linuxcnc_tools ? ", and L1, L10, L11" : ", and L10-L13 for tool offsets") + ")",
+      unsupported(column,
+                  "G10 L" + std::to_string(l) + " is not supported (only L2 and L20" +
+                      (linuxcnc_tools ? ", and L1, L10, L11" : ", and L10-L13 for tool offsets") +
+                      ")",
                   "G10 L");
     } else {
       work_offset_entry(l, column);
@@ -393,7 +407,8 @@ void Interpreter::State::work_offset_entry(long long l, int column) {
   int key = 0;
   if (l == 2 || linuxcnc) {
     if (w.has('R'))
-      unsupported(w.col('R'), "G10 L" + std::to_string(l) + " R (a rotated coordinate system) is not supported",
+      unsupported(w.col('R'),
+                  "G10 L" + std::to_string(l) + " R (a rotated coordinate system) is not supported",
                   "G10 R", false);
     key = static_cast<int>(integer('P', linuxcnc ? "G10 P" : "G10 L2 P", 0, 6));
   } else {
@@ -415,7 +430,8 @@ void Interpreter::State::work_offset_entry(long long l, int column) {
   // any other would turn the part under the program, which tridex does not model.
   for (char c : {'A', 'B', 'C'})
     if (w.has(c) && w.take(c) != 0 && !(linuxcnc && !machine.kinematics))
-      error(w.col(c), std::string("G10 ") + c + format_number(w.value[static_cast<std::size_t>(letter_index(c))]) +
+      error(w.col(c), std::string("G10 ") + c +
+                          format_number(w.value[static_cast<std::size_t>(letter_index(c))]) +
                           ": a rotary work offset other than 0 is not simulated");
   if (key == work_key) comp_forbid(column, "G10 on the active work offset");
   offsets[key] = value;
@@ -442,14 +458,14 @@ void Interpreter::State::motion_mode_codes(const BlockCodes& codes) {
   const int motion_code = codes.motion;
   if (motion_code < 0) return;
   if (codes.axis_consumer && motion_code != kG80)
-    error(motion_column, code_name('G', motion_code) +
-                             " in a block whose X/Y/Z belong to another code");
-  if (motion_code == kG80 || !is_cycle(motion_code)) cycle_active = false;
-  if (is_cycle(motion_code) && motion != motion_code) cycle_active = false;
-  if (motion == kG5_2 && motion_code != kG5_2 && !nurbs_points.empty())
+    error(motion_column,
+          code_name('G', motion_code) + " in a block whose X/Y/Z belong to another code");
+  if (motion_code == kG80 || !is_cycle(motion_code)) canned.active = false;
+  if (is_cycle(motion_code) && motion != motion_code) canned.active = false;
+  if (motion == kG5_2 && motion_code != kG5_2 && !splines.nurbs_points.empty())
     warn(motion_column, "the G5.2 control points before this " + code_name('G', motion_code) +
                             " are dropped: no G5.3 ended them (LinuxCNC drops them too)");
-  if (motion_code == kG5_2 && motion != kG5_2) nurbs_points.clear();  // a new curve starts
+  if (motion_code == kG5_2 && motion != kG5_2) splines.nurbs_points.clear();  // a new curve starts
   motion = motion_code;
 }
 
@@ -486,8 +502,7 @@ void Interpreter::State::block_move(const BlockCodes& codes) {
 // G53 X Y Z: a move in machine coordinates, under G0 or G1.
 void Interpreter::State::machine_coordinate_move() {
   comp_forbid(w.find_g(kG53), "G53");
-  if (motion != kG0 && motion != kG1)
-    error(motion_column, "G53 needs G0 or G1 modal");
+  if (motion != kG0 && motion != kG1) error(motion_column, "G53 needs G0 or G1 modal");
   if (motion == kG1) require_feed();
   Vec3 target(0.0);
   unsigned mask = 0;
@@ -526,7 +541,8 @@ void Interpreter::State::motion_mode_move(bool new_code) {
       cycle(motion);
     }
   } else if (axes) {
-    error(motion_column, "X/Y/Z without an active motion mode (G0, G1, G2, G3, G5, G5.1, G5.2 or a cycle)");
+    error(motion_column,
+          "X/Y/Z without an active motion mode (G0, G1, G2, G3, G5, G5.1, G5.2 or a cycle)");
   }
 }
 
@@ -541,12 +557,14 @@ Flow Interpreter::State::flow_codes() {
     const int column = w.find_m(m);
     if (!column) continue;
     const std::string name = m == kM98 ? "M98" : "M97";
-    if (!w.has('P')) error(column, name + (m == kM98 ? " needs P (the O number to call)" : " needs P (the N number to call)"));
-    call_label = static_cast<int>(integer('P', (name + " P").c_str(), 0, 999'999'999));
+    if (!w.has('P'))
+      error(column, name + (m == kM98 ? " needs P (the O number to call)"
+                                      : " needs P (the N number to call)"));
+    call_request.label = static_cast<int>(integer('P', (name + " P").c_str(), 0, 999'999'999));
     if (w.has('L') && w.has('K')) error(w.col('K'), "repeat count given twice (L and K)");
-    call_repeats = 1;
-    if (w.has('L')) call_repeats = integer('L', (name + " repeat count").c_str(), 0, 9999);
-    if (w.has('K')) call_repeats = integer('K', (name + " repeat count").c_str(), 0, 9999);
+    call_request.repeats = 1;
+    if (w.has('L')) call_request.repeats = integer('L', (name + " repeat count").c_str(), 0, 9999);
+    if (w.has('K')) call_request.repeats = integer('K', (name + " repeat count").c_str(), 0, 9999);
     flow = Flow::call;
   }
   if (w.find_m(kM99)) flow = Flow::ret;
@@ -557,7 +575,8 @@ Flow Interpreter::State::flow_codes() {
 void Interpreter::State::check_words_used() {
   // Fanuc keeps a D word for the next G41/G42 (`T4 D04 M06`); LinuxCNC refuses it, as rs274.
   if (machine.dialect != Dialect::linuxcnc && w.has('D') && !((w.used >> letter_index('D')) & 1u))
-    offset_d = static_cast<int>(integer('D', "D (a cutter radius offset number)", 0, 99'999'999));
+    comp.offset_d =
+        static_cast<int>(integer('D', "D (a cutter radius offset number)", 0, 99'999'999));
   std::uint32_t free_words = w.present & ~w.used;
   for (char c : {'F', 'S', 'T', 'O'}) free_words &= ~(1u << letter_index(c));
   if (w.m_arguments)
@@ -574,23 +593,26 @@ void Interpreter::State::check_words_used() {
       // turned the axes) an axis that stays at zero turns nothing, whatever the machine. Any
       // other angle is never dropped, even lenient.
       if (w.value[k] == 0 && glm::dot(axis, Vec3(0, 0, 1)) >= 1 - kSameDirection) {
-        if (warned_rotary_at_zero.insert(c).second)
-          warn(w.column[k], std::string("rotary word ") + c + "0 read as the axis staying at zero (the "
-                            "tool stays along +Z); a machine file with \"kinematics\" models the axis");
+        if (warned_once.rotary_at_zero.insert(c).second)
+          warn(w.column[k],
+               std::string("rotary word ") + c +
+                   "0 read as the axis staying at zero (the "
+                   "tool stays along +Z); a machine file with \"kinematics\" models the axis");
         continue;
       }
-      error(w.column[k], std::string("rotary word ") + c + format_number(w.value[k]) +
-                             ": reading A/B/C needs a machine file with \"kinematics\" (--machine)");
+      error(w.column[k],
+            std::string("rotary word ") + c + format_number(w.value[k]) +
+                ": reading A/B/C needs a machine file with \"kinematics\" (--machine)");
     }
     // Only words that never carry geometry may be dropped: E (an extruder), D and H (offset
     // numbers, which tridex does not apply).
     bool skippable = c == 'E' || c == 'D' || c == 'H';
-    unsupported(w.column[k], std::string("word ") + c + format_number(w.value[k]) +
-                                 " is not used by any code in this block",
+    unsupported(w.column[k],
+                std::string("word ") + c + format_number(w.value[k]) +
+                    " is not used by any code in this block",
                 std::string("unused word ") + c, skippable);
   }
 }
-
 
 // G65 P<program> L<repeats> <arguments>: a macro call. Argument words become the callee's locals
 // by Fanuc's argument specification I: A B C I J K D E F H M Q R S T U V W X Y Z are #1 #2 #3 #4
@@ -599,17 +621,16 @@ Flow Interpreter::State::macro_call(int column) {
   if (w.g_count > 1 || w.m_count > 0)
     error(column, "G65 must be the only G or M code of its block");
   if (!w.has('P')) error(column, "G65 needs P (the O number of the macro)");
-  call_label = static_cast<int>(integer('P', "G65 P", 0, 999'999'999));
-  call_repeats = w.has('L') ? integer('L', "G65 repeat count", 0, 9999) : 1;
-  static constexpr int kArgument[26] = {1,  2,  3,  7,  8,  9,  0,  11, 4,  5,  6,  0,  13,
-                                        0,  0,  0,  17, 18, 19, 20, 21, 22, 23, 24, 25, 26};
-  call_arguments.fill(Value{0, true});
+  call_request.label = static_cast<int>(integer('P', "G65 P", 0, 999'999'999));
+  call_request.repeats = w.has('L') ? integer('L', "G65 repeat count", 0, 9999) : 1;
+  static constexpr int kArgument[26] = {1, 2, 3, 7,  8,  9,  0,  11, 4,  5,  6,  0,  13,
+                                        0, 0, 0, 17, 18, 19, 20, 21, 22, 23, 24, 25, 26};
+  call_request.arguments.fill(Value{0, true});
   for (int i = 0; i < 26; ++i) {
     char c = static_cast<char>('A' + i);
     if (!w.has(c) || c == 'L' || c == 'P') continue;
-    if (kArgument[i] == 0)
-      error(w.col(c), std::string("G65: ") + c + " is not an argument word");
-    call_arguments[static_cast<std::size_t>(kArgument[i])] = Value{w.take(c), false};
+    if (kArgument[i] == 0) error(w.col(c), std::string("G65: ") + c + " is not an argument word");
+    call_request.arguments[static_cast<std::size_t>(kArgument[i])] = Value{w.take(c), false};
   }
   w.used = w.present;
   return Flow::macro;
@@ -638,9 +659,10 @@ void Interpreter::State::local_offsets(int code, int column) {
         // In raw rotary form "far" is along the turned tool, which any linear axis may follow.
         bool along_axis = std::abs(axis[i]) > kAxisEps || raw_rotary();
         if (far && along_axis)
-          error(w.col(c), std::string("G92 ") += c + std::string(
-                              " with the tool retracted far along its axis: its position is "
-                              "unknown (a machine file can set the start position)"));
+          error(w.col(c),
+                std::string("G92 ") +=
+                c + std::string(" with the tool retracted far along its axis: its position is "
+                                "unknown (a machine file can set the start position)"));
         local_offset[i] = linear_axes()[i] - work_offset[i] - v;
       }
     }
@@ -650,7 +672,8 @@ void Interpreter::State::local_offsets(int code, int column) {
   // Under a tilted plane only a code that leaves the offset as it is (LinuxCNC's tilted-plane
   // demos clear G52 to zero in a subroutine) is read: a shift there has no agreed meaning.
   if (tilted && local_offset != before)
-    error(column, code_name('G', code) + " changes the local offset under a tilted plane (cancel it first)");
+    error(column, code_name('G', code) +
+                      " changes the local offset under a tilted plane (cancel it first)");
   update_frame();
 }
 
