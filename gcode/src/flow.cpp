@@ -192,7 +192,7 @@ void ProgramFlow::jump(const Position& to) {
 }
 
 void ProgramFlow::count_block(int column) {
-  if (++s_.blocks > s_.options.max_blocks && s_.options.max_blocks > 0)
+  if (++s_.summary.blocks > s_.options.max_blocks && s_.options.max_blocks > 0)
     error(column, "more than " + std::to_string(s_.options.max_blocks) +
                       " blocks executed (the block limit; an endless loop?)");
 }

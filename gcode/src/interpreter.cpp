@@ -47,10 +47,12 @@ Interpreter::~Interpreter() = default;
 Interpreter::Interpreter(Interpreter&&) noexcept = default;
 Interpreter& Interpreter::operator=(Interpreter&&) noexcept = default;
 
-const std::vector<Diagnostic>& Interpreter::warnings() const { return state_->warnings; }
-const std::set<int>& Interpreter::tools_used() const { return state_->tools_used; }
-const std::map<int, int>& Interpreter::tool_first_line() const { return state_->tool_first_line; }
-long long Interpreter::blocks() const { return state_->blocks; }
+const std::vector<Diagnostic>& Interpreter::warnings() const { return state_->summary.warnings; }
+const std::set<int>& Interpreter::tools_used() const { return state_->summary.tools_used; }
+const std::map<int, int>& Interpreter::tool_first_line() const {
+  return state_->summary.tool_first_line;
+}
+long long Interpreter::blocks() const { return state_->summary.blocks; }
 const std::vector<std::string>& Interpreter::files() const { return state_->files; }
 
 void Interpreter::run(std::istream& program, const std::string& file_name,
@@ -100,10 +102,10 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
       std::string lines;
       for (int l : skipped.lines) lines += (lines.empty() ? "" : ", ") + std::to_string(l);
       if (skipped.count > static_cast<long long>(skipped.lines.size())) lines += ", …";
-      s.warnings.push_back(Diagnostic{file_name, 0, 0,
-                                      std::string("lenient mode ") + verb + " " +
-                                          std::to_string(skipped.count) + " × " + cause +
-                                          " (lines " + lines + ")"});
+      s.summary.warnings.push_back(Diagnostic{file_name, 0, 0,
+                                              std::string("lenient mode ") + verb + " " +
+                                                  std::to_string(skipped.count) + " × " + cause +
+                                                  " (lines " + lines + ")"});
     }
   };
   summarize(s.skipped, "skipped");

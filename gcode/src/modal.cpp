@@ -183,8 +183,8 @@ void Interpreter::State::tool_length_entry(long long l, int column) {
 // Last, every word of the block must have been read by some code.
 Flow Interpreter::State::execute(const Block& block) {
   gather(block);
-  if (tilt.plane_blocks.code &&
-      !w.find_g(tilt.plane_blocks.code))  // a G68.2 P2/P3 plane is under way
+  // A G68.2 P2/P3 plane under way takes the next blocks.
+  if (tilt.plane_blocks.code && !w.find_g(tilt.plane_blocks.code))
     error(block.words.front().column, incomplete_plane());
   if (int column = w.find_g(kG65)) return macro_call(column);
   BlockCodes codes = block_codes();
@@ -264,7 +264,7 @@ void Interpreter::State::tool_change_codes() {
     comp_forbid(w.find_m(kM6) ? w.find_m(kM6) : w.col('T'), "a tool change");
     comp.programmed_current = false;  // LinuxCNC resynchronises with where the tool really is
     load_tool(tool_selected);
-    tool_first_line.emplace(tool, line);
+    summary.tool_first_line.emplace(tool, line);
     if (machine.tool_change == ToolChange::retract_far) go_far();
     if (machine.tool_change == ToolChange::to_position) {
       if (glm::dot(axis, Vec3(0, 0, 1)) < 1 - kSameDirection)

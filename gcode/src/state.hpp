@@ -38,10 +38,14 @@ struct Interpreter::State : ParameterReader {
   InterpreterOptions options;
   MachineConfig machine;
 
-  std::vector<Diagnostic> warnings;
-  std::set<int> tools_used;
-  std::map<int, int> tool_first_line;
-  long long blocks = 0;
+  // What the run tells its caller besides the moves (Interpreter::warnings, tools_used, ...).
+  struct RunSummary {
+    std::vector<Diagnostic> warnings;
+    std::set<int> tools_used;
+    std::map<int, int> tool_first_line;
+    long long blocks = 0;
+  };
+  RunSummary summary;
 
   // Context of the block being executed.
   const std::string* file = nullptr;
@@ -236,8 +240,8 @@ struct Interpreter::State : ParameterReader {
   }
   void warn(int column, std::string message) {
     // Bounded: a warning per block of a long program would grow memory with its length.
-    if (warnings.size() < 1000)
-      warnings.push_back(Diagnostic{*file, line, column, std::move(message)});
+    if (summary.warnings.size() < 1000)
+      summary.warnings.push_back(Diagnostic{*file, line, column, std::move(message)});
   }
   // Lenient mode may skip a word only where skipping cannot change the tool path; `cause` names
   // the kind of word (counted for the run's summary, however many there are).
@@ -494,7 +498,7 @@ struct Interpreter::State : ParameterReader {
       move.rotary = rotary_position;
       move.machine = machine_from_part(*machine.kinematics, b, rotary_position);
     }
-    if (tools_used.insert(tool).second) tool_first_line.emplace(tool, line);
+    if (summary.tools_used.insert(tool).second) summary.tool_first_line.emplace(tool, line);
     (*sink)(move);
   }
 
