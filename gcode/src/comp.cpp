@@ -50,48 +50,54 @@ bool inside_arc(int side, int turn) { return side * turn > 0; }
 }  // namespace
 
 void Interpreter::State::comp_forbid(int column, const std::string& what) const {
-  if (comp_side != 0)
-    error(column, what + " with cutter compensation on (turn it off with G40 first, as LinuxCNC requires)");
+  if (comp.side != 0)
+    error(column,
+          what + " with cutter compensation on (turn it off with G40 first, as LinuxCNC requires)");
 }
 
 void Interpreter::State::cutter_comp_codes(int code, int column) {
-  if (code == 400) {
-    if (comp_active() && !comp_first) {
-      comp_move_endpoint_and_flush(plane_uv(comp_current));
+  if (code == kG40) {
+    if (comp_active() && !comp.first) {
+      comp_move_endpoint_and_flush(plane_uv(comp.current));
       comp_dequeue();
-      comp_programmed_current = true;  // LinuxCNC: the current point is the programmed one
-      comp_arc_forbidden = true;
+      comp.programmed_current = true;  // LinuxCNC: the current point is the programmed one
+      comp.arc_forbidden = true;
     }
-    comp_side = 0;
-    comp_first = true;
-    comp_entry_pending = false;
+    comp.side = 0;
+    comp.first = true;
+    comp.entry_pending = false;
     return;
   }
   std::string name = code_name('G', code);
-  if (plane != 170 && plane != 180)
+  if (plane != kG17 && plane != kG18)
     error(column, name + " in " + code_name('G', plane) +
                       ": cutter compensation works in the XY (G17) or XZ (G18) plane only");
-  const bool was_on = comp_side != 0;
-  if (was_on && (machine.dialect == Dialect::linuxcnc || code == 411 || code == 421))
+  const bool was_on = comp.side != 0;
+  if (was_on && (machine.dialect == Dialect::linuxcnc || code == kG41_1 || code == kG42_1))
     error(column, name + " while cutter compensation is already on (G40 first)");
-  int side = code == 410 || code == 411 ? 1 : -1;
+  int side = code == kG41 || code == kG41_1 ? 1 : -1;
   double radius = 0;
-  if (code == 411 || code == 421) {  // LinuxCNC: D is the diameter itself
+  if (code == kG41_1 || code == kG42_1) {  // LinuxCNC: D is the diameter itself
     if (!w.has('D')) error(column, name + " needs D (the tool diameter)");
-    if (w.has('L')) error(w.col('L'), name + " L (a lathe tool's orientation) is not simulated: tridex simulates mills");
+    if (w.has('L'))
+      error(w.col('L'),
+            name + " L (a lathe tool's orientation) is not simulated: tridex simulates mills");
     radius = length('D') / 2;
   } else {
     // LinuxCNC: D names a tool, the loaded one without D. Fanuc and Haas: D names an offset and
     // is modal; before any D the control holds D0, no offset (Haas: "a nonzero D code must be
     // specified" to compensate).
     const bool fanuc = machine.dialect != Dialect::linuxcnc;
-    int number = offset_d >= 0 ? offset_d : fanuc ? 0 : tool;
-    if (w.has('D')) number = static_cast<int>(integer('D', (name + " D (a tool number)").c_str(), 0, 99'999'999));
-    if (w.has('D') && fanuc) offset_d = number;
-    if (fanuc && number == 0 && !w.has('D') && !warned_comp_without_d) {
-      warned_comp_without_d = true;
-      warn(column, name + " with no D word and none before: the control compensates by D0, nothing; "
-                          "write " + name + " D<n> for the tool's radius");
+    int number = comp.offset_d >= 0 ? comp.offset_d : fanuc ? 0 : tool;
+    if (w.has('D'))
+      number = static_cast<int>(integer('D', (name + " D (a tool number)").c_str(), 0, 99'999'999));
+    if (w.has('D') && fanuc) comp.offset_d = number;
+    if (fanuc && number == 0 && !w.has('D') && !warned_once.comp_without_d) {
+      warned_once.comp_without_d = true;
+      warn(column, name +
+                       " with no D word and none before: the control compensates by D0, nothing; "
+                       "write " +
+                       name + " D<n> for the tool's radius");
     }
     radius = d_offset_radius(number, w.has('D') ? w.col('D') : column, name);
   }
@@ -99,14 +105,16 @@ void Interpreter::State::cutter_comp_codes(int code, int column) {
     radius = -radius;
     side = -side;
   }
-  if (was_on) {  // Fanuc and Haas: the mode given again, which changes nothing if side and radius stay
-    if (side != comp_side || std::abs(radius - comp_radius) > 1e-9)
-      error(column, name + " changes the side or the radius of cutter compensation while it is on: "
-                           "tridex needs G40 between (the control's transition is not simulated)");
+  if (was_on) {  // Fanuc and Haas: the mode given again, which changes nothing if side and radius
+                 // stay
+    if (side != comp.side || std::abs(radius - comp.radius) > 1e-9)
+      error(column, name +
+                        " changes the side or the radius of cutter compensation while it is on: "
+                        "tridex needs G40 between (the control's transition is not simulated)");
     return;
   }
-  comp_side = side;
-  comp_radius = radius;
+  comp.side = side;
+  comp.radius = radius;
 }
 
 // The radius G41/G42 D<number> offsets by. Where the program (or the machine file) wrote that
@@ -118,37 +126,40 @@ double Interpreter::State::d_offset_radius(int number, int column, const std::st
   if (number == 0) return 0;
   const std::string d = code + " D" + std::to_string(number);
   auto diameter = machine.tool_diameters.find(number);
-  auto set = d_set_at.find(number);
-  if (set == d_set_at.end()) {
+  auto set = comp.d_set_at.find(number);
+  if (set == comp.d_set_at.end()) {
     if (diameter == machine.tool_diameters.end())
-      error(column, code + ": tool " + std::to_string(number) +
-                        " is not in the tool table (its diameter sets the offset; give the tools with "
-                        "--tools or a project)");
+      error(column,
+            code + ": tool " + std::to_string(number) +
+                " is not in the tool table (its diameter sets the offset; give the tools with "
+                "--tools or a project)");
     return diameter->second / 2;
   }
   const std::optional<double> scale = d_register_scale();
   if (!scale)
-    error(column, d + ": offset " + std::to_string(number) + " was written by " + set->second +
-                      ", a diameter or a radius after Haas's setting 40; say which with \"d_offsets\": "
-                      "\"radius\" or \"diameter\" in the machine file (README: Machine files)");
+    error(column,
+          d + ": offset " + std::to_string(number) + " was written by " + set->second +
+              ", a diameter or a radius after Haas's setting 40; say which with \"d_offsets\": "
+              "\"radius\" or \"diameter\" in the machine file (README: Machine files)");
   double geometry = 0;
-  if (auto it = d_geometry.find(number); it != d_geometry.end()) {
+  if (auto it = comp.d_geometry.find(number); it != comp.d_geometry.end()) {
     geometry = it->second;
   } else if (diameter != machine.tool_diameters.end()) {
     geometry = diameter->second / 2 / *scale;
   } else {
-    error(column, d + ": offset " + std::to_string(number) + " has a wear written by " + set->second +
-                      " but no geometry: its geometry is tool " + std::to_string(number) +
-                      "'s diameter, and that tool is not in the tool table (give the tools with --tools)");
+    error(column,
+          d + ": offset " + std::to_string(number) + " has a wear written by " + set->second +
+              " but no geometry: its geometry is tool " + std::to_string(number) +
+              "'s diameter, and that tool is not in the tool table (give the tools with --tools)");
   }
-  auto wear = d_wear.find(number);
-  return (geometry + (wear == d_wear.end() ? 0.0 : wear->second)) * *scale;
+  auto wear = comp.d_wear.find(number);
+  return (geometry + (wear == comp.d_wear.end() ? 0.0 : wear->second)) * *scale;
 }
 
 void Interpreter::State::comp_dequeue() {
-  comp_endpoint_valid = false;
+  comp.endpoint_valid = false;
   int saved_line = line;
-  for (const CompMove& q : comp_queue) {
+  for (const CompMove& q : comp.queue) {
     line = q.line;
     if (q.kind == CompMove::straight) {
       Vec3 end = to_machine(q.end);
@@ -162,84 +173,95 @@ void Interpreter::State::comp_dequeue() {
     }
   }
   line = saved_line;
-  comp_queue.clear();
+  comp.queue.clear();
 }
 
 // Moves the end of every queued move to `to` (where the offset paths of a concave corner meet)
 // and emits them; an error where that reverses a straight move or lengthens an arc.
 void Interpreter::State::comp_move_endpoint_and_flush(const Vec2& to) {
-  if (comp_queue.empty()) return;
-  for (CompMove& q : comp_queue) {
+  if (comp.queue.empty()) return;
+  for (CompMove& q : comp.queue) {
     if (q.kind == CompMove::arc) {
       double r1 = glm::length(plane_uv(q.end) - q.centre), r2 = glm::length(to - q.centre);
-      double l2 = find_turn(comp_endpoint, q.centre, q.turn, to);
+      double l2 = find_turn(comp.endpoint, q.centre, q.turn, to);
       if (std::abs(r1 - r2) > 0.01 * unit)
         error(motion_column, "cutter compensation made an arc with mismatched radii " +
                                  format_number(r1) + " and " + format_number(r2) + " (a bug)");
-      if (q.original_sweep != 0.0 && comp_endpoint_valid &&
+      if (q.original_sweep != 0.0 && comp.endpoint_valid &&
           std::abs(l2) > std::abs(q.original_sweep) + 0.0254)
-        error(motion_column, "arc move in a concave corner cannot be reached by the tool without "
-                             "gouging (cutter compensation)");
+        error(motion_column,
+              "arc move in a concave corner cannot be reached by the tool without "
+              "gouging (cutter compensation)");
     } else {
-      double dot = glm::dot(q.direction, to - comp_endpoint);
-      if (comp_endpoint_valid && dot < 0)
-        error(motion_column, std::string(q.move_kind == MoveKind::rapid ? "straight traverse" : "straight feed") +
-                                 " in a concave corner cannot be reached by the tool without gouging "
-                                 "(cutter compensation: the corner is too small for the tool radius " +
-                                 format_number(comp_radius) + " mm)");
+      double dot = glm::dot(q.direction, to - comp.endpoint);
+      if (comp.endpoint_valid && dot < 0)
+        error(motion_column,
+              std::string(q.move_kind == MoveKind::rapid ? "straight traverse" : "straight feed") +
+                  " in a concave corner cannot be reached by the tool without gouging "
+                  "(cutter compensation: the corner is too small for the tool radius " +
+                  format_number(comp.radius) + " mm)");
     }
     q.end = with_plane_uv(q.end, to);
   }
   comp_dequeue();
-  comp_endpoint = to;
-  comp_endpoint_valid = true;
+  comp.endpoint = to;
+  comp.endpoint_valid = true;
+}
+
+// The entry move (convert_straight_comp1): it ends one radius to the side of its programmed end.
+void Interpreter::State::comp_straight_entry(CompMove& move, const Vec3& target) {
+  const double r = comp.radius;
+  const int side = comp.side;
+  const Vec2 p = plane_uv(target);
+  Vec2 c = plane_uv(to_program(pos));
+  double distance = glm::length(p - c);
+  const bool fanuc_start = machine.dialect != Dialect::linuxcnc;
+  if (fanuc_start && !(distance > kEqual)) {
+    // Haas: "If cutter compensation is turned on ... in a block without any X-Y move, there is
+    // no change made to cutter compensation until the next X or Y move": a plunge goes as
+    // programmed, and the next move in the plane is the entry.
+    const Vec3 end = to_machine(target);
+    emit(move.move_kind, pos, end, move.feed);
+    pos = end;
+    return;
+  }
+  if (!fanuc_start && distance <= r)
+    error(motion_column, "cutter compensation entry move of length " + format_number(distance) +
+                             " mm is not longer than the tool radius " + format_number(r) + " mm");
+  comp.entry_pending = fanuc_start;
+  double alpha = angle_of(p - c) + (side > 0 ? kHalfPi : -kHalfPi);
+  Vec2 end = p + r * polar(alpha);
+  comp.endpoint = c;
+  comp.endpoint_valid = true;
+  move.direction = polar(alpha);  // as LinuxCNC records it
+  move.end = with_plane_uv(target, end);
+  comp.queue.push_back(move);
+  comp.first = false;
+  comp.current = move.end;
+  comp.programmed = target;
+  comp.programmed_current = true;
 }
 
 void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double move_feed) {
   if (far)
-    error(motion_column, "cutter compensation from a retracted (far) position: the tool's position "
-                         "is unknown; position it with X, Y and Z first");
-  const double r = comp_radius;
-  const int side = comp_side;
+    error(motion_column,
+          "cutter compensation from a retracted (far) position: the tool's position "
+          "is unknown; position it with X, Y and Z first");
+  const double r = comp.radius;
+  const int side = comp.side;
   const Vec2 p = plane_uv(target);
   CompMove move;
   move.move_kind = kind;
   move.line = line;
   move.feed = move_feed;
-  if (comp_first) {  // the entry move (convert_straight_comp1)
-    Vec2 c = plane_uv(to_program(pos));
-    double distance = glm::length(p - c);
-    const bool fanuc_start = machine.dialect != Dialect::linuxcnc;
-    if (fanuc_start && !(distance > kEqual)) {
-      // Haas: "If cutter compensation is turned on ... in a block without any X-Y move, there is
-      // no change made to cutter compensation until the next X or Y move": a plunge goes as
-      // programmed, and the next move in the plane is the entry.
-      const Vec3 end = to_machine(target);
-      emit(kind, pos, end, move_feed);
-      pos = end;
-      return;
-    }
-    if (!fanuc_start && distance <= r)
-      error(motion_column, "cutter compensation entry move of length " + format_number(distance) +
-                               " mm is not longer than the tool radius " + format_number(r) + " mm");
-    comp_entry_pending = fanuc_start;
-    double alpha = angle_of(p - c) + (side > 0 ? kHalfPi : -kHalfPi);
-    Vec2 end = p + r * polar(alpha);
-    comp_endpoint = c;
-    comp_endpoint_valid = true;
-    move.direction = polar(alpha);  // as LinuxCNC records it
-    move.end = with_plane_uv(target, end);
-    comp_queue.push_back(move);
-    comp_first = false;
-    comp_current = move.end;
-    comp_programmed = target;
-    comp_programmed_current = true;
+  if (comp.first) {
+    comp_straight_entry(move, target);
     return;
   }
   // Later moves (convert_straight_comp2).
-  if (comp_entry_pending) comp_resolve_entry(p - plane_uv(comp_programmed));
-  const Vec2 c = plane_uv(comp_current);
-  const Vec2 op = plane_uv(comp_programmed);
+  if (comp.entry_pending) comp_resolve_entry(p - plane_uv(comp.programmed));
+  const Vec2 c = plane_uv(comp.current);
+  const Vec2 op = plane_uv(comp.programmed);
   Vec2 end = c;
   if (p.x == op.x && p.y == op.y) {  // no motion in the plane: stays where the tool is, for now
     move.direction = Vec2(0.0);
@@ -258,7 +280,7 @@ void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double
     }
     end = p + r * polar(alpha + gamma);
     Vec2 mid = op + r * polar(alpha + gamma);
-    const CompMove* front = comp_queue.empty() ? nullptr : &comp_queue.front();
+    const CompMove* front = comp.queue.empty() ? nullptr : &comp.queue.front();
     bool front_arc = front && front->kind == CompMove::arc;
     bool concave = beta < -kConcaveCorner || beta > kPi + kConcaveCorner;
     // An "h" shape: over the round part, then down beside the straight one; LinuxCNC keeps the
@@ -269,7 +291,7 @@ void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double
     if (!concave && beta > kConcaveCorner) {  // convex corner: an arc about it (G0: a line)
       comp_move_endpoint_and_flush(c);
       CompMove corner = move;
-      corner.end = with_plane_uv(comp_current, mid);
+      corner.end = with_plane_uv(comp.current, mid);
       if (kind == MoveKind::rapid) {
         corner.direction = Vec2(0.0);
       } else {
@@ -278,10 +300,10 @@ void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double
         corner.centre = op;
         corner.turn = side > 0 ? -1 : 1;
       }
-      comp_queue.push_back(corner);
+      comp.queue.push_back(corner);
       comp_dequeue();
-      comp_endpoint = mid;
-      comp_endpoint_valid = true;
+      comp.endpoint = mid;
+      comp.endpoint_valid = true;
     } else if (concave) {
       Vec2 meet;
       if (!front_arc) {  // line to line: back along the offset path to where they cross
@@ -301,8 +323,9 @@ void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double
         double d = programmed_radius * std::cos(th - phi);
         double l = (inside ? d - r : d + r) / old_radius;
         if (l > 1.0 || l < -1.0)
-          error(motion_column, "arc to straight motion makes a corner the compensated tool can't "
-                               "fit in without gouging (cutter compensation)");
+          error(motion_column,
+                "arc to straight motion makes a corner the compensated tool can't "
+                "fit in without gouging (cutter compensation)");
         double turn_sign = (prev.turn > 0) == inside ? -1.0 : 1.0;
         double angle = turn_sign * std::acos(l) + th + kPi;
         meet = prev.centre + old_radius * polar(angle);
@@ -310,16 +333,16 @@ void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double
       comp_move_endpoint_and_flush(meet);
     } else {  // straight on (collinear, or tangent from an arc)
       comp_dequeue();
-      comp_endpoint = c;
-      comp_endpoint_valid = true;
+      comp.endpoint = c;
+      comp.endpoint_valid = true;
     }
     move.direction = p - op;
   }
   move.end = with_plane_uv(target, end);
-  comp_queue.push_back(move);
-  comp_current = move.end;
-  comp_programmed = target;
-  comp_programmed_current = true;
+  comp.queue.push_back(move);
+  comp.current = move.end;
+  comp.programmed = target;
+  comp.programmed_current = true;
 }
 
 // Fanuc's and Haas's start-up (Fanuc's type A): the entry move, queued ending perpendicular to
@@ -327,23 +350,64 @@ void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double
 // start instead; the next move then starts straight on from it, with no corner. A next move with
 // no motion in the plane leaves the entry as it was.
 void Interpreter::State::comp_resolve_entry(const Vec2& next_direction) {
-  comp_entry_pending = false;
+  comp.entry_pending = false;
   const double length = glm::length(next_direction);
-  if (!(length > kEqual) || comp_queue.size() != 1) return;
+  if (!(length > kEqual) || comp.queue.size() != 1) return;
   const Vec2 unit_direction = next_direction / length;
-  const Vec2 side = comp_side > 0 ? Vec2(-unit_direction.y, unit_direction.x) : Vec2(unit_direction.y, -unit_direction.x);
-  CompMove& entry = comp_queue.front();
-  entry.end = with_plane_uv(entry.end, plane_uv(comp_programmed) + comp_radius * side);
-  entry.direction = plane_uv(entry.end) - comp_endpoint;  // from where the entry starts
-  comp_current = entry.end;
+  const Vec2 side = comp.side > 0 ? Vec2(-unit_direction.y, unit_direction.x)
+                                  : Vec2(unit_direction.y, -unit_direction.x);
+  CompMove& entry = comp.queue.front();
+  entry.end = with_plane_uv(entry.end, plane_uv(comp.programmed) + comp.radius * side);
+  entry.direction = plane_uv(entry.end) - comp.endpoint;  // from where the entry starts
+  comp.current = entry.end;
+}
+
+// The entry arc (convert_arc_comp1): it keeps its start and ends one radius from its programmed
+// end.
+void Interpreter::State::comp_arc_entry(CompMove& move, bool ccw, bool inside,
+                                        const std::string& too_small) {
+  const double r = comp.radius;
+  const int turn = move.turn;
+  Vec3 current = to_program(pos);
+  Vec2 c = plane_uv(current);
+  ArcData a = arc_data(current, ccw);
+  if (feed_mode == FeedMode::inverse_time)
+    inverse_time_rate(arc_length(current, a, ccw, move.extra_turns));
+  move.feed = feed;
+  Vec2 end = plane_uv(a.end);
+  if (glm::length(end - c) <= r)
+    error(motion_column,
+          "cutter compensation entry arc: its end is not farther than the tool "
+          "radius " +
+              format_number(r) + " mm from its start");
+  double arc_radius = a.programmed_radius > 0 ? a.programmed_radius : glm::length(a.centre - c);
+  if (arc_radius <= r && inside) error(motion_column, too_small);
+  double gamma = inside ? angle_of(a.centre - end) : angle_of(end - a.centre);
+  comp.first = false;
+  comp.programmed = a.end;
+  end += r * polar(gamma);
+  // The compensated arc keeps its start and passes through the new end: its centre lies on
+  // the line from the end through the programmed centre, equally far from both.
+  double b_len = glm::length(c - end) / 2;
+  double ab = angle_of(a.centre - end);
+  double a_angle = angle_of(c - end) - ab;
+  if (std::abs(std::cos(a_angle)) < kEqual) error(motion_column, too_small);
+  Vec2 centre = end + (b_len / std::cos(a_angle)) * polar(ab);
+  move.end = with_plane_uv(a.end, end);
+  move.centre = centre;
+  move.original_sweep = find_turn(c, centre, turn, end);
+  comp.queue.push_back(move);
+  comp.current = move.end;
+  comp.programmed_current = true;
 }
 
 void Interpreter::State::comp_arc(bool ccw) {
   if (far)
-    error(motion_column, "cutter compensation from a retracted (far) position: the tool's position "
-                         "is unknown; position it with X, Y and Z first");
-  const double r = comp_radius;
-  const int side = comp_side;
+    error(motion_column,
+          "cutter compensation from a retracted (far) position: the tool's position "
+          "is unknown; position it with X, Y and Z first");
+  const double r = comp.radius;
+  const int side = comp.side;
   const int turn = ccw ? 1 : -1;
   const bool inside = inside_arc(side, turn);
   CompMove move;
@@ -355,46 +419,20 @@ void Interpreter::State::comp_arc(bool ccw) {
   move.extra_turns = arc_extra_turns();
   const std::string too_small = "the tool radius " + format_number(r) +
                                 " mm is not less than the arc radius (cutter compensation)";
-  if (comp_first) {  // the entry arc (convert_arc_comp1)
-    Vec3 current = to_program(pos);
-    Vec2 c = plane_uv(current);
-    ArcData a = arc_data(current, ccw);
-    if (feed_mode == FeedMode::inverse_time) inverse_time_rate(arc_length(current, a, ccw, move.extra_turns));
-    move.feed = feed;
-    Vec2 end = plane_uv(a.end);
-    if (glm::length(end - c) <= r)
-      error(motion_column, "cutter compensation entry arc: its end is not farther than the tool "
-                           "radius " + format_number(r) + " mm from its start");
-    double arc_radius = a.programmed_radius > 0 ? a.programmed_radius : glm::length(a.centre - c);
-    if (arc_radius <= r && inside) error(motion_column, too_small);
-    double gamma = inside ? angle_of(a.centre - end) : angle_of(end - a.centre);
-    comp_first = false;
-    comp_programmed = a.end;
-    end += r * polar(gamma);
-    // The compensated arc keeps its start and passes through the new end: its centre lies on
-    // the line from the end through the programmed centre, equally far from both.
-    double b_len = glm::length(c - end) / 2;
-    double ab = angle_of(a.centre - end);
-    double a_angle = angle_of(c - end) - ab;
-    if (std::abs(std::cos(a_angle)) < kEqual) error(motion_column, too_small);
-    Vec2 centre = end + (b_len / std::cos(a_angle)) * polar(ab);
-    move.end = with_plane_uv(a.end, end);
-    move.centre = centre;
-    move.original_sweep = find_turn(c, centre, turn, end);
-    comp_queue.push_back(move);
-    comp_current = move.end;
-    comp_programmed_current = true;
+  if (comp.first) {
+    comp_arc_entry(move, ccw, inside, too_small);
     return;
   }
   // Later arcs (convert_arc_comp2).
-  ArcData a = arc_data(comp_programmed, ccw);
-  if (comp_entry_pending) {  // the arc's tangent at its start
-    const Vec2 radial = plane_uv(comp_programmed) - a.centre;
+  ArcData a = arc_data(comp.programmed, ccw);
+  if (comp.entry_pending) {  // the arc's tangent at its start
+    const Vec2 radial = plane_uv(comp.programmed) - a.centre;
     comp_resolve_entry(ccw ? Vec2(-radial.y, radial.x) : Vec2(radial.y, -radial.x));
   }
-  const Vec2 op = plane_uv(comp_programmed);
-  const Vec2 c = plane_uv(comp_current);
-  if (feed_mode == FeedMode::inverse_time) inverse_time_rate(arc_length(comp_programmed, a, ccw, move.extra_turns));
+  const Vec2 op = plane_uv(comp.programmed);
+  const Vec2 c = plane_uv(comp.current);
+  if (feed_mode == FeedMode::inverse_time)
+    inverse_time_rate(arc_length(comp.programmed, a, ccw, move.extra_turns));
   move.feed = feed;
   const Vec2 centre = a.centre, end = plane_uv(a.end);
   double arc_radius = glm::length(centre - end);
@@ -402,8 +440,10 @@ void Interpreter::State::comp_arc(bool ccw) {
   double delta = angle_of(centre - op);
   double alpha = ccw ? delta - kHalfPi : delta + kHalfPi;
   double beta = side > 0 ? theta - alpha : alpha - theta;
-  if (beta > 1.5 * kPi) beta -= 2 * kPi;
-  else if (beta < -kHalfPi) beta += 2 * kPi;
+  if (beta > 1.5 * kPi)
+    beta -= 2 * kPi;
+  else if (beta < -kHalfPi)
+    beta += 2 * kPi;
   double gamma;
   if (inside) {
     gamma = angle_of(centre - end);
@@ -416,11 +456,12 @@ void Interpreter::State::comp_arc(bool ccw) {
   move.end = with_plane_uv(a.end, new_end);
   move.centre = centre;
   move.original_sweep = find_turn(op, centre, turn, end);
-  const std::string gouge = "arc move in a concave corner cannot be reached by the tool without "
-                            "gouging (cutter compensation)";
+  const std::string gouge =
+      "arc move in a concave corner cannot be reached by the tool without "
+      "gouging (cutter compensation)";
   if (beta < -kConcaveCorner || beta > kPi + kConcaveCorner ||
       (std::abs(beta - kPi) < kConcaveCorner && !inside)) {  // concave
-    const CompMove* front = comp_queue.empty() ? nullptr : &comp_queue.front();
+    const CompMove* front = comp.queue.empty() ? nullptr : &comp.queue.front();
     Vec2 meet;
     if (!front || front->kind != CompMove::arc) {  // line to arc
       double along = arc_radius * std::sin(beta - kHalfPi);
@@ -436,13 +477,16 @@ void Interpreter::State::comp_arc(bool ccw) {
       double new_radius = inside ? arc_radius - r : arc_radius + r;
       double centres = glm::length(prev.centre - centre);
       if (old_radius == 0 || centres == 0)
-        error(motion_column, "arc to arc motion is invalid because the arcs have the same centre "
-                             "(cutter compensation)");
-      double cos_pullback = (old_radius * old_radius + centres * centres - new_radius * new_radius) /
-                            (2 * old_radius * centres);
+        error(motion_column,
+              "arc to arc motion is invalid because the arcs have the same centre "
+              "(cutter compensation)");
+      double cos_pullback =
+          (old_radius * old_radius + centres * centres - new_radius * new_radius) /
+          (2 * old_radius * centres);
       if (cos_pullback > 1.0 || cos_pullback < -1.0)
-        error(motion_column, "arc to arc motion makes a corner the compensated tool can't fit in "
-                             "without gouging (cutter compensation)");
+        error(motion_column,
+              "arc to arc motion makes a corner the compensated tool can't fit in "
+              "without gouging (cutter compensation)");
       double pullback = std::acos(cos_pullback);
       double direction = angle_of(centre - prev.centre);
       bool add = inside_arc(side, prev.turn) == (turn > 0);
@@ -453,23 +497,23 @@ void Interpreter::State::comp_arc(bool ccw) {
     Vec2 mid = op + r * polar(delta);
     comp_dequeue();
     CompMove corner = move;
-    corner.end = with_plane_uv(comp_current, mid);
+    corner.end = with_plane_uv(comp.current, mid);
     corner.centre = op;
     corner.turn = side > 0 ? -1 : 1;
     corner.original_sweep = 0;
-    comp_queue.push_back(corner);
+    comp.queue.push_back(corner);
     comp_dequeue();
-    comp_endpoint = mid;
-    comp_endpoint_valid = true;
+    comp.endpoint = mid;
+    comp.endpoint_valid = true;
   } else {  // tangent
     comp_dequeue();
-    comp_endpoint = c;
-    comp_endpoint_valid = true;
+    comp.endpoint = c;
+    comp.endpoint_valid = true;
   }
-  comp_queue.push_back(move);
-  comp_programmed = a.end;
-  comp_current = move.end;
-  comp_programmed_current = true;
+  comp.queue.push_back(move);
+  comp.programmed = a.end;
+  comp.current = move.end;
+  comp.programmed_current = true;
 }
 
 }  // namespace tridex::gcode

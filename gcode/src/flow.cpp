@@ -12,6 +12,7 @@
 #include <cctype>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <map>
 #include <set>
 
@@ -32,9 +33,9 @@ struct Source {
     std::uint64_t body = 0;  // offset of the line after the label
     int line = 0;            // line number of the label
   };
-  std::map<int, Label> programs;              // O numbers
-  std::map<std::string, Label> subroutines;   // o<name> sub / o100 sub
-  std::map<long long, Label> sequences;       // N numbers that GOTO looked for (at the N line)
+  std::map<int, Label> programs;             // O numbers
+  std::map<std::string, Label> subroutines;  // o<name> sub / o100 sub
+  std::map<long long, Label> sequences;      // N numbers that GOTO looked for (at the N line)
   std::uint64_t scanned_to = 0;
   int scanned_line = 0;
   std::uint64_t start = 0;
@@ -105,15 +106,26 @@ class ProgramFlow {
   bool scan_for(const std::function<bool()>& found);
   std::optional<std::pair<std::size_t, Source::Label>> find_external(const std::string& label,
                                                                      bool o_word);
-  std::optional<std::filesystem::path> find_by_o_number(const std::filesystem::path& dir, int number);
+  std::optional<std::filesystem::path> find_by_o_number(const std::filesystem::path& dir,
+                                                        int number);
   template <class Key>
   std::optional<Position> find_body(std::map<Key, Source::Label> Source::*table, const Key& key,
                                     const std::string& label, bool o_word, int column);
 
-  void skip_until(const std::function<bool(const Skim&)>& stop, const std::string& what, int column);
+  void skip_until(const std::function<bool(const Skim&)>& stop, const std::string& what,
+                  int column);
   void call(CallKind kind, const std::string& label, long long repeats, int column);
   void give_back(int column);
   void o_word(const Control& control);
+  std::vector<Loop>::reverse_iterator find_o_loop(const std::string& label);
+  OKeyword skip_to(const Control& control, std::initializer_list<OKeyword> keywords,
+                   const std::string& what);
+  void o_return(const Control& control);
+  void o_if(const Control& control);
+  void o_while(const Control& control);
+  void o_repeat(const Control& control);
+  void o_loop_end(const Control& control);
+  void o_break(const Control& control);
   void linuxcnc_program_number(const Word& label);
   void loop_control(const Control& control);
   Position find_sequence(long long number, const std::string& what, int column);
@@ -180,9 +192,9 @@ void ProgramFlow::jump(const Position& to) {
 }
 
 void ProgramFlow::count_block(int column) {
-  if (++s_.blocks > s_.options.max_blocks && s_.options.max_blocks > 0)
+  if (++s_.summary.blocks > s_.options.max_blocks && s_.options.max_blocks > 0)
     error(column, "more than " + std::to_string(s_.options.max_blocks) +
-                 " blocks executed (the block limit; an endless loop?)");
+                      " blocks executed (the block limit; an endless loop?)");
 }
 
 // Reads ahead from the furthest line seen, noting labels, until `found` or the end of the file;
@@ -223,7 +235,8 @@ std::optional<std::pair<std::size_t, Source::Label>> ProgramFlow::find_external(
   dirs.push_back(std::filesystem::path(sources_[0]->name).parent_path());
   for (std::size_t k = 0; k < sources_.size(); ++k)
     if (sources_[k]->name == label) return std::pair{k, Source::Label{sources_[k]->start, 0}};
-  auto open = [&](const std::filesystem::path& path) -> std::optional<std::pair<std::size_t, Source::Label>> {
+  auto open = [&](const std::filesystem::path& path)
+      -> std::optional<std::pair<std::size_t, Source::Label>> {
     std::string shown = path.string();
     for (std::size_t k = 0; k < sources_.size(); ++k)
       if (sources_[k]->name == shown) return std::pair{k, Source::Label{sources_[k]->start, 0}};
@@ -252,19 +265,23 @@ std::optional<std::pair<std::size_t, Source::Label>> ProgramFlow::find_external(
 // The file of `dir` whose program starts with O<number> (or Fanuc's `:<number>`) on its first line
 // after `%`, blank lines and comments, whatever its name. The folder's files with a G-code
 // extension (or none) are read once, their first kilobyte each.
-std::optional<std::filesystem::path> ProgramFlow::find_by_o_number(const std::filesystem::path& dir, int number) {
+std::optional<std::filesystem::path> ProgramFlow::find_by_o_number(const std::filesystem::path& dir,
+                                                                   int number) {
   auto [index, fresh] = o_numbers_.try_emplace(dir);
   if (fresh) {
-    static const std::set<std::string> kExtensions = {"", ".nc", ".ngc", ".tap", ".txt", ".cnc", ".eia",
-                                                      ".min", ".mpf", ".spf", ".ptp", ".gcode", ".iso"};
+    static const std::set<std::string> kExtensions = {"",     ".nc",    ".ngc", ".tap", ".txt",
+                                                      ".cnc", ".eia",   ".min", ".mpf", ".spf",
+                                                      ".ptp", ".gcode", ".iso"};
     std::error_code ec;
     std::vector<std::filesystem::path> files;
-    for (std::filesystem::directory_iterator it(dir.empty() ? "." : dir, ec), end; !ec && it != end; it.increment(ec)) {
+    for (std::filesystem::directory_iterator it(dir.empty() ? "." : dir, ec), end; !ec && it != end;
+         it.increment(ec)) {
       std::string ext = it->path().extension().string();
       for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
       if (it->is_regular_file(ec) && kExtensions.count(ext)) files.push_back(it->path());
     }
-    std::sort(files.begin(), files.end());  // the first in name order wins a number two files start with
+    std::sort(files.begin(),
+              files.end());  // the first in name order wins a number two files start with
     for (const auto& path : files) {
       std::ifstream in(path, std::ios::binary);
       std::string head(1024, '\0');
@@ -284,7 +301,9 @@ std::optional<std::filesystem::path> ProgramFlow::find_by_o_number(const std::fi
       }
       if (i >= head.size() || (head[i] != 'O' && head[i] != 'o' && head[i] != ':')) continue;
       std::size_t digits = i + 1;
-      while (digits < head.size() && digits - i <= 9 && std::isdigit(static_cast<unsigned char>(head[digits]))) ++digits;
+      while (digits < head.size() && digits - i <= 9 &&
+             std::isdigit(static_cast<unsigned char>(head[digits])))
+        ++digits;
       if (digits == i + 1 || digits - i > 9) continue;
       index->second.try_emplace(std::stoi(head.substr(i + 1, digits - i - 1)), path);
     }
@@ -339,29 +358,32 @@ std::optional<Position> ProgramFlow::find_body(std::map<Key, Source::Label> Sour
 void ProgramFlow::call(CallKind kind, const std::string& label, long long repeats, int column) {
   if (repeats <= 0) return;
   if (static_cast<int>(calls_.size()) >= s_.options.max_call_depth)
-    error(column, "subprogram calls nested deeper than " + std::to_string(s_.options.max_call_depth));
+    error(column,
+          "subprogram calls nested deeper than " + std::to_string(s_.options.max_call_depth));
   Call c{kind, label, here(), {}, repeats, loops_.size(), branches_.size(), false};
   std::optional<Position> body =
       kind == CallKind::o_call ? find_body(&Source::subroutines, label, label, true, column)
-      : kind == CallKind::m97  ? find_sequence(std::stoll(label), "M97 P" + label, column)
-                               : find_body(&Source::programs, std::stoi(label), label, false, column);
+      : kind == CallKind::m97
+          ? find_sequence(std::stoll(label), "M97 P" + label, column)
+          : find_body(&Source::programs, std::stoi(label), label, false, column);
   if (!body) {
     if (kind == CallKind::o_call)
       error(column, "o<" + label + "> call: no such subroutine in the program, and no " + label +
                         ".ngc in the subprogram folders");
-    std::string message = std::string(kind == CallKind::m98 ? "M98 P" : "G65 P") + label + ": no O" +
-                          label + " in the program nor in the subprogram folders (--subprograms)";
+    std::string message = std::string(kind == CallKind::m98 ? "M98 P" : "G65 P") + label +
+                          ": no O" + label +
+                          " in the program nor in the subprogram folders (--subprograms)";
     if (!s_.options.lenient) error(column, message);
     s_.warn(column, message + "; the call is skipped (lenient mode)");
     return;
   }
   c.body = *body;
   if (kind == CallKind::g65 || kind == CallKind::o_call) {  // M98 and M97 share the caller's locals
-    s_.scopes.emplace_back();
+    s_.parameters.scopes.emplace_back();
     c.scope = true;
-    auto& locals = s_.scopes.back().locals;
+    auto& locals = s_.parameters.scopes.back().locals;
     if (kind == CallKind::g65) {
-      locals = c.arguments = s_.call_arguments;
+      locals = c.arguments = s_.call_request.arguments;
     } else {
       for (std::size_t k = 0; k < o_arguments_.size() && k + 1 < locals.size(); ++k)
         locals[k + 1] = o_arguments_[k];
@@ -378,12 +400,12 @@ void ProgramFlow::give_back(int column) {
   branches_.resize(std::min(branches_.size(), c.branches));
   (void)column;
   if (--c.remaining > 0) {
-    if (c.kind == CallKind::g65) s_.scopes.back().locals = c.arguments;  // G65 L: afresh
+    if (c.kind == CallKind::g65) s_.parameters.scopes.back().locals = c.arguments;  // G65 L: afresh
     jump(c.body);
     return;
   }
   Position back = c.back;
-  if (c.scope) s_.scopes.pop_back();
+  if (c.scope) s_.parameters.scopes.pop_back();
   calls_.pop_back();
   jump(back);
 }
@@ -398,8 +420,8 @@ std::vector<Value> ProgramFlow::arguments(const Control& control) {
 bool ProgramFlow::condition(const Control& control) {
   std::vector<Value> values = arguments(control);
   if (values.size() != 1)
-    error(control.arguments_column, std::string("o-word ") + to_string(control.keyword) +
-                                        " needs one condition in [ ]");
+    error(control.arguments_column,
+          std::string("o-word ") + to_string(control.keyword) + " needs one condition in [ ]");
   return values[0].number != 0;
 }
 
@@ -449,7 +471,8 @@ void ProgramFlow::loop_control(const Control& control) {
   start.offset = statement_offset_;
   if (control.kind == ControlKind::while_loop) {
     auto same = std::find_if(loops_.begin(), loops_.end(), [&](const Loop& l) {
-      return l.kind == LoopKind::fanuc && l.start.source == start.source && l.start.offset == start.offset;
+      return l.kind == LoopKind::fanuc && l.start.source == start.source &&
+             l.start.offset == start.offset;
     });
     if (control.condition) {
       if (same != loops_.end()) {
@@ -497,78 +520,56 @@ void ProgramFlow::linuxcnc_program_number(const Word& label) {
   started_ = true;
 }
 
+// The innermost o-word loop labelled `label` (rend(): none).
+std::vector<Loop>::reverse_iterator ProgramFlow::find_o_loop(const std::string& label) {
+  return std::find_if(loops_.rbegin(), loops_.rend(),
+                      [&](const Loop& l) { return l.kind != LoopKind::fanuc && l.label == label; });
+}
+
+// Skips to the next o-word of `control`'s label with one of `keywords`, and says which it met.
+OKeyword ProgramFlow::skip_to(const Control& control, std::initializer_list<OKeyword> keywords,
+                              const std::string& what) {
+  const std::string& label = control.label;
+  OKeyword hit = OKeyword::sub;
+  skip_until(
+      [&](const Skim& k) {
+        if (k.kind != ControlKind::o_word || k.label != label) return false;
+        for (OKeyword kw : keywords)
+          if (k.keyword == kw) {
+            hit = kw;
+            return true;
+          }
+        return false;
+      },
+      what, control.column);
+  return hit;
+}
+
+// LinuxCNC's o-words: a statement per keyword (subroutines, branches, loops).
 void ProgramFlow::o_word(const Control& control) {
   const std::string& label = control.label;
-  auto find_loop = [&]() {
-    return std::find_if(loops_.rbegin(), loops_.rend(), [&](const Loop& l) {
-      return l.kind != LoopKind::fanuc && l.label == label;
-    });
-  };
-  auto skip_to = [&](std::initializer_list<OKeyword> keywords, const std::string& what) {
-    OKeyword hit = OKeyword::sub;
-    skip_until(
-        [&](const Skim& k) {
-          if (k.kind != ControlKind::o_word || k.label != label) return false;
-          for (OKeyword kw : keywords)
-            if (k.keyword == kw) {
-              hit = kw;
-              return true;
-            }
-          return false;
-        },
-        what, control.column);
-    return hit;
-  };
-  Position start{current_, statement_offset_, line_ - 1};
   switch (control.keyword) {
     case OKeyword::sub:  // a definition met in the flow of the program: note it, skip it
       source().subroutines.emplace(label, Source::Label{here().offset, line_});
-      skip_to({OKeyword::endsub}, "o" + label + " endsub");
+      skip_to(control, {OKeyword::endsub}, "o" + label + " endsub");
       return;
     case OKeyword::endsub:
-    case OKeyword::return_: {
-      if (calls_.empty() || calls_.back().kind != CallKind::o_call)
-        error(control.column, "o" + label + " " + to_string(control.keyword) + " outside a call");
-      std::vector<Value> values = arguments(control);
-      if (!values.empty()) {
-        s_.named_globals["_value"] = values[0];
-        s_.named_globals["_value_returned"] = Value{1, false};
-      } else {
-        s_.named_globals["_value_returned"] = Value{0, false};
-      }
-      give_back(control.column);
+    case OKeyword::return_:
+      o_return(control);
       return;
-    }
     case OKeyword::call:
       o_arguments_ = arguments(control);
       call(CallKind::o_call, label, 1, control.column);
       return;
-    case OKeyword::if_: {
-      bool taken = condition(control);
-      if (branches_.size() >= kMaxControlDepth) error(control.column, "if nested too deeply");
-      branches_.push_back(Branch{label, taken});
-      while (!branches_.back().taken) {
-        OKeyword hit = skip_to({OKeyword::elseif, OKeyword::else_, OKeyword::endif}, "o" + label + " endif");
-        if (hit == OKeyword::endif) {
-          branches_.pop_back();
-          return;
-        }
-        if (hit == OKeyword::else_) {
-          branches_.back().taken = true;
-        } else {  // elseif: skimmed, so its condition is evaluated now
-          Block b;
-          if (!lex_line(skipped_, b, lex_error_, &s_))
-            throw SyntaxError(Diagnostic{source().name, line_, lex_error_.column, lex_error_.message});
-          branches_.back().taken = condition(b.control);
-        }
-      }
+    case OKeyword::if_:
+      o_if(control);
       return;
-    }
     case OKeyword::elseif:
     case OKeyword::else_:
       if (branches_.empty() || branches_.back().label != label)
-        error(control.column, "o" + label + " " + to_string(control.keyword) + " without o" + label + " if");
-      skip_to({OKeyword::endif}, "o" + label + " endif");
+        error(control.column,
+              "o" + label + " " + to_string(control.keyword) + " without o" + label + " if");
+      skip_to(control, {OKeyword::endif}, "o" + label + " endif");
       branches_.pop_back();
       return;
     case OKeyword::endif:
@@ -576,78 +577,137 @@ void ProgramFlow::o_word(const Control& control) {
         error(control.column, "o" + label + " endif without o" + label + " if");
       branches_.pop_back();
       return;
-    case OKeyword::while_: {
-      auto loop = find_loop();
-      if (loop != loops_.rend() && loop->kind == LoopKind::o_do) {  // the end of a do … while
-        if (condition(control)) {
-          jump(loop->start);
-        } else {
-          loops_.erase(std::prev(loop.base()), loops_.end());
-        }
-        return;
-      }
-      bool running = loop != loops_.rend() && loop->start.offset == start.offset;
-      if (condition(control)) {
-        if (!running) {
-          if (loops_.size() >= kMaxControlDepth) error(control.column, "loops nested too deeply");
-          loops_.push_back(Loop{LoopKind::o_while, 0, label, start, 0});
-        }
-        return;
-      }
-      if (running) loops_.erase(std::prev(loop.base()), loops_.end());
-      skip_to({OKeyword::endwhile}, "o" + label + " endwhile");
+    case OKeyword::while_:
+      o_while(control);
       return;
-    }
     case OKeyword::do_:
       if (loops_.size() >= kMaxControlDepth) error(control.column, "loops nested too deeply");
       loops_.push_back(Loop{LoopKind::o_do, 0, label, here(), 0});
       return;
-    case OKeyword::repeat: {
-      std::vector<Value> values = arguments(control);
-      if (values.size() != 1) error(control.arguments_column, "o" + label + " repeat needs a count in [ ]");
-      long long count = std::llround(values[0].number);
-      if (count <= 0) {
-        skip_to({OKeyword::endrepeat}, "o" + label + " endrepeat");
-        return;
-      }
-      if (loops_.size() >= kMaxControlDepth) error(control.column, "loops nested too deeply");
-      loops_.push_back(Loop{LoopKind::o_repeat, 0, label, here(), count});
+    case OKeyword::repeat:
+      o_repeat(control);
       return;
-    }
     case OKeyword::endwhile:
     case OKeyword::endrepeat:
-    case OKeyword::continue_: {
-      auto loop = find_loop();
-      if (loop == loops_.rend())
-        error(control.column, "o" + label + " " + to_string(control.keyword) + " outside its loop");
-      loops_.erase(loop.base(), loops_.end());  // loops opened inside it end here
-      if (loop->kind == LoopKind::o_repeat) {
-        if (--loop->remaining > 0) {
-          jump(loop->start);
-        } else {
-          bool at_end = control.keyword == OKeyword::endrepeat;
-          loops_.pop_back();
-          if (!at_end) skip_to({OKeyword::endrepeat}, "o" + label + " endrepeat");
-        }
-        return;
-      }
-      jump(loop->start);  // while: its condition again; do: its first line
+    case OKeyword::continue_:
+      o_loop_end(control);
+      return;
+    case OKeyword::break_:
+      o_break(control);
+      return;
+  }
+}
+
+// o endsub / o return [value]: back to the caller, the value in #<_value>.
+void ProgramFlow::o_return(const Control& control) {
+  const std::string& label = control.label;
+  if (calls_.empty() || calls_.back().kind != CallKind::o_call)
+    error(control.column, "o" + label + " " + to_string(control.keyword) + " outside a call");
+  std::vector<Value> values = arguments(control);
+  if (!values.empty()) {
+    s_.parameters.named_globals["_value"] = values[0];
+    s_.parameters.named_globals["_value_returned"] = Value{1, false};
+  } else {
+    s_.parameters.named_globals["_value_returned"] = Value{0, false};
+  }
+  give_back(control.column);
+}
+
+// o if: skips to the branch taken (an elseif's condition is evaluated when it is reached).
+void ProgramFlow::o_if(const Control& control) {
+  const std::string& label = control.label;
+  bool taken = condition(control);
+  if (branches_.size() >= kMaxControlDepth) error(control.column, "if nested too deeply");
+  branches_.push_back(Branch{label, taken});
+  while (!branches_.back().taken) {
+    OKeyword hit = skip_to(control, {OKeyword::elseif, OKeyword::else_, OKeyword::endif},
+                           "o" + label + " endif");
+    if (hit == OKeyword::endif) {
+      branches_.pop_back();
       return;
     }
-    case OKeyword::break_: {
-      auto loop = find_loop();
-      if (loop == loops_.rend()) error(control.column, "o" + label + " break outside its loop");
-      LoopKind kind = loop->kind;
-      loops_.erase(std::prev(loop.base()), loops_.end());
-      if (kind == LoopKind::o_repeat)
-        skip_to({OKeyword::endrepeat}, "o" + label + " endrepeat");
-      else if (kind == LoopKind::o_do)
-        skip_to({OKeyword::while_}, "o" + label + " while");
-      else
-        skip_to({OKeyword::endwhile}, "o" + label + " endwhile");
-      return;
+    if (hit == OKeyword::else_) {
+      branches_.back().taken = true;
+    } else {  // elseif: skimmed, so its condition is evaluated now
+      Block b;
+      if (!lex_line(skipped_, b, lex_error_, &s_))
+        throw SyntaxError(Diagnostic{source().name, line_, lex_error_.column, lex_error_.message});
+      branches_.back().taken = condition(b.control);
     }
   }
+}
+
+// o while: the start of a while loop (its condition read at each turn), or the end of a do loop.
+void ProgramFlow::o_while(const Control& control) {
+  const std::string& label = control.label;
+  Position start{current_, statement_offset_, line_ - 1};
+  auto loop = find_o_loop(label);
+  if (loop != loops_.rend() && loop->kind == LoopKind::o_do) {  // the end of a do … while
+    if (condition(control)) {
+      jump(loop->start);
+    } else {
+      loops_.erase(std::prev(loop.base()), loops_.end());
+    }
+    return;
+  }
+  bool running = loop != loops_.rend() && loop->start.offset == start.offset;
+  if (condition(control)) {
+    if (!running) {
+      if (loops_.size() >= kMaxControlDepth) error(control.column, "loops nested too deeply");
+      loops_.push_back(Loop{LoopKind::o_while, 0, label, start, 0});
+    }
+    return;
+  }
+  if (running) loops_.erase(std::prev(loop.base()), loops_.end());
+  skip_to(control, {OKeyword::endwhile}, "o" + label + " endwhile");
+}
+
+void ProgramFlow::o_repeat(const Control& control) {
+  const std::string& label = control.label;
+  std::vector<Value> values = arguments(control);
+  if (values.size() != 1)
+    error(control.arguments_column, "o" + label + " repeat needs a count in [ ]");
+  long long count = std::llround(values[0].number);
+  if (count <= 0) {
+    skip_to(control, {OKeyword::endrepeat}, "o" + label + " endrepeat");
+    return;
+  }
+  if (loops_.size() >= kMaxControlDepth) error(control.column, "loops nested too deeply");
+  loops_.push_back(Loop{LoopKind::o_repeat, 0, label, here(), count});
+}
+
+// o endwhile, o endrepeat, o continue: the loop's next turn, or its end.
+void ProgramFlow::o_loop_end(const Control& control) {
+  const std::string& label = control.label;
+  auto loop = find_o_loop(label);
+  if (loop == loops_.rend())
+    error(control.column, "o" + label + " " + to_string(control.keyword) + " outside its loop");
+  loops_.erase(loop.base(), loops_.end());  // loops opened inside it end here
+  if (loop->kind == LoopKind::o_repeat) {
+    if (--loop->remaining > 0) {
+      jump(loop->start);
+    } else {
+      bool at_end = control.keyword == OKeyword::endrepeat;
+      loops_.pop_back();
+      if (!at_end) skip_to(control, {OKeyword::endrepeat}, "o" + label + " endrepeat");
+    }
+    return;
+  }
+  jump(loop->start);  // while: its condition again; do: its first line
+}
+
+void ProgramFlow::o_break(const Control& control) {
+  const std::string& label = control.label;
+  auto loop = find_o_loop(label);
+  if (loop == loops_.rend()) error(control.column, "o" + label + " break outside its loop");
+  LoopKind kind = loop->kind;
+  loops_.erase(std::prev(loop.base()), loops_.end());
+  if (kind == LoopKind::o_repeat)
+    skip_to(control, {OKeyword::endrepeat}, "o" + label + " endrepeat");
+  else if (kind == LoopKind::o_do)
+    skip_to(control, {OKeyword::while_}, "o" + label + " while");
+  else
+    skip_to(control, {OKeyword::endwhile}, "o" + label + " endwhile");
 }
 
 void ProgramFlow::run() {
@@ -670,8 +730,7 @@ void ProgramFlow::run() {
         percent_seen_ = true;
         continue;
       }
-      if (!calls_.empty())
-        error(1, "'%' (end of tape) inside subprogram " + calls_.back().label);
+      if (!calls_.empty()) error(1, "'%' (end of tape) inside subprogram " + calls_.back().label);
       ended_ = true;
       break;
     }
@@ -711,8 +770,8 @@ void ProgramFlow::run() {
         started_ = true;
         continue;
       }
-      std::string message = "the main program runs into O" + format_number(label.value) +
-                            " without M2/M30";
+      std::string message =
+          "the main program runs into O" + format_number(label.value) + " without M2/M30";
       if (!s_.options.lenient) error(label.column, message);
       s_.warn(label.column, message + "; treated as the end of the program");
       ended_ = true;
@@ -720,8 +779,10 @@ void ProgramFlow::run() {
     }
     started_ = true;
     // The statement starts at its first word or assignment, whichever comes first on the line.
-    int statement = block_.words.empty() ? block_.assignments.front().column : block_.words.front().column;
-    if (!block_.assignments.empty()) statement = std::min(statement, block_.assignments.front().column);
+    int statement =
+        block_.words.empty() ? block_.assignments.front().column : block_.words.front().column;
+    if (!block_.assignments.empty())
+      statement = std::min(statement, block_.assignments.front().column);
     count_block(statement);
     for (const Assignment& a : block_.assignments) s_.assign(a);
     if (block_.words.empty()) continue;
@@ -731,21 +792,24 @@ void ProgramFlow::run() {
       break;
     }
     if (flow == Flow::call || flow == Flow::macro) {
-      const int m97 = s_.w.find_m(97);
-      int column = flow == Flow::macro ? s_.w.find_g(650) : m97 ? m97 : s_.w.find_m(98);
-      call(flow == Flow::macro ? CallKind::g65 : m97 ? CallKind::m97 : CallKind::m98,
-           std::to_string(s_.call_label), s_.call_repeats, column);
+      const int m97 = s_.w.find_m(kM97);
+      int column = flow == Flow::macro ? s_.w.find_g(kG65) : m97 ? m97 : s_.w.find_m(kM98);
+      call(flow == Flow::macro ? CallKind::g65
+           : m97               ? CallKind::m97
+                               : CallKind::m98,
+           std::to_string(s_.call_request.label), s_.call_request.repeats, column);
       continue;
     }
     if (flow == Flow::ret) {
       if (calls_.empty()) {
-        s_.warn(s_.w.find_m(99), "M99 in the main program: treated as the end of the program");
+        s_.warn(s_.w.find_m(kM99), "M99 in the main program: treated as the end of the program");
         ended_ = true;
         break;
       }
       if (calls_.back().kind == CallKind::o_call)
-        error(s_.w.find_m(99), "M99 inside o" + calls_.back().label + " sub (use endsub or return)");
-      give_back(s_.w.find_m(99));
+        error(s_.w.find_m(kM99),
+              "M99 inside o" + calls_.back().label + " sub (use endsub or return)");
+      give_back(s_.w.find_m(kM99));
     }
   }
   if (!ended_) {

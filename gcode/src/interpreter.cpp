@@ -19,10 +19,9 @@
 #include <string_view>
 #include <utility>
 
-#include "tridex/gcode/lexer.hpp"
-
 #include "line_reader.hpp"
 #include "state.hpp"
+#include "tridex/gcode/lexer.hpp"
 
 namespace tridex::gcode {
 
@@ -48,10 +47,12 @@ Interpreter::~Interpreter() = default;
 Interpreter::Interpreter(Interpreter&&) noexcept = default;
 Interpreter& Interpreter::operator=(Interpreter&&) noexcept = default;
 
-const std::vector<Diagnostic>& Interpreter::warnings() const { return state_->warnings; }
-const std::set<int>& Interpreter::tools_used() const { return state_->tools_used; }
-const std::map<int, int>& Interpreter::tool_first_line() const { return state_->tool_first_line; }
-long long Interpreter::blocks() const { return state_->blocks; }
+const std::vector<Diagnostic>& Interpreter::warnings() const { return state_->summary.warnings; }
+const std::set<int>& Interpreter::tools_used() const { return state_->summary.tools_used; }
+const std::map<int, int>& Interpreter::tool_first_line() const {
+  return state_->summary.tool_first_line;
+}
+long long Interpreter::blocks() const { return state_->summary.blocks; }
 const std::vector<std::string>& Interpreter::files() const { return state_->files; }
 
 void Interpreter::run(std::istream& program, const std::string& file_name,
@@ -73,7 +74,8 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
   s.dwell_sink = &dwell_sink;
   s.offsets = s.machine.work_offsets;
   for (const auto& [n, value] : s.machine.variables) s.preset(n, value);
-  for (const auto& [name, value] : s.machine.named_variables) s.named_globals[name] = Value{value, false};
+  for (const auto& [name, value] : s.machine.named_variables)
+    s.parameters.named_globals[name] = Value{value, false};
   if (auto it = s.offsets.find(1); it != s.offsets.end()) s.work_offset = it->second;
   s.world_origin = s.work_offset;
   s.unit = s.machine.inch_at_start ? 25.4 : 1.0;
@@ -88,9 +90,9 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
   }
   run_program(s, program, file_name);
   s.comp_finish();  // compensated moves still waiting for a next move
-  if (s.plane_blocks.code) {
+  if (s.tilt.plane_blocks.code) {
     s.file = &file_name;
-    s.line = s.plane_blocks.first_line;
+    s.line = s.tilt.plane_blocks.first_line;
     s.error(0, s.incomplete_plane());
   }
   // One line per kind of word lenient mode skipped or block it read otherwise, however many:
@@ -100,9 +102,10 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
       std::string lines;
       for (int l : skipped.lines) lines += (lines.empty() ? "" : ", ") + std::to_string(l);
       if (skipped.count > static_cast<long long>(skipped.lines.size())) lines += ", …";
-      s.warnings.push_back(Diagnostic{file_name, 0, 0,
-                                      std::string("lenient mode ") + verb + " " + std::to_string(skipped.count) +
-                                          " × " + cause + " (lines " + lines + ")"});
+      s.summary.warnings.push_back(Diagnostic{file_name, 0, 0,
+                                              std::string("lenient mode ") + verb + " " +
+                                                  std::to_string(skipped.count) + " × " + cause +
+                                                  " (lines " + lines + ")"});
     }
   };
   summarize(s.skipped, "skipped");

@@ -10,8 +10,9 @@ namespace tridex::gcode {
 
 // Moves the tip to program point `target` of the frame (rot, org); coordinate i was set
 // absolutely when set_absolute[i]. Handles the far state (see interpreter.hpp).
-void Interpreter::State::move_to(Vec3 target, const std::array<bool, 3>& set_absolute, const Mat3& rot,
-             const Vec3& org, MoveKind kind, double move_feed) {
+void Interpreter::State::move_to(Vec3 target, const std::array<bool, 3>& set_absolute,
+                                 const Mat3& rot, const Vec3& org, MoveKind kind,
+                                 double move_feed) {
   auto to_frame_machine = [&](const Vec3& p) { return org + rot * p; };
   if (!far) {
     Vec3 end = to_frame_machine(target);
@@ -60,9 +61,9 @@ Interpreter::State::Target Interpreter::State::axis_word_target(const Vec3& curr
 void Interpreter::State::linear(MoveKind kind, double move_feed) {
   // Under cutter compensation the programmed point, not the offset tip, is where coordinates
   // count from (and, just after G40, until the next move).
-  Vec3 current = comp_programmed_current ? comp_programmed : to_program(pos);
+  Vec3 current = comp.programmed_current ? comp.programmed : to_program(pos);
   const auto [target, set] = axis_word_target(current);
-  comp_programmed_current = false;
+  comp.programmed_current = false;
   if (kind == MoveKind::feed && feed_mode == FeedMode::inverse_time) {
     inverse_time_rate(glm::length(target - current));
     move_feed = feed;
@@ -71,20 +72,22 @@ void Interpreter::State::linear(MoveKind kind, double move_feed) {
     comp_straight(kind, target, move_feed);
     return;
   }
-  comp_arc_forbidden = false;
+  comp.arc_forbidden = false;
   move_to(target, set, rotation, origin, kind, move_feed);
 }
 
 void Interpreter::State::require_feed() {
   if (feed_mode == FeedMode::inverse_time) {  // LinuxCNC's checks (interp_convert.cc)
     if (!w.has('F'))
-      error(motion_column, "F word missing with inverse time (G93) feed move: every G1, G2 and G3 "
-                           "block needs its own F");
+      error(motion_column,
+            "F word missing with inverse time (G93) feed move: every G1, G2 and G3 "
+            "block needs its own F");
     if (!(inverse_time > 0)) error(w.col('F'), "inverse time (G93) F0: the move would never end");
     return;
   }
   if (feed_mode == FeedMode::per_revolution) {
-    if (!(feed_per_rev > 0)) error(motion_column, "feed move with no feed per revolution (F) set (G95)");
+    if (!(feed_per_rev > 0))
+      error(motion_column, "feed move with no feed per revolution (F) set (G95)");
     if (!(speed > 0))
       error(motion_column, "cannot feed with zero spindle speed in feed per revolution mode (G95)");
     return;
@@ -94,7 +97,8 @@ void Interpreter::State::require_feed() {
     if (w.vacant_words)
       for (const std::string& word : *w.vacant_words)
         if (word[0] == 'F')
-          left_out = ": this block's " + word + " was left out, its value vacant (a variable the control keeps, such "
+          left_out = ": this block's " + word +
+                     " was left out, its value vacant (a variable the control keeps, such "
                      "as #500-#999, is set at the start by the machine file's \"variables\")";
     error(motion_column, "feed move with no feed rate (F) set" + left_out);
   }
@@ -109,7 +113,8 @@ void Interpreter::State::inverse_time_rate(double length) {
 
 // The length of the arc (a helix along the plane normal) from `start` (program frame) that
 // arc_data found, as LinuxCNC's find_arc_length: the start radius times the sweep, and the rise.
-double Interpreter::State::arc_length(const Vec3& start, const ArcData& a, bool ccw, int extra_turns) const {
+double Interpreter::State::arc_length(const Vec3& start, const ArcData& a, bool ccw,
+                                      int extra_turns) const {
   const std::array<int, 3> axes = plane_axes(plane);
   double radius = glm::length(a.centre - Vec2(start[axes[0]], start[axes[1]]));
   double sweep = arc_sweep(start, a.end, a.centre, ccw) + 2 * kPi * extra_turns;
@@ -129,9 +134,10 @@ int Interpreter::State::arc_extra_turns() {
 
 // ---- arcs ----
 void Interpreter::State::arc(bool ccw) {
-  if (comp_arc_forbidden)
-    error(motion_column, "the move just after turning cutter compensation off (G40) must be straight, "
-                         "not an arc (as LinuxCNC requires)");
+  if (comp.arc_forbidden)
+    error(motion_column,
+          "the move just after turning cutter compensation off (G40) must be straight, "
+          "not an arc (as LinuxCNC requires)");
   if (comp_active()) {
     require_feed();
     comp_arc(ccw);
@@ -146,8 +152,9 @@ void Interpreter::State::arc(bool ccw) {
       char c = kAxisLetter[i];
       if (!w.has(c)) continue;
       if (std::abs(along[i]) > kAxisEps)
-        error(w.col(c), "arc from a retracted position that also moves along the tool axis: the "
-                        "tool is far along its axis and its start is unknown; position it first");
+        error(w.col(c),
+              "arc from a retracted position that also moves along the tool axis: the "
+              "tool is far along its axis and its start is unknown; position it first");
       target[i] = incremental ? target[i] + length(c) : length(c);
     }
     for (char c : {'I', 'J', 'K', 'R'})
@@ -160,8 +167,10 @@ void Interpreter::State::arc(bool ccw) {
   Vec3 start = to_program(pos);
   ArcData a = arc_data(start, ccw);
   const int extra_turns = arc_extra_turns();
-  if (feed_mode == FeedMode::inverse_time) inverse_time_rate(arc_length(start, a, ccw, extra_turns));
-  arc_chords(start, a.end, a.centre, ccw, arc_sweep(start, a.end, a.centre, ccw) + 2 * kPi * extra_turns, feed);
+  if (feed_mode == FeedMode::inverse_time)
+    inverse_time_rate(arc_length(start, a, ccw, extra_turns));
+  arc_chords(start, a.end, a.centre, ccw,
+             arc_sweep(start, a.end, a.centre, ccw) + 2 * kPi * extra_turns, feed);
   pos = to_machine(a.end);
 }
 
@@ -181,8 +190,8 @@ Interpreter::State::ArcData Interpreter::State::arc_data(const Vec3& start, bool
   if (has_center && has_radius)
     error(w.col('R'), "arc with both R and " + std::string(1, cu) + "/" + cv + " words");
   if (!has_center && !has_radius)
-    error(motion_column, std::string("arc needs ") + cu + "/" + cv + " (in " +
-                             code_name('G', plane) + ") or R");
+    error(motion_column,
+          std::string("arc needs ") + cu + "/" + cv + " (in " + code_name('G', plane) + ") or R");
   Vec2 s(start[u], start[v]), e(end[u], end[v]), c;
   ArcData result;
   result.end = end;
@@ -236,7 +245,8 @@ Interpreter::State::ArcData Interpreter::State::arc_data(const Vec3& start, bool
 
 // How far an arc from `start` to `end` (program frame) turns about `c` in the active plane:
 // (0, 2π], a full circle when the two points coincide.
-double Interpreter::State::arc_sweep(const Vec3& start, const Vec3& end, const Vec2& c, bool ccw) const {
+double Interpreter::State::arc_sweep(const Vec3& start, const Vec3& end, const Vec2& c,
+                                     bool ccw) const {
   const std::array<int, 3> axes = plane_axes(plane);
   const int u = axes[0], v = axes[1];
   Vec2 s(start[u], start[v]), e(end[u], end[v]);
@@ -297,27 +307,28 @@ void Interpreter::State::arc_chords(const Vec3& start, const Vec3& end, const Ve
 // tripped"). Where a real probe touches is known only on the machine: said once in the warnings.
 void Interpreter::State::probe(int code) {
   const std::string name = code_name('G', code);
-  if (comp_side != 0) error(motion_column, name + ": cannot probe with cutter radius compensation on");
+  if (comp.side != 0)
+    error(motion_column, name + ": cannot probe with cutter radius compensation on");
   if (feed_mode == FeedMode::per_revolution)
     error(motion_column, name + ": cannot probe in feed per revolution mode (G95)");
   if (!(feed > 0)) error(motion_column, name + ": cannot probe with zero feed rate");
-  Vec3 current = comp_programmed_current ? comp_programmed : to_program(pos);
+  Vec3 current = comp.programmed_current ? comp.programmed : to_program(pos);
   const auto [target, set] = axis_word_target(current);
-  comp_programmed_current = false;
-  comp_arc_forbidden = false;
-  const bool must_move = code == 382 || code == 384;  // G38.3/G38.5 may stand still
+  comp.programmed_current = false;
+  comp.arc_forbidden = false;
+  const bool must_move = code == kG38_2 || code == kG38_4;  // G38.3/G38.5 may stand still
   if (must_move && target == current)
     error(motion_column, name + ": start point too close to probe point (the probe does not move)");
-  if (!warned_probe) {
-    warned_probe = true;
-    warn(motion_column, name + " read as LinuxCNC's rs274 standalone does: the probe reaches the "
-                               "programmed point and backs off 0.254 mm; where it really touches is "
-                               "known only on the machine");
+  if (!warned_once.probe) {
+    warned_once.probe = true;
+    warn(motion_column, name +
+                            " read as LinuxCNC's rs274 standalone does: the probe reaches the "
+                            "programmed point and backs off 0.254 mm; where it really touches is "
+                            "known only on the machine");
   }
   move_to(target, set, rotation, origin, MoveKind::feed, feed);
-  for (int i = 0; i < 3; ++i)
-    globals[5061 + i] = Value{target[i] / unit, false};
-  globals[5070] = Value{0, false};
+  for (int i = 0; i < 3; ++i) parameters.globals[5061 + i] = Value{target[i] / unit, false};
+  parameters.globals[5070] = Value{0, false};
   double distance = glm::length(target - current);
   if (far || !(distance > 0)) return;
   Vec3 back = to_machine(target + 0.254 * (current - target) / distance);
@@ -326,6 +337,15 @@ void Interpreter::State::probe(int code) {
 }
 
 // ---- canned cycles ----
+namespace {
+// The cycles that dwell at the bottom of the hole.
+bool cycle_dwells(int code) {
+  return code == kG74 || code == kG82 || code == kG84 || code == kG86 || code == kG89;
+}
+}  // namespace
+
+// A canned cycle's block: its sticky words, the levels along its axis, then each hole (L or K
+// repeats) in turn.
 void Interpreter::State::cycle(int code) {
   const std::array<int, 3> axes = plane_axes(plane);
   const int u = axes[0], v = axes[1], n = axes[2];
@@ -333,74 +353,10 @@ void Interpreter::State::cycle(int code) {
   if (glm::dot(drill, axis) < 1 - 1e-9)
     error(motion_column, code_name('G', code) + " drills along the " + code_name('G', plane) +
                              " plane normal, which is not the spindle direction");
-  char depth_letter = kAxisLetter[n];
-  if (w.has('R')) {
-    cycle_r = length('R');
-    has_cycle_r = true;
-  }
-  if (w.has(depth_letter)) {
-    cycle_z = length(depth_letter);
-    has_cycle_z = true;
-  }
-  if (code == 730 || code == 830) {
-    if (w.has('Q')) {
-      cycle_q = length('Q');
-      has_cycle_q = true;
-    }
-    if (!has_cycle_q || !(cycle_q > 0))
-      error(motion_column, code_name('G', code) + " needs a positive peck depth Q");
-  }
-  // The cycles that dwell at the bottom read P. Fanuc and Haas keep P as modal cycle data in any
-  // cycle (a post writes it on G81 too), for a later one that dwells.
-  const bool dwells = code == 740 || code == 820 || code == 840 || code == 860 || code == 890;
-  if ((dwells || machine.dialect != Dialect::linuxcnc) && w.has('P')) {
-    double p = w.take('P');
-    if (p < 0) error(w.col('P'), "dwell P must not be negative");
-    cycle_dwell = dwell_seconds(p);
-  }
-  if (feed_mode == FeedMode::inverse_time)
-    error(motion_column, code_name('G', code) + ": canned cycles cannot run in inverse time feed "
-                                                "(G93), as LinuxCNC requires; G94 first");
-  if (!has_cycle_r) error(motion_column, code_name('G', code) + " needs R (retract plane)");
-  if (!has_cycle_z)
-    error(motion_column, code_name('G', code) + " needs " + depth_letter + " (hole bottom)");
-  require_feed();
-  if (w.has('L') && w.has('K')) error(w.col('K'), "repeat count given twice (L and K)");
-  if (w.has('L') && (code == 740 || code == 840) && machine.dialect == Dialect::linuxcnc)
-    error(w.col('L'), code_name('G', code) + " L: LinuxCNC's rs274 takes no repeats on a tapping cycle");
-  long long repeats = 1;
-  if (w.has('L')) repeats = integer('L', "repeat count", 0, 9999);
-  if (w.has('K')) repeats = integer('K', "repeat count", 0, 9999);
+  const long long repeats = cycle_words(code, kAxisLetter[n]);
 
   Vec3 current = to_program(pos);
-  if (!cycle_active) {
-    cycle_active = true;
-    cycle_initial_far = far;
-    cycle_initial = current[n];
-  }
-  if (far && incremental)
-    error(motion_column, "incremental canned cycle from a retracted (far) position");
-  // G91: R counts from the initial level of the cycle (kept while the cycle mode lasts, as
-  // LinuxCNC's cycle_il and Fanuc's initial point), not from where the last hole left the tool.
-  double incremental_base = cycle_initial_far ? current[n] : cycle_initial;
-  double r_level = incremental ? incremental_base + cycle_r : cycle_r;
-  double bottom = incremental ? r_level + cycle_z : cycle_z;
-  if (bottom > r_level)
-    error(motion_column, "hole bottom " + format_number(bottom) + " is above the R plane " +
-                             format_number(r_level));
-  if (code == 730 || code == 830) {
-    // A real control pecks a hole a few hundred times at most; a tiny Q against a deep hole
-    // (or a far R plane) would emit moves without end, and below one ulp would never finish.
-    constexpr double kMaxPecks = 100000;
-    double pecks = (r_level - bottom) / cycle_q;
-    if (!(pecks <= kMaxPecks))
-      error(motion_column, code_name('G', code) + " would peck " + format_number(pecks) +
-                               " times (R " + format_number(r_level) + " to " + format_number(bottom) +
-                               " by Q " + format_number(cycle_q) + "); at most 100000 per hole");
-  }
-  bool clear_far = !retract_to_r && cycle_initial_far;
-  double clear = retract_to_r ? r_level : std::max(cycle_initial, r_level);
-  if (clear_far) clear = r_level;
+  const CycleLevels levels = cycle_levels(code, current[n]);
 
   // Lateral target of the first hole; increments repeat under G91.
   double du = w.has(kAxisLetter[u]) ? length(kAxisLetter[u]) : 0.0;
@@ -412,22 +368,8 @@ void Interpreter::State::cycle(int code) {
   double step_radius = w.has('@') ? length('@') : 0.0;
   double step_angle = w.has('^') ? glm::radians(w.take('^')) : 0.0;
 
-  auto at = [&](double uu, double vv, double depth) {
-    Vec3 p;
-    p[u] = uu;
-    p[v] = vv;
-    p[n] = depth;
-    return to_machine(p);
-  };
-  auto rapid = [&](const Vec3& to) {
-    emit(MoveKind::cycle, pos, to, 0.0);
-    pos = to;
-  };
-  auto cut = [&](const Vec3& to) {
-    emit(MoveKind::cycle, pos, to, feed);
-    pos = to;
-  };
-  if (!far && current[n] < r_level - 1e-9) rapid(at(current[u], current[v], r_level));
+  if (!far && current[n] < levels.r_level - 1e-9)
+    cycle_rapid(cycle_point(current[u], current[v], levels.r_level));
   for (long long k = 0; k < repeats; ++k) {
     if (incremental) {
       hole_u += du;
@@ -435,63 +377,175 @@ void Interpreter::State::cycle(int code) {
     }
     if (step_radius != 0 || step_angle != 0) {
       if (hole_u == 0 && hole_v == 0)
-        error(motion_column, "incremental (G91) polar coordinates at the origin: the direction is unknown");
+        error(motion_column,
+              "incremental (G91) polar coordinates at the origin: the direction is unknown");
       double radius = std::hypot(hole_u, hole_v) + step_radius;
       double angle = std::atan2(hole_v, hole_u) + step_angle;
       hole_u = radius * std::cos(angle);
       hole_v = radius * std::sin(angle);
     }
-    if (far) {
-      // Come back from far straight down the axis onto the R plane of the hole.
-      Vec3 r_point = at(hole_u, hole_v, r_level);
-      emit(MoveKind::cycle, r_point + machine.far_distance * axis, r_point, 0.0, true);
-      pos = r_point;
-      far = false;
-    } else {
-      Vec3 level = to_program(pos);
-      rapid(at(hole_u, hole_v, level[n]));
-      rapid(at(hole_u, hole_v, r_level));
-    }
-    double d = options.peck_clearance;
-    switch (code) {
-      case 730:
-        for (double depth = r_level - cycle_q; depth > bottom; depth -= cycle_q) {
-          cut(at(hole_u, hole_v, depth));
-          rapid(at(hole_u, hole_v, depth + d));
-        }
-        cut(at(hole_u, hole_v, bottom));
-        break;
-      case 830:
-        for (double depth = r_level - cycle_q; depth > bottom; depth -= cycle_q) {
-          cut(at(hole_u, hole_v, depth));
-          rapid(at(hole_u, hole_v, r_level));
-          rapid(at(hole_u, hole_v, depth + d));
-        }
-        cut(at(hole_u, hole_v, bottom));
-        break;
-      default:  // the others go down at feed in one piece
-        cut(at(hole_u, hole_v, bottom));
-        break;
-    }
-    if (dwells) emit_dwell(cycle_dwell);  // at the bottom
-    switch (code) {  // the way out: at feed for these, at rapid for the others (below)
-      case 740:  // tapping (G74 left hand, G84 right hand): the spindle reverses and the tap
-      case 840:  // backs out at feed: to R on Fanuc and Haas, as G85; LinuxCNC's to the clear level
-        cut(at(hole_u, hole_v, machine.dialect == Dialect::linuxcnc && !clear_far ? clear : r_level));
-        break;
-      case 850:  // to R (then rapid to the clear level)
-        cut(at(hole_u, hole_v, r_level));
-        break;
-      case 890:  // all the way to the clear level, as LinuxCNC does
-        cut(at(hole_u, hole_v, clear_far ? r_level : clear));
-        break;
-      default:
-        break;
-    }
-    Vec3 out = at(hole_u, hole_v, clear);
-    if (out != pos) rapid(out);
-    if (clear_far) far = true;
+    cycle_hole(code, hole_u, hole_v, levels);
   }
+}
+
+// The cycle's words: R, the depth along the plane's normal and Q stay from block to block (the
+// cycle's sticky data), P where the cycle reads it; the repeat count (L or K) is returned.
+long long Interpreter::State::cycle_words(int code, char depth_letter) {
+  if (w.has('R')) {
+    canned.r = length('R');
+    canned.has_r = true;
+  }
+  if (w.has(depth_letter)) {
+    canned.z = length(depth_letter);
+    canned.has_z = true;
+  }
+  if (code == kG73 || code == kG83) {
+    if (w.has('Q')) {
+      canned.q = length('Q');
+      canned.has_q = true;
+    }
+    if (!canned.has_q || !(canned.q > 0))
+      error(motion_column, code_name('G', code) + " needs a positive peck depth Q");
+  }
+  // The cycles that dwell at the bottom read P. Fanuc and Haas keep P as modal cycle data in any
+  // cycle (a post writes it on G81 too), for a later one that dwells.
+  if ((cycle_dwells(code) || machine.dialect != Dialect::linuxcnc) && w.has('P')) {
+    double p = w.take('P');
+    if (p < 0) error(w.col('P'), "dwell P must not be negative");
+    canned.dwell = dwell_seconds(p);
+  }
+  if (feed_mode == FeedMode::inverse_time)
+    error(motion_column, code_name('G', code) +
+                             ": canned cycles cannot run in inverse time feed "
+                             "(G93), as LinuxCNC requires; G94 first");
+  if (!canned.has_r) error(motion_column, code_name('G', code) + " needs R (retract plane)");
+  if (!canned.has_z)
+    error(motion_column, code_name('G', code) + " needs " + depth_letter + " (hole bottom)");
+  require_feed();
+  if (w.has('L') && w.has('K')) error(w.col('K'), "repeat count given twice (L and K)");
+  if (w.has('L') && (code == kG74 || code == kG84) && machine.dialect == Dialect::linuxcnc)
+    error(w.col('L'),
+          code_name('G', code) + " L: LinuxCNC's rs274 takes no repeats on a tapping cycle");
+  long long repeats = 1;
+  if (w.has('L')) repeats = integer('L', "repeat count", 0, 9999);
+  if (w.has('K')) repeats = integer('K', "repeat count", 0, 9999);
+  return repeats;
+}
+
+// The R plane, the bottom and the clear level along the cycle's axis, from `current` (the tool's
+// place along it); the cycle's initial level is kept while the cycle mode lasts.
+Interpreter::State::CycleLevels Interpreter::State::cycle_levels(int code, double current) {
+  if (!canned.active) {
+    canned.active = true;
+    canned.initial_far = far;
+    canned.initial = current;
+  }
+  if (far && incremental)
+    error(motion_column, "incremental canned cycle from a retracted (far) position");
+  // G91: R counts from the initial level of the cycle (kept while the cycle mode lasts, as
+  // LinuxCNC's cycle_il and Fanuc's initial point), not from where the last hole left the tool.
+  double incremental_base = canned.initial_far ? current : canned.initial;
+  double r_level = incremental ? incremental_base + canned.r : canned.r;
+  double bottom = incremental ? r_level + canned.z : canned.z;
+  if (bottom > r_level)
+    error(motion_column, "hole bottom " + format_number(bottom) + " is above the R plane " +
+                             format_number(r_level));
+  if (code == kG73 || code == kG83) {
+    // A real control pecks a hole a few hundred times at most; a tiny Q against a deep hole
+    // (or a far R plane) would emit moves without end, and below one ulp would never finish.
+    constexpr double kMaxPecks = 100000;
+    double pecks = (r_level - bottom) / canned.q;
+    if (!(pecks <= kMaxPecks))
+      error(motion_column, code_name('G', code) + " would peck " + format_number(pecks) +
+                               " times (R " + format_number(r_level) + " to " +
+                               format_number(bottom) + " by Q " + format_number(canned.q) +
+                               "); at most 100000 per hole");
+  }
+  bool clear_far = !retract_to_r && canned.initial_far;
+  double clear = retract_to_r ? r_level : std::max(canned.initial, r_level);
+  if (clear_far) clear = r_level;
+  return CycleLevels{r_level, bottom, clear, clear_far};
+}
+
+// A point of the cycle: (u, v) in the plane and `depth` along its normal, program frame.
+Vec3 Interpreter::State::cycle_point(double u_coordinate, double v_coordinate, double depth) const {
+  const std::array<int, 3> axes = plane_axes(plane);
+  Vec3 p;
+  p[axes[0]] = u_coordinate;
+  p[axes[1]] = v_coordinate;
+  p[axes[2]] = depth;
+  return to_machine(p);
+}
+
+void Interpreter::State::cycle_rapid(const Vec3& to) {
+  emit(MoveKind::cycle, pos, to, 0.0);
+  pos = to;
+}
+
+void Interpreter::State::cycle_cut(const Vec3& to) {
+  emit(MoveKind::cycle, pos, to, feed);
+  pos = to;
+}
+
+// One hole: onto its R plane, down (pecking for G73 and G83), the dwell, and out to the clear
+// level.
+void Interpreter::State::cycle_hole(int code, double hole_u, double hole_v,
+                                    const CycleLevels& levels) {
+  const int n = plane_axes(plane)[2];
+  const double r_level = levels.r_level, bottom = levels.bottom, clear = levels.clear;
+  const bool clear_far = levels.clear_far;
+  auto at = [&](double uu, double vv, double depth) { return cycle_point(uu, vv, depth); };
+  if (far) {
+    // Come back from far straight down the axis onto the R plane of the hole.
+    Vec3 r_point = at(hole_u, hole_v, r_level);
+    emit(MoveKind::cycle, r_point + machine.far_distance * axis, r_point, 0.0, true);
+    pos = r_point;
+    far = false;
+  } else {
+    Vec3 level = to_program(pos);
+    cycle_rapid(at(hole_u, hole_v, level[n]));
+    cycle_rapid(at(hole_u, hole_v, r_level));
+  }
+  double d = options.peck_clearance;
+  switch (code) {
+    case kG73:
+      for (double depth = r_level - canned.q; depth > bottom; depth -= canned.q) {
+        cycle_cut(at(hole_u, hole_v, depth));
+        cycle_rapid(at(hole_u, hole_v, depth + d));
+      }
+      cycle_cut(at(hole_u, hole_v, bottom));
+      break;
+    case kG83:
+      for (double depth = r_level - canned.q; depth > bottom; depth -= canned.q) {
+        cycle_cut(at(hole_u, hole_v, depth));
+        cycle_rapid(at(hole_u, hole_v, r_level));
+        cycle_rapid(at(hole_u, hole_v, depth + d));
+      }
+      cycle_cut(at(hole_u, hole_v, bottom));
+      break;
+    default:  // the others go down at feed in one piece
+      cycle_cut(at(hole_u, hole_v, bottom));
+      break;
+  }
+  if (cycle_dwells(code)) emit_dwell(canned.dwell);  // at the bottom
+  switch (code) {  // the way out: at feed for these, at rapid for the others (below)
+    case kG74:     // tapping (G74 left hand, G84 right hand): the spindle reverses and the tap
+    case kG84:  // backs out at feed: to R on Fanuc and Haas, as G85; LinuxCNC's to the clear level
+      cycle_cut(
+          at(hole_u, hole_v, machine.dialect == Dialect::linuxcnc && !clear_far ? clear : r_level));
+      break;
+    case kG85:  // to R (then rapid to the clear level)
+      cycle_cut(at(hole_u, hole_v, r_level));
+      break;
+    case kG89:  // all the way to the clear level, as LinuxCNC does
+      cycle_cut(at(hole_u, hole_v, clear_far ? r_level : clear));
+      break;
+    default:
+      break;
+  }
+  Vec3 out = at(hole_u, hole_v, clear);
+  if (out != pos) cycle_rapid(out);
+  if (clear_far) far = true;
 }
 
 // ---- LinuxCNC polar coordinates ----
@@ -505,16 +559,18 @@ void Interpreter::State::polar_words(bool axis_consumer, int nonmodal) {
   int column = w.col(w.has('@') ? '@' : '^');
   if (machine.dialect != Dialect::linuxcnc)
     error(column, "'@' and '^' (polar coordinates) are LinuxCNC's words: use --machine linuxcnc");
-  if (nonmodal == 530) error(column, "polar coordinates cannot be used with G53");
-  bool moving = motion == 0 || motion == 10 || motion == 20 || motion == 30 || is_cycle(motion);
-  if (axis_consumer || nonmodal == 280 || nonmodal == 300 || !moving)
+  if (nonmodal == kG53) error(column, "polar coordinates cannot be used with G53");
+  bool moving =
+      motion == kG0 || motion == kG1 || motion == kG2 || motion == kG3 || is_cycle(motion);
+  if (axis_consumer || nonmodal == kG28 || nonmodal == kG30 || !moving)
     error(column, "polar coordinates can only be used for motion (G0, G1, G2, G3 or a cycle)");
-  if (plane != 170) error(column, "polar coordinates need the XY plane (G17)");
+  if (plane != kG17) error(column, "polar coordinates need the XY plane (G17)");
   for (char c : {'X', 'Y'})
-    if (w.has(c)) error(w.col(c), std::string("polar coordinates and an ") + c + " word in the same block");
+    if (w.has(c))
+      error(w.col(c), std::string("polar coordinates and an ") + c + " word in the same block");
   bool cycle_block = is_cycle(motion);
   if (cycle_block && incremental) return;  // a step of every repeat: cycle() reads the words
-  Vec3 current = (comp_programmed_current ? comp_programmed : to_program(pos)) / unit;
+  Vec3 current = (comp.programmed_current ? comp.programmed : to_program(pos)) / unit;
   double x = current.x, y = current.y;
   bool has_radius = w.has('@'), has_angle = w.has('^');
   double radius = has_radius ? w.take('@') : 0, angle = has_angle ? glm::radians(w.take('^')) : 0;
@@ -547,7 +603,8 @@ void Interpreter::State::polar_words(bool axis_consumer, int nonmodal) {
 // coordinates, which is only unambiguous with the tool along +Z. A machine whose zero is known
 // (MachineConfig::g53_literal, e.g. LinuxCNC's rs274) moves to the point named, as G28 does to a
 // configured position.
-void Interpreter::State::machine_move(const Vec3& gauge, unsigned mask, MoveKind kind, double move_feed) {
+void Interpreter::State::machine_move(const Vec3& gauge, unsigned mask, MoveKind kind,
+                                      double move_feed) {
   Vec3 target = tip_below(gauge);
   Vec3 end = pos;
   for (int i = 0; i < 3; ++i)
@@ -564,8 +621,9 @@ void Interpreter::State::machine_move(const Vec3& gauge, unsigned mask, MoveKind
     return;
   }
   if (!along_z)
-    error(motion_column, "G53 X/Y with a tilted tool depends on the machine's kinematics; "
-                         "retract with G53 Z (or G28) first");
+    error(motion_column,
+          "G53 X/Y with a tilted tool depends on the machine's kinematics; "
+          "retract with G53 Z (or G28) first");
   if (kind == MoveKind::feed && feed_mode == FeedMode::inverse_time) {
     inverse_time_rate(glm::length(end - pos));
     move_feed = feed;
@@ -575,7 +633,7 @@ void Interpreter::State::machine_move(const Vec3& gauge, unsigned mask, MoveKind
 }
 
 void Interpreter::State::home_return(bool second) {
-  int column = w.find_g(second ? 300 : 280);
+  int column = w.find_g(second ? kG30 : kG28);
   if (second && w.has('P')) {
     if (integer('P', "G30 reference number", 2, 2) != 2) error(w.col('P'), "only G30 P2");
   }
@@ -599,7 +657,7 @@ void Interpreter::State::home_return(bool second) {
     }
   const Vec3& target = second ? machine.reference2 : machine.home;
   bool is_default = second ? machine.reference2_is_default : machine.home_is_default;
-  bool& warned = second ? warned_reference2 : warned_home;
+  bool& warned = second ? warned_once.reference2 : warned_once.home;
   // Returning Z alone (the posts' `G28 G91 Z0`) retracts to the top of Z's travel on any mill,
   // which the far rule models exactly; only a return of X or Y lands at a position the default
   // reference has to guess.
@@ -639,7 +697,8 @@ void Interpreter::State::home_return(bool second) {
   far = true;
   if (turns) {
     // The tip goes far while the axes turn; the direction follows the kinematic model.
-    axis = machine.kinematics ? tool_direction(*machine.kinematics, rotary_position) : Vec3(0, 0, 1);
+    axis =
+        machine.kinematics ? tool_direction(*machine.kinematics, rotary_position) : Vec3(0, 0, 1);
     update_frame();
   }
 }

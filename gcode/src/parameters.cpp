@@ -70,29 +70,55 @@ std::optional<OffsetRegister> offset_register(int n, Dialect dialect) {
 
 Value Interpreter::State::numbered(int n) {
   if (n == 0) return Value{0, true};
-  if (n <= 33) return scopes.back().locals[static_cast<std::size_t>(n)];
+  if (n <= 33) return parameters.scopes.back().locals[static_cast<std::size_t>(n)];
   Vec3 program = to_program(pos);  // the end of the last block: the tip is there
   switch (n) {
     // Fanuc modal information of the block before (#4001 + group − 1).
-    case 4001: return number(motion < 0 ? 0 : motion / 10.0);
-    case 4002: return number(plane / 10.0);
-    case 4003: return number(incremental ? 91 : 90);
-    case 4005: return number(feed_mode == FeedMode::inverse_time ? 93 : feed_mode == FeedMode::per_minute ? 94 : 95);
-    case 4006: return number(unit == 1.0 ? 21 : 20);
-    case 4007: return number(comp_side == 0 ? 40 : comp_side > 0 ? 41 : 42);
-    case 4008: return number(49);
-    case 4009: return number(is_cycle(motion) ? motion / 10.0 : 80);
-    case 4010: return number(retract_to_r ? 99 : 98);
-    case 4014: return number(work_key >= 100 ? 54.1 : 53 + work_key);
-    case 4109: return number(programmed_feed());
-    case 4119: return number(speed);
-    case 4120: return number(tool);
-    case 5001: case 5002: case 5003: return number(program[n - 5001] / unit);
-    case 5041: case 5042: case 5043: return number(program[n - 5041] / unit);
-    case 5021: case 5022: case 5023: return number(pos[n - 5021] / unit);
+    case 4001:
+      return number(motion < 0 ? 0 : motion / 10.0);
+    case 4002:
+      return number(plane / 10.0);
+    case 4003:
+      return number(incremental ? 91 : 90);
+    case 4005:
+      return number(feed_mode == FeedMode::inverse_time ? 93
+                    : feed_mode == FeedMode::per_minute ? 94
+                                                        : 95);
+    case 4006:
+      return number(unit == 1.0 ? 21 : 20);
+    case 4007:
+      return number(comp.side == 0 ? 40 : comp.side > 0 ? 41 : 42);
+    case 4008:
+      return number(49);
+    case 4009:
+      return number(is_cycle(motion) ? motion / 10.0 : 80);
+    case 4010:
+      return number(retract_to_r ? 99 : 98);
+    case 4014:
+      return number(work_key >= 100 ? 54.1 : 53 + work_key);
+    case 4109:
+      return number(programmed_feed());
+    case 4119:
+      return number(speed);
+    case 4120:
+      return number(tool);
+    case 5001:
+    case 5002:
+    case 5003:
+      return number(program[n - 5001] / unit);
+    case 5041:
+    case 5042:
+    case 5043:
+      return number(program[n - 5041] / unit);
+    case 5021:
+    case 5022:
+    case 5023:
+      return number(pos[n - 5021] / unit);
     // LinuxCNC: the active coordinate system (1 = G54), the tool, the current position.
-    case 5220: return number(work_key >= 100 ? 0 : work_key);
-    case 5400: return number(tool);
+    case 5220:
+      return number(work_key >= 100 ? 0 : work_key);
+    case 5400:
+      return number(tool);
     // The loaded tool's diameter as LinuxCNC's tool table holds it (rs274ngc_pre.cc,
     // set_tool_parameters: parameters[5410] = tool_table[0].diameter): in the table's units, the
     // machine's (inches for rs274 run standalone), not the program's; 0 with no tool or one the
@@ -102,10 +128,20 @@ Value Interpreter::State::numbered(int n) {
       if (auto d = machine.tool_diameters.find(tool); d != machine.tool_diameters.end())
         return number(d->second / (machine.tool_table_in_inches ? 25.4 : 1.0));
       return number(0);
-    case 5420: case 5421: case 5422: return number(program[n - 5420] / unit);
-    case 5423: case 5424: case 5425: return number(0);
-    case 5426: case 5427: case 5428: return number(uvw_position[n - 5426] / unit);
-    default: break;
+    case 5420:
+    case 5421:
+    case 5422:
+      return number(program[n - 5420] / unit);
+    case 5423:
+    case 5424:
+    case 5425:
+      return number(0);
+    case 5426:
+    case 5427:
+    case 5428:
+      return number(uvw_position[n - 5426] / unit);
+    default:
+      break;
   }
   int component = 0;
   if (int key = offset_variable(n, component); key >= 0) {
@@ -115,19 +151,24 @@ Value Interpreter::State::numbered(int n) {
   if (auto r = offset_register(n, machine.dialect)) {
     // H: what G43 reads (a geometry never set is the machine's length of that tool). D: what the
     // program wrote, else the tool table's radius or diameter, as the machine's D registers hold.
-    if (r->length) return number((r->wear ? wear_of(r->number) : length_geometry(r->number).value_or(0.0)) / unit);
-    const std::map<int, double>& written = r->wear ? d_wear : d_geometry;
+    if (r->length)
+      return number((r->wear ? wear_of(r->number) : length_geometry(r->number).value_or(0.0)) /
+                    unit);
+    const std::map<int, double>& written = r->wear ? comp.d_wear : comp.d_geometry;
     if (auto it = written.find(r->number); it != written.end()) return number(it->second / unit);
     if (r->wear) return number(0);
     const std::optional<double> scale = d_register_scale();
     if (!scale)
-      detail::fail("#", n, " (D", r->number, "'s geometry) holds a diameter or a radius after Haas's setting 40: ",
-                   "say which with \"d_offsets\" in the machine file, or set it in the program before reading it");
+      detail::fail("#", n, " (D", r->number,
+                   "'s geometry) holds a diameter or a radius after Haas's setting 40: ",
+                   "say which with \"d_offsets\" in the machine file, or set it in the program "
+                   "before reading it");
     auto diameter = machine.tool_diameters.find(r->number);
-    return number(diameter == machine.tool_diameters.end() ? 0.0 : diameter->second / 2 / *scale / unit);
+    return number(diameter == machine.tool_diameters.end() ? 0.0
+                                                           : diameter->second / 2 / *scale / unit);
   }
-  auto it = globals.find(n);
-  if (it != globals.end()) return it->second;
+  auto it = parameters.globals.find(n);
+  if (it != parameters.globals.end()) return it->second;
   // Unset: Fanuc's vacant; LinuxCNC's parameters start at 0 (the word rule tells them apart).
   return Value{0, true};
 }
@@ -151,10 +192,10 @@ std::optional<Value> Interpreter::State::named(std::string_view name) {
     if (key == "_rpm") return number(speed);
     if (key == "_motion_mode") return number(motion < 0 ? 0 : motion);
     if (key == "_plane") return number(plane);
-    if (key == "_coord_system") return number(work_key >= 100 ? 0 : 530 + 10 * work_key);
-    if (key == "_call_level") return number(static_cast<double>(scopes.size() - 1));
+    if (key == "_coord_system") return number(work_key >= 100 ? 0 : kG53 + 10 * work_key);
+    if (key == "_call_level") return number(static_cast<double>(parameters.scopes.size() - 1));
     if (key == "_line") return number(line);
-    if (key == "_ccomp") return number(comp_side == 0 ? 400 : comp_side > 0 ? 410 : 420);
+    if (key == "_ccomp") return number(comp.side == 0 ? kG40 : comp.side > 0 ? kG41 : kG42);
     if (key == "_spindle_on") return number(spindle_direction != 0 ? 1 : 0);
     if (key == "_spindle_cw") return number(spindle_direction > 0 ? 1 : 0);
     if (key == "_ijk_absolute_mode") return number(arc_absolute ? 1 : 0);
@@ -164,11 +205,11 @@ std::optional<Value> Interpreter::State::named(std::string_view name) {
     if (key == "_speed_override" || key == "_feed_override") return number(1);
     if (key == "_vmajor") return number(2.9);
     if (key == "_vminor") return number(0);
-    auto it = named_globals.find(key);
-    if (it == named_globals.end()) return std::nullopt;
+    auto it = parameters.named_globals.find(key);
+    if (it == parameters.named_globals.end()) return std::nullopt;
     return it->second;
   }
-  auto& locals = scopes.back().named;
+  auto& locals = parameters.scopes.back().named;
   auto it = locals.find(key);
   if (it == locals.end()) return std::nullopt;
   return it->second;
@@ -177,32 +218,35 @@ std::optional<Value> Interpreter::State::named(std::string_view name) {
 void Interpreter::State::assign(const Assignment& a) {
   if (a.number < 0) {
     if (!a.name.empty() && a.name[0] == '_')
-      named_globals[a.name] = a.value;
+      parameters.named_globals[a.name] = a.value;
     else
-      scopes.back().named[a.name] = a.value;
+      parameters.scopes.back().named[a.name] = a.value;
     return;
   }
   int n = a.number;
   if (n == 0) error(a.column, "#0 is the vacant value and cannot be set");
   if (n <= 33) {
-    scopes.back().locals[static_cast<std::size_t>(n)] = a.value;
+    parameters.scopes.back().locals[static_cast<std::size_t>(n)] = a.value;
     return;
   }
   if (n == 3000)  // Fanuc's alarm: the program stops with this number
     error(a.column, "the program raises alarm #3000 = " + format_number(a.value.number));
   if (n == 3006) {  // a stop with a message for the operator
-    warn(a.column, "#3006 = " + format_number(a.value.number) + ": the program stops for the operator here");
+    warn(a.column,
+         "#3006 = " + format_number(a.value.number) + ": the program stops for the operator here");
     return;
   }
   // An offset moves the tool as a word does, and is held to a word's range.
   auto offset_value = [&] {
     const double value = a.value.vacant ? 0.0 : a.value.number;
     if (!std::isfinite(value) || std::abs(value) > kMaxWordValue)
-      error(a.column, "#" + std::to_string(n) + " = " + format_number(value) + ": out of range (limit 1e9)");
+      error(a.column,
+            "#" + std::to_string(n) + " = " + format_number(value) + ": out of range (limit 1e9)");
     return value;
   };
   int component = 0;
-  if (int key = offset_variable(n, component); key >= 0) {  // probing macros set work offsets this way
+  if (int key = offset_variable(n, component);
+      key >= 0) {  // probing macros set work offsets this way
     if (tilted && key == work_key)
       error(a.column, "the active work offset changes under a tilted plane");
     Vec3 value = offsets.count(key) ? offsets[key] : Vec3(0.0);
@@ -217,19 +261,19 @@ void Interpreter::State::assign(const Assignment& a) {
   if (auto r = offset_register(n, machine.dialect)) {  // tool setting and probing macros
     const double value = offset_value();
     if (r->length) {
-      (r->wear ? length_wear : set_lengths)[r->number] = value * unit;
+      (r->wear ? tool_table.wear : tool_table.lengths)[r->number] = value * unit;
     } else {  // read back as written, and by a G41/G42 using it (comp.cpp)
-      (r->wear ? d_wear : d_geometry)[r->number] = value * unit;
+      (r->wear ? comp.d_wear : comp.d_geometry)[r->number] = value * unit;
       std::string by(1, '#');
       by += std::to_string(n);
       by += line > 0 ? " at line " + std::to_string(line) : " in the machine file's \"variables\"";
-      d_set_at[r->number] = std::move(by);
+      comp.d_set_at[r->number] = std::move(by);
     }
     return;
   }
   if ((n >= 4001 && n <= 4400) || (n >= 5001 && n <= 5043) || (n >= 5420 && n <= 5428))
     error(a.column, "#" + std::to_string(n) + " is a read-only system variable");
-  globals[n] = a.value;
+  parameters.globals[n] = a.value;
 }
 
 // Offsets the control holds at the start are its registers, set as a program would set them
@@ -239,7 +283,7 @@ void Interpreter::State::preset(int n, double value) {
   if (offset_variable(n, component) >= 0 || offset_register(n, machine.dialect))
     assign(Assignment{n, {}, Value{value, false}, 0});
   else
-    globals[n] = Value{value, false};
+    parameters.globals[n] = Value{value, false};
 }
 
 }  // namespace tridex::gcode

@@ -76,9 +76,9 @@ class Nurbs {
     auto t = [&](std::size_t j) { return knots_[j]; };
     const auto index = [&](auto it) { return static_cast<std::size_t>(it - knots_.begin()); };
     std::size_t first = index(std::lower_bound(knots_.begin(), knots_.end(), u));  // t(first) >= u
-    first = first == 0 ? 0 : first - 1;                                           // t(first + 1) >= u
-    std::size_t last = index(std::upper_bound(knots_.begin(), knots_.end(), u));   // t(last) > u
-    last = std::min(last == 0 ? 0 : last - 1, knots_.size() - 2);                  // t(last) <= u
+    first = first == 0 ? 0 : first - 1;  // t(first + 1) >= u
+    std::size_t last = index(std::upper_bound(knots_.begin(), knots_.end(), u));  // t(last) > u
+    last = std::min(last == 0 ? 0 : last - 1, knots_.size() - 2);                 // t(last) <= u
     const std::size_t k_max = static_cast<std::size_t>(order_);
     const std::size_t lo = first >= k_max - 1 ? first - (k_max - 1) : 0;
     basis_.assign(last + 2 - lo, 0.0);  // i in [lo, last + 1]; N_last+1 stays 0 at every order
@@ -104,19 +104,23 @@ class Nurbs {
 
 void Interpreter::State::spline(bool quadratic) {
   const char* name = quadratic ? "G5.1" : "G5";
-  if (comp_side != 0)
-    error(motion_column, std::string(name) + " with cutter radius compensation on: LinuxCNC refuses "
-                                             "it (G40 first)");
+  if (comp.side != 0)
+    error(motion_column, std::string(name) +
+                             " with cutter radius compensation on: LinuxCNC refuses "
+                             "it (G40 first)");
   require_feed();
   if (feed_mode == FeedMode::inverse_time)  // its length is known only once its biarcs are made
-    error(motion_column, std::string(name) + " in inverse time feed (G93) is not supported: G94 first");
-  if (plane != 170) error(motion_column, std::string(name) + " is a spline in the XY plane only (G17)");
+    error(motion_column,
+          std::string(name) + " in inverse time feed (G93) is not supported: G94 first");
+  if (plane != kG17)
+    error(motion_column, std::string(name) + " is a spline in the XY plane only (G17)");
   for (char c : {'Z', 'A', 'B', 'C'})
     if (w.has(c))
-      error(w.col(c), std::string(name) + " may not move " + c + " (LinuxCNC's splines stay in XY)");
+      error(w.col(c),
+            std::string(name) + " may not move " + c + " (LinuxCNC's splines stay in XY)");
 
-  Vec3 start = comp_programmed_current ? comp_programmed : to_program(pos);
-  comp_programmed_current = false;
+  Vec3 start = comp.programmed_current ? comp.programmed : to_program(pos);
+  comp.programmed_current = false;
   std::vector<NurbsPoint> control(quadratic ? 3 : 4);
   control[0].p = Vec2(start);
   Vec2 first(0.0);  // P1 − P0
@@ -125,11 +129,12 @@ void Interpreter::State::spline(bool quadratic) {
     first = Vec2(length('I'), length('J'));
   } else if (w.has('I') || w.has('J')) {
     if (!w.has('I') || !w.has('J'))
-      error(w.col(w.has('I') ? 'I' : 'J'), "G5 needs both I and J, or neither (to mirror the "
-                                           "previous G5's end)");
+      error(w.col(w.has('I') ? 'I' : 'J'),
+            "G5 needs both I and J, or neither (to mirror the "
+            "previous G5's end)");
     first = Vec2(length('I'), length('J'));
   } else {
-    first = spline_mirror * unit;
+    first = splines.mirror * unit;
   }
   Vec3 end = start;
   for (int i = 0; i < 2; ++i) {
@@ -144,7 +149,7 @@ void Interpreter::State::spline(bool quadratic) {
     double p = w.take('P'), q = w.take('Q');
     control[2].p = Vec2(end) + Vec2(p, q) * unit;
     control[3].p = Vec2(end);
-    spline_mirror = Vec2(-p, -q);
+    splines.mirror = Vec2(-p, -q);
   }
 
   if (far) {  // the far rule, as for arcs: only the lateral position changes
@@ -163,11 +168,13 @@ void Interpreter::State::spline(bool quadratic) {
 // G5.3 (G91: increments from it, not from the previous control point); L sets the order, 3 by
 // default (LinuxCNC takes L only from 4 on).
 void Interpreter::State::nurbs_point() {
-  if (comp_side != 0)
-    error(motion_column, "G5.2 with cutter radius compensation on: its curve is not offset (G40 first)");
-  if (plane != 170) error(motion_column, "G5.2 is a NURBS in the XY plane only (G17)");
+  if (comp.side != 0)
+    error(motion_column,
+          "G5.2 with cutter radius compensation on: its curve is not offset (G40 first)");
+  if (plane != kG17) error(motion_column, "G5.2 is a NURBS in the XY plane only (G17)");
   for (char c : {'Z', 'A', 'B', 'C'})
-    if (w.has(c)) error(w.col(c), std::string("G5.2 may not move ") + c + " (its control points are in XY)");
+    if (w.has(c))
+      error(w.col(c), std::string("G5.2 may not move ") + c + " (its control points are in XY)");
   if (w.has('X') != w.has('Y'))
     error(w.col(w.has('X') ? 'X' : 'Y'), "a G5.2 control point needs both X and Y");
   require_feed();
@@ -175,45 +182,49 @@ void Interpreter::State::nurbs_point() {
   double weight = 0;
   if (w.has('P')) {
     weight = w.take('P');
-    if (!(weight > 0)) error(w.col('P'), "G5.2 weight P" + format_number(weight) + " must be positive");
+    if (!(weight > 0))
+      error(w.col('P'), "G5.2 weight P" + format_number(weight) + " must be positive");
   }
-  if (nurbs_points.empty()) {
-    Vec3 start = comp_programmed_current ? comp_programmed : to_program(pos);
-    nurbs_points.push_back({Vec2(start), !point && weight > 0 ? weight : 1.0});
-    nurbs_order = 3;
+  if (splines.nurbs_points.empty()) {
+    Vec3 start = comp.programmed_current ? comp.programmed : to_program(pos);
+    splines.nurbs_points.push_back({Vec2(start), !point && weight > 0 ? weight : 1.0});
+    splines.nurbs_order = 3;
   } else if (!point) {
-    error(motion_column, "G5.2 needs X and Y (a control point): P alone weighs only the first point");
+    error(motion_column,
+          "G5.2 needs X and Y (a control point): P alone weighs only the first point");
   }
   if (w.has('L')) {
     // LinuxCNC ignores L below 4 (order 3 stays): an L1 or L2 is refused rather than misread.
-    nurbs_order = static_cast<int>(integer('L', "G5.2 order L", 3, kMaxNurbsOrder));
+    splines.nurbs_order = static_cast<int>(integer('L', "G5.2 order L", 3, kMaxNurbsOrder));
   }
   if (!point) return;
   if (!w.has('P')) error(motion_column, "a G5.2 control point needs its weight P (positive)");
   Vec3 start = to_program(pos);
   Vec2 at(length('X'), length('Y'));
   if (incremental) at += Vec2(start);
-  nurbs_points.push_back({at, weight});
+  splines.nurbs_points.push_back({at, weight});
 }
 
 // G5.3: the NURBS of the G5.2 blocks before it is cut, as LinuxCNC's NURBS_FEED does, and the
 // tool stands at its last control point (Z unchanged). No motion mode is left active.
 void Interpreter::State::nurbs_end(int column) {
-  if (motion != 52) error(column, "G5.3 without G5.2 before it (LinuxCNC refuses it)");
-  if (static_cast<int>(nurbs_points.size()) < nurbs_order)
-    error(column, "G5.3: " + std::to_string(nurbs_points.size()) + " control points, fewer than the order L = " +
-                      std::to_string(nurbs_order));
+  if (motion != kG5_2) error(column, "G5.3 without G5.2 before it (LinuxCNC refuses it)");
+  if (static_cast<int>(splines.nurbs_points.size()) < splines.nurbs_order)
+    error(column,
+          "G5.3: " + std::to_string(splines.nurbs_points.size()) +
+              " control points, fewer than the order L = " + std::to_string(splines.nurbs_order));
   Vec3 start = to_program(pos);
-  Vec3 end(nurbs_points.back().p, start[2]);
-  if (!far) nurbs_feed(std::move(nurbs_points), nurbs_order, Vec2(end), start[2]);
-  nurbs_points.clear();
+  Vec3 end(splines.nurbs_points.back().p, start[2]);
+  if (!far) nurbs_feed(std::move(splines.nurbs_points), splines.nurbs_order, Vec2(end), start[2]);
+  splines.nurbs_points.clear();
   pos = to_machine(end);
   motion = -1;
 }
 
 // emccanon's NURBS_FEED: 4 × (control points) equal steps of u, a biarc each, the last ending
 // exactly on `end` (the last control point).
-void Interpreter::State::nurbs_feed(std::vector<NurbsPoint> control, int order, const Vec2& end, double z) {
+void Interpreter::State::nurbs_feed(std::vector<NurbsPoint> control, int order, const Vec2& end,
+                                    double z) {
   Nurbs curve(std::move(control), order);
   const int steps = 4 * curve.count();
   Vec2 p0 = curve.first(), t0 = curve.tangent(0);  // where the tool stands, exactly
@@ -230,7 +241,8 @@ void Interpreter::State::nurbs_feed(std::vector<NurbsPoint> control, int order, 
 // Two arcs from `p0` (tangent `t0`) to `p4` (tangent `t4`) meeting tangentially, with equal
 // tangent lengths (emccanon's biarc with r = 1); a straight piece where no such pair exists (the
 // end tangents parallel or pointing away: LinuxCNC then emits nothing and jumps).
-void Interpreter::State::biarc(const Vec2& p0, const Vec2& t0, const Vec2& p4, const Vec2& t4, double z) {
+void Interpreter::State::biarc(const Vec2& p0, const Vec2& t0, const Vec2& p4, const Vec2& t4,
+                               double z) {
   Vec2 v = p0 - p4;
   double c = glm::dot(v, v);
   double b = 2 * glm::dot(v, t0 + t4);
@@ -253,7 +265,8 @@ void Interpreter::State::biarc(const Vec2& p0, const Vec2& t0, const Vec2& p4, c
 
 // emccanon's arc(): the circle through `from` and `to` tangent to `tangent` at `from`, or a line
 // when the chord runs along the tangent (|2 (chord × tangent)| ≤ 1e-6 program units).
-void Interpreter::State::spline_piece(const Vec2& from, const Vec2& to, const Vec2& tangent, double z) {
+void Interpreter::State::spline_piece(const Vec2& from, const Vec2& to, const Vec2& tangent,
+                                      double z) {
   Vec2 d = to - from;
   if (glm::length(d) <= 1e-9) return;
   Vec3 end(to.x, to.y, z);

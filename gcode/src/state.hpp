@@ -1,6 +1,10 @@
 // tridex::gcode — the interpreter's state: the modal machine, the tool and the program context,
 // shared by the stage files (modal.cpp: one block's codes; motion.cpp: lines, arcs, cycles,
-// returns; interpreter.cpp: reading and program flow).
+// returns; interpreter.cpp: reading and program flow). What one stage alone keeps between blocks
+// is a part of its own, named for it: ToolTable (modal.cpp), Splines (spline.cpp), TiltedPlane
+// (tilted_plane_codes.cpp), CannedCycle (motion.cpp), CallRequest (modal.cpp, read by flow.cpp),
+// Parameters (parameters.cpp), WarnedOnce and CutterComp (comp.cpp). The modal state, the tool
+// and the frame, which every stage reads, stay at the top.
 #pragma once
 
 #include <algorithm>
@@ -13,8 +17,8 @@
 #include <numbers>
 #include <optional>
 #include <set>
-#include <unordered_map>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "codes.hpp"
@@ -24,7 +28,7 @@
 namespace tridex::gcode {
 
 inline constexpr double kPi = std::numbers::pi;
-inline constexpr double kAxisEps = 1e-9;        // a frame axis "has a component" along the tool axis
+inline constexpr double kAxisEps = 1e-9;  // a frame axis "has a component" along the tool axis
 inline constexpr double kSameDirection = 1e-12;  // 1 − cos of the angle below which axes are equal
 inline constexpr long long kMaxArcPieces = 10'000'000;
 inline constexpr long long kMaxNurbsOrder = 100;  // G5.2 L: far above any CAM output
@@ -34,10 +38,14 @@ struct Interpreter::State : ParameterReader {
   InterpreterOptions options;
   MachineConfig machine;
 
-  std::vector<Diagnostic> warnings;
-  std::set<int> tools_used;
-  std::map<int, int> tool_first_line;
-  long long blocks = 0;
+  // What the run tells its caller besides the moves (Interpreter::warnings, tools_used, ...).
+  struct RunSummary {
+    std::vector<Diagnostic> warnings;
+    std::set<int> tools_used;
+    std::map<int, int> tool_first_line;
+    long long blocks = 0;
+  };
+  RunSummary summary;
 
   // Context of the block being executed.
   const std::string* file = nullptr;
@@ -52,7 +60,7 @@ struct Interpreter::State : ParameterReader {
   double unit = 1.0;  // mm per program unit
   bool incremental = false;
   bool arc_absolute = false;
-  int plane = 170;
+  int plane = kG17;
   int motion = -1;  // -1: none yet
   bool retract_to_r = false;
   int work_key = 1;
@@ -68,17 +76,23 @@ struct Interpreter::State : ParameterReader {
   double feed_per_rev = 0;  // G95: mm per revolution
   // The feed rate as LinuxCNC's #<_feed> reads it, in program units: per revolution under G95,
   // under G93 the rate of the last feed move.
-  double programmed_feed() const { return (feed_mode == FeedMode::per_revolution ? feed_per_rev : feed) / unit; }
+  double programmed_feed() const {
+    return (feed_mode == FeedMode::per_revolution ? feed_per_rev : feed) / unit;
+  }
   void feed_mode_codes();                 // G93, G94, G95, F and S (modal.cpp)
   void inverse_time_rate(double length);  // G93: feed for a block `length` mm long (motion.cpp)
-  Vec2 spline_mirror{0.0};  // G5 without I J: P1 − P0, program units (−P, −Q of the last G5)
-  // G5.2 control points gathered for G5.3 (program units, XY) and the curve's order (L).
+  // LinuxCNC's splines and NURBS between blocks (spline.cpp).
   struct NurbsPoint {
     Vec2 p{0.0};
     double weight = 1;
   };
-  std::vector<NurbsPoint> nurbs_points;
-  int nurbs_order = 3;
+  struct Splines {
+    Vec2 mirror{0.0};  // G5 without I J: P1 − P0, program units (−P, −Q of the last G5)
+    // G5.2 control points gathered for G5.3 (program units, XY) and the curve's order (L).
+    std::vector<NurbsPoint> nurbs_points;
+    int nurbs_order = 3;
+  };
+  Splines splines;
   double speed = 0;
   int spindle_direction = 0;
   int tool_selected = 0;
@@ -97,15 +111,20 @@ struct Interpreter::State : ParameterReader {
   // (modal.cpp): the lengths G43 H reads (mm), geometry plus Fanuc's wear. The tool itself keeps
   // the machine's length (loaded_length): a program that sets a wrong length moves the tip as the
   // real machine would.
-  std::map<int, double> set_lengths, length_wear;
+  struct ToolTable {
+    std::map<int, double> lengths, wear;
+  };
+  ToolTable tool_table;
   std::optional<double> length_geometry(int number) const {
-    if (auto it = set_lengths.find(number); it != set_lengths.end()) return it->second;
-    if (auto it = machine.tool_lengths.find(number); it != machine.tool_lengths.end()) return it->second;
+    if (auto it = tool_table.lengths.find(number); it != tool_table.lengths.end())
+      return it->second;
+    if (auto it = machine.tool_lengths.find(number); it != machine.tool_lengths.end())
+      return it->second;
     return std::nullopt;
   }
   double wear_of(int number) const {
-    auto it = length_wear.find(number);
-    return it == length_wear.end() ? 0.0 : it->second;
+    auto it = tool_table.wear.find(number);
+    return it == tool_table.wear.end() ? 0.0 : it->second;
   }
   std::optional<double> table_length(int number) const {
     std::optional<double> geometry = length_geometry(number);
@@ -121,22 +140,28 @@ struct Interpreter::State : ParameterReader {
   // Tilted working plane and the active program frame (program point p -> machine
   // origin + rotation·p).
   bool tilted = false;
-  Mat3 tilt_rotation{1.0};
-  Vec3 tilt_origin{0.0};
-  int tilt_line = 0;
   Mat3 rotation{1.0};
   Vec3 origin{0.0};
   // G68.2 / G68.4 P2 (three points) and P3 (two vectors) are written over consecutive blocks,
-  // one Q each (tilt.cpp); their words are gathered here until the last one completes the plane.
+  // one Q each (tilted_plane_codes.cpp); their words are gathered here until the last one
+  // completes the plane.
   struct PlaneBlocks {
-    int code = 0;  // 682 or 684 while a plane is under way; 0 otherwise
+    int code = 0;  // kG68_2 or kG68_4 while a plane is under way; 0 otherwise
     int p = 0;
     int first_line = 0;
     unsigned given = 0;  // bit q: the Q block has been read
     std::array<Vec3, 4> xyz{}, ijk{};
     double r = 0;
   };
-  PlaneBlocks plane_blocks;
+  // The tilted plane (tilted_plane_codes.cpp): its frame, the line that set it, and a
+  // several-block form under way.
+  struct TiltedPlane {
+    Mat3 rotation{1.0};
+    Vec3 origin{0.0};
+    int line = 0;
+    PlaneBlocks plane_blocks;
+  };
+  TiltedPlane tilt;
 
   // Rotary axes (rotary.cpp; only with MachineConfig::kinematics): their positions and how X Y Z
   // are read. raw: machine coordinates (the part frame is machine_to_part of the rotaries);
@@ -151,42 +176,55 @@ struct Interpreter::State : ParameterReader {
   Vec3 pos{0.0};
   bool far = true;
   bool ambiguous = false;
-  bool warned_home = false;
-  bool warned_reference2 = false;
-  std::set<int> warned_m_codes;
-  std::set<char> warned_rotary_at_zero;  // A/B/C words of 0 read on a machine without kinematics
+  // The warnings given once a run (each stage's own; rotary.cpp keeps its two below).
+  struct WarnedOnce {
+    bool home = false;
+    bool reference2 = false;
+    std::set<int> m_codes;
+    std::set<char> rotary_at_zero;  // A/B/C words of 0 read on a machine without kinematics
+    bool probe = false;             // G38.x read as rs274 standalone does
+    bool comp_without_d = false;    // Fanuc/Haas G41/G42 with no D yet: D0
+  };
+  WarnedOnce warned_once;
   bool warned_plain_rotary = false;  // A/B/C on a LinuxCNC machine without kinematics
   bool warned_uvw = false;           // U/V/W on a LinuxCNC machine
   Vec3 uvw_position{0.0};            // mm, where the U/V/W words put those axes
-  bool warned_probe = false;         // G38.x read as rs274 standalone does
-  bool warned_comp_without_d = false;  // Fanuc/Haas G41/G42 with no D yet: D0
-  Vec3 local_offset{0.0};  // G52 / G92 (one register, as LinuxCNC keeps it), machine axes
-  Vec3 saved_local_offset{0.0};  // G92.2 suspends, G92.3 restores
+  Vec3 local_offset{0.0};            // G52 / G92 (one register, as LinuxCNC keeps it), machine axes
+  Vec3 saved_local_offset{0.0};      // G92.2 suspends, G92.3 restores
   Vec3 world_origin{0.0};
 
-  // Canned cycle state (sticky values, program units converted to mm, as written).
-  bool cycle_active = false;
-  bool cycle_initial_far = false;
-  double cycle_initial = 0;
-  double cycle_r = 0, cycle_z = 0, cycle_q = 0;
-  double cycle_dwell = 0;  // seconds at the hole's bottom (G82, G86, G89)
-  bool has_cycle_r = false, has_cycle_z = false, has_cycle_q = false;
+  // Canned cycle state (motion.cpp; sticky values, program units converted to mm, as written).
+  struct CannedCycle {
+    bool active = false;
+    bool initial_far = false;
+    double initial = 0;
+    double r = 0, z = 0, q = 0;
+    double dwell = 0;  // seconds at the hole's bottom (G82, G86, G89)
+    bool has_r = false, has_z = false, has_q = false;
+  };
+  CannedCycle canned;
 
-  // Subprogram calls requested by the block just executed (flow.cpp carries them out).
-  int call_label = 0;
-  long long call_repeats = 0;
-  std::array<Value, 34> call_arguments{};  // G65: #1..#33 from the argument words
+  // Subprogram calls requested by the block just executed (modal.cpp; flow.cpp carries them out).
+  struct CallRequest {
+    int label = 0;
+    long long repeats = 0;
+    std::array<Value, 34> arguments{};  // G65: #1..#33 from the argument words
+  };
+  CallRequest call_request;
 
   // Parameters (parameters.cpp): #1..#33 of each call level (Fanuc locals; LinuxCNC's #1..#30),
   // named locals of each o-word call, and the globals. Fanuc's vacant is the default.
-  struct Scope {
-    std::array<Value, 34> locals;
-    std::unordered_map<std::string, Value> named;
-    Scope() { locals.fill(Value{0, true}); }
+  struct Parameters {
+    struct Scope {
+      std::array<Value, 34> locals;
+      std::unordered_map<std::string, Value> named;
+      Scope() { locals.fill(Value{0, true}); }
+    };
+    std::vector<Scope> scopes = std::vector<Scope>(1);
+    std::unordered_map<int, Value> globals;
+    std::unordered_map<std::string, Value> named_globals;
   };
-  std::vector<Scope> scopes = std::vector<Scope>(1);
-  std::unordered_map<int, Value> globals;
-  std::unordered_map<std::string, Value> named_globals;
+  Parameters parameters;
 
   Value numbered(int n) override;
   std::optional<Value> named(std::string_view name) override;
@@ -202,7 +240,8 @@ struct Interpreter::State : ParameterReader {
   }
   void warn(int column, std::string message) {
     // Bounded: a warning per block of a long program would grow memory with its length.
-    if (warnings.size() < 1000) warnings.push_back(Diagnostic{*file, line, column, std::move(message)});
+    if (summary.warnings.size() < 1000)
+      summary.warnings.push_back(Diagnostic{*file, line, column, std::move(message)});
   }
   // Lenient mode may skip a word only where skipping cannot change the tool path; `cause` names
   // the kind of word (counted for the run's summary, however many there are).
@@ -255,11 +294,11 @@ struct Interpreter::State : ParameterReader {
   // The modal group of a G code in this block: g_group, and the motions of the LinuxCNC dialect
   // (G5 and G5.1 splines, G5.2 NURBS and its G5.3 end, G38.2–G38.5 straight probes).
   int block_g_group(int code) const {
-    if ((code == 50 && g5_spline) || (code == 51 && g5_1_spline)) return kMotion;
-    if (machine.dialect == Dialect::linuxcnc && (code == 52 || code == 53))
-      return code == 52 ? kMotion : kNonModal;
-    if (code >= 382 && code <= 385 && machine.dialect == Dialect::linuxcnc) return kMotion;
-    if (code == 680 && machine.dialect == Dialect::linuxcnc) return -1;  // no G68 in LinuxCNC
+    if ((code == kG5 && g5_spline) || (code == kG5_1 && g5_1_spline)) return kMotion;
+    if (machine.dialect == Dialect::linuxcnc && (code == kG5_2 || code == kG5_3))
+      return code == kG5_2 ? kMotion : kNonModal;
+    if (code >= kG38_2 && code <= kG38_5 && machine.dialect == Dialect::linuxcnc) return kMotion;
+    if (code == kG68 && machine.dialect == Dialect::linuxcnc) return -1;  // no G68 in LinuxCNC
     return g_group(code);
   }
 
@@ -272,9 +311,10 @@ struct Interpreter::State : ParameterReader {
     std::array<int, kGroupCount> g_seen{};
     std::array<int, kMGroupCount> m_seen{};
     // In a G65 block M is an argument (#13), not an M-code (Fanuc's argument specification I).
-    const bool macro_call = machine.dialect != Dialect::linuxcnc &&
-                            std::any_of(block.words.begin(), block.words.end(),
-                                        [](const Word& word) { return word.letter == 'G' && word.value == 65; });
+    const bool macro_call =
+        machine.dialect != Dialect::linuxcnc &&
+        std::any_of(block.words.begin(), block.words.end(),
+                    [](const Word& word) { return word.letter == 'G' && word.value == 65; });
     for (const Word& word : block.words) {
       if (word.letter == 'G' || (word.letter == 'M' && !macro_call)) {
         // Codes are small; anything else is unsupported before it reaches an int (fuzz finding).
@@ -289,53 +329,63 @@ struct Interpreter::State : ParameterReader {
           // declares it), an error where the machine forbids it.
           int m = code / 10;
           if (machine.forbidden_m_codes.count(m))
-            error(word.column, code_name('M', code) + " is not allowed on this machine (machine file)");
-          if (!machine.m_codes.count(m) && warned_m_codes.insert(m).second)
-            warn(word.column, code_name('M', code) +
-                                  " has no effect on the tool path here (accepted; declare it in the "
-                                  "machine file's m_codes to silence this)");
+            error(word.column,
+                  code_name('M', code) + " is not allowed on this machine (machine file)");
+          if (!machine.m_codes.count(m) && warned_once.m_codes.insert(m).second)
+            warn(word.column,
+                 code_name('M', code) +
+                     " has no effect on the tool path here (accepted; declare it in the "
+                     "machine file's m_codes to silence this)");
           // Spindle orientation (M19 R Q P), LinuxCNC's override switches (M50-M53 P), I/O
           // codes (M62-M65 P, M66 P E L Q, M67/M68 E Q) and user codes (M100-M199 P Q) take
           // arguments of their own.
-          w.m_arguments |= m == 19 || (m >= 50 && m <= 53) || (m >= 62 && m <= 68) || (m >= 100 && m <= 199);
+          w.m_arguments |=
+              m == 19 || (m >= 50 && m <= 53) || (m >= 62 && m <= 68) || (m >= 100 && m <= 199);
           continue;
         }
         if (group < 0) {
           // Codes known to leave the path alone (feed and speed modes, exact stop, cancels of
           // modes tridex never enters) may be skipped in a block without coordinates; any other
           // unknown code could move the tool or change how later coordinates read.
-          static constexpr int kHarmless[] = {50, 90, 131, 500, 501, 611, 620, 630, 670, 960};
-          bool harmless = word.letter == 'G' && integral &&
-                          std::find(std::begin(kHarmless), std::end(kHarmless), code) != std::end(kHarmless);
+          static constexpr int kHarmless[] = {kG5,    kG9,  kG13_1, kG50, kG50_1,
+                                              kG61_1, kG62, kG63,   kG67, kG96};
+          bool harmless =
+              word.letter == 'G' && integral &&
+              std::find(std::begin(kHarmless), std::end(kHarmless), code) != std::end(kHarmless);
           bool coordinates = false;
           for (const Word& other : block.words)
             coordinates |= other.letter == 'X' || other.letter == 'Y' || other.letter == 'Z';
           std::string name = integral ? code_name(word.letter, code)
                                       : std::string(1, word.letter) + format_number(word.value);
-          if (word.letter == 'G' && ((code >= 382 && code <= 385) || code == 310))  // never skipped: it moves
-            error(word.column, name + " (probing) is not simulated: where the probe touches, and so "
-                                      "where the tool goes next, is known only on the machine; "
-                                      "leave the probing cycle out of the program tridex reads (or, "
-                                      "with --machine linuxcnc, read it as rs274 does)");
-          if (word.letter == 'G' && (code == 52 || code == 53))
+          if (word.letter == 'G' &&
+              ((code >= kG38_2 && code <= kG38_5) || code == kG31))  // never skipped: it moves
+            error(word.column, name +
+                                   " (probing) is not simulated: where the probe touches, and so "
+                                   "where the tool goes next, is known only on the machine; "
+                                   "leave the probing cycle out of the program tridex reads (or, "
+                                   "with --machine linuxcnc, read it as rs274 does)");
+          if (word.letter == 'G' && (code == kG5_2 || code == kG5_3))
             error(word.column, name + " (LinuxCNC's NURBS) is read with --machine linuxcnc only");
           if (word.letter == 'G' && integral && machine.dialect == Dialect::linuxcnc) {
             // Never skipped, even lenient: each moves the tool or sets how it moves. LinuxCNC's
             // lathe codes (G7 diameter mode, G33 threading, G70-G72 turning cycles, G76 threading
             // cycle, G96 constant surface speed) have no meaning on a mill.
-            static constexpr int kLathe[] = {70, 330, 700, 710, 711, 712, 720, 721, 722, 760, 960};
+            static constexpr int kLathe[] = {kG7,  kG33,   kG70,   kG71, kG71_1, kG71_2,
+                                             kG72, kG72_1, kG72_2, kG76, kG96};
             if (std::find(std::begin(kLathe), std::end(kLathe), code) != std::end(kLathe))
               error(word.column, name + " is a lathe code: tridex simulates milling machines");
           }
-          unsupported(word.column, "unsupported code " + name, "code " + name, harmless && !coordinates);
+          unsupported(word.column, "unsupported code " + name, "code " + name,
+                      harmless && !coordinates);
           continue;
         }
         if (word.letter == 'G') {
           int& seen = g_seen[static_cast<std::size_t>(group)];
-          if (seen && group == kMotion && (code == 800 || w.g[static_cast<std::size_t>(seen - 1)].code == 800)) {
+          if (seen && group == kMotion &&
+              (code == kG80 || w.g[static_cast<std::size_t>(seen - 1)].code == kG80)) {
             // G80 beside another motion code (the safe-start line `G0 G17 G40 G49 G80 G90`):
             // rs274, Fanuc and Haas read it as the other code, which ends any cycle anyway.
-            if (code != 800) w.g[static_cast<std::size_t>(seen - 1)] = Code{code, word.column};
+            if (code != kG80) w.g[static_cast<std::size_t>(seen - 1)] = Code{code, word.column};
             continue;
           }
           if (seen)
@@ -388,15 +438,16 @@ struct Interpreter::State : ParameterReader {
   // which differ from the tip's place on the part as soon as a table axis is turned.
   bool raw_rotary() const { return machine.kinematics && !tcp && !dwo && !tilted; }
   Vec3 linear_axes() const {
-    return raw_rotary() ? machine_from_part(*machine.kinematics, pos, rotary_position) : pos - length_shift();
+    return raw_rotary() ? machine_from_part(*machine.kinematics, pos, rotary_position)
+                        : pos - length_shift();
   }
   Vec3 to_machine(const Vec3& p) const { return origin + rotation * p; }
   Vec3 to_program(const Vec3& m) const { return glm::transpose(rotation) * (m - origin); }
 
   void update_frame() {
     if (tilted) {
-      rotation = tilt_rotation;
-      origin = tilt_origin + length_shift();
+      rotation = tilt.rotation;
+      origin = tilt.origin + length_shift();
     } else if (raw_rotary()) {
       // Raw rotary programs: X Y Z (after the work offset) are the machine's linear axes.
       Frame m = machine_to_part(*machine.kinematics, rotary_position);
@@ -406,25 +457,30 @@ struct Interpreter::State : ParameterReader {
       rotation = Mat3(1.0);
       origin = work_offset + local_offset + length_shift();
     }
-    ambiguous = tilted && glm::dot(tilt_rotation[2], axis) < 1 - kSameDirection;
+    ambiguous = tilted && glm::dot(tilt.rotation[2], axis) < 1 - kSameDirection;
   }
 
   // ---- emitting ----
   void emit(MoveKind kind, const Vec3& a, const Vec3& b, double move_feed, bool from_far = false) {
     if (ambiguous) {
       std::string message = "spindle direction is ambiguous: the plane tilted at line " +
-                            std::to_string(tilt_line) +
+                            std::to_string(tilt.line) +
                             " is not normal to the tool and no G53.1/G53.6/G253 has oriented it";
       if (!options.lenient) error(motion_column, message);
-      lenient_read(motion_column, message + "; read along the current direction " + direction_text(axis) +
-                                      " (lenient mode)",
-                   "move under an ambiguous tilted plane along the current direction " + direction_text(axis));
+      lenient_read(motion_column,
+                   message + "; read along the current direction " + direction_text(axis) +
+                       " (lenient mode)",
+                   "move under an ambiguous tilted plane along the current direction " +
+                       direction_text(axis));
     }
     if (machine.kinematics && length_shift() != Vec3(0.0))
-      error(motion_column, "the tool length offset (" + format_number(length_offset) + " mm) differs from the loaded tool " +
-                               std::to_string(tool) + "'s length (" + format_number(loaded_length()) +
-                               " mm) on a machine with rotary axes, which tridex does not simulate: "
-                               "use G43 H" + std::to_string(tool) + " (or G43.4), or a tool table without tool lengths");
+      error(motion_column,
+            "the tool length offset (" + format_number(length_offset) +
+                " mm) differs from the loaded tool " + std::to_string(tool) + "'s length (" +
+                format_number(loaded_length()) +
+                " mm) on a machine with rotary axes, which tridex does not simulate: "
+                "use G43 H" +
+                std::to_string(tool) + " (or G43.4), or a tool table without tool lengths");
     Move move;
     move.line = line;
     move.file = file_index;
@@ -442,7 +498,7 @@ struct Interpreter::State : ParameterReader {
       move.rotary = rotary_position;
       move.machine = machine_from_part(*machine.kinematics, b, rotary_position);
     }
-    if (tools_used.insert(tool).second) tool_first_line.emplace(tool, line);
+    if (summary.tools_used.insert(tool).second) summary.tool_first_line.emplace(tool, line);
     (*sink)(move);
   }
 
@@ -455,27 +511,41 @@ struct Interpreter::State : ParameterReader {
   }
 
   // ---- cutter radius compensation (comp.cpp) ----
-  // Side: +1 left (G41), −1 right (G42), 0 off. Compensated moves wait in comp_queue until the
+  // Side: +1 left (G41), −1 right (G42), 0 off. Compensated moves wait in comp.queue until the
   // next move tells where they end (LinuxCNC's queue of canonical moves, interp_queue.cc).
   struct CompMove {
     enum Kind { straight, arc } kind = straight;
     MoveKind move_kind = MoveKind::feed;
     int line = 0;
     double feed = 0;
-    Vec2 direction{0.0};  // straight: the direction it was programmed in, for the gouge check
-    Vec3 end{0.0};        // program frame
-    Vec2 centre{0.0};     // arc
-    int turn = 0;         // arc: +1 counter-clockwise, −1 clockwise
-    int extra_turns = 0;  // arc: full circles before its end (LinuxCNC's P − 1)
+    Vec2 direction{0.0};        // straight: the direction it was programmed in, for the gouge check
+    Vec3 end{0.0};              // program frame
+    Vec2 centre{0.0};           // arc
+    int turn = 0;               // arc: +1 counter-clockwise, −1 clockwise
+    int extra_turns = 0;        // arc: full circles before its end (LinuxCNC's P − 1)
     double original_sweep = 0;  // arc: signed radians when queued (0: never checked)
   };
-  int comp_side = 0;
-  double comp_radius = 0;              // mm, ≥ 0
-  int offset_d = -1;                   // Fanuc: the last D word, modal (#4107); -1: none yet
-  // Fanuc/Haas: the D offsets a program wrote (G10 L12/L13, or a macro variable such as #13001)
-  // and what wrote them ("G10 L12 at line 3"), and their geometry and wear as written (mm).
-  std::map<int, std::string> d_set_at;
-  std::map<int, double> d_geometry, d_wear;
+  // Cutter radius compensation (comp.cpp).
+  struct CutterComp {
+    int side = 0;
+    double radius = 0;  // mm, ≥ 0
+    int offset_d = -1;  // Fanuc: the last D word, modal (#4107); -1: none yet
+    // Fanuc/Haas: the D offsets a program wrote (G10 L12/L13, or a macro variable such as #13001)
+    // and what wrote them ("G10 L12 at line 3"), and their geometry and wear as written (mm).
+    std::map<int, std::string> d_set_at;
+    std::map<int, double> d_geometry, d_wear;
+    bool first = true;  // the next compensated move is the entry move
+    // Fanuc/Haas: the entry move's end waits for the next move's start direction (comp.cpp).
+    bool entry_pending = false;
+    bool arc_forbidden = false;       // just after G40: the next move must be straight
+    bool programmed_current = false;  // coordinates count from programmed, not the tip
+    Vec3 programmed{0.0};             // the last programmed point (program frame)
+    Vec3 current{0.0};                // where the queued moves end (program frame)
+    std::vector<CompMove> queue;
+    Vec2 endpoint{0.0};  // where the queued moves start (program frame)
+    bool endpoint_valid = false;
+  };
+  CutterComp comp;
   // Radius per unit of a D register: 1 (it holds a radius), 0.5 (a diameter), none where the
   // machine does not say (Haas, whose setting 40 decides).
   std::optional<double> d_register_scale() const {
@@ -484,18 +554,8 @@ struct Interpreter::State : ParameterReader {
     return std::nullopt;
   }
   double d_offset_radius(int number, int column, const std::string& code);  // comp.cpp
-  bool comp_first = true;              // the next compensated move is the entry move
-  // Fanuc/Haas: the entry move's end waits for the next move's start direction (comp.cpp).
-  bool comp_entry_pending = false;
   void comp_resolve_entry(const Vec2& next_direction);
-  bool comp_arc_forbidden = false;     // just after G40: the next move must be straight
-  bool comp_programmed_current = false;  // coordinates count from comp_programmed, not the tip
-  Vec3 comp_programmed{0.0};           // the last programmed point (program frame)
-  Vec3 comp_current{0.0};              // where the queued moves end (program frame)
-  std::vector<CompMove> comp_queue;
-  Vec2 comp_endpoint{0.0};             // where the queued moves start (program frame)
-  bool comp_endpoint_valid = false;
-  bool comp_active() const { return comp_side != 0 && comp_radius > 0; }
+  bool comp_active() const { return comp.side != 0 && comp.radius > 0; }
   // A program point's coordinates in the active plane, (u, v) of plane_axes (G17: X Y; G18: Z X,
   // LinuxCNC's order for compensation), and a point with those replaced.
   Vec2 plane_uv(const Vec3& p) const {
@@ -511,11 +571,13 @@ struct Interpreter::State : ParameterReader {
   void cutter_comp_codes(int code, int column);  // G40, G41, G42, G41.1, G42.1
   void comp_forbid(int column, const std::string& what) const;
   void comp_straight(MoveKind kind, const Vec3& target, double move_feed);
+  void comp_straight_entry(CompMove& move, const Vec3& target);
   void comp_arc(bool ccw);
+  void comp_arc_entry(CompMove& move, bool ccw, bool inside, const std::string& too_small);
   void comp_move_endpoint_and_flush(const Vec2& to);
   void comp_dequeue();
   void comp_finish() {  // at the end of the program: emit what waits
-    if (!comp_queue.empty()) comp_move_endpoint_and_flush(plane_uv(comp_current));
+    if (!comp.queue.empty()) comp_move_endpoint_and_flush(plane_uv(comp.current));
   }
 
   // ---- motion (motion.cpp) ----
@@ -532,8 +594,8 @@ struct Interpreter::State : ParameterReader {
   void require_feed();
   void arc(bool ccw);
   struct ArcData {
-    Vec3 end{0.0};             // program frame
-    Vec2 centre{0.0};          // in the plane's (u, v)
+    Vec3 end{0.0};                 // program frame
+    Vec2 centre{0.0};              // in the plane's (u, v)
     double programmed_radius = 0;  // R arcs: |R|; 0 for I/J/K
   };
   ArcData arc_data(const Vec3& start, bool ccw);
@@ -543,6 +605,17 @@ struct Interpreter::State : ParameterReader {
   void arc_chords(const Vec3& start, const Vec3& end, const Vec2& c, bool ccw, double sweep,
                   double move_feed);
   void cycle(int code);
+  // A canned cycle's levels along its axis (program frame), and whether it clears far.
+  struct CycleLevels {
+    double r_level = 0, bottom = 0, clear = 0;
+    bool clear_far = false;
+  };
+  long long cycle_words(int code, char depth_letter);
+  CycleLevels cycle_levels(int code, double current);
+  Vec3 cycle_point(double u_coordinate, double v_coordinate, double depth) const;
+  void cycle_rapid(const Vec3& to);
+  void cycle_cut(const Vec3& to);
+  void cycle_hole(int code, double hole_u, double hole_v, const CycleLevels& levels);
   // LinuxCNC's G5 / G5.1 splines as biarcs (spline.cpp).
   void spline(bool quadratic);
   void biarc(const Vec2& p0, const Vec2& t0, const Vec2& p4, const Vec2& t4, double z);
@@ -553,12 +626,13 @@ struct Interpreter::State : ParameterReader {
   void nurbs_feed(std::vector<NurbsPoint> control, int order, const Vec2& end, double z);
   void probe(int code);  // LinuxCNC's G38.2–G38.5 (motion.cpp)
   void machine_move(const Vec3& target, unsigned mask, MoveKind kind, double move_feed);
-  void polar_words(bool axis_consumer, int nonmodal);  // LinuxCNC @ and ^ become X and Y (motion.cpp)
+  void polar_words(bool axis_consumer,
+                   int nonmodal);  // LinuxCNC @ and ^ become X and Y (motion.cpp)
   void home_return(bool second);
-  void tool_length_codes();               // G43 H, G43.1, G44 H, G49 (modal.cpp)
-  void load_tool(int number);              // the tip moves with the tool's length (modal.cpp)
+  void tool_length_codes();    // G43 H, G43.1, G44 H, G49 (modal.cpp)
+  void load_tool(int number);  // the tip moves with the tool's length (modal.cpp)
   void go_far() { far = true; }
-  Flow macro_call(int column);          // G65 (modal.cpp)
+  Flow macro_call(int column);               // G65 (modal.cpp)
   void local_offsets(int code, int column);  // G52, G92, G92.1, G92.2, G92.3 (modal.cpp)
 
   // ---- rotary axes, DWO and TCP (rotary.cpp) ----
@@ -567,15 +641,44 @@ struct Interpreter::State : ParameterReader {
   void extra_linear_words(bool track);  // LinuxCNC's U/V/W
   void set_rotary(const RotaryPositions& next);
 
-  // ---- tilted planes (tilt.cpp) ----
+  // ---- tilted planes (tilted_plane_codes.cpp) ----
   std::optional<Frame> plane_words(int code);  // nullopt: a several-block form awaits more blocks
   std::optional<Frame> several_block_plane(int code, int p);
   std::string incomplete_plane() const;
   void tilted_plane(int code);
   void orient_to_plane(int code);
 
-  // ---- one block ----
+  // ---- one block (modal.cpp): execute calls a stage per modal group, in RS274/NGC's order ----
   Flow execute(const Block& block);
+  // The block's codes that decide the later stages (-1: none), and whether a code other than the
+  // motion takes its X/Y/Z (G10, G52, G92, a tilted plane).
+  struct BlockCodes {
+    int motion = -1;
+    int nonmodal = -1;
+    int tilt = -1;
+    int orient = -1;
+    bool axis_consumer = false;
+  };
+  BlockCodes block_codes();
+  void units_codes();
+  void tool_change_codes();  // T, M6, M61
+  void spindle_codes();
+  void dwell_code(const BlockCodes& codes);
+  void plane_codes();
+  void distance_mode_codes();
+  void smoothing_codes(const BlockCodes& codes);
+  void return_mode_codes();
+  void work_system_codes();
+  void offset_codes(BlockCodes& codes);             // G52, G92, G10
+  void work_offset_entry(long long l, int column);  // G10 L2, L20
+  void tilted_plane_group(BlockCodes& codes);
+  void motion_mode_codes(const BlockCodes& codes);
+  void axis_words(const BlockCodes& codes);
+  void block_move(const BlockCodes& codes);
+  void machine_coordinate_move();  // G53
+  void motion_mode_move(bool new_code);
+  Flow flow_codes();
+  void check_words_used();
 };
 
 // Runs a whole program through `state` (flow.cpp).

@@ -1,4 +1,4 @@
-// The tilted-plane words as the interpreter reads them (tilt.cpp): each control's G68.2 form,
+// The tilted-plane words as the interpreter reads them (tilted_plane_codes.cpp): each control's G68.2 form,
 // G68.3, G68.4, G268's Q orders and LinuxCNC's G53.3, run as programs and compared with the frames
 // of tilted_plane.hpp (tested against the manuals' definitions in test_tilted_forms.cpp) and with
 // each other.

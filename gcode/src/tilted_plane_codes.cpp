@@ -44,7 +44,7 @@ std::optional<Frame> Interpreter::State::plane_words(int code) {
   int column = w.find_g(code);
   long long p = 0;
   if (w.has('P')) {
-    if (code == 2680) error(w.col('P'), "G268 has no P word");
+    if (code == kG268) error(w.col('P'), "G268 has no P word");
     p = integer('P', "G68.2 P", 0, 3);
   }
   if (p == 2 || p == 3) return several_block_plane(code, static_cast<int>(p));
@@ -54,32 +54,34 @@ std::optional<Frame> Interpreter::State::plane_words(int code) {
   bool abc = w.has('A') || w.has('B') || w.has('C');
   bool uvw = w.has('U') || w.has('V') || w.has('W');
   bool ijk = w.has('I') || w.has('J') || w.has('K');
-  int q = code == 2680 || p == 1 ? 123 : 0;
+  int q = code == kG268 || p == 1 ? 123 : 0;
   int q_column = column;
   if (w.has('Q')) {
     q_column = w.col('Q');
     q = static_cast<int>(integer('Q', (code_name('G', code) + " Q").c_str(), 0, 999));
   }
   if (abc && (ijk || uvw))
-    error(w.col(w.has('A') ? 'A' : w.has('B') ? 'B' : 'C'),
+    error(w.col(w.has('A')   ? 'A'
+                : w.has('B') ? 'B'
+                             : 'C'),
           code_name('G', code) + " with both A B C and I J K/U V W angles");
   if (abc && (p != 0 || w.has('Q')))
     error(column, code_name('G', code) + " A B C (Mazak's Euler angles) take no P1 or Q");
   if (uvw && (p != 0 || w.has('Q')))
     error(column, code_name('G', code) + " I J K U V W (Hurco's vectors) take no P1 or Q");
-  if (uvw && code == 2680) error(column, "G268 has no U V W words");
-  if (abc && code == 2680) error(column, "G268 takes its angles in I J K, not A B C");
+  if (uvw && code == kG268) error(column, "G268 has no U V W words");
+  if (abc && code == kG268) error(column, "G268 takes its angles in I J K, not A B C");
   try {
     if (uvw) {
       Vec3 x = word_vector(w, 'I', 'J', 'K'), y = word_vector(w, 'U', 'V', 'W');
       return hurco_vector_frame(o, x, y);
     }
     Vec3 angles = abc ? word_vector(w, 'A', 'B', 'C') : word_vector(w, 'I', 'J', 'K');
-    bool linuxcnc = machine.dialect == Dialect::linuxcnc && code != 2680;
+    bool linuxcnc = machine.dialect == Dialect::linuxcnc && code != kG268;
     if (p == 1 && linuxcnc)  // LinuxCNC's P1: I J K the first to third angle of the order Q
       return linuxcnc_angles_frame(1, q, o, angles.x, angles.y, angles.z,
                                    w.has('R') ? w.take('R') : 0.0);
-    if (code == 2680 || p == 1) return fixed_axis_angles(o, angles.x, angles.y, angles.z, q);
+    if (code == kG268 || p == 1) return fixed_axis_angles(o, angles.x, angles.y, angles.z, q);
     if (w.has('Q'))  // LinuxCNC's P0: Q names the Euler order; R turns about the work Z
       return linuxcnc_angles_frame(0, q, o, angles.x, angles.y, angles.z,
                                    w.has('R') ? w.take('R') : 0.0);
@@ -116,8 +118,9 @@ std::optional<Frame> Interpreter::State::several_block_plane(int code, int p) {
   int q_column = w.has('Q') ? w.col('Q') : w.find_g(code);
   int q = w.has('Q') ? static_cast<int>(integer('Q', (form + " Q").c_str(), 0, 3)) : 0;
   if (!((allowed >> q) & 1u))
-    error(q_column, form + " Q" + std::to_string(q) + ": this form's blocks are " + q_list(allowed));
-  PlaneBlocks& b = plane_blocks;
+    error(q_column,
+          form + " Q" + std::to_string(q) + ": this form's blocks are " + q_list(allowed));
+  PlaneBlocks& b = tilt.plane_blocks;
   if (b.code == 0) b = PlaneBlocks{code, p, line, 0, {}, {}, 0.0};
   if (b.code != code || b.p != p)
     error(w.find_g(code), form + " while " + code_name('G', b.code) + " P" + std::to_string(b.p) +
@@ -132,7 +135,8 @@ std::optional<Frame> Interpreter::State::several_block_plane(int code, int p) {
     char c = kAxisLetter[i];
     if (!w.has(c)) continue;
     if (direction_only)
-      error(w.col(c), form + " Q" + std::to_string(q) + " takes only I J K (a direction), not " + c);
+      error(w.col(c),
+            form + " Q" + std::to_string(q) + " takes only I J K (a direction), not " + c);
     b.xyz[static_cast<std::size_t>(q)][i] = length(c);
   }
   if (p == 3) b.ijk[static_cast<std::size_t>(q)] = word_vector(w, 'I', 'J', 'K');
@@ -140,7 +144,7 @@ std::optional<Frame> Interpreter::State::several_block_plane(int code, int p) {
   if ((b.given & needed) != needed) return std::nullopt;
 
   PlaneBlocks done = b;
-  plane_blocks = PlaneBlocks{};
+  tilt.plane_blocks = PlaneBlocks{};
   auto& xyz = done.xyz;
   auto& ijk = done.ijk;
   try {
@@ -159,7 +163,7 @@ std::optional<Frame> Interpreter::State::several_block_plane(int code, int p) {
 // A several-block plane under way: what is missing, for the error of the block that is not its
 // next one (execute) or of the program's end (Interpreter::run).
 std::string Interpreter::State::incomplete_plane() const {
-  const PlaneBlocks& b = plane_blocks;
+  const PlaneBlocks& b = tilt.plane_blocks;
   unsigned needed = several_block_needed(b.p, machine.dialect == Dialect::linuxcnc);
   return code_name('G', b.code) + " P" + std::to_string(b.p) + " begun at line " +
          std::to_string(b.first_line) + " is incomplete (" + q_list(needed & ~b.given) +
@@ -167,7 +171,7 @@ std::string Interpreter::State::incomplete_plane() const {
 }
 
 void Interpreter::State::tilted_plane(int code) {
-  if (code == 690 || code == 2690) {
+  if (code == kG69 || code == kG269) {
     tilted = false;
     update_frame();
     return;
@@ -175,24 +179,27 @@ void Interpreter::State::tilted_plane(int code) {
   int column = w.find_g(code);
   if (incremental) error(column, code_name('G', code) + " under G91 is not supported; use G90");
   Frame feature;
-  if (code == 680) {
+  if (code == kG68) {
     // Fanuc's coordinate rotation G68 X Y R (G17; Fanuc 0i-MF operator's manual, "Coordinate
     // system rotation"): the program's points turn by R degrees, counter-clockwise, about the
     // centre X Y (where either is left out, the current point's): p = C + Rz(R)·(p' − C).
     if (tilted) error(column, "G68 while a rotation or tilted plane is active (G69 first)");
-    if (plane != 170) error(column, "G68 (coordinate rotation) is read in the XY plane (G17) only");
-    if (w.has('Z')) error(w.col('Z'), "G68 Z: the rotation in G17 is about an axis along Z through X Y");
+    if (plane != kG17)
+      error(column, "G68 (coordinate rotation) is read in the XY plane (G17) only");
+    if (w.has('Z'))
+      error(w.col('Z'), "G68 Z: the rotation in G17 is about an axis along Z through X Y");
     if (!w.has('R')) error(column, "G68 needs R (the angle of rotation, degrees)");
     if ((!w.has('X') || !w.has('Y')) && far)
-      error(column, "G68 without X and Y turns about the current point, but the tool is retracted "
-                    "far along its axis: give X and Y");
+      error(column,
+            "G68 without X and Y turns about the current point, but the tool is retracted "
+            "far along its axis: give X and Y");
     Vec3 centre = far ? Vec3(0.0) : to_program(pos);
     if (w.has('X')) centre.x = length('X');
     if (w.has('Y')) centre.y = length('Y');
     centre.z = 0;
     const Mat3 turn = rotation_z(w.take('R'));
     feature = Frame{turn, centre - turn * centre + work_offset + local_offset};
-  } else if (code == 683) {
+  } else if (code == kG68_3) {
     // G68.3 X Y Z R (Fanuc B-79976E): Z along the tool; the origin is X Y Z, all three or none
     // (none: the tool tip where it stands).
     int given = int(w.has('X')) + int(w.has('Y')) + int(w.has('Z'));
@@ -204,8 +211,9 @@ void Interpreter::State::tilted_plane(int code) {
       o += work_offset + local_offset;
     } else {
       if (far)
-        error(column, "G68.3 without X Y Z takes the tool tip as the origin, but the tool is "
-                      "retracted far along its axis: give X, Y and Z");
+        error(column,
+              "G68.3 without X Y Z takes the tool tip as the origin, but the tool is "
+              "retracted far along its axis: give X, Y and Z");
       o = pos;
     }
     try {
@@ -213,22 +221,22 @@ void Interpreter::State::tilted_plane(int code) {
     } catch (const Error& e) {
       error(column, std::string("G68.3: ") + e.what());
     }
-  } else if (code == 684) {
+  } else if (code == kG68_4) {
     // G68.4: the same forms as G68.2, given in the active feature frame and composed with it.
     if (!tilted) error(column, "G68.4 (incremental tilted plane) without an active tilted plane");
-    std::optional<Frame> incremental_frame = plane_words(684);
+    std::optional<Frame> incremental_frame = plane_words(kG68_4);
     if (!incremental_frame) return;
-    feature = compose(Frame{tilt_rotation, tilt_origin}, *incremental_frame);
+    feature = compose(Frame{tilt.rotation, tilt.origin}, *incremental_frame);
   } else {
     std::optional<Frame> written = plane_words(code);
     if (!written) return;
     feature = *written;
     feature.origin += work_offset + local_offset;  // on the active work coordinate system
   }
-  tilt_rotation = feature.rotation;
-  tilt_origin = feature.origin;
+  tilt.rotation = feature.rotation;
+  tilt.origin = feature.origin;
   tilted = true;
-  tilt_line = line;
+  tilt.line = line;
   update_frame();
 }
 
@@ -240,8 +248,8 @@ void Interpreter::State::tilted_plane(int code) {
 void Interpreter::State::orient_to_plane(int code) {
   int column = w.find_g(code);
   if (!tilted) error(column, code_name('G', code) + " without an active tilted plane");
-  if (code != 2530 && w.has('P')) integer('P', (code_name('G', code) + " P").c_str(), 0, 2);
-  Vec3 direction = glm::normalize(tilt_rotation[2]);
+  if (code != kG253 && w.has('P')) integer('P', (code_name('G', code) + " P").c_str(), 0, 2);
+  Vec3 direction = glm::normalize(tilt.rotation[2]);
   if (machine.kinematics) {  // the machine must reach it; the rotaries it picks are remembered
     try {
       rotary_position = orient_tool(*machine.kinematics, direction, rotary_position);
@@ -254,11 +262,12 @@ void Interpreter::State::orient_to_plane(int code) {
     go_far();  // the machine turns the tool: where the tip ends is the kinematics' business
   }
   update_frame();
-  if (machine.dialect == Dialect::linuxcnc) motion = 0;
-  if (code != 533) return;
+  if (machine.dialect == Dialect::linuxcnc) motion = kG0;
+  if (code != kG53_3) return;
   // LinuxCNC's remap (g533remap.ngc) requires X, Y and Z, and hands them on to M530 as I J K.
   for (char c : {'I', 'J', 'K'})
-    if (w.has(c)) error(w.col(c), "G53.3 takes the point of the plane to go to as X Y Z, not I J K");
+    if (w.has(c))
+      error(w.col(c), "G53.3 takes the point of the plane to go to as X Y Z, not I J K");
   if (!(w.has('X') && w.has('Y') && w.has('Z')))
     error(column, "G53.3 needs X, Y and Z: the point of the plane to go to");
   Vec3 target(length('X'), length('Y'), length('Z'));
