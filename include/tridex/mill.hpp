@@ -45,14 +45,12 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <span>
-#include <thread>
 #include <vector>
 
 #if defined(__SSE2__) || defined(__AVX__) || defined(__AVX512F__)
@@ -62,6 +60,7 @@
 #include "tridex/cutter.hpp"
 #include "tridex/error.hpp"
 #include "tridex/geometry.hpp"
+#include "tridex/parallel.hpp"
 #include "tridex/zmap.hpp"
 
 namespace tridex {
@@ -941,17 +940,9 @@ class Miller {
 
   void run(unsigned threads) {
     bin_moves();
-    std::atomic<std::size_t> next_bin{0};
-    std::size_t bin_count = static_cast<std::size_t>(bins_x_) * static_cast<std::size_t>(bins_y_);
-    auto worker = [&] {
-      BlockScratch scratch;
-      for (std::size_t b; (b = next_bin.fetch_add(1)) < bin_count;) mill_bin(b, scratch);
-    };
-    threads = std::max(1u, std::min<unsigned>(threads, static_cast<unsigned>(bin_count)));
-    std::vector<std::thread> pool;
-    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
-    worker();
-    for (std::thread& t : pool) t.join();
+    const std::size_t bin_count = static_cast<std::size_t>(bins_x_) * static_cast<std::size_t>(bins_y_);
+    for_each_chunk_with(bin_count, threads, [](unsigned) { return BlockScratch{}; },
+                        [&](std::size_t b, BlockScratch& scratch) { mill_bin(b, scratch); });
   }
 
  private:
@@ -1765,8 +1756,7 @@ inline void mill(ZMap& map, std::span<const Cutter> cutters, std::span<const Cut
                    cutters.size(), " are given");
   }
   if (map.heights.size() != map.grid.size()) detail::fail("mill: Z-map heights do not match its grid");
-  unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
-  detail::Miller(map, cutters, moves).run(threads);
+  detail::Miller(map, cutters, moves).run(options.threads);
 }
 
 }  // namespace tridex

@@ -37,15 +37,11 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstdint>
-#include <exception>
 #include <limits>
-#include <mutex>
 #include <span>
-#include <thread>
 #include <unordered_set>
 #include <utility>
 #include <vector>
@@ -56,6 +52,7 @@
 #include "tridex/dexel_ops.hpp"
 #include "tridex/error.hpp"
 #include "tridex/mesh.hpp"
+#include "tridex/parallel.hpp"
 #include "tridex/surface_tables.hpp"
 
 namespace tridex {
@@ -142,32 +139,17 @@ class Extractor {
     const int slab = std::max(8, (layers + 31) / 32);
     const int slabs = (layers + slab - 1) / slab;
     std::vector<SlabMesh> parts(static_cast<std::size_t>(slabs));
-    std::atomic<int> next{0};
-    std::exception_ptr error;
-    std::mutex error_mutex;
-    auto worker = [&] {
-      try {
-        Scratch scratch(*this);
-        for (int s; (s = next.fetch_add(1)) < slabs;) {
-          SlabMesh& part = parts[static_cast<std::size_t>(s)];
-          process_slab(s * slab, std::min(layers, (s + 1) * slab), scratch, part);
-          // Normals were only needed inside the slab; the rest waits for the join, at its size.
-          std::vector<glm::vec3>().swap(part.normals);
-          part.positions.shrink_to_fit();
-          part.triangles.shrink_to_fit();
-        }
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(error_mutex);
-        if (!error) error = std::current_exception();
-      }
-    };
-    unsigned count = std::min<unsigned>(threads ? threads : std::max(1u, std::thread::hardware_concurrency()),
-                                        static_cast<unsigned>(slabs));
-    std::vector<std::thread> pool;
-    for (unsigned t = 1; t < count; ++t) pool.emplace_back(worker);
-    worker();
-    for (std::thread& t : pool) t.join();
-    if (error) std::rethrow_exception(error);
+    detail::for_each_chunk_with(static_cast<std::size_t>(slabs), threads, [&](unsigned) { return Scratch(*this); },
+                                [&](std::size_t chunk, Scratch& scratch) {
+                                  const int s = static_cast<int>(chunk);
+                                  SlabMesh& part = parts[chunk];
+                                  process_slab(s * slab, std::min(layers, (s + 1) * slab), scratch, part);
+                                  // Normals were only needed inside the slab; the rest waits for the
+                                  // join, at its size.
+                                  std::vector<glm::vec3>().swap(part.normals);
+                                  part.positions.shrink_to_fit();
+                                  part.triangles.shrink_to_fit();
+                                });
     return join(parts);
   }
 

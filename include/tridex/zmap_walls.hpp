@@ -14,17 +14,16 @@
 #pragma once
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <span>
-#include <thread>
 #include <utility>
 #include <vector>
 
 #include "tridex/dexel_ops.hpp"
 #include "tridex/geometry.hpp"
 #include "tridex/mill.hpp"
+#include "tridex/parallel.hpp"
 #include "tridex/zmap.hpp"
 
 namespace tridex {
@@ -132,11 +131,11 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
   std::vector<std::uint8_t> tile_walls(static_cast<std::size_t>(bands) * tiles_x, 0);
   for (std::uint32_t c : cells)
     tile_walls[c / static_cast<std::uint32_t>(g.nx) / kBandRows * tiles_x + c % static_cast<std::uint32_t>(g.nx) / kTile] = 1;
-  std::atomic<int> next{0};
-  auto worker = [&] {
-    for (int band; (band = next.fetch_add(1)) < bands;) {
+  detail::for_each_chunk(static_cast<std::size_t>(bands), options.threads, [&](std::size_t band_index) {
+    {
+      const int band = static_cast<int>(band_index);
       const int j0 = band * kBandRows, j1 = std::min(g.ny - 1, j0 + kBandRows);
-      if (row_begin[static_cast<std::size_t>(j0)] == row_begin[static_cast<std::size_t>(j1)]) continue;
+      if (row_begin[static_cast<std::size_t>(j0)] == row_begin[static_cast<std::size_t>(j1)]) return;
       for (std::size_t at = band_begin[static_cast<std::size_t>(band)]; at < band_begin[static_cast<std::size_t>(band) + 1];
            ++at) {
         const std::size_t m = band_moves[at];
@@ -199,14 +198,7 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
         }
       }
     }
-  };
-  {
-    const unsigned threads = std::min<unsigned>(detail::resolve_threads(options.threads), static_cast<unsigned>(bands));
-    std::vector<std::thread> pool;
-    for (unsigned id = 1; id < threads; ++id) pool.emplace_back(worker);
-    worker();
-    for (std::thread& th : pool) th.join();
-  }
+  });
   map.set_fine_cells(std::move(cells), std::move(sub));
 }
 
