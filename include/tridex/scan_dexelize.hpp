@@ -341,7 +341,7 @@ inline TripleDexel scan_dexelize(const ZMap& map, const DexelLattice& lattice, u
 
 // W0 ∩ M1 ∩ … ∩ MN on the stock's lattice, each Mi scan-converted; rays already empty are not
 // scanned again. Throws tridex::Error for a malformed stock or a Z-map as scan_dexelize does.
-inline TripleDexel scan_machine(const TripleDexel& stock, std::span<const ZMap> milled, unsigned threads = 0) {
+inline TripleDexel scan_intersect_milled(const TripleDexel& stock, std::span<const ZMap> milled, unsigned threads = 0) {
   validate(stock);
   for (const ZMap& map : milled) detail::require_solid_zmap(map, "scan machine");
   const DexelLattice lattice = stock.lattice();

@@ -47,7 +47,7 @@ struct ZMapLimits {
 // the heights at its corners say only that the surface drops somewhere inside it, and the
 // two triangles ramp across the whole cell: the solid is off by up to a cell at the wall's rims,
 // where other directions' cuts meet it. A fine cell carries the surface's heights on a
-// kSteps × kSteps sub-grid of its own (refine_steep_cells in zmap_walls.hpp takes them from the
+// kSteps × kSteps sub-grid of its own (refine_steep_cells in fine_cells.hpp takes them from the
 // moves), triangulated like the grid, so the ramp spans a sub-cell only. Its corners are the
 // map's points; two fine cells that share an edge share its sub-points; where a fine cell meets
 // a plain one (or the grid's border) the solid's top steps vertically along their edge, between

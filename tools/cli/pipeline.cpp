@@ -14,12 +14,12 @@
 #include "tridex/backends/backends.hpp"
 #include "tridex/dexel_ops.hpp"
 #include "tridex/dexelize.hpp"
-#include "tridex/machine.hpp"
+#include "tridex/intersect_milled.hpp"
 #include "tridex/mill.hpp"
 #include "tridex/polyhedron.hpp"
 #include "tridex/stl.hpp"
 #include "tridex/surface.hpp"
-#include "tridex/zmap_walls.hpp"
+#include "tridex/fine_cells.hpp"
 
 namespace tridex::cli {
 
