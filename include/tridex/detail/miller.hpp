@@ -580,6 +580,15 @@ class Miller {
   void mill_tile(std::span<const Candidate> cuts, Tile& tile, const BlockScratch& scratch,
                  bool every_row);
   static constexpr std::size_t kPart = 64;
+  // mill_tile for at most kPart moves. The ball end's and the flat end's moves are evaluated at
+  // every point of a row: a test per group costs more in mispredicted branches and in the chain
+  // through h than the evaluations it saves (measured; the flat end's is a closed form with one
+  // square root, cheaper than a test). Their values are rounded to float and raised to the empty
+  // height once per row, at the end: heights are floats and never below it, so min(h, round(max(z,
+  // empty))) = round(max(min(h, z), empty)). With RowTest::fresh (the other cutters' near-equal
+  // surfaces, a flat end's neighbouring passes, leave a row's first cut far from its final shape,
+  // often not covering it all) the row is measured again after each move, and rejects the moves
+  // that it has become lower than.
   template <RowTest kTest>
   void mill_part(std::span<const Candidate> cuts, Tile& tile, const BlockScratch& scratch);
 

@@ -307,17 +307,9 @@ inline void Miller::mill_part(std::span<const Candidate> cuts, Tile& tile,
         loaded = true;
       }
       if (ball) {
-        // Every point of the row: a test per group costs more in mispredicted branches and
-        // in the chain through h than the evaluations it saves (measured).
         const double uy = y - ball->ay;
-        for (int g = 0; g < kGroups; ++g) {
-          // Rounded to float and raised to the empty height once per row, below: heights are
-          // floats and never below it, so min(h, round(max(z, empty))) = round(max(min(h, z),
-          // empty)).
-          h[g] = min_n(h[g], ball->at(x[g] - ball->ax, splat(uy)));
-        }
+        for (int g = 0; g < kGroups; ++g) h[g] = min_n(h[g], ball->at(x[g] - ball->ax, splat(uy)));
       } else if (kind == LaneKind::flat) {
-        // As the ball end: a closed form with one square root, cheaper than a test.
         const FlatLanes& flat = scratch.flats[c.move];
         const double uy = y - flat.ay;
         for (int g = 0; g < kGroups; ++g) h[g] = min_n(h[g], flat.at(x[g] - flat.ax, splat(uy)));
@@ -352,10 +344,7 @@ inline void Miller::mill_part(std::span<const Candidate> cuts, Tile& tile,
                   std::min(h[g][l], std::max(static_cast<double>(static_cast<float>(z)), empty));
             }
       }
-      if constexpr (kTest == RowTest::fresh) {
-        // The other cutters' near-equal surfaces (a flat end's neighbouring passes) leave a
-        // row's first cut far from its final shape, often not covering it all: measured again
-        // after each move, the row rejects the moves that it has become lower than.
+      if constexpr (kTest == RowTest::fresh) {  // measured again after each move (see above)
         DoubleN top = h[0], excess = h[0] - (tile_row + plane.gradient.x * dx[0]);
         for (int g = 1; g < kGroups; ++g) {
           top = max_n(top, h[g]);
