@@ -29,7 +29,8 @@ inline unsigned resolve_threads(unsigned threads) {
 // How many workers the for_each_chunk family uses for `chunks` chunks on up to `threads` threads
 // (0: every hardware thread): never more than there are chunks, and at least one (the caller).
 inline unsigned chunk_workers(std::size_t chunks, unsigned threads) {
-  return static_cast<unsigned>(std::min<std::size_t>(resolve_threads(threads), std::max<std::size_t>(1, chunks)));
+  return static_cast<unsigned>(
+      std::min<std::size_t>(resolve_threads(threads), std::max<std::size_t>(1, chunks)));
 }
 
 // Calls work(c, scratch) once for every chunk c in [0, chunks), on chunk_workers(chunks, threads)
@@ -39,7 +40,8 @@ inline unsigned chunk_workers(std::size_t chunks, unsigned threads) {
 // make_scratch) throws, no further chunk is handed out, every worker is joined, and the first
 // exception caught is rethrown here; chunks already taken by other workers run to their end.
 template <class MakeScratch, class Work>
-void for_each_chunk_with(std::size_t chunks, unsigned threads, MakeScratch&& make_scratch, Work&& work) {
+void for_each_chunk_with(std::size_t chunks, unsigned threads, MakeScratch&& make_scratch,
+                         Work&& work) {
   const unsigned count = chunk_workers(chunks, threads);
   std::atomic<std::size_t> next{0};
   std::atomic<bool> failed{false};
@@ -48,7 +50,8 @@ void for_each_chunk_with(std::size_t chunks, unsigned threads, MakeScratch&& mak
   auto worker = [&](unsigned id) {
     try {
       auto scratch = make_scratch(id);
-      for (std::size_t c; !failed.load(std::memory_order_relaxed) && (c = next.fetch_add(1)) < chunks;)
+      for (std::size_t c;
+           !failed.load(std::memory_order_relaxed) && (c = next.fetch_add(1)) < chunks;)
         work(c, scratch);
     } catch (...) {
       failed.store(true, std::memory_order_relaxed);
@@ -74,14 +77,16 @@ void for_each_chunk_with(std::size_t chunks, unsigned threads, MakeScratch&& mak
 // chunk: work(c, worker), for results gathered per worker and merged afterwards.
 template <class Work>
 void for_each_chunk_indexed(std::size_t chunks, unsigned threads, Work&& work) {
-  for_each_chunk_with(chunks, threads, [](unsigned id) { return id; },
-                      [&](std::size_t c, unsigned id) { work(c, id); });
+  for_each_chunk_with(
+      chunks, threads, [](unsigned id) { return id; },
+      [&](std::size_t c, unsigned id) { work(c, id); });
 }
 
 // The same with no scratch: work(c) once for every chunk c.
 template <class Work>
 void for_each_chunk(std::size_t chunks, unsigned threads, Work&& work) {
-  for_each_chunk_with(chunks, threads, [](unsigned) { return 0; }, [&](std::size_t c, int) { work(c); });
+  for_each_chunk_with(
+      chunks, threads, [](unsigned) { return 0; }, [&](std::size_t c, int) { work(c); });
 }
 
 // One task run on a thread of its own beside the caller's, started by start() and waited for by

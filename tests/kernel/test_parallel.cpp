@@ -58,7 +58,8 @@ TEST_CASE("parallel: each worker has its own scratch, made once, and its own ind
     for (int w : chunk_worker) CHECK((w >= 0 && w < static_cast<int>(workers)));
 
     std::vector<std::vector<std::size_t>> found(workers);
-    for_each_chunk_indexed(chunks, threads, [&](std::size_t c, unsigned id) { found[id].push_back(c); });
+    for_each_chunk_indexed(chunks, threads,
+                           [&](std::size_t c, unsigned id) { found[id].push_back(c); });
     std::vector<int> runs(chunks, 0);
     for (const auto& list : found)
       for (std::size_t c : list) ++runs[c];
@@ -66,7 +67,8 @@ TEST_CASE("parallel: each worker has its own scratch, made once, and its own ind
   }
 }
 
-TEST_CASE("parallel: an exception thrown by a chunk reaches the caller, after every worker stopped") {
+TEST_CASE(
+    "parallel: an exception thrown by a chunk reaches the caller, after every worker stopped") {
   for (unsigned threads : {1u, 2u, 8u}) {
     std::atomic<int> started{0};
     const std::size_t chunks = 10000;
@@ -80,13 +82,16 @@ TEST_CASE("parallel: an exception thrown by a chunk reaches the caller, after ev
     if (threads == 1) CHECK(started.load() == 4);
   }
   // From the scratch maker too.
-  CHECK_THROWS_AS(for_each_chunk_with(
-                      8, 4, [](unsigned id) -> int { return id == 2 ? throw std::logic_error("no scratch") : 0; },
-                      [](std::size_t, int&) {}),
-                  std::logic_error);
+  CHECK_THROWS_AS(
+      for_each_chunk_with(
+          8, 4,
+          [](unsigned id) -> int { return id == 2 ? throw std::logic_error("no scratch") : 0; },
+          [](std::size_t, int&) {}),
+      std::logic_error);
 }
 
-TEST_CASE("parallel: a background task runs beside the caller and its exception is rethrown at join") {
+TEST_CASE(
+    "parallel: a background task runs beside the caller and its exception is rethrown at join") {
   std::atomic<int> done{0};
   {
     BackgroundTask task;
