@@ -19,7 +19,7 @@
 
 #include "tridex/dexel_ops.hpp"
 #include "tridex/dexelize.hpp"
-#include "tridex/machine.hpp"
+#include "tridex/intersect_milled.hpp"
 
 namespace {
 
@@ -138,13 +138,13 @@ void step3_intersect_six(benchmark::State& state) {
   state.counters["volume_mm3"] = volume(result);
 }
 
-// Steps 2 + 3 fused, as the pipeline runs them: machine() on six maps.
+// Steps 2 + 3 fused, as the pipeline runs them: intersect_milled() on six maps.
 void machine_six(benchmark::State& state) {
   const std::vector<ZMap>& all = maps();
   TripleDexel result;
   double cpu_start = process_cpu_s();
   for (auto _ : state) {
-    result = machine(kStock, lattice(), all, static_cast<unsigned>(state.range(0)));
+    result = intersect_milled(kStock, lattice(), all, static_cast<unsigned>(state.range(0)));
     benchmark::DoNotOptimize(result.grids[0].intervals.data());
   }
   report(state, result, cpu_start);

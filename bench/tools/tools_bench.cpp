@@ -112,7 +112,7 @@ BENCHMARK(BM_simulate_example)
     ->Iterations(1);
 
 // Steps 1-3 of `simulate` on the example with fine cells at the walls (second argument 1) or
-// without (0), at --dexel-res RES (first argument): what the refinement (zmap_walls.hpp) costs.
+// without (0), at --dexel-res RES (first argument): what the refinement (fine_cells.hpp) costs.
 // Counters: Step 1 (zmap_s), the maps' preparation for Step 2 with the refinement
 // (prepare_s: raise_uncut, refine_steep_cells, the stock's triple dexel), Steps 2-3 (intersect_s,
 // where the scan converter reads the fine cells).

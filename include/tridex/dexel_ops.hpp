@@ -8,13 +8,11 @@
 #pragma once
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <limits>
-#include <thread>
 #include <vector>
 
 #include "tridex/dexel.hpp"
@@ -39,25 +37,15 @@ DexelGrid build_grid(const DexelLattice& lattice, int axis, unsigned threads, Pe
   const std::size_t chunk = 4096;
   const std::size_t chunks = (rays + chunk - 1) / chunk;
   std::vector<std::vector<DexelInterval>> parts(chunks);
-  std::atomic<std::size_t> next{0};
-  auto worker = [&] {
-    for (std::size_t c; (c = next.fetch_add(1)) < chunks;) {
-      std::vector<DexelInterval>& out = parts[c];
-      std::size_t end = std::min(rays, (c + 1) * chunk);
-      for (std::size_t r = c * chunk; r < end; ++r) {
-        std::size_t before = out.size();
-        per_ray(r, out);
-        g.offsets[r + 1] = static_cast<std::uint32_t>(out.size() - before);  // count, summed below
-      }
+  for_each_chunk(chunks, threads, [&](std::size_t c) {
+    std::vector<DexelInterval>& out = parts[c];
+    std::size_t end = std::min(rays, (c + 1) * chunk);
+    for (std::size_t r = c * chunk; r < end; ++r) {
+      std::size_t before = out.size();
+      per_ray(r, out);
+      g.offsets[r + 1] = static_cast<std::uint32_t>(out.size() - before);  // count, summed below
     }
-  };
-  threads = static_cast<unsigned>(std::min<std::size_t>(resolve_threads(threads), std::max<std::size_t>(1, chunks)));
-  {
-    std::vector<std::thread> pool;
-    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
-    worker();
-    for (std::thread& t : pool) t.join();
-  }
+  });
   std::size_t total = 0;
   for (const auto& p : parts) total += p.size();
   if (total > std::numeric_limits<std::uint32_t>::max())

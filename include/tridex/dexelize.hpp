@@ -18,12 +18,10 @@
 #pragma once
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <span>
-#include <thread>
 #include <vector>
 
 #include "tridex/dexel_ops.hpp"
@@ -31,6 +29,7 @@
 #include "tridex/grid_tree.hpp"
 #include "tridex/mesh_check.hpp"
 #include "tridex/mesh.hpp"
+#include "tridex/parallel.hpp"
 #include "tridex/zmap.hpp"
 
 namespace tridex {
@@ -147,11 +146,11 @@ inline TripleDexel dexelize(const Mesh& mesh, const DexelLattice& lattice, Dexel
     // Crossings, gathered per thread over chunks of triangles.
     const std::size_t triangle_count = mesh.triangles.size();
     std::vector<std::vector<detail::MeshHit>> found(threads);
-    std::atomic<std::size_t> next{0};
     const std::size_t chunk = 1024;
-    auto worker = [&](unsigned id) {
+    auto work = [&](std::size_t chunk_index, unsigned id) {
       std::vector<detail::MeshHit>& hits = found[id];
-      for (std::size_t c; (c = next.fetch_add(chunk)) < triangle_count;) {
+      {
+        const std::size_t c = chunk_index * chunk;
         std::size_t end = std::min(triangle_count, c + chunk);
         for (std::size_t k = c; k < end; ++k) {
           const glm::uvec3& t = mesh.triangles[k];
@@ -187,12 +186,7 @@ inline TripleDexel dexelize(const Mesh& mesh, const DexelLattice& lattice, Dexel
         }
       }
     };
-    {
-      std::vector<std::thread> pool;
-      for (unsigned id = 1; id < threads; ++id) pool.emplace_back(worker, id);
-      worker(0);
-      for (std::thread& th : pool) th.join();
-    }
+    detail::for_each_chunk_indexed((triangle_count + chunk - 1) / chunk, threads, work);
     result.grids[axis] = detail::grid_from_hits(lattice, axis, threads, found, [&](std::size_t r, float t) {
       detail::fail("dexelize: mesh is not closed or not outward-oriented: ray ", r % static_cast<std::size_t>(nu), ", ",
                    r / static_cast<std::size_t>(nu), " along axis ", "xyz"[axis], " has unbalanced crossings at ", t);

@@ -28,17 +28,16 @@
 #pragma once
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <span>
-#include <thread>
 #include <vector>
 
 #include "tridex/dexel_ops.hpp"
 #include "tridex/dexelize.hpp"
 #include "tridex/error.hpp"
+#include "tridex/parallel.hpp"
 #include "tridex/polyhedron.hpp"
 #include "tridex/zmap.hpp"
 
@@ -314,19 +313,11 @@ inline DexelGrid scan_family(const ZMap& map, const DexelLattice& lattice, int a
   const int rows_per_item = 16;
   const int items = (rows + rows_per_item - 1) / rows_per_item + 1;  // the last item: walls and bottom
   std::vector<std::vector<MeshHit>> found(threads);
-  std::atomic<int> next{0};
-  auto worker = [&](unsigned id) {
-    for (int item; (item = next.fetch_add(1)) < items;) {
-      if (item == items - 1) scanner.scan_walls_and_bottom(found[id]);
-      else scanner.scan_rows(item * rows_per_item, std::min(rows, (item + 1) * rows_per_item), found[id]);
-    }
-  };
-  {
-    std::vector<std::thread> pool;
-    for (unsigned id = 1; id < threads; ++id) pool.emplace_back(worker, id);
-    worker(0);
-    for (std::thread& th : pool) th.join();
-  }
+  for_each_chunk_indexed(static_cast<std::size_t>(items), threads, [&](std::size_t chunk, unsigned id) {
+    const int item = static_cast<int>(chunk);
+    if (item == items - 1) scanner.scan_walls_and_bottom(found[id]);
+    else scanner.scan_rows(item * rows_per_item, std::min(rows, (item + 1) * rows_per_item), found[id]);
+  });
   const std::size_t nu = static_cast<std::size_t>(lattice.n[TripleDexel::u_axis(axis)]);
   return grid_from_hits(lattice, axis, threads, found, [&](std::size_t r, float t) {
     fail("scan dexelize: unbalanced crossings on ray ", r % nu, ", ", r / nu, " along axis ", "xyz"[axis], " at ", t,
@@ -350,7 +341,7 @@ inline TripleDexel scan_dexelize(const ZMap& map, const DexelLattice& lattice, u
 
 // W0 ∩ M1 ∩ … ∩ MN on the stock's lattice, each Mi scan-converted; rays already empty are not
 // scanned again. Throws tridex::Error for a malformed stock or a Z-map as scan_dexelize does.
-inline TripleDexel scan_machine(const TripleDexel& stock, std::span<const ZMap> milled, unsigned threads = 0) {
+inline TripleDexel scan_intersect_milled(const TripleDexel& stock, std::span<const ZMap> milled, unsigned threads = 0) {
   validate(stock);
   for (const ZMap& map : milled) detail::require_solid_zmap(map, "scan machine");
   const DexelLattice lattice = stock.lattice();

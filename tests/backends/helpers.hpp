@@ -13,7 +13,7 @@
 #include "tridex/dexel.hpp"
 #include "tridex/mill.hpp"
 #include "tridex/zmap.hpp"
-#include "tridex/zmap_walls.hpp"
+#include "tridex/fine_cells.hpp"
 
 namespace backend_tests {
 
@@ -27,7 +27,7 @@ inline Frame random_frame(std::mt19937& rng, bool tilted) {
 
 // A box stock's Z-map in `frame`, milled by random ball, flat and bull-nose moves, some of them
 // through the stock (so that some points become empty).
-// With `fine`, the steep cells are then refined from the same moves (zmap_walls.hpp).
+// With `fine`, the steep cells are then refined from the same moves (fine_cells.hpp).
 inline ZMap random_milled_map(std::mt19937& rng, const Aabb& stock, const Frame& frame, double cell, int moves_count = 12,
                               bool fine = false) {
   ZMap map = ZMap::from_box(frame, stock, cell);

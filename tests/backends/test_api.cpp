@@ -5,7 +5,7 @@
 #include "helpers.hpp"
 #include "tridex/backends/backends.hpp"
 #include "tridex/dexel_ops.hpp"
-#include "tridex/machine.hpp"
+#include "tridex/intersect_milled.hpp"
 
 using namespace tridex;
 using namespace backend_tests;
@@ -31,7 +31,7 @@ TEST_CASE("every dexel backend computes the same machining result through machin
   l.origin += Vec3(0.011, 0.007, 0.013);
   TripleDexel w0 = TripleDexel::box(l, stock);
   TripleDexel tree = be::machine_with(be::DexelBackend::tree, w0, maps, 2);
-  CHECK(compare_rays(tree, machine(w0, maps, 1), 0).mismatches == 0);
+  CHECK(compare_rays(tree, intersect_milled(w0, maps, 1), 0).mismatches == 0);
   for (be::DexelBackend b : {be::DexelBackend::embree, be::DexelBackend::scan}) {
     TripleDexel other = be::machine_with(b, w0, maps, 2);
     RayComparison c = compare_rays(tree, other, 2e-4);

@@ -6,7 +6,7 @@
 #include "tridex/backends/embree_dexelize.hpp"
 #include "tridex/dexel_ops.hpp"
 #include "tridex/dexelize.hpp"
-#include "tridex/machine.hpp"
+#include "tridex/intersect_milled.hpp"
 
 using namespace tridex;
 using namespace backend_tests;
@@ -48,7 +48,7 @@ TEST_CASE("embree machine equals the kernel's machine (W0 ∩ M1 ∩ … ∩ MN)
     DexelLattice l = DexelLattice::covering(stock, 0.07 + 0.03 * unit(rng));
     l.origin += Vec3(unit(rng), unit(rng), unit(rng)) * (0.3 * l.spacing);
     TripleDexel w0 = TripleDexel::box(l, stock);
-    TripleDexel reference = machine(w0, maps, 2);
+    TripleDexel reference = intersect_milled(w0, maps, 2);
     TripleDexel embree = backends::embree_machine(w0, maps, 2);
     validate(embree);
     RayComparison c = compare_rays(reference, embree, 2e-4);

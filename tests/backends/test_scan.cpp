@@ -5,7 +5,7 @@
 #include "helpers.hpp"
 #include "tridex/dexel_ops.hpp"
 #include "tridex/dexelize.hpp"
-#include "tridex/machine.hpp"
+#include "tridex/intersect_milled.hpp"
 #include "tridex/polyhedron.hpp"
 #include "tridex/scan_dexelize.hpp"
 
@@ -102,8 +102,8 @@ TEST_CASE("scan machine equals the kernel's machine (W0 ∩ M1 ∩ … ∩ MN)")
     DexelLattice l = DexelLattice::covering(stock, 0.07 + 0.03 * unit(rng));
     l.origin += Vec3(unit(rng), unit(rng), unit(rng)) * (0.3 * l.spacing);
     TripleDexel w0 = TripleDexel::box(l, stock);
-    TripleDexel reference = machine(w0, maps, 2);
-    TripleDexel scan = scan_machine(w0, maps, 2);
+    TripleDexel reference = intersect_milled(w0, maps, 2);
+    TripleDexel scan = scan_intersect_milled(w0, maps, 2);
     validate(scan);
     RayComparison c = compare_rays(reference, scan, 1e-4);
     INFO("trial ", trial, " mismatches ", c.mismatches, " worst ", c.worst);
@@ -111,7 +111,7 @@ TEST_CASE("scan machine equals the kernel's machine (W0 ∩ M1 ∩ … ∩ MN)")
     CHECK(volume(scan) < volume(w0));
     // The result is independent of the order of the maps.
     std::vector<ZMap> reversed(maps.rbegin(), maps.rend());
-    CHECK(compare_rays(scan, scan_machine(w0, reversed, 1), 0).mismatches == 0);
+    CHECK(compare_rays(scan, scan_intersect_milled(w0, reversed, 1), 0).mismatches == 0);
   }
 }
 

@@ -4,7 +4,7 @@
 // beyond h/2 and none beyond 1.5 h.
 //
 // Both cases meet it with the command's defaults: a Z-map cell of h/2 and fine cells at the
-// walls (zmap_walls.hpp). Where one direction's pocket wall (parallel to its spindle) meets
+// walls (fine_cells.hpp). Where one direction's pocket wall (parallel to its spindle) meets
 // the other's surface, the plain Z-map polyhedron ramps across the wall's cell and is off by up
 // to a cell at the rim (docs/design.md, "Known errors"); the second case shows that fine cells
 // remove those errors.
@@ -15,11 +15,11 @@
 #include <string>
 #include <utility>
 
-#include "tridex/machine.hpp"
+#include "tridex/intersect_milled.hpp"
 #include "tridex/mill.hpp"
 #include "tridex/surface.hpp"
 #include "tridex/zmap.hpp"
-#include "tridex/zmap_walls.hpp"
+#include "tridex/fine_cells.hpp"
 #include "edge_sampling.hpp"
 
 using namespace tridex;
@@ -137,7 +137,7 @@ EdgeErrors machine_and_measure(std::mt19937& rng, bool pocket, double h, double 
     raise_uncut(maps.back(), initial);
     if (fine) refine_steep_cells(maps.back(), cutters, d.moves, {.threads = 2});
   }
-  const Mesh mesh = extract_surface(machine(stock, DexelLattice::covering(stock, h), maps));
+  const Mesh mesh = extract_surface(intersect_milled(stock, DexelLattice::covering(stock, h), maps));
   const EdgeReference ref(stock, program, cutters);
   return test::measure_edges(stock, [&](const Vec3& p) { return ref.label(p); }, mesh, h, samples, rng);
 }
@@ -165,7 +165,7 @@ TEST_CASE("edges where two directions meet: tilted planar and scalloped ball-end
 }
 
 TEST_CASE("edges where two directions meet: a pocket wall of one direction meeting the other's scallops") {
-  // The same pairs with and without fine cells at the walls (zmap_walls.hpp). Without them the
+  // The same pairs with and without fine cells at the walls (fine_cells.hpp). Without them the
   // wall's rims are off by up to a Z-map cell (here h/2), which puts edge points wrong beyond
   // h/2; with them, by up to a sub-cell.
   const double h = 0.1;

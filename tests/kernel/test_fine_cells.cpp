@@ -1,5 +1,5 @@
 // Fine cells of a Z-map (ZMapFineCells, zmap.hpp; issue 17): the polyhedron, the grid tree and
-// zmap_height agree on the finer solid, and refine_steep_cells (zmap_walls.hpp) puts a wall
+// zmap_height agree on the finer solid, and refine_steep_cells (fine_cells.hpp) puts a wall
 // parallel to the spindle inside its cell, within a sub-cell of where the moves put it.
 #include <doctest/doctest.h>
 
@@ -10,7 +10,7 @@
 #include "tridex/mesh_check.hpp"
 #include "tridex/mill.hpp"
 #include "tridex/polyhedron.hpp"
-#include "tridex/zmap_walls.hpp"
+#include "tridex/fine_cells.hpp"
 
 using namespace tridex;
 using namespace tridex_test;

@@ -1,5 +1,6 @@
 // Surface extraction at the end of the kernel pipeline: a box stock milled in tilted directions
-// (mill.hpp), combined by machine() into W0 ∩ M1 ∩ … ∩ MN (machine.hpp), then extract_surface.
+// (mill.hpp), combined by intersect_milled() into W0 ∩ M1 ∩ … ∩ MN (intersect_milled.hpp), then
+// extract_surface.
 // The dexels come from Z-map polyhedra through the grid tree, with their stair steps and the
 // rounding of three independently cast ray families.
 #include <doctest/doctest.h>
@@ -9,7 +10,7 @@
 #include <random>
 
 #include "tridex/dexel_ops.hpp"
-#include "tridex/machine.hpp"
+#include "tridex/intersect_milled.hpp"
 #include "tridex/mesh_check.hpp"
 #include "tridex/mill.hpp"
 #include "tridex/surface.hpp"
@@ -41,9 +42,9 @@ TEST_CASE("extract_surface on a machined stock: closed, inside the stock, the st
     const Vec3 e = stock.size();
     const double stock_volume = e.x * e.y * e.z, area = 2 * (e.x * e.y + e.y * e.z + e.z * e.x);
     // The unmilled stock comes back exactly (its faces lie between nodes, sharp features on).
-    Mesh raw = extract_surface(machine(stock, lattice, std::span<const ZMap>()));
+    Mesh raw = extract_surface(intersect_milled(stock, lattice, std::span<const ZMap>()));
     CHECK(raw.signed_volume() == doctest::Approx(stock_volume).epsilon(1e-5));
-    TripleDexel solid = machine(stock, lattice, maps);
+    TripleDexel solid = intersect_milled(stock, lattice, maps);
     for (bool sharp : {false, true}) {
       CAPTURE(sharp);
       Mesh m = extract_surface(solid, {.sharp_features = sharp});
@@ -90,7 +91,7 @@ TEST_CASE("a machined box keeps its top edges on every side, when it is a whole 
   mill(map, cutters, moves);
   raise_uncut(map, initial);
   std::vector<ZMap> maps{map};
-  const Mesh mesh = extract_surface(machine(stock, lattice, maps));
+  const Mesh mesh = extract_surface(intersect_milled(stock, lattice, maps));
   // Every vertex on a side face is below the top, and the top edge is there: within each
   // stretch of a spacing along the face, the highest vertex is within 3/4 of a spacing of the
   // top (measured: 0.17 on the min faces, 0.57 on the max faces; 1.3 before).

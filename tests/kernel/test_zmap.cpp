@@ -3,7 +3,7 @@
 #include <random>
 
 #include "test_dexel_shapes.hpp"
-#include "tridex/machine.hpp"
+#include "tridex/intersect_milled.hpp"
 #include "tridex/mill.hpp"
 #include "tridex/zmap.hpp"
 
@@ -130,7 +130,7 @@ TEST_CASE("raise_uncut: no fin of stock left between the last grid row and a fac
   mill(milled, cutters, facing);
   raise_uncut(milled, initial);
   std::vector<ZMap> maps{milled};
-  const TripleDexel result = machine(stock, lattice, maps);
+  const TripleDexel result = intersect_milled(stock, lattice, maps);
   int checked = 0, above_cut = 0;
   for (int a = 0; a < 2; ++a) {  // the rays along x and along y: those that cross the faces
     const DexelGrid& g = result.grids[a];
@@ -155,11 +155,11 @@ TEST_CASE("raise_uncut: an uncut direction keeps the whole stock; cuts stay cut"
     const ZMap initial = ZMap::from_box(f, stock, 0.2);
     // The stock's own top, interpolated cell by cell, shaves a tilted stock where nothing is cut...
     std::vector<ZMap> maps{initial};
-    double shaved = volume(machine(stock, lattice, maps));
+    double shaved = volume(intersect_milled(stock, lattice, maps));
     if (axis.z != 1) CHECK(shaved < stock_volume * (1 - 1e-4));
     // ...raised, it keeps it all.
     raise_uncut(maps[0], initial);
-    CHECK(volume(machine(stock, lattice, maps)) == doctest::Approx(stock_volume).epsilon(1e-9));
+    CHECK(volume(intersect_milled(stock, lattice, maps)) == doctest::Approx(stock_volume).epsilon(1e-9));
     // A plunge through the middle stays: cut points keep their heights, cut-through stays low.
     ZMap milled = initial;
     Vec3 centre = f.to_local(stock.center());
@@ -173,7 +173,7 @@ TEST_CASE("raise_uncut: an uncut direction keeps the whole stock; cuts stay cut"
       if (milled.heights[p] != initial.heights[p]) kept += raised.heights[p] == milled.heights[p];
     CHECK(kept > 100);
     std::vector<ZMap> cut{raised};
-    CHECK(volume(machine(stock, lattice, cut)) < stock_volume - 0.5 * 3.14 * 1.5 * 1.5 * 5);
+    CHECK(volume(intersect_milled(stock, lattice, cut)) < stock_volume - 0.5 * 3.14 * 1.5 * 1.5 * 5);
   }
   ZMap other = ZMap::from_box(Frame{}, stock, 0.5);
   ZMap mismatched = ZMap::from_box(Frame{}, stock, 0.25);

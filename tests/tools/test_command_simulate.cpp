@@ -225,7 +225,7 @@ TEST_CASE("simulate: the bundled example, from its CAMotics project, matches the
   check_against_reference(s, ref, 11);
   // Along the edges where two directions' cuts meet (the +X bevel's top edge, the side
   // features' rims). At this resolution (h 0.5 mm, Z-map cell 0.4 h) with fine cells at the
-  // walls (zmap_walls.hpp): none of 3000 points wrong beyond h/2 (the worst 0.19 h); without
+  // walls (fine_cells.hpp): none of 3000 points wrong beyond h/2 (the worst 0.19 h); without
   // them the walls' rims are off by up to a Z-map cell (docs/design.md, "Known errors"). The
   // target, 2 in 10,000, is below what 3000 points resolve.
   std::mt19937 rng(13);

@@ -4,7 +4,7 @@
 // must not exceed the limit. Just below the estimate the same run is refused with exit status 2.
 // Shapes: many directions, a fine resolution, a large STL stock, check with a large design,
 // groups holding many moves, --html, --dump-zmaps, and a field of slots whose walls make many
-// Z-map cells fine (zmap_walls.hpp), counted only once the maps are milled.
+// Z-map cells fine (fine_cells.hpp), counted only once the maps are milled.
 #include <doctest/doctest.h>
 
 #include <spawn.h>
@@ -20,7 +20,7 @@
 #include "tridex/gcode/move.hpp"
 #include "tridex/mill.hpp"
 #include "tridex/stl.hpp"
-#include "tridex/zmap_walls.hpp"
+#include "tridex/fine_cells.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -5,7 +5,7 @@
 #include "tridex/backends/embree_dexelize.hpp"
 #include "tridex/backends/gl_mill.hpp"
 #include "tridex/error.hpp"
-#include "tridex/machine.hpp"
+#include "tridex/intersect_milled.hpp"
 #include "tridex/scan_dexelize.hpp"
 
 namespace tridex::backends {
@@ -55,9 +55,9 @@ void mill_with(ZMapBackend backend, ZMap& map, std::span<const Cutter> cutters, 
 TripleDexel machine_with(DexelBackend backend, const TripleDexel& stock, std::span<const ZMap> milled,
                          unsigned threads) {
   switch (backend) {
-    case DexelBackend::tree: return machine(stock, milled, threads);
+    case DexelBackend::tree: return intersect_milled(stock, milled, threads);
     case DexelBackend::embree: return embree_machine(stock, milled, threads);
-    case DexelBackend::scan: return scan_machine(stock, milled, threads);
+    case DexelBackend::scan: return scan_intersect_milled(stock, milled, threads);
   }
   detail::fail("machine_with: invalid dexel backend ", static_cast<int>(backend));
 }

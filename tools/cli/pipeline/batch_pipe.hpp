@@ -18,9 +18,10 @@
 #include <exception>
 #include <functional>
 #include <mutex>
-#include <thread>
 #include <utility>
 #include <vector>
+
+#include "tridex/parallel.hpp"
 
 namespace tridex::cli {
 
@@ -33,7 +34,7 @@ class BatchPipe {
   BatchPipe(std::function<void(const Item&)> consume, bool threaded) : consume_(std::move(consume)) {
     if (!threaded) return;
     current_.reserve(kBatchItems);
-    worker_ = std::thread([this] { work(); });
+    worker_.start([this] { work(); });
   }
   BatchPipe(const BatchPipe&) = delete;
   BatchPipe& operator=(const BatchPipe&) = delete;
@@ -41,7 +42,7 @@ class BatchPipe {
   ~BatchPipe() { stop(); }
 
   void push(const Item& item) {
-    if (!worker_.joinable()) {
+    if (!worker_.running()) {
       consume_(item);
       return;
     }
@@ -51,7 +52,7 @@ class BatchPipe {
 
   // Waits until the worker has consumed everything pushed; rethrows what `consume` threw.
   void finish() {
-    if (worker_.joinable()) {
+    if (worker_.running()) {
       if (!current_.empty()) hand_over();
       {
         std::unique_lock lock(mutex_);
@@ -106,7 +107,7 @@ class BatchPipe {
   }
 
   void stop() {
-    if (!worker_.joinable()) return;
+    if (!worker_.running()) return;
     {
       std::lock_guard lock(mutex_);
       stopping_ = true;
@@ -125,7 +126,7 @@ class BatchPipe {
   bool busy_ = false;  // the worker holds a batch
   bool stopping_ = false;
   std::exception_ptr error_;
-  std::thread worker_;
+  detail::BackgroundTask worker_;  // runs work(), which keeps what consume_ throws in error_
 };
 
 }  // namespace tridex::cli

@@ -26,7 +26,7 @@ struct MemoryEstimate {
   double dexels = 0;  // the stock triple dexel, the result, the grid trees over the Z-maps
   double mesh = 0;    // the surface while it is extracted
   double after = 0;   // what the caller needs after the surface (check: trees, samples)
-  double walls = 0;   // the steep cells' sub-grids (zmap_walls.hpp), counted once the maps are milled
+  double walls = 0;   // the steep cells' sub-grids (fine_cells.hpp), counted once the maps are milled
   double total() const { return held + zmaps + dexels + mesh + after + walls; }
 };
 

@@ -15,12 +15,12 @@
 #include "tridex/backends/backends.hpp"
 #include "tridex/dexel_ops.hpp"
 #include "tridex/dexelize.hpp"
-#include "tridex/machine.hpp"
+#include "tridex/intersect_milled.hpp"
 #include "tridex/mill.hpp"
 #include "tridex/polyhedron.hpp"
 #include "tridex/stl.hpp"
 #include "tridex/surface.hpp"
-#include "tridex/zmap_walls.hpp"
+#include "tridex/fine_cells.hpp"
 
 namespace tridex::cli {
 
@@ -538,7 +538,7 @@ void dump_zmaps(const std::string& directory, const SimulationResult& r, Progres
 }
 
 // Walls parallel to a spindle are placed inside their cells: the steep cells take finer heights
-// from the moves (zmap_walls.hpp). How many cells are steep is known only now: their sub-grids
+// from the moves (fine_cells.hpp). How many cells are steep is known only now: their sub-grids
 // are checked against --max-memory before any is allocated.
 void refine_walls(const SimulateOptions& options, std::uint64_t max_memory, SimulationResult& r) {
   std::vector<ZMap>& maps = r.maps;
@@ -577,7 +577,7 @@ void refine_walls(const SimulateOptions& options, std::uint64_t max_memory, Simu
 }
 
 // Steps 2 and 3: the stock as a triple dexel, cut by every direction's Z-map (r.result).
-// machine() fuses the two steps ray by ray (each ray of the stock clipped by each Z-map's
+// intersect_milled() fuses the two steps ray by ray (each ray of the stock clipped by each Z-map's
 // polyhedron in turn, never storing M_i), so "intersect" times them together.
 void intersect_directions(const SimulateOptions& options, const PipelineRequest& request,
                           std::uint64_t max_memory, Progress& progress, SimulationResult& r) {

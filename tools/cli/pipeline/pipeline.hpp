@@ -64,7 +64,7 @@ struct PipelineRequest {
   // near misses within this clearance (mm); none: not checked.
   std::optional<double> body_clearance;
   bool keep_maps = false;  // keep the milled Z-maps (otherwise released after Step 3)
-  // Fine cells at walls parallel to a spindle (zmap_walls.hpp); off only to measure what they
+  // Fine cells at walls parallel to a spindle (fine_cells.hpp); off only to measure what they
   // cost and gain (bench/tools: BM_simulate_fine_cells).
   bool fine_cells = true;
   // What the caller allocates after the surface, in bytes, given the lattice spacing and the

@@ -4,7 +4,7 @@
 //   Z-map:  cpu    the kernel's exact milling (mill.hpp)
 //           gl     the swept cutters drawn into a 32-bit float depth buffer (OSMesa), the way
 //                  the paper's Z-map simulator does (its refs [9, 10]); see gl_mill.hpp
-//   dexel:  tree   the paper's grid AABB tree (machine.hpp)
+//   dexel:  tree   the paper's grid AABB tree (intersect_milled.hpp)
 //           embree Embree 3 ray casting of each Z-map's polyhedron, every hit of each ray
 //           scan   scan conversion of the Z-map's implicit triangles onto the ray grids
 //                  (scan_dexelize.hpp), no mesh and no BVH

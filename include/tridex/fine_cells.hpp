@@ -1,5 +1,5 @@
-// tridex — walls inside their Z-map cells (issue 17; the step-like errors of Inui, Chen and
-// Umezu, CAD&A 19(4) 2022, §5, at walls parallel to a spindle).
+// tridex — fine cells: walls inside their Z-map cells (issue 17; the step-like errors of Inui,
+// Chen and Umezu, CAD&A 19(4) 2022, §5, at walls parallel to a spindle).
 //
 // A milled Z-map knows its heights at grid points only. Where a wall parallel to the spindle
 // crosses a cell (a pocket's side, or the edge of a cut next to stock that raise_uncut lifted),
@@ -14,17 +14,16 @@
 #pragma once
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <span>
-#include <thread>
 #include <utility>
 #include <vector>
 
 #include "tridex/dexel_ops.hpp"
 #include "tridex/geometry.hpp"
 #include "tridex/mill.hpp"
+#include "tridex/parallel.hpp"
 #include "tridex/zmap.hpp"
 
 namespace tridex {
@@ -65,38 +64,17 @@ inline std::vector<std::uint32_t> steep_cells(const ZMap& map, double steep_slop
   return cells;
 }
 
-// Makes the steep cells of `map` fine, with sub-point heights from the moves it was milled with
-// (the same cutters and moves, in its frame). Call it on a map prepared by raise_uncut, last:
-// it reads the map's heights. `cells` are the map's steep cells as steep_cells gives them
-// (with options.steep_slope), for a caller that needed them beforehand. Throws tridex::Error
-// for a move with a cutter out of range.
-inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::span<const CutMove> moves,
-                               WallOptions options, std::vector<std::uint32_t> cells) {
+namespace detail {
+
+// The heart of refine_steep_cells: lowers `sub` (the fine cells' sub-point heights, kPoints per
+// cell of `cells`, all starting at `ceiling`) to the lowest point of every move's swept cutter
+// above them, band by band on `threads` threads (0: every hardware thread). row_begin[j] is the
+// first of `cells` in cell row j (cells.size() where the row has none).
+inline void lower_fine_cells(const ZMapGrid& g, std::span<const Cutter> cutters, std::span<const CutMove> moves,
+                             const std::vector<std::uint32_t>& cells, const std::vector<std::size_t>& row_begin,
+                             float ceiling, unsigned threads, std::vector<float>& sub) {
   constexpr int kSteps = ZMapFineCells::kSteps, kSide = ZMapFineCells::kSide;
   constexpr auto kPoints = static_cast<std::size_t>(ZMapFineCells::kPoints);
-  for (std::size_t k = 0; k < moves.size(); ++k)
-    if (moves[k].cutter >= cutters.size())
-      detail::fail("refine steep cells: move ", k, " uses cutter ", moves[k].cutter, " but only ", cutters.size(),
-                   " are given");
-  const ZMapGrid& g = map.grid;
-  const auto map_bands = static_cast<std::size_t>((g.ny + detail::kMapBandRows - 1) / detail::kMapBandRows);
-  std::vector<float> band_ceiling(map_bands, map.empty_height);
-  detail::for_each_chunk(map_bands, options.threads, [&](std::size_t band) {
-    const std::size_t p0 = band * detail::kMapBandRows * static_cast<std::size_t>(g.nx);
-    const std::size_t p1 = std::min(g.size(), p0 + detail::kMapBandRows * static_cast<std::size_t>(g.nx));
-    for (std::size_t p = p0; p < p1; ++p) band_ceiling[band] = std::max(band_ceiling[band], map.heights[p]);
-  });
-  const float ceiling = *std::max_element(band_ceiling.begin(), band_ceiling.end());
-  if (cells.empty()) {
-    map.fine = {};
-    return;
-  }
-  // Cells come out ascending, so a row's fine cells are a contiguous, sorted run.
-  std::vector<std::size_t> row_begin(static_cast<std::size_t>(g.ny), cells.size());
-  for (std::size_t k = cells.size(); k-- > 0;) row_begin[cells[k] / static_cast<std::uint32_t>(g.nx)] = k;
-  for (std::size_t row = row_begin.size() - 1; row-- > 0;) row_begin[row] = std::min(row_begin[row], row_begin[row + 1]);
-
-  std::vector<float> sub(cells.size() * kPoints, ceiling);
   const double step = g.cell / kSteps;  // exact: kSteps is a power of two
   // Bands of cell rows, one thread each at a time. Each band gets the moves whose swept box
   // reaches it, in program order (a counting sort: one pass to count, one to place), so that a
@@ -126,17 +104,17 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
   std::vector<float> cell_top(cells.size(), ceiling);
   const double half_diagonal = g.cell * std::sqrt(0.5) * (1 + 1e-9);
   // Which tiles (a band's rows by as many columns) hold a fine cell.
-  constexpr std::size_t kTile = kBandRows;
-  const std::size_t tiles_x = (static_cast<std::size_t>(g.nx) - 1 + kTile - 1) / kTile;
-  const double tile_half_diagonal = kTile * half_diagonal;
+  constexpr std::size_t kBandTile = kBandRows;
+  const std::size_t tiles_x = (static_cast<std::size_t>(g.nx) - 1 + kBandTile - 1) / kBandTile;
+  const double tile_half_diagonal = kBandTile * half_diagonal;
   std::vector<std::uint8_t> tile_walls(static_cast<std::size_t>(bands) * tiles_x, 0);
   for (std::uint32_t c : cells)
-    tile_walls[c / static_cast<std::uint32_t>(g.nx) / kBandRows * tiles_x + c % static_cast<std::uint32_t>(g.nx) / kTile] = 1;
-  std::atomic<int> next{0};
-  auto worker = [&] {
-    for (int band; (band = next.fetch_add(1)) < bands;) {
+    tile_walls[c / static_cast<std::uint32_t>(g.nx) / kBandRows * tiles_x + c % static_cast<std::uint32_t>(g.nx) / kBandTile] = 1;
+  detail::for_each_chunk(static_cast<std::size_t>(bands), threads, [&](std::size_t band_index) {
+    {
+      const int band = static_cast<int>(band_index);
       const int j0 = band * kBandRows, j1 = std::min(g.ny - 1, j0 + kBandRows);
-      if (row_begin[static_cast<std::size_t>(j0)] == row_begin[static_cast<std::size_t>(j1)]) continue;
+      if (row_begin[static_cast<std::size_t>(j0)] == row_begin[static_cast<std::size_t>(j1)]) return;
       for (std::size_t at = band_begin[static_cast<std::size_t>(band)]; at < band_begin[static_cast<std::size_t>(band) + 1];
            ++at) {
         const std::size_t m = band_moves[at];
@@ -151,19 +129,19 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
         auto i1 = static_cast<std::uint32_t>(std::clamp(std::floor((hi_x - g.x0) / g.cell), 0.0, double(g.nx)));
         // Only the band's tiles that hold a fine cell and come within the radius of the tip
         // path: most of a map has no wall, and a move's box spans many cell rows.
-        const std::size_t tx0 = i0 / kTile, tx1 = std::min<std::size_t>(i1, static_cast<std::size_t>(g.nx - 2)) / kTile;
+        const std::size_t tx0 = i0 / kBandTile, tx1 = std::min<std::size_t>(i1, static_cast<std::size_t>(g.nx - 2)) / kBandTile;
         std::size_t first_tile = tiles_x, last_tile = 0;
         for (std::size_t tx = tx0; tx <= tx1; ++tx) {
           if (!tile_walls[static_cast<std::size_t>(band) * tiles_x + tx]) continue;
-          const double cx = g.x0 + (double(tx) + 0.5) * kTile * g.cell, cy = g.y0 + 0.5 * (j0 + j1) * g.cell;
+          const double cx = g.x0 + (double(tx) + 0.5) * kBandTile * g.cell, cy = g.y0 + 0.5 * (j0 + j1) * g.cell;
           if (distance2_point_segment(Vec2(cx, cy), Vec2(s.a.x, s.a.y), Vec2(s.b.x, s.b.y)) >
               (r + tile_half_diagonal) * (r + tile_half_diagonal))
             continue;
           first_tile = std::min(first_tile, tx), last_tile = tx;
         }
         if (first_tile > last_tile) continue;
-        i0 = std::max(i0, static_cast<std::uint32_t>(first_tile * kTile));
-        i1 = std::min(i1, static_cast<std::uint32_t>(last_tile * kTile + kTile - 1));
+        i0 = std::max(i0, static_cast<std::uint32_t>(first_tile * kBandTile));
+        i1 = std::min(i1, static_cast<std::uint32_t>(last_tile * kBandTile + kBandTile - 1));
         // Built here, for the few (band, move) pairs that come this far: kept for every move up
         // front, the program's geometry took longer to write than the bands take to read.
         const detail::MoveGeometry move(cutters[moves[m].cutter], s);
@@ -199,14 +177,43 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
         }
       }
     }
-  };
-  {
-    const unsigned threads = std::min<unsigned>(detail::resolve_threads(options.threads), static_cast<unsigned>(bands));
-    std::vector<std::thread> pool;
-    for (unsigned id = 1; id < threads; ++id) pool.emplace_back(worker);
-    worker();
-    for (std::thread& th : pool) th.join();
+  });
+}
+
+}  // namespace detail
+
+// Makes the steep cells of `map` fine, with sub-point heights from the moves it was milled with
+// (the same cutters and moves, in its frame). Call it on a map prepared by raise_uncut, last:
+// it reads the map's heights. `cells` are the map's steep cells as steep_cells gives them
+// (with options.steep_slope), for a caller that needed them beforehand. Throws tridex::Error
+// for a move with a cutter out of range.
+inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::span<const CutMove> moves,
+                               WallOptions options, std::vector<std::uint32_t> cells) {
+  constexpr auto kPoints = static_cast<std::size_t>(ZMapFineCells::kPoints);
+  for (std::size_t k = 0; k < moves.size(); ++k)
+    if (moves[k].cutter >= cutters.size())
+      detail::fail("refine steep cells: move ", k, " uses cutter ", moves[k].cutter, " but only ", cutters.size(),
+                   " are given");
+  const ZMapGrid& g = map.grid;
+  const auto map_bands = static_cast<std::size_t>((g.ny + detail::kMapBandRows - 1) / detail::kMapBandRows);
+  std::vector<float> band_ceiling(map_bands, map.empty_height);
+  detail::for_each_chunk(map_bands, options.threads, [&](std::size_t band) {
+    const std::size_t p0 = band * detail::kMapBandRows * static_cast<std::size_t>(g.nx);
+    const std::size_t p1 = std::min(g.size(), p0 + detail::kMapBandRows * static_cast<std::size_t>(g.nx));
+    for (std::size_t p = p0; p < p1; ++p) band_ceiling[band] = std::max(band_ceiling[band], map.heights[p]);
+  });
+  const float ceiling = *std::max_element(band_ceiling.begin(), band_ceiling.end());
+  if (cells.empty()) {
+    map.fine = {};
+    return;
   }
+  // Cells come out ascending, so a row's fine cells are a contiguous, sorted run.
+  std::vector<std::size_t> row_begin(static_cast<std::size_t>(g.ny), cells.size());
+  for (std::size_t k = cells.size(); k-- > 0;) row_begin[cells[k] / static_cast<std::uint32_t>(g.nx)] = k;
+  for (std::size_t row = row_begin.size() - 1; row-- > 0;) row_begin[row] = std::min(row_begin[row], row_begin[row + 1]);
+
+  std::vector<float> sub(cells.size() * kPoints, ceiling);
+  detail::lower_fine_cells(g, cutters, moves, cells, row_begin, ceiling, options.threads, sub);
   map.set_fine_cells(std::move(cells), std::move(sub));
 }
 

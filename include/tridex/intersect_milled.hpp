@@ -1,6 +1,6 @@
-// tridex — the machining result as one kernel call (Inui, Chen and Umezu, CAD&A 19(4) 2022,
-// §3.2, Steps 2–3): W = W0 ∩ M1 ∩ … ∩ MN, Mi the polyhedron of direction i's milled Z-map,
-// taken back to world coordinates by its frame.
+// tridex — Steps 2–3 as one kernel call, the intersection of the stock with the milled Z-maps
+// (Inui, Chen and Umezu, CAD&A 19(4) 2022, §3.2): intersect_milled gives W = W0 ∩ M1 ∩ … ∩ MN,
+// Mi the polyhedron of direction i's milled Z-map, taken back to world coordinates by its frame.
 //
 // Mi is never stored as a triple dexel. Each ray starts from the stock's intervals and is cut by
 // each Z-map in turn, its grid-tree query clipped to the stock's extent on that ray (an empty ray
@@ -20,7 +20,7 @@ namespace tridex {
 
 // W0 ∩ M1 ∩ … ∩ MN on the stock's lattice. Throws tridex::Error for a malformed stock or a
 // Z-map with fewer than 2 × 2 points.
-inline TripleDexel machine(const TripleDexel& stock, std::span<const ZMap> milled, unsigned threads = 0) {
+inline TripleDexel intersect_milled(const TripleDexel& stock, std::span<const ZMap> milled, unsigned threads = 0) {
   validate(stock);
   std::vector<GridTree> trees;
   trees.reserve(milled.size());
@@ -75,15 +75,15 @@ inline TripleDexel machine(const TripleDexel& stock, std::span<const ZMap> mille
 }
 
 // The same from a box stock on `lattice`.
-inline TripleDexel machine(const Aabb& stock, const DexelLattice& lattice, std::span<const ZMap> milled,
-                           unsigned threads = 0) {
-  return machine(TripleDexel::box(lattice, stock), milled, threads);
+inline TripleDexel intersect_milled(const Aabb& stock, const DexelLattice& lattice, std::span<const ZMap> milled,
+                                    unsigned threads = 0) {
+  return intersect_milled(TripleDexel::box(lattice, stock), milled, threads);
 }
 
 // The same from a closed stock mesh (for example an STL) dexelized on `lattice`.
-inline TripleDexel machine(const Mesh& stock, const DexelLattice& lattice, std::span<const ZMap> milled,
-                           unsigned threads = 0) {
-  return machine(dexelize(stock, lattice, {.threads = threads}), milled, threads);
+inline TripleDexel intersect_milled(const Mesh& stock, const DexelLattice& lattice, std::span<const ZMap> milled,
+                                    unsigned threads = 0) {
+  return intersect_milled(dexelize(stock, lattice, {.threads = threads}), milled, threads);
 }
 
 }  // namespace tridex

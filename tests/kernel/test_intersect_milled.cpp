@@ -3,7 +3,7 @@
 #include <random>
 
 #include "test_dexel_shapes.hpp"
-#include "tridex/machine.hpp"
+#include "tridex/intersect_milled.hpp"
 #include "tridex/mill.hpp"
 
 using namespace tridex;
@@ -50,7 +50,7 @@ bool removed(const std::vector<Direction>& program, const std::vector<Cutter>& c
 
 }  // namespace
 
-TEST_CASE("machine: a box milled in several tilted directions matches the point-membership reference") {
+TEST_CASE("intersect_milled: a box milled in several tilted directions matches the point-membership reference") {
   std::mt19937 rng(101);
   std::uniform_real_distribution<double> unit(0, 1);
   const std::vector<Cutter> cutters{Cutter::ball(1.0), Cutter::flat(0.7), Cutter::bull_nose(0.9, 0.3)};
@@ -64,7 +64,7 @@ TEST_CASE("machine: a box milled in several tilted directions matches the point-
       mill(maps.back(), cutters, d.moves);
     }
     DexelLattice lattice = DexelLattice::covering(stock, spacing);
-    TripleDexel result = machine(stock, lattice, maps);
+    TripleDexel result = intersect_milled(stock, lattice, maps);
     validate(result);
     // Away from every surface (the stock's faces and the cut) by the Z-map and dexel error
     // bands, the classification must agree.
@@ -91,7 +91,7 @@ TEST_CASE("machine: a box milled in several tilted directions matches the point-
   }
 }
 
-TEST_CASE("machine: independent of the order of directions and of the thread count; equals the Booleans") {
+TEST_CASE("intersect_milled: independent of the order of directions and of the thread count; equals the Booleans") {
   std::mt19937 rng(7);
   const std::vector<Cutter> cutters{Cutter::ball(1.0), Cutter::flat(0.7), Cutter::ball(0.5)};
   Aabb stock{Vec3(0), Vec3(5, 4, 3)};
@@ -102,9 +102,9 @@ TEST_CASE("machine: independent of the order of directions and of the thread cou
     mill(maps.back(), cutters, d.moves);
   }
   DexelLattice lattice = DexelLattice::covering(stock, 0.1);
-  TripleDexel a = machine(stock, lattice, maps, 1);
+  TripleDexel a = intersect_milled(stock, lattice, maps, 1);
   std::vector<ZMap> reversed(maps.rbegin(), maps.rend());
-  TripleDexel b = machine(stock, lattice, reversed, 3);
+  TripleDexel b = intersect_milled(stock, lattice, reversed, 3);
   for (int k = 0; k < 3; ++k) {
     CHECK(a.grids[k].offsets == b.grids[k].offsets);
     bool same = a.grids[k].intervals.size() == b.grids[k].intervals.size();
@@ -117,8 +117,8 @@ TEST_CASE("machine: independent of the order of directions and of the thread cou
   for (const ZMap& m : maps) booleans = intersect(booleans, dexelize(m, lattice));
   CHECK(volume(a) == doctest::Approx(volume(booleans)).epsilon(1e-6));
   // From a stock mesh: the same solid.
-  TripleDexel from_mesh = machine(tridex_test::box_mesh(stock.min, stock.max), lattice, maps);
+  TripleDexel from_mesh = intersect_milled(tridex_test::box_mesh(stock.min, stock.max), lattice, maps);
   CHECK(volume(from_mesh) == doctest::Approx(volume(a)).epsilon(1e-3));
   // No map: the stock itself.
-  CHECK(volume(machine(stock, lattice, {})) == doctest::Approx(volume(TripleDexel::box(lattice, stock))));
+  CHECK(volume(intersect_milled(stock, lattice, {})) == doctest::Approx(volume(TripleDexel::box(lattice, stock))));
 }
