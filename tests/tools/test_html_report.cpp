@@ -1,4 +1,4 @@
-// The --html page's writer (tools/cli/html_report.*): base64 against RFC 4648's vectors, the
+// The --html page's writer (tools/cli/outputs/html_report.*): base64 against RFC 4648's vectors, the
 // display mesh against its budget and the triangles it must keep, the thinned toolpath against the
 // moves (every stop reachable in program order, every move within the tolerance of the segment that
 // stands for it), the program order across groups and files,
