@@ -35,12 +35,19 @@ double peak_rss_mib() {
 
 Frame direction(int i) {
   switch (i) {
-    case 0: return Frame{};
-    case 1: return Frame::from_rotation(rotation_y(30), kStock.center());
-    case 2: return Frame::from_rotation(rotation_y(-30), kStock.center());
-    case 3: return Frame::from_rotation(rotation_x(30), kStock.center());
-    case 4: return Frame::from_rotation(rotation_x(-30), kStock.center());
-    default: return Frame::from_rotation(rotation_z(45) * rotation_y(45) * rotation_z(-45), kStock.center());
+    case 0:
+      return Frame{};
+    case 1:
+      return Frame::from_rotation(rotation_y(30), kStock.center());
+    case 2:
+      return Frame::from_rotation(rotation_y(-30), kStock.center());
+    case 3:
+      return Frame::from_rotation(rotation_x(30), kStock.center());
+    case 4:
+      return Frame::from_rotation(rotation_x(-30), kStock.center());
+    default:
+      return Frame::from_rotation(rotation_z(45) * rotation_y(45) * rotation_z(-45),
+                                  kStock.center());
   }
 }
 
@@ -52,14 +59,16 @@ ZMap mold_map(int i) {
   double cell = std::max(local.max.x - local.min.x, local.max.y - local.min.y) / 4998.0;
   ZMap map = ZMap::from_box(frame, kStock, cell);
   const ZMapGrid& g = map.grid;
-  double cx = 0.5 * (local.min.x + local.max.x) + 10 * i, cy = 0.5 * (local.min.y + local.max.y) - 7 * i;
+  double cx = 0.5 * (local.min.x + local.max.x) + 10 * i,
+         cy = 0.5 * (local.min.y + local.max.y) - 7 * i;
   for (int j = 0; j < g.ny; ++j)
     for (int k = 0; k < g.nx; ++k) {
       float& h = map.heights[g.index(k, j)];
       if (h <= map.empty_height) continue;
       double x = g.x(k), y = g.y(j);
       double r2 = ((x - cx) * (x - cx) + (y - cy) * (y - cy)) / (40.0 * 40.0);
-      double surface = local.max.z - 4 - 30 * std::max(0.0, 1 - r2) - 2 * std::sin(x / 7) * std::cos(y / 9) -
+      double surface = local.max.z - 4 - 30 * std::max(0.0, 1 - r2) -
+                       2 * std::sin(x / 7) * std::cos(y / 9) -
                        8 * std::exp(-std::pow((x - cx + 50) / 6, 2));
       h = std::max(map.empty_height, std::min(h, static_cast<float>(surface)));
     }
@@ -131,7 +140,8 @@ void step3_intersect_six(benchmark::State& state) {
   double cpu_start = process_cpu_s();
   for (auto _ : state) {
     result = stock;
-    for (const TripleDexel& m : models) result = intersect(result, m, static_cast<unsigned>(state.range(0)));
+    for (const TripleDexel& m : models)
+      result = intersect(result, m, static_cast<unsigned>(state.range(0)));
     benchmark::DoNotOptimize(result.grids[0].intervals.data());
   }
   report(state, result, cpu_start);
@@ -162,11 +172,14 @@ void dexelize_mesh_sphere(benchmark::State& state) {
     for (int k = 0; k < slices; ++k) {
       double theta = 2 * M_PI * k / slices;
       m.positions.emplace_back(static_cast<float>(r * std::cos(phi) * std::cos(theta)),
-                               static_cast<float>(r * std::cos(phi) * std::sin(theta)), static_cast<float>(r * std::sin(phi)));
+                               static_cast<float>(r * std::cos(phi) * std::sin(theta)),
+                               static_cast<float>(r * std::sin(phi)));
     }
   }
   m.positions.emplace_back(0.0f, 0.0f, static_cast<float>(r));
-  auto at = [&](int s, int k) { return static_cast<std::uint32_t>(1 + (s - 1) * slices + (k % slices)); };
+  auto at = [&](int s, int k) {
+    return static_cast<std::uint32_t>(1 + (s - 1) * slices + (k % slices));
+  };
   auto north = static_cast<std::uint32_t>(m.positions.size() - 1);
   for (int k = 0; k < slices; ++k) {
     m.triangles.emplace_back(0u, at(1, k + 1), at(1, k));
@@ -189,7 +202,12 @@ void dexelize_mesh_sphere(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(step2_dexelize_zmap)->Args({0, 0})->Args({5, 0})->Args({5, 1})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(step2_dexelize_zmap)
+    ->Args({0, 0})
+    ->Args({5, 0})
+    ->Args({5, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(step3_intersect_six)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(machine_six)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(dexelize_mesh_sphere)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -54,7 +54,8 @@ std::vector<CutMove> raster(double stepover, double step, double lift, std::uint
   for (int l = 0; l < lines; ++l)
     for (int s = 0; s <= steps; ++s) {
       const double x = s * step, y = l * stepover;
-      tips[static_cast<std::size_t>(l * (steps + 1) + s)] = touching ? touching_tip(*touching, x, y) : wavy(x, y);
+      tips[static_cast<std::size_t>(l * (steps + 1) + s)] =
+          touching ? touching_tip(*touching, x, y) : wavy(x, y);
     }
   for (int l = 0; l < lines; ++l) {
     double y = l * stepover;
@@ -68,7 +69,8 @@ std::vector<CutMove> raster(double stepover, double step, double lift, std::uint
   return moves;
 }
 
-void mill_moves(benchmark::State& state, const std::vector<Cutter>& cutters, const std::vector<CutMove>& moves) {
+void mill_moves(benchmark::State& state, const std::vector<Cutter>& cutters,
+                const std::vector<CutMove>& moves) {
   static const ZMap stock = ZMap::from_box(Frame{}, Aabb{Vec3(0), Vec3(kSide, kSide, 25)}, kCell);
   MillOptions options{static_cast<unsigned>(state.range(0))};
   ZMap map = stock;
@@ -80,8 +82,8 @@ void mill_moves(benchmark::State& state, const std::vector<Cutter>& cutters, con
     benchmark::DoNotOptimize(map.heights.data());
   }
   state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * moves.size()));
-  state.counters["segments/s"] =
-      benchmark::Counter(static_cast<double>(moves.size()), benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["segments/s"] = benchmark::Counter(static_cast<double>(moves.size()),
+                                                    benchmark::Counter::kIsIterationInvariantRate);
 }
 
 const std::vector<CutMove>& finishing() {
@@ -89,7 +91,9 @@ const std::vector<CutMove>& finishing() {
   return moves;
 }
 
-void one_cutter(benchmark::State& state, Cutter cutter) { mill_moves(state, {cutter}, finishing()); }
+void one_cutter(benchmark::State& state, Cutter cutter) {
+  mill_moves(state, {cutter}, finishing());
+}
 
 void ball_d6(benchmark::State& s) { one_cutter(s, Cutter::ball(3)); }
 void flat_d6(benchmark::State& s) { one_cutter(s, Cutter::flat(3)); }
@@ -129,7 +133,9 @@ void roughing(benchmark::State& state, Cutter rough, double lift, bool with_ball
 void flat_d10_rough_below(benchmark::State& s) { roughing(s, Cutter::flat(5), -0.4, false); }
 void ball_and_flat_d10_below(benchmark::State& s) { roughing(s, Cutter::flat(5), -0.4, true); }
 void bull_d8_rough_below(benchmark::State& s) { roughing(s, Cutter::bull_nose(4, 1), -0.4, false); }
-void ball_and_bull_d8_below(benchmark::State& s) { roughing(s, Cutter::bull_nose(4, 1), -0.4, true); }
+void ball_and_bull_d8_below(benchmark::State& s) {
+  roughing(s, Cutter::bull_nose(4, 1), -0.4, true);
+}
 void flat_d10_rough_above(benchmark::State& s) { roughing(s, Cutter::flat(5), 0.3, false); }
 void ball_and_flat_d10_above(benchmark::State& s) { roughing(s, Cutter::flat(5), 0.3, true); }
 

@@ -68,7 +68,8 @@ struct Mold {
 TripleDexel build_mold(int cells) {
   Mold mold;
   const double h = mold.size / cells;
-  DexelLattice lattice{Vec3(-2 * h), h, glm::ivec3(cells + 5, cells + 5, int(std::ceil(65 / h)) + 5)};
+  DexelLattice lattice{Vec3(-2 * h), h,
+                       glm::ivec3(cells + 5, cells + 5, int(std::ceil(65 / h)) + 5)};
   TripleDexel d = TripleDexel::empty(lattice);
   auto node = [&](int a, int m) { return lattice.origin[a] + h * m; };
   const double lo = 0, hi = mold.size;
@@ -78,7 +79,8 @@ TripleDexel build_mold(int cells) {
     for (int j = 0; j < g.nv; ++j)
       for (int i = 0; i < g.nu; ++i) {
         double x = node(0, i), y = node(1, j);
-        if (x > lo && x < hi && y > lo && y < hi) g.intervals.push_back({0.0f, float(mold.height(x, y))});
+        if (x > lo && x < hi && y > lo && y < hi)
+          g.intervals.push_back({0.0f, float(mold.height(x, y))});
         g.offsets[g.ray_index(i, j) + 1] = static_cast<std::uint32_t>(g.intervals.size());
       }
   }
@@ -112,8 +114,10 @@ TripleDexel build_mold(int cells) {
           bool rising = f1 > f0;
           if (rising ? !(f0 < z && z <= f1) : !(f1 < z && z <= f0)) continue;
           float x = float(t[m] + (t[m + 1] - t[m]) * (z - f0) / (f1 - f0));
-          if (rising) open[k] = x;
-          else if (x > open[k]) rays[ray_of(k)].push_back({open[k], x});
+          if (rising)
+            open[k] = x;
+          else if (x > open[k])
+            rays[ray_of(k)].push_back({open[k], x});
         }
       }
       for (int k = 0; k < levels; ++k)
@@ -146,7 +150,8 @@ const CachedMold& mold_dexel(int cells) {
 double dexel_mib(const TripleDexel& d) {
   double bytes = 0;
   for (const DexelGrid& g : d.grids)
-    bytes += double(g.offsets.size() * sizeof(std::uint32_t) + g.intervals.size() * sizeof(DexelInterval));
+    bytes += double(g.offsets.size() * sizeof(std::uint32_t) +
+                    g.intervals.size() * sizeof(DexelInterval));
   return bytes / (1024.0 * 1024.0);
 }
 
@@ -167,7 +172,8 @@ void BM_extract_surface(benchmark::State& state) {
   state.counters["triangles"] = double(triangles);
   state.counters["vertices"] = double(vertices);
   state.counters["dexel_MiB"] = dexel_mib(d);
-  state.counters["mesh_MiB"] = double(triangles * sizeof(glm::uvec3) + vertices * sizeof(glm::vec3)) / (1024.0 * 1024.0);
+  state.counters["mesh_MiB"] =
+      double(triangles * sizeof(glm::uvec3) + vertices * sizeof(glm::vec3)) / (1024.0 * 1024.0);
   // Peak resident set of the whole process (ru_maxrss): run one configuration per process to
   // read it as "dexel + extraction"; rss_before_MiB is the peak before the first extraction.
   state.counters["rss_before_MiB"] = mold.rss_after_build_mib;

@@ -30,8 +30,10 @@ ZMap mold_map(double tilt_deg, int points) {
     for (int i = 0; i < map.grid.nx; ++i) {
       float& h = map.heights[map.grid.index(i, j)];
       if (h <= map.empty_height) continue;
-      double x = (map.grid.x(i) - local.center().x) / 50, y = (map.grid.y(j) - local.center().y) / 50;
-      double surface = local.max.z - 20 + 12 * std::exp(-2 * (x * x + y * y)) + 1.5 * std::sin(9 * x) * std::cos(7 * y);
+      double x = (map.grid.x(i) - local.center().x) / 50,
+             y = (map.grid.y(j) - local.center().y) / 50;
+      double surface = local.max.z - 20 + 12 * std::exp(-2 * (x * x + y * y)) +
+                       1.5 * std::sin(9 * x) * std::cos(7 * y);
       h = std::min(h, static_cast<float>(surface));
     }
   return map;
@@ -49,7 +51,8 @@ std::vector<CutMove> raster(const ZMap& map, int lines, int per_line) {
   for (int l = 0; l < lines; ++l)
     for (int k = 0; k < per_line; ++k) {
       double t = double(l) / (lines - 1);
-      moves.push_back({Segment{point(double(k) / per_line, t), point(double(k + 1) / per_line, t)}, 0});
+      moves.push_back(
+          {Segment{point(double(k) / per_line, t), point(double(k + 1) / per_line, t)}, 0});
     }
   return moves;
 }
@@ -62,16 +65,18 @@ void BM_dexelize(benchmark::State& state) {
   if (made != points) map = mold_map(30, points), made = points;
   const DexelLattice lattice = DexelLattice::covering_resolution(kStock, 256);
   for (auto _ : state) {
-    TripleDexel d = backend == be::DexelBackend::tree     ? dexelize(map, lattice)
-                    : backend == be::DexelBackend::scan   ? scan_dexelize(map, lattice)
-                                                          : be::embree_dexelize(map, lattice);
+    TripleDexel d = backend == be::DexelBackend::tree   ? dexelize(map, lattice)
+                    : backend == be::DexelBackend::scan ? scan_dexelize(map, lattice)
+                                                        : be::embree_dexelize(map, lattice);
     benchmark::DoNotOptimize(d.grids[0].intervals.data());
   }
   state.SetLabel(be::to_string(backend));
   state.counters["zmap_points"] = double(map.grid.size());
 }
 BENCHMARK(BM_dexelize)
-    ->ArgsProduct({{int(be::DexelBackend::tree), int(be::DexelBackend::embree), int(be::DexelBackend::scan)}, {1000, 2000}})
+    ->ArgsProduct({{int(be::DexelBackend::tree), int(be::DexelBackend::embree),
+                    int(be::DexelBackend::scan)},
+                   {1000, 2000}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
@@ -90,7 +95,11 @@ void BM_mill(benchmark::State& state) {
   state.SetLabel(be::to_string(backend));
   state.counters["moves"] = double(moves.size());
 }
-BENCHMARK(BM_mill)->Arg(int(be::ZMapBackend::cpu))->Arg(int(be::ZMapBackend::gl))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_mill)
+    ->Arg(int(be::ZMapBackend::cpu))
+    ->Arg(int(be::ZMapBackend::gl))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 

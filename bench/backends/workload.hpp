@@ -42,12 +42,12 @@ namespace detail {
 
 struct Direction {
   const char* name;
-  bool tilted;       // G68.2 in use
-  double i, j, k;    // G68.2 Euler angles (degrees)
-  Vec3 origin;       // G68.2 X Y Z: the feature frame's origin in work coordinates
+  bool tilted;            // G68.2 in use
+  double i, j, k;         // G68.2 Euler angles (degrees)
+  Vec3 origin;            // G68.2 X Y Z: the feature frame's origin in work coordinates
   double half_w, half_h;  // the machined region: |x| ≤ half_w, |y| ≤ half_h in the feature frame
-  double top;        // feature z of the stock face the direction machines
-  double share;      // of all segments
+  double top;             // feature z of the stock face the direction machines
+  double share;           // of all segments
 };
 
 inline std::array<Direction, 5> directions() {
@@ -86,14 +86,16 @@ class Writer {
 
 // One raster pass: `levels` Z levels (roughing, tip at max(level, surface + allowance)) or one
 // (finishing, levels = 0), lines along x (along_x) or y, about `budget` G01 segments.
-inline void raster(Writer& w, const Direction& d, double radius, int levels, double allowance, bool along_x,
-                   long long budget, Vec2 shift) {
+inline void raster(Writer& w, const Direction& d, double radius, int levels, double allowance,
+                   bool along_x, long long budget, Vec2 shift) {
   const double clear = d.top + 10;
-  const double len = along_x ? 2 * d.half_w : 2 * d.half_h, across = along_x ? 2 * d.half_h : 2 * d.half_w;
+  const double len = along_x ? 2 * d.half_w : 2 * d.half_h,
+               across = along_x ? 2 * d.half_h : 2 * d.half_w;
   const int passes = std::max(1, levels);
   // Lines and segments per line so that segments are about a quarter of the step-over long.
   const double per_pass = std::max(4.0, double(budget) / passes);
-  const int lines = std::max(2, static_cast<int>(std::lround(std::sqrt(per_pass * across / (4 * len)))));
+  const int lines =
+      std::max(2, static_cast<int>(std::lround(std::sqrt(per_pass * across / (4 * len)))));
   const int per_line = std::max(1, static_cast<int>(std::lround(per_pass / lines)) - 1);
   const double top_level = d.top - 2, bottom_level = d.top - (d.tilted ? 9.0 : 38.0) + allowance;
   for (int p = 0; p < passes; ++p) {
@@ -156,12 +158,13 @@ inline long long write_workload(std::FILE* out, long long segments, WorkloadVari
       w.line("S10000 M3");
       w.line("G54");
       if (d.tilted) {
-        std::snprintf(text, sizeof text, "G68.2 X%.3f Y%.3f Z%.3f I%.1f J%.1f K%.1f", d.origin.x, d.origin.y, d.origin.z,
-                      d.i, d.j, d.k);
+        std::snprintf(text, sizeof text, "G68.2 X%.3f Y%.3f Z%.3f I%.1f J%.1f K%.1f", d.origin.x,
+                      d.origin.y, d.origin.z, d.i, d.j, d.k);
         w.line(text);
         w.line("G53.1");
       }
-      auto budget = static_cast<long long>(std::llround(double(segments) * d.share * tool_share[t]));
+      auto budget =
+          static_cast<long long>(std::llround(double(segments) * d.share * tool_share[t]));
       const double radius = tools[t].cutter.radius();
       // Without G68.2 (+Z) the feature frame is the work frame: the raster is shifted to the
       // origin instead.

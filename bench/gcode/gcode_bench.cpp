@@ -18,7 +18,9 @@ using namespace tridex::gcode;
 namespace {
 
 struct MemoryBuffer : std::streambuf {
-  explicit MemoryBuffer(std::string& text) { setg(text.data(), text.data(), text.data() + text.size()); }
+  explicit MemoryBuffer(std::string& text) {
+    setg(text.data(), text.data(), text.data() + text.size());
+  }
 };
 
 // A 3-axis finishing program as CAM systems write it: N numbers, G1 with three coordinates of
@@ -26,7 +28,8 @@ struct MemoryBuffer : std::streambuf {
 std::string finishing_program(long long blocks, bool arcs) {
   std::mt19937_64 rng(1);
   std::uniform_real_distribution<double> coord(-100, 100), depth(-20, 0);
-  std::string text = "%\nO1000\nG21 G90 G17 G40 G49 G80\nT1 M6\nS10000 M3\nG0 X0 Y0\nG43 Z10 H1\nF1200\n";
+  std::string text =
+      "%\nO1000\nG21 G90 G17 G40 G49 G80\nT1 M6\nS10000 M3\nG0 X0 Y0\nG43 Z10 H1\nF1200\n";
   char line[160];
   double x = 0, y = 0;
   for (long long i = 0; i < blocks; ++i) {
@@ -66,7 +69,8 @@ std::string macro_raster(long long passes) {
 std::string expression_program(long long blocks) {
   std::mt19937_64 rng(1);
   std::uniform_real_distribution<double> coord(-100, 100), depth(-20, 0);
-  std::string text = "%\nO1000\nG21 G90 G17\nT1 M6\nG0 X0 Y0 Z5.\nF1200\n#1 = 0.5\n#2 = 2.\n#<z> = -1\n";
+  std::string text =
+      "%\nO1000\nG21 G90 G17\nT1 M6\nG0 X0 Y0 Z5.\nF1200\n#1 = 0.5\n#2 = 2.\n#<z> = -1\n";
   char line[200];
   for (long long i = 0; i < blocks; ++i) {
     std::snprintf(line, sizeof line, "N%lld G1 X[%.3f + #1] Y[%.3f * #2] Z[#<z> + %.3f]\n", i,
@@ -86,8 +90,8 @@ void run_program(benchmark::State& state, std::string& text, long long blocks) {
     interpreter.run(in, "bench.nc", [&](const Move& m) { sum += m.end.x; });
     benchmark::DoNotOptimize(sum);
   }
-  state.counters["blocks/s"] =
-      benchmark::Counter(static_cast<double>(blocks), benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["blocks/s"] = benchmark::Counter(static_cast<double>(blocks),
+                                                  benchmark::Counter::kIsIterationInvariantRate);
   state.counters["MB/s"] = benchmark::Counter(static_cast<double>(text.size()) / 1e6,
                                               benchmark::Counter::kIsIterationInvariantRate);
 }

@@ -49,7 +49,8 @@ void BM_moves_json_lines(benchmark::State& state) {
     });
   }
   benchmark::DoNotOptimize(bytes);
-  state.counters["moves/s"] = benchmark::Counter(static_cast<double>(moves), benchmark::Counter::kIsRate);
+  state.counters["moves/s"] =
+      benchmark::Counter(static_cast<double>(moves), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_moves_json_lines)->Unit(benchmark::kMillisecond);
 
@@ -87,7 +88,8 @@ BENCHMARK(BM_render_mesh)->Arg(250)->Arg(600)->Unit(benchmark::kMillisecond);
 // writing the STL, the picture and the report to a scratch folder; the command's own timings
 // of each stage become counters.
 void BM_simulate_example(benchmark::State& state) {
-  std::filesystem::path dir = std::filesystem::temp_directory_path() / ("tridex-bench-" + std::to_string(::getpid()));
+  std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("tridex-bench-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   cli::SimulateOptions options;
   options.program = kExamples + "mold_3plus2.camotics";
@@ -145,9 +147,11 @@ BENCHMARK(BM_simulate_fine_cells)
 std::string tools_with_holders(const std::vector<std::pair<int, std::string>>& cutters) {
   std::string text = "{";
   for (const auto& [number, cutter] : cutters)
-    text += (text.size() > 1 ? ",\n" : "\n") + std::string("\"") + std::to_string(number) + "\": {" + cutter +
+    text += (text.size() > 1 ? ",\n" : "\n") + std::string("\"") + std::to_string(number) +
+            "\": {" + cutter +
             ", \"flute-length\": 25, \"stick-out\": 40, \"holder\": [{\"bottom-diameter\": 40, "
-            "\"top-diameter\": 40, \"length\": 30}, {\"bottom-diameter\": 40, \"top-diameter\": 63, \"length\": 20}]}";
+            "\"top-diameter\": 40, \"length\": 30}, {\"bottom-diameter\": 40, \"top-diameter\": "
+            "63, \"length\": 20}]}";
   return text + "}";
 }
 
@@ -155,7 +159,8 @@ std::string tools_with_holders(const std::vector<std::pair<int, std::string>>& c
 // holder check (second argument 1) or without (0): on the example (first argument 0, at
 // --dexel-res 320) or on the paper-scale workload of that many thousand segments (--dexel-res 512).
 void BM_collision_check(benchmark::State& state) {
-  std::filesystem::path dir = std::filesystem::temp_directory_path() / ("tridex-bench-cc-" + std::to_string(::getpid()));
+  std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("tridex-bench-cc-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   cli::SimulateOptions options;
   options.quiet = true;
@@ -163,10 +168,11 @@ void BM_collision_check(benchmark::State& state) {
   if (state.range(0) == 0) {
     options.program = kExamples + "mold_3plus2.camotics";
     options.dexel_res = cli::kDefaultDexelRes;
-    std::ofstream(options.tools) << tools_with_holders({{1, R"("shape": "cylindrical", "diameter": 10)"},
-                                                       {2, R"("shape": "ballnose", "diameter": 8)"},
-                                                       {3, R"("shape": "ballnose", "diameter": 4)"},
-                                                       {4, R"("shape": "ballnose", "diameter": 2)"}});
+    std::ofstream(options.tools) << tools_with_holders(
+        {{1, R"("shape": "cylindrical", "diameter": 10)"},
+         {2, R"("shape": "ballnose", "diameter": 8)"},
+         {3, R"("shape": "ballnose", "diameter": 4)"},
+         {4, R"("shape": "ballnose", "diameter": 2)"}});
   } else {
     options.program = (dir / "workload.nc").string();
     std::FILE* out = std::fopen(options.program.c_str(), "w");
@@ -174,10 +180,11 @@ void BM_collision_check(benchmark::State& state) {
     std::fclose(out);
     options.stock = "box:0,0,0,200,200,130";
     options.dexel_res = 512;
-    std::ofstream(options.tools) << tools_with_holders({{1, R"("shape": "cylindrical", "diameter": 10)"},
-                                                       {2, R"("shape": "bullnose", "diameter": 8, "corner-radius": 1)"},
-                                                       {3, R"("shape": "ballnose", "diameter": 6)"},
-                                                       {4, R"("shape": "ballnose", "diameter": 3)"}});
+    std::ofstream(options.tools) << tools_with_holders(
+        {{1, R"("shape": "cylindrical", "diameter": 10)"},
+         {2, R"("shape": "bullnose", "diameter": 8, "corner-radius": 1)"},
+         {3, R"("shape": "ballnose", "diameter": 6)"},
+         {4, R"("shape": "ballnose", "diameter": 3)"}});
   }
   cli::PipelineRequest request;
   request.rapid_check = cli::RapidCheck::in_program_order;

@@ -41,7 +41,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     options.lenient = lenient;
     options.arc_tolerance = 0.01;  // keeps huge arcs cheap
     options.max_blocks = 20000;    // keeps M98 L loops bounded
-    MachineConfig machine;  // no subprogram folders: calls stay inside the input
+    MachineConfig machine;         // no subprogram folders: calls stay inside the input
     machine.dialect = dialect;
     Interpreter interpreter(options, machine);
     DirectionGrouper grouper;

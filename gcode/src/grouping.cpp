@@ -48,8 +48,7 @@ std::size_t DirectionGrouper::add(const Move& move) {
   return found;
 }
 
-std::vector<MoveGroup> group_by_direction(std::span<const Move> moves,
-                                          double angle_tolerance_deg) {
+std::vector<MoveGroup> group_by_direction(std::span<const Move> moves, double angle_tolerance_deg) {
   DirectionGrouper grouper(angle_tolerance_deg);
   for (const Move& move : moves) grouper.add(move);
   return grouper.take();

@@ -103,10 +103,17 @@ double clamp_to_limits(const RotaryAxis& axis, double angle) {
 
 int rotary_index(char letter) {
   switch (letter) {
-    case 'A': case 'a': return 0;
-    case 'B': case 'b': return 1;
-    case 'C': case 'c': return 2;
-    default: return -1;
+    case 'A':
+    case 'a':
+      return 0;
+    case 'B':
+    case 'b':
+      return 1;
+    case 'C':
+    case 'c':
+      return 2;
+    default:
+      return -1;
   }
 }
 
@@ -148,11 +155,13 @@ void Kinematics::validate() const {
       break;
     case MachineType::head_table:
       if (heads != 1 || tables != 1)
-        detail::fail("kinematics: a head-table machine has one axis on the head and one on the "
-                     "table");
+        detail::fail(
+            "kinematics: a head-table machine has one axis on the head and one on the "
+            "table");
       break;
   }
-  if (axes.size() == 2 && glm::length(glm::cross(axes[0].direction, axes[1].direction)) < kParallelAxes)
+  if (axes.size() == 2 &&
+      glm::length(glm::cross(axes[0].direction, axes[1].direction)) < kParallelAxes)
     detail::fail("kinematics: axes ", axes[0].letter, " and ", axes[1].letter,
                  " are parallel, so they cannot turn the tool to an arbitrary direction");
 }
@@ -166,8 +175,8 @@ Frame head_offset(const Kinematics& kin, const RotaryPositions& rotary) {
 }
 
 Vec3 tool_direction(const Kinematics& kin, const RotaryPositions& rotary) {
-  return glm::transpose(part_to_machine(kin, rotary).rotation) *
-         head_offset(kin, rotary).rotation * Vec3(0, 0, 1);
+  return glm::transpose(part_to_machine(kin, rotary).rotation) * head_offset(kin, rotary).rotation *
+         Vec3(0, 0, 1);
 }
 
 Vec3 tip_in_part(const Kinematics& kin, const Vec3& machine_xyz, const RotaryPositions& rotary) {
@@ -188,8 +197,7 @@ void check_limits(const Kinematics& kin, const RotaryPositions& rotary) {
   for (const RotaryAxis& axis : kin.axes) {
     double v = rotary[std::size_t(rotary_index(axis.letter))];
     if (!std::isfinite(v)) detail::fail(axis.letter, " must be finite, got ", v);
-    if (axis.limits &&
-        (v < (*axis.limits)[0] - kLimitSlack || v > (*axis.limits)[1] + kLimitSlack))
+    if (axis.limits && (v < (*axis.limits)[0] - kLimitSlack || v > (*axis.limits)[1] + kLimitSlack))
       detail::fail(axis.letter, v, " is outside the axis limits ", (*axis.limits)[0], " to ",
                    (*axis.limits)[1]);
   }
@@ -226,7 +234,8 @@ RotaryPositions orient_tool(const Kinematics& kin, const Vec3& part_direction,
     // One axis: table v = Rot(u, −θ)·ez ⇔ Rot(u, θ)·v = ez; head v = Rot(u, θ)·ez.
     const Vec3& u = first.direction;
     Vec3 x = first.on_head ? ez : v, y = first.on_head ? v : ez;
-    if (std::abs(glm::dot(u, x) - glm::dot(u, y)) < 1e-9) candidates.push_back({turn_onto(u, x, y), {}});
+    if (std::abs(glm::dot(u, x) - glm::dot(u, y)) < 1e-9)
+      candidates.push_back({turn_onto(u, x, y), {}});
   } else {
     // a, x, α = sa·θ(ia); b, y, β = sb·θ(ib).
     const RotaryAxis *axis_a, *axis_b;
@@ -257,7 +266,8 @@ RotaryPositions orient_tool(const Kinematics& kin, const Vec3& part_direction,
     }
   }
   if (candidates.empty())
-    detail::fail("tool direction ", vector_text(v), " is not reachable: the machine's rotary axes "
+    detail::fail("tool direction ", vector_text(v),
+                 " is not reachable: the machine's rotary axes "
                  "cannot turn the tool there");
 
   // Each candidate on the turns nearest the current positions, within the limits; the nearest.
@@ -295,7 +305,8 @@ RotaryPositions orient_tool(const Kinematics& kin, const Vec3& part_direction,
     if (excluded.tellp() > 0)
       detail::fail("tool direction ", vector_text(v), " is outside the rotary limits: it needs ",
                    excluded.str());
-    detail::fail("tool direction ", vector_text(v), " is not reachable: the machine's rotary axes "
+    detail::fail("tool direction ", vector_text(v),
+                 " is not reachable: the machine's rotary axes "
                  "cannot turn the tool there");
   }
   return *best;

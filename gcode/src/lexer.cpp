@@ -22,7 +22,7 @@ constexpr double kDegree = std::numbers::pi / 180.0;
 // counter built from decimal steps still meets its bound.
 constexpr double kEqualTolerance = 1e-4;
 constexpr int kMaxParameter = 999999;  // Fanuc: six digits (#901001 in pallet programs)
-constexpr int kMaxDepth = 64;  // nested brackets and parameter references
+constexpr int kMaxDepth = 64;          // nested brackets and parameter references
 
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
 bool is_digit(char c) { return c >= '0' && c <= '9'; }
@@ -51,21 +51,54 @@ struct Failure {
   std::string message;
 };
 
-enum class Op { none, power, times, divide, mod, plus, minus, eq, ne, gt, ge, lt, le, and_, or_, xor_ };
+enum class Op {
+  none,
+  power,
+  times,
+  divide,
+  mod,
+  plus,
+  minus,
+  eq,
+  ne,
+  gt,
+  ge,
+  lt,
+  le,
+  and_,
+  or_,
+  xor_
+};
 
 int precedence(Op op) {
   switch (op) {
-    case Op::power: return 5;
-    case Op::times: case Op::divide: case Op::mod: return 4;
-    case Op::plus: case Op::minus: return 3;
-    case Op::eq: case Op::ne: case Op::gt: case Op::ge: case Op::lt: case Op::le: return 2;
-    case Op::and_: case Op::or_: case Op::xor_: return 1;
-    case Op::none: return 0;
+    case Op::power:
+      return 5;
+    case Op::times:
+    case Op::divide:
+    case Op::mod:
+      return 4;
+    case Op::plus:
+    case Op::minus:
+      return 3;
+    case Op::eq:
+    case Op::ne:
+    case Op::gt:
+    case Op::ge:
+    case Op::lt:
+    case Op::le:
+      return 2;
+    case Op::and_:
+    case Op::or_:
+    case Op::xor_:
+      return 1;
+    case Op::none:
+      return 0;
   }
   return 0;
 }
 
-constexpr const char* kFunctions[] = {"ABS", "ACOS", "ASIN", "ATAN", "COS",   "EXISTS", "EXP",
+constexpr const char* kFunctions[] = {"ABS", "ACOS", "ASIN", "ATAN",  "COS", "EXISTS", "EXP",
                                       "FIX", "FUP",  "LN",   "ROUND", "SIN", "SQRT",   "TAN"};
 
 class Parser {
@@ -106,12 +139,14 @@ class Parser {
     if (result.ptr != text_.data() + i_) fail(start, "malformed number");
     if (result.ec != std::errc() || !std::isfinite(value) || value > kMaxWordValue)
       fail(start, "number out of range (limit 1e9) '" +
-                      std::string(text_.substr(start, std::min<std::size_t>(i_ - start, 24))) + "'");
+                      std::string(text_.substr(start, std::min<std::size_t>(i_ - start, 24))) +
+                      "'");
     return value;
   }
 
   ParameterReader& reader(std::size_t at) {
-    if (!parameters_) fail(at, describe(text_[at]) + ": parameters and expressions are not supported");
+    if (!parameters_)
+      fail(at, describe(text_[at]) + ": parameters and expressions are not supported");
     return *parameters_;
   }
 
@@ -129,7 +164,8 @@ class Parser {
       while (i_ < n_ && text_[i_] != '>') {
         if (!is_space(text_[i_])) {
           as_written.push_back(text_[i_]);
-          ref.name.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(text_[i_]))));
+          ref.name.push_back(
+              static_cast<char>(std::tolower(static_cast<unsigned char>(text_[i_]))));
         }
         ++i_;
       }
@@ -140,10 +176,11 @@ class Parser {
       // HAL_PIN_VARS); rs274 run standalone has none and refuses it, "not defined".
       if (ref.name.starts_with("_hal["))
         fail(hash, "parameter #<" + as_written + "> reads HAL pin " +
-                           as_written.substr(5, as_written.find(']') == std::string::npos ? std::string::npos
-                                                                                          : as_written.find(']') - 5) +
-                           ", whose value is known only on the running machine (LinuxCNC's rs274 run "
-                           "standalone refuses it too): set the value in the program instead");
+                       as_written.substr(5, as_written.find(']') == std::string::npos
+                                                ? std::string::npos
+                                                : as_written.find(']') - 5) +
+                       ", whose value is known only on the running machine (LinuxCNC's rs274 run "
+                       "standalone refuses it too): set the value in the program instead");
       return ref;
     }
     Value index = primary(hash);
@@ -211,7 +248,8 @@ class Parser {
     std::size_t at = i_;
     std::string name;
     while (i_ < n_ && is_alpha(text_[i_])) name.push_back(upper(text_[i_++]));
-    bool known = std::find(std::begin(kFunctions), std::end(kFunctions), name) != std::end(kFunctions);
+    bool known =
+        std::find(std::begin(kFunctions), std::end(kFunctions), name) != std::end(kFunctions);
     if (!known) fail(at, "unknown function or word '" + name + "'");
     reader(at);
     spaces();
@@ -242,25 +280,33 @@ class Parser {
       return Value{std::atan(x) / kDegree, false};
     }
     double r = 0;
-    if (name == "ABS") r = std::abs(x);
+    if (name == "ABS")
+      r = std::abs(x);
     else if (name == "ACOS" || name == "ASIN") {
       if (x < -1 || x > 1) fail(at, name + " of " + format(x) + " (outside [-1, 1])");
       r = (name == "ACOS" ? std::acos(x) : std::asin(x)) / kDegree;
-    } else if (name == "COS") r = std::cos(x * kDegree);
-    else if (name == "SIN") r = std::sin(x * kDegree);
-    else if (name == "TAN") r = std::tan(x * kDegree);
-    else if (name == "EXP") r = std::exp(x);
+    } else if (name == "COS")
+      r = std::cos(x * kDegree);
+    else if (name == "SIN")
+      r = std::sin(x * kDegree);
+    else if (name == "TAN")
+      r = std::tan(x * kDegree);
+    else if (name == "EXP")
+      r = std::exp(x);
     else if (name == "LN") {
       if (!(x > 0)) fail(at, "LN of " + format(x) + " (must be positive)");
       r = std::log(x);
     } else if (name == "SQRT") {
       if (x < 0) fail(at, "SQRT of " + format(x) + " (negative)");
       r = std::sqrt(x);
-    } else if (name == "ROUND") r = std::round(x);
+    } else if (name == "ROUND")
+      r = std::round(x);
     // Fanuc rounds FIX toward zero and FUP away from it; LinuxCNC floors and ceils.
-    else if (name == "FIX") r = parameters_->vacant_words_omitted() ? std::trunc(x) : std::floor(x);
+    else if (name == "FIX")
+      r = parameters_->vacant_words_omitted() ? std::trunc(x) : std::floor(x);
     else if (name == "FUP")
-      r = parameters_->vacant_words_omitted() ? (x < 0 ? std::floor(x) : std::ceil(x)) : std::ceil(x);
+      r = parameters_->vacant_words_omitted() ? (x < 0 ? std::floor(x) : std::ceil(x))
+                                              : std::ceil(x);
     (void)y;
     if (!std::isfinite(r)) fail(at, name + " of " + format(x) + " is out of range");
     return Value{r, false};
@@ -274,12 +320,13 @@ class Parser {
       i_ += length;
       return op;
     };
-    if (c == '*') return i_ + 1 < n_ && text_[i_ + 1] == '*' ? take(2, Op::power) : take(1, Op::times);
+    if (c == '*')
+      return i_ + 1 < n_ && text_[i_ + 1] == '*' ? take(2, Op::power) : take(1, Op::times);
     if (c == '/') return take(1, Op::divide);
     if (c == '+') return take(1, Op::plus);
     if (c == '-') return take(1, Op::minus);
     static constexpr std::pair<std::string_view, Op> kWords[] = {
-        {"MOD", Op::mod}, {"EQ", Op::eq}, {"NE", Op::ne}, {"GT", Op::gt}, {"GE", Op::ge},
+        {"MOD", Op::mod}, {"EQ", Op::eq}, {"NE", Op::ne},    {"GT", Op::gt},    {"GE", Op::ge},
         {"LT", Op::lt},   {"LE", Op::le}, {"AND", Op::and_}, {"XOR", Op::xor_}, {"OR", Op::or_}};
     for (const auto& [word, op] : kWords)
       if (keyword(word)) return op;
@@ -290,9 +337,11 @@ class Parser {
     double x = a.number, y = b.number;
     switch (op) {
       case Op::power:
-        if (x < 0 && y != std::floor(y)) fail(at, "negative " + format(x) + " raised to a fraction");
+        if (x < 0 && y != std::floor(y))
+          fail(at, "negative " + format(x) + " raised to a fraction");
         return finite(std::pow(x, y), at);
-      case Op::times: return finite(x * y, at);
+      case Op::times:
+        return finite(x * y, at);
       case Op::divide:
         if (y == 0) fail(at, "division by zero");
         return finite(x / y, at);
@@ -302,8 +351,10 @@ class Parser {
         if (r < 0) r += std::abs(y);  // rs274ngc's rule: the result is not negative
         return Value{r, false};
       }
-      case Op::plus: return finite(x + y, at);
-      case Op::minus: return finite(x - y, at);
+      case Op::plus:
+        return finite(x + y, at);
+      case Op::minus:
+        return finite(x - y, at);
       case Op::eq:
       case Op::ne: {
         // Fanuc: vacant equals only vacant (#1 EQ 0 is false for an unset #1). LinuxCNC has no
@@ -312,14 +363,22 @@ class Parser {
         bool equal = by_vacancy ? a.vacant == b.vacant : std::abs(x - y) < kEqualTolerance;
         return Value{(op == Op::eq) == equal ? 1.0 : 0.0, false};
       }
-      case Op::gt: return Value{x > y ? 1.0 : 0.0, false};
-      case Op::ge: return Value{x >= y ? 1.0 : 0.0, false};
-      case Op::lt: return Value{x < y ? 1.0 : 0.0, false};
-      case Op::le: return Value{x <= y ? 1.0 : 0.0, false};
-      case Op::and_: return Value{(x != 0 && y != 0) ? 1.0 : 0.0, false};
-      case Op::or_: return Value{(x != 0 || y != 0) ? 1.0 : 0.0, false};
-      case Op::xor_: return Value{((x != 0) != (y != 0)) ? 1.0 : 0.0, false};
-      case Op::none: break;
+      case Op::gt:
+        return Value{x > y ? 1.0 : 0.0, false};
+      case Op::ge:
+        return Value{x >= y ? 1.0 : 0.0, false};
+      case Op::lt:
+        return Value{x < y ? 1.0 : 0.0, false};
+      case Op::le:
+        return Value{x <= y ? 1.0 : 0.0, false};
+      case Op::and_:
+        return Value{(x != 0 && y != 0) ? 1.0 : 0.0, false};
+      case Op::or_:
+        return Value{(x != 0 || y != 0) ? 1.0 : 0.0, false};
+      case Op::xor_:
+        return Value{((x != 0) != (y != 0)) ? 1.0 : 0.0, false};
+      case Op::none:
+        break;
     }
     return a;
   }
@@ -504,7 +563,8 @@ class LineLexer : public Parser {
     if (i_ == n_ || text_[i_] != '=') fail(i_, "expected '=' after the parameter");
     ++i_;
     Value v = expression(hash);
-    block_.assignments.push_back(Assignment{ref.number, std::move(ref.name), v, static_cast<int>(hash) + 1});
+    block_.assignments.push_back(
+        Assignment{ref.number, std::move(ref.name), v, static_cast<int>(hash) + 1});
   }
 
   long long integer_value(std::size_t at, const char* what) {
@@ -624,7 +684,8 @@ class LineLexer : public Parser {
     if (j < n_ && text_[j] == '<') {
       std::size_t open = j++;
       while (j < n_ && text_[j] != '>') {
-        if (!is_space(text_[j])) label.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(text_[j]))));
+        if (!is_space(text_[j]))
+          label.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(text_[j]))));
         ++j;
       }
       if (j == n_) fail(open, "o-word name '<' is not closed by '>'");
@@ -644,13 +705,20 @@ class LineLexer : public Parser {
       return false;
     }
     static constexpr std::pair<std::string_view, OKeyword> kKeywords[] = {
-        {"ENDSUB", OKeyword::endsub},       {"SUB", OKeyword::sub},
-        {"CALL", OKeyword::call},           {"ELSEIF", OKeyword::elseif},
-        {"ELSE", OKeyword::else_},          {"ENDIF", OKeyword::endif},
-        {"IF", OKeyword::if_},              {"ENDWHILE", OKeyword::endwhile},
-        {"WHILE", OKeyword::while_},        {"DO", OKeyword::do_},
-        {"ENDREPEAT", OKeyword::endrepeat}, {"REPEAT", OKeyword::repeat},
-        {"BREAK", OKeyword::break_},        {"CONTINUE", OKeyword::continue_},
+        {"ENDSUB", OKeyword::endsub},
+        {"SUB", OKeyword::sub},
+        {"CALL", OKeyword::call},
+        {"ELSEIF", OKeyword::elseif},
+        {"ELSE", OKeyword::else_},
+        {"ENDIF", OKeyword::endif},
+        {"IF", OKeyword::if_},
+        {"ENDWHILE", OKeyword::endwhile},
+        {"WHILE", OKeyword::while_},
+        {"DO", OKeyword::do_},
+        {"ENDREPEAT", OKeyword::endrepeat},
+        {"REPEAT", OKeyword::repeat},
+        {"BREAK", OKeyword::break_},
+        {"CONTINUE", OKeyword::continue_},
         {"RETURN", OKeyword::return_}};
     // The keyword is the whole run of letters: `callsub` is not `call` followed by junk.
     std::size_t end = j;
@@ -672,7 +740,8 @@ class LineLexer : public Parser {
       }
     }
     fail(j, "unknown o-word keyword '" + std::string(name) +
-                "' (LinuxCNC's are sub, endsub, call, return, if, elseif, else, endif, while, endwhile, "
+                "' (LinuxCNC's are sub, endsub, call, return, if, elseif, else, endif, while, "
+                "endwhile, "
                 "do, repeat, endrepeat, break, continue)");
   }
 
@@ -683,21 +752,36 @@ class LineLexer : public Parser {
 
 const char* to_string(OKeyword keyword) {
   switch (keyword) {
-    case OKeyword::sub: return "sub";
-    case OKeyword::endsub: return "endsub";
-    case OKeyword::call: return "call";
-    case OKeyword::if_: return "if";
-    case OKeyword::elseif: return "elseif";
-    case OKeyword::else_: return "else";
-    case OKeyword::endif: return "endif";
-    case OKeyword::while_: return "while";
-    case OKeyword::endwhile: return "endwhile";
-    case OKeyword::do_: return "do";
-    case OKeyword::repeat: return "repeat";
-    case OKeyword::endrepeat: return "endrepeat";
-    case OKeyword::break_: return "break";
-    case OKeyword::continue_: return "continue";
-    case OKeyword::return_: return "return";
+    case OKeyword::sub:
+      return "sub";
+    case OKeyword::endsub:
+      return "endsub";
+    case OKeyword::call:
+      return "call";
+    case OKeyword::if_:
+      return "if";
+    case OKeyword::elseif:
+      return "elseif";
+    case OKeyword::else_:
+      return "else";
+    case OKeyword::endif:
+      return "endif";
+    case OKeyword::while_:
+      return "while";
+    case OKeyword::endwhile:
+      return "endwhile";
+    case OKeyword::do_:
+      return "do";
+    case OKeyword::repeat:
+      return "repeat";
+    case OKeyword::endrepeat:
+      return "endrepeat";
+    case OKeyword::break_:
+      return "break";
+    case OKeyword::continue_:
+      return "continue";
+    case OKeyword::return_:
+      return "return";
   }
   return "?";
 }
@@ -725,7 +809,8 @@ bool evaluate_arguments(std::string_view text, int column, ParameterReader& para
       char c = text[parser.i_];
       if (c == '(') {
         while (parser.i_ < parser.n_ && text[parser.i_] != ')') ++parser.i_;
-        if (parser.i_ == parser.n_) parser.fail(parser.i_, "comment '(' is not closed on this line");
+        if (parser.i_ == parser.n_)
+          parser.fail(parser.i_, "comment '(' is not closed on this line");
         ++parser.i_;
         continue;
       }

@@ -65,8 +65,9 @@ void Interpreter::State::extra_linear_words(bool track) {
   }
   if (!warned_uvw) {
     warned_uvw = true;
-    warn(first, "U/V/W read as plain axes, as LinuxCNC does on a machine that has them: they do not move "
-                "the tool tridex simulates");
+    warn(first,
+         "U/V/W read as plain axes, as LinuxCNC does on a machine that has them: they do not move "
+         "the tool tridex simulates");
   }
 }
 
@@ -85,8 +86,9 @@ void Interpreter::State::rotary_words() {
       if (w.has(c) && !((w.used >> letter_index(c)) & 1u)) w.take(c);
     if (!warned_plain_rotary) {
       warned_plain_rotary = true;
-      warn(first, "A/B/C read as plain axes, as LinuxCNC does on a machine without kinematics: the "
-                  "tool does not tilt (give the machine file \"kinematics\" to simulate them)");
+      warn(first,
+           "A/B/C read as plain axes, as LinuxCNC does on a machine without kinematics: the "
+           "tool does not tilt (give the machine file \"kinematics\" to simulate them)");
     }
     return;
   }
@@ -99,28 +101,32 @@ void Interpreter::State::rotary_words() {
     const RotaryAxis* a = kin.find(c);
     if (!a) {
       std::string letters;
-      for (const RotaryAxis& x : kin.axes) letters += (letters.empty() ? "" : ", ") + std::string(1, x.letter);
-      error(w.col(c), std::string("rotary word ") + c + format_number(w.value[static_cast<std::size_t>(letter_index(c))]) +
+      for (const RotaryAxis& x : kin.axes)
+        letters += (letters.empty() ? "" : ", ") + std::string(1, x.letter);
+      error(w.col(c), std::string("rotary word ") + c +
+                          format_number(w.value[static_cast<std::size_t>(letter_index(c))]) +
                           ": the machine has no " + c + " axis (its rotary axes: " + letters + ")");
     }
     double v = w.take(c);
     std::size_t i = static_cast<std::size_t>(rotary_index(c));
     next[i] = incremental ? rotary_position[i] + v : v;
     if (a->limits && (next[i] < (*a->limits)[0] || next[i] > (*a->limits)[1]))
-      error(w.col(c), std::string("rotary position ") + c + format_number(next[i]) + " is outside the " +
-                          c + " axis's limits [" + format_number((*a->limits)[0]) + ", " +
-                          format_number((*a->limits)[1]) + "] (machine file)");
+      error(w.col(c), std::string("rotary position ") + c + format_number(next[i]) +
+                          " is outside the " + c + " axis's limits [" +
+                          format_number((*a->limits)[0]) + ", " + format_number((*a->limits)[1]) +
+                          "] (machine file)");
   }
   if (next == rotary_position) return;
   const bool cut = motion == 10;
-  const std::string message = "rotary motion during a cut (G1 turning A/B/C: simultaneous 5-axis) is "
-                              "outside 3+2";
+  const std::string message =
+      "rotary motion during a cut (G1 turning A/B/C: simultaneous 5-axis) is "
+      "outside 3+2";
   if (cut && !options.lenient) error(first, message + "; index with G0 first");
   set_rotary(next);
   if (cut)  // lenient: said on the line and counted per direction for the run's summary
     lenient_read(first,
-                 message + "; read as indexed at its end orientation, direction " + direction_text(axis) +
-                     " (lenient mode)",
+                 message + "; read as indexed at its end orientation, direction " +
+                     direction_text(axis) + " (lenient mode)",
                  "rotary motion during a cut read as indexed along " + direction_text(axis));
   if (!cut && (tilted || tcp || dwo)) go_far();
 }

@@ -50,10 +50,14 @@ bool order_digits(int q, std::array<int, 3>& digits) {
 
 Mat3 axis_rotation(int axis, double degrees) {
   switch (axis) {
-    case 1: return rotation_x(degrees);
-    case 2: return rotation_y(degrees);
-    case 3: return rotation_z(degrees);
-    default: detail::fail("rotation axis must be 1 (X), 2 (Y) or 3 (Z), got ", axis);
+    case 1:
+      return rotation_x(degrees);
+    case 2:
+      return rotation_y(degrees);
+    case 3:
+      return rotation_z(degrees);
+    default:
+      detail::fail("rotation axis must be 1 (X), 2 (Y) or 3 (Z), got ", axis);
   }
 }
 
@@ -110,8 +114,10 @@ Frame hurco_vector_frame(const Vec3& origin, const Vec3& x_direction, const Vec3
   Vec3 y = unit(y_direction, "G68.2 U V W (the feature Y direction)");
   double cosine = glm::dot(x, y);
   if (std::abs(cosine) > kNormalCosine)
-    detail::fail("G68.2: the X direction I J K and the Y direction U V W are not normal to each "
-                 "other (cosine ", cosine, ")");
+    detail::fail(
+        "G68.2: the X direction I J K and the Y direction U V W are not normal to each "
+        "other (cosine ",
+        cosine, ")");
   return from_x_y(origin, x, glm::normalize(y - cosine * x));
 }
 
@@ -139,8 +145,8 @@ Frame compose(const Frame& current, const Frame& incremental) {
 Mat3 linuxcnc_euler_rotation(double first, double second, double third, int q, int p) {
   std::array<int, 3> d{};
   bool shape = order_digits(q, d) && d[0] != d[1] && d[1] != d[2];
-  bool proper = shape && d[0] == d[2];            // 121 131 212 232 313 323
-  bool tait_bryan = shape && d[0] != d[2];        // 123 132 213 231 312 321
+  bool proper = shape && d[0] == d[2];      // 121 131 212 232 313 323
+  bool tait_bryan = shape && d[0] != d[2];  // 123 132 213 231 312 321
   if (p == 0 && !proper)
     detail::fail("G68.2 P0 Q", q, ": LinuxCNC takes Q121 Q131 Q212 Q232 Q313 Q323");
   if (p == 1 && !tait_bryan)

@@ -32,7 +32,7 @@ enum class CutterShape { flat, ball, bull_nose, general };
 struct ProfilePiece {
   double d0 = 0, d1 = 0;
   bool is_arc = false;
-  double h0 = 0, slope = 0;                         // line
+  double h0 = 0, slope = 0;                       // line
   double centre_d = 0, centre_h = 0, radius = 0;  // arc
 
   double height(double d) const {
@@ -68,7 +68,8 @@ class Cutter {
     detail::require_positive(radius, "bull nose cutter radius");
     detail::require_positive(corner_radius, "bull nose corner radius");
     if (corner_radius > radius)
-      detail::fail("bull nose corner radius ", corner_radius, " exceeds the cutter radius ", radius);
+      detail::fail("bull nose corner radius ", corner_radius, " exceeds the cutter radius ",
+                   radius);
     if (corner_radius == radius) return ball(radius);
     Cutter c(CutterShape::bull_nose, radius, "bull nose");
     c.corner_ = corner_radius;
@@ -79,7 +80,9 @@ class Cutter {
   }
 
   // A sharp cone (engraving V-bit) with half-angle `half_angle_deg` between side and axis.
-  static Cutter cone(double radius, double half_angle_deg) { return chamfer(radius, 0, half_angle_deg); }
+  static Cutter cone(double radius, double half_angle_deg) {
+    return chamfer(radius, 0, half_angle_deg);
+  }
 
   // A flat tip of radius `tip_radius`, then a cone of half-angle `half_angle_deg` up to `radius`.
   static Cutter chamfer(double radius, double tip_radius, double half_angle_deg) {
@@ -121,7 +124,8 @@ class Cutter {
   static Cutter from_profile(const std::vector<Vec2>& rho_h) {
     if (rho_h.size() < 2) detail::fail("cutter profile needs at least two points");
     for (const Vec2& p : rho_h)
-      if (!std::isfinite(p.x) || !std::isfinite(p.y)) detail::fail("cutter profile point is not finite");
+      if (!std::isfinite(p.x) || !std::isfinite(p.y))
+        detail::fail("cutter profile point is not finite");
     if (rho_h[0].y != 0 || rho_h[0].x < 0)
       detail::fail("cutter profile must start at the tip (h = 0, ρ ≥ 0)");
     Cutter c(CutterShape::general, rho_h.back().x, "profile");
@@ -132,8 +136,7 @@ class Cutter {
       if (!(q.x > p.x) || !(q.y >= p.y))
         detail::fail("cutter profile point ", k, " must have larger ρ and no smaller h");
       double slope = (q.y - p.y) / (q.x - p.x);
-      if (slope < previous_slope - 1e-12)
-        detail::fail("cutter profile is not convex at point ", k);
+      if (slope < previous_slope - 1e-12) detail::fail("cutter profile is not convex at point ", k);
       previous_slope = slope;
       c.add_line(p.x, q.x, p.y, slope);
     }

@@ -34,7 +34,9 @@ struct DexelLattice {
 
   Vec3 node(int i, int j, int k) const { return origin + spacing * Vec3(i, j, k); }
   // The box spanned by the nodes.
-  Aabb bounds() const { return Aabb{origin, origin + spacing * Vec3(glm::max(n - 1, glm::ivec3(0)))}; }
+  Aabb bounds() const {
+    return Aabb{origin, origin + spacing * Vec3(glm::max(n - 1, glm::ivec3(0)))};
+  }
   bool operator==(const DexelLattice&) const = default;
 
   // Nodes covering `box` with the given spacing, centred on it, with the outermost nodes more
@@ -52,13 +54,16 @@ struct DexelInterval {
 
 struct DexelGrid {
   int axis = 0;
-  int nu = 0, nv = 0;                   // rays along the u and v axes
-  std::vector<std::uint32_t> offsets;   // nu·nv + 1 entries; offsets[0] == 0
+  int nu = 0, nv = 0;                    // rays along the u and v axes
+  std::vector<std::uint32_t> offsets;    // nu·nv + 1 entries; offsets[0] == 0
   std::vector<DexelInterval> intervals;  // all rays' intervals, ray after ray
 
-  std::size_t ray_count() const { return static_cast<std::size_t>(nu) * static_cast<std::size_t>(nv); }
+  std::size_t ray_count() const {
+    return static_cast<std::size_t>(nu) * static_cast<std::size_t>(nv);
+  }
   std::size_t ray_index(int iu, int iv) const {
-    return static_cast<std::size_t>(iu) + static_cast<std::size_t>(nu) * static_cast<std::size_t>(iv);
+    return static_cast<std::size_t>(iu) +
+           static_cast<std::size_t>(nu) * static_cast<std::size_t>(iv);
   }
   std::span<const DexelInterval> ray(std::size_t r) const {
     return {intervals.data() + offsets[r], intervals.data() + offsets[r + 1]};
@@ -67,10 +72,10 @@ struct DexelGrid {
 };
 
 struct TripleDexel {
-  Vec3 origin{0};        // world position of lattice node (0, 0, 0)
-  double spacing = 1;    // lattice spacing, the same along x, y and z
-  glm::ivec3 n{0};       // lattice nodes along x, y, z
-  DexelGrid grids[3];    // grids[a]: rays parallel to axis a
+  Vec3 origin{0};      // world position of lattice node (0, 0, 0)
+  double spacing = 1;  // lattice spacing, the same along x, y and z
+  glm::ivec3 n{0};     // lattice nodes along x, y, z
+  DexelGrid grids[3];  // grids[a]: rays parallel to axis a
 
   static int u_axis(int a) { return (a + 1) % 3; }
   static int v_axis(int a) { return (a + 2) % 3; }
@@ -95,13 +100,15 @@ inline void require_lattice(const DexelLattice& l, const char* who) {
     fail(who, ": lattice of ", l.n.x, " x ", l.n.y, " x ", l.n.z, " nodes is empty");
   // Offsets are 32-bit and ray indices must fit in memory: 2^31 nodes per face is far beyond use.
   double face = std::max({double(l.n.x) * l.n.y, double(l.n.y) * l.n.z, double(l.n.z) * l.n.x});
-  if (face > 2e9) fail(who, ": lattice of ", l.n.x, " x ", l.n.y, " x ", l.n.z, " nodes is too large");
+  if (face > 2e9)
+    fail(who, ": lattice of ", l.n.x, " x ", l.n.y, " x ", l.n.z, " nodes is too large");
 }
 
 inline int lattice_count(double extent, double spacing) {
   double n = std::floor(extent / spacing) + 3;  // > spacing/2 of margin on each side
-  if (!(n < 1e6)) fail("dexel lattice: ", n, " nodes along one side is too many (extent ", extent,
-                       ", spacing ", spacing, ")");
+  if (!(n < 1e6))
+    fail("dexel lattice: ", n, " nodes along one side is too many (extent ", extent, ", spacing ",
+         spacing, ")");
   return static_cast<int>(n);
 }
 
@@ -129,7 +136,8 @@ inline DexelLattice DexelLattice::covering(const Aabb& box, double spacing) {
 
 inline DexelLattice DexelLattice::covering_resolution(const Aabb& box, int cells_on_longest_side) {
   if (cells_on_longest_side < 1)
-    detail::fail("dexel lattice: cells on the longest side must be at least 1, got ", cells_on_longest_side);
+    detail::fail("dexel lattice: cells on the longest side must be at least 1, got ",
+                 cells_on_longest_side);
   if (box.empty() || !is_finite(box.min) || !is_finite(box.max))
     detail::fail("dexel lattice: box is empty or not finite");
   Vec3 size = box.size();
@@ -151,7 +159,8 @@ inline TripleDexel TripleDexel::empty(const DexelLattice& lattice) {
 }
 
 inline TripleDexel TripleDexel::box(const DexelLattice& lattice, const Aabb& solid) {
-  if (!is_finite(solid.min) || !is_finite(solid.max)) detail::fail("triple dexel: box is not finite");
+  if (!is_finite(solid.min) || !is_finite(solid.max))
+    detail::fail("triple dexel: box is not finite");
   TripleDexel d = empty(lattice);
   if (solid.empty()) return d;
   for (int a = 0; a < 3; ++a) {

@@ -49,12 +49,14 @@ DexelGrid build_grid(const DexelLattice& lattice, int axis, unsigned threads, Pe
   std::size_t total = 0;
   for (const auto& p : parts) total += p.size();
   if (total > std::numeric_limits<std::uint32_t>::max())
-    fail("triple dexel: grid ", axis, " would hold ", total, " intervals, over the 32-bit offset limit");
+    fail("triple dexel: grid ", axis, " would hold ", total,
+         " intervals, over the 32-bit offset limit");
   for (std::size_t r = 0; r < rays; ++r) g.offsets[r + 1] += g.offsets[r];
   g.intervals.resize(total);
   std::size_t at = 0;
   for (auto& p : parts) {
-    if (!p.empty()) std::memcpy(g.intervals.data() + at, p.data(), p.size() * sizeof(DexelInterval));
+    if (!p.empty())
+      std::memcpy(g.intervals.data() + at, p.data(), p.size() * sizeof(DexelInterval));
     at += p.size();
     std::vector<DexelInterval>().swap(p);
   }
@@ -63,9 +65,10 @@ DexelGrid build_grid(const DexelLattice& lattice, int axis, unsigned threads, Pe
 
 inline void require_same_lattice(const TripleDexel& a, const TripleDexel& b, const char* who) {
   if (a.lattice() == b.lattice()) return;
-  fail(who, ": operands are on different lattices (origin (", a.origin.x, ", ", a.origin.y, ", ", a.origin.z,
-       ") spacing ", a.spacing, " nodes ", a.n.x, "x", a.n.y, "x", a.n.z, " vs origin (", b.origin.x, ", ",
-       b.origin.y, ", ", b.origin.z, ") spacing ", b.spacing, " nodes ", b.n.x, "x", b.n.y, "x", b.n.z, ")");
+  fail(who, ": operands are on different lattices (origin (", a.origin.x, ", ", a.origin.y, ", ",
+       a.origin.z, ") spacing ", a.spacing, " nodes ", a.n.x, "x", a.n.y, "x", a.n.z,
+       " vs origin (", b.origin.x, ", ", b.origin.y, ", ", b.origin.z, ") spacing ", b.spacing,
+       " nodes ", b.n.x, "x", b.n.y, "x", b.n.z, ")");
 }
 
 inline void intersect_ray(std::span<const DexelInterval> a, std::span<const DexelInterval> b,
@@ -74,8 +77,10 @@ inline void intersect_ray(std::span<const DexelInterval> a, std::span<const Dexe
   while (i < a.size() && j < b.size()) {
     float lo = std::max(a[i].enter, b[j].enter), hi = std::min(a[i].exit, b[j].exit);
     if (lo < hi) out.push_back({lo, hi});
-    if (a[i].exit < b[j].exit) ++i;
-    else ++j;
+    if (a[i].exit < b[j].exit)
+      ++i;
+    else
+      ++j;
   }
 }
 
@@ -85,7 +90,8 @@ inline void unite_ray(std::span<const DexelInterval> a, std::span<const DexelInt
   bool open = false;
   DexelInterval current{};
   while (i < a.size() || j < b.size()) {
-    const DexelInterval& next = (j == b.size() || (i < a.size() && a[i].enter <= b[j].enter)) ? a[i++] : b[j++];
+    const DexelInterval& next =
+        (j == b.size() || (i < a.size() && a[i].enter <= b[j].enter)) ? a[i++] : b[j++];
     if (open && next.enter <= current.exit) {
       current.exit = std::max(current.exit, next.exit);  // touching spans merge: no zero gaps
     } else {
@@ -118,9 +124,9 @@ TripleDexel combine(const TripleDexel& a, const TripleDexel& b, unsigned threads
   out.origin = a.origin, out.spacing = a.spacing, out.n = a.n;
   for (int axis = 0; axis < 3; ++axis) {
     const DexelGrid &ga = a.grids[axis], &gb = b.grids[axis];
-    out.grids[axis] = build_grid(a.lattice(), axis, threads, [&](std::size_t r, std::vector<DexelInterval>& o) {
-      op(ga.ray(r), gb.ray(r), o);
-    });
+    out.grids[axis] = build_grid(
+        a.lattice(), axis, threads,
+        [&](std::size_t r, std::vector<DexelInterval>& o) { op(ga.ray(r), gb.ray(r), o); });
   }
   return out;
 }
@@ -137,16 +143,20 @@ inline void validate(const TripleDexel& d) {
     if (g.axis != a || g.nu != d.n[TripleDexel::u_axis(a)] || g.nv != d.n[TripleDexel::v_axis(a)])
       detail::fail("triple dexel: grid ", a, " has axis ", g.axis, " and ", g.nu, " x ", g.nv,
                    " rays, which does not match the lattice");
-    if (g.offsets.size() != g.ray_count() + 1 || g.offsets.front() != 0 || g.offsets.back() != g.intervals.size())
-      detail::fail("triple dexel: grid ", a, " offsets do not match its ", g.ray_count(), " rays and ",
-                   g.intervals.size(), " intervals");
+    if (g.offsets.size() != g.ray_count() + 1 || g.offsets.front() != 0 ||
+        g.offsets.back() != g.intervals.size())
+      detail::fail("triple dexel: grid ", a, " offsets do not match its ", g.ray_count(),
+                   " rays and ", g.intervals.size(), " intervals");
     for (std::size_t r = 0; r < g.ray_count(); ++r) {
-      if (g.offsets[r] > g.offsets[r + 1]) detail::fail("triple dexel: grid ", a, " offsets decrease at ray ", r);
+      if (g.offsets[r] > g.offsets[r + 1])
+        detail::fail("triple dexel: grid ", a, " offsets decrease at ray ", r);
       float previous = -std::numeric_limits<float>::infinity();
       for (const DexelInterval& s : g.ray(r)) {
-        if (!std::isfinite(s.enter) || !std::isfinite(s.exit) || !(s.enter < s.exit) || !(s.enter > previous))
-          detail::fail("triple dexel: grid ", a, " ray ", r, " has an empty, unsorted or overlapping interval [",
-                       s.enter, ", ", s.exit, "]");
+        if (!std::isfinite(s.enter) || !std::isfinite(s.exit) || !(s.enter < s.exit) ||
+            !(s.enter > previous))
+          detail::fail("triple dexel: grid ", a, " ray ", r,
+                       " has an empty, unsorted or overlapping interval [", s.enter, ", ", s.exit,
+                       "]");
         previous = s.exit;
       }
     }
@@ -199,7 +209,8 @@ inline bool contains(const TripleDexel& d, const Vec3& p) {
   int votes = 0;
   for (int a = 0; a < 3; ++a) {
     int u = TripleDexel::u_axis(a), v = TripleDexel::v_axis(a);
-    double fu = std::round((p[u] - d.origin[u]) / d.spacing), fv = std::round((p[v] - d.origin[v]) / d.spacing);
+    double fu = std::round((p[u] - d.origin[u]) / d.spacing),
+           fv = std::round((p[v] - d.origin[v]) / d.spacing);
     if (fu < 0 || fv < 0 || fu >= d.n[u] || fv >= d.n[v]) continue;
     std::span<const DexelInterval> ray = d.grids[a].ray(static_cast<int>(fu), static_cast<int>(fv));
     auto it = std::upper_bound(ray.begin(), ray.end(), p[a],

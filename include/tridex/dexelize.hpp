@@ -42,7 +42,8 @@ namespace detail {
 
 // The spans of one ray as float intervals: rounding can make a span empty or make two touch;
 // those are dropped or merged so that the ray's list stays sorted, disjoint and non-empty.
-inline void push_span(std::vector<DexelInterval>& out, std::size_t ray_start, double enter, double exit) {
+inline void push_span(std::vector<DexelInterval>& out, std::size_t ray_start, double enter,
+                      double exit) {
   float e0 = static_cast<float>(enter), e1 = static_cast<float>(exit);
   if (!(e0 < e1)) return;
   if (out.size() > ray_start && e0 <= out.back().exit) {
@@ -114,11 +115,13 @@ DexelGrid grid_from_hits(const DexelLattice& lattice, int axis, unsigned threads
 // that is not finite, a triangle naming a missing vertex, a mesh reaching too far beyond the
 // lattice for exact arithmetic (over ~4 million spacings), or a ray whose crossings do not balance
 // (the mesh is open or inside out; the message names the ray).
-inline TripleDexel dexelize(const Mesh& mesh, const DexelLattice& lattice, DexelizeOptions options = {}) {
+inline TripleDexel dexelize(const Mesh& mesh, const DexelLattice& lattice,
+                            DexelizeOptions options = {}) {
   detail::require_lattice(lattice, "dexelize");
   detail::require_valid_indices(mesh, "dexelize");
   for (std::size_t v = 0; v < mesh.positions.size(); ++v)
-    if (!is_finite(Vec3(mesh.positions[v]))) detail::fail("dexelize: mesh vertex ", v, " is not finite");
+    if (!is_finite(Vec3(mesh.positions[v])))
+      detail::fail("dexelize: mesh vertex ", v, " is not finite");
   TripleDexel result = TripleDexel::empty(lattice);
   if (mesh.triangles.empty()) return result;
   const unsigned threads = detail::resolve_threads(options.threads);
@@ -131,10 +134,12 @@ inline TripleDexel dexelize(const Mesh& mesh, const DexelLattice& lattice, Dexel
     // 2^30 and edge functions below 2^61.
     double reach = std::max(nu, nv) + 2.0;
     for (const glm::vec3& p : mesh.positions)
-      reach = std::max({reach, std::abs((p[u] - lattice.origin[u]) / s), std::abs((p[v] - lattice.origin[v]) / s)});
+      reach = std::max({reach, std::abs((p[u] - lattice.origin[u]) / s),
+                        std::abs((p[v] - lattice.origin[v]) / s)});
     int bits = 28 - static_cast<int>(std::ceil(std::log2(reach + 1)));
     if (bits < 6)
-      detail::fail("dexelize: mesh reaches ", reach, " spacings from the lattice origin, too far for exact ray tests");
+      detail::fail("dexelize: mesh reaches ", reach,
+                   " spacings from the lattice origin, too far for exact ray tests");
     bits = std::min(bits, 24);
     const double scale = std::ldexp(1.0, bits);
     std::vector<std::int64_t> qu(mesh.positions.size()), qv(mesh.positions.size());
@@ -154,7 +159,8 @@ inline TripleDexel dexelize(const Mesh& mesh, const DexelLattice& lattice, Dexel
         std::size_t end = std::min(triangle_count, c + chunk);
         for (std::size_t k = c; k < end; ++k) {
           const glm::uvec3& t = mesh.triangles[k];
-          std::int64_t au = qu[t.x], av = qv[t.x], bu = qu[t.y], bv = qv[t.y], cu = qu[t.z], cv = qv[t.z];
+          std::int64_t au = qu[t.x], av = qv[t.x], bu = qu[t.y], bv = qv[t.y], cu = qu[t.z],
+                       cv = qv[t.z];
           std::int64_t area = (bu - au) * (cv - av) - (bv - av) * (cu - au);
           if (area == 0) continue;  // seen edge-on: the perturbed ray misses it
           const int orientation = area > 0 ? 1 : -1;
@@ -163,10 +169,15 @@ inline TripleDexel dexelize(const Mesh& mesh, const DexelLattice& lattice, Dexel
           // Rays with index in [ceil(lo), floor(hi)]; the perturbation only moves rays up/right,
           // so a ray on the box's low side may still hit and one on the high side cannot matter.
           std::int64_t one = std::int64_t{1} << bits;
-          auto floor_div = [&](std::int64_t x) { return x >= 0 ? x / one : -((-x + one - 1) / one); };
-          std::int64_t iu0 = std::max<std::int64_t>(0, floor_div(lo_u)), iu1 = std::min<std::int64_t>(nu - 1, floor_div(hi_u));
-          std::int64_t iv0 = std::max<std::int64_t>(0, floor_div(lo_v)), iv1 = std::min<std::int64_t>(nv - 1, floor_div(hi_v));
-          const double za = mesh.positions[t.x][axis], zb = mesh.positions[t.y][axis], zc = mesh.positions[t.z][axis];
+          auto floor_div = [&](std::int64_t x) {
+            return x >= 0 ? x / one : -((-x + one - 1) / one);
+          };
+          std::int64_t iu0 = std::max<std::int64_t>(0, floor_div(lo_u)),
+                       iu1 = std::min<std::int64_t>(nu - 1, floor_div(hi_u));
+          std::int64_t iv0 = std::max<std::int64_t>(0, floor_div(lo_v)),
+                       iv1 = std::min<std::int64_t>(nv - 1, floor_div(hi_v));
+          const double za = mesh.positions[t.x][axis], zb = mesh.positions[t.y][axis],
+                       zc = mesh.positions[t.z][axis];
           for (std::int64_t iv = iv0; iv <= iv1; ++iv)
             for (std::int64_t iu = iu0; iu <= iu1; ++iu) {
               std::int64_t pu = iu * one, pv = iv * one;
@@ -187,23 +198,27 @@ inline TripleDexel dexelize(const Mesh& mesh, const DexelLattice& lattice, Dexel
       }
     };
     detail::for_each_chunk_indexed((triangle_count + chunk - 1) / chunk, threads, work);
-    result.grids[axis] = detail::grid_from_hits(lattice, axis, threads, found, [&](std::size_t r, float t) {
-      detail::fail("dexelize: mesh is not closed or not outward-oriented: ray ", r % static_cast<std::size_t>(nu), ", ",
-                   r / static_cast<std::size_t>(nu), " along axis ", "xyz"[axis], " has unbalanced crossings at ", t);
-    });
+    result.grids[axis] =
+        detail::grid_from_hits(lattice, axis, threads, found, [&](std::size_t r, float t) {
+          detail::fail("dexelize: mesh is not closed or not outward-oriented: ray ",
+                       r % static_cast<std::size_t>(nu), ", ", r / static_cast<std::size_t>(nu),
+                       " along axis ", "xyz"[axis], " has unbalanced crossings at ", t);
+        });
   }
   return result;
 }
 
 // (a): the polyhedron of a Z-map (polyhedron.hpp), through its grid tree. Throws tridex::Error
 // for an invalid lattice or a Z-map with fewer than 2 × 2 points.
-inline TripleDexel dexelize(const ZMap& map, const DexelLattice& lattice, DexelizeOptions options = {}) {
+inline TripleDexel dexelize(const ZMap& map, const DexelLattice& lattice,
+                            DexelizeOptions options = {}) {
   detail::require_lattice(lattice, "dexelize");
   const GridTree tree(map);
   const Frame& frame = map.grid.frame;
   // The polyhedron's world box, for skipping rays that miss it.
-  Aabb local{Vec3(map.grid.x(0), map.grid.y(0), tree.bottom()),
-             Vec3(map.grid.x(map.grid.nx - 1), map.grid.y(map.grid.ny - 1), double(tree.nodes()[0].hi))};
+  Aabb local{
+      Vec3(map.grid.x(0), map.grid.y(0), tree.bottom()),
+      Vec3(map.grid.x(map.grid.nx - 1), map.grid.y(map.grid.ny - 1), double(tree.nodes()[0].hi))};
   Aabb world;
   for (const Vec3& c : local.corners()) world.extend(frame.to_world(c));
   TripleDexel result;
@@ -214,18 +229,25 @@ inline TripleDexel dexelize(const ZMap& map, const DexelLattice& lattice, Dexeli
     Vec3 direction(0);
     direction[axis] = 1;
     const Vec3 d = frame.direction_to_local(direction);
-    result.grids[axis] = detail::build_grid(lattice, axis, options.threads, [&](std::size_t r, std::vector<DexelInterval>& out) {
-      Vec3 o(0);
-      o[u] = lattice.origin[u] + lattice.spacing * static_cast<double>(r % static_cast<std::size_t>(nu));
-      o[v] = lattice.origin[v] + lattice.spacing * static_cast<double>(r / static_cast<std::size_t>(nu));
-      if (o[u] < world.min[u] || o[u] > world.max[u] || o[v] < world.min[v] || o[v] > world.max[v]) return;
-      thread_local std::vector<RaySpan> spans;
-      spans.clear();
-      // With o on the plane axis = 0 and a unit direction, t is the world coordinate along axis.
-      tree.spans(frame.to_local(o), d, spans, world.min[axis] - 1, world.max[axis] + 1);
-      std::size_t ray_start = out.size();
-      for (const RaySpan& span : spans) detail::push_span(out, ray_start, span.enter, span.exit);
-    });
+    result.grids[axis] = detail::build_grid(
+        lattice, axis, options.threads, [&](std::size_t r, std::vector<DexelInterval>& out) {
+          Vec3 o(0);
+          o[u] = lattice.origin[u] +
+                 lattice.spacing * static_cast<double>(r % static_cast<std::size_t>(nu));
+          o[v] = lattice.origin[v] +
+                 lattice.spacing * static_cast<double>(r / static_cast<std::size_t>(nu));
+          if (o[u] < world.min[u] || o[u] > world.max[u] || o[v] < world.min[v] ||
+              o[v] > world.max[v])
+            return;
+          thread_local std::vector<RaySpan> spans;
+          spans.clear();
+          // With o on the plane axis = 0 and a unit direction, t is the world coordinate along
+          // axis.
+          tree.spans(frame.to_local(o), d, spans, world.min[axis] - 1, world.max[axis] + 1);
+          std::size_t ray_start = out.size();
+          for (const RaySpan& span : spans)
+            detail::push_span(out, ray_start, span.enter, span.exit);
+        });
   }
   return result;
 }

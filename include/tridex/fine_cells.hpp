@@ -49,15 +49,19 @@ inline bool is_steep_cell(const ZMap& map, int i, int j, double steep_slope) {
 
 // The steep cells of `map` (grid.index of their (i, j) corners), ascending. Rows are split
 // among `threads` threads (0: every hardware thread); the list is the same for any count.
-inline std::vector<std::uint32_t> steep_cells(const ZMap& map, double steep_slope, unsigned threads = 1) {
+inline std::vector<std::uint32_t> steep_cells(const ZMap& map, double steep_slope,
+                                              unsigned threads = 1) {
   const ZMapGrid& g = map.grid;
-  const auto bands = static_cast<std::size_t>((g.ny - 1 + detail::kMapBandRows - 1) / detail::kMapBandRows);
+  const auto bands =
+      static_cast<std::size_t>((g.ny - 1 + detail::kMapBandRows - 1) / detail::kMapBandRows);
   std::vector<std::vector<std::uint32_t>> found(bands);
   detail::for_each_chunk(bands, threads, [&](std::size_t band) {
-    const int j0 = static_cast<int>(band) * detail::kMapBandRows, j1 = std::min(g.ny - 1, j0 + detail::kMapBandRows);
+    const int j0 = static_cast<int>(band) * detail::kMapBandRows,
+              j1 = std::min(g.ny - 1, j0 + detail::kMapBandRows);
     for (int j = j0; j < j1; ++j)
       for (int i = 0; i + 1 < g.nx; ++i)
-        if (is_steep_cell(map, i, j, steep_slope)) found[band].push_back(static_cast<std::uint32_t>(g.index(i, j)));
+        if (is_steep_cell(map, i, j, steep_slope))
+          found[band].push_back(static_cast<std::uint32_t>(g.index(i, j)));
   });
   std::vector<std::uint32_t> cells;
   for (const auto& part : found) cells.insert(cells.end(), part.begin(), part.end());
@@ -66,13 +70,54 @@ inline std::vector<std::uint32_t> steep_cells(const ZMap& map, double steep_slop
 
 namespace detail {
 
+// The moves whose swept box reaches each band of kWallBandRows cell rows, in program order: a
+// counting sort (one pass to count, one to place), so that a band never scans the whole program.
+struct MovesByBand {
+  // Band b's moves are band_moves[band_begin[b]] up to band_moves[band_begin[b + 1]].
+  std::vector<std::size_t> band_begin;
+  std::vector<std::uint32_t> band_moves;
+};
+inline MovesByBand moves_by_band(const ZMapGrid& g, std::span<const Cutter> cutters,
+                                 std::span<const CutMove> moves, int bands) {
+  constexpr int kBandRows = kWallBandRows;
+  auto band_range = [&](const CutMove& m) {
+    const double r = cutters[m.cutter].radius();
+    const double lo_y = std::min(m.tip.a.y, m.tip.b.y) - r,
+                 hi_y = std::max(m.tip.a.y, m.tip.b.y) + r;
+    const double row0 = std::floor((lo_y - g.y0) / g.cell),
+                 row1 = std::floor((hi_y - g.y0) / g.cell);
+    return std::pair{
+        static_cast<int>(std::clamp(row0, 0.0, double(g.ny - 1))) / kBandRows,
+        row1 < 0 ? -1 : static_cast<int>(std::min(row1, double(g.ny - 2))) / kBandRows};
+  };
+  MovesByBand by_band;
+  std::vector<std::size_t>& band_begin = by_band.band_begin;
+  band_begin.assign(static_cast<std::size_t>(bands) + 1, 0);
+  for (const CutMove& m : moves)
+    for (auto [b0, b1] = band_range(m); b0 <= b1; ++b0)
+      ++band_begin[static_cast<std::size_t>(b0) + 1];
+  for (std::size_t b = 0; b < static_cast<std::size_t>(bands); ++b)
+    band_begin[b + 1] += band_begin[b];
+  std::vector<std::uint32_t>& band_moves = by_band.band_moves;
+  band_moves.resize(band_begin.back());
+  {
+    std::vector<std::size_t> at(band_begin.begin(), band_begin.end() - 1);
+    for (std::size_t m = 0; m < moves.size(); ++m)
+      for (auto [b0, b1] = band_range(moves[m]); b0 <= b1; ++b0)
+        band_moves[at[static_cast<std::size_t>(b0)]++] = static_cast<std::uint32_t>(m);
+  }
+  return by_band;
+}
+
 // The heart of refine_steep_cells: lowers `sub` (the fine cells' sub-point heights, kPoints per
 // cell of `cells`, all starting at `ceiling`) to the lowest point of every move's swept cutter
 // above them, band by band on `threads` threads (0: every hardware thread). row_begin[j] is the
 // first of `cells` in cell row j (cells.size() where the row has none).
-inline void lower_fine_cells(const ZMapGrid& g, std::span<const Cutter> cutters, std::span<const CutMove> moves,
-                             const std::vector<std::uint32_t>& cells, const std::vector<std::size_t>& row_begin,
-                             float ceiling, unsigned threads, std::vector<float>& sub) {
+inline void lower_fine_cells(const ZMapGrid& g, std::span<const Cutter> cutters,
+                             std::span<const CutMove> moves,
+                             const std::vector<std::uint32_t>& cells,
+                             const std::vector<std::size_t>& row_begin, float ceiling,
+                             unsigned threads, std::vector<float>& sub) {
   constexpr int kSteps = ZMapFineCells::kSteps, kSide = ZMapFineCells::kSide;
   constexpr auto kPoints = static_cast<std::size_t>(ZMapFineCells::kPoints);
   const double step = g.cell / kSteps;  // exact: kSteps is a power of two
@@ -81,24 +126,9 @@ inline void lower_fine_cells(const ZMapGrid& g, std::span<const Cutter> cutters,
   // band never scans the whole program: a 5000-row map has 313 bands.
   constexpr int kBandRows = kWallBandRows;
   const int bands = (g.ny - 1 + kBandRows - 1) / kBandRows;
-  auto band_range = [&](const CutMove& m) {
-    const double r = cutters[m.cutter].radius();
-    const double lo_y = std::min(m.tip.a.y, m.tip.b.y) - r, hi_y = std::max(m.tip.a.y, m.tip.b.y) + r;
-    const double row0 = std::floor((lo_y - g.y0) / g.cell), row1 = std::floor((hi_y - g.y0) / g.cell);
-    return std::pair{static_cast<int>(std::clamp(row0, 0.0, double(g.ny - 1))) / kBandRows,
-                     row1 < 0 ? -1 : static_cast<int>(std::min(row1, double(g.ny - 2))) / kBandRows};
-  };
-  std::vector<std::size_t> band_begin(static_cast<std::size_t>(bands) + 1, 0);
-  for (const CutMove& m : moves)
-    for (auto [b0, b1] = band_range(m); b0 <= b1; ++b0) ++band_begin[static_cast<std::size_t>(b0) + 1];
-  for (std::size_t b = 0; b < static_cast<std::size_t>(bands); ++b) band_begin[b + 1] += band_begin[b];
-  std::vector<std::uint32_t> band_moves(band_begin.back());
-  {
-    std::vector<std::size_t> at(band_begin.begin(), band_begin.end() - 1);
-    for (std::size_t m = 0; m < moves.size(); ++m)
-      for (auto [b0, b1] = band_range(moves[m]); b0 <= b1; ++b0)
-        band_moves[at[static_cast<std::size_t>(b0)]++] = static_cast<std::uint32_t>(m);
-  }
+  const MovesByBand by_band = moves_by_band(g, cutters, moves, bands);
+  const std::vector<std::size_t>& band_begin = by_band.band_begin;
+  const std::vector<std::uint32_t>& band_moves = by_band.band_moves;
   // The highest sub-point of each fine cell so far: a move whose swept cutter cannot reach below
   // it over the cell cannot lower any of them, and is skipped.
   std::vector<float> cell_top(cells.size(), ceiling);
@@ -109,14 +139,16 @@ inline void lower_fine_cells(const ZMapGrid& g, std::span<const Cutter> cutters,
   const double tile_half_diagonal = kBandTile * half_diagonal;
   std::vector<std::uint8_t> tile_walls(static_cast<std::size_t>(bands) * tiles_x, 0);
   for (std::uint32_t c : cells)
-    tile_walls[c / static_cast<std::uint32_t>(g.nx) / kBandRows * tiles_x + c % static_cast<std::uint32_t>(g.nx) / kBandTile] = 1;
+    tile_walls[c / static_cast<std::uint32_t>(g.nx) / kBandRows * tiles_x +
+               c % static_cast<std::uint32_t>(g.nx) / kBandTile] = 1;
   detail::for_each_chunk(static_cast<std::size_t>(bands), threads, [&](std::size_t band_index) {
     {
       const int band = static_cast<int>(band_index);
       const int j0 = band * kBandRows, j1 = std::min(g.ny - 1, j0 + kBandRows);
-      if (row_begin[static_cast<std::size_t>(j0)] == row_begin[static_cast<std::size_t>(j1)]) return;
-      for (std::size_t at = band_begin[static_cast<std::size_t>(band)]; at < band_begin[static_cast<std::size_t>(band) + 1];
-           ++at) {
+      if (row_begin[static_cast<std::size_t>(j0)] == row_begin[static_cast<std::size_t>(j1)])
+        return;
+      for (std::size_t at = band_begin[static_cast<std::size_t>(band)];
+           at < band_begin[static_cast<std::size_t>(band) + 1]; ++at) {
         const std::size_t m = band_moves[at];
         const Segment& s = moves[m].tip;
         const double r = cutters[moves[m].cutter].radius();
@@ -125,15 +157,20 @@ inline void lower_fine_cells(const ZMapGrid& g, std::span<const Cutter> cutters,
         const int row1 = std::min(j1 - 1, static_cast<int>(std::floor((hi_y - g.y0) / g.cell)));
         if (row0 > row1) continue;
         const double lo_x = std::min(s.a.x, s.b.x) - r, hi_x = std::max(s.a.x, s.b.x) + r;
-        auto i0 = static_cast<std::uint32_t>(std::clamp(std::floor((lo_x - g.x0) / g.cell), 0.0, double(g.nx)));
-        auto i1 = static_cast<std::uint32_t>(std::clamp(std::floor((hi_x - g.x0) / g.cell), 0.0, double(g.nx)));
+        auto i0 = static_cast<std::uint32_t>(
+            std::clamp(std::floor((lo_x - g.x0) / g.cell), 0.0, double(g.nx)));
+        auto i1 = static_cast<std::uint32_t>(
+            std::clamp(std::floor((hi_x - g.x0) / g.cell), 0.0, double(g.nx)));
         // Only the band's tiles that hold a fine cell and come within the radius of the tip
         // path: most of a map has no wall, and a move's box spans many cell rows.
-        const std::size_t tx0 = i0 / kBandTile, tx1 = std::min<std::size_t>(i1, static_cast<std::size_t>(g.nx - 2)) / kBandTile;
+        const std::size_t tx0 = i0 / kBandTile,
+                          tx1 = std::min<std::size_t>(i1, static_cast<std::size_t>(g.nx - 2)) /
+                                kBandTile;
         std::size_t first_tile = tiles_x, last_tile = 0;
         for (std::size_t tx = tx0; tx <= tx1; ++tx) {
           if (!tile_walls[static_cast<std::size_t>(band) * tiles_x + tx]) continue;
-          const double cx = g.x0 + (double(tx) + 0.5) * kBandTile * g.cell, cy = g.y0 + 0.5 * (j0 + j1) * g.cell;
+          const double cx = g.x0 + (double(tx) + 0.5) * kBandTile * g.cell,
+                       cy = g.y0 + 0.5 * (j0 + j1) * g.cell;
           if (distance2_point_segment(Vec2(cx, cy), Vec2(s.a.x, s.a.y), Vec2(s.b.x, s.b.y)) >
               (r + tile_half_diagonal) * (r + tile_half_diagonal))
             continue;
@@ -160,10 +197,13 @@ inline void lower_fine_cells(const ZMapGrid& g, std::span<const Cutter> cutters,
             // least the profile's height at `reach` above its lowest tip there (profiles rise
             // outward), less a rounding margin far below float heights.
             const double cx = g.x0 + (i + 0.5) * g.cell, cy = g.y0 + (j + 0.5) * g.cell;
-            const double reach =
-                std::sqrt(distance2_point_segment(Vec2(cx, cy), Vec2(s.a.x, s.a.y), Vec2(s.b.x, s.b.y))) - half_diagonal;
+            const double reach = std::sqrt(distance2_point_segment(Vec2(cx, cy), Vec2(s.a.x, s.a.y),
+                                                                   Vec2(s.b.x, s.b.y))) -
+                                 half_diagonal;
             if (reach > r + tile_half_diagonal) continue;
-            if (tip + move.cutter->lower_height(std::max(0.0, reach)) - 1e-6 >= double(cell_top[index])) continue;
+            if (tip + move.cutter->lower_height(std::max(0.0, reach)) - 1e-6 >=
+                double(cell_top[index]))
+              continue;
             float* h = sub.data() + index * kPoints;
             for (int b = 0; b < kSide; ++b)
               for (int a = 0; a < kSide; ++a) {
@@ -187,20 +227,24 @@ inline void lower_fine_cells(const ZMapGrid& g, std::span<const Cutter> cutters,
 // it reads the map's heights. `cells` are the map's steep cells as steep_cells gives them
 // (with options.steep_slope), for a caller that needed them beforehand. Throws tridex::Error
 // for a move with a cutter out of range.
-inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::span<const CutMove> moves,
-                               WallOptions options, std::vector<std::uint32_t> cells) {
+inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters,
+                               std::span<const CutMove> moves, WallOptions options,
+                               std::vector<std::uint32_t> cells) {
   constexpr auto kPoints = static_cast<std::size_t>(ZMapFineCells::kPoints);
   for (std::size_t k = 0; k < moves.size(); ++k)
     if (moves[k].cutter >= cutters.size())
-      detail::fail("refine steep cells: move ", k, " uses cutter ", moves[k].cutter, " but only ", cutters.size(),
-                   " are given");
+      detail::fail("refine steep cells: move ", k, " uses cutter ", moves[k].cutter, " but only ",
+                   cutters.size(), " are given");
   const ZMapGrid& g = map.grid;
-  const auto map_bands = static_cast<std::size_t>((g.ny + detail::kMapBandRows - 1) / detail::kMapBandRows);
+  const auto map_bands =
+      static_cast<std::size_t>((g.ny + detail::kMapBandRows - 1) / detail::kMapBandRows);
   std::vector<float> band_ceiling(map_bands, map.empty_height);
   detail::for_each_chunk(map_bands, options.threads, [&](std::size_t band) {
     const std::size_t p0 = band * detail::kMapBandRows * static_cast<std::size_t>(g.nx);
-    const std::size_t p1 = std::min(g.size(), p0 + detail::kMapBandRows * static_cast<std::size_t>(g.nx));
-    for (std::size_t p = p0; p < p1; ++p) band_ceiling[band] = std::max(band_ceiling[band], map.heights[p]);
+    const std::size_t p1 =
+        std::min(g.size(), p0 + detail::kMapBandRows * static_cast<std::size_t>(g.nx));
+    for (std::size_t p = p0; p < p1; ++p)
+      band_ceiling[band] = std::max(band_ceiling[band], map.heights[p]);
   });
   const float ceiling = *std::max_element(band_ceiling.begin(), band_ceiling.end());
   if (cells.empty()) {
@@ -209,8 +253,10 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
   }
   // Cells come out ascending, so a row's fine cells are a contiguous, sorted run.
   std::vector<std::size_t> row_begin(static_cast<std::size_t>(g.ny), cells.size());
-  for (std::size_t k = cells.size(); k-- > 0;) row_begin[cells[k] / static_cast<std::uint32_t>(g.nx)] = k;
-  for (std::size_t row = row_begin.size() - 1; row-- > 0;) row_begin[row] = std::min(row_begin[row], row_begin[row + 1]);
+  for (std::size_t k = cells.size(); k-- > 0;)
+    row_begin[cells[k] / static_cast<std::uint32_t>(g.nx)] = k;
+  for (std::size_t row = row_begin.size() - 1; row-- > 0;)
+    row_begin[row] = std::min(row_begin[row], row_begin[row + 1]);
 
   std::vector<float> sub(cells.size() * kPoints, ceiling);
   detail::lower_fine_cells(g, cutters, moves, cells, row_begin, ceiling, options.threads, sub);
@@ -218,9 +264,10 @@ inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::
 }
 
 // The same, finding the steep cells itself.
-inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters, std::span<const CutMove> moves,
-                               WallOptions options = {}) {
-  refine_steep_cells(map, cutters, moves, options, steep_cells(map, options.steep_slope, options.threads));
+inline void refine_steep_cells(ZMap& map, std::span<const Cutter> cutters,
+                               std::span<const CutMove> moves, WallOptions options = {}) {
+  refine_steep_cells(map, cutters, moves, options,
+                     steep_cells(map, options.steep_slope, options.threads));
 }
 
 }  // namespace tridex

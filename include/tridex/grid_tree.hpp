@@ -77,7 +77,8 @@ class GridTree {
   };
   std::vector<NodeCells> node_cells() const {
     std::vector<NodeCells> cells(nodes_.size());
-    std::vector<std::pair<std::uint32_t, Range>> stack{{0, Range{0, 0, map_->grid.nx - 1, map_->grid.ny - 1, 0}}};
+    std::vector<std::pair<std::uint32_t, Range>> stack{
+        {0, Range{0, 0, map_->grid.nx - 1, map_->grid.ny - 1, 0}}};
     while (!stack.empty()) {
       auto [index, r] = stack.back();
       stack.pop_back();
@@ -106,7 +107,8 @@ class GridTree {
     const ZMapGrid& g = map_->grid;
     double ta = t_min, tb = t_max;
     // Clip to the box: the grid's rectangle, and the bottom up to the highest top.
-    const double lo[3] = {g.x(0), g.y(0), bottom_}, hi[3] = {g.x(g.nx - 1), g.y(g.ny - 1), double(nodes_[0].hi)};
+    const double lo[3] = {g.x(0), g.y(0), bottom_},
+                 hi[3] = {g.x(g.nx - 1), g.y(g.ny - 1), double(nodes_[0].hi)};
     for (int a = 0; a < 3; ++a) {
       if (d[a] == 0) {
         if (o[a] < lo[a] || o[a] > hi[a]) return;
@@ -129,7 +131,8 @@ class GridTree {
     spans(o, d, s);
     std::vector<RayHit> out;
     out.reserve(2 * s.size());
-    for (const RaySpan& span : s) out.push_back({span.enter, true}), out.push_back({span.exit, false});
+    for (const RaySpan& span : s)
+      out.push_back({span.enter, true}), out.push_back({span.exit, false});
     return out;
   }
 
@@ -158,8 +161,10 @@ class GridTree {
     Range child(int axis, int at, bool upper) const {
       Range r = *this;
       ++r.depth;
-      if (axis == 0) (upper ? r.i0 : r.i1) = at;
-      else (upper ? r.j0 : r.j1) = at;
+      if (axis == 0)
+        (upper ? r.i0 : r.i1) = at;
+      else
+        (upper ? r.j0 : r.j1) = at;
       return r;
     }
   };
@@ -253,8 +258,10 @@ class GridTree {
       // Pieces arrive in order and share their end values exactly: a span that starts where the
       // last ended continues it.
       // A lone zero-length piece is a touch, not a span.
-      if (out.size() > first && t0 <= out.back().exit) out.back().exit = std::max(out.back().exit, t1);
-      else if (t0 < t1) out.push_back({t0, t1});
+      if (out.size() > first && t0 <= out.back().exit)
+        out.back().exit = std::max(out.back().exit, t1);
+      else if (t0 < t1)
+        out.push_back({t0, t1});
     }
 
     void visit(std::uint32_t index, const Range& r, double ta, double tb) {
@@ -262,7 +269,7 @@ class GridTree {
       const Node& node = tree.nodes_[index];
       double za = o.z + ta * d.z, zb = o.z + tb * d.z;
       if (std::min(za, zb) > node.hi) return;  // wholly above the top: outside
-      if (std::max(za, zb) < node.lo) {         // wholly below the top: inside
+      if (std::max(za, zb) < node.lo) {        // wholly below the top: inside
         emit(ta, tb);
         return;
       }
@@ -286,8 +293,10 @@ class GridTree {
       double oa = o[axis], da = d[axis];
       Range lower = r.child(axis, at, false), upper = r.child(axis, at, true);
       if (da == 0) {  // parallel to the split line: wholly on one side (the line itself: upper)
-        if (oa < line) visit(node.left, lower, ta, tb);
-        else visit(node.left + 1, upper, ta, tb);
+        if (oa < line)
+          visit(node.left, lower, ta, tb);
+        else
+          visit(node.left + 1, upper, ta, tb);
         return;
       }
       double tm = std::clamp((line - oa) / da, ta, tb);
@@ -327,12 +336,16 @@ class GridTree {
     void cell_piece(const Range& r, double t0, double t1) {
       const ZMapGrid& g = tree.map_->grid;
       double tm = 0.5 * (t0 + t1);
-      int i = std::clamp(static_cast<int>(std::floor((o.x + tm * d.x - g.x0) / g.cell)), r.i0, r.i1 - 1);
-      int j = std::clamp(static_cast<int>(std::floor((o.y + tm * d.y - g.y0) / g.cell)), r.j0, r.j1 - 1);
+      int i = std::clamp(static_cast<int>(std::floor((o.x + tm * d.x - g.x0) / g.cell)), r.i0,
+                         r.i1 - 1);
+      int j = std::clamp(static_cast<int>(std::floor((o.y + tm * d.y - g.y0) / g.cell)), r.j0,
+                         r.j1 - 1);
       const ZMap& map = *tree.map_;
       if (const float* f = map.fine_cell(i, j)) return fine_piece(i, j, f, t0, t1);
-      double h00 = detail::zmap_top(map, g.index(i, j)), h10 = detail::zmap_top(map, g.index(i + 1, j));
-      double h01 = detail::zmap_top(map, g.index(i, j + 1)), h11 = detail::zmap_top(map, g.index(i + 1, j + 1));
+      double h00 = detail::zmap_top(map, g.index(i, j)),
+             h10 = detail::zmap_top(map, g.index(i + 1, j));
+      double h01 = detail::zmap_top(map, g.index(i, j + 1)),
+             h11 = detail::zmap_top(map, g.index(i + 1, j + 1));
       quad_piece(g.x(i), g.y(j), g.cell, h00, h10, h01, h11, t0, t1);
     }
 
@@ -359,25 +372,29 @@ class GridTree {
       cuts[count++] = t1;
       for (int k = 0; k + 1 < count; ++k) {
         const double tm = 0.5 * (cuts[k] + cuts[k + 1]);
-        const int a = std::clamp(static_cast<int>(std::floor((o.x + tm * d.x - x0) / step)), 0, kSteps - 1);
-        const int b = std::clamp(static_cast<int>(std::floor((o.y + tm * d.y - y0) / step)), 0, kSteps - 1);
-        quad_piece(x0 + a * step, y0 + b * step, step, f[a + kSide * b], f[a + 1 + kSide * b], f[a + kSide * (b + 1)],
-                   f[a + 1 + kSide * (b + 1)], cuts[k], cuts[k + 1]);
+        const int a =
+            std::clamp(static_cast<int>(std::floor((o.x + tm * d.x - x0) / step)), 0, kSteps - 1);
+        const int b =
+            std::clamp(static_cast<int>(std::floor((o.y + tm * d.y - y0) / step)), 0, kSteps - 1);
+        quad_piece(x0 + a * step, y0 + b * step, step, f[a + kSide * b], f[a + 1 + kSide * b],
+                   f[a + kSide * (b + 1)], f[a + 1 + kSide * (b + 1)], cuts[k], cuts[k + 1]);
       }
     }
 
     // The piece [t0, t1] over one square of the triangulation (a cell, or a fine cell's
     // sub-cell) with corner (x0, y0), side `size` and corner heights h00 … h11.
-    void quad_piece(double x0, double y0, double size, double h00, double h10, double h01, double h11, double t0,
-                    double t1) {
+    void quad_piece(double x0, double y0, double size, double h00, double h10, double h01,
+                    double h11, double t0, double t1) {
       // Square-local coordinates along the ray: f(t) = (o + t·d − corner) / size.
       double fx0 = (o.x - x0) / size, fdx = d.x / size;
       double fy0 = (o.y - y0) / size, fdy = d.y / size;
       auto g_lower = [&](double t) {  // triangle fx ≥ fy
-        return o.z + t * d.z - (h00 + (fx0 + t * fdx) * (h10 - h00) + (fy0 + t * fdy) * (h11 - h10));
+        return o.z + t * d.z -
+               (h00 + (fx0 + t * fdx) * (h10 - h00) + (fy0 + t * fdy) * (h11 - h10));
       };
       auto g_upper = [&](double t) {  // triangle fx < fy
-        return o.z + t * d.z - (h00 + (fx0 + t * fdx) * (h11 - h01) + (fy0 + t * fdy) * (h01 - h00));
+        return o.z + t * d.z -
+               (h00 + (fx0 + t * fdx) * (h11 - h01) + (fy0 + t * fdy) * (h01 - h00));
       };
       // The diagonal fx = fy splits the piece where (fx0 − fy0) + t·(fdx − fdy) changes sign.
       double c0 = fx0 - fy0, cd = fdx - fdy;
@@ -385,8 +402,10 @@ class GridTree {
       // Each sub-piece picks its triangle at its own midpoint, so a split that rounding puts a
       // hair inside the piece cannot send the long part to the wrong triangle.
       auto solve_on = [&](double a, double b) {
-        if ((c0 + 0.5 * (a + b) * cd) >= 0) solve(g_lower, a, b);
-        else solve(g_upper, a, b);
+        if ((c0 + 0.5 * (a + b) * cd) >= 0)
+          solve(g_lower, a, b);
+        else
+          solve(g_upper, a, b);
       };
       if (split > t0 && split < t1) {
         solve_on(t0, split);
@@ -403,8 +422,10 @@ class GridTree {
       if (g0 <= 0 && g1 <= 0) return emit(t0, t1);
       if (g0 > 0 && g1 > 0) return;
       double root = std::clamp(t0 + (t1 - t0) * (g0 / (g0 - g1)), t0, t1);
-      if (g0 <= 0) emit(t0, root);
-      else emit(root, t1);
+      if (g0 <= 0)
+        emit(t0, root);
+      else
+        emit(root, t1);
     }
   };
 

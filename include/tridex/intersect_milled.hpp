@@ -20,7 +20,8 @@ namespace tridex {
 
 // W0 ∩ M1 ∩ … ∩ MN on the stock's lattice. Throws tridex::Error for a malformed stock or a
 // Z-map with fewer than 2 × 2 points.
-inline TripleDexel intersect_milled(const TripleDexel& stock, std::span<const ZMap> milled, unsigned threads = 0) {
+inline TripleDexel intersect_milled(const TripleDexel& stock, std::span<const ZMap> milled,
+                                    unsigned threads = 0) {
   validate(stock);
   std::vector<GridTree> trees;
   trees.reserve(milled.size());
@@ -28,8 +29,9 @@ inline TripleDexel intersect_milled(const TripleDexel& stock, std::span<const ZM
   for (const ZMap& map : milled) {
     trees.emplace_back(map);
     const GridTree& tree = trees.back();
-    Aabb local{Vec3(map.grid.x(0), map.grid.y(0), tree.bottom()),
-               Vec3(map.grid.x(map.grid.nx - 1), map.grid.y(map.grid.ny - 1), double(tree.nodes()[0].hi))};
+    Aabb local{
+        Vec3(map.grid.x(0), map.grid.y(0), tree.bottom()),
+        Vec3(map.grid.x(map.grid.nx - 1), map.grid.y(map.grid.ny - 1), double(tree.nodes()[0].hi))};
     Aabb world;
     for (const Vec3& c : local.corners()) world.extend(map.grid.frame.to_world(c));
     world_boxes.push_back(world);
@@ -41,48 +43,50 @@ inline TripleDexel intersect_milled(const TripleDexel& stock, std::span<const ZM
     const int u = TripleDexel::u_axis(axis), v = TripleDexel::v_axis(axis);
     const auto nu = static_cast<std::size_t>(lattice.n[u]);
     const DexelGrid& source = stock.grids[axis];
-    result.grids[axis] = detail::build_grid(lattice, axis, threads, [&](std::size_t r, std::vector<DexelInterval>& out) {
-      std::span<const DexelInterval> initial = source.ray(r);
-      if (initial.empty()) return;
-      thread_local std::vector<DexelInterval> current, next;
-      thread_local std::vector<DexelInterval> cut;
-      thread_local std::vector<RaySpan> spans;
-      current.assign(initial.begin(), initial.end());
-      Vec3 o(0), direction(0);
-      o[u] = lattice.origin[u] + lattice.spacing * static_cast<double>(r % nu);
-      o[v] = lattice.origin[v] + lattice.spacing * static_cast<double>(r / nu);
-      direction[axis] = 1;
-      for (std::size_t m = 0; m < trees.size() && !current.empty(); ++m) {
-        const Aabb& box = world_boxes[m];
-        if (o[u] < box.min[u] || o[u] > box.max[u] || o[v] < box.min[v] || o[v] > box.max[v]) {
-          current.clear();  // the ray misses Mi altogether
-          break;
-        }
-        const Frame& frame = milled[m].grid.frame;
-        spans.clear();
-        trees[m].spans(frame.to_local(o), frame.direction_to_local(direction), spans,
-                       double(initial.front().enter) - 1e-3, double(initial.back().exit) + 1e-3);
-        cut.clear();
-        for (const RaySpan& s : spans) detail::push_span(cut, 0, s.enter, s.exit);
-        next.clear();
-        detail::intersect_ray(current, cut, next);
-        current.swap(next);
-      }
-      out.insert(out.end(), current.begin(), current.end());
-    });
+    result.grids[axis] = detail::build_grid(
+        lattice, axis, threads, [&](std::size_t r, std::vector<DexelInterval>& out) {
+          std::span<const DexelInterval> initial = source.ray(r);
+          if (initial.empty()) return;
+          thread_local std::vector<DexelInterval> current, next;
+          thread_local std::vector<DexelInterval> cut;
+          thread_local std::vector<RaySpan> spans;
+          current.assign(initial.begin(), initial.end());
+          Vec3 o(0), direction(0);
+          o[u] = lattice.origin[u] + lattice.spacing * static_cast<double>(r % nu);
+          o[v] = lattice.origin[v] + lattice.spacing * static_cast<double>(r / nu);
+          direction[axis] = 1;
+          for (std::size_t m = 0; m < trees.size() && !current.empty(); ++m) {
+            const Aabb& box = world_boxes[m];
+            if (o[u] < box.min[u] || o[u] > box.max[u] || o[v] < box.min[v] || o[v] > box.max[v]) {
+              current.clear();  // the ray misses Mi altogether
+              break;
+            }
+            const Frame& frame = milled[m].grid.frame;
+            spans.clear();
+            trees[m].spans(frame.to_local(o), frame.direction_to_local(direction), spans,
+                           double(initial.front().enter) - 1e-3,
+                           double(initial.back().exit) + 1e-3);
+            cut.clear();
+            for (const RaySpan& s : spans) detail::push_span(cut, 0, s.enter, s.exit);
+            next.clear();
+            detail::intersect_ray(current, cut, next);
+            current.swap(next);
+          }
+          out.insert(out.end(), current.begin(), current.end());
+        });
   }
   return result;
 }
 
 // The same from a box stock on `lattice`.
-inline TripleDexel intersect_milled(const Aabb& stock, const DexelLattice& lattice, std::span<const ZMap> milled,
-                                    unsigned threads = 0) {
+inline TripleDexel intersect_milled(const Aabb& stock, const DexelLattice& lattice,
+                                    std::span<const ZMap> milled, unsigned threads = 0) {
   return intersect_milled(TripleDexel::box(lattice, stock), milled, threads);
 }
 
 // The same from a closed stock mesh (for example an STL) dexelized on `lattice`.
-inline TripleDexel intersect_milled(const Mesh& stock, const DexelLattice& lattice, std::span<const ZMap> milled,
-                                    unsigned threads = 0) {
+inline TripleDexel intersect_milled(const Mesh& stock, const DexelLattice& lattice,
+                                    std::span<const ZMap> milled, unsigned threads = 0) {
   return intersect_milled(dexelize(stock, lattice, {.threads = threads}), milled, threads);
 }
 

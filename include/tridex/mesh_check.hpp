@@ -30,7 +30,9 @@ struct MeshCheck {
 
   // Every edge shared by exactly two triangles with opposite orientation. Degenerate triangles
   // are counted separately: they do not open a mesh, but most consumers reject them too.
-  bool closed() const { return boundary_edges == 0 && non_manifold_edges == 0 && misoriented_edges == 0; }
+  bool closed() const {
+    return boundary_edges == 0 && non_manifold_edges == 0 && misoriented_edges == 0;
+  }
 };
 
 namespace detail {
@@ -42,7 +44,8 @@ constexpr double kDegenerateRatio = 1e-12;
 inline bool is_degenerate(const Mesh& mesh, const glm::uvec3& t) {
   if (t.x == t.y || t.y == t.z || t.z == t.x) return true;
   Vec3 a(mesh.positions[t.x]), b(mesh.positions[t.y]), c(mesh.positions[t.z]);
-  double longest = std::max({glm::dot(b - a, b - a), glm::dot(c - b, c - b), glm::dot(a - c, a - c)});
+  double longest =
+      std::max({glm::dot(b - a, b - a), glm::dot(c - b, c - b), glm::dot(a - c, a - c)});
   double doubled_area = glm::length(glm::cross(b - a, c - a));
   return !(doubled_area > kDegenerateRatio * longest);
 }
@@ -52,8 +55,8 @@ inline void require_valid_indices(const Mesh& mesh, const char* who) {
   for (std::size_t k = 0; k < mesh.triangles.size(); ++k) {
     const glm::uvec3& t = mesh.triangles[k];
     if (t.x >= n || t.y >= n || t.z >= n)
-      fail(who, ": triangle ", k, " refers to vertex ", std::max({t.x, t.y, t.z}), " but the mesh has ",
-           n, " vertices");
+      fail(who, ": triangle ", k, " refers to vertex ", std::max({t.x, t.y, t.z}),
+           " but the mesh has ", n, " vertices");
   }
 }
 
@@ -78,7 +81,8 @@ inline MeshCheck check_mesh(const Mesh& mesh) {
       }
     }
   };
-  for_each_edge([&](std::uint32_t a, std::uint32_t b) { ++first[std::min(a, b) + std::size_t{1}]; });
+  for_each_edge(
+      [&](std::uint32_t a, std::uint32_t b) { ++first[std::min(a, b) + std::size_t{1}]; });
   for (std::size_t v = 0; v < n; ++v) first[v + 1] += first[v];
   std::vector<std::uint64_t> entries(first[n]);
   {
@@ -96,9 +100,12 @@ inline MeshCheck check_mesh(const Mesh& mesh) {
       std::size_t forward = 0;
       for (; j != hi && (*j >> 1) == (*i >> 1); ++j) forward += *j & 1;
       const auto uses = j - i;
-      if (uses == 1) ++result.boundary_edges;
-      else if (uses > 2) ++result.non_manifold_edges;
-      else if (forward != 1) ++result.misoriented_edges;
+      if (uses == 1)
+        ++result.boundary_edges;
+      else if (uses > 2)
+        ++result.non_manifold_edges;
+      else if (forward != 1)
+        ++result.misoriented_edges;
       i = j;
     }
   }
@@ -129,12 +136,14 @@ inline Mesh weld_vertices(const Mesh& mesh) {
   index.reserve(mesh.positions.size());
   std::vector<std::uint32_t> remap(mesh.positions.size());
   for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
-    auto [it, inserted] = index.try_emplace(key_of(mesh.positions[v]), static_cast<std::uint32_t>(out.positions.size()));
+    auto [it, inserted] = index.try_emplace(key_of(mesh.positions[v]),
+                                            static_cast<std::uint32_t>(out.positions.size()));
     if (inserted) out.positions.push_back(mesh.positions[v]);
     remap[v] = it->second;
   }
   out.triangles.reserve(mesh.triangles.size());
-  for (const glm::uvec3& t : mesh.triangles) out.triangles.emplace_back(remap[t.x], remap[t.y], remap[t.z]);
+  for (const glm::uvec3& t : mesh.triangles)
+    out.triangles.emplace_back(remap[t.x], remap[t.y], remap[t.z]);
   return out;
 }
 

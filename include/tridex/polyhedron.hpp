@@ -28,9 +28,11 @@ namespace detail {
 
 inline void require_solid_zmap(const ZMap& map, const char* who) {
   if (map.grid.nx < 2 || map.grid.ny < 2)
-    fail(who, ": a Z-map of ", map.grid.nx, " x ", map.grid.ny, " points has no cell to enclose a solid");
+    fail(who, ": a Z-map of ", map.grid.nx, " x ", map.grid.ny,
+         " points has no cell to enclose a solid");
   if (map.heights.size() != map.grid.size())
-    fail(who, ": Z-map holds ", map.heights.size(), " heights for ", map.grid.size(), " grid points");
+    fail(who, ": Z-map holds ", map.heights.size(), " heights for ", map.grid.size(),
+         " grid points");
   if (!std::isfinite(map.empty_height)) fail(who, ": Z-map empty height is not finite");
 }
 
@@ -67,10 +69,10 @@ inline const std::array<FineSide, 4>& fine_sides() {
   static const std::array<FineSide, 4> sides = [] {
     std::array<FineSide, 4> out{};
     for (int m = 0; m <= k; ++m) {
-      out[0].point[m] = m;                  // y = y(j), +x
-      out[1].point[m] = k + s * m;          // x = x(i + 1), +y
-      out[2].point[m] = (k - m) + s * k;    // y = y(j + 1), −x
-      out[3].point[m] = s * (k - m);        // x = x(i), −y
+      out[0].point[m] = m;                // y = y(j), +x
+      out[1].point[m] = k + s * m;        // x = x(i + 1), +y
+      out[2].point[m] = (k - m) + s * k;  // y = y(j + 1), −x
+      out[3].point[m] = s * (k - m);      // x = x(i), −y
     }
     out[0].di = 0, out[0].dj = -1, out[1].di = 1, out[1].dj = 0;
     out[2].di = 0, out[2].dj = 1, out[3].di = -1, out[3].dj = 0;
@@ -81,7 +83,8 @@ inline const std::array<FineSide, 4>& fine_sides() {
 
 // Whether cell (i, j) is fine; false for cells outside the grid.
 inline bool is_fine_cell(const ZMap& map, int i, int j) {
-  return i >= 0 && j >= 0 && i + 1 < map.grid.nx && j + 1 < map.grid.ny && map.fine_cell(i, j) != nullptr;
+  return i >= 0 && j >= 0 && i + 1 < map.grid.nx && j + 1 < map.grid.ny &&
+         map.fine_cell(i, j) != nullptr;
 }
 
 // The top triangles of the fine cells and their steps to plain neighbours, appended to `mesh`.
@@ -129,7 +132,9 @@ void polyhedrize_fine_cells(const ZMap& map, Mesh& mesh, const Add& add) {
       if (is_fine_cell(map, i + side.di, j + side.dj)) continue;
       std::uint32_t p[kSide];
       for (int m = 0; m < kSide; ++m) p[m] = v[side.point[m]];
-      fine_cell_step(p, [&](std::uint32_t a, std::uint32_t b, std::uint32_t c3) { mesh.triangles.emplace_back(a, b, c3); });
+      fine_cell_step(p, [&](std::uint32_t a, std::uint32_t b, std::uint32_t c3) {
+        mesh.triangles.emplace_back(a, b, c3);
+      });
     }
   }
 }
@@ -151,10 +156,12 @@ inline double zmap_height(const ZMap& map, double x, double y) {
     const int a = std::clamp(static_cast<int>(std::floor(fx)), 0, kSteps - 1);
     const int b = std::clamp(static_cast<int>(std::floor(fy)), 0, kSteps - 1);
     fx -= a, fy -= b;
-    h00 = f[a + kSide * b], h10 = f[a + 1 + kSide * b], h01 = f[a + kSide * (b + 1)], h11 = f[a + 1 + kSide * (b + 1)];
+    h00 = f[a + kSide * b], h10 = f[a + 1 + kSide * b], h01 = f[a + kSide * (b + 1)],
+    h11 = f[a + 1 + kSide * (b + 1)];
   } else {
     h00 = detail::zmap_top(map, g.index(i, j)), h10 = detail::zmap_top(map, g.index(i + 1, j));
-    h01 = detail::zmap_top(map, g.index(i, j + 1)), h11 = detail::zmap_top(map, g.index(i + 1, j + 1));
+    h01 = detail::zmap_top(map, g.index(i, j + 1)),
+    h11 = detail::zmap_top(map, g.index(i + 1, j + 1));
   }
   if (fx >= fy) return h00 + fx * (h10 - h00) + fy * (h11 - h10);
   return h00 + fx * (h11 - h01) + fy * (h01 - h00);
@@ -173,12 +180,14 @@ inline Mesh polyhedrize(const ZMap& map) {
   Mesh mesh;
   auto add = [&](double x, double y, double z) {
     Vec3 w = g.frame.to_world(Vec3(x, y, z));
-    mesh.positions.emplace_back(static_cast<float>(w.x), static_cast<float>(w.y), static_cast<float>(w.z));
+    mesh.positions.emplace_back(static_cast<float>(w.x), static_cast<float>(w.y),
+                                static_cast<float>(w.z));
     return static_cast<std::uint32_t>(mesh.positions.size() - 1);
   };
   std::size_t top_count = g.size(), border_count = 2 * static_cast<std::size_t>(nx + ny) - 4;
   mesh.positions.reserve(top_count + border_count + 1);
-  mesh.triangles.reserve(2 * static_cast<std::size_t>(nx - 1) * static_cast<std::size_t>(ny - 1) + 3 * border_count);
+  mesh.triangles.reserve(2 * static_cast<std::size_t>(nx - 1) * static_cast<std::size_t>(ny - 1) +
+                         3 * border_count);
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i) add(g.x(i), g.y(j), detail::zmap_top(map, g.index(i, j)));
   auto top = [&](int i, int j) { return static_cast<std::uint32_t>(g.index(i, j)); };
@@ -197,7 +206,8 @@ inline Mesh polyhedrize(const ZMap& map) {
   for (int i = nx - 1; i > 0; --i) border.emplace_back(i, ny - 1);
   for (int j = ny - 1; j > 0; --j) border.emplace_back(0, j);
   std::vector<std::uint32_t> below(border.size());
-  for (std::size_t k = 0; k < border.size(); ++k) below[k] = add(g.x(border[k].x), g.y(border[k].y), bottom);
+  for (std::size_t k = 0; k < border.size(); ++k)
+    below[k] = add(g.x(border[k].x), g.y(border[k].y), bottom);
   std::uint32_t centre = add(0.5 * (g.x(0) + g.x(nx - 1)), 0.5 * (g.y(0) + g.y(ny - 1)), bottom);
   for (std::size_t k = 0; k < border.size(); ++k) {
     std::size_t next = (k + 1) % border.size();

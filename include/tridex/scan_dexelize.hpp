@@ -65,7 +65,8 @@ class ZMapScanner {
     const Mat3& r = grid_.frame.rotation;  // r[column][row]: column = local axis
     const Vec3& o = grid_.frame.origin;
     const double s = lattice.spacing, c = grid_.cell;
-    // Lattice units along u and v, and world coordinate along the axis, as affine maps of (i, j, h).
+    // Lattice units along u and v, and world coordinate along the axis, as affine maps of (i, j,
+    // h).
     double a[2], bx[2], by[2], bz[2];
     const int comps[2] = {u_, v_};
     for (int k = 0; k < 2; ++k) {
@@ -87,41 +88,55 @@ class ZMapScanner {
       for (int cj = 0; cj < 2; ++cj)
         for (double h : {bottom_, top}) {
           double i = ci ? grid_.nx - 1 : 0, j = cj ? grid_.ny - 1 : 0;
-          for (int k = 0; k < 2; ++k) reach = std::max(reach, std::abs(a[k] + i * bx[k] + j * by[k] + h * bz[k]));
+          for (int k = 0; k < 2; ++k)
+            reach = std::max(reach, std::abs(a[k] + i * bx[k] + j * by[k] + h * bz[k]));
         }
     int bits = 59 - static_cast<int>(std::ceil(std::log2(reach + 2)));
     if (bits < 16)
-      fail("scan dexelize: the Z-map reaches ", reach, " spacings from the lattice origin, too far for exact ray tests");
+      fail("scan dexelize: the Z-map reaches ", reach,
+           " spacings from the lattice origin, too far for exact ray tests");
     bits_ = std::min(bits, 40);
     const double scale = std::ldexp(1.0, bits_);
     // A grid step is exactly kSteps fine sub-steps, so a grid point has the same fixed-point
     // coordinates whether a plain cell or a fine one asks.
     for (int k = 0; k < 2; ++k) {
       q0_[k] = std::llround(a[k] * scale), qz_[k] = bz[k] * scale;
-      qx_[k] = kSteps * std::llround(bx[k] / kSteps * scale), qy_[k] = kSteps * std::llround(by[k] / kSteps * scale);
+      qx_[k] = kSteps * std::llround(bx[k] / kSteps * scale),
+      qy_[k] = kSteps * std::llround(by[k] / kSteps * scale);
     }
   }
 
   // Appends the crossings of the top triangles of cell rows [j0, j1) to `hits`.
   void scan_rows(int j0, int j1, std::vector<MeshHit>& hits) const {
     const int nx = grid_.nx;
-    std::vector<ScanVertex> lower(static_cast<std::size_t>(nx)), upper(static_cast<std::size_t>(nx));
+    std::vector<ScanVertex> lower(static_cast<std::size_t>(nx)),
+        upper(static_cast<std::size_t>(nx));
     std::vector<double> hl(static_cast<std::size_t>(nx)), hu(static_cast<std::size_t>(nx));
     fill_row(j0, lower, hl);
     for (int j = j0; j < j1; ++j) {
       fill_row(j + 1, upper, hu);
       // The row's fine cells, in ascending order: each is scanned as its sub-grid instead.
-      const std::uint32_t* fine = map_.fine.empty() ? nullptr : map_.fine.cells.data() + map_.fine.row_begin[static_cast<std::size_t>(j)];
-      const std::uint32_t* fine_end = fine ? map_.fine.cells.data() + map_.fine.row_begin[static_cast<std::size_t>(j) + 1] : nullptr;
+      const std::uint32_t* fine =
+          map_.fine.empty()
+              ? nullptr
+              : map_.fine.cells.data() + map_.fine.row_begin[static_cast<std::size_t>(j)];
+      const std::uint32_t* fine_end =
+          fine ? map_.fine.cells.data() + map_.fine.row_begin[static_cast<std::size_t>(j) + 1]
+               : nullptr;
       const std::size_t row_base = grid_.index(0, j);
       for (int i = 0; i + 1 < nx; ++i) {
         const auto ii = static_cast<std::size_t>(i);
         if (fine != fine_end && *fine == row_base + ii) {
-          fine_cell(i, j, map_.fine.heights.data() + static_cast<std::size_t>(fine - map_.fine.cells.data()) * ZMapFineCells::kPoints, hits);
+          fine_cell(
+              i, j,
+              map_.fine.heights.data() +
+                  static_cast<std::size_t>(fine - map_.fine.cells.data()) * ZMapFineCells::kPoints,
+              hits);
           ++fine;
           continue;
         }
-        const ScanVertex &p00 = lower[ii], &p10 = lower[ii + 1], &p01 = upper[ii], &p11 = upper[ii + 1];
+        const ScanVertex &p00 = lower[ii], &p10 = lower[ii + 1], &p01 = upper[ii],
+                         &p11 = upper[ii + 1];
         std::int64_t lo_u = std::min(std::min(p00.u, p10.u), std::min(p01.u, p11.u));
         std::int64_t hi_u = std::max(std::max(p00.u, p10.u), std::max(p01.u, p11.u));
         std::int64_t iu0 = ceil_units(lo_u), iu1 = ceil_units(hi_u) - 1;
@@ -174,13 +189,16 @@ class ZMapScanner {
   void fine_cell(int i, int j, const float* f, std::vector<MeshHit>& hits) const {
     constexpr int kSide = ZMapFineCells::kSide;
     ScanVertex p[ZMapFineCells::kPoints];
-    std::int64_t lo_u = std::numeric_limits<std::int64_t>::max(), hi_u = std::numeric_limits<std::int64_t>::min();
+    std::int64_t lo_u = std::numeric_limits<std::int64_t>::max(),
+                 hi_u = std::numeric_limits<std::int64_t>::min();
     std::int64_t lo_v = lo_u, hi_v = hi_u;
     for (int b = 0; b < kSide; ++b)
       for (int a = 0; a < kSide; ++a) {
         ScanVertex& q = p[a + kSide * b];
-        q = sub_vertex(std::int64_t{kSteps} * i + a, std::int64_t{kSteps} * j + b, double(f[a + kSide * b]));
-        lo_u = std::min(lo_u, q.u), hi_u = std::max(hi_u, q.u), lo_v = std::min(lo_v, q.v), hi_v = std::max(hi_v, q.v);
+        q = sub_vertex(std::int64_t{kSteps} * i + a, std::int64_t{kSteps} * j + b,
+                       double(f[a + kSide * b]));
+        lo_u = std::min(lo_u, q.u), hi_u = std::max(hi_u, q.u), lo_v = std::min(lo_v, q.v),
+        hi_v = std::max(hi_v, q.v);
       }
     // The steps lie between the cell's sub-points and its straight edges, so within this box too.
     if (ceil_units(lo_u) > ceil_units(hi_u) - 1 || ceil_units(lo_v) > ceil_units(hi_v) - 1) return;
@@ -195,21 +213,26 @@ class ZMapScanner {
       if (is_fine_cell(map_, i + side.di, j + side.dj)) continue;
       const ScanVertex* q[kSide];
       for (int m = 0; m < kSide; ++m) q[m] = &p[side.point[m]];
-      fine_cell_step(q, [&](const ScanVertex* a, const ScanVertex* b, const ScanVertex* c) { triangle(*a, *b, *c, hits); });
+      fine_cell_step(q, [&](const ScanVertex* a, const ScanVertex* b, const ScanVertex* c) {
+        triangle(*a, *b, *c, hits);
+      });
     }
   }
 
   // The vertex at fine sub-point (I, J) (grid point (i, j) is (kSteps·i, kSteps·j)).
   ScanVertex sub_vertex(std::int64_t I, std::int64_t J, double h) const {
     return {q0_[0] + I * (qx_[0] / kSteps) + J * (qy_[0] / kSteps) + round_fixed(h * qz_[0]),
-            q0_[1] + I * (qx_[1] / kSteps) + J * (qy_[1] / kSteps) + round_fixed(h * qz_[1]), world_t(I, J, h)};
+            q0_[1] + I * (qx_[1] / kSteps) + J * (qy_[1] / kSteps) + round_fixed(h * qz_[1]),
+            world_t(I, J, h)};
   }
 
   std::int64_t ceil_units(std::int64_t x) const { return -((-x) >> bits_); }
 
   // Rounding to the nearest fixed-point unit (ties away from zero), inline: llround is a libm
   // call and was a seventh of the scan. |x| < 2^62 here.
-  static std::int64_t round_fixed(double x) { return static_cast<std::int64_t>(x + (x >= 0 ? 0.5 : -0.5)); }
+  static std::int64_t round_fixed(double x) {
+    return static_cast<std::int64_t>(x + (x >= 0 ? 0.5 : -0.5));
+  }
 
   // The world coordinate along the ray axis at fine sub-point (I, J) and height h.
   double world_t(std::int64_t I, std::int64_t J, double h) const {
@@ -218,7 +241,8 @@ class ZMapScanner {
 
   ScanVertex vertex(int i, int j, double h) const {
     return {q0_[0] + i * qx_[0] + j * qy_[0] + round_fixed(h * qz_[0]),
-            q0_[1] + i * qx_[1] + j * qy_[1] + round_fixed(h * qz_[1]), world_t(std::int64_t{kSteps} * i, std::int64_t{kSteps} * j, h)};
+            q0_[1] + i * qx_[1] + j * qy_[1] + round_fixed(h * qz_[1]),
+            world_t(std::int64_t{kSteps} * i, std::int64_t{kSteps} * j, h)};
   }
 
   void fill_row(int j, std::vector<ScanVertex>& row, std::vector<double>& h) const {
@@ -235,7 +259,8 @@ class ZMapScanner {
   }
 
   // The crossings of triangle a, b, c (counter-clockwise seen from outside) with the rays.
-  void triangle(const ScanVertex& a, const ScanVertex& b, const ScanVertex& c, std::vector<MeshHit>& hits) const {
+  void triangle(const ScanVertex& a, const ScanVertex& b, const ScanVertex& c,
+                std::vector<MeshHit>& hits) const {
     const ScanWide area = ScanWide(b.u - a.u) * (c.v - a.v) - ScanWide(b.v - a.v) * (c.u - a.u);
     if (area == 0) return;  // seen edge-on: the perturbed ray misses it
     const int orientation = area > 0 ? 1 : -1;
@@ -261,9 +286,14 @@ class ZMapScanner {
           const ScanVertex &p = *corners[e], &q = *corners[(e + 1) % 3];
           double p_u = double(p.u), p_v = double(p.v), q_u = double(q.u), q_v = double(q.v);
           if (pv < std::min(p_v, q_v) - one || pv > std::max(p_v, q_v) + one) continue;
-          double u_at = p_v == q_v ? p_u : p_u + (std::clamp(pv, std::min(p_v, q_v), std::max(p_v, q_v)) - p_v) * (q_u - p_u) / (q_v - p_v);
-          if (p_v == q_v) lo = std::min({lo, p_u, q_u}), hi = std::max({hi, p_u, q_u});
-          else lo = std::min(lo, u_at), hi = std::max(hi, u_at);
+          double u_at = p_v == q_v
+                            ? p_u
+                            : p_u + (std::clamp(pv, std::min(p_v, q_v), std::max(p_v, q_v)) - p_v) *
+                                        (q_u - p_u) / (q_v - p_v);
+          if (p_v == q_v)
+            lo = std::min({lo, p_u, q_u}), hi = std::max({hi, p_u, q_u});
+          else
+            lo = std::min(lo, u_at), hi = std::max(hi, u_at);
         }
         if (!(lo <= hi)) continue;
         row_u0 = std::max(iu0, static_cast<std::int64_t>(std::floor(lo / one)) - 1);
@@ -271,13 +301,17 @@ class ZMapScanner {
       }
       for (std::int64_t iu = row_u0; iu <= row_u1; ++iu) {
         auto ray = static_cast<std::uint32_t>(iu + std::int64_t{nu_} * iv);
-        if (mask_ && mask_->offsets[ray] == mask_->offsets[ray + 1]) continue;  // nothing left to cut
+        if (mask_ && mask_->offsets[ray] == mask_->offsets[ray + 1])
+          continue;  // nothing left to cut
         const std::int64_t pu = iu << bits_, pv = iv << bits_;
-        ScanWide wc = ScanWide(b.u - a.u) * (pv - a.v) - ScanWide(b.v - a.v) * (pu - a.u);  // edge a→b
+        ScanWide wc =
+            ScanWide(b.u - a.u) * (pv - a.v) - ScanWide(b.v - a.v) * (pu - a.u);  // edge a→b
         if (perturbed_sign_wide(wc, b.u - a.u, b.v - a.v) != orientation) continue;
-        ScanWide wa = ScanWide(c.u - b.u) * (pv - b.v) - ScanWide(c.v - b.v) * (pu - b.u);  // edge b→c
+        ScanWide wa =
+            ScanWide(c.u - b.u) * (pv - b.v) - ScanWide(c.v - b.v) * (pu - b.u);  // edge b→c
         if (perturbed_sign_wide(wa, c.u - b.u, c.v - b.v) != orientation) continue;
-        ScanWide wb = ScanWide(a.u - c.u) * (pv - c.v) - ScanWide(a.v - c.v) * (pu - c.u);  // edge c→a
+        ScanWide wb =
+            ScanWide(a.u - c.u) * (pv - c.v) - ScanWide(a.v - c.v) * (pu - c.u);  // edge c→a
         if (perturbed_sign_wide(wb, a.u - c.u, a.v - c.v) != orientation) continue;
         double t = (double(wa) * a.t + double(wb) * b.t + double(wc) * c.t) * inverse_area;
         t = std::clamp(t, lo_t, hi_t);  // rounding: the crossing lies within the triangle's extent
@@ -305,23 +339,28 @@ class ZMapScanner {
 };
 
 // One family of rays: scan on `threads` threads, counting-sort the crossings by ray, pair them.
-inline DexelGrid scan_family(const ZMap& map, const DexelLattice& lattice, int axis, unsigned threads,
-                             const DexelGrid* mask) {
+inline DexelGrid scan_family(const ZMap& map, const DexelLattice& lattice, int axis,
+                             unsigned threads, const DexelGrid* mask) {
   const ZMapScanner scanner(map, lattice, axis, mask);
   threads = resolve_threads(threads);
   const int rows = map.grid.ny - 1;
   const int rows_per_item = 16;
-  const int items = (rows + rows_per_item - 1) / rows_per_item + 1;  // the last item: walls and bottom
+  const int items =
+      (rows + rows_per_item - 1) / rows_per_item + 1;  // the last item: walls and bottom
   std::vector<std::vector<MeshHit>> found(threads);
-  for_each_chunk_indexed(static_cast<std::size_t>(items), threads, [&](std::size_t chunk, unsigned id) {
-    const int item = static_cast<int>(chunk);
-    if (item == items - 1) scanner.scan_walls_and_bottom(found[id]);
-    else scanner.scan_rows(item * rows_per_item, std::min(rows, (item + 1) * rows_per_item), found[id]);
-  });
+  for_each_chunk_indexed(
+      static_cast<std::size_t>(items), threads, [&](std::size_t chunk, unsigned id) {
+        const int item = static_cast<int>(chunk);
+        if (item == items - 1)
+          scanner.scan_walls_and_bottom(found[id]);
+        else
+          scanner.scan_rows(item * rows_per_item, std::min(rows, (item + 1) * rows_per_item),
+                            found[id]);
+      });
   const std::size_t nu = static_cast<std::size_t>(lattice.n[TripleDexel::u_axis(axis)]);
   return grid_from_hits(lattice, axis, threads, found, [&](std::size_t r, float t) {
-    fail("scan dexelize: unbalanced crossings on ray ", r % nu, ", ", r / nu, " along axis ", "xyz"[axis], " at ", t,
-         " (an internal error: please report the Z-map and lattice)");
+    fail("scan dexelize: unbalanced crossings on ray ", r % nu, ", ", r / nu, " along axis ",
+         "xyz"[axis], " at ", t, " (an internal error: please report the Z-map and lattice)");
   });
 }
 
@@ -330,18 +369,21 @@ inline DexelGrid scan_family(const ZMap& map, const DexelLattice& lattice, int a
 // The polyhedron of a Z-map (polyhedron.hpp) on `lattice`, by scan conversion. Throws
 // tridex::Error for an invalid lattice, a Z-map with fewer than 2 × 2 points, or one reaching
 // too far beyond the lattice for exact arithmetic (over ~10^13 spacings).
-inline TripleDexel scan_dexelize(const ZMap& map, const DexelLattice& lattice, unsigned threads = 0) {
+inline TripleDexel scan_dexelize(const ZMap& map, const DexelLattice& lattice,
+                                 unsigned threads = 0) {
   detail::require_lattice(lattice, "scan dexelize");
   detail::require_solid_zmap(map, "scan dexelize");
   TripleDexel result;
   result.origin = lattice.origin, result.spacing = lattice.spacing, result.n = lattice.n;
-  for (int axis = 0; axis < 3; ++axis) result.grids[axis] = detail::scan_family(map, lattice, axis, threads, nullptr);
+  for (int axis = 0; axis < 3; ++axis)
+    result.grids[axis] = detail::scan_family(map, lattice, axis, threads, nullptr);
   return result;
 }
 
 // W0 ∩ M1 ∩ … ∩ MN on the stock's lattice, each Mi scan-converted; rays already empty are not
 // scanned again. Throws tridex::Error for a malformed stock or a Z-map as scan_dexelize does.
-inline TripleDexel scan_intersect_milled(const TripleDexel& stock, std::span<const ZMap> milled, unsigned threads = 0) {
+inline TripleDexel scan_intersect_milled(const TripleDexel& stock, std::span<const ZMap> milled,
+                                         unsigned threads = 0) {
   validate(stock);
   for (const ZMap& map : milled) detail::require_solid_zmap(map, "scan machine");
   const DexelLattice lattice = stock.lattice();
@@ -350,9 +392,10 @@ inline TripleDexel scan_intersect_milled(const TripleDexel& stock, std::span<con
     for (int axis = 0; axis < 3; ++axis) {
       DexelGrid cut = detail::scan_family(map, lattice, axis, threads, &result.grids[axis]);
       const DexelGrid& current = result.grids[axis];
-      result.grids[axis] = detail::build_grid(lattice, axis, threads, [&](std::size_t r, std::vector<DexelInterval>& out) {
-        detail::intersect_ray(current.ray(r), cut.ray(r), out);
-      });
+      result.grids[axis] = detail::build_grid(
+          lattice, axis, threads, [&](std::size_t r, std::vector<DexelInterval>& out) {
+            detail::intersect_ray(current.ray(r), cut.ray(r), out);
+          });
     }
   }
   return result;

@@ -58,7 +58,8 @@ inline constexpr std::uint64_t kStlBytesPerTriangle = 128;
 namespace detail {
 
 inline std::uint32_t load_u32_le(const unsigned char* p) {
-  return std::uint32_t{p[0]} | (std::uint32_t{p[1]} << 8) | (std::uint32_t{p[2]} << 16) | (std::uint32_t{p[3]} << 24);
+  return std::uint32_t{p[0]} | (std::uint32_t{p[1]} << 8) | (std::uint32_t{p[2]} << 16) |
+         (std::uint32_t{p[3]} << 24);
 }
 
 inline float load_f32_le(const unsigned char* p) { return std::bit_cast<float>(load_u32_le(p)); }
@@ -67,9 +68,12 @@ inline void store_u32_le(unsigned char* p, std::uint32_t v) {
   for (int k = 0; k < 4; ++k) p[k] = static_cast<unsigned char>(v >> (8 * k));
 }
 
-inline void store_f32_le(unsigned char* p, float f) { store_u32_le(p, std::bit_cast<std::uint32_t>(f)); }
+inline void store_f32_le(unsigned char* p, float f) {
+  store_u32_le(p, std::bit_cast<std::uint32_t>(f));
+}
 
-inline void add_stl_corner(Mesh& mesh, const glm::vec3& p, const std::string& path, std::size_t triangle) {
+inline void add_stl_corner(Mesh& mesh, const glm::vec3& p, const std::string& path,
+                           std::size_t triangle) {
   if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
     fail("STL ", path, ": triangle ", triangle, " has a coordinate that is not finite");
   mesh.positions.push_back(p);
@@ -85,12 +89,15 @@ inline Mesh read_stl_binary(std::istream& in, const std::string& path, std::uint
     std::size_t n = std::min<std::size_t>(batch, count - done);
     in.read(reinterpret_cast<char*>(buffer.data()), static_cast<std::streamsize>(50 * n));
     if (static_cast<std::size_t>(in.gcount()) != 50 * n)
-      fail("STL ", path, ": binary file is truncated in triangle ", done + static_cast<std::size_t>(in.gcount()) / 50);
+      fail("STL ", path, ": binary file is truncated in triangle ",
+           done + static_cast<std::size_t>(in.gcount()) / 50);
     for (std::size_t k = 0; k < n; ++k) {
       const unsigned char* record = buffer.data() + 50 * k + 12;  // skip the stored normal
       auto base = static_cast<std::uint32_t>(soup.positions.size());
       for (int c = 0; c < 3; ++c)
-        add_stl_corner(soup, glm::vec3(load_f32_le(record + 12 * c), load_f32_le(record + 12 * c + 4), load_f32_le(record + 12 * c + 8)),
+        add_stl_corner(soup,
+                       glm::vec3(load_f32_le(record + 12 * c), load_f32_le(record + 12 * c + 4),
+                                 load_f32_le(record + 12 * c + 8)),
                        path, done + k);
       soup.triangles.emplace_back(base, base + 1, base + 2);
     }
@@ -132,16 +139,19 @@ class StlText {
     if (!w.empty() && *first == '+') ++first;  // from_chars does not take a leading '+'
     auto [end, error] = std::from_chars(first, w.data() + w.size(), value);
     if (w.empty() || (error != std::errc() && error != std::errc::result_out_of_range) ||
-        end != w.data() + w.size() || std::isnan(value) || (error == std::errc() && std::isinf(value)))
+        end != w.data() + w.size() || std::isnan(value) ||
+        (error == std::errc() && std::isinf(value)))
       fail("STL ", path_, ": line ", word_line_, ": expected a finite number but found '",
            w.empty() ? std::string_view("end of file") : w, "'");
     // from_chars leaves the value alone when out of range; strtod gives ±HUGE_VAL for an overflow
     // and 0 or a subnormal for an underflow, which is harmless.
-    if (error == std::errc::result_out_of_range) value = std::strtod(std::string(w).c_str(), nullptr);
+    if (error == std::errc::result_out_of_range)
+      value = std::strtod(std::string(w).c_str(), nullptr);
     // Positions are float: a value beyond its range would become infinite.
     if (std::abs(value) > double(std::numeric_limits<float>::max()))
-      fail("STL ", path_, ": line ", word_line_, ": ", w, " is beyond the range of an STL coordinate (float, ±",
-           std::numeric_limits<float>::max(), ")");
+      fail("STL ", path_, ": line ", word_line_, ": ", w,
+           " is beyond the range of an STL coordinate (float, ±", std::numeric_limits<float>::max(),
+           ")");
     return static_cast<float>(value);
   }
 
@@ -182,7 +192,8 @@ inline Mesh read_stl_ascii(std::string text, const std::string& path, const StlO
       in.skip_line();
       continue;
     }
-    if (w != "facet") fail("STL ", path, ": line ", line, ": expected 'facet' or 'endsolid' but found '", w, "'");
+    if (w != "facet")
+      fail("STL ", path, ": line ", line, ": expected 'facet' or 'endsolid' but found '", w, "'");
     in.expect("normal");
     for (int k = 0; k < 3; ++k) in.number();  // recomputed from the vertex order when written
     in.expect("outer");
@@ -197,9 +208,11 @@ inline Mesh read_stl_ascii(std::string text, const std::string& path, const StlO
     in.expect("endfacet");
     soup.triangles.emplace_back(base, base + 1, base + 2);
     if (soup.positions.size() > 0xFFFFFFF0u) fail("STL ", path, ": too many triangles");
-    if (options.max_bytes && text_bytes + kStlBytesPerTriangle * soup.triangles.size() > options.max_bytes)
-      fail("STL ", path, ": line ", line, ": ", soup.triangles.size(), " triangles and ", text_bytes,
-           " bytes of text need more than ", options.limit_name, " (", options.max_bytes, " bytes)");
+    if (options.max_bytes &&
+        text_bytes + kStlBytesPerTriangle * soup.triangles.size() > options.max_bytes)
+      fail("STL ", path, ": line ", line, ": ", soup.triangles.size(), " triangles and ",
+           text_bytes, " bytes of text need more than ", options.limit_name, " (",
+           options.max_bytes, " bytes)");
   }
   return soup;
 }
@@ -216,7 +229,8 @@ inline Mesh read_stl(const std::string& path, StlOptions options = {}) {
     std::error_code error;
     fs::file_status status = fs::status(path, error);
     if (fs::is_directory(status)) detail::fail("STL ", path, ": is a directory");
-    if (fs::exists(status) && !fs::is_regular_file(status)) detail::fail("STL ", path, ": is not a regular file");
+    if (fs::exists(status) && !fs::is_regular_file(status))
+      detail::fail("STL ", path, ": is not a regular file");
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) detail::fail("STL ", path, ": cannot open the file");
@@ -228,39 +242,44 @@ inline Mesh read_stl(const std::string& path, StlOptions options = {}) {
   in.read(reinterpret_cast<char*>(header), 84);
   std::uint64_t binary_count = in.gcount() == 84 ? detail::load_u32_le(header + 80) : 0;
   if (in.gcount() == 84 && size == 84 + 50 * binary_count) {
-    if (binary_count > 0x55555550u) detail::fail("STL ", path, ": too many triangles (", binary_count, ")");
+    if (binary_count > 0x55555550u)
+      detail::fail("STL ", path, ": too many triangles (", binary_count, ")");
     if (options.max_bytes && kStlBytesPerTriangle * binary_count > options.max_bytes)
       detail::fail("STL ", path, ": the header declares ", binary_count, " triangles, about ",
-                   kStlBytesPerTriangle * binary_count / (1 << 20), " MiB to read, more than ", options.limit_name,
-                   " (", options.max_bytes / (1 << 20), " MiB)");
+                   kStlBytesPerTriangle * binary_count / (1 << 20), " MiB to read, more than ",
+                   options.limit_name, " (", options.max_bytes / (1 << 20), " MiB)");
     soup = detail::read_stl_binary(in, path, static_cast<std::uint32_t>(binary_count));
   } else {
-    std::string_view start(reinterpret_cast<const char*>(header), static_cast<std::size_t>(in.gcount()));
+    std::string_view start(reinterpret_cast<const char*>(header),
+                           static_cast<std::size_t>(in.gcount()));
     std::size_t first = start.find_first_not_of(" \t\r\n");
     if (first == std::string_view::npos || start.substr(first, 5) != "solid") {
-      if (size < 84) detail::fail("STL ", path, ": file of ", size, " bytes is too short for a binary STL");
-      detail::fail("STL ", path, ": binary header announces ", binary_count, " triangles (", 84 + 50 * binary_count,
-                   " bytes) but the file has ", size, " bytes: truncated or not an STL file");
+      if (size < 84)
+        detail::fail("STL ", path, ": file of ", size, " bytes is too short for a binary STL");
+      detail::fail("STL ", path, ": binary header announces ", binary_count, " triangles (",
+                   84 + 50 * binary_count, " bytes) but the file has ", size,
+                   " bytes: truncated or not an STL file");
     }
     if (options.max_bytes && size > options.max_bytes)
-      detail::fail("STL ", path, ": ", size, " bytes of text are more than ", options.limit_name, " (",
-                   options.max_bytes, " bytes)");
+      detail::fail("STL ", path, ": ", size, " bytes of text are more than ", options.limit_name,
+                   " (", options.max_bytes, " bytes)");
     std::string text(static_cast<std::size_t>(size), '\0');
     in.seekg(0, std::ios::beg);
     in.read(text.data(), static_cast<std::streamsize>(size));
     if (static_cast<std::uint64_t>(in.gcount()) != size) detail::fail("STL ", path, ": read error");
     // Text never holds a NUL byte; a binary file whose header starts with "solid" does.
     if (text.find('\0') != std::string::npos)
-      detail::fail("STL ", path, ": binary header announces ", binary_count, " triangles (", 84 + 50 * binary_count,
-                   " bytes) but the file has ", size, " bytes: truncated");
+      detail::fail("STL ", path, ": binary header announces ", binary_count, " triangles (",
+                   84 + 50 * binary_count, " bytes) but the file has ", size, " bytes: truncated");
     soup = detail::read_stl_ascii(std::move(text), path, options);
   }
   Mesh mesh = weld_vertices(soup);
   if (options.require_closed) {
     MeshCheck c = check_mesh(mesh);
     if (!c.closed())
-      detail::fail("STL ", path, ": mesh is not closed (", c.boundary_edges, " boundary edges, ", c.non_manifold_edges,
-                   " non-manifold edges, ", c.misoriented_edges, " misoriented edges)");
+      detail::fail("STL ", path, ": mesh is not closed (", c.boundary_edges, " boundary edges, ",
+                   c.non_manifold_edges, " non-manifold edges, ", c.misoriented_edges,
+                   " misoriented edges)");
   }
   return mesh;
 }
@@ -269,7 +288,8 @@ inline Mesh read_stl(const std::string& path, StlOptions options = {}) {
 // vertex, the mesh has more than 2^32 − 1 triangles, or the stream fails.
 inline void write_stl(std::ostream& out, const Mesh& mesh) {
   detail::require_valid_indices(mesh, "write_stl");
-  if (mesh.triangles.size() > 0xFFFFFFFFu) detail::fail("write_stl: ", mesh.triangles.size(), " triangles do not fit in STL");
+  if (mesh.triangles.size() > 0xFFFFFFFFu)
+    detail::fail("write_stl: ", mesh.triangles.size(), " triangles do not fit in STL");
   unsigned char header[84] = {};
   const char title[] = "binary STL written by tridex";
   std::memcpy(header, title, sizeof title - 1);
@@ -306,7 +326,8 @@ inline void write_stl(const std::string& path, const Mesh& mesh) {
   static std::atomic<unsigned> counter{0};
   fs::path target(path);
   fs::path temporary = target;
-  temporary += ".tmp-" + std::to_string(TRIDEX_GETPID()) + "-" + std::to_string(counter.fetch_add(1));
+  temporary +=
+      ".tmp-" + std::to_string(TRIDEX_GETPID()) + "-" + std::to_string(counter.fetch_add(1));
   try {
     {
       std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
@@ -317,7 +338,8 @@ inline void write_stl(const std::string& path, const Mesh& mesh) {
     }
     std::error_code error;
     fs::rename(temporary, target, error);
-    if (error) detail::fail("write_stl: cannot rename the temporary file to ", path, ": ", error.message());
+    if (error)
+      detail::fail("write_stl: cannot rename the temporary file to ", path, ": ", error.message());
   } catch (const Error& e) {
     std::error_code ignored;
     fs::remove(temporary, ignored);

@@ -58,7 +58,8 @@ constexpr CubeTables make_cube_tables() {
       for (int bu = 0; bu < 2; ++bu) {
         int e = cube_edge(a, bu, bv);
         int from = (bu << u) | (bv << v);
-        t.edge_corners[e] = {static_cast<std::uint8_t>(from), static_cast<std::uint8_t>(from | (1 << a))};
+        t.edge_corners[e] = {static_cast<std::uint8_t>(from),
+                             static_cast<std::uint8_t>(from | (1 << a))};
         t.edge_faces[e] = static_cast<std::uint8_t>((1 << (2 * u + bu)) | (1 << (2 * v + bv)));
       }
   }
@@ -78,7 +79,8 @@ constexpr CubeTables make_cube_tables() {
         int c = t.face_corners[f][k], d = t.face_corners[f][(k + 1) % 4];
         int diff = c ^ d, axis = diff == 1 ? 0 : diff == 2 ? 1 : 2;
         int base = c & d, eu = (axis + 1) % 3, ev = (axis + 2) % 3;
-        t.face_edges[f][k] = static_cast<std::uint8_t>(cube_edge(axis, (base >> eu) & 1, (base >> ev) & 1));
+        t.face_edges[f][k] =
+            static_cast<std::uint8_t>(cube_edge(axis, (base >> eu) & 1, (base >> ev) & 1));
       }
     }
   }
@@ -87,7 +89,8 @@ constexpr CubeTables make_cube_tables() {
     for (int f = 0; f < 6; ++f) {
       int crossing[4] = {}, enter[4] = {}, count = 0;
       for (int k = 0; k < 4; ++k) {
-        bool in_c = (mask >> t.face_corners[f][k]) & 1, in_d = (mask >> t.face_corners[f][(k + 1) % 4]) & 1;
+        bool in_c = (mask >> t.face_corners[f][k]) & 1,
+             in_d = (mask >> t.face_corners[f][(k + 1) % 4]) & 1;
         if (in_c != in_d) crossing[count] = t.face_edges[f][k], enter[count++] = !in_c;
       }
       for (int p = 0; p < count; ++p)
@@ -108,7 +111,8 @@ constexpr CubeTables make_cube_tables() {
       for (int r = 0; r < size && fan == 255; ++r) {
         bool ok = true;
         for (int i = 2; i + 1 < size; ++i)
-          if (t.edge_faces[cc.edges[first + r]] & t.edge_faces[cc.edges[first + (r + i) % size]]) ok = false;
+          if (t.edge_faces[cc.edges[first + r]] & t.edge_faces[cc.edges[first + (r + i) % size]])
+            ok = false;
         if (ok) fan = static_cast<std::uint8_t>(r);
       }
       cc.loop_size[cc.loop_count] = static_cast<std::uint8_t>(size);

@@ -35,7 +35,7 @@ struct BodySection {
 };
 
 struct BodyPart {
-  std::string name;  // "shank", "holder section 1" (the bottom one), ...
+  std::string name;   // "shank", "holder section 1" (the bottom one), ...
   double bottom = 0;  // height of its bottom above the tool tip
   BodySection shape;
 };
@@ -55,7 +55,8 @@ inline Cutter part_surface(const BodyPart& part, double grow) {
   if (!(s.top_radius > s.bottom_radius) || !(s.length < std::numeric_limits<double>::infinity()) ||
       !(s.length > 0)) {
     // The bottom disc is the widest part seen from below.
-    return grow > 0 ? Cutter::bull_nose(s.bottom_radius + grow, grow) : Cutter::flat(s.bottom_radius);
+    return grow > 0 ? Cutter::bull_nose(s.bottom_radius + grow, grow)
+                    : Cutter::flat(s.bottom_radius);
   }
   const double rise = s.top_radius - s.bottom_radius;
   const double half_angle_deg = glm::degrees(std::atan2(rise, s.length));
@@ -69,7 +70,8 @@ inline Cutter part_surface(const BodyPart& part, double grow) {
     for (int k = 0; k <= kArcPieces; ++k) {
       double a = from + (to - from) * k / kArcPieces;
       Vec2 p(centre_rho + grow * std::cos(a), centre_h + grow * std::sin(a));
-      if (p.x > points.back().x + 1e-12 * (1 + p.x)) points.push_back(Vec2(p.x, std::max(p.y, points.back().y)));
+      if (p.x > points.back().x + 1e-12 * (1 + p.x))
+        points.push_back(Vec2(p.x, std::max(p.y, points.back().y)));
     }
   };
   arc(s.bottom_radius, grow, -M_PI / 2, normal_angle);

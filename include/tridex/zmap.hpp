@@ -57,10 +57,12 @@ struct ZMapFineCells {
   static constexpr int kSide = kSteps + 1;
   static constexpr int kPoints = kSide * kSide;  // sub-point (a, b) at a + kSide·b, a along x
 
-  std::vector<std::uint32_t> cells;      // grid.index(i, j) of each fine cell's (i, j) corner, ascending
-  std::vector<std::uint32_t> row_begin;  // fine cells of cell row j: [row_begin[j], row_begin[j + 1])
-  std::vector<float> heights;            // kPoints per fine cell, in the order of `cells`; tops
-                                         // (never below the map's empty height)
+  std::vector<std::uint32_t>
+      cells;  // grid.index(i, j) of each fine cell's (i, j) corner, ascending
+  std::vector<std::uint32_t>
+      row_begin;               // fine cells of cell row j: [row_begin[j], row_begin[j + 1])
+  std::vector<float> heights;  // kPoints per fine cell, in the order of `cells`; tops
+                               // (never below the map's empty height)
   bool empty() const { return cells.empty(); }
 };
 
@@ -76,12 +78,14 @@ class ZMap {
   const float* fine_cell(int i, int j) const {
     if (fine.cells.empty()) return nullptr;
     const auto row = static_cast<std::size_t>(j);
-    const auto first = fine.cells.begin() + fine.row_begin[row], last = fine.cells.begin() + fine.row_begin[row + 1];
+    const auto first = fine.cells.begin() + fine.row_begin[row],
+               last = fine.cells.begin() + fine.row_begin[row + 1];
     if (first == last) return nullptr;
     const auto key = static_cast<std::uint32_t>(grid.index(i, j));
     const auto at = std::lower_bound(first, last, key);
     if (at == last || *at != key) return nullptr;
-    return fine.heights.data() + static_cast<std::size_t>(at - fine.cells.begin()) * ZMapFineCells::kPoints;
+    return fine.heights.data() +
+           static_cast<std::size_t>(at - fine.cells.begin()) * ZMapFineCells::kPoints;
   }
 
   // Makes the cells `cells` (grid.index of their (i, j) corners, any order, no repeats) fine,
@@ -111,16 +115,13 @@ class ZMap {
                        unsigned threads = 1);
 
   // Initialisation from the top surface of a closed mesh seen along the frame's z.
-  static ZMap from_mesh(const Frame& frame, const Mesh& stock, double cell,
-                        ZMapLimits limits = {});
-
+  static ZMap from_mesh(const Frame& frame, const Mesh& stock, double cell, ZMapLimits limits = {});
 
   static void validate(const ZMapGrid& g, ZMapLimits limits) {
     detail::require_positive(g.cell, "Z-map cell size");
     detail::require_finite(g.x0, "Z-map origin x");
     detail::require_finite(g.y0, "Z-map origin y");
-    if (g.nx < 1 || g.ny < 1)
-      detail::fail("Z-map grid is empty (", g.nx, " x ", g.ny, " points)");
+    if (g.nx < 1 || g.ny < 1) detail::fail("Z-map grid is empty (", g.nx, " x ", g.ny, " points)");
     if (g.size() > limits.max_points)
       detail::fail("Z-map grid of ", g.nx, " x ", g.ny, " points needs ",
                    static_cast<double>(g.size()) * 4.0 / (1 << 20), " MiB, over the limit of ",
@@ -172,24 +173,28 @@ inline ZMapGrid ZMapGrid::covering(const Frame& frame, const Aabb& local_box, do
   return g;
 }
 
-inline ZMap ZMap::from_box(const Frame& frame, const Aabb& stock, double cell, ZMapLimits limits, unsigned threads) {
+inline ZMap ZMap::from_box(const Frame& frame, const Aabb& stock, double cell, ZMapLimits limits,
+                           unsigned threads) {
   const auto [g, empty] = detail::box_map_grid(frame, stock, cell);
   ZMap map(g, empty, empty, limits);
-  const auto bands = static_cast<std::size_t>((g.ny + detail::kMapBandRows - 1) / detail::kMapBandRows);
+  const auto bands =
+      static_cast<std::size_t>((g.ny + detail::kMapBandRows - 1) / detail::kMapBandRows);
   detail::for_each_chunk(bands, threads, [&](std::size_t band) {
-    const int j0 = static_cast<int>(band) * detail::kMapBandRows, j1 = std::min(g.ny, j0 + detail::kMapBandRows);
-    for (int j = j0; j < j1; ++j) detail::box_top_row(g, stock, empty, j, map.heights.data() + g.index(0, j));
+    const int j0 = static_cast<int>(band) * detail::kMapBandRows,
+              j1 = std::min(g.ny, j0 + detail::kMapBandRows);
+    for (int j = j0; j < j1; ++j)
+      detail::box_top_row(g, stock, empty, j, map.heights.data() + g.index(0, j));
   });
   return map;
 }
 
-inline ZMap ZMap::from_mesh(const Frame& frame, const Mesh& stock, double cell,
-                            ZMapLimits limits) {
+inline ZMap ZMap::from_mesh(const Frame& frame, const Mesh& stock, double cell, ZMapLimits limits) {
   const detail::MeshTop top(frame, stock, cell);
   const ZMapGrid& g = top.grid();
   ZMap map(g, top.empty(), top.empty(), limits);
   for (std::size_t t = 0; t < top.triangles(); ++t)
-    top.raster_rows(t, 0, g.ny - 1, [&](int i, int j) -> float& { return map.heights[g.index(i, j)]; });
+    top.raster_rows(t, 0, g.ny - 1,
+                    [&](int i, int j) -> float& { return map.heights[g.index(i, j)]; });
   return map;
 }
 
@@ -197,22 +202,28 @@ inline void ZMap::set_fine_cells(std::vector<std::uint32_t> cells, std::vector<f
   constexpr int kSide = ZMapFineCells::kSide, kSteps = ZMapFineCells::kSteps;
   constexpr auto kPoints = static_cast<std::size_t>(ZMapFineCells::kPoints);
   if (sub_heights.size() != cells.size() * kPoints)
-    detail::fail("Z-map fine cells: ", sub_heights.size(), " sub-heights for ", cells.size(), " cells");
+    detail::fail("Z-map fine cells: ", sub_heights.size(), " sub-heights for ", cells.size(),
+                 " cells");
   // Sort the cells, carrying their heights along.
   std::vector<std::uint32_t> order(cells.size());
   for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<std::uint32_t>(k);
-  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return cells[a] < cells[b]; });
+  std::sort(order.begin(), order.end(),
+            [&](std::uint32_t a, std::uint32_t b) { return cells[a] < cells[b]; });
   fine = {};
   fine.cells.reserve(cells.size());
   fine.heights.reserve(sub_heights.size());
   for (std::uint32_t k : order) {
     const std::uint32_t c = cells[k];
-    const int i = static_cast<int>(c % static_cast<std::uint32_t>(grid.nx)), j = static_cast<int>(c / static_cast<std::uint32_t>(grid.nx));
-    if (i + 1 >= grid.nx || j + 1 >= grid.ny) detail::fail("Z-map fine cells: point ", c, " is not the corner of a cell");
-    if (!fine.cells.empty() && fine.cells.back() == c) detail::fail("Z-map fine cells: cell ", c, " given twice");
+    const int i = static_cast<int>(c % static_cast<std::uint32_t>(grid.nx)),
+              j = static_cast<int>(c / static_cast<std::uint32_t>(grid.nx));
+    if (i + 1 >= grid.nx || j + 1 >= grid.ny)
+      detail::fail("Z-map fine cells: point ", c, " is not the corner of a cell");
+    if (!fine.cells.empty() && fine.cells.back() == c)
+      detail::fail("Z-map fine cells: cell ", c, " given twice");
     fine.cells.push_back(c);
     const float* from = sub_heights.data() + k * kPoints;
-    for (std::size_t p = 0; p < kPoints; ++p) fine.heights.push_back(std::max(from[p], empty_height));
+    for (std::size_t p = 0; p < kPoints; ++p)
+      fine.heights.push_back(std::max(from[p], empty_height));
     float* h = fine.heights.data() + fine.heights.size() - kPoints;
     auto corner = [&](int di, int dj) { return std::max(height(i + di, j + dj), empty_height); };
     h[0] = corner(0, 0), h[kSteps] = corner(1, 0);
@@ -241,7 +252,8 @@ inline void raise_uncut(ZMap& milled, const ZMap& initial, unsigned threads) {
     detail::fail("raise_uncut: the milled and initial Z-maps have different grids");
   detail::raise_uncut_rows(
       milled, initial.empty_height,
-      [&](int j, float* row) { std::copy_n(initial.heights.data() + b.index(0, j), b.nx, row); }, threads);
+      [&](int j, float* row) { std::copy_n(initial.heights.data() + b.index(0, j), b.nx, row); },
+      threads);
 }
 
 inline void raise_uncut(ZMap& milled, const Aabb& box_stock, unsigned threads) {
@@ -250,7 +262,8 @@ inline void raise_uncut(ZMap& milled, const Aabb& box_stock, unsigned threads) {
   if (!detail::same_points(a, b) || milled.heights.size() != b.size())
     detail::fail("raise_uncut: the milled Z-map's grid is not the box stock's");
   detail::raise_uncut_rows(
-      milled, empty, [&](int j, float* row) { detail::box_top_row(b, box_stock, empty, j, row); }, threads);
+      milled, empty, [&](int j, float* row) { detail::box_top_row(b, box_stock, empty, j, row); },
+      threads);
 }
 
 inline void raise_uncut(ZMap& milled, const Mesh& stock, unsigned threads) {
@@ -259,7 +272,8 @@ inline void raise_uncut(ZMap& milled, const Mesh& stock, unsigned threads) {
   if (!detail::same_points(a, top.grid()) || milled.heights.size() != top.grid().size())
     detail::fail("raise_uncut: the milled Z-map's grid is not the stock mesh's");
   top.index_bands();
-  detail::raise_uncut_rows(milled, top.empty(), [&](int j, float* row) { top.row(j, row); }, threads);
+  detail::raise_uncut_rows(
+      milled, top.empty(), [&](int j, float* row) { top.row(j, row); }, threads);
 }
 
 }  // namespace tridex

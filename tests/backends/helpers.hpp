@@ -22,14 +22,15 @@ using namespace tridex;
 inline Frame random_frame(std::mt19937& rng, bool tilted) {
   std::uniform_real_distribution<double> angle(-70, 70), spin(-180, 180);
   if (!tilted) return Frame{};
-  return Frame::from_rotation(rotation_z(spin(rng)) * rotation_x(angle(rng)) * rotation_z(spin(rng)), Vec3(0.3, -0.2, 0.1));
+  return Frame::from_rotation(
+      rotation_z(spin(rng)) * rotation_x(angle(rng)) * rotation_z(spin(rng)), Vec3(0.3, -0.2, 0.1));
 }
 
 // A box stock's Z-map in `frame`, milled by random ball, flat and bull-nose moves, some of them
 // through the stock (so that some points become empty).
 // With `fine`, the steep cells are then refined from the same moves (fine_cells.hpp).
-inline ZMap random_milled_map(std::mt19937& rng, const Aabb& stock, const Frame& frame, double cell, int moves_count = 12,
-                              bool fine = false) {
+inline ZMap random_milled_map(std::mt19937& rng, const Aabb& stock, const Frame& frame, double cell,
+                              int moves_count = 12, bool fine = false) {
   ZMap map = ZMap::from_box(frame, stock, cell);
   std::uniform_real_distribution<double> unit(0, 1);
   Aabb local = local_bounds(frame, stock);
@@ -38,7 +39,8 @@ inline ZMap random_milled_map(std::mt19937& rng, const Aabb& stock, const Frame&
   for (int k = 0; k < moves_count; ++k) {
     double depth = k % 5 == 4 ? 1.3 : 0.8;  // every fifth move may cut through
     auto point = [&] {
-      return Vec3(local.min.x + unit(rng) * (local.max.x - local.min.x), local.min.y + unit(rng) * (local.max.y - local.min.y),
+      return Vec3(local.min.x + unit(rng) * (local.max.x - local.min.x),
+                  local.min.y + unit(rng) * (local.max.y - local.min.y),
                   local.max.z - 0.1 - depth * (local.max.z - local.min.z) * unit(rng));
     };
     moves.push_back({Segment{point(), point()}, static_cast<std::uint32_t>(k % 3)});
@@ -64,7 +66,8 @@ inline RayComparison compare_rays(const TripleDexel& a, const TripleDexel& b, do
       c.intervals += x.size();
       bool same = x.size() == y.size();
       for (std::size_t k = 0; same && k < x.size(); ++k) {
-        double d = std::max(std::abs(double(x[k].enter) - y[k].enter), std::abs(double(x[k].exit) - y[k].exit));
+        double d = std::max(std::abs(double(x[k].enter) - y[k].enter),
+                            std::abs(double(x[k].exit) - y[k].exit));
         c.worst = std::max(c.worst, d);
         same = d <= epsilon;
       }

@@ -12,11 +12,15 @@ using namespace backend_tests;
 namespace be = tridex::backends;
 
 TEST_CASE("backend names round-trip and unknown names list the valid ones") {
-  for (be::ZMapBackend b : {be::ZMapBackend::cpu, be::ZMapBackend::gl}) CHECK(be::parse_zmap_backend(be::to_string(b)) == b);
-  for (be::DexelBackend b : {be::DexelBackend::tree, be::DexelBackend::embree, be::DexelBackend::scan})
+  for (be::ZMapBackend b : {be::ZMapBackend::cpu, be::ZMapBackend::gl})
+    CHECK(be::parse_zmap_backend(be::to_string(b)) == b);
+  for (be::DexelBackend b :
+       {be::DexelBackend::tree, be::DexelBackend::embree, be::DexelBackend::scan})
     CHECK(be::parse_dexel_backend(be::to_string(b)) == b);
-  CHECK_THROWS_WITH_AS(be::parse_zmap_backend("vulkan"), "unknown Z-map backend 'vulkan' (valid: cpu, gl)", Error);
-  CHECK_THROWS_WITH_AS(be::parse_dexel_backend("Tree"), "unknown dexel backend 'Tree' (valid: tree, embree, scan)", Error);
+  CHECK_THROWS_WITH_AS(be::parse_zmap_backend("vulkan"),
+                       "unknown Z-map backend 'vulkan' (valid: cpu, gl)", Error);
+  CHECK_THROWS_WITH_AS(be::parse_dexel_backend("Tree"),
+                       "unknown dexel backend 'Tree' (valid: tree, embree, scan)", Error);
   CHECK(be::available(be::default_zmap_backend));
   CHECK(be::available(be::default_dexel_backend));
 }
@@ -26,7 +30,8 @@ TEST_CASE("every dexel backend computes the same machining result through machin
   std::uniform_real_distribution<double> unit(0, 1);
   const Aabb stock{Vec3(0, 0, 0), Vec3(3, 2, 1.5)};
   std::vector<ZMap> maps;
-  for (int m = 0; m < 4; ++m) maps.push_back(random_milled_map(rng, stock, random_frame(rng, m > 0), 0.07, 10));
+  for (int m = 0; m < 4; ++m)
+    maps.push_back(random_milled_map(rng, stock, random_frame(rng, m > 0), 0.07, 10));
   DexelLattice l = DexelLattice::covering(stock, 0.06);
   l.origin += Vec3(0.011, 0.007, 0.013);
   TripleDexel w0 = TripleDexel::box(l, stock);

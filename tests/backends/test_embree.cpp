@@ -32,7 +32,8 @@ TEST_CASE("embree dexelize equals the grid tree ray by ray on random Z-maps and 
   // rays, so an end point moves by that rounding divided by the angle between ray and surface:
   // a ray that grazes a nearly parallel triangle can differ by more than the epsilon (one such
   // ray in 76 000 here, by 5e-4). The kernel's own mesh-vs-tree test allows the same 1e-4 rate.
-  INFO("rays ", total.rays, " intervals ", total.intervals, " mismatches ", total.mismatches, " worst ", total.worst);
+  INFO("rays ", total.rays, " intervals ", total.intervals, " mismatches ", total.mismatches,
+       " worst ", total.worst);
   CHECK(total.rays > 50000);
   CHECK(total.intervals > 20000);
   CHECK(total.mismatches * 10000 <= total.rays);
@@ -44,7 +45,8 @@ TEST_CASE("embree machine equals the kernel's machine (W0 ∩ M1 ∩ … ∩ MN)
   const Aabb stock{Vec3(-1, 0, 0), Vec3(2, 2.5, 1.8)};
   for (int trial = 0; trial < 3; ++trial) {
     std::vector<ZMap> maps;
-    for (int m = 0; m < 3; ++m) maps.push_back(random_milled_map(rng, stock, random_frame(rng, m > 0), 0.08, 8));
+    for (int m = 0; m < 3; ++m)
+      maps.push_back(random_milled_map(rng, stock, random_frame(rng, m > 0), 0.08, 8));
     DexelLattice l = DexelLattice::covering(stock, 0.07 + 0.03 * unit(rng));
     l.origin += Vec3(unit(rng), unit(rng), unit(rng)) * (0.3 * l.spacing);
     TripleDexel w0 = TripleDexel::box(l, stock);
@@ -60,7 +62,9 @@ TEST_CASE("embree machine equals the kernel's machine (W0 ∩ M1 ∩ … ∩ MN)
 
 TEST_CASE("embree dexelize rejects bad input with clear errors") {
   ZMap tiny(ZMapGrid{Frame{}, 0, 0, 1, 1, 5}, 1, 0);
-  CHECK_THROWS_WITH_AS(backends::embree_dexelize(tiny, DexelLattice{Vec3(0), 1, glm::ivec3(4)}), doctest::Contains("no cell"), Error);
+  CHECK_THROWS_WITH_AS(backends::embree_dexelize(tiny, DexelLattice{Vec3(0), 1, glm::ivec3(4)}),
+                       doctest::Contains("no cell"), Error);
   ZMap map = ZMap::from_box(Frame{}, Aabb{Vec3(0), Vec3(2)}, 0.5);
-  CHECK_THROWS_WITH_AS(backends::embree_dexelize(map, DexelLattice{Vec3(0), 1, glm::ivec3(0)}), doctest::Contains("empty"), Error);
+  CHECK_THROWS_WITH_AS(backends::embree_dexelize(map, DexelLattice{Vec3(0), 1, glm::ivec3(0)}),
+                       doctest::Contains("empty"), Error);
 }

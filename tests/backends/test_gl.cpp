@@ -24,14 +24,19 @@ struct Bracket {
 Bracket bracket(int kind, double eps, double delta) {
   const double R = 0.5;
   switch (kind) {
-    case 0: return {Cutter::flat(R), Cutter::bull_nose(R + delta, delta), Cutter::flat(R - eps), delta, eps};
-    case 1: return {Cutter::ball(R), Cutter::ball(R + delta), Cutter::ball(R - eps), delta, eps};
-    case 2: return {Cutter::bull_nose(R, 0.2), Cutter::bull_nose(R + delta, 0.2 + delta), Cutter::bull_nose(R - eps, 0.2 - eps), delta, eps};
+    case 0:
+      return {Cutter::flat(R), Cutter::bull_nose(R + delta, delta), Cutter::flat(R - eps), delta,
+              eps};
+    case 1:
+      return {Cutter::ball(R), Cutter::ball(R + delta), Cutter::ball(R - eps), delta, eps};
+    case 2:
+      return {Cutter::bull_nose(R, 0.2), Cutter::bull_nose(R + delta, 0.2 + delta),
+              Cutter::bull_nose(R - eps, 0.2 - eps), delta, eps};
     default: {  // chamfer: flat tip r0, then a 40° cone; erosion keeps a flat tip of r0'
       const double r0 = 0.2, alpha = glm::radians(40.0);
       double r0_inner = r0 - eps * std::cos(alpha) + eps * (1 - std::sin(alpha)) * std::tan(alpha);
-      return {Cutter::chamfer(R, r0, 40), Cutter::chamfer(R + delta, r0 + delta, 40), Cutter::chamfer(R - eps, r0_inner, 40),
-              delta, eps};
+      return {Cutter::chamfer(R, r0, 40), Cutter::chamfer(R + delta, r0 + delta, 40),
+              Cutter::chamfer(R - eps, r0_inner, 40), delta, eps};
     }
   }
 }
@@ -40,12 +45,13 @@ std::vector<CutMove> random_moves(std::mt19937& rng, const ZMap& map, int count)
   std::uniform_real_distribution<double> unit(0, 1);
   const ZMapGrid& g = map.grid;
   auto point = [&] {
-    return Vec3(g.x(0) + unit(rng) * (g.x(g.nx - 1) - g.x(0)), g.y(0) + unit(rng) * (g.y(g.ny - 1) - g.y(0)), 0.6 + 1.2 * unit(rng));
+    return Vec3(g.x(0) + unit(rng) * (g.x(g.nx - 1) - g.x(0)),
+                g.y(0) + unit(rng) * (g.y(g.ny - 1) - g.y(0)), 0.6 + 1.2 * unit(rng));
   };
   std::vector<CutMove> moves;
   for (int k = 0; k < count; ++k) {
     Vec3 a = point(), b = point();
-    if (k % 4 == 1) b.z = a.z;               // level
+    if (k % 4 == 1) b.z = a.z;                // level
     if (k % 4 == 2) b = Vec3(a.x, a.y, b.z);  // plunge or retract
     if (k % 7 == 3) b = a;                    // a point
     moves.push_back({Segment{a, b}, 0});
@@ -60,7 +66,9 @@ std::vector<CutMove> shifted(std::vector<CutMove> moves, double dz) {
 
 }  // namespace
 
-TEST_CASE("gl milling is bracketed by the exact milling of the cutter and of its erosion by the tolerance") {
+TEST_CASE(
+    "gl milling is bracketed by the exact milling of the cutter and of its erosion by the "
+    "tolerance") {
   if (!backends::gl_available()) {
     MESSAGE("no OSMesa float depth framebuffer here: skipped");
     return;
@@ -74,7 +82,8 @@ TEST_CASE("gl milling is bracketed by the exact milling of the cutter and of its
       ZMap initial = ZMap::from_box(Frame{}, stock, 0.05);
       std::vector<CutMove> moves = random_moves(rng, initial, 14);
       ZMap gl = initial, exact = initial, outer = initial, inner = initial;
-      backends::gl_mill(gl, std::span(&b.cutter, 1), moves, {.tolerance = eps, .max_tile = tiled ? 32 : 0});
+      backends::gl_mill(gl, std::span(&b.cutter, 1), moves,
+                        {.tolerance = eps, .max_tile = tiled ? 32 : 0});
       mill(exact, std::span(&b.cutter, 1), moves);
       auto lowered = shifted(moves, -b.outer_drop), raised = shifted(moves, b.inner_lift);
       mill(outer, std::span(&b.outer, 1), lowered);
@@ -88,8 +97,8 @@ TEST_CASE("gl milling is bracketed by the exact milling of the cutter and of its
         mean_error += std::abs(double(gl.heights[k]) - exact.heights[k]);
       }
       mean_error /= double(gl.heights.size());
-      INFO("cutter ", b.cutter.name(), std::string(tiled ? " tiled" : ""), ": below ", below, " above ", above, " cut ", cut,
-           " mean |gl - cpu| ", mean_error);
+      INFO("cutter ", b.cutter.name(), std::string(tiled ? " tiled" : ""), ": below ", below,
+           " above ", above, " cut ", cut, " mean |gl - cpu| ", mean_error);
       CHECK(below == 0);
       CHECK(above == 0);
       CHECK(cut > gl.heights.size() / 10);
@@ -97,7 +106,9 @@ TEST_CASE("gl milling is bracketed by the exact milling of the cutter and of its
     }
 }
 
-TEST_CASE("gl milling of a tilted frame's map through mill_with, tiled, agrees with cpu within the tolerance") {
+TEST_CASE(
+    "gl milling of a tilted frame's map through mill_with, tiled, agrees with cpu within the "
+    "tolerance") {
   if (!backends::gl_available()) return;
   std::mt19937 rng(9);
   const Aabb stock{Vec3(0, 0, 0), Vec3(4, 3, 2)};
@@ -108,7 +119,10 @@ TEST_CASE("gl milling of a tilted frame's map through mill_with, tiled, agrees w
   const ZMapGrid& g = map.grid;
   float top = *std::max_element(map.heights.begin(), map.heights.end());
   for (int k = 0; k < 30; ++k) {
-    auto point = [&] { return Vec3(g.x(0) + unit(rng) * (g.x(g.nx - 1) - g.x(0)), g.y(0) + unit(rng) * (g.y(g.ny - 1) - g.y(0)), top - 1.5 * unit(rng)); };
+    auto point = [&] {
+      return Vec3(g.x(0) + unit(rng) * (g.x(g.nx - 1) - g.x(0)),
+                  g.y(0) + unit(rng) * (g.y(g.ny - 1) - g.y(0)), top - 1.5 * unit(rng));
+    };
     moves.push_back({Segment{point(), point()}, static_cast<std::uint32_t>(k % 3)});
   }
   ZMap gl = map, cpu = map;
@@ -116,12 +130,15 @@ TEST_CASE("gl milling of a tilted frame's map through mill_with, tiled, agrees w
   backends::mill_with(backends::ZMapBackend::cpu, cpu, cutters, moves);
   // Where the surface is not steep the difference is at most the tolerance.
   std::size_t close = 0;
-  for (std::size_t k = 0; k < gl.heights.size(); ++k) close += std::abs(gl.heights[k] - cpu.heights[k]) <= 0.01 + 1e-5;
+  for (std::size_t k = 0; k < gl.heights.size(); ++k)
+    close += std::abs(gl.heights[k] - cpu.heights[k]) <= 0.01 + 1e-5;
   CHECK(close >= gl.heights.size() * 98 / 100);
   ZMap via_api = map;
-  backends::mill_with(backends::ZMapBackend::gl, via_api, cutters, moves);  // default tolerance cell / 4
+  backends::mill_with(backends::ZMapBackend::gl, via_api, cutters,
+                      moves);  // default tolerance cell / 4
   std::size_t close_api = 0;
-  for (std::size_t k = 0; k < gl.heights.size(); ++k) close_api += std::abs(via_api.heights[k] - cpu.heights[k]) <= 0.0125 + 1e-5;
+  for (std::size_t k = 0; k < gl.heights.size(); ++k)
+    close_api += std::abs(via_api.heights[k] - cpu.heights[k]) <= 0.0125 + 1e-5;
   CHECK(close_api >= gl.heights.size() * 98 / 100);
 }
 
@@ -129,11 +146,14 @@ TEST_CASE("gl milling rejects bad input with clear errors") {
   ZMap map = ZMap::from_box(Frame{}, Aabb{Vec3(0), Vec3(2)}, 0.1);
   Cutter ball = Cutter::ball(0.5);
   std::vector<CutMove> moves{{Segment{Vec3(1, 1, 1), Vec3(1.5, 1, 1)}, 3}};
-  CHECK_THROWS_WITH_AS(backends::gl_mill(map, std::span(&ball, 1), moves), doctest::Contains("cutter 3"), Error);
+  CHECK_THROWS_WITH_AS(backends::gl_mill(map, std::span(&ball, 1), moves),
+                       doctest::Contains("cutter 3"), Error);
   moves[0].cutter = 0;
-  CHECK_THROWS_WITH_AS(backends::gl_mill(map, std::span(&ball, 1), moves, {.tolerance = -1}), doctest::Contains("tolerance"), Error);
+  CHECK_THROWS_WITH_AS(backends::gl_mill(map, std::span(&ball, 1), moves, {.tolerance = -1}),
+                       doctest::Contains("tolerance"), Error);
   moves[0].tip.b.x = std::nan("");
-  CHECK_THROWS_WITH_AS(backends::gl_mill(map, std::span(&ball, 1), moves), doctest::Contains("not finite"), Error);
+  CHECK_THROWS_WITH_AS(backends::gl_mill(map, std::span(&ball, 1), moves),
+                       doctest::Contains("not finite"), Error);
 }
 
 // Mesa keeps a few small allocations of its global state until exit (not ours): tell

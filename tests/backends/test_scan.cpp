@@ -31,14 +31,17 @@ TEST_CASE("scan dexelize equals the grid tree ray by ray on random Z-maps and fr
     total.rays += c.rays, total.mismatches += c.mismatches, total.intervals += c.intervals;
     total.worst = std::max(total.worst, c.worst);
   }
-  INFO("rays ", total.rays, " intervals ", total.intervals, " mismatches ", total.mismatches, " worst ", total.worst);
+  INFO("rays ", total.rays, " intervals ", total.intervals, " mismatches ", total.mismatches,
+       " worst ", total.worst);
   CHECK(total.rays > 50000);
   CHECK(total.intervals > 20000);
   CHECK(total.mismatches == 0);
   CHECK(total.worst < 1e-4);
 }
 
-TEST_CASE("scan dexelize on a lattice aligned with the Z-map grid equals dexelizing the polyhedron mesh") {
+TEST_CASE(
+    "scan dexelize on a lattice aligned with the Z-map grid equals dexelizing the polyhedron "
+    "mesh") {
   // Every ray passes through grid points and cell edges: the tie-breaking (symbolic
   // perturbation) decides them the way the mesh dexelizer does.
   std::mt19937 rng(7);
@@ -74,19 +77,23 @@ TEST_CASE("scan dexelize equals the grid tree and the polyhedron mesh on maps wi
     const double cell = aligned ? 0.125 : 0.06 + 0.1 * unit(rng);
     const ZMap map = random_milled_map(rng, stock, frame, cell, 12, true);
     fine_cells += map.fine.cells.size();
-    DexelLattice l = DexelLattice::covering(stock.inflated(0.4), aligned ? cell / 4 : 0.05 + 0.1 * unit(rng));
+    DexelLattice l =
+        DexelLattice::covering(stock.inflated(0.4), aligned ? cell / 4 : 0.05 + 0.1 * unit(rng));
     if (aligned) l.origin = Vec3(-0.5, -0.5, -0.75);
     const TripleDexel scan = scan_dexelize(map, l);
     validate(scan);
     const TripleDexel tree = dexelize(map, l);
     const TripleDexel mesh = dexelize(polyhedrize(map), l);
-    RayComparison with_tree = compare_rays(tree, scan, 1e-4), with_mesh = compare_rays(mesh, scan, 1e-4);
-    INFO("trial ", trial, ": ", with_tree.mismatches, " and ", with_mesh.mismatches, " mismatches of ", with_tree.rays,
-         " rays against the tree and the mesh");
+    RayComparison with_tree = compare_rays(tree, scan, 1e-4),
+                  with_mesh = compare_rays(mesh, scan, 1e-4);
+    INFO("trial ", trial, ": ", with_tree.mismatches, " and ", with_mesh.mismatches,
+         " mismatches of ", with_tree.rays, " rays against the tree and the mesh");
     // On the aligned lattice the tree decides exact ties its own way, and the mesh's float
     // positions are exact; tilted, they are not (an overlapping step can leave a sliver).
-    if (aligned) CHECK(with_mesh.mismatches == 0);
-    else CHECK(with_tree.mismatches == 0);
+    if (aligned)
+      CHECK(with_mesh.mismatches == 0);
+    else
+      CHECK(with_tree.mismatches == 0);
     CHECK(volume(scan) == doctest::Approx(volume(tree)).epsilon(1e-4));
   }
   CHECK(fine_cells > 500);
@@ -98,7 +105,8 @@ TEST_CASE("scan machine equals the kernel's machine (W0 ∩ M1 ∩ … ∩ MN)")
   const Aabb stock{Vec3(-1, 0, 0), Vec3(2, 2.5, 1.8)};
   for (int trial = 0; trial < 4; ++trial) {
     std::vector<ZMap> maps;
-    for (int m = 0; m < 3; ++m) maps.push_back(random_milled_map(rng, stock, random_frame(rng, m > 0), 0.08, 8));
+    for (int m = 0; m < 3; ++m)
+      maps.push_back(random_milled_map(rng, stock, random_frame(rng, m > 0), 0.08, 8));
     DexelLattice l = DexelLattice::covering(stock, 0.07 + 0.03 * unit(rng));
     l.origin += Vec3(unit(rng), unit(rng), unit(rng)) * (0.3 * l.spacing);
     TripleDexel w0 = TripleDexel::box(l, stock);
@@ -120,7 +128,8 @@ TEST_CASE("scan dexelize rejects bad input with clear errors") {
   DexelLattice l{Vec3(0), 1, glm::ivec3(4)};
   CHECK_THROWS_WITH_AS(scan_dexelize(tiny, l), doctest::Contains("no cell"), Error);
   ZMap map = ZMap::from_box(Frame{}, Aabb{Vec3(0), Vec3(2)}, 0.5);
-  CHECK_THROWS_WITH_AS(scan_dexelize(map, DexelLattice{Vec3(0), 0, glm::ivec3(4)}), doctest::Contains("spacing"), Error);
+  CHECK_THROWS_WITH_AS(scan_dexelize(map, DexelLattice{Vec3(0), 0, glm::ivec3(4)}),
+                       doctest::Contains("spacing"), Error);
   DexelLattice far{Vec3(0), 1e-15, glm::ivec3(4)};
   CHECK_THROWS_WITH_AS(scan_dexelize(map, far), doctest::Contains("too far"), Error);
 }

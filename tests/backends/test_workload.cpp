@@ -36,9 +36,11 @@ TEST_CASE("the benchmark workload parses into the paper's five directions with f
     std::vector<gcode::MoveGroup> groups = gcode::group_by_direction(moves);
     REQUIRE(groups.size() == 5);
     const double c20 = std::cos(glm::radians(20.0)), s20 = std::sin(glm::radians(20.0));
-    const Vec3 expected[5] = {Vec3(0, 0, 1), Vec3(c20, 0, s20), Vec3(0, 1, 0), Vec3(-1, 0, 0), Vec3(0, -1, 0)};
+    const Vec3 expected[5] = {Vec3(0, 0, 1), Vec3(c20, 0, s20), Vec3(0, 1, 0), Vec3(-1, 0, 0),
+                              Vec3(0, -1, 0)};
     for (int k = 0; k < 5; ++k) {
-      INFO("direction ", k, ": (", groups[k].axis.x, ", ", groups[k].axis.y, ", ", groups[k].axis.z, ")");
+      INFO("direction ", k, ": (", groups[k].axis.x, ", ", groups[k].axis.y, ", ", groups[k].axis.z,
+           ")");
       CHECK(glm::length(groups[k].axis - expected[k]) < 1e-9);
       CHECK(groups[k].tools == std::set<int>{1, 2, 3, 4});
     }
@@ -47,12 +49,15 @@ TEST_CASE("the benchmark workload parses into the paper's five directions with f
     const Aabb reach = bench::workload_stock().inflated(12);
     std::size_t outside = 0;
     for (const gcode::Move& m : moves)
-      if (m.kind == gcode::MoveKind::feed && (!reach.contains(m.start) || !reach.contains(m.end))) ++outside;
+      if (m.kind == gcode::MoveKind::feed && (!reach.contains(m.start) || !reach.contains(m.end)))
+        ++outside;
     CHECK(outside == 0);
   }
 }
 
-TEST_CASE("the workload's variants: sloped roughing, and the ball ends alone with their moves unchanged") {
+TEST_CASE(
+    "the workload's variants: sloped roughing, and the ball ends alone with their moves "
+    "unchanged") {
   auto write = [](bench::WorkloadVariant variant, long long& written) {
     char* text = nullptr;
     std::size_t size = 0;
@@ -97,7 +102,8 @@ TEST_CASE("the workload's variants: sloped roughing, and the ball ends alone wit
     } else {
       // Roughing: Z levels go back up to the clearance once per level; the sloped raster once.
       auto rapids_up = [](const std::vector<std::string>& lines) {
-        return std::count_if(lines.begin(), lines.end(), [](const std::string& l) { return l.rfind("G0 Z", 0) == 0; });
+        return std::count_if(lines.begin(), lines.end(),
+                             [](const std::string& l) { return l.rfind("G0 Z", 0) == 0; });
       };
       CHECK(rapids_up(sloped[k].second) < rapids_up(levels[k].second));
     }

@@ -12,13 +12,13 @@ using namespace tridex::gcode::test;
 namespace {
 
 struct ArcCase {
-  int plane;     // 17, 18, 19
+  int plane;  // 17, 18, 19
   bool ccw;
-  Vec2 centre;   // in the plane's (u, v) = G17 (X,Y), G18 (Z,X), G19 (Y,Z)
+  Vec2 centre;  // in the plane's (u, v) = G17 (X,Y), G18 (Z,X), G19 (Y,Z)
   double radius;
-  double a0;     // start angle
-  double sweep;  // (0, 2π]
-  double w0, w1; // helix: normal coordinate at start and end
+  double a0;      // start angle
+  double sweep;   // (0, 2π]
+  double w0, w1;  // helix: normal coordinate at start and end
 };
 
 std::array<int, 3> axes(int plane) {
@@ -74,9 +74,10 @@ TEST_CASE("arcs (I/J/K): on the circle, within the chord tolerance, turning the 
     Vec2 offset = c.centre - Vec2(start[u], start[v]);
     const char* letters = "IJK";
     std::string program = header(c, start) + (c.ccw ? "G3" : "G2") + " X" + fmt(end.x) + " Y" +
-                          fmt(end.y) + " Z" + fmt(end.z) + " " + letters[u] + fmt(offset.x) +
-                          " " + letters[v] + fmt(offset.y) + "\nM30\n";
-    Vec2 centre = Vec2(start[u], start[v]) + Vec2(std::stod(fmt(offset.x)), std::stod(fmt(offset.y)));
+                          fmt(end.y) + " Z" + fmt(end.z) + " " + letters[u] + fmt(offset.x) + " " +
+                          letters[v] + fmt(offset.y) + "\nM30\n";
+    Vec2 centre =
+        Vec2(start[u], start[v]) + Vec2(std::stod(fmt(offset.x)), std::stod(fmt(offset.y)));
     InterpreterOptions options;
     Result r = run_program(program, options, at_origin());
     REQUIRE(r.moves.size() >= 2);
@@ -124,7 +125,8 @@ TEST_CASE("arcs: the R form gives the same path as the I/J/K form") {
     Result a = run_program(base + ijk, {}, at_origin());
     Result b = run_program(base + r, {}, at_origin());
     REQUIRE(a.moves.size() == b.moves.size());
-    for (std::size_t k = 0; k < a.moves.size(); ++k) CHECK(near(a.moves[k].end, b.moves[k].end, 1e-6));
+    for (std::size_t k = 0; k < a.moves.size(); ++k)
+      CHECK(near(a.moves[k].end, b.moves[k].end, 1e-6));
   }
 }
 
@@ -179,9 +181,10 @@ TEST_CASE("arcs: bad arcs are errors with their position") {
   CHECK(d.message.find("retracted") != std::string::npos);
 }
 
-// LinuxCNC 2.9 (interp_arc.cc; each case checked with rs274) cuts an I/J/K arc whose end radius differs from its start radius
-// as a spiral up to 0.02·√2 mm (G21) or 0.002·√2 in (G20), and up to 100 times that within 0.1 %
-// of the radius; the machine's arc_radius_tolerance (0.02 mm unless set) stays for other machines.
+// LinuxCNC 2.9 (interp_arc.cc; each case checked with rs274) cuts an I/J/K arc whose end radius
+// differs from its start radius as a spiral up to 0.02·√2 mm (G21) or 0.002·√2 in (G20), and up to
+// 100 times that within 0.1 % of the radius; the machine's arc_radius_tolerance (0.02 mm unless
+// set) stays for other machines.
 TEST_CASE("arcs: LinuxCNC's spiral tolerance on --machine linuxcnc") {
   const MachineConfig linuxcnc = *MachineConfig::bundled("linuxcnc");
   // Radius 10 → 10.02 mm: within 0.02·√2 mm.
@@ -198,17 +201,19 @@ TEST_CASE("arcs: LinuxCNC's spiral tolerance on --machine linuxcnc") {
   MachineConfig tight;
   tight.arc_radius_tolerance = 0.002;
   CHECK(error_of(inch4, {}, tight).message.find("by more than 0.002 mm") != std::string::npos);
-  CHECK(error_of("G21 G17 G90 F100\nG0 X10 Y0 Z0\nG3 X0 Y10.03 I-10 J0\n").message.find("by more than 0.02 mm") !=
-        std::string::npos);
+  CHECK(error_of("G21 G17 G90 F100\nG0 X10 Y0 Z0\nG3 X0 Y10.03 I-10 J0\n")
+            .message.find("by more than 0.02 mm") != std::string::npos);
   // 10 → 10.03 mm: over 0.0283 mm and over 0.1 % of the radius.
   Diagnostic d = error_of("G21 G17 G90 F100\nG0 X10 Y0 Z0\nG3 X0 Y10.03 I-10 J0\n", {}, linuxcnc);
   CHECK(d.message.find("spiral tolerance") != std::string::npos);
   // Radius 100 → 100.05 mm: over 0.0283 mm but within 0.1 %.
-  CHECK(!run_program("G21 G17 G90 F100\nG0 X100 Y0 Z0\nG3 X0 Y100.05 I-100 J0\n", {}, linuxcnc).moves.empty());
+  CHECK(!run_program("G21 G17 G90 F100\nG0 X100 Y0 Z0\nG3 X0 Y100.05 I-100 J0\n", {}, linuxcnc)
+             .moves.empty());
   // In inches the bound is 0.002·√2 in: 1 → 1.0025 in is within, 1 → 1.003 in is not.
-  CHECK(!run_program("G20 G17 G90 F10\nG0 X1 Y0 Z0\nG3 X0 Y1.0025 I-1 J0\n", {}, linuxcnc).moves.empty());
-  CHECK(error_of("G20 G17 G90 F10\nG0 X1 Y0 Z0\nG3 X0 Y1.003 I-1 J0\n", {}, linuxcnc).message.find("spiral") !=
-        std::string::npos);
+  CHECK(!run_program("G20 G17 G90 F10\nG0 X1 Y0 Z0\nG3 X0 Y1.0025 I-1 J0\n", {}, linuxcnc)
+             .moves.empty());
+  CHECK(error_of("G20 G17 G90 F10\nG0 X1 Y0 Z0\nG3 X0 Y1.003 I-1 J0\n", {}, linuxcnc)
+            .message.find("spiral") != std::string::npos);
 }
 
 // LinuxCNC's G2/G3 P: the number of turns. rs274 prints `G3 X10 Y0 I-10 J0 Z-6 P3` as
@@ -240,9 +245,10 @@ TEST_CASE("arcs: LinuxCNC's P on G2/G3 winds P − 1 full circles before the end
   };
   const double pi = std::numbers::pi;
   double z_half = 0;
-  Result r = run_program("G21 G17 G90 F100\nG0 X10 Y0 Z0\nG3 X10 Y0 I-10 J0 Z-6 P3\n"
-                         "G2 X0 Y10 I-10 J0 Z-8 P2\nG3 X-10 Y0 R10 P2\nM2\n",
-                         {}, linuxcnc);
+  Result r = run_program(
+      "G21 G17 G90 F100\nG0 X10 Y0 Z0\nG3 X10 Y0 I-10 J0 Z-6 P3\n"
+      "G2 X0 Y10 I-10 J0 Z-8 P2\nG3 X-10 Y0 R10 P2\nM2\n",
+      {}, linuxcnc);
   CHECK(turned(r, 3, Vec2(0, 0), z_half) == doctest::Approx(6 * pi));
   CHECK(z_half == doctest::Approx(-3).epsilon(0.01));  // the rise shared over all three turns
   CHECK(near(r.moves.back().end, Vec3(-10, 0, -8)));
@@ -257,20 +263,23 @@ TEST_CASE("arcs: LinuxCNC's P on G2/G3 winds P − 1 full circles before the end
   CHECK(r.moves.back().feed == doctest::Approx(2 * (4 * pi * 10)));
   // Under cutter compensation (rs274: G41.1 D2 then this arc prints ARC_FEED(…, 2, …)).
   MachineConfig comp = linuxcnc;
-  r = run_program("G21 G17 G90 F100\nG0 X20 Y0 Z0\nG41.1 D2\nG1 X10 Y0\nG3 X10 Y0 I-10 J0 P2\n"
-                  "G1 X10 Y-5\nG40\nG0 X30\nM2\n",
-                  {}, comp);
+  r = run_program(
+      "G21 G17 G90 F100\nG0 X20 Y0 Z0\nG41.1 D2\nG1 X10 Y0\nG3 X10 Y0 I-10 J0 P2\n"
+      "G1 X10 Y-5\nG40\nG0 X30\nM2\n",
+      {}, comp);
   double around = 0;  // the chords on the offset circle (radius 9), not the corner arcs at X10 Y0
   for (const Move& m : r.moves)
-    if (m.line == 5 && std::abs(glm::length(Vec2(m.start)) - 9) < 1e-6 && std::abs(glm::length(Vec2(m.end)) - 9) < 1e-6)
-      around += std::atan2(m.start.x * m.end.y - m.start.y * m.end.x, glm::dot(Vec2(m.start), Vec2(m.end)));
+    if (m.line == 5 && std::abs(glm::length(Vec2(m.start)) - 9) < 1e-6 &&
+        std::abs(glm::length(Vec2(m.end)) - 9) < 1e-6)
+      around += std::atan2(m.start.x * m.end.y - m.start.y * m.end.x,
+                           glm::dot(Vec2(m.start), Vec2(m.end)));
   CHECK(around == doctest::Approx(4 * pi));
   // rs274's errors: P an integer of 1 or more.
-  CHECK(error_of("G21 G17 F100\nG0 X10 Y0 Z0\nG3 X10 Y0 I-10 P1.5\n", {}, linuxcnc).message.find("integer") !=
-        std::string::npos);
-  CHECK(error_of("G21 G17 F100\nG0 X10 Y0 Z0\nG3 X10 Y0 I-10 P0\n", {}, linuxcnc).message.find("integer in [1") !=
-        std::string::npos);
+  CHECK(error_of("G21 G17 F100\nG0 X10 Y0 Z0\nG3 X10 Y0 I-10 P1.5\n", {}, linuxcnc)
+            .message.find("integer") != std::string::npos);
+  CHECK(error_of("G21 G17 F100\nG0 X10 Y0 Z0\nG3 X10 Y0 I-10 P0\n", {}, linuxcnc)
+            .message.find("integer in [1") != std::string::npos);
   // Fanuc has no such word: P on an arc is still a word no code of the block uses.
-  CHECK(error_of("G21 G17 F100\nG0 X10 Y0 Z0\nG3 X10 Y0 I-10 P2\n", {}, at_origin()).message.find("P2") !=
-        std::string::npos);
+  CHECK(error_of("G21 G17 F100\nG0 X10 Y0 Z0\nG3 X10 Y0 I-10 P2\n", {}, at_origin())
+            .message.find("P2") != std::string::npos);
 }

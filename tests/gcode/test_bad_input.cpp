@@ -82,9 +82,10 @@ TEST_CASE("bad input: random binary garbage and random word soup") {
     for (char& c : text) c = static_cast<char>(rng() % 256);
     survives(text);
   }
-  const char* words[] = {"G0", "G1", "G2", "G3", "G81", "G83", "G68.2", "G53.1", "G69", "G91",
-                         "G90", "G28", "G53", "M98", "M99", "O1", "X1", "Y-2", "Z3.5", "I1",
-                         "J-1", "K2", "R1", "R-2", "Q0.5", "P1", "L2", "F100", "T1", "M6", "\n"};
+  const char* words[] = {"G0",   "G1",  "G2",   "G3",   "G81", "G83", "G68.2", "G53.1",
+                         "G69",  "G91", "G90",  "G28",  "G53", "M98", "M99",   "O1",
+                         "X1",   "Y-2", "Z3.5", "I1",   "J-1", "K2",  "R1",    "R-2",
+                         "Q0.5", "P1",  "L2",   "F100", "T1",  "M6",  "\n"};
   for (int i = 0; i < 2000; ++i) {
     std::string text;
     int n = static_cast<int>(rng() % 40);

@@ -54,7 +54,8 @@ TEST_CASE("G42 outside a square: every point one radius from the contour, corner
   for (const Move& m : r.moves) {
     if (m.line < 5 || m.line > 9) continue;  // the entry (line 4) and the exit (line 10) cross over
     Vec2 p(m.end.x, m.end.y);
-    CHECK_MESSAGE(std::abs(to_polygon(p, square) - 3.0) < 1e-9, "line " << m.line << " " << p.x << " " << p.y);
+    CHECK_MESSAGE(std::abs(to_polygon(p, square) - 3.0) < 1e-9,
+                  "line " << m.line << " " << p.x << " " << p.y);
     bool inside = p.x > 0 && p.x < 40 && p.y > 0 && p.y < 40;
     CHECK(!inside);
     ++on_contour;
@@ -95,13 +96,15 @@ TEST_CASE("G41 inside a square: concave corners end where the offset lines meet"
 TEST_CASE("compensation by zero, by a diameter (G41.1) and by a negative diameter") {
   const char* contour = "G1 X30 Y0\nG1 X30 Y30\nG40 G1 X50 Y50\nM2\n";
   auto run = [&](const std::string& on) {
-    return run_program(std::string("G21 G17 G90 F300\nT1 M6\nG0 X-10 Y-10 Z0\n") + on + " G1 X0 Y0\n" + contour,
-                       {}, with_tools());
+    return run_program(
+        std::string("G21 G17 G90 F300\nT1 M6\nG0 X-10 Y-10 Z0\n") + on + " G1 X0 Y0\n" + contour,
+        {}, with_tools());
   };
   Result plain = run("G40");
   Result zero = run("G41 D3");
   REQUIRE(zero.moves.size() == plain.moves.size());
-  for (std::size_t i = 0; i < plain.moves.size(); ++i) CHECK(near(zero.moves[i].end, plain.moves[i].end));
+  for (std::size_t i = 0; i < plain.moves.size(); ++i)
+    CHECK(near(zero.moves[i].end, plain.moves[i].end));
   Result by_table = run("G41 D1");
   Result by_diameter = run("G41.1 D6");
   REQUIRE(by_table.moves.size() == by_diameter.moves.size());
@@ -110,7 +113,8 @@ TEST_CASE("compensation by zero, by a diameter (G41.1) and by a negative diamete
   // A negative diameter offsets to the other side.
   Result right = run("G42 D1"), flipped = run("G41 D4");
   REQUIRE(right.moves.size() == flipped.moves.size());
-  for (std::size_t i = 0; i < right.moves.size(); ++i) CHECK(near(right.moves[i].end, flipped.moves[i].end, 1e-12));
+  for (std::size_t i = 0; i < right.moves.size(); ++i)
+    CHECK(near(right.moves[i].end, flipped.moves[i].end, 1e-12));
   // The entry (G41, radius 3, from (-10, -10) to (0, 0)) ends one radius to its left,
   // perpendicular to it; the turn onto +X is convex there, so an arc follows to (0, 3).
   const Move& entry = by_table.moves[1];
@@ -150,13 +154,16 @@ TEST_CASE("cutter compensation errors, each at its block") {
 }
 
 TEST_CASE("lenient mode runs G41/G42 like strict mode; #4007 reads the mode") {
-  const std::string text = "G21 G17 G90 F300\nT1 M6\nG0 X-10 Y-10 Z0\nG41 D1 G1 X0 Y0\n"
-                           "#1 = #4007\nG1 X[#1] Y0\nG1 Y30\nG40 G1 X-10 Y40\nM2\n";
+  const std::string text =
+      "G21 G17 G90 F300\nT1 M6\nG0 X-10 Y-10 Z0\nG41 D1 G1 X0 Y0\n"
+      "#1 = #4007\nG1 X[#1] Y0\nG1 Y30\nG40 G1 X-10 Y40\nM2\n";
   InterpreterOptions lenient;
   lenient.lenient = true;
-  Result strict = run_program(text, {}, with_tools()), loose = run_program(text, lenient, with_tools());
+  Result strict = run_program(text, {}, with_tools()),
+         loose = run_program(text, lenient, with_tools());
   REQUIRE(strict.moves.size() == loose.moves.size());
-  for (std::size_t i = 0; i < strict.moves.size(); ++i) CHECK(near(strict.moves[i].end, loose.moves[i].end));
+  for (std::size_t i = 0; i < strict.moves.size(); ++i)
+    CHECK(near(strict.moves[i].end, loose.moves[i].end));
   CHECK(loose.warnings.empty());
   // #4007 = 41 while G41 is on: the side runs to X41, offset up by the radius to y = 3.
   bool at_41 = false;
@@ -168,23 +175,29 @@ TEST_CASE("probing (G38.x, Fanuc's G31 skip) is an error that names it, even len
   InterpreterOptions lenient;
   lenient.lenient = true;
   for (const char* code : {"G38.2", "G38.3", "G38.4", "G38.5", "G31"}) {
-    Diagnostic d = error_of(std::string("G0 X0 Y0 Z0\n") + code + " Z-10 F100\nM2\n", lenient, at_origin());
+    Diagnostic d =
+        error_of(std::string("G0 X0 Y0 Z0\n") + code + " Z-10 F100\nM2\n", lenient, at_origin());
     CHECK(d.line == 2);
-    CHECK_MESSAGE(d.message.find(std::string(code) + " (probing) is not simulated") != std::string::npos, d.message);
+    CHECK_MESSAGE(
+        d.message.find(std::string(code) + " (probing) is not simulated") != std::string::npos,
+        d.message);
   }
 }
 
-TEST_CASE("after G40 the next move counts from the programmed point, after a tool change from the tip") {
+TEST_CASE(
+    "after G40 the next move counts from the programmed point, after a tool change from the tip") {
   // LinuxCNC: G40 makes the programmed point current (a Z move then also returns X/Y to it); a
   // tool change resynchronises with where the tool is (useful-subroutines.ngc relies on it).
-  const std::string head = "G21 G17 G90 F300\nT1 M6\nG0 X-10 Y-10 Z0\nG41 D1 G1 X0 Y0\nG1 X20 Y0\nG0 Z5\nG40\n";
+  const std::string head =
+      "G21 G17 G90 F300\nT1 M6\nG0 X-10 Y-10 Z0\nG41 D1 G1 X0 Y0\nG1 X20 Y0\nG0 Z5\nG40\n";
   Result plain = run_program(head + "G0 Z10\nM2\n", {}, with_tools());
   CHECK(near(plain.moves.back().end, Vec3(20, 0, 10), 1e-9));
   Result changed = run_program(head + "T2 M6\nG0 Z10\nM2\n", {}, with_tools());
   CHECK(near(changed.moves.back().end, Vec3(20, 3, 10), 1e-9));
 }
 
-TEST_CASE("Fanuc and Haas start-up (type A): the entry ends perpendicular to the next move's start") {
+TEST_CASE(
+    "Fanuc and Haas start-up (type A): the entry ends perpendicular to the next move's start") {
   for (const Dialect dialect : {Dialect::fanuc, Dialect::haas}) {
     CAPTURE(static_cast<int>(dialect));
     MachineConfig m = with_tools();
@@ -192,9 +205,10 @@ TEST_CASE("Fanuc and Haas start-up (type A): the entry ends perpendicular to the
     // A hole of radius 8 milled from its centre with a D6 (r = 3): the entry ends at (-5, 0),
     // perpendicular to the circle's start, and the tool runs round at radius 5 (LinuxCNC finds no
     // corner there: the entry's offset line y = -3 meets that circle only for r <= 2.5).
-    Result hole = run_program("G21 G17 G90 F300\nT1 M6\nG0 X0 Y0 Z5\nG1 Z-2\nG41 D1 G1 X-8 Y0\nG3 I8 J0\n"
-                              "G40 G1 X0 Y0\nM30\n",
-                              {}, m);
+    Result hole = run_program(
+        "G21 G17 G90 F300\nT1 M6\nG0 X0 Y0 Z5\nG1 Z-2\nG41 D1 G1 X-8 Y0\nG3 I8 J0\n"
+        "G40 G1 X0 Y0\nM30\n",
+        {}, m);
     int on_circle = 0;
     for (const Move& move : hole.moves) {
       if (move.line == 5) CHECK(near(move.end, Vec3(-5, 0, -2)));
@@ -206,31 +220,39 @@ TEST_CASE("Fanuc and Haas start-up (type A): the entry ends perpendicular to the
     CHECK(near(hole.moves.back().end, Vec3(0, 0, -2)));
     // Line to line, turning left under G41: the entry ends at (7, 0), beside the next move's
     // start, with no corner to cut back; an entry shorter than the radius is fine.
-    Result corner = run_program("G21 G17 G90 F300\nT1 M6\nG0 X0 Y0 Z-1\nG41 D1 G1 X10 Y0\nG1 Y10\nG40 G1 X20\nM30\n",
-                                {}, m);
+    Result corner = run_program(
+        "G21 G17 G90 F300\nT1 M6\nG0 X0 Y0 Z-1\nG41 D1 G1 X10 Y0\nG1 Y10\nG40 G1 X20\nM30\n", {},
+        m);
     REQUIRE(corner.moves.size() >= 3);
     CHECK(near(corner.moves[1].end, Vec3(7, 0, -1)));
     CHECK(near(corner.moves[2].end, Vec3(7, 10, -1)));
-    Result short_entry = run_program("G21 G17 G90 F300\nT1 M6\nG0 X0 Y0 Z-1\nG41 D1 G1 X1 Y0\nG1 X20\nG40 G1 Y-10\nM30\n",
-                                     {}, m);
+    Result short_entry = run_program(
+        "G21 G17 G90 F300\nT1 M6\nG0 X0 Y0 Z-1\nG41 D1 G1 X1 Y0\nG1 X20\nG40 G1 Y-10\nM30\n", {},
+        m);
     REQUIRE(short_entry.moves.size() >= 3);
     CHECK(near(short_entry.moves[1].end, Vec3(1, 3, -1)));
     CHECK(near(short_entry.moves[2].end, Vec3(20, 3, -1)));
     // A move with no motion in the plane after G41 goes as programmed; the next one is the entry.
-    Result plunge = run_program("G21 G17 G90 F300\nT1 M6\nG0 X0 Y0 Z5\nG41 D1\nG1 Z-1\nG1 X1 Y0\nG1 X20\nG40 G1 Y-10\nM30\n",
-                                {}, m);
+    Result plunge = run_program(
+        "G21 G17 G90 F300\nT1 M6\nG0 X0 Y0 Z5\nG41 D1\nG1 Z-1\nG1 X1 Y0\nG1 X20\nG40 G1 "
+        "Y-10\nM30\n",
+        {}, m);
     REQUIRE(plunge.moves.size() == short_entry.moves.size() + 1);
     CHECK(near(plunge.moves[1].end, Vec3(0, 0, -1)));
-    for (std::size_t i = 1; i < short_entry.moves.size(); ++i) CHECK(near(plunge.moves[i + 1].end, short_entry.moves[i].end));
+    for (std::size_t i = 1; i < short_entry.moves.size(); ++i)
+      CHECK(near(plunge.moves[i + 1].end, short_entry.moves[i].end));
     // G41 given again with the same side and radius changes nothing; another radius is refused.
-    Result again = run_program("G21 G17 G90 F300\nT1 M6\nG0 X0 Y0 Z-1\nG41 D1 G1 X1 Y0\nG41 G1 X20\nG40 G1 Y-10\nM30\n",
-                               {}, m);
+    Result again = run_program(
+        "G21 G17 G90 F300\nT1 M6\nG0 X0 Y0 Z-1\nG41 D1 G1 X1 Y0\nG41 G1 X20\nG40 G1 Y-10\nM30\n",
+        {}, m);
     REQUIRE(again.moves.size() == short_entry.moves.size());
-    for (std::size_t i = 0; i < again.moves.size(); ++i) CHECK(near(again.moves[i].end, short_entry.moves[i].end));
+    for (std::size_t i = 0; i < again.moves.size(); ++i)
+      CHECK(near(again.moves[i].end, short_entry.moves[i].end));
     CHECK(error_of("G21 G17 G90 F300\nT1 M6\nG0 X0 Y0 Z-1\nG41 D1 G1 X1 Y0\nG41 D2 G1 X20\n", {}, m)
               .message.find("changes the side or the radius") != std::string::npos);
   }
   // LinuxCNC keeps its own rule: the same short entry is refused.
-  CHECK(error_of("G21 G17 G90 F300\nT1 M6\nG0 X0 Y0 Z-1\nG41 D1 G1 X1 Y0\nG1 X20\n", {}, with_tools())
-            .message.find("not longer than the tool radius") != std::string::npos);
+  CHECK(
+      error_of("G21 G17 G90 F300\nT1 M6\nG0 X0 Y0 Z-1\nG41 D1 G1 X1 Y0\nG1 X20\n", {}, with_tools())
+          .message.find("not longer than the tool radius") != std::string::npos);
 }

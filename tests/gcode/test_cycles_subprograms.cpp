@@ -16,8 +16,8 @@ std::vector<Vec3> ends(const Result& r, MoveKind kind) {
 }  // namespace
 
 TEST_CASE("G81 with G98 and G99: retract levels") {
-  Result r = run_program("G90 F100\nG0 X0 Y0 Z10\nG99 G81 X1 Y1 Z-2 R1\nG98 X2\nG80\nM30\n",
-                         {}, at_origin());
+  Result r = run_program("G90 F100\nG0 X0 Y0 Z10\nG99 G81 X1 Y1 Z-2 R1\nG98 X2\nG80\nM30\n", {},
+                         at_origin());
   std::vector<Vec3> want = {Vec3(1, 1, 10), Vec3(1, 1, 1), Vec3(1, 1, -2), Vec3(1, 1, 1),
                             Vec3(2, 1, 1),  Vec3(2, 1, 1), Vec3(2, 1, -2), Vec3(2, 1, 10)};
   std::vector<Vec3> got = ends(r, MoveKind::cycle);
@@ -61,9 +61,10 @@ TEST_CASE("G83/G73 pecks: each step at most Q deeper, the last at the bottom, ra
 }
 
 TEST_CASE("G85/G89 feed out, G86 rapids out; L repeats step under G91") {
-  Result r = run_program("G90 F100\nG0 X0 Y0 Z5\nG85 X1 Y0 Z-3 R1\nG80\n"
-                         "G91 G99 G81 X2 Y1 Z-4 R-3 L3\nG90 G80\nM30\n",
-                         {}, at_origin());
+  Result r = run_program(
+      "G90 F100\nG0 X0 Y0 Z5\nG85 X1 Y0 Z-3 R1\nG80\n"
+      "G91 G99 G81 X2 Y1 Z-4 R-3 L3\nG90 G80\nM30\n",
+      {}, at_origin());
   std::vector<Move> cycle;
   for (const Move& m : r.moves)
     if (m.kind == MoveKind::cycle) cycle.push_back(m);
@@ -77,14 +78,19 @@ TEST_CASE("G85/G89 feed out, G86 rapids out; L repeats step under G91") {
   for (std::size_t i = 5; i < cycle.size(); ++i)
     if (cycle[i].feed > 0) bottoms.push_back(cycle[i].end);
   REQUIRE(bottoms.size() == 3);
-  for (int k = 0; k < 3; ++k) CHECK(near(bottoms[static_cast<std::size_t>(k)], Vec3(3 + 2 * k, 1 + k, -2)));
+  for (int k = 0; k < 3; ++k)
+    CHECK(near(bottoms[static_cast<std::size_t>(k)], Vec3(3 + 2 * k, 1 + k, -2)));
   // K is the Fanuc spelling of the repeat count.
-  Result k = run_program("G90 F100\nG0 X0 Y0 Z5\nG91 G81 X1 Z-1 R-1 K2\nG90 G80\nM30\n", {}, at_origin());
+  Result k =
+      run_program("G90 F100\nG0 X0 Y0 Z5\nG91 G81 X1 Z-1 R-1 K2\nG90 G80\nM30\n", {}, at_origin());
   CHECK(near(k.moves.back().end, Vec3(2, 0, 5)));
 }
 
-TEST_CASE("G84/G74 tapping back out at feed: to R on Fanuc, to the clear level on LinuxCNC; P kept on any Fanuc cycle") {
-  const std::string program = "G90 F100 S500 M3\nG0 X0 Y0 Z10\nG98 G84 X1 Y1 Z-3 R2 P200\nG80\nM30\n";
+TEST_CASE(
+    "G84/G74 tapping back out at feed: to R on Fanuc, to the clear level on LinuxCNC; P kept on "
+    "any Fanuc cycle") {
+  const std::string program =
+      "G90 F100 S500 M3\nG0 X0 Y0 Z10\nG98 G84 X1 Y1 Z-3 R2 P200\nG80\nM30\n";
   for (const Dialect dialect : {Dialect::fanuc, Dialect::haas, Dialect::linuxcnc}) {
     CAPTURE(static_cast<int>(dialect));
     MachineConfig machine = at_origin();
@@ -110,22 +116,25 @@ TEST_CASE("G84/G74 tapping back out at feed: to R on Fanuc, to the clear level o
     REQUIRE(a.moves.size() == b.moves.size());
     for (std::size_t i = 0; i < a.moves.size(); ++i) CHECK(near(a.moves[i].end, b.moves[i].end));
   };
-  same_ends(run_program("G90 F100 S500 M4\nG0 X0 Y0 Z10\nG99 G74 X1 Y1 Z-3 R2\nX2\nG80\nM30\n", {}, at_origin()),
-            run_program("G90 F100 S500 M4\nG0 X0 Y0 Z10\nG99 G85 X1 Y1 Z-3 R2\nX2\nG80\nM30\n", {}, at_origin()));
-  CHECK(error_of("G90 F100\nG0 X0 Y0 Z10\nG84 X1 Z-3 R2 L2\n", {}, linuxcnc_at_origin()).message.find("no repeats") !=
-        std::string::npos);
+  same_ends(run_program("G90 F100 S500 M4\nG0 X0 Y0 Z10\nG99 G74 X1 Y1 Z-3 R2\nX2\nG80\nM30\n", {},
+                        at_origin()),
+            run_program("G90 F100 S500 M4\nG0 X0 Y0 Z10\nG99 G85 X1 Y1 Z-3 R2\nX2\nG80\nM30\n", {},
+                        at_origin()));
+  CHECK(error_of("G90 F100\nG0 X0 Y0 Z10\nG84 X1 Z-3 R2 L2\n", {}, linuxcnc_at_origin())
+            .message.find("no repeats") != std::string::npos);
   // A P written on G81 (a post's habit): modal cycle data on Fanuc, an unused word on LinuxCNC.
   same_ends(run_program("G90 F100\nG0 X0 Y0 Z10\nG81 X1 Z-3 R2 P500\nG80\nM30\n", {}, at_origin()),
             run_program("G90 F100\nG0 X0 Y0 Z10\nG81 X1 Z-3 R2\nG80\nM30\n", {}, at_origin()));
-  CHECK(error_of("G90 F100\nG0 X0 Y0 Z10\nG81 X1 Z-3 R2 P500\n", {}, linuxcnc_at_origin()).message.find("P500") !=
-        std::string::npos);
+  CHECK(error_of("G90 F100\nG0 X0 Y0 Z10\nG81 X1 Z-3 R2 P500\n", {}, linuxcnc_at_origin())
+            .message.find("P500") != std::string::npos);
 }
 
 TEST_CASE("cycle errors: missing words, bottom above R, wrong axis, retracted incremental") {
   CHECK(error_of("G0 X0 Y0 Z5\nG81 X1 Z-1 F10\n").message.find("needs R") != std::string::npos);
   CHECK(error_of("G0 X0 Y0 Z5\nG83 X1 Z-1 R1 F10\n").message.find("Q") != std::string::npos);
   CHECK(error_of("G0 X0 Y0 Z5\nG81 X1 Z2 R1 F10\n").message.find("above") != std::string::npos);
-  CHECK(error_of("G0 X0 Y0 Z5\nG18 G81 X1 Y-1 R1 F10\n").message.find("spindle") != std::string::npos);
+  CHECK(error_of("G0 X0 Y0 Z5\nG18 G81 X1 Y-1 R1 F10\n").message.find("spindle") !=
+        std::string::npos);
   CHECK(error_of("G91 G81 X1 Z-1 R1 F10\n").message.find("retracted") != std::string::npos);
   CHECK(error_of("G0 X0 Y0 Z5\nG81 X1 Z-1 R1 F10 L2 K2\n").column == 22);
   // From far (program start) a cycle comes straight down onto its R plane.
@@ -235,10 +244,11 @@ TEST_CASE("LinuxCNC: the flow goes on through a bare O number, as rs274 does") {
   CHECK(ends(r) == std::vector<double>{1, 2, 3, 5});
   // Inside an o-word call it is an error (rs274: "Fanuc 'O....' subroutine must be called with
   // 'M98'").
-  Diagnostic d = error_of("G21 G90\no100 call\nM2\no100 sub\nO5\nG0 X2\no100 endsub\n", {}, linuxcnc);
+  Diagnostic d =
+      error_of("G21 G90\no100 call\nM2\no100 sub\nO5\nG0 X2\no100 endsub\n", {}, linuxcnc);
   CHECK(d.line == 5);
   CHECK(d.message.find("M98") != std::string::npos);
   // Fanuc and Haas keep refusing a main program that runs into the next O number.
-  CHECK(error_of("G21 G90\nG0 X1 Y0 Z0\nO100\nG0 X2\nM99\n", {}, at_origin()).message.find("M2/M30") !=
-        std::string::npos);
+  CHECK(error_of("G21 G90\nG0 X1 Y0 Z0\nO100\nG0 X2\nM99\n", {}, at_origin())
+            .message.find("M2/M30") != std::string::npos);
 }

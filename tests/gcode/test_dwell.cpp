@@ -23,13 +23,16 @@ Stream run_with_dwells(const std::string& text, MachineConfig machine) {
   Interpreter interpreter({}, machine);
   Stream s;
   interpreter.run(
-      in, "test.nc", [&](const Move& m) { s.moves.push_back(m); }, [&](const Dwell& d) { s.dwells.push_back(d); });
+      in, "test.nc", [&](const Move& m) { s.moves.push_back(m); },
+      [&](const Dwell& d) { s.dwells.push_back(d); });
   return s;
 }
 
 }  // namespace
 
-TEST_CASE("dwell: G4 in seconds (LinuxCNC) or milliseconds and X seconds (Fanuc), with line, tool and axis") {
+TEST_CASE(
+    "dwell: G4 in seconds (LinuxCNC) or milliseconds and X seconds (Fanuc), with line, tool and "
+    "axis") {
   MachineConfig linuxcnc = at_origin();
   linuxcnc.dialect = Dialect::linuxcnc;
   Stream s = run_with_dwells("T3 M6\nG1 X1 F100\nG4 P1.5\n", linuxcnc);
@@ -65,7 +68,9 @@ TEST_CASE("dwell: G82, G86 and G89 pause at each hole's bottom, P sticky; G81 an
     CHECK(plain.moves[k].end == s.moves[k].end);
   }
   for (const char* code : {"G86", "G89"})
-    CHECK(run_with_dwells(std::string("G0 Z10\n") + code + " X1 Z-2 R1 P1 F100\nG80\n", machine).dwells.size() == 1);
+    CHECK(run_with_dwells(std::string("G0 Z10\n") + code + " X1 Z-2 R1 P1 F100\nG80\n", machine)
+              .dwells.size() == 1);
   for (const char* code : {"G81", "G85"})
-    CHECK(run_with_dwells(std::string("G0 Z10\n") + code + " X1 Z-2 R1 F100\nG80\n", machine).dwells.empty());
+    CHECK(run_with_dwells(std::string("G0 Z10\n") + code + " X1 Z-2 R1 F100\nG80\n", machine)
+              .dwells.empty());
 }

@@ -34,14 +34,15 @@ double feed_on(const std::vector<Move>& moves, int line) {
 
 TEST_CASE("feed modes: G93 inverse time takes 1/F minutes per block, lines and arcs; G94 back") {
   for (const MachineConfig& machine : {at_origin(), linuxcnc_at_origin()}) {
-    Result r = run_program("G21 G0 X0 Y0 Z0\n"
-                           "G93 G1 X30 Y40 F2\n"          // 50 mm in 1/2 min: 100 mm/min
-                           "G1 X0 Y40 F0.25\n"            // 30 mm in 4 min
-                           "G3 X-10 Y30 I0 J-10 F3\n"     // a quarter circle of radius 10
-                           "G2 X-10 Y30 I10 J0 Z-6 F1\n"  // a full helix: hypot(20π, 6)
-                           "G20 G1 X0 F10\n"              // 10 mm in 1/10 min, whatever the units
-                           "G21 G94 G1 Y0 F300\n",        // 30 mm at 300 mm/min
-                           {}, machine);
+    Result r = run_program(
+        "G21 G0 X0 Y0 Z0\n"
+        "G93 G1 X30 Y40 F2\n"          // 50 mm in 1/2 min: 100 mm/min
+        "G1 X0 Y40 F0.25\n"            // 30 mm in 4 min
+        "G3 X-10 Y30 I0 J-10 F3\n"     // a quarter circle of radius 10
+        "G2 X-10 Y30 I10 J0 Z-6 F1\n"  // a full helix: hypot(20π, 6)
+        "G20 G1 X0 F10\n"              // 10 mm in 1/10 min, whatever the units
+        "G21 G94 G1 Y0 F300\n",        // 30 mm at 300 mm/min
+        {}, machine);
     std::map<int, double> minutes = minutes_by_line(r.moves);
     REQUIRE(minutes.size() == 6);
     CHECK(minutes[2] == doctest::Approx(0.5));
@@ -68,7 +69,8 @@ TEST_CASE("feed modes: the path does not depend on the feed mode") {
     }
     return run_program(text, {}, linuxcnc_at_origin()).moves;
   };
-  std::vector<Move> per_minute = with("G94", "200"), inverse = with("G93", "3"), per_rev = with("G95", "0.2");
+  std::vector<Move> per_minute = with("G94", "200"), inverse = with("G93", "3"),
+                    per_rev = with("G95", "0.2");
   REQUIRE(per_minute.size() == inverse.size());
   REQUIRE(per_minute.size() == per_rev.size());
   for (std::size_t i = 0; i < per_minute.size(); ++i) {
@@ -79,14 +81,17 @@ TEST_CASE("feed modes: the path does not depend on the feed mode") {
 }
 
 TEST_CASE("feed modes: G95 feeds F per revolution at the spindle speed S, in program units") {
-  Result r = run_program("G0 X0 Y0 Z0\nG95 G1 X10 F0.1 S1200\nS600 X20\nG20 X1 F0.01\n", {}, linuxcnc_at_origin());
+  Result r = run_program("G0 X0 Y0 Z0\nG95 G1 X10 F0.1 S1200\nS600 X20\nG20 X1 F0.01\n", {},
+                         linuxcnc_at_origin());
   CHECK(feed_on(r.moves, 2) == doctest::Approx(120));
   CHECK(feed_on(r.moves, 3) == doctest::Approx(60));
   CHECK(feed_on(r.moves, 4) == doctest::Approx(0.01 * 25.4 * 600));
 }
 
-TEST_CASE("feed modes: G94 and G95 clear the feed rate under LinuxCNC; elsewhere a change of mode does") {
-  // rs274: G94 sets the feed rate to 0 (interp_convert.cc convert_feed_mode), even when already in G94.
+TEST_CASE(
+    "feed modes: G94 and G95 clear the feed rate under LinuxCNC; elsewhere a change of mode does") {
+  // rs274: G94 sets the feed rate to 0 (interp_convert.cc convert_feed_mode), even when already in
+  // G94.
   Diagnostic d = error_of("F100\nG94\nG1 X1\n", {}, linuxcnc_at_origin());
   CHECK(d.line == 3);
   CHECK(d.message.find("no feed rate") != std::string::npos);
@@ -122,8 +127,9 @@ TEST_CASE("feed modes: LinuxCNC's errors, with line and column") {
 
 TEST_CASE("feed modes: Fanuc's #4005 and #4109 read the mode and F of the block before") {
   // Each X is read before its block's codes apply: the mode (and F) the previous block left.
-  Result r = run_program("G0 X0 Y0 Z0\nG93 G1 X1 F2\nG1 X#4005 F1\nG95 S10 G1 X#4005 F0.5\nG1 X#4109\n", {},
-                         at_origin());
+  Result r =
+      run_program("G0 X0 Y0 Z0\nG93 G1 X1 F2\nG1 X#4005 F1\nG95 S10 G1 X#4005 F0.5\nG1 X#4109\n",
+                  {}, at_origin());
   REQUIRE(r.moves.size() >= 4);
   CHECK(r.moves[r.moves.size() - 3].end.x == doctest::Approx(93));
   CHECK(r.moves[r.moves.size() - 2].end.x == doctest::Approx(93));

@@ -42,7 +42,8 @@ TEST_CASE("G0/G1 random walk, absolute and incremental, matches an accumulated r
 
 TEST_CASE("units, feed, spindle and tool travel on every move") {
   Result r = run_program(
-      "G20 G90\nT3 M6\nS1000 M3\nG1 X1 Y2 Z-0.5 F10\nM4 S500\nG0 X2\nM5\nT7\nG1 X3\nM6\nG1 X4\nM30\n",
+      "G20 G90\nT3 M6\nS1000 M3\nG1 X1 Y2 Z-0.5 F10\nM4 S500\nG0 X2\nM5\nT7\nG1 X3\nM6\nG1 "
+      "X4\nM30\n",
       {}, at_origin());
   REQUIRE(r.moves.size() == 4);
   CHECK(near(r.moves[0].end, Vec3(25.4, 50.8, -12.7)));
@@ -73,10 +74,10 @@ TEST_CASE("work offsets: table, G54.1 P, G10 L2/L20; output in the G54 frame") {
       {}, at_origin(machine));
   REQUIRE(r.moves.size() == 5);
   CHECK(near(r.moves[0].end, Vec3(1, 1, 1)));
-  CHECK(near(r.moves[1].end, Vec3(101, 11, 1)));        // G55 point, seen from G54
-  CHECK(near(r.moves[2].end, Vec3(-99, 1, -49)));       // G54.1 P7
-  CHECK(near(r.moves[3].end, Vec3(-95, 6, 7)));         // G56 set by G10 L2 P3
-  CHECK(near(r.moves[4].end, Vec3(-100, 0, -60)));      // G10 L20 on the active system
+  CHECK(near(r.moves[1].end, Vec3(101, 11, 1)));    // G55 point, seen from G54
+  CHECK(near(r.moves[2].end, Vec3(-99, 1, -49)));   // G54.1 P7
+  CHECK(near(r.moves[3].end, Vec3(-95, 6, 7)));     // G56 set by G10 L2 P3
+  CHECK(near(r.moves[4].end, Vec3(-100, 0, -60)));  // G10 L20 on the active system
 }
 
 TEST_CASE("program start and home returns: far along the tool axis, approach straight down") {
@@ -87,7 +88,7 @@ TEST_CASE("program start and home returns: far along the tool axis, approach str
   CHECK(near(r.moves[0].start, Vec3(10, 20, 5 + far)));  // the approach from far above
   CHECK(near(r.moves[0].end, Vec3(10, 20, 5)));
   CHECK(near(r.moves[1].end, Vec3(10, 20, -1)));
-  CHECK(near(r.moves[2].start, r.moves[2].end));  // G28's intermediate point: where it is
+  CHECK(near(r.moves[2].start, r.moves[2].end));         // G28's intermediate point: where it is
   CHECK(near(r.moves[3].start, Vec3(50, 50, 3 + far)));  // G28 retracted; X Y stayed far
   CHECK(near(r.moves[3].end, Vec3(50, 50, 3)));
   CHECK(r.warnings.empty());  // Z alone: the top of Z's travel, no guess
@@ -107,13 +108,13 @@ TEST_CASE("G28 X Y with a vertical tool rapids to home X Y; G53 moves in machine
       "G0 X0 Y0 Z10\nG28 X5 Y5\nZ3\nG53 G0 X0 Y0\nG53 Z0\nX1 Y1\nZ2\nG28 Y0\nX0 Y0 Z1\nM30\n",
       InterpreterOptions{}, machine);
   REQUIRE(r.moves.size() == 9);
-  CHECK(near(r.moves[1].end, Vec3(5, 5, 10)));          // intermediate point
-  CHECK(near(r.moves[2].end, Vec3(-110, -120, 10)));    // home X Y (machine -> G54), same height
+  CHECK(near(r.moves[1].end, Vec3(5, 5, 10)));        // intermediate point
+  CHECK(near(r.moves[2].end, Vec3(-110, -120, 10)));  // home X Y (machine -> G54), same height
   CHECK(near(r.moves[3].end, Vec3(-110, -120, 3)));
-  CHECK(near(r.moves[4].end, Vec3(-100, -100, 3)));     // G53 X0 Y0
+  CHECK(near(r.moves[4].end, Vec3(-100, -100, 3)));                     // G53 X0 Y0
   CHECK(near(r.moves[5].start, Vec3(1, 1, 2 + machine.far_distance)));  // after G53 Z: far
-  CHECK(near(r.moves[6].end, Vec3(1, 0, 2)));           // G28 Y0: intermediate point,
-  CHECK(near(r.moves[7].end, Vec3(1, -120, 2)));        // then home Y at the same height
+  CHECK(near(r.moves[6].end, Vec3(1, 0, 2)));     // G28 Y0: intermediate point,
+  CHECK(near(r.moves[7].end, Vec3(1, -120, 2)));  // then home Y at the same height
   CHECK(near(r.moves[8].end, Vec3(0, 0, 1)));
   CHECK(r.warnings.empty());
   Diagnostic d = error_of("G68.2 X0 Y0 Z0 I0 J30 K0\nG53.1\nG0 X0 Y0 Z5\nG53 X0\n");
@@ -159,7 +160,8 @@ TEST_CASE("rejected blocks name line, column and word") {
 TEST_CASE("lenient mode turns unsupported words into warnings and skips them") {
   InterpreterOptions options;
   options.lenient = true;
-  Result r = run_program("G0 X1 Y1 Z1\nG61.1\nG1 X2 F100 E4\nG1 X3 E5\nM30\n", options, at_origin());
+  Result r =
+      run_program("G0 X1 Y1 Z1\nG61.1\nG1 X2 F100 E4\nG1 X3 E5\nM30\n", options, at_origin());
   CHECK(r.moves.size() == 3);
   REQUIRE(r.warnings.size() == 5);  // three skips, then one summary line per kind of word
   CHECK(r.warnings[0].line == 2);
@@ -167,8 +169,8 @@ TEST_CASE("lenient mode turns unsupported words into warnings and skips them") {
   CHECK(r.warnings[4].message.find("skipped 2 × unused word E (lines 3, 4)") != std::string::npos);
   // What would change the path is never skipped: an unknown code beside coordinates, a rotary
   // word, a rotated coordinate system.
-  for (const char* text : {"G0 X1 Y1 Z1\nG16 X2\nM30\n",
-                           "G0 X1 Y1 Z1\nG0 X2 B90\nM30\n", "G10 L2 P1 X0 R30\nM30\n"}) {
+  for (const char* text :
+       {"G0 X1 Y1 Z1\nG16 X2\nM30\n", "G0 X1 Y1 Z1\nG0 X2 B90\nM30\n", "G10 L2 P1 X0 R30\nM30\n"}) {
     Diagnostic d = error_of(text, options, at_origin());
     CAPTURE(d.message);
     CHECK((d.message.find("cannot be skipped") != std::string::npos ||

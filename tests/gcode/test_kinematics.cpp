@@ -18,10 +18,10 @@
 
 using namespace tridex;
 using namespace tridex::gcode;
+using nlohmann::json;
 using tridex::gcode::test::about;
 using tridex::gcode::test::message_of;
 using tridex::gcode::test::near;
-using nlohmann::json;
 
 namespace {
 
@@ -155,7 +155,9 @@ TEST_CASE("every profile: rotary positions -> tool direction -> inverse -> the s
       Vec3 v = tool_direction(kin, r);
       // From the pose itself the nearest solution is the pose.
       RotaryPositions same = orient_tool(kin, v, r);
-      for (int i = 0; i < 3; ++i) CHECK_MESSAGE(same[std::size_t(i)] == doctest::Approx(r[std::size_t(i)]).epsilon(1e-7), name);
+      for (int i = 0; i < 3; ++i)
+        CHECK_MESSAGE(same[std::size_t(i)] == doctest::Approx(r[std::size_t(i)]).epsilon(1e-7),
+                      name);
       // From elsewhere: some pose within the limits with the same direction.
       RotaryPositions from = random_pose(kin, rng);
       RotaryPositions got = orient_tool(kin, v, from);
@@ -283,8 +285,9 @@ TEST_CASE("machine file: a profile name or an object, checked key by key") {
   CHECK_MESSAGE(m.find("\"axes\" is missing") != std::string::npos, m);
   m = error(json::parse(R"({"type": "table-table", "axes": []})"));
   CHECK_MESSAGE(m.find("kinematics.axes") != std::string::npos, m);
-  CHECK(message_of([&] { kinematics_from_json(json(3), "machine.kinematics"); })
-            .find("machine.kinematics") != std::string::npos);
+  CHECK(message_of([&] {
+          kinematics_from_json(json(3), "machine.kinematics");
+        }).find("machine.kinematics") != std::string::npos);
 }
 
 TEST_CASE("travel: the machine file's linear travel and the rotary limits, axis by axis") {
@@ -316,10 +319,13 @@ TEST_CASE("travel: the machine file's linear travel and the rotary limits, axis 
         }
       }
   // A bundled profile with the machine's own travel.
-  Kinematics bc = kinematics_from_json(json::parse(R"({"profile": "bc-trunnion", "travel": {"Y": [-5, 5]}})"));
+  Kinematics bc =
+      kinematics_from_json(json::parse(R"({"profile": "bc-trunnion", "travel": {"Y": [-5, 5]}})"));
   CHECK(bc.axes[0].letter == 'B');
   CHECK(travel_violations(bc, Vec3(0, 6, 0), {0, 0, 0}).size() == 1);
-  auto error = [](const char* text) { return message_of([&] { kinematics_from_json(json::parse(text)); }); };
+  auto error = [](const char* text) {
+    return message_of([&] { kinematics_from_json(json::parse(text)); });
+  };
   std::string m = error(R"({"profile": "bc-trunnion", "travel": {"Z": [1, -1]}})");
   CHECK_MESSAGE(m.find("kinematics.travel.Z") != std::string::npos, m);
   m = error(R"({"profile": "bc-trunnion", "travel": {"W": [1, 2]}})");

@@ -34,9 +34,9 @@ namespace {
 
 struct Point {
   Vec3 p;
-  double tolerance;  // mm
-  int record;        // rs274 output line, or source line for tridex
-  bool chord = false;  // tridex: a chord end inside an arc (see compare_paths)
+  double tolerance;     // mm
+  int record;           // rs274 output line, or source line for tridex
+  bool chord = false;   // tridex: a chord end inside an arc (see compare_paths)
   bool spline = false;  // rs274: a NURBS_FEED, which prints no point
 };
 
@@ -57,21 +57,23 @@ std::vector<double> arguments(const std::string& line, std::size_t open) {
 }
 
 void push(std::vector<Point>& points, const Point& point) {
-  auto last = std::find_if(points.rbegin(), points.rend(), [](const Point& q) { return !q.spline; });
+  auto last =
+      std::find_if(points.rbegin(), points.rend(), [](const Point& q) { return !q.spline; });
   Vec3 previous = last == points.rend() ? Vec3(0.0) : last->p;
   if (glm::length(point.p - previous) > 1e-9) points.push_back(point);
 }
 
 // rs274 run standalone without -t loads its own tool table (the same as LinuxCNC's sample
 // sim.tbl): T1 0.511 in long, T2 0.1 in, T3 1.273 in, T98876 0.1 in. In mm:
-const std::map<int, double> kRs274ToolLengths{{1, 0.511 * 25.4}, {2, 0.1 * 25.4}, {3, 1.273 * 25.4},
-                                              {98876, 0.1 * 25.4}};
+const std::map<int, double> kRs274ToolLengths{
+    {1, 0.511 * 25.4}, {2, 0.1 * 25.4}, {3, 1.273 * 25.4}, {98876, 0.1 * 25.4}};
 
 // `tool_table`: a LinuxCNC tool table for -t (standalone rs274 reads its diameters in inches);
 // `tool_lengths` (mm) the lengths it holds. rs274 prints the controlled point: the tip of a tool
 // as long as the active offset (USE_TOOL_LENGTH_OFFSET, program units). tridex follows the tip of
 // the tool in the spindle (CHANGE_TOOL), which lies (offset − its length) from that point.
-std::vector<Point> run_rs274(const fs::path& program, std::string& log, const fs::path& tool_table = {},
+std::vector<Point> run_rs274(const fs::path& program, std::string& log,
+                             const fs::path& tool_table = {},
                              const std::map<int, double>& tool_lengths = kRs274ToolLengths) {
   fs::path out = fs::temp_directory_path() /
                  ("tridex_rs274_" + std::to_string(::getpid()) + "_" + program.filename().string());
@@ -90,12 +92,12 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log, const fs
   std::ifstream in(out);
   std::vector<Point> points;
   double scale = 1;
-  Vec3 offset(0.0);  // mm, G5x
-  Vec3 local(0.0);   // mm, G92 / G52
+  Vec3 offset(0.0);                             // mm, G5x
+  Vec3 local(0.0);                              // mm, G92 / G52
   double length_offset = 0, loaded_length = 0;  // mm
   Vec3 last_controlled(0.0);
   double last_length_offset = 0;  // at the last point printed
-  char plane = 'Z';  // XY: Z, XZ: Y, YZ: X (the arc's axis)
+  char plane = 'Z';               // XY: Z, XZ: Y, YZ: X (the arc's axis)
   std::string line;
   int record = 0;
   while (std::getline(in, line)) {
@@ -170,7 +172,8 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log, const fs
       last_length_offset = length_offset;
       if (glm::length(controlled - last_controlled) <= 1e-9 && !offset_changed) continue;
       last_controlled = controlled;
-      push(points, Point{controlled + Vec3(0, 0, length_offset - loaded_length), 0.5e-4 * scale + 1e-6, record});
+      push(points, Point{controlled + Vec3(0, 0, length_offset - loaded_length),
+                         0.5e-4 * scale + 1e-6, record});
     }
   }
   fs::remove(out);
@@ -181,8 +184,8 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log, const fs
 
 // `tool_diameters`: the tool table for G41/G42 D (mm). With `chords`, every chord of an arc is a
 // point (marked `chord`, its last one not); without, only the end of each arc.
-std::vector<Point> run_tridex(const fs::path& program, const std::map<int, double>& tool_diameters = {},
-                              bool chords = false,
+std::vector<Point> run_tridex(const fs::path& program,
+                              const std::map<int, double>& tool_diameters = {}, bool chords = false,
                               const std::map<int, double>& tool_lengths = kRs274ToolLengths) {
   InterpreterOptions options;
   options.block_delete = false;  // rs274's block-delete switch is off by default
@@ -223,10 +226,12 @@ std::vector<Point> run_tridex(const fs::path& program, const std::map<int, doubl
 
 std::vector<fs::path> corpus() {
   std::vector<fs::path> files;
-  for (const auto& entry : fs::directory_iterator(fs::path(TRIDEX_TEST_DATA) / "gcode" / "linuxcnc"))
+  for (const auto& entry :
+       fs::directory_iterator(fs::path(TRIDEX_TEST_DATA) / "gcode" / "linuxcnc"))
     if (entry.path().extension() == ".ngc") files.push_back(entry.path());
   // Programs written by others (tests/data/gcode/public: a hobby mill's Fusion 360 output).
-  for (const auto& entry : fs::recursive_directory_iterator(fs::path(TRIDEX_TEST_DATA) / "gcode" / "public"))
+  for (const auto& entry :
+       fs::recursive_directory_iterator(fs::path(TRIDEX_TEST_DATA) / "gcode" / "public"))
     if (entry.path().extension() == ".nc") files.push_back(entry.path());
   std::sort(files.begin(), files.end());
   // LinuxCNC's own sample programs that use only codes both interpreters support.
@@ -243,8 +248,9 @@ std::vector<fs::path> corpus() {
   // Text engraved with G5.1 splines, two tools of different lengths changed between rapids. It
   // is one of linuxcnc-uspace's documentation examples, which an image that leaves out
   // /usr/share/doc does not have.
-  const fs::path tcdemo = "/usr/share/doc/linuxcnc/examples/sample-configs/sim/axis/remap/"
-                          "manual-toolchange-with-tool-length-switch/nc_files/tcdemo.ngc";
+  const fs::path tcdemo =
+      "/usr/share/doc/linuxcnc/examples/sample-configs/sim/axis/remap/"
+      "manual-toolchange-with-tool-length-switch/nc_files/tcdemo.ngc";
   if (fs::exists(tcdemo)) files.push_back(tcdemo);
   return files;
 }
@@ -332,7 +338,8 @@ struct Comparison {
 };
 
 // `ours`: the program tridex reads, when it is not the same (an rs274 refuses words of it).
-Comparison compare_with_rs274(const fs::path& program, int max_reports, const fs::path& ours_program = {}) {
+Comparison compare_with_rs274(const fs::path& program, int max_reports,
+                              const fs::path& ours_program = {}) {
   std::string log;
   std::vector<Point> theirs = run_rs274(program, log);
   std::vector<Point> ours = run_tridex(ours_program.empty() ? program : ours_program);
@@ -349,10 +356,10 @@ Comparison compare_with_rs274(const fs::path& program, int max_reports, const fs
     Vec3 d = glm::abs(ours[j].p - theirs[i].p);
     if (std::max(d.x, std::max(d.y, d.z)) > theirs[i].tolerance) {
       ++reported;
-      FAIL_CHECK("move " << compared << ": tridex (line " << ours[j].record << ") " << ours[j].p.x << " "
-                         << ours[j].p.y << " " << ours[j].p.z << " vs rs274 (record "
-                         << theirs[i].record << ") " << theirs[i].p.x << " " << theirs[i].p.y
-                         << " " << theirs[i].p.z);
+      FAIL_CHECK("move " << compared << ": tridex (line " << ours[j].record << ") " << ours[j].p.x
+                         << " " << ours[j].p.y << " " << ours[j].p.z << " vs rs274 (record "
+                         << theirs[i].record << ") " << theirs[i].p.x << " " << theirs[i].p.y << " "
+                         << theirs[i].p.z);
     }
     ++j;
     ++compared;
@@ -382,10 +389,11 @@ void compare_paths(const fs::path& program, const fs::path& tool_table,
     };
     while (j < ours.size() && !near(ours[j])) {
       if (!ours[j].chord) {
-        FAIL_CHECK("rs274 end point " << i << " (record " << theirs[i].record << ") "
-                   << theirs[i].p.x << " " << theirs[i].p.y << " " << theirs[i].p.z
-                   << ": tridex ends a move (line " << ours[j].record << ") at " << ours[j].p.x
-                   << " " << ours[j].p.y << " " << ours[j].p.z);
+        FAIL_CHECK("rs274 end point "
+                   << i << " (record " << theirs[i].record << ") " << theirs[i].p.x << " "
+                   << theirs[i].p.y << " " << theirs[i].p.z << ": tridex ends a move (line "
+                   << ours[j].record << ") at " << ours[j].p.x << " " << ours[j].p.y << " "
+                   << ours[j].p.z);
         ok = false;
         break;
       }
@@ -424,8 +432,9 @@ std::map<int, double> tbl_diameters(const fs::path& table) {
 // TRIDEX_DIFF_COMP_ONLY=FILE runs one program this way (ad hoc).
 TEST_CASE("differential: LinuxCNC's G41/G42 samples agree with rs274 given a tool table") {
   if (!rs274_available()) {
-    MESSAGE("SKIPPED: rs274 not found (install the Debian package linuxcnc-uspace); the LinuxCNC "
-            "differential test did not run");
+    MESSAGE(
+        "SKIPPED: rs274 not found (install the Debian package linuxcnc-uspace); the LinuxCNC "
+        "differential test did not run");
     return;
   }
   const fs::path table = fs::path(TRIDEX_TEST_DATA) / "gcode" / "linuxcnc" / "sweep_tools.tbl";
@@ -436,8 +445,8 @@ TEST_CASE("differential: LinuxCNC's G41/G42 samples agree with rs274 given a too
     // lathecomp.ngc is a lathe's program, but its codes are a mill's (G18, G41/G42): with this
     // table's mill tools both interpreters offset the path in XZ alike.
     for (const char* name : {"comp.ngc", "comp-g1.ngc", "comp311.ngc", "comp311_2.ngc",
-                             "gmoccapy_2_tools_with_cutter_radius_compensation.ngc", "lathecomp.ngc",
-                             "useful-subroutines.ngc"})
+                             "gmoccapy_2_tools_with_cutter_radius_compensation.ngc",
+                             "lathecomp.ngc", "useful-subroutines.ngc"})
       programs.push_back(fs::path("/usr/share/linuxcnc/ncfiles") / name);
   }
   const std::map<int, double> diameters = tbl_diameters(table);
@@ -451,8 +460,9 @@ TEST_CASE("differential: LinuxCNC's G41/G42 samples agree with rs274 given a too
 
 TEST_CASE("differential: cutter compensation (G41/G42) agrees with rs274") {
   if (!rs274_available()) {
-    MESSAGE("SKIPPED: rs274 not found (install the Debian package linuxcnc-uspace); the LinuxCNC "
-            "differential test did not run");
+    MESSAGE(
+        "SKIPPED: rs274 not found (install the Debian package linuxcnc-uspace); the LinuxCNC "
+        "differential test did not run");
     return;
   }
   fs::path folder = fs::path(TRIDEX_TEST_DATA) / "gcode" / "linuxcnc" / "comp";
@@ -471,15 +481,16 @@ TEST_CASE("differential: cutter compensation (G41/G42) agrees with rs274") {
 
 TEST_CASE("differential: random programs agree with rs274") {
   if (!rs274_available()) {
-    MESSAGE("SKIPPED: rs274 not found (install the Debian package linuxcnc-uspace); the LinuxCNC "
-            "differential test did not run");
+    MESSAGE(
+        "SKIPPED: rs274 not found (install the Debian package linuxcnc-uspace); the LinuxCNC "
+        "differential test did not run");
     return;
   }
   std::mt19937_64 rng(31);
   std::size_t compared = 0;
   for (int trial = 0; trial < 30; ++trial) {
-    fs::path program = fs::temp_directory_path() /
-                       ("tridex_random_" + std::to_string(::getpid()) + "_" + std::to_string(trial) + ".ngc");
+    fs::path program = fs::temp_directory_path() / ("tridex_random_" + std::to_string(::getpid()) +
+                                                    "_" + std::to_string(trial) + ".ngc");
     {
       std::ofstream out(program);
       out << random_program(rng);
@@ -494,8 +505,9 @@ TEST_CASE("differential: random programs agree with rs274") {
 
 TEST_CASE("differential: LinuxCNC rs274 and tridex agree on every move end point") {
   if (!rs274_available()) {
-    MESSAGE("SKIPPED: rs274 not found (install the Debian package linuxcnc-uspace); the LinuxCNC "
-            "differential test did not run");
+    MESSAGE(
+        "SKIPPED: rs274 not found (install the Debian package linuxcnc-uspace); the LinuxCNC "
+        "differential test did not run");
     return;
   }
   for (const fs::path& program : corpus()) {
@@ -514,8 +526,9 @@ TEST_CASE("differential: LinuxCNC rs274 and tridex agree on every move end point
 // not copied here) and run with that one block split.
 TEST_CASE("differential: skeleton.ngc's tool length offset agrees with rs274") {
   if (!rs274_available()) {
-    MESSAGE("SKIPPED: rs274 not found (install the Debian package linuxcnc-uspace); the LinuxCNC "
-            "differential test did not run");
+    MESSAGE(
+        "SKIPPED: rs274 not found (install the Debian package linuxcnc-uspace); the LinuxCNC "
+        "differential test did not run");
     return;
   }
   const fs::path installed = "/usr/share/linuxcnc/ncfiles/skeleton.ngc";
@@ -526,7 +539,8 @@ TEST_CASE("differential: skeleton.ngc's tool length offset agrees with rs274") {
   std::size_t at = text.find(block);
   REQUIRE(at != std::string::npos);
   text.replace(at, block.size(), "T1 M06\nG43 H1");
-  fs::path program = fs::temp_directory_path() / ("tridex_skeleton_" + std::to_string(::getpid()) + ".ngc");
+  fs::path program =
+      fs::temp_directory_path() / ("tridex_skeleton_" + std::to_string(::getpid()) + ".ngc");
   {
     std::ofstream out(program);
     out << text;
@@ -547,13 +561,16 @@ TEST_CASE("differential: skeleton.ngc's tool length offset agrees with rs274") {
 // of the feed blocks of feed_modes.ngc (one STRAIGHT_FEED or ARC_FEED each) are compared in order.
 TEST_CASE("differential: feed rates in G93, G94 and G95 agree with rs274") {
   if (!rs274_available()) {
-    MESSAGE("SKIPPED: rs274 not found (install the Debian package linuxcnc-uspace); the LinuxCNC "
-            "differential test did not run");
+    MESSAGE(
+        "SKIPPED: rs274 not found (install the Debian package linuxcnc-uspace); the LinuxCNC "
+        "differential test did not run");
     return;
   }
   const fs::path program = fs::path(TRIDEX_TEST_DATA) / "gcode" / "linuxcnc" / "feed_modes.ngc";
-  const fs::path out = fs::temp_directory_path() / ("tridex_rs274_feeds_" + std::to_string(::getpid()));
-  std::string command = "rs274 -g '" + program.string() + "' '" + out.string() + "' < /dev/null > /dev/null 2>&1";
+  const fs::path out =
+      fs::temp_directory_path() / ("tridex_rs274_feeds_" + std::to_string(::getpid()));
+  std::string command =
+      "rs274 -g '" + program.string() + "' '" + out.string() + "' < /dev/null > /dev/null 2>&1";
   (void)std::system(command.c_str());
   std::vector<std::pair<double, double>> theirs;  // mm/min, tolerance
   {
@@ -564,11 +581,16 @@ TEST_CASE("differential: feed rates in G93, G94 and G95 agree with rs274") {
       std::size_t at;
       if (line.find("USE_LENGTH_UNITS(CANON_UNITS_INCHES") != std::string::npos) scale = 25.4;
       if (line.find("USE_LENGTH_UNITS(CANON_UNITS_MM") != std::string::npos) scale = 1;
-      if ((at = line.find("SET_FEED_MODE(")) != std::string::npos) per_rev = arguments(line, line.find('(', at)).at(1) == 1;
-      if ((at = line.find("SET_FEED_RATE(")) != std::string::npos) rate = arguments(line, line.find('(', at)).at(0);
-      if ((at = line.find("SET_SPINDLE_SPEED(")) != std::string::npos) speed = arguments(line, line.find('(', at)).at(1);
-      if (line.find("STRAIGHT_FEED(") != std::string::npos || line.find("ARC_FEED(") != std::string::npos)
-        theirs.emplace_back(rate * scale * (per_rev ? speed : 1), 0.5e-4 * scale * (per_rev ? speed : 1) + 1e-6);
+      if ((at = line.find("SET_FEED_MODE(")) != std::string::npos)
+        per_rev = arguments(line, line.find('(', at)).at(1) == 1;
+      if ((at = line.find("SET_FEED_RATE(")) != std::string::npos)
+        rate = arguments(line, line.find('(', at)).at(0);
+      if ((at = line.find("SET_SPINDLE_SPEED(")) != std::string::npos)
+        speed = arguments(line, line.find('(', at)).at(1);
+      if (line.find("STRAIGHT_FEED(") != std::string::npos ||
+          line.find("ARC_FEED(") != std::string::npos)
+        theirs.emplace_back(rate * scale * (per_rev ? speed : 1),
+                            0.5e-4 * scale * (per_rev ? speed : 1) + 1e-6);
     }
   }
   fs::remove(out);
@@ -598,8 +620,9 @@ TEST_CASE("differential: feed rates in G93, G94 and G95 agree with rs274") {
 // reads it whole, and its X/Y/Z must not move for them.
 TEST_CASE("differential: cone.ngc's W axis moves no X/Y/Z, as rs274 without its W words") {
   if (!rs274_available()) {
-    MESSAGE("SKIPPED: rs274 not found (install the Debian package linuxcnc-uspace); the LinuxCNC "
-            "differential test did not run");
+    MESSAGE(
+        "SKIPPED: rs274 not found (install the Debian package linuxcnc-uspace); the LinuxCNC "
+        "differential test did not run");
     return;
   }
   const fs::path installed = "/usr/share/linuxcnc/ncfiles/cone.ngc";
@@ -609,10 +632,11 @@ TEST_CASE("differential: cone.ngc's W axis moves no X/Y/Z, as rs274 without its 
   std::size_t removed = 0;
   for (std::size_t at = 0; (at = text.find_first_of("wW", at)) != std::string::npos;) {
     std::size_t end = at + 1;
-    while (end < text.size() && (std::isdigit(static_cast<unsigned char>(text[end])) || text[end] == '.' ||
-                                 text[end] == '-'))
+    while (end < text.size() && (std::isdigit(static_cast<unsigned char>(text[end])) ||
+                                 text[end] == '.' || text[end] == '-'))
       ++end;
-    bool word = end > at + 1 && (at == 0 || !std::isalpha(static_cast<unsigned char>(text[at - 1])));
+    bool word =
+        end > at + 1 && (at == 0 || !std::isalpha(static_cast<unsigned char>(text[at - 1])));
     if (!word) {
       at = end;
       continue;
@@ -621,7 +645,8 @@ TEST_CASE("differential: cone.ngc's W axis moves no X/Y/Z, as rs274 without its 
     ++removed;
   }
   REQUIRE(removed == 2);
-  fs::path stripped = fs::temp_directory_path() / ("tridex_cone_" + std::to_string(::getpid()) + ".ngc");
+  fs::path stripped =
+      fs::temp_directory_path() / ("tridex_cone_" + std::to_string(::getpid()) + ".ngc");
   {
     std::ofstream out(stripped);
     out << text;

@@ -55,7 +55,7 @@ TEST_CASE("macros: each operator and function against hand-computed values") {
   CHECK(value_of("10-4-3") == 3);     // left-associative
   CHECK(value_of("10/4") == 2.5);
   CHECK(value_of("7 MOD 3") == 1);
-  CHECK(value_of("-7 MOD 3") == 2);   // rs274ngc: the result is not negative
+  CHECK(value_of("-7 MOD 3") == 2);  // rs274ngc: the result is not negative
   CHECK(value_of("1 EQ 1.00001") == 1);
   CHECK(value_of("1 NE 1.001") == 1);
   CHECK(value_of("3 GT 2 AND 1 LT 0") == 0);
@@ -91,16 +91,20 @@ TEST_CASE("macros: parameters, indirection, named parameters and the vacant valu
   // LinuxCNC: settings on a line take effect after the line is read.
   r = run_program("#1 = 1\n#1 = 2 #2 = #1\nG0 X#1 Y#2 Z0\nM30\n", {}, dialect(Dialect::linuxcnc));
   CHECK(near(r.moves[0].end, Vec3(2, 1, 0)));
-  r = run_program("#<depth> = -2\n#<_safe> = 5\nG0 X EXISTS[#<depth>] Y EXISTS[#<nope>] Z[#<_safe> + #<depth>]\nM30\n",
-                  {}, dialect(Dialect::linuxcnc));
+  r = run_program(
+      "#<depth> = -2\n#<_safe> = 5\nG0 X EXISTS[#<depth>] Y EXISTS[#<nope>] Z[#<_safe> + "
+      "#<depth>]\nM30\n",
+      {}, dialect(Dialect::linuxcnc));
   CHECK(near(r.moves[0].end, Vec3(1, 0, 3)));
   // Fanuc: a word whose value is vacant is left out; vacant is 0 in arithmetic and only EQ #0.
-  r = run_program("G0 X1 Y2 Z3\n#5 = #0\nG0 X#5 Y[#5 + 4] Z[#5 EQ #0]\nM30\n", {}, dialect(Dialect::fanuc));
+  r = run_program("G0 X1 Y2 Z3\n#5 = #0\nG0 X#5 Y[#5 + 4] Z[#5 EQ #0]\nM30\n", {},
+                  dialect(Dialect::fanuc));
   REQUIRE(r.moves.size() == 2);
   CHECK(near(r.moves[1].end, Vec3(1, 4, 1)));
   CHECK(value_of("0 EQ #0") == 0);
   // A feed left out for a vacant value (a persistent common the machine holds) is named.
-  CHECK(error_of("G0 X0 Y0 Z5\nG1 Z0 F#650\n").message.find("F#650 was left out") != std::string::npos);
+  CHECK(error_of("G0 X0 Y0 Z5\nG1 Z0 F#650\n").message.find("F#650 was left out") !=
+        std::string::npos);
   // LinuxCNC reads the same word as 0.
   r = run_program("G0 X1 Y2 Z3\nG0 X#5\nM30\n", {}, dialect(Dialect::linuxcnc));
   CHECK(near(r.moves[1].end, Vec3(0, 2, 3)));
@@ -121,7 +125,8 @@ TEST_CASE("macros: random expressions agree with a reference evaluation of the s
     int left = -1, right = -1;
   };
   // Precedence (LinuxCNC's): ** 5; * / MOD 4; + - 3; comparisons 2; AND OR XOR 1.
-  const char* names[] = {"**", "*", "/", "MOD", "+", "-", "EQ", "NE", "GT", "GE", "LT", "LE", "AND", "OR", "XOR"};
+  const char* names[] = {"**", "*",  "/",  "MOD", "+",   "-",  "EQ", "NE",
+                         "GT", "GE", "LT", "LE",  "AND", "OR", "XOR"};
   const int prec[] = {5, 4, 4, 4, 3, 3, 2, 2, 2, 2, 2, 2, 1, 1, 1};
   for (int trial = 0; trial < 400; ++trial) {
     std::vector<Node> nodes;
@@ -145,25 +150,39 @@ TEST_CASE("macros: random expressions agree with a reference evaluation of the s
       double a = eval(n.left), b = eval(n.right);
       if (std::isnan(a) || std::isnan(b)) return std::nan("");  // an error anywhere fails it all
       switch (n.op) {
-        case 0: return std::pow(a, b);
-        case 1: return a * b;
-        case 2: return b == 0 ? NAN : a / b;
+        case 0:
+          return std::pow(a, b);
+        case 1:
+          return a * b;
+        case 2:
+          return b == 0 ? NAN : a / b;
         case 3: {
           if (b == 0) return std::nan("");
           double r = std::fmod(a, b);
           return r < 0 ? r + std::abs(b) : r;
         }
-        case 4: return a + b;
-        case 5: return a - b;
-        case 6: return std::abs(a - b) < 1e-4 ? 1.0 : 0.0;
-        case 7: return std::abs(a - b) < 1e-4 ? 0.0 : 1.0;
-        case 8: return a > b ? 1.0 : 0.0;
-        case 9: return a >= b ? 1.0 : 0.0;
-        case 10: return a < b ? 1.0 : 0.0;
-        case 11: return a <= b ? 1.0 : 0.0;
-        case 12: return a != 0 && b != 0 ? 1.0 : 0.0;
-        case 13: return a != 0 || b != 0 ? 1.0 : 0.0;
-        default: return (a != 0) != (b != 0) ? 1.0 : 0.0;
+        case 4:
+          return a + b;
+        case 5:
+          return a - b;
+        case 6:
+          return std::abs(a - b) < 1e-4 ? 1.0 : 0.0;
+        case 7:
+          return std::abs(a - b) < 1e-4 ? 0.0 : 1.0;
+        case 8:
+          return a > b ? 1.0 : 0.0;
+        case 9:
+          return a >= b ? 1.0 : 0.0;
+        case 10:
+          return a < b ? 1.0 : 0.0;
+        case 11:
+          return a <= b ? 1.0 : 0.0;
+        case 12:
+          return a != 0 && b != 0 ? 1.0 : 0.0;
+        case 13:
+          return a != 0 || b != 0 ? 1.0 : 0.0;
+        default:
+          return (a != 0) != (b != 0) ? 1.0 : 0.0;
       }
     };
     // Brackets only where precedence needs them (and at random elsewhere).
@@ -172,8 +191,8 @@ TEST_CASE("macros: random expressions agree with a reference evaluation of the s
       if (n.op < 0) return cat(n.value);
       std::string text = cat(print(n.left, prec[n.op], false), " ", names[n.op], " ",
                              print(n.right, prec[n.op], true));
-      bool needed = prec[n.op] < parent || (prec[n.op] == parent && right) ||
-                    (parent == 5 && !right);
+      bool needed =
+          prec[n.op] < parent || (prec[n.op] == parent && right) || (parent == 5 && !right);
       return needed || rng() % 4 == 0 ? "[" + text + "]" : text;
     };
     double expected = eval(root);
@@ -192,38 +211,51 @@ TEST_CASE("macros: Fanuc control flow gives the moves of the same program writte
   same_moves("#1 = 0\nWHILE [#1 LT 3] DO1\nG0 X#1 Y0 Z0\n#1 = #1 + 1\nEND1\nM30\n",
              "G0 X0 Y0 Z0\nG0 X1\nG0 X2\nM30\n");
   // Nested loops, a counted GOTO loop backwards, a forward IF GOTO past a block.
-  same_moves("#1 = 0\nWHILE [#1 LT 2] DO1\n#2 = 0\nWHILE [#2 LT 2] DO2\nG0 X#1 Y#2 Z0\n#2 = #2 + 1\n"
-             "END2\n#1 = #1 + 1\nEND1\nM30\n",
-             "G0 X0 Y0 Z0\nY1\nX1 Y0\nY1\nM30\n");
-  same_moves("#1 = 3\nN10 G0 X#1 Y0 Z0\n#1 = #1 - 1\nIF [#1 GT 0] GOTO 10\nIF [1] GOTO 30\nG0 X99\nN30 G0 Z5\nM30\n",
-             "G0 X3 Y0 Z0\nX2\nX1\nZ5\nM30\n");
+  same_moves(
+      "#1 = 0\nWHILE [#1 LT 2] DO1\n#2 = 0\nWHILE [#2 LT 2] DO2\nG0 X#1 Y#2 Z0\n#2 = #2 + 1\n"
+      "END2\n#1 = #1 + 1\nEND1\nM30\n",
+      "G0 X0 Y0 Z0\nY1\nX1 Y0\nY1\nM30\n");
+  same_moves(
+      "#1 = 3\nN10 G0 X#1 Y0 Z0\n#1 = #1 - 1\nIF [#1 GT 0] GOTO 10\nIF [1] GOTO 30\nG0 X99\nN30 G0 "
+      "Z5\nM30\n",
+      "G0 X3 Y0 Z0\nX2\nX1\nZ5\nM30\n");
   same_moves("#1 = 1\nIF [#1 EQ 1] THEN #2 = 5\nIF [#1 EQ 2] THEN #2 = 6\nG0 X#2 Y0 Z0\nM30\n",
              "G0 X5 Y0 Z0\nM30\n");
   // A false WHILE skips to its END; DO without WHILE runs until a GOTO leaves it.
-  same_moves("WHILE [0] DO1\nG0 X9 Y9 Z9\nEND1\n#1 = 0\nDO2\n#1 = #1 + 1\nG0 X#1 Y0 Z0\nIF [#1 GE 2] GOTO 5\nEND2\nN5 M30\n",
-             "G0 X1 Y0 Z0\nX2\nM30\n");
+  same_moves(
+      "WHILE [0] DO1\nG0 X9 Y9 Z9\nEND1\n#1 = 0\nDO2\n#1 = #1 + 1\nG0 X#1 Y0 Z0\nIF [#1 GE 2] GOTO "
+      "5\nEND2\nN5 M30\n",
+      "G0 X1 Y0 Z0\nX2\nM30\n");
   // G65: arguments become locals of a new level; the caller's locals are untouched.
-  same_moves("#1 = 100\nG65 P9000 A1 B2 X3 L2\nG0 X#1 Y0 Z0\nM30\nO9000\nG0 X[#1 + #2] Y#24 Z#3\n#1 = 50\nM99\n",
-             "G0 X3 Y3 Z0\nG0 X3 Y3 Z0\nG0 X100 Y0 Z0\nM30\n");
+  same_moves(
+      "#1 = 100\nG65 P9000 A1 B2 X3 L2\nG0 X#1 Y0 Z0\nM30\nO9000\nG0 X[#1 + #2] Y#24 Z#3\n#1 = "
+      "50\nM99\n",
+      "G0 X3 Y3 Z0\nG0 X3 Y3 Z0\nG0 X100 Y0 Z0\nM30\n");
   // M, S and T are arguments in a G65 block (#13, #19, #20), not codes.
-  same_moves("G65 P9100 M0.07 T13.16 S5.\nM30\nO9100\nG0 X#13 Y#20 Z#19\nM99\n", "G0 X0.07 Y13.16 Z5\nM30\n");
+  same_moves("G65 P9100 M0.07 T13.16 S5.\nM30\nO9100\nG0 X#13 Y#20 Z#19\nM99\n",
+             "G0 X0.07 Y13.16 Z5\nM30\n");
 }
 
 TEST_CASE("macros: LinuxCNC o-words give the moves of the same program written out") {
   Dialect l = Dialect::linuxcnc;
   same_moves("o100 sub\nG0 X#1 Y#2 Z0\no100 endsub\no100 call [1] [2]\no100 call [3] [4]\nM2\n",
              "G0 X1 Y2 Z0\nG0 X3 Y4 Z0\nM2\n", l);
-  same_moves("#1 = 2\no1 if [#1 EQ 1]\nG0 X1 Y0 Z0\no1 elseif [#1 EQ 2]\nG0 X2 Y0 Z0\no1 else\nG0 X3 Y0 Z0\no1 endif\nM2\n",
-             "G0 X2 Y0 Z0\nM2\n", l);
+  same_moves(
+      "#1 = 2\no1 if [#1 EQ 1]\nG0 X1 Y0 Z0\no1 elseif [#1 EQ 2]\nG0 X2 Y0 Z0\no1 else\nG0 X3 Y0 "
+      "Z0\no1 endif\nM2\n",
+      "G0 X2 Y0 Z0\nM2\n", l);
   same_moves("#1 = 0\no2 while [#1 LT 3]\nG0 X#1 Y0 Z0\n#1 = [#1 + 1]\no2 endwhile\nM2\n",
              "G0 X0 Y0 Z0\nX1\nX2\nM2\n", l);
   same_moves("#1 = 0\no3 do\nG0 X#1 Y0 Z0\n#1 = [#1 + 1]\no3 while [#1 LT 2]\nM2\n",
              "G0 X0 Y0 Z0\nX1\nM2\n", l);
-  same_moves("#1 = 0\no4 repeat [5]\n#1 = [#1 + 1]\no5 if [#1 EQ 2]\no4 continue\no5 endif\n"
-             "o6 if [#1 EQ 4]\no4 break\no6 endif\nG0 X#1 Y0 Z0\no4 endrepeat\nM2\n",
-             "G0 X1 Y0 Z0\nX3\nM2\n", l);
-  same_moves("o<twice> sub\no<twice> return [#1 * 2]\no<twice> endsub\no<twice> call [21]\nG0 X#<_value> Y0 Z0\nM2\n",
-             "G0 X42 Y0 Z0\nM2\n", l);
+  same_moves(
+      "#1 = 0\no4 repeat [5]\n#1 = [#1 + 1]\no5 if [#1 EQ 2]\no4 continue\no5 endif\n"
+      "o6 if [#1 EQ 4]\no4 break\no6 endif\nG0 X#1 Y0 Z0\no4 endrepeat\nM2\n",
+      "G0 X1 Y0 Z0\nX3\nM2\n", l);
+  same_moves(
+      "o<twice> sub\no<twice> return [#1 * 2]\no<twice> endsub\no<twice> call [21]\nG0 X#<_value> "
+      "Y0 Z0\nM2\n",
+      "G0 X42 Y0 Z0\nM2\n", l);
   // A numbered subroutine defined after its call, read ahead as rs274 finds it (interp_o_word.cc
   // control_back_to: "skip to the o_word"); `o100 sub` was taken for a Fanuc program number O100,
   // so the call found no subroutine.
@@ -231,8 +263,9 @@ TEST_CASE("macros: LinuxCNC o-words give the moves of the same program written o
   same_moves("o100 call\nG0 X3 Y0 Z0\nM2\no100 sub (a comment)\nG0 X2 Y0 Z0\no100 endsub\n",
              "G0 X2 Y0 Z0\nX3\nM2\n", l);
   // Named locals belong to the call; globals are shared.
-  same_moves("o10 sub\n#<a> = 7\n#<_g> = 8\no10 endsub\n#<a> = 1\no10 call\nG0 X#<a> Y#<_g> Z0\nM2\n",
-             "G0 X1 Y8 Z0\nM2\n", l);
+  same_moves(
+      "o10 sub\n#<a> = 7\n#<_g> = 8\no10 endsub\n#<a> = 1\no10 call\nG0 X#<a> Y#<_g> Z0\nM2\n",
+      "G0 X1 Y8 Z0\nM2\n", l);
 }
 
 // LinuxCNC's #5410: the loaded tool's diameter as its tool table holds it, in the table's units
@@ -252,7 +285,8 @@ TEST_CASE("macros: LinuxCNC's #5410 is the loaded tool's diameter in the tool ta
   CHECK(x_of("G21 G90\nT1 M6\nG0 X#5410 Y0 Z0\nM2\n") == doctest::Approx(0.125));
   CHECK(x_of("G20 G90\nT1 M6\nG0 X#5410 Y0 Z0\nM2\n") == doctest::Approx(0.125 * 25.4));
   // G10 L1 rewrites the loaded tool's entry, and #5410 with it (rs274: R0.5 mm, 0.0394 in).
-  CHECK(x_of("G21 G90\nT1 M6\nG10 L1 P1 R0.5\nG0 X#5410 Y0 Z0\nM2\n") == doctest::Approx(1.0 / 25.4));
+  CHECK(x_of("G21 G90\nT1 M6\nG10 L1 P1 R0.5\nG0 X#5410 Y0 Z0\nM2\n") ==
+        doctest::Approx(1.0 / 25.4));
   // A machine whose table is in mm (LinuxCNC's LINEAR_UNITS = mm) holds millimetres.
   m.tool_table_in_inches = false;
   CHECK(x_of("G21 G90\nT2 M6\nG0 X#5410 Y0 Z0\nM2\n") == doctest::Approx(6.0));
@@ -277,12 +311,13 @@ TEST_CASE("macros: subprogram files are found by name, or by the O number they s
   CHECK(near(r.moves[0].end, Vec3(4, 5, 1)));
   CHECK(near(r.moves[2].end, Vec3(3, 3, 2)));
   // Each move names its file (an index into Interpreter::files()) and its line in that file.
-  CHECK((r.moves[0].file == 1 && r.moves[0].line == 3 && r.moves[1].file == 1 && r.moves[2].file == 2 &&
-         r.moves[2].line == 2));
+  CHECK((r.moves[0].file == 1 && r.moves[0].line == 3 && r.moves[1].file == 1 &&
+         r.moves[2].file == 2 && r.moves[2].line == 2));
   Interpreter interpreter({}, m);
   std::istringstream program("G0 X0 Y0 Z0\no<corner> call [3]\nM98 P9810\nG0 X1\nM30\n");
   std::vector<std::pair<int, int>> places;
-  interpreter.run(program, "main.nc", [&](const Move& move) { places.emplace_back(move.file, move.line); });
+  interpreter.run(program, "main.nc",
+                  [&](const Move& move) { places.emplace_back(move.file, move.line); });
   CHECK(places == std::vector<std::pair<int, int>>{{0, 1}, {1, 2}, {2, 3}, {0, 4}});
   REQUIRE(interpreter.files().size() == 3);
   CHECK(interpreter.files()[0] == "main.nc");
@@ -326,8 +361,9 @@ TEST_CASE("macros: bad input is an error at its line and column") {
   CHECK(error_of("END1\n", {}, m).message.find("END 1") != std::string::npos);
   CHECK(error_of("GOTO 50\nM30\n", {}, m).message.find("N50") != std::string::npos);
   CHECK(error_of("WHILE [0] DO1\nG0 X1 Y1 Z1\n", {}, m).message.find("END 1") != std::string::npos);
-  CHECK(error_of("o1 if [0]\nG0 X1 Y1 Z1\n", {}, dialect(Dialect::linuxcnc)).message.find("endif") !=
-        std::string::npos);
+  CHECK(
+      error_of("o1 if [0]\nG0 X1 Y1 Z1\n", {}, dialect(Dialect::linuxcnc)).message.find("endif") !=
+      std::string::npos);
   // LinuxCNC's own nestedcall.ngc says `o<g20sub> callsub`: rs274 refuses it too ("Unexpected
   // character after O-word"). The keyword is the whole word, named in the message.
   d = error_of("o<g20sub> callsub\n", {}, dialect(Dialect::linuxcnc));

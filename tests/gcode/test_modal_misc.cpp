@@ -11,7 +11,8 @@ using namespace tridex::gcode::test;
 
 TEST_CASE("codes without effect on the path are accepted; stops and dwells move nothing") {
   Result r = run_program(
-      "%\nO42 (name)\nN1 G15 G40 G49 G61 G80 G94 G97 G91.1\nG64 P0.01 Q0.01\nG0 X0 Y0 Z5\nM0\nM1\nM8\nM7\n"
+      "%\nO42 (name)\nN1 G15 G40 G49 G61 G80 G94 G97 G91.1\nG64 P0.01 Q0.01\nG0 X0 Y0 "
+      "Z5\nM0\nM1\nM8\nM7\n"
       "M9\nG4 P1.5\nG4 X2\nG44 H3\nG43 H1\nG49\nG1 X1 F10\nM30\n%\nG0 X99\n",
       {}, at_origin());
   REQUIRE(r.moves.size() == 2);
@@ -36,12 +37,13 @@ TEST_CASE("block delete: skipped by default, executed when the switch is off") {
 }
 
 TEST_CASE("G53.6 orients like G53.1; G269 cancels G268; G69 cancels G68.2") {
-  Result r = run_program("G68.2 X0 Y0 Z0 I0 J90 K0\nG53.6\nG0 X0 Y0 Z3\nG69\nG0 X1 Y-3 Z0\n"
-                         "G268 X0 Y0 Z0 I0 J90 K0 Q123\nG253\nG0 X0 Y0 Z2\nG269\nG0 X2 Y0 Z0\nM30\n");
+  Result r = run_program(
+      "G68.2 X0 Y0 Z0 I0 J90 K0\nG53.6\nG0 X0 Y0 Z3\nG69\nG0 X1 Y-3 Z0\n"
+      "G268 X0 Y0 Z0 I0 J90 K0 Q123\nG253\nG0 X0 Y0 Z2\nG269\nG0 X2 Y0 Z0\nM30\n");
   REQUIRE(r.moves.size() == 4);
   CHECK(near(r.moves[0].axis, Vec3(0, -1, 0), 1e-12));
   CHECK(near(r.moves[0].end, Vec3(0, -3, 0), 1e-9));
-  CHECK(near(r.moves[1].end, Vec3(1, -3, 0), 1e-9));  // G69: work coordinates again
+  CHECK(near(r.moves[1].end, Vec3(1, -3, 0), 1e-9));   // G69: work coordinates again
   CHECK(near(r.moves[2].axis, Vec3(1, 0, 0), 1e-12));  // Ry(90)·z = +X
   CHECK(near(r.moves[2].end, Vec3(2, 0, 0), 1e-9));
   CHECK(near(r.moves[3].end, Vec3(2, 0, 0), 1e-9));
@@ -55,18 +57,21 @@ TEST_CASE("LinuxCNC: G53.1, G53.3 and G53.6 leave G0 the motion mode; Fanuc's ke
   linuxcnc.dialect = Dialect::linuxcnc;
   for (const char* orient : {"G53.1", "G53.6", "G53.3 X0 Y0 Z30"}) {
     CAPTURE(orient);
-    Result r = run_program(std::string("G21 G90 G0 X0 Y0 Z50\nG1 X1 F100\nG68.2 X10 Y0 Z0 Q121 I0 J90\n") + orient +
-                               "\nX5 Y5 Z20\nG1 X6\nM2\n",
-                           InterpreterOptions{}, linuxcnc);
+    Result r =
+        run_program(std::string("G21 G90 G0 X0 Y0 Z50\nG1 X1 F100\nG68.2 X10 Y0 Z0 Q121 I0 J90\n") +
+                        orient + "\nX5 Y5 Z20\nG1 X6\nM2\n",
+                    InterpreterOptions{}, linuxcnc);
     const Move& bare = r.moves[r.moves.size() - 2];
     CHECK(bare.kind == MoveKind::rapid);
-    CHECK(near(bare.axis, Vec3(1, 0, 0), 1e-12));       // Q121 J90: the tool along +X
-    // Ry(90°) takes the plane's x, y, z to −Z, +Y, +X: (5, 5, 20) lands at (10, 0, 0) + (20, 5, −5).
+    CHECK(near(bare.axis, Vec3(1, 0, 0), 1e-12));  // Q121 J90: the tool along +X
+    // Ry(90°) takes the plane's x, y, z to −Z, +Y, +X: (5, 5, 20) lands at (10, 0, 0) + (20, 5,
+    // −5).
     CHECK(near(bare.end, Vec3(30, 5, -5), 1e-9));
     CHECK(r.moves.back().kind == MoveKind::feed);
   }
   // Fanuc's G53.1 is no motion code: the G1 before it goes on.
-  Result fanuc = run_program("G21 G90 G0 X0 Y0 Z50\nG1 X1 F100\nG68.2 X10 Y0 Z0 I0 J90 K0\nG53.1\nX5 Y5 Z20\nM30\n");
+  Result fanuc = run_program(
+      "G21 G90 G0 X0 Y0 Z50\nG1 X1 F100\nG68.2 X10 Y0 Z0 I0 J90 K0\nG53.1\nX5 Y5 Z20\nM30\n");
   CHECK(fanuc.moves.back().kind == MoveKind::feed);
 }
 

@@ -21,13 +21,16 @@ Move numbered(int n) {
   return m;
 }
 
-bool same(const Move& a, const Move& b) { return a.line == b.line && a.tool == b.tool && a.end == b.end; }
+bool same(const Move& a, const Move& b) {
+  return a.line == b.line && a.tool == b.tool && a.end == b.end;
+}
 
 void check_same(const MoveList& list, const std::vector<Move>& reference) {
   REQUIRE(list.size() == reference.size());
   CHECK(list.empty() == reference.empty());
   bool indexed = true, walked = true;
-  for (std::size_t i = 0; i < reference.size(); ++i) indexed = indexed && same(list[i], reference[i]);
+  for (std::size_t i = 0; i < reference.size(); ++i)
+    indexed = indexed && same(list[i], reference[i]);
   std::size_t i = 0;
   for (const Move& m : list) walked = walked && same(m, reference[i++]);
   CHECK(indexed);
@@ -46,9 +49,10 @@ TEST_CASE("MoveList: the same moves as a vector, whatever the size") {
   std::mt19937 random(11);
   // Past the doubling chunks (130,816 moves) and one more full chunk, then sizes around the
   // chunk boundaries and small ones.
-  for (std::size_t size : {std::size_t{0}, std::size_t{1}, std::size_t{255}, std::size_t{256}, std::size_t{257},
-                           std::size_t{767}, std::size_t{768}, std::size_t{130815}, std::size_t{130816},
-                           std::size_t{130817}, std::size_t{130816 + 65536 + 3}}) {
+  for (std::size_t size :
+       {std::size_t{0}, std::size_t{1}, std::size_t{255}, std::size_t{256}, std::size_t{257},
+        std::size_t{767}, std::size_t{768}, std::size_t{130815}, std::size_t{130816},
+        std::size_t{130817}, std::size_t{130816 + 65536 + 3}}) {
     CAPTURE(size);
     MoveList list;
     std::vector<Move> reference;
@@ -66,7 +70,8 @@ TEST_CASE("MoveList: the same moves as a vector, whatever the size") {
       const std::size_t a = pick(random), b = pick(random);
       MoveList::const_iterator it = list.begin() + static_cast<std::ptrdiff_t>(a);
       it += static_cast<std::ptrdiff_t>(b) - static_cast<std::ptrdiff_t>(a);
-      jumped = jumped && same(*it, reference[b]) && it - list.begin() == static_cast<std::ptrdiff_t>(b);
+      jumped =
+          jumped && same(*it, reference[b]) && it - list.begin() == static_cast<std::ptrdiff_t>(b);
       if (b > 0) {
         --it;
         jumped = jumped && same(*it, reference[b - 1]);
@@ -76,7 +81,8 @@ TEST_CASE("MoveList: the same moves as a vector, whatever the size") {
     std::vector<Move> backwards(reference.rbegin(), reference.rend());
     std::vector<Move> walked_back;
     for (auto it = list.end(); it != list.begin();) walked_back.push_back(*--it);
-    CHECK(std::equal(walked_back.begin(), walked_back.end(), backwards.begin(), backwards.end(), same));
+    CHECK(std::equal(walked_back.begin(), walked_back.end(), backwards.begin(), backwards.end(),
+                     same));
 
     // A copy is equal and independent.
     MoveList copy = list;
@@ -101,8 +107,11 @@ TEST_CASE("MoveList: the same moves as a vector, whatever the size") {
 TEST_CASE("MoveList: standard algorithms take its iterators") {
   MoveList list;
   for (int k = 0; k < 5000; ++k) list.push_back(numbered(k % 10));
-  CHECK(std::count_if(list.begin() + 100, list.begin() + 200, [](const Move& m) { return m.line == 3; }) == 10);
-  CHECK(std::find_if(list.begin(), list.end(), [](const Move& m) { return m.line == 9; }) - list.begin() == 9);
+  CHECK(std::count_if(list.begin() + 100, list.begin() + 200,
+                      [](const Move& m) { return m.line == 3; }) == 10);
+  CHECK(std::find_if(list.begin(), list.end(), [](const Move& m) { return m.line == 9; }) -
+            list.begin() ==
+        9);
   list.clear();
   CHECK(list.empty());
   CHECK(list.begin() == list.end());

@@ -36,7 +36,8 @@ Vec2 de_boor(const std::vector<ControlPoint>& control, int order, double u) {
     for (int j = p; j >= r; --j) {
       int i = span - p + j;
       double alpha = (u - knot(i)) / (knot(i + p + 1 - r) - knot(i));
-      d[static_cast<std::size_t>(j)] = (1 - alpha) * d[static_cast<std::size_t>(j - 1)] + alpha * d[static_cast<std::size_t>(j)];
+      d[static_cast<std::size_t>(j)] =
+          (1 - alpha) * d[static_cast<std::size_t>(j - 1)] + alpha * d[static_cast<std::size_t>(j)];
     }
   return Vec2(d[static_cast<std::size_t>(p)]) / d[static_cast<std::size_t>(p)].z;
 }
@@ -51,8 +52,8 @@ std::vector<Move> moves_of_line(const Result& r, int line) {
 // The G5.3 pieces: a continuous path at the curve's Z, through the curve's points at the
 // 4 × (control points) equal steps of u where LinuxCNC's biarcs join, every chord end within
 // `tolerance` (mm) of the curve, ending exactly on the last control point.
-void check_follows(const std::vector<Move>& pieces, const std::vector<ControlPoint>& control, int order,
-                   double tolerance) {
+void check_follows(const std::vector<Move>& pieces, const std::vector<ControlPoint>& control,
+                   int order, double tolerance) {
   REQUIRE(!pieces.empty());
   CHECK(near(Vec3(Vec2(pieces.front().start), 0), Vec3(control.front().p, 0), 1e-9));
   CHECK(near(Vec3(Vec2(pieces.back().end), 0), Vec3(control.back().p, 0), 1e-9));
@@ -81,7 +82,8 @@ const MachineConfig kLinuxcnc = *MachineConfig::bundled("linuxcnc");
 
 }  // namespace
 
-TEST_CASE("G5.2/G5.3: biarcs through the de Boor curve's points, random points, weights and orders") {
+TEST_CASE(
+    "G5.2/G5.3: biarcs through the de Boor curve's points, random points, weights and orders") {
   std::mt19937_64 rng(52);
   std::uniform_real_distribution<double> coordinate(-20, 20), weight(0.3, 3);
   for (int trial = 0; trial < 40; ++trial) {
@@ -89,10 +91,10 @@ TEST_CASE("G5.2/G5.3: biarcs through the de Boor curve's points, random points, 
     int count = order + static_cast<int>(rng() % 6);
     auto printable = [&] { return std::round(coordinate(rng) * 1e4) / 1e4; };
     std::vector<ControlPoint> control{{Vec2(printable(), printable()), 1.0}};
-    std::string text = cat("G21 G17 G90 F100\nG0 X", fmt(control[0].p.x), " Y", fmt(control[0].p.y), " Z-1\n");
+    std::string text =
+        cat("G21 G17 G90 F100\nG0 X", fmt(control[0].p.x), " Y", fmt(control[0].p.y), " Z-1\n");
     for (int i = 1; i < count; ++i) {
-      ControlPoint c{Vec2(printable(), printable()),
-                     std::round(weight(rng) * 1e3) / 1e3};
+      ControlPoint c{Vec2(printable(), printable()), std::round(weight(rng) * 1e3) / 1e3};
       control.push_back(c);
       text += cat(i == 1 ? "G5.2 " : "", "X", fmt(c.p.x), " Y", fmt(c.p.y), " P", fmt(c.w),
                   i == 1 ? cat(" L", order) : std::string(), "\n");
@@ -110,20 +112,24 @@ TEST_CASE("G5.2/G5.3: biarcs through the de Boor curve's points, random points, 
   }
 }
 
-TEST_CASE("G5.2: the first block's P weighs the start; G91 reads from the start; inches; default order 3") {
+TEST_CASE(
+    "G5.2: the first block's P weighs the start; G91 reads from the start; inches; default order "
+    "3") {
   // A first block without X Y: its P is the start point's weight.
-  Result r = run_program("G21 G17 G90 F100\nG0 X0 Y0 Z-1\nG5.2 P3\nX10 Y10 P1\nX20 Y0 P0.5\nG5.3\n", {},
-                         kLinuxcnc);
+  Result r = run_program("G21 G17 G90 F100\nG0 X0 Y0 Z-1\nG5.2 P3\nX10 Y10 P1\nX20 Y0 P0.5\nG5.3\n",
+                         {}, kLinuxcnc);
   check_follows(moves_of_line(r, 6), {{{0, 0}, 3}, {{10, 10}, 1}, {{20, 0}, 0.5}}, 3, 0.2);
   // G91: each point is an increment from the start (the current point does not move until G5.3).
-  Result g91 = run_program("G20 G17 G91 F10\nG0 X1 Y1 Z-0.1\nG5.2 X1 Y1 P1\nX2 Y0 P2\nX3 Y1 P1\nG5.3\n", {},
-                           kLinuxcnc);
+  Result g91 = run_program(
+      "G20 G17 G91 F10\nG0 X1 Y1 Z-0.1\nG5.2 X1 Y1 P1\nX2 Y0 P2\nX3 Y1 P1\nG5.3\n", {}, kLinuxcnc);
   const double in = 25.4;
   check_follows(moves_of_line(g91, 6),
-                {{{in, in}, 1}, {{2 * in, 2 * in}, 1}, {{3 * in, in}, 2}, {{4 * in, 2 * in}, 1}}, 3, 1.0);
+                {{{in, in}, 1}, {{2 * in, 2 * in}, 1}, {{3 * in, in}, 2}, {{4 * in, 2 * in}, 1}}, 3,
+                1.0);
   // Two control points after the start and the default order 3: the quadratic Bezier, which
   // G5.1 cuts as the same pieces.
-  Result nurbs = run_program("G21 G17 G90 F100\nG0 X0 Y0 Z-1\nG5.2 X2 Y4 P1\nX6 Y0 P1\nG5.3\n", {}, kLinuxcnc);
+  Result nurbs =
+      run_program("G21 G17 G90 F100\nG0 X0 Y0 Z-1\nG5.2 X2 Y4 P1\nX6 Y0 P1\nG5.3\n", {}, kLinuxcnc);
   Result g51 = run_program("G21 G17 G90 F100\nG0 X0 Y0 Z-1\nG5.1 I2 J4 X6 Y0\n", {}, kLinuxcnc);
   std::vector<Move> a = moves_of_line(nurbs, 5), b = moves_of_line(g51, 3);
   REQUIRE(a.size() == b.size());

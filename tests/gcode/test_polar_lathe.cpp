@@ -30,7 +30,8 @@ Vec3 polar(double radius, double degrees, double z) {
 
 TEST_CASE("polar: @ and ^ under G90 and G91 give the points written out") {
   // G90: a word left out keeps the current radius or angle; G91: @ adds to the radius, ^ turns.
-  std::vector<Vec3> p = ends("G21 G90 F100\nG0 X10 Y0 Z1\nG1 @20 ^30\n^75\n@12.5\nG91 @5\n^-40\n@-3 ^10 Z0.5\nM2\n");
+  std::vector<Vec3> p =
+      ends("G21 G90 F100\nG0 X10 Y0 Z1\nG1 @20 ^30\n^75\n@12.5\nG91 @5\n^-40\n@-3 ^10 Z0.5\nM2\n");
   REQUIRE(p.size() == 7);
   CHECK(near(p[1], polar(20, 30, 1), 1e-9));
   CHECK(near(p[2], polar(20, 75, 1), 1e-9));
@@ -48,17 +49,20 @@ TEST_CASE("polar: @ and ^ under G90 and G91 give the points written out") {
 
 TEST_CASE("polar: G91 drilling repeats step along the circle") {
   // Five holes 72 degrees apart on a 25 mm radius, the first one step from X25 Y0.
-  Result r = run_program("G21 G90 F100\nG0 X25 Y0 Z5\nG91 G81 ^72 R-4 Z-4 L5\nM2\n", {}, linuxcnc());
+  Result r =
+      run_program("G21 G90 F100\nG0 X25 Y0 Z5\nG91 G81 ^72 R-4 Z-4 L5\nM2\n", {}, linuxcnc());
   std::vector<Vec3> bottoms;
   for (const Move& m : r.moves)
     if (m.kind == MoveKind::cycle && m.feed > 0) bottoms.push_back(m.end);
   REQUIRE(bottoms.size() == 5);
-  for (int k = 0; k < 5; ++k) CHECK(near(bottoms[static_cast<std::size_t>(k)], polar(25, 72.0 * (k + 1), -3), 1e-9));
+  for (int k = 0; k < 5; ++k)
+    CHECK(near(bottoms[static_cast<std::size_t>(k)], polar(25, 72.0 * (k + 1), -3), 1e-9));
 }
 
 TEST_CASE("polar: errors name the word and the rule") {
   MachineConfig m = linuxcnc();
-  CHECK(error_of("G0 X1 Y1 Z1\nG0 @1 ^2\n", {}, at_origin()).message.find("LinuxCNC") != std::string::npos);
+  CHECK(error_of("G0 X1 Y1 Z1\nG0 @1 ^2\n", {}, at_origin()).message.find("LinuxCNC") !=
+        std::string::npos);
   Diagnostic d = error_of("G0 X1 Y1 Z1\nG0 @1 X2\n", {}, m);
   CHECK((d.line == 2 && d.column == 7));
   CHECK(error_of("G0 X1 Y1 Z1\nG18 G0 @1 ^2\n", {}, m).message.find("G17") != std::string::npos);
@@ -71,8 +75,8 @@ TEST_CASE("polar: errors name the word and the rule") {
 TEST_CASE("lathe codes are errors that name them, even lenient") {
   InterpreterOptions lenient;
   lenient.lenient = true;
-  for (const char* code : {"G7", "G33 Z-1 K0.1", "G76 P0.05 Z-1 I-0.01 J0.01 K0.03", "G70 Q1", "G71 Q1",
-                           "G72 Q1", "G96 D2500 S200"}) {
+  for (const char* code : {"G7", "G33 Z-1 K0.1", "G76 P0.05 Z-1 I-0.01 J0.01 K0.03", "G70 Q1",
+                           "G71 Q1", "G72 Q1", "G96 D2500 S200"}) {
     Diagnostic d = error_of(std::string("G0 X0 Y0 Z0\n") + code + "\nM2\n", lenient, linuxcnc());
     CHECK(d.line == 2);
     CHECK_MESSAGE(d.message.find("is a lathe code") != std::string::npos, d.message);
@@ -91,5 +95,6 @@ TEST_CASE("lathe codes are errors that name them, even lenient") {
     }
   }
   // Fanuc's G76 is a mill's fine boring cycle: not called a lathe code there.
-  CHECK(error_of("G0 X0 Y0 Z0\nG76 X1 Z-1 R1 Q0.1\n", {}, at_origin()).message.find("lathe") == std::string::npos);
+  CHECK(error_of("G0 X0 Y0 Z0\nG76 X1 Z-1 R1 Q0.1\n", {}, at_origin()).message.find("lathe") ==
+        std::string::npos);
 }

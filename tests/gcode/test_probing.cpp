@@ -15,9 +15,10 @@ const MachineConfig kLinuxcnc = *MachineConfig::bundled("linuxcnc");
 }
 
 TEST_CASE("G38.2-G38.5 under linuxcnc: to the point, 0.254 mm back, #5061-#5063 set, one warning") {
-  Result r = run_program("G21 G90 F100\nG0 X1 Y2 Z3\nG38.2 X4 Y6 Z3\nG38.4 Z-1\n"
-                         "G0 X#5061 Y#5062 Z[#5063 + 10 + #5070]\nM2\n",
-                         {}, kLinuxcnc);
+  Result r = run_program(
+      "G21 G90 F100\nG0 X1 Y2 Z3\nG38.2 X4 Y6 Z3\nG38.4 Z-1\n"
+      "G0 X#5061 Y#5062 Z[#5063 + 10 + #5070]\nM2\n",
+      {}, kLinuxcnc);
   REQUIRE(r.moves.size() == 6);
   CHECK(near(r.moves[1].end, Vec3(4, 6, 3)));
   CHECK(r.moves[1].kind == MoveKind::feed);
@@ -40,8 +41,10 @@ TEST_CASE("G38.2-G38.5 under linuxcnc: to the point, 0.254 mm back, #5061-#5063 
 
 TEST_CASE("G38.x errors as rs274's, at the block; the default machine still refuses probing") {
   const std::string start = "G21 G90 F100\nG0 X0 Y0 Z0\n";
-  CHECK(error_of(start + "G38.2 Z0\n", {}, kLinuxcnc).message.find("too close") != std::string::npos);
-  CHECK(error_of(start + "G38.4 X0\n", {}, kLinuxcnc).message.find("too close") != std::string::npos);
+  CHECK(error_of(start + "G38.2 Z0\n", {}, kLinuxcnc).message.find("too close") !=
+        std::string::npos);
+  CHECK(error_of(start + "G38.4 X0\n", {}, kLinuxcnc).message.find("too close") !=
+        std::string::npos);
   for (const Move& m : run_program(start + "G38.3 Z0\nG38.5 Z0\n", {}, kLinuxcnc).moves)
     CHECK(near(m.end, Vec3(0.0)));  // they may stand still, and then do not back off
   Diagnostic no_feed = error_of("G21 G90\nG0 X0 Y0 Z0\nG38.2 Z-1\n", {}, kLinuxcnc);

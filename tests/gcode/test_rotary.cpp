@@ -49,7 +49,8 @@ void check_same(const std::vector<Move>& a, const std::vector<Move>& b, const ch
     CHECK(near(a[i].end, b[i].end, 1e-6));
     CHECK(near(a[i].axis, b[i].axis, 1e-9));
     CHECK(near(a[i].machine, b[i].machine, 1e-6));
-    for (std::size_t k = 0; k < 3; ++k) CHECK(a[i].rotary[k] == doctest::Approx(b[i].rotary[k]).epsilon(1e-9));
+    for (std::size_t k = 0; k < 3; ++k)
+      CHECK(a[i].rotary[k] == doctest::Approx(b[i].rotary[k]).epsilon(1e-9));
   }
 }
 
@@ -82,10 +83,10 @@ TEST_CASE("rotary 3+2: G68.2 + G53.1, DWO, TCP and raw rotary words give the sam
         return machine_from_part(kin, feature.to_world(p) + g54, r) - g54;
       };
       std::string rotary = cat("G0", rotary_words(kin, r), "\n");
-      Result tilted = run_program(program(cat("G68.2 ", xyz(o), " I", num(i), " J", num(j), " K",
-                                              num(k), "\nG53.1\n"),
-                                          in_feature, "G69\n"),
-                                  {}, machine);
+      Result tilted = run_program(
+          program(cat("G68.2 ", xyz(o), " I", num(i), " J", num(j), " K", num(k), "\nG53.1\n"),
+                  in_feature, "G69\n"),
+          {}, machine);
       Result dwo = run_program(program(cat(rotary, "G254\n"), in_work, "G255\n"), {}, machine);
       Result tcp = run_program(program(cat("G43.4 H1\n", rotary), in_work, "G49\n"), {}, machine);
       Result raw = run_program(program(rotary, in_machine, ""), {}, machine);
@@ -116,7 +117,8 @@ TEST_CASE("rotary 3+2: G43.5 I J K and the remembered G53.1 positions") {
   RotaryPositions picked{r.moves[0].rotary[0], r.moves[0].rotary[1], r.moves[0].rotary[2]};
   CHECK(std::abs(picked[0]) == doctest::Approx(45));
   CHECK(picked[2] == doctest::Approx(0));
-  CHECK(near(tool_direction(*machine.kinematics, picked), fanuc_euler(Vec3(0), 0, 45, 0).rotation[2], 1e-9));
+  CHECK(near(tool_direction(*machine.kinematics, picked),
+             fanuc_euler(Vec3(0), 0, 45, 0).rotation[2], 1e-9));
   CHECK(near(r.moves[0].end, tip_in_part(*machine.kinematics, Vec3(0, 0, 10), picked), 1e-9));
 }
 
@@ -147,13 +149,15 @@ TEST_CASE("rotary 3+2: G92 and G52 in raw form shift machine coordinates, rotari
     MachineConfig machine = with_kinematics(name, Vec3(3, -4, 5));
     const Kinematics& kin = *machine.kinematics;
     RotaryPositions turned{};
-    for (const RotaryAxis& a : kin.axes) turned[static_cast<std::size_t>(rotary_index(a.letter))] = 25;
+    for (const RotaryAxis& a : kin.axes)
+      turned[static_cast<std::size_t>(rotary_index(a.letter))] = 25;
     std::string index = cat("G0", rotary_words(kin, turned), "\n");
-    Result by_hand = run_program(cat("G0 X10 Y2 Z20\n", index, "G1 X15 Y1 Z18 F100\nM30\n"), {}, machine);
-    Result g92 = run_program(cat("G0 X10 Y2 Z20\n", index, "G92 X0 Y0 Z0\nG1 X5 Y-1 Z-2 F100\nM30\n"), {},
-                             machine);
-    Result g52 = run_program(cat("G52 X7 Y-3 Z1\nG0 X3 Y5 Z19\n", index, "G1 X8 Y4 Z17 F100\nM30\n"), {},
-                             machine);
+    Result by_hand =
+        run_program(cat("G0 X10 Y2 Z20\n", index, "G1 X15 Y1 Z18 F100\nM30\n"), {}, machine);
+    Result g92 = run_program(
+        cat("G0 X10 Y2 Z20\n", index, "G92 X0 Y0 Z0\nG1 X5 Y-1 Z-2 F100\nM30\n"), {}, machine);
+    Result g52 = run_program(
+        cat("G52 X7 Y-3 Z1\nG0 X3 Y5 Z19\n", index, "G1 X8 Y4 Z17 F100\nM30\n"), {}, machine);
     REQUIRE(by_hand.moves.size() == 2);
     REQUIRE(g92.moves.size() == 2);
     REQUIRE(g52.moves.size() == 2);
@@ -219,7 +223,8 @@ TEST_CASE("rotary 3+2, lenient: every line read otherwise is counted, past the 1
   lenient.lenient = true;
   Result r = run_program(text, lenient, ac);
   REQUIRE(r.moves.size() == 1 + 1500 + 1200);
-  CHECK(near(r.moves[1500].axis, tool_direction(*ac.kinematics, {10, 0, 0}), 1e-12));  // k = 1500: A10
+  CHECK(near(r.moves[1500].axis, tool_direction(*ac.kinematics, {10, 0, 0}),
+             1e-12));  // k = 1500: A10
   auto summary = [&](const std::string& start) {
     for (const Diagnostic& d : r.warnings)
       if (d.message.rfind(start, 0) == 0) return d.message;
@@ -231,17 +236,22 @@ TEST_CASE("rotary 3+2, lenient: every line read otherwise is counted, past the 1
     std::snprintf(words, sizeof words, "(%.10g, %.10g, %.10g)", d.x, d.y, d.z);
     return std::string(words);
   };
-  const std::string cut = "lenient mode read 750 × rotary motion during a cut read as indexed along ";
+  const std::string cut =
+      "lenient mode read 750 × rotary motion during a cut read as indexed along ";
   CHECK(summary(cut + direction(20) + " (lines 2, 4, 6, 8, 10, …)") != "");
   CHECK(summary(cut + direction(10) + " (lines 3, 5, 7, 9, 11, …)") != "");
-  CHECK(summary("lenient mode read 1200 × move under an ambiguous tilted plane along the current direction (0, 0, 1) "
+  CHECK(summary("lenient mode read 1200 × move under an ambiguous tilted plane along the current "
+                "direction (0, 0, 1) "
                 "(lines 1504, 1505, 1506, 1507, 1508, …)") != "");
   CHECK(r.warnings.size() == 1000 + 3);  // capped per line; three summaries (A10, A20, the plane)
 }
 
-TEST_CASE("A/B/C on a LinuxCNC machine without kinematics are plain axes, as in rs274; elsewhere errors") {
+TEST_CASE(
+    "A/B/C on a LinuxCNC machine without kinematics are plain axes, as in rs274; elsewhere "
+    "errors") {
   MachineConfig linuxcnc = *MachineConfig::bundled("linuxcnc");
-  Result r = run_program("G21 G90 F100\nG0 X1 Y2 Z3 A90\nG1 X4 B45 C10\nG0 A0\nG2 X6 Y2 I1 J0 C5\nM2\n", {}, linuxcnc);
+  Result r = run_program(
+      "G21 G90 F100\nG0 X1 Y2 Z3 A90\nG1 X4 B45 C10\nG0 A0\nG2 X6 Y2 I1 J0 C5\nM2\n", {}, linuxcnc);
   REQUIRE(r.moves.size() >= 3);
   CHECK(near(r.moves[0].end, Vec3(1, 2, 3)));
   CHECK(near(r.moves[1].end, Vec3(4, 2, 3)));
@@ -257,10 +267,13 @@ TEST_CASE("A/B/C on a LinuxCNC machine without kinematics are plain axes, as in 
   CHECK(d.message.find("kinematics") != std::string::npos);
 }
 
-TEST_CASE("G28/G30 with X Y and a rotary word at zero return X and Y too (a 4-axis post's G28 X0. Y0. A0.)") {
+TEST_CASE(
+    "G28/G30 with X Y and a rotary word at zero return X and Y too (a 4-axis post's G28 X0. Y0. "
+    "A0.)") {
   // LinuxCNC without kinematics (as rs274: STRAIGHT_TRAVERSE to the origin), in G90 and G91.
   MachineConfig linuxcnc = *MachineConfig::bundled("linuxcnc");
-  Result r = run_program("G20 G90 G17\nG0 X1 Y1 Z.5 A0\nG91 G28 Z0\nG28 X0 Y0 A0\nM2\n", {}, linuxcnc);
+  Result r =
+      run_program("G20 G90 G17\nG0 X1 Y1 Z.5 A0\nG91 G28 Z0\nG28 X0 Y0 A0\nM2\n", {}, linuxcnc);
   REQUIRE(!r.moves.empty());
   CHECK(near(r.moves.back().end, Vec3(0, 0, 0), 1e-9));
   r = run_program("G21 G90\nG0 X10 Y10 Z5 A30\nG28 X4 Y4 A0\nG0 Z7\nM2\n", {}, linuxcnc);

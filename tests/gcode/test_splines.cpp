@@ -29,7 +29,8 @@ std::vector<Move> moves_of_line(const Result& r, int line) {
 
 // The pieces join the curve at every step of u (4 × control points steps, LinuxCNC's biarc
 // ends), every chord end stays within `tolerance` of the curve, and the path is continuous.
-void check_follows(const std::vector<Move>& pieces, const std::vector<Vec2>& control, double tolerance) {
+void check_follows(const std::vector<Move>& pieces, const std::vector<Vec2>& control,
+                   double tolerance) {
   REQUIRE(!pieces.empty());
   for (std::size_t k = 1; k < pieces.size(); ++k) CHECK(near(pieces[k].start, pieces[k - 1].end));
   std::vector<Vec2> dense;
@@ -54,7 +55,8 @@ const MachineConfig kLinuxcnc = *MachineConfig::bundled("linuxcnc");
 }  // namespace
 
 TEST_CASE("G5: biarcs through the cubic Bezier's points, G1 continuous, end exact") {
-  Result r = run_program("G21 G17 G90 F100\nG0 X1 Y1 Z-1\nG5 I0 J6 P8 Q-6 X3 Y3\nG1 Z0\n", {}, kLinuxcnc);
+  Result r =
+      run_program("G21 G17 G90 F100\nG0 X1 Y1 Z-1\nG5 I0 J6 P8 Q-6 X3 Y3\nG1 Z0\n", {}, kLinuxcnc);
   std::vector<Move> pieces = moves_of_line(r, 3);
   // Biarcs (LinuxCNC's pieces) and their chords stay within 0.01 mm of this 10 mm curve.
   check_follows(pieces, {{1, 1}, {1, 7}, {11, -3}, {3, 3}}, 0.01);
@@ -66,7 +68,8 @@ TEST_CASE("G5: biarcs through the cubic Bezier's points, G1 continuous, end exac
   for (std::size_t k = 0; k < same.size(); ++k) CHECK(near(same[k].end, pieces[k].end));
 }
 
-TEST_CASE("G5 without I and J mirrors the previous G5's P and Q; inches and G91 read as rs274 does") {
+TEST_CASE(
+    "G5 without I and J mirrors the previous G5's P and Q; inches and G91 read as rs274 does") {
   std::string head = "G20 G17 G90 F10\nG0 X0 Y0 Z-0.1\nG5 I0 J0.5 P0.3 Q-0.2 X1 Y1\n";
   Result mirrored = run_program(head + "G91 G5 P0.2 Q0.4 X1 Y-0.5\n", {}, kLinuxcnc);
   Result explicit_ij = run_program(head + "G91 G5 I-0.3 J0.2 P0.2 Q0.4 X1 Y-0.5\n", {}, kLinuxcnc);
@@ -74,18 +77,20 @@ TEST_CASE("G5 without I and J mirrors the previous G5's P and Q; inches and G91 
   REQUIRE(a.size() == b.size());
   for (std::size_t k = 0; k < a.size(); ++k) CHECK(near(a[k].end, b[k].end));
   const double in = 25.4;
-  check_follows(a, {{in, in}, {0.7 * in, 1.2 * in}, {2.2 * in, 0.9 * in}, {2 * in, 0.5 * in}}, 0.03);
+  check_follows(a, {{in, in}, {0.7 * in, 1.2 * in}, {2.2 * in, 0.9 * in}, {2 * in, 0.5 * in}},
+                0.03);
 }
 
-TEST_CASE("G5.1: biarcs through the quadratic Bezier's points; Fanuc's G5.1 Q1 stays a smoothing mode") {
+TEST_CASE(
+    "G5.1: biarcs through the quadratic Bezier's points; Fanuc's G5.1 Q1 stays a smoothing mode") {
   Result r = run_program("G21 G17 G90 F100\nG0 X0 Y0 Z-1\nG5.1 I2 J4 X6 Y0\n", {}, kLinuxcnc);
   check_follows(moves_of_line(r, 3), {{0, 0}, {2, 4}, {6, 0}}, 0.01);
   Result fanuc = run_program("G21 G17 G90 F100\nG0 X0 Y0 Z-1\nG5.1 Q1\nG1 X5\n");
   REQUIRE(fanuc.moves.size() == 2);
   CHECK(fanuc.moves.back().kind == MoveKind::feed);
   // Fanuc's G05 P10000 (high-speed machining on) stays an unsupported mode, not a spline.
-  CHECK(error_of("G21 G17 G90 F100\nG0 X0 Y0 Z-1\nG05 P10000\n").message.find("unsupported code G5") !=
-        std::string::npos);
+  CHECK(error_of("G21 G17 G90 F100\nG0 X0 Y0 Z-1\nG05 P10000\n")
+            .message.find("unsupported code G5") != std::string::npos);
   Result spline = run_program("G21 G17 G90 F100\nG0 X0 Y0 Z-1\nG5.1 I2 J4 X6 Y0\n");
   CHECK(moves_of_line(spline, 3).size() == moves_of_line(r, 3).size());
 }

@@ -79,8 +79,8 @@ TEST_CASE("G68.2 on random Euler angles: axis formula, points O + R·p, arcs and
     std::vector<Vec3> cycle;
     for (; k < r.moves.size(); ++k)
       if (r.moves[k].kind == MoveKind::cycle) cycle.push_back(r.moves[k].end);
-    std::vector<Vec3> want = {Vec3(0, 10, 2),   Vec3(20, 20, 2),  Vec3(20, 20, 2),
-                              Vec3(20, 20, -3), Vec3(20, 20, 2),  Vec3(-20, 20, 2),
+    std::vector<Vec3> want = {Vec3(0, 10, 2),   Vec3(20, 20, 2),   Vec3(20, 20, 2),
+                              Vec3(20, 20, -3), Vec3(20, 20, 2),   Vec3(-20, 20, 2),
                               Vec3(-20, 20, 2), Vec3(-20, 20, -3), Vec3(-20, 20, 2)};
     REQUIRE(cycle.size() == want.size());
     for (std::size_t i = 0; i < want.size(); ++i) CHECK(near(cycle[i], world(want[i]), 1e-9));
@@ -113,7 +113,8 @@ TEST_CASE("G68.2 without G53.1: ambiguous direction is an error, unless the tool
   // A rotation about Z alone keeps the feature plane normal to the tool.
   Result r = run_program("G21 G90\n" + g682(Vec3(0.0), 30, 0, 0) + "G0 X1 Y0 Z5\nM30\n");
   REQUIRE(r.moves.size() == 1);
-  CHECK(near(r.moves[0].end, Vec3(std::cos(std::acos(-1.0) / 6), std::sin(std::acos(-1.0) / 6), 5)));
+  CHECK(
+      near(r.moves[0].end, Vec3(std::cos(std::acos(-1.0) / 6), std::sin(std::acos(-1.0) / 6), 5)));
   InterpreterOptions lenient;
   lenient.lenient = true;
   r = run_program("G21 G90\nG0 X0 Y0 Z50\n" + g682(Vec3(0.0), 0, 30, 0) + "G0 X1 Y1 Z5\nM30\n",
@@ -140,8 +141,8 @@ TEST_CASE("Haas G268 Q123 / G253 / G269: R = Rz(K)·Ry(J)·Rx(I)") {
            k = std::stod(fmt(angle(rng)));
     Vec3 o(std::stod(fmt(coord(rng))), std::stod(fmt(coord(rng))), std::stod(fmt(coord(rng))));
     Mat3 R = haas_xyz(i, j, k);
-    Result r = run_program("G21 G90\nG268 X" + fmt(o.x) + " Y" + fmt(o.y) + " Z" + fmt(o.z) +
-                           " I" + fmt(i) + " J" + fmt(j) + " K" + fmt(k) +
+    Result r = run_program("G21 G90\nG268 X" + fmt(o.x) + " Y" + fmt(o.y) + " Z" + fmt(o.z) + " I" +
+                           fmt(i) + " J" + fmt(j) + " K" + fmt(k) +
                            " Q123\nG253\nG0 X1 Y2 Z3\nG269\nG91 G28 Z0\nM30\n");
     REQUIRE(r.moves.size() >= 1);
     CHECK(near(r.moves[0].axis, R * Vec3(0, 0, 1), 1e-12));
@@ -207,7 +208,8 @@ TEST_CASE("grouping by direction: one group per direction, in order of first app
     std::size_t total = 0;
     for (std::size_t g = 0; g < groups.size(); ++g) {
       CHECK(glm::dot(groups[g].axis, order[g]) > 1 - 1e-12);
-      CHECK(near(groups[g].frame.to_local(groups[g].frame.origin + groups[g].axis), Vec3(0, 0, 1), 1e-12));
+      CHECK(near(groups[g].frame.to_local(groups[g].frame.origin + groups[g].axis), Vec3(0, 0, 1),
+                 1e-12));
       int last_line = -1;
       for (const Move& m : groups[g].moves) {
         CHECK(glm::dot(m.axis, groups[g].axis) > std::cos(glm::radians(1e-3)));

@@ -102,7 +102,8 @@ TEST_CASE("LinuxCNC G68.2 Q121: the issue's plane") {
   // The issue: `G68.2 … I30 J15 Q121` means (0.259, −0.483, 0.837); read as Fanuc's Z-X-Z it
   // came out (0.129, −0.224, 0.966).
   Frame f = linuxcnc_angles_frame(0, 121, Vec3(0), 30, 15, 0);
-  Vec3 want(std::sin(glm::radians(15.0)), -std::sin(glm::radians(30.0)) * std::cos(glm::radians(15.0)),
+  Vec3 want(std::sin(glm::radians(15.0)),
+            -std::sin(glm::radians(30.0)) * std::cos(glm::radians(15.0)),
             std::cos(glm::radians(30.0)) * std::cos(glm::radians(15.0)));
   CHECK(near(f.rotation[2], want, 1e-12));
   CHECK(near(f.rotation[2], Vec3(0.259, -0.483, 0.837), 1e-3));
@@ -132,8 +133,10 @@ TEST_CASE("LinuxCNC's Euler orders: intrinsic, I J K the first, second and third
   CHECK(same_rotation(linuxcnc_angles_frame(0, 313, Vec3(0), 10, 20, 30, 40).rotation,
                       about(kZ, 40) * fanuc_euler(Vec3(0), 10, 20, 30).rotation));
   // P0 takes proper Euler orders only, P1 Tait-Bryan only.
-  CHECK(message_of([] { linuxcnc_euler_rotation(0, 0, 0, 123, 0); }).find("Q123") != std::string::npos);
-  CHECK(message_of([] { linuxcnc_euler_rotation(0, 0, 0, 121, 1); }).find("Q121") != std::string::npos);
+  CHECK(message_of([] { linuxcnc_euler_rotation(0, 0, 0, 123, 0); }).find("Q123") !=
+        std::string::npos);
+  CHECK(message_of([] { linuxcnc_euler_rotation(0, 0, 0, 121, 1); }).find("Q121") !=
+        std::string::npos);
   CHECK_THROWS_AS(linuxcnc_euler_rotation(0, 0, 0, 313, 2), tridex::Error);
 }
 
@@ -144,8 +147,8 @@ TEST_CASE("one plane written five ways: Hurco's 90-degree turn about Y") {
   Frame want{about(kY, 90), o};
   CHECK(same_frame(hurco, want));
   CHECK(near(hurco.rotation[2], kX));
-  CHECK(same_frame(fanuc_euler(o, 90, 90, -90), want));                // P0: Rz(90)·Rx(90)·Rz(−90)
-  CHECK(same_frame(fixed_axis_angles(o, 0, 90, 0, 123), want));         // P1 Q123 J90
+  CHECK(same_frame(fanuc_euler(o, 90, 90, -90), want));          // P0: Rz(90)·Rx(90)·Rz(−90)
+  CHECK(same_frame(fixed_axis_angles(o, 0, 90, 0, 123), want));  // P1 Q123 J90
   CHECK(same_frame(two_vector_frame(o, Vec3(0, 0, -2), Vec3(5, 0, 0)), want));  // P3
   // P2: the origin, a point on +X (2 mm down), a point on the +Y side of the plane.
   CHECK(same_frame(three_point_frame(o, o + Vec3(0, 0, -2), o + Vec3(0, 4, -1)), want));
@@ -161,9 +164,9 @@ TEST_CASE("P2, P3 and the Hurco vectors rebuild random frames") {
     Vec3 o(length(rng), length(rng), length(rng));
     Frame want{r, o};
     Vec3 x = r[0], y = r[1], z = r[2];
-    CHECK(same_frame(three_point_frame(o, o + positive(rng) * x,
-                                       o + length(rng) * x + positive(rng) * y),
-                     want, 1e-9));
+    CHECK(same_frame(
+        three_point_frame(o, o + positive(rng) * x, o + length(rng) * x + positive(rng) * y), want,
+        1e-9));
     CHECK(same_frame(two_vector_frame(o, positive(rng) * x, positive(rng) * z), want));
     CHECK(same_frame(hurco_vector_frame(o, positive(rng) * x, positive(rng) * y), want));
     // LinuxCNC's P3 gives I J K as a point on X and turns by Rz(R) on the left.

@@ -1,7 +1,7 @@
-// The tilted-plane words as the interpreter reads them (tilted_plane_codes.cpp): each control's G68.2 form,
-// G68.3, G68.4, G268's Q orders and LinuxCNC's G53.3, run as programs and compared with the frames
-// of tilted_plane.hpp (tested against the manuals' definitions in test_tilted_forms.cpp) and with
-// each other.
+// The tilted-plane words as the interpreter reads them (tilted_plane_codes.cpp): each control's
+// G68.2 form, G68.3, G68.4, G268's Q orders and LinuxCNC's G53.3, run as programs and compared with
+// the frames of tilted_plane.hpp (tested against the manuals' definitions in test_tilted_forms.cpp)
+// and with each other.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -36,8 +36,8 @@ Vec3 tool_of(const Result& r) {
 bool same_moves(const Result& a, const Result& b, double eps = 1e-9) {
   if (a.moves.size() != b.moves.size()) return false;
   for (std::size_t i = 0; i < a.moves.size(); ++i)
-    if (!near(a.moves[i].start, b.moves[i].start, eps) || !near(a.moves[i].end, b.moves[i].end, eps) ||
-        !near(a.moves[i].axis, b.moves[i].axis, eps))
+    if (!near(a.moves[i].start, b.moves[i].start, eps) ||
+        !near(a.moves[i].end, b.moves[i].end, eps) || !near(a.moves[i].axis, b.moves[i].axis, eps))
       return false;
   return true;
 }
@@ -59,15 +59,15 @@ TEST_CASE("G68.2 forms: one plane written five ways gives the same moves") {
   CHECK(near(tool_of(hurco), Vec3(1, 0, 0), 1e-12));
   Frame f = hurco_vector_frame(Vec3(3, -3, -6), Vec3(0, 0, -1), Vec3(0, 1, 0));
   CHECK(near(hurco.moves.back().end, f.to_world(Vec3(0, 0, 5)), 1e-9));
-  CHECK(same_moves(hurco, square_in("G68.2 X3 Y-3 Z-6 I90 J90 K-90")));        // Fanuc P0
-  CHECK(same_moves(hurco, square_in("G68.2 X3 Y-3 Z-6 A90 B90 C-90")));        // Mazak A B C
-  CHECK(same_moves(hurco, square_in("G68.2 P1 Q123 X3 Y-3 Z-6 J90")));         // Fanuc P1
-  CHECK(same_moves(hurco, square_in("G268 X3 Y-3 Z-6 J90 Q123", "G253")));     // Haas
-  CHECK(same_moves(hurco, square_in("G68.2 P0 Q313 X3 Y-3 Z-6 I90 J90 K-90"))); // LinuxCNC P0
+  CHECK(same_moves(hurco, square_in("G68.2 X3 Y-3 Z-6 I90 J90 K-90")));          // Fanuc P0
+  CHECK(same_moves(hurco, square_in("G68.2 X3 Y-3 Z-6 A90 B90 C-90")));          // Mazak A B C
+  CHECK(same_moves(hurco, square_in("G68.2 P1 Q123 X3 Y-3 Z-6 J90")));           // Fanuc P1
+  CHECK(same_moves(hurco, square_in("G268 X3 Y-3 Z-6 J90 Q123", "G253")));       // Haas
+  CHECK(same_moves(hurco, square_in("G68.2 P0 Q313 X3 Y-3 Z-6 I90 J90 K-90")));  // LinuxCNC P0
 }
 
 TEST_CASE("G68.2 P1 and G268: the Q order decides") {
-  CHECK(near(tool_of(square_in("G68.2 P1 I90 K90")), Vec3(1, 0, 0), 1e-12));       // Q123 default
+  CHECK(near(tool_of(square_in("G68.2 P1 I90 K90")), Vec3(1, 0, 0), 1e-12));  // Q123 default
   CHECK(near(tool_of(square_in("G68.2 P1 Q321 I90 K90")), Vec3(0, -1, 0), 1e-12));
   CHECK(near(tool_of(square_in("G268 I90 K90 Q321", "G253")), Vec3(0, -1, 0), 1e-12));
   CHECK(near(tool_of(square_in("G268 I90 J90 Q213", "G253")), Vec3(1, 0, 0), 1e-12));
@@ -104,7 +104,8 @@ TEST_CASE("G68.4 composes with the active plane; G68.3 takes the tool axis") {
                    square_in(cat("G68.2 X10 Y", fmt(-2 * std::sin(glm::radians(30.0))), " Z",
                                  fmt(2 * std::cos(glm::radians(30.0))), " J45")),
                    1e-4));
-  CHECK(error_of("G68.4 J15\n").message.find("without an active tilted plane") != std::string::npos);
+  CHECK(error_of("G68.4 J15\n").message.find("without an active tilted plane") !=
+        std::string::npos);
   // G68.3 after orienting to a plane, with the plane cancelled: Z along that tool axis (+X).
   Result r = square_in("G68.2 I90 J90 K0\nG53.1\nG69\nG68.3 X1 Y2 Z3 R30");
   Frame g = tool_axis_frame(Vec3(1, 2, 3), Vec3(1, 0, 0), 30);
@@ -153,14 +154,14 @@ TEST_CASE("G68.2 P2 and P3 over several blocks agree with the P0 plane they desc
     Frame f = fanuc_euler(o, i, j, k);
     Vec3 x = f.rotation[0], y = f.rotation[1], z = f.rotation[2];
     Vec3 p2 = o + scale(rng) * x, p3 = o + coord(rng) * x + scale(rng) * y;
-    std::string points = cat("G68.2 P2 Q1 ", xyz(o), "\nG68.2 P2 Q2 ", xyz(p2), "\nG68.2 P2 Q3 ",
-                             xyz(p3));
+    std::string points =
+        cat("G68.2 P2 Q1 ", xyz(o), "\nG68.2 P2 Q2 ", xyz(p2), "\nG68.2 P2 Q3 ", xyz(p3));
     Result p0 = square_in(cat("G68.2 ", xyz(o), " I", num(i), " J", num(j), " K", num(k)));
     CHECK(same_moves(square_in(points), p0, 1e-6));
     // Fanuc P2 Q0: the shift from point 1 in the feature frame, then R about the feature Z —
     // the P0 plane at o + R·shift with K + R.
-    Result shifted = square_in(cat("G68.2 ", xyz(f.to_world(shift)), " I", num(i), " J", num(j),
-                                   " K", num(k + r)));
+    Result shifted = square_in(
+        cat("G68.2 ", xyz(f.to_world(shift)), " I", num(i), " J", num(j), " K", num(k + r)));
     CHECK(same_moves(square_in(cat("G68.2 P2 Q0 ", xyz(shift), " R", num(r), "\n", points)),
                      shifted, 1e-6));
     CHECK(same_moves(square_in(cat("G68.2 P2 Q2 ", xyz(p2), "\nG68.2 P2 Q0 ", xyz(shift), " R",
@@ -175,12 +176,12 @@ TEST_CASE("G68.2 P2 and P3 over several blocks agree with the P0 plane they desc
     MachineConfig linuxcnc = at_origin();
     linuxcnc.dialect = Dialect::linuxcnc;
     Vec3 at(coord(rng), coord(rng), coord(rng));
-    Result lc0 = square_in(cat("G68.2 P0 Q313 ", xyz(at), " I", num(i), " J", num(j), " K",
-                               num(k), " R", num(r)),
-                           "G53.1", linuxcnc);
-    CHECK(same_moves(square_in(cat("G68.2 P2 Q0 ", xyz(at), " R", num(r), "\n", points), "G53.1",
-                               linuxcnc),
-                     lc0, 1e-6));
+    Result lc0 = square_in(
+        cat("G68.2 P0 Q313 ", xyz(at), " I", num(i), " J", num(j), " K", num(k), " R", num(r)),
+        "G53.1", linuxcnc);
+    CHECK(same_moves(
+        square_in(cat("G68.2 P2 Q0 ", xyz(at), " R", num(r), "\n", points), "G53.1", linuxcnc), lc0,
+        1e-6));
     CHECK(same_moves(square_in(cat("G68.2 P3 Q1 ", ijk(z), "\nG68.2 P3 Q0 ", xyz(at), " ",
                                    ijk(at + scale(rng) * x), " R", num(r)),
                                "G53.1", linuxcnc),
@@ -198,13 +199,15 @@ TEST_CASE("G68.2 P2 by hand: Q1 the origin, Q1 -> Q2 the X axis, Q3 on the +Y si
   // origin, the second gives +X from it, the third lies in the plane on the +Y side; Z = X x Y.
   // Q0 X Y Z shifts the origin in the feature frame, R then turns the frame about its Z.
   auto end_of = [](const std::string& plane, const Vec3& feature_point) {
-    Result r = run_program(cat("G21 G90\nG0 X0 Y0 Z50\n", plane, "\nG53.1\nG0 ", "X", num(feature_point.x), " Y",
-                               num(feature_point.y), " Z", num(feature_point.z), "\nM30\n"),
-                           {}, at_origin());
+    Result r =
+        run_program(cat("G21 G90\nG0 X0 Y0 Z50\n", plane, "\nG53.1\nG0 ", "X", num(feature_point.x),
+                        " Y", num(feature_point.y), " Z", num(feature_point.z), "\nM30\n"),
+                    {}, at_origin());
     REQUIRE(r.moves.size() >= 1);
     return std::pair<Vec3, Vec3>{r.moves.back().end, r.moves.back().axis};
   };
-  // The plane level, X along work +Y: feature (1, 2, 3) is (10, 20, 5) + 1·(0,1,0) + 2·(-1,0,0) + 3·Z.
+  // The plane level, X along work +Y: feature (1, 2, 3) is (10, 20, 5) + 1·(0,1,0) + 2·(-1,0,0) +
+  // 3·Z.
   const std::string level = "G68.2 P2 Q1 X10 Y20 Z5\nG68.2 P2 Q2 X10 Y30 Z5\nG68.2 P2 Q3 X0 Y25 Z5";
   auto [end, axis] = end_of(level, Vec3(1, 2, 3));
   CHECK(near(end, Vec3(8, 21, 8), 1e-12));
@@ -214,7 +217,8 @@ TEST_CASE("G68.2 P2 by hand: Q1 the origin, Q1 -> Q2 the X axis, Q3 on the +Y si
   CHECK(near(end, Vec3(9, 19, 8), 1e-12));
   // Tilted 45° about X: Z = (1,0,0) x (0,10,10) normalised = (0, -s, s), Y = (0, s, s).
   const double s = std::sqrt(0.5);
-  std::tie(end, axis) = end_of("G68.2 P2 Q1 X0 Y0 Z0\nG68.2 P2 Q2 X10 Y0 Z0\nG68.2 P2 Q3 X0 Y10 Z10", Vec3(0, 2, 1));
+  std::tie(end, axis) =
+      end_of("G68.2 P2 Q1 X0 Y0 Z0\nG68.2 P2 Q2 X10 Y0 Z0\nG68.2 P2 Q3 X0 Y10 Z10", Vec3(0, 2, 1));
   CHECK(near(axis, Vec3(0, -s, s), 1e-12));
   CHECK(near(end, Vec3(0, 2 * s - s, 2 * s + s), 1e-12));
 }

@@ -36,8 +36,9 @@ TEST_CASE("G10 L1: G43 H reads the length the program set; the tool keeps its ow
 TEST_CASE("G10 L10 and L11: the length that makes the current position read Z") {
   // At programmed Z0 under H1 = 15 the gauge is at 15; L10 Z2 gives 13, and G43 H1 then reads
   // the same place as Z2: a move to Z0 puts the gauge at 13, the tip at 3.
-  Result r = run_program("T1 M6\nG10 L1 P1 Z15\nG43 H1\nG0 X0 Y0 Z0\nG10 L10 P1 Z2\nG43 H1\nG0 Z0\n", {},
-                         linuxcnc_lengths());
+  Result r =
+      run_program("T1 M6\nG10 L1 P1 Z15\nG43 H1\nG0 X0 Y0 Z0\nG10 L10 P1 Z2\nG43 H1\nG0 Z0\n", {},
+                  linuxcnc_lengths());
   CHECK(near(r.moves.back().end, Vec3(0, 0, 3)));
   // L10 counts in the active system with G92; L11 in G59.3 (0 here) without them. Under G55
   // Z−4 and G92 (work Z 6 reads 1: offset 5), at programmed Z1 the gauge is at machine
@@ -53,7 +54,8 @@ TEST_CASE("G10 L10 and L11: the length that makes the current position read Z") 
 
 TEST_CASE("G10 L1 R: G41 D offsets by the radius the program set") {
   MachineConfig machine = linuxcnc_lengths();
-  Result r = run_program("G0 X0 Y0 Z0\nG10 L1 P2 R1.5\nG41 D2 G1 X10 F100\nG1 X20\nG40 G1 X30\n", {}, machine);
+  Result r = run_program("G0 X0 Y0 Z0\nG10 L1 P2 R1.5\nG41 D2 G1 X10 F100\nG1 X20\nG40 G1 X30\n",
+                         {}, machine);
   bool found = false;
   for (const Move& m : r.moves)
     if (m.line == 4) found = near(m.end, Vec3(20, 1.5, 0));

@@ -44,7 +44,8 @@ class MeshInside {
   bool inside(const Vec3& p) const {
     if (!box_.contains(p)) return false;
     int crossings = 0;
-    for (std::uint32_t t : cells_[static_cast<std::size_t>(bin(p.x, box_.min.x, nx_) + nx_ * bin(p.y, box_.min.y, ny_))]) {
+    for (std::uint32_t t : cells_[static_cast<std::size_t>(bin(p.x, box_.min.x, nx_) +
+                                                           nx_ * bin(p.y, box_.min.y, ny_))]) {
       const Vec3 a(mesh_.positions[mesh_.triangles[t].x]), b(mesh_.positions[mesh_.triangles[t].y]),
           c(mesh_.positions[mesh_.triangles[t].z]);
       const double det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
@@ -59,7 +60,9 @@ class MeshInside {
   }
 
  private:
-  int bin(double v, double lo, int count) const { return std::clamp(static_cast<int>(std::floor((v - lo) / bucket_)), 0, count - 1); }
+  int bin(double v, double lo, int count) const {
+    return std::clamp(static_cast<int>(std::floor((v - lo) / bucket_)), 0, count - 1);
+  }
   const Mesh& mesh_;
   Aabb box_;
   double bucket_;
@@ -69,7 +72,7 @@ class MeshInside {
 
 struct EdgeErrors {
   int samples = 0, wrong = 0, beyond_half = 0, beyond_one_and_half = 0;
-  double worst = 0;  // in spacings
+  double worst = 0;                                     // in spacings
   std::vector<std::pair<Vec3, double>> beyond_half_at;  // where, and how far (spacings)
 };
 
@@ -88,7 +91,8 @@ inline std::vector<Vec3> sphere_directions() {
 // material removed by two directions at their corners.
 // `label(p)`: 0 outside the stock, 1 kept, otherwise a bit (2 << i) for each direction i whose
 // moves remove p.
-inline EdgeErrors measure_edges(const Aabb& stock, const std::function<unsigned(const Vec3&)>& label, const Mesh& mesh,
+inline EdgeErrors measure_edges(const Aabb& stock,
+                                const std::function<unsigned(const Vec3&)>& label, const Mesh& mesh,
                                 double h, int count, std::mt19937& rng) {
   auto kept = [&](const Vec3& p) { return label(p) == 1; };
   const std::vector<Vec3> dirs = sphere_directions();
@@ -119,7 +123,9 @@ inline EdgeErrors measure_edges(const Aabb& stock, const std::function<unsigned(
   const double g = 4 * h;
   const glm::ivec3 n = glm::ivec3(glm::ceil(stock.size() / g)) + 1;
   std::vector<unsigned> labels(static_cast<std::size_t>(n.x * n.y * n.z));
-  auto at = [&](int i, int j, int k) -> unsigned& { return labels[static_cast<std::size_t>(i + n.x * (j + n.y * k))]; };
+  auto at = [&](int i, int j, int k) -> unsigned& {
+    return labels[static_cast<std::size_t>(i + n.x * (j + n.y * k))];
+  };
   for (int k = 0; k < n.z; ++k)
     for (int j = 0; j < n.y; ++j)
       for (int i = 0; i < n.x; ++i) at(i, j, k) = label(stock.min + g * Vec3(i, j, k) + Vec3(1e-4));
@@ -141,7 +147,8 @@ inline EdgeErrors measure_edges(const Aabb& stock, const std::function<unsigned(
   std::uniform_real_distribution<double> unit(0, 1);
   EdgeErrors e;
   for (int t = 0; t < 400 * count && e.samples < count; ++t) {
-    const glm::ivec3 c = cells[std::min(cells.size() - 1, static_cast<std::size_t>(unit(rng) * double(cells.size())))];
+    const glm::ivec3 c = cells[std::min(
+        cells.size() - 1, static_cast<std::size_t>(unit(rng) * double(cells.size())))];
     const Vec3 p = stock.min + g * (Vec3(c) + Vec3(unit(rng), unit(rng), unit(rng)));
     if (!near_edge(p)) continue;
     ++e.samples;

@@ -20,12 +20,15 @@ struct RadiusFunction {
   std::function<double(double)> rho;
 };
 
-inline RadiusFunction flat_rho(double r) { return {r, [r](double) { return r; }}; }
+inline RadiusFunction flat_rho(double r) {
+  return {r, [r](double) { return r; }};
+}
 inline RadiusFunction ball_rho(double r) {
   return {r, [r](double h) { return h >= r ? r : std::sqrt(r * r - (r - h) * (r - h)); }};
 }
 inline RadiusFunction bull_rho(double r, double c) {
-  return {r, [r, c](double h) { return h >= c ? r : (r - c) + std::sqrt(c * c - (c - h) * (c - h)); }};
+  return {r,
+          [r, c](double h) { return h >= c ? r : (r - c) + std::sqrt(c * c - (c - h) * (c - h)); }};
 }
 inline RadiusFunction chamfer_rho(double r, double tip, double half_angle_deg) {
   double t = std::tan(half_angle_deg * M_PI / 180);

@@ -43,7 +43,7 @@ TEST_CASE("lower surface of every cutter kind matches its radius function") {
       // vertical (the rim of a ball), so compare heights loosely and radii tightly.
       double h = c.cutter.lower_height(distance);
       CHECK(h == doctest::Approx(test::lowest_height(c.reference, distance)).epsilon(1e-6));
-      CHECK(c.reference.rho(h) >= distance - 1e-9);       // reaches d at h...
+      CHECK(c.reference.rho(h) >= distance - 1e-9);               // reaches d at h...
       if (h > 1e-6) CHECK(c.reference.rho(h - 1e-6) < distance);  // ...and not below it
     }
     CHECK(std::isinf(c.cutter.lower_height(c.cutter.radius() * 1.0001)));

@@ -18,10 +18,12 @@ TripleDexel random_dexel(const DexelLattice& l, std::mt19937& rng) {
     for (std::size_t r = 0; r < g.ray_count(); ++r) {
       int count = std::uniform_int_distribution<int>(0, 3)(rng);
       std::vector<int> ends;
-      for (int k = 0; k < 2 * count; ++k) ends.push_back(std::uniform_int_distribution<int>(0, 20)(rng));
+      for (int k = 0; k < 2 * count; ++k)
+        ends.push_back(std::uniform_int_distribution<int>(0, 20)(rng));
       std::sort(ends.begin(), ends.end());
       for (std::size_t k = 0; k + 1 < ends.size(); k += 2)
-        if (ends[k] < ends[k + 1] && (g.intervals.size() == g.offsets[r] || float(ends[k]) * 0.5f > g.intervals.back().exit))
+        if (ends[k] < ends[k + 1] &&
+            (g.intervals.size() == g.offsets[r] || float(ends[k]) * 0.5f > g.intervals.back().exit))
           g.intervals.push_back({float(ends[k]) * 0.5f, float(ends[k + 1]) * 0.5f});
       g.offsets[r + 1] = static_cast<std::uint32_t>(g.intervals.size());
     }
@@ -78,8 +80,10 @@ TEST_CASE("dexel Boolean identities on random solids") {
     CHECK(same(unite(a, a), unite(a, TripleDexel::empty(kLattice))));
     CHECK(interval_count(subtract(a, a)) == 0);
     CHECK(volume(subtract(a, a)) == 0);
-    CHECK(volume(unite(a, b)) + volume(intersect(a, b)) == doctest::Approx(volume(a) + volume(b)).epsilon(1e-12));
-    CHECK(volume(subtract(a, b)) + volume(intersect(a, b)) == doctest::Approx(volume(a)).epsilon(1e-12));
+    CHECK(volume(unite(a, b)) + volume(intersect(a, b)) ==
+          doctest::Approx(volume(a) + volume(b)).epsilon(1e-12));
+    CHECK(volume(subtract(a, b)) + volume(intersect(a, b)) ==
+          doctest::Approx(volume(a)).epsilon(1e-12));
     CHECK(same(intersect(a, b), intersect(b, a)));
     CHECK(same(unite(a, b), unite(b, a)));
     CHECK(same(subtract(a, subtract(a, b)), intersect(a, b)));

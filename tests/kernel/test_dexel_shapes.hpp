@@ -18,7 +18,8 @@ using tridex::Mesh;
 using tridex::Vec3;
 
 inline std::uint32_t add_vertex(Mesh& m, const Vec3& p) {
-  m.positions.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z));
+  m.positions.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y),
+                           static_cast<float>(p.z));
   return static_cast<std::uint32_t>(m.positions.size() - 1);
 }
 
@@ -48,15 +49,19 @@ inline Mesh sphere_mesh(const Vec3& c, double r, int slices = 48, int stacks = 2
     double phi = std::numbers::pi * s / stacks - std::numbers::pi / 2;
     for (int k = 0; k < slices; ++k) {
       double theta = 2 * std::numbers::pi * k / slices;
-      add_vertex(m, c + r * Vec3(std::cos(phi) * std::cos(theta), std::cos(phi) * std::sin(theta), std::sin(phi)));
+      add_vertex(m, c + r * Vec3(std::cos(phi) * std::cos(theta), std::cos(phi) * std::sin(theta),
+                                 std::sin(phi)));
     }
   }
   std::uint32_t north = add_vertex(m, c + Vec3(0, 0, r));
-  auto at = [&](int s, int k) { return static_cast<std::uint32_t>(1 + (s - 1) * slices + (k % slices)); };
+  auto at = [&](int s, int k) {
+    return static_cast<std::uint32_t>(1 + (s - 1) * slices + (k % slices));
+  };
   for (int k = 0; k < slices; ++k) {
     m.triangles.emplace_back(south, at(1, k + 1), at(1, k));
     m.triangles.emplace_back(north, at(stacks - 1, k), at(stacks - 1, k + 1));
-    for (int s = 1; s + 1 < stacks; ++s) add_quad(m, at(s, k), at(s, k + 1), at(s + 1, k + 1), at(s + 1, k));
+    for (int s = 1; s + 1 < stacks; ++s)
+      add_quad(m, at(s, k), at(s, k + 1), at(s + 1, k + 1), at(s + 1, k));
   }
   return m;
 }
@@ -92,7 +97,8 @@ inline Mesh torus_mesh(const Vec3& c, double major, double minor, int nu = 64, i
     }
   auto at = [&](int i, int j) { return static_cast<std::uint32_t>((i % nu) * nv + (j % nv)); };
   for (int i = 0; i < nu; ++i)
-    for (int j = 0; j < nv; ++j) add_quad(m, at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+    for (int j = 0; j < nv; ++j)
+      add_quad(m, at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
   return m;
 }
 

@@ -16,12 +16,14 @@ namespace {
 double surface_area(const Mesh& m) {
   double area = 0;
   for (const glm::uvec3& t : m.triangles)
-    area += 0.5 * glm::length(glm::cross(Vec3(m.positions[t.y]) - Vec3(m.positions[t.x]), Vec3(m.positions[t.z]) - Vec3(m.positions[t.x])));
+    area += 0.5 * glm::length(glm::cross(Vec3(m.positions[t.y]) - Vec3(m.positions[t.x]),
+                                         Vec3(m.positions[t.z]) - Vec3(m.positions[t.x])));
   return area;
 }
 
 // Every ray of `d` against the brute-force crossings of `m` (rays in general position only).
-void check_rays_against_brute_force(const TripleDexel& d, const Mesh& m, int& compared, int stride = 1) {
+void check_rays_against_brute_force(const TripleDexel& d, const Mesh& m, int& compared,
+                                    int stride = 1) {
   for (int a = 0; a < 3; ++a) {
     int u = TripleDexel::u_axis(a), v = TripleDexel::v_axis(a);
     const DexelGrid& g = d.grids[a];
@@ -46,15 +48,18 @@ void check_rays_against_brute_force(const TripleDexel& d, const Mesh& m, int& co
 
 }  // namespace
 
-TEST_CASE("dexelize mesh: box, sphere, cylinder, torus — rays match brute force, volume within the spacing") {
+TEST_CASE(
+    "dexelize mesh: box, sphere, cylinder, torus — rays match brute force, volume within the "
+    "spacing") {
   std::mt19937 rng(21);
   std::uniform_real_distribution<double> unit(0, 1);
   int compared = 0;
   for (int trial = 0; trial < 8; ++trial) {
     Vec3 c(10 * unit(rng) - 5, 10 * unit(rng) - 5, 10 * unit(rng) - 5);
-    std::vector<Mesh> shapes{box_mesh(c, c + Vec3(1 + 3 * unit(rng), 1 + 3 * unit(rng), 1 + 3 * unit(rng))),
-                             sphere_mesh(c, 1 + 2 * unit(rng)), cylinder_mesh(c, 1 + unit(rng), 1 + 3 * unit(rng)),
-                             torus_mesh(c, 2 + unit(rng), 0.5 + 0.5 * unit(rng))};
+    std::vector<Mesh> shapes{
+        box_mesh(c, c + Vec3(1 + 3 * unit(rng), 1 + 3 * unit(rng), 1 + 3 * unit(rng))),
+        sphere_mesh(c, 1 + 2 * unit(rng)), cylinder_mesh(c, 1 + unit(rng), 1 + 3 * unit(rng)),
+        torus_mesh(c, 2 + unit(rng), 0.5 + 0.5 * unit(rng))};
     for (const Mesh& m : shapes) {
       double s = 0.05 + 0.15 * unit(rng);
       DexelLattice l = DexelLattice::covering(m.bounds(), s);
@@ -98,8 +103,11 @@ Mesh voxel_mesh(const Voxels& vox, std::mt19937& rng) {
   Mesh m;
   std::map<std::tuple<int, int, int>, std::uint32_t> index;
   auto vertex = [&](glm::ivec3 p) {
-    auto [it, inserted] = index.try_emplace({p.x, p.y, p.z}, static_cast<std::uint32_t>(m.positions.size()));
-    if (inserted) m.positions.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z));
+    auto [it, inserted] =
+        index.try_emplace({p.x, p.y, p.z}, static_cast<std::uint32_t>(m.positions.size()));
+    if (inserted)
+      m.positions.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y),
+                               static_cast<float>(p.z));
     return it->second;
   };
   for (int z = 0; z < vox.n; ++z)
@@ -118,12 +126,15 @@ Mesh voxel_mesh(const Voxels& vox, std::mt19937& rng) {
             glm::ivec3 eu(0), ev(0);
             eu[u] = 1, ev[v] = 1;
             // Counter-clockwise seen from outside (+a side: u then v; −a side: reversed).
-            std::uint32_t q[4] = {vertex(base), vertex(base + eu), vertex(base + eu + ev), vertex(base + ev)};
+            std::uint32_t q[4] = {vertex(base), vertex(base + eu), vertex(base + eu + ev),
+                                  vertex(base + ev)};
             if (!side) std::swap(q[1], q[3]);
             if (rng() & 1) {
-              m.triangles.emplace_back(q[0], q[1], q[2]), m.triangles.emplace_back(q[0], q[2], q[3]);
+              m.triangles.emplace_back(q[0], q[1], q[2]),
+                  m.triangles.emplace_back(q[0], q[2], q[3]);
             } else {
-              m.triangles.emplace_back(q[1], q[2], q[3]), m.triangles.emplace_back(q[1], q[3], q[0]);
+              m.triangles.emplace_back(q[1], q[2], q[3]),
+                  m.triangles.emplace_back(q[1], q[3], q[0]);
             }
           }
       }
@@ -132,7 +143,8 @@ Mesh voxel_mesh(const Voxels& vox, std::mt19937& rng) {
 
 }  // namespace
 
-TEST_CASE("dexelize mesh: rays exactly through vertices and along edges neither lose nor double a hit") {
+TEST_CASE(
+    "dexelize mesh: rays exactly through vertices and along edges neither lose nor double a hit") {
   std::mt19937 rng(77);
   for (int trial = 0; trial < 25; ++trial) {
     Voxels vox{7, {}};
@@ -156,8 +168,10 @@ TEST_CASE("dexelize mesh: rays exactly through vertices and along edges neither 
             glm::ivec3 c(0);
             c[a] = k, c[u] = iu - 1, c[v] = iv - 1;
             if (!vox.at(c.x, c.y, c.z)) continue;
-            if (!expected.empty() && expected.back().exit == float(k)) expected.back().exit = float(k + 1);
-            else expected.push_back({float(k), float(k + 1)});
+            if (!expected.empty() && expected.back().exit == float(k))
+              expected.back().exit = float(k + 1);
+            else
+              expected.push_back({float(k), float(k + 1)});
           }
           auto ray = d.grids[a].ray(iu, iv);
           REQUIRE(ray.size() == expected.size());
@@ -176,7 +190,8 @@ TEST_CASE("dexelize mesh: rays exactly through vertices and along edges neither 
 TEST_CASE("dexelize mesh: an octahedron with rays through its vertices") {
   // Vertices at (±2, 0, 0), (0, ±2, 0), (0, 0, ±2): integer lattice rays hit vertices and edges.
   Mesh m;
-  for (Vec3 p : {Vec3(2, 0, 0), Vec3(-2, 0, 0), Vec3(0, 2, 0), Vec3(0, -2, 0), Vec3(0, 0, 2), Vec3(0, 0, -2)})
+  for (Vec3 p : {Vec3(2, 0, 0), Vec3(-2, 0, 0), Vec3(0, 2, 0), Vec3(0, -2, 0), Vec3(0, 0, 2),
+                 Vec3(0, 0, -2)})
     add_vertex(m, p);
   for (std::uint32_t x : {0u, 1u})
     for (std::uint32_t y : {2u, 3u})

@@ -20,7 +20,8 @@ ZMap milled_map(std::mt19937& rng, const Aabb& stock, const Frame& frame, double
   std::vector<CutMove> moves;
   for (int k = 0; k < 6; ++k) {
     auto point = [&] {
-      return Vec3(local.min.x + unit(rng) * (local.max.x - local.min.x), local.min.y + unit(rng) * (local.max.y - local.min.y),
+      return Vec3(local.min.x + unit(rng) * (local.max.x - local.min.x),
+                  local.min.y + unit(rng) * (local.max.y - local.min.y),
                   local.max.z - 0.2 - 1.2 * unit(rng));
     };
     moves.push_back({Segment{point(), point()}, static_cast<std::uint32_t>(k % 2)});
@@ -61,7 +62,9 @@ TEST_CASE("dexelize Z-map through the grid tree equals dexelizing its polyhedron
   CHECK(mismatches * 10000 <= rays_compared);
 }
 
-TEST_CASE("dexelize Z-map of an unmilled box stock: stock ∩ M = stock, up to the Z-map's silhouette band") {
+TEST_CASE(
+    "dexelize Z-map of an unmilled box stock: stock ∩ M = stock, up to the Z-map's silhouette "
+    "band") {
   // The polyhedron interpolates linearly between the last point inside the stock's projection
   // and the first empty one, so along the silhouette it shaves a wedge at most one Z-map cell
   // wide off the stock (the paper's step error on walls parallel to the spindle). Deeper than
@@ -71,7 +74,9 @@ TEST_CASE("dexelize Z-map of an unmilled box stock: stock ∩ M = stock, up to t
   for (int trial = 0; trial < 8; ++trial) {
     Aabb stock{Vec3(-1, 0, 2), Vec3(2 + unit(rng), 1.5 + unit(rng), 3 + unit(rng))};
     if (trial == 0) stock.max = Vec3(2.5, 1.75, 3.6);  // whole cells: grid points on every wall
-    Frame frame = trial == 0 ? Frame{} : Frame::from_rotation(rotation_z(angle(rng)) * rotation_y(angle(rng)));
+    Frame frame = trial == 0
+                      ? Frame{}
+                      : Frame::from_rotation(rotation_z(angle(rng)) * rotation_y(angle(rng)));
     const double cell = 0.05;
     ZMap map = ZMap::from_box(frame, stock, cell);
     DexelLattice l = DexelLattice::covering(stock, 0.1);

@@ -37,7 +37,8 @@ struct Direction {
 // are bucketed on a grid of its local x-y plane, so a query looks at a few of them.
 class EdgeReference {
  public:
-  EdgeReference(const Aabb& stock, const std::vector<Direction>& program, const std::vector<Cutter>& cutters)
+  EdgeReference(const Aabb& stock, const std::vector<Direction>& program,
+                const std::vector<Cutter>& cutters)
       : stock_(stock), program_(program) {
     for (const Direction& d : program) {
       Bucketed b;
@@ -49,8 +50,10 @@ class EdgeReference {
         b.moves.emplace_back(cutters[m.cutter], m.tip);
         const double r = cutters[m.cutter].radius();
         const auto index = static_cast<std::uint32_t>(b.moves.size() - 1);
-        for (int j = b.bin_y(std::min(m.tip.a.y, m.tip.b.y) - r); j <= b.bin_y(std::max(m.tip.a.y, m.tip.b.y) + r); ++j)
-          for (int i = b.bin_x(std::min(m.tip.a.x, m.tip.b.x) - r); i <= b.bin_x(std::max(m.tip.a.x, m.tip.b.x) + r); ++i)
+        for (int j = b.bin_y(std::min(m.tip.a.y, m.tip.b.y) - r);
+             j <= b.bin_y(std::max(m.tip.a.y, m.tip.b.y) + r); ++j)
+          for (int i = b.bin_x(std::min(m.tip.a.x, m.tip.b.x) - r);
+               i <= b.bin_x(std::max(m.tip.a.x, m.tip.b.x) + r); ++i)
             b.cells[static_cast<std::size_t>(i + b.nx * j)].push_back(index);
       }
       buckets_.push_back(std::move(b));
@@ -81,8 +84,12 @@ class EdgeReference {
     int nx = 0, ny = 0;
     std::vector<detail::MoveGeometry> moves;
     std::vector<std::vector<std::uint32_t>> cells;
-    int bin_x(double x) const { return std::clamp(static_cast<int>(std::floor((x - box.min.x) / kBucket)), 0, nx - 1); }
-    int bin_y(double y) const { return std::clamp(static_cast<int>(std::floor((y - box.min.y) / kBucket)), 0, ny - 1); }
+    int bin_x(double x) const {
+      return std::clamp(static_cast<int>(std::floor((x - box.min.x) / kBucket)), 0, nx - 1);
+    }
+    int bin_y(double y) const {
+      return std::clamp(static_cast<int>(std::floor((y - box.min.y) / kBucket)), 0, ny - 1);
+    }
   };
   Aabb stock_;
   const std::vector<Direction>& program_;
@@ -97,11 +104,16 @@ std::vector<Direction> random_pair(std::mt19937& rng, const Aabb& stock, bool po
   std::uniform_real_distribution<double> unit(0, 1);
   std::vector<Direction> program;
   {
-    Direction d{Frame::from_axis(glm::normalize(Vec3(0.5 * (unit(rng) - 0.5), 0.5 * (unit(rng) - 0.5), 1))), {}};
+    Direction d{
+        Frame::from_axis(glm::normalize(Vec3(0.5 * (unit(rng) - 0.5), 0.5 * (unit(rng) - 0.5), 1))),
+        {}};
     const Aabb local = local_bounds(d.frame, stock);
-    const double z0 = local.max.z - 0.8 - 0.5 * unit(rng), sx = 0.15 * (unit(rng) - 0.5), sy = 0.15 * (unit(rng) - 0.5);
+    const double z0 = local.max.z - 0.8 - 0.5 * unit(rng), sx = 0.15 * (unit(rng) - 0.5),
+                 sy = 0.15 * (unit(rng) - 0.5);
     const double step = 0.5 + 0.4 * unit(rng);  // × the ball's radius, 1
-    auto z = [&](double x, double y) { return z0 + sx * (x - local.min.x) + sy * (y - local.min.y) + 0.2 * std::sin(x); };
+    auto z = [&](double x, double y) {
+      return z0 + sx * (x - local.min.x) + sy * (y - local.min.y) + 0.2 * std::sin(x);
+    };
     for (double y = local.min.y - 1; y <= local.max.y + 1; y += step)
       for (double x = local.min.x - 1; x < local.max.x + 1; x += 0.7)
         d.moves.push_back({Segment{Vec3(x, y, z(x, y)), Vec3(x + 0.7, y, z(x + 0.7, y))}, 0});
@@ -109,7 +121,9 @@ std::vector<Direction> random_pair(std::mt19937& rng, const Aabb& stock, bool po
   }
   {
     const double tilt = (50 + 30 * unit(rng)) * M_PI / 180, azimuth = 2 * M_PI * unit(rng);
-    Direction d{Frame::from_axis(Vec3(std::sin(tilt) * std::cos(azimuth), std::sin(tilt) * std::sin(azimuth), std::cos(tilt))), {}};
+    Direction d{Frame::from_axis(Vec3(std::sin(tilt) * std::cos(azimuth),
+                                      std::sin(tilt) * std::sin(azimuth), std::cos(tilt))),
+                {}};
     const Aabb local = local_bounds(d.frame, stock);
     const double c = local.max.z - (0.25 + 0.2 * unit(rng)) * (local.max.z - local.min.z);
     for (double y = local.min.y - 1; y <= local.max.y + 1; y += 1.5)
@@ -117,14 +131,16 @@ std::vector<Direction> random_pair(std::mt19937& rng, const Aabb& stock, bool po
     if (pocket) {
       const double y0 = local.min.y + (0.3 + 0.2 * unit(rng)) * (local.max.y - local.min.y);
       for (double y = y0; y <= y0 + 1.5; y += 0.75)
-        d.moves.push_back({Segment{Vec3(local.min.x - 1, y, c - 0.8), Vec3(local.max.x + 1, y, c - 0.8)}, 1});
+        d.moves.push_back(
+            {Segment{Vec3(local.min.x - 1, y, c - 0.8), Vec3(local.max.x + 1, y, c - 0.8)}, 1});
     }
     program.push_back(d);
   }
   return program;
 }
 
-EdgeErrors machine_and_measure(std::mt19937& rng, bool pocket, double h, double cell, int samples, bool fine = true) {
+EdgeErrors machine_and_measure(std::mt19937& rng, bool pocket, double h, double cell, int samples,
+                               bool fine = true) {
   std::uniform_real_distribution<double> unit(0, 1);
   const Aabb stock{Vec3(0), Vec3(6 + unit(rng), 5 + unit(rng), 4 + unit(rng))};
   const std::vector<Cutter> cutters{Cutter::ball(1.0), Cutter::flat(1.0)};
@@ -137,9 +153,11 @@ EdgeErrors machine_and_measure(std::mt19937& rng, bool pocket, double h, double 
     raise_uncut(maps.back(), initial);
     if (fine) refine_steep_cells(maps.back(), cutters, d.moves, {.threads = 2});
   }
-  const Mesh mesh = extract_surface(intersect_milled(stock, DexelLattice::covering(stock, h), maps));
+  const Mesh mesh =
+      extract_surface(intersect_milled(stock, DexelLattice::covering(stock, h), maps));
   const EdgeReference ref(stock, program, cutters);
-  return test::measure_edges(stock, [&](const Vec3& p) { return ref.label(p); }, mesh, h, samples, rng);
+  return test::measure_edges(
+      stock, [&](const Vec3& p) { return ref.label(p); }, mesh, h, samples, rng);
 }
 
 void add(EdgeErrors& total, const EdgeErrors& e) {
@@ -149,22 +167,27 @@ void add(EdgeErrors& total, const EdgeErrors& e) {
 
 }  // namespace
 
-TEST_CASE("edges where two directions meet: tilted planar and scalloped ball-end cuts, Z-map cell h/2") {
+TEST_CASE(
+    "edges where two directions meet: tilted planar and scalloped ball-end cuts, Z-map cell h/2") {
   // Measured: 4500 edge points, 0 wrong beyond h/2, worst 0.37 h.
   std::mt19937 rng(17);
   const double h = 0.1;
   EdgeErrors total;
-  for (int trial = 0; trial < 3; ++trial) add(total, machine_and_measure(rng, false, h, 0.5 * h, 1500));
-  MESSAGE("planar + scalloped, cell h/2: " << total.samples << " edge points, " << total.wrong << " wrong, "
-                                           << total.beyond_half << " beyond h/2, " << total.beyond_one_and_half
-                                           << " beyond 1.5h, worst " << total.worst << " h");
+  for (int trial = 0; trial < 3; ++trial)
+    add(total, machine_and_measure(rng, false, h, 0.5 * h, 1500));
+  MESSAGE("planar + scalloped, cell h/2: " << total.samples << " edge points, " << total.wrong
+                                           << " wrong, " << total.beyond_half << " beyond h/2, "
+                                           << total.beyond_one_and_half << " beyond 1.5h, worst "
+                                           << total.worst << " h");
   CHECK(total.samples == 4500);
   CHECK(total.beyond_one_and_half == 0);
   CHECK(total.beyond_half * 10000 <= 2 * total.samples);  // the target: 2 in 10,000
   CHECK(total.worst < 0.75);
 }
 
-TEST_CASE("edges where two directions meet: a pocket wall of one direction meeting the other's scallops") {
+TEST_CASE(
+    "edges where two directions meet: a pocket wall of one direction meeting the other's "
+    "scallops") {
   // The same pairs with and without fine cells at the walls (fine_cells.hpp). Without them the
   // wall's rims are off by up to a Z-map cell (here h/2), which puts edge points wrong beyond
   // h/2; with them, by up to a sub-cell.
@@ -175,14 +198,17 @@ TEST_CASE("edges where two directions meet: a pocket wall of one direction meeti
     add(fine, machine_and_measure(a, true, h, 0.5 * h, 1500, true));
     add(plain, machine_and_measure(b, true, h, 0.5 * h, 1500, false));
   }
-  for (const auto& [name, e] : {std::pair{std::string("fine cells"), fine}, std::pair{std::string("plain cells"), plain}})
-    MESSAGE("pocket wall + scalloped, cell h/2, " << name << ": " << e.samples << " edge points, " << e.wrong
-                                                  << " wrong, " << e.beyond_half << " beyond h/2, "
-                                                  << e.beyond_one_and_half << " beyond 1.5h, worst " << e.worst << " h");
+  for (const auto& [name, e] :
+       {std::pair{std::string("fine cells"), fine}, std::pair{std::string("plain cells"), plain}})
+    MESSAGE("pocket wall + scalloped, cell h/2, "
+            << name << ": " << e.samples << " edge points, " << e.wrong << " wrong, "
+            << e.beyond_half << " beyond h/2, " << e.beyond_one_and_half << " beyond 1.5h, worst "
+            << e.worst << " h");
   CHECK(fine.samples == 4500);
   CHECK(plain.samples == 4500);
   CHECK(fine.beyond_one_and_half == 0);
-  CHECK(fine.beyond_half * 10000 <= 2 * fine.samples);  // the target; measured: 0 in 4500, worst 0.43 h
+  CHECK(fine.beyond_half * 10000 <=
+        2 * fine.samples);  // the target; measured: 0 in 4500, worst 0.43 h
   CHECK(fine.worst < 0.5);
   CHECK(plain.beyond_half * 10000 > 2 * plain.samples);  // measured: 7 in 4500, worst 0.62 h
 }

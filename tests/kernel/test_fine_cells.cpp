@@ -24,10 +24,12 @@ constexpr int kSteps = ZMapFineCells::kSteps, kSide = ZMapFineCells::kSide;
 ZMap random_fine_map(std::mt19937& rng, int nx, int ny) {
   std::uniform_real_distribution<double> angle(-60, 60), unit(0, 1);
   ZMapGrid g;
-  g.frame = Frame::from_rotation(rotation_z(angle(rng)) * rotation_x(angle(rng)), Vec3(unit(rng), unit(rng), unit(rng)));
+  g.frame = Frame::from_rotation(rotation_z(angle(rng)) * rotation_x(angle(rng)),
+                                 Vec3(unit(rng), unit(rng), unit(rng)));
   g.x0 = -2 * unit(rng), g.y0 = -2 * unit(rng), g.cell = 0.3 + unit(rng), g.nx = nx, g.ny = ny;
   ZMap map(g, 0.0f, -0.5f);
-  for (float& h : map.heights) h = unit(rng) < 0.15 ? map.empty_height : static_cast<float>(3 * unit(rng));
+  for (float& h : map.heights)
+    h = unit(rng) < 0.15 ? map.empty_height : static_cast<float>(3 * unit(rng));
   std::vector<std::uint32_t> cells;
   std::vector<float> sub;
   for (int j = 0; j + 1 < ny; ++j)
@@ -50,7 +52,9 @@ double reference_volume(const ZMap& map) {
   auto quad = [&](double h00, double h10, double h01, double h11, double side) {
     return side * side / 2 * ((h00 + h10 + h11) / 3 + (h00 + h11 + h01) / 3 - 2 * bottom);
   };
-  auto top = [&](int i, int j) { return std::max(double(map.height(i, j)), double(map.empty_height)); };
+  auto top = [&](int i, int j) {
+    return std::max(double(map.height(i, j)), double(map.empty_height));
+  };
   for (int j = 0; j + 1 < g.ny; ++j)
     for (int i = 0; i + 1 < g.nx; ++i) {
       const float* f = map.fine_cell(i, j);
@@ -60,8 +64,8 @@ double reference_volume(const ZMap& map) {
       }
       for (int b = 0; b < kSteps; ++b)
         for (int a = 0; a < kSteps; ++a)
-          sum += quad(f[a + kSide * b], f[a + 1 + kSide * b], f[a + kSide * (b + 1)], f[a + 1 + kSide * (b + 1)],
-                      g.cell / kSteps);
+          sum += quad(f[a + kSide * b], f[a + 1 + kSide * b], f[a + kSide * (b + 1)],
+                      f[a + 1 + kSide * (b + 1)], g.cell / kSteps);
     }
   return sum;
 }
@@ -74,7 +78,8 @@ std::vector<double> winding_crossings(const Mesh& m, const Vec3& o, const Vec3& 
   std::vector<std::pair<double, int>> hits;
   for (const glm::uvec3& t : m.triangles) {
     const Vec3 a(m.positions[t.x]), b(m.positions[t.y]), c(m.positions[t.z]);
-    const Vec3 e1 = b - a, e2 = c - a, p = glm::cross(d, e2);  // Möller–Trumbore, as brute_force_hits
+    const Vec3 e1 = b - a, e2 = c - a,
+               p = glm::cross(d, e2);  // Möller–Trumbore, as brute_force_hits
     const double det = glm::dot(e1, p);
     if (std::abs(det) < 1e-300) continue;
     const Vec3 s = o - a, q = glm::cross(s, e1);
@@ -97,11 +102,14 @@ std::vector<double> winding_crossings(const Mesh& m, const Vec3& o, const Vec3& 
 
 }  // namespace
 
-TEST_CASE("fine cells: corners are the map's points, shared edges agree, the polyhedron is closed with the finer volume") {
+TEST_CASE(
+    "fine cells: corners are the map's points, shared edges agree, the polyhedron is closed with "
+    "the finer volume") {
   std::mt19937 rng(41);
   std::uniform_real_distribution<double> unit(0, 1);
   for (int trial = 0; trial < 12; ++trial) {
-    const int nx = std::uniform_int_distribution<int>(2, 20)(rng), ny = std::uniform_int_distribution<int>(2, 20)(rng);
+    const int nx = std::uniform_int_distribution<int>(2, 20)(rng),
+              ny = std::uniform_int_distribution<int>(2, 20)(rng);
     const ZMap map = random_fine_map(rng, nx, ny);
     const ZMapGrid& g = map.grid;
     for (int j = 0; j + 1 < ny; ++j)
@@ -113,9 +121,11 @@ TEST_CASE("fine cells: corners are the map's points, shared edges agree, the pol
         if (const float* right = i + 2 < nx ? map.fine_cell(i + 1, j) : nullptr)
           for (int b = 0; b < kSide; ++b) CHECK(right[kSide * b] == f[kSteps + kSide * b]);
         // zmap_height interpolates the sub-grid: at a sub-point, its height.
-        const int a = std::uniform_int_distribution<int>(0, kSteps)(rng), b = std::uniform_int_distribution<int>(0, kSteps)(rng);
+        const int a = std::uniform_int_distribution<int>(0, kSteps)(rng),
+                  b = std::uniform_int_distribution<int>(0, kSteps)(rng);
         const double x = g.x(i) + a * g.cell / kSteps, y = g.y(j) + b * g.cell / kSteps;
-        if (a > 0 && a < kSteps && b > 0 && b < kSteps) CHECK(zmap_height(map, x, y) == doctest::Approx(f[a + kSide * b]));
+        if (a > 0 && a < kSteps && b > 0 && b < kSteps)
+          CHECK(zmap_height(map, x, y) == doctest::Approx(f[a + kSide * b]));
       }
     const Mesh mesh = polyhedrize(map);
     const MeshCheck c = check_mesh(mesh);
@@ -129,7 +139,8 @@ TEST_CASE("fine cells: grid tree hits equal brute-force hits on the polyhedron f
   std::uniform_real_distribution<double> unit(0, 1);
   int compared = 0, through_fine = 0;
   for (int trial = 0; trial < 10; ++trial) {
-    const ZMap map = random_fine_map(rng, std::uniform_int_distribution<int>(2, 16)(rng), std::uniform_int_distribution<int>(2, 16)(rng));
+    const ZMap map = random_fine_map(rng, std::uniform_int_distribution<int>(2, 16)(rng),
+                                     std::uniform_int_distribution<int>(2, 16)(rng));
     const Frame& frame = map.grid.frame;
     const GridTree tree(map);
     const Mesh mesh = polyhedrize(map);
@@ -143,10 +154,12 @@ TEST_CASE("fine cells: grid tree hits equal brute-force hits on the polyhedron f
       const std::vector<double> expected = winding_crossings(mesh, o, d);
       const std::vector<RayHit> got = tree.hits(frame.to_local(o), frame.direction_to_local(d));
       REQUIRE(got.size() == expected.size());
-      for (std::size_t h = 0; h < got.size(); ++h) CHECK(got[h].t == doctest::Approx(expected[h]).epsilon(1e-6));
+      for (std::size_t h = 0; h < got.size(); ++h)
+        CHECK(got[h].t == doctest::Approx(expected[h]).epsilon(1e-6));
       const Vec3 local = frame.to_local(target);
       const ZMapGrid& g = map.grid;
-      const int i = static_cast<int>(std::floor((local.x - g.x0) / g.cell)), j = static_cast<int>(std::floor((local.y - g.y0) / g.cell));
+      const int i = static_cast<int>(std::floor((local.x - g.x0) / g.cell)),
+                j = static_cast<int>(std::floor((local.y - g.y0) / g.cell));
       through_fine += i >= 0 && j >= 0 && i + 1 < g.nx && j + 1 < g.ny && map.fine_cell(i, j);
       ++compared;
     }
@@ -155,7 +168,8 @@ TEST_CASE("fine cells: grid tree hits equal brute-force hits on the polyhedron f
   CHECK(through_fine > 150);
 }
 
-TEST_CASE("refine steep cells: a pocket's walls lie within a sub-cell of where the moves put them") {
+TEST_CASE(
+    "refine steep cells: a pocket's walls lie within a sub-cell of where the moves put them") {
   // A flat end sinks a round pocket and a ball end a slot into a box (the ball's shank above its
   // centre makes a wall too), in a frame turned about z so that no wall follows the grid. On
   // random points of the fine cells, the solid z ≤ H is classified at a level through the walls
@@ -175,7 +189,9 @@ TEST_CASE("refine steep cells: a pocket's walls lie within a sub-cell of where t
   std::vector<CutMove> moves;
   for (int k = 0; k < 24; ++k) {  // a circle of radius 1.2 round c
     const double a0 = 2 * M_PI * k / 24, a1 = 2 * M_PI * (k + 1) / 24;
-    moves.push_back({Segment{c + 1.2 * Vec3(std::cos(a0), std::sin(a0), 0), c + 1.2 * Vec3(std::cos(a1), std::sin(a1), 0)}, 0});
+    moves.push_back({Segment{c + 1.2 * Vec3(std::cos(a0), std::sin(a0), 0),
+                             c + 1.2 * Vec3(std::cos(a1), std::sin(a1), 0)},
+                     0});
   }
   moves.push_back({Segment{Vec3(c.x + 2.5, c.y - 2, floor), Vec3(c.x + 3.1, c.y + 2, floor)}, 1});
   mill(map, cutters, moves, {.threads = 1});
@@ -191,7 +207,8 @@ TEST_CASE("refine steep cells: a pocket's walls lie within a sub-cell of where t
       if (detail::MoveGeometry(cutters[m.cutter], m.tip).lowest(x, y).z < level) return true;
     return false;
   };
-  auto to_wall = [&](double x, double y) {  // along 16 directions, in steps of a hundredth of a cell
+  auto to_wall = [&](double x,
+                     double y) {  // along 16 directions, in steps of a hundredth of a cell
     const bool side = below(x, y);
     double best = 2 * cell;
     for (int dir = 0; dir < 16; ++dir)
@@ -212,26 +229,29 @@ TEST_CASE("refine steep cells: a pocket's walls lie within a sub-cell of where t
       const double x = g.x(i) + unit(rng) * cell, y = g.y(j) + unit(rng) * cell;
       const bool truth = below(x, y);
       ++samples;
-      if ((zmap_height(map, x, y) < level) != truth) ++wrong_plain, worst_plain = std::max(worst_plain, to_wall(x, y));
-      if ((zmap_height(fine, x, y) < level) != truth) ++wrong_fine, worst_fine = std::max(worst_fine, to_wall(x, y));
+      if ((zmap_height(map, x, y) < level) != truth)
+        ++wrong_plain, worst_plain = std::max(worst_plain, to_wall(x, y));
+      if ((zmap_height(fine, x, y) < level) != truth)
+        ++wrong_fine, worst_fine = std::max(worst_fine, to_wall(x, y));
     }
   }
   const double sub = cell / kSteps;
-  MESSAGE("wall cells: " << samples << " points, plain map wrong at " << wrong_plain << " (up to " << worst_plain / cell
-                         << " cells from the wall), fine cells wrong at " << wrong_fine << " (up to " << worst_fine / cell
-                         << ")");
+  MESSAGE("wall cells: " << samples << " points, plain map wrong at " << wrong_plain << " (up to "
+                         << worst_plain / cell << " cells from the wall), fine cells wrong at "
+                         << wrong_fine << " (up to " << worst_fine / cell << ")");
   CHECK(samples > 500);
   CHECK(worst_fine <= sub * 1.02);
   CHECK(worst_plain > 2 * sub);  // the plain map's ramp is off farther: the test can tell
   CHECK(wrong_fine * 3 < wrong_plain);
 }
 
-TEST_CASE("refine steep cells: every inner sub-point is the brute-force lowest point over all moves") {
+TEST_CASE(
+    "refine steep cells: every inner sub-point is the brute-force lowest point over all moves") {
   // Random short and long moves of mixed cutters, level, sloped and vertical, over a map of many
   // 16-row bands (the moves are sorted into bands and skipped by their lowest tip and by their
-  // distance to a cell and the profile's height there): each fine cell's sub-points other than its corners (which are the
-  // map's own points) must be min(ceiling, min over every move of MoveGeometry::lowest), raised
-  // to the empty height, exactly.
+  // distance to a cell and the profile's height there): each fine cell's sub-points other than its
+  // corners (which are the map's own points) must be min(ceiling, min over every move of
+  // MoveGeometry::lowest), raised to the empty height, exactly.
   std::mt19937 rng(1717);
   std::uniform_real_distribution<double> unit(0, 1);
   const Aabb stock{Vec3(0), Vec3(12, 9, 4)};
@@ -239,16 +259,20 @@ TEST_CASE("refine steep cells: every inner sub-point is the brute-force lowest p
   ZMap map = ZMap::from_box(frame, stock, 0.09);
   const ZMap initial = map;
   const Aabb local = local_bounds(frame, stock);
-  const std::vector<Cutter> cutters{Cutter::ball(0.5), Cutter::flat(0.4), Cutter::bull_nose(0.6, 0.2),
-                                    Cutter::cone(0.5, 30), Cutter::tapered_ball(0.7, 0.3, 10)};
+  const std::vector<Cutter> cutters{Cutter::ball(0.5), Cutter::flat(0.4),
+                                    Cutter::bull_nose(0.6, 0.2), Cutter::cone(0.5, 30),
+                                    Cutter::tapered_ball(0.7, 0.3, 10)};
   std::vector<CutMove> moves;
   auto point = [&] {
     return Vec3(local.min.x - 1 + (local.max.x - local.min.x + 2) * unit(rng),
-                local.min.y - 1 + (local.max.y - local.min.y + 2) * unit(rng), local.max.z - 2.5 * unit(rng));
+                local.min.y - 1 + (local.max.y - local.min.y + 2) * unit(rng),
+                local.max.z - 2.5 * unit(rng));
   };
   for (int k = 0; k < 400; ++k) {
     const Vec3 a = point();
-    Vec3 b = k % 3 == 0 ? point() : a + Vec3(1.5 * unit(rng) - 0.75, 1.5 * unit(rng) - 0.75, 0.4 * unit(rng) - 0.2);
+    Vec3 b = k % 3 == 0
+                 ? point()
+                 : a + Vec3(1.5 * unit(rng) - 0.75, 1.5 * unit(rng) - 0.75, 0.4 * unit(rng) - 0.2);
     if (k % 7 == 0) b = Vec3(a.x, a.y, b.z);  // vertical
     if (k % 5 == 0) b.z = a.z;                // level
     moves.push_back({Segment{a, b}, static_cast<std::uint32_t>(k % cutters.size())});
@@ -276,7 +300,8 @@ TEST_CASE("refine steep cells: every inner sub-point is the brute-force lowest p
         double lowest = ceiling;
         for (const detail::MoveGeometry& m : geometry) lowest = std::min(lowest, m.lowest(x, y).z);
         const float expected = std::max(static_cast<float>(lowest), map.empty_height);
-        wrong += map.fine.heights[k * ZMapFineCells::kPoints + static_cast<std::size_t>(a + kSide * b)] != expected;
+        wrong += map.fine.heights[k * ZMapFineCells::kPoints +
+                                  static_cast<std::size_t>(a + kSide * b)] != expected;
         ++compared;
       }
   }
@@ -284,7 +309,9 @@ TEST_CASE("refine steep cells: every inner sub-point is the brute-force lowest p
   CHECK(wrong == 0);
 }
 
-TEST_CASE("steep cells: the row bands on any thread count list every steep cell, ascending, as a scan of all cells") {
+TEST_CASE(
+    "steep cells: the row bands on any thread count list every steep cell, ascending, as a scan of "
+    "all cells") {
   std::mt19937 rng(31);
   std::uniform_real_distribution<double> unit(0, 1);
   for (int trial = 0; trial < 4; ++trial) {
@@ -295,11 +322,14 @@ TEST_CASE("steep cells: the row bands on any thread count list every steep cell,
     ZMap map(g, 0.0f, -0.5f);
     for (int j = 0; j < g.ny; ++j)
       for (int i = 0; i < g.nx; ++i)
-        if (j % 50 < 30) map.heights[g.index(i, j)] = unit(rng) < 0.1 ? -1.0f : static_cast<float>(0.4 * unit(rng));
+        if (j % 50 < 30)
+          map.heights[g.index(i, j)] =
+              unit(rng) < 0.1 ? -1.0f : static_cast<float>(0.4 * unit(rng));
     std::vector<std::uint32_t> want;
     for (int j = 0; j + 1 < g.ny; ++j)
       for (int i = 0; i + 1 < g.nx; ++i)
-        if (is_steep_cell(map, i, j, 1.5)) want.push_back(static_cast<std::uint32_t>(g.index(i, j)));
+        if (is_steep_cell(map, i, j, 1.5))
+          want.push_back(static_cast<std::uint32_t>(g.index(i, j)));
     REQUIRE(want.size() > 100);
     for (unsigned threads : {1u, 2u, 3u}) CHECK(steep_cells(map, 1.5, threads) == want);
   }

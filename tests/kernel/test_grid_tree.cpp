@@ -13,7 +13,8 @@ namespace {
 ZMap random_map(std::mt19937& rng, int nx, int ny, const Frame& frame) {
   std::uniform_real_distribution<double> unit(0, 1);
   ZMapGrid g;
-  g.frame = frame, g.x0 = -1 + unit(rng), g.y0 = -1 + unit(rng), g.cell = 0.3 + unit(rng), g.nx = nx, g.ny = ny;
+  g.frame = frame, g.x0 = -1 + unit(rng), g.y0 = -1 + unit(rng), g.cell = 0.3 + unit(rng),
+  g.nx = nx, g.ny = ny;
   ZMap map(g, 0.0f, -0.5f);
   // Smooth hills plus noise plus some cut-through points.
   double fx = 0.2 + unit(rng), fy = 0.2 + unit(rng);
@@ -33,12 +34,16 @@ TEST_CASE("grid tree: node bounds enclose their heights, leaves have at most 4 x
   GridTree tree(map);
   const auto& nodes = tree.nodes();
   float lo = 1e30f, hi = -1e30f;
-  for (float h : map.heights) lo = std::min(lo, std::max(h, map.empty_height)), hi = std::max(hi, h);
+  for (float h : map.heights)
+    lo = std::min(lo, std::max(h, map.empty_height)), hi = std::max(hi, h);
   CHECK(nodes[0].lo == lo);
   CHECK(nodes[0].hi == hi);
   std::size_t leaves = 0;
   for (const auto& n : nodes) {
-    if (n.left == 0) { ++leaves; continue; }
+    if (n.left == 0) {
+      ++leaves;
+      continue;
+    }
     CHECK(nodes[n.left].lo >= n.lo);
     CHECK(nodes[n.left + 1].hi <= n.hi);
     CHECK(std::min(nodes[n.left].lo, nodes[n.left + 1].lo) == n.lo);
@@ -53,7 +58,8 @@ TEST_CASE("grid tree: every node's height range and plane bound hold at all its 
   std::uniform_real_distribution<double> angle(-60, 60);
   for (int trial = 0; trial < 6; ++trial) {
     Frame frame = Frame::from_rotation(rotation_z(angle(rng)) * rotation_x(angle(rng)));
-    ZMap map = trial % 2 ? random_map(rng, 41, 29, frame) : ZMap::from_box(frame, Aabb{Vec3(0), Vec3(7, 5, 3)}, 0.13);
+    ZMap map = trial % 2 ? random_map(rng, 41, 29, frame)
+                         : ZMap::from_box(frame, Aabb{Vec3(0), Vec3(7, 5, 3)}, 0.13);
     GridTree tree(map);
     const auto& nodes = tree.nodes();
     std::vector<GridTree::NodeCells> cells = tree.node_cells();
@@ -70,14 +76,16 @@ TEST_CASE("grid tree: every node's height range and plane bound hold at all its 
         CHECK((c.j1 - c.j0 == 4 || c.j1 == map.grid.ny - 1));
       } else {  // the children tile the node
         const GridTree::NodeCells &a = cells[nodes[k].left], &b = cells[nodes[k].left + 1];
-        CHECK((a.i1 - a.i0) * (a.j1 - a.j0) + (b.i1 - b.i0) * (b.j1 - b.j0) == (c.i1 - c.i0) * (c.j1 - c.j0));
+        CHECK((a.i1 - a.i0) * (a.j1 - a.j0) + (b.i1 - b.i0) * (b.j1 - b.j0) ==
+              (c.i1 - c.i0) * (c.j1 - c.j0));
       }
       float lo = 1e30f, hi = -1e30f;
       for (int j = c.j0; j <= c.j1; ++j)
         for (int i = c.i0; i <= c.i1; ++i) {
           double h = std::max(map.height(i, j), map.empty_height);
           lo = std::min(lo, static_cast<float>(h)), hi = std::max(hi, static_cast<float>(h));
-          CHECK(std::abs(h - tree.plane_at(k, c, map.grid.x(i), map.grid.y(j))) <= nodes[k].deviation);
+          CHECK(std::abs(h - tree.plane_at(k, c, map.grid.x(i), map.grid.y(j))) <=
+                nodes[k].deviation);
         }
       CHECK(nodes[k].lo == lo);
       CHECK(nodes[k].hi == hi);
@@ -96,8 +104,10 @@ TEST_CASE("grid tree: hits equal brute-force hits on the polyhedron for random r
   std::uniform_real_distribution<double> unit(0, 1), angle(-70, 70);
   int compared = 0;
   for (int trial = 0; trial < 12; ++trial) {
-    Frame frame = Frame::from_rotation(rotation_z(angle(rng)) * rotation_x(angle(rng)), Vec3(unit(rng), unit(rng), unit(rng)));
-    ZMap map = random_map(rng, std::uniform_int_distribution<int>(2, 40)(rng), std::uniform_int_distribution<int>(2, 40)(rng), frame);
+    Frame frame = Frame::from_rotation(rotation_z(angle(rng)) * rotation_x(angle(rng)),
+                                       Vec3(unit(rng), unit(rng), unit(rng)));
+    ZMap map = random_map(rng, std::uniform_int_distribution<int>(2, 40)(rng),
+                          std::uniform_int_distribution<int>(2, 40)(rng), frame);
     GridTree tree(map);
     Mesh mesh = polyhedrize(map);
     Aabb box = mesh.bounds();
@@ -145,10 +155,13 @@ TEST_CASE("grid tree: rays exactly through grid points and along grid lines") {
   // Horizontal rays along grid lines and diagonals, at the heights of grid points (so they touch
   // vertices exactly): the solid part agrees with dense samples of the top.
   for (int trial = 0; trial < 300; ++trial) {
-    int i = std::uniform_int_distribution<int>(0, g.nx - 1)(rng), j = std::uniform_int_distribution<int>(0, g.ny - 1)(rng);
+    int i = std::uniform_int_distribution<int>(0, g.nx - 1)(rng),
+        j = std::uniform_int_distribution<int>(0, g.ny - 1)(rng);
     double z = std::max(map.height(i, j), map.empty_height);
     Vec3 o(g.x(i), g.y(j), z);
-    Vec3 d = trial % 3 == 0 ? Vec3(1, 0, 0) : trial % 3 == 1 ? Vec3(0, 1, 0) : glm::normalize(Vec3(1, 1, 0));
+    Vec3 d = trial % 3 == 0   ? Vec3(1, 0, 0)
+             : trial % 3 == 1 ? Vec3(0, 1, 0)
+                              : glm::normalize(Vec3(1, 1, 0));
     std::vector<RaySpan> spans;
     tree.spans(o, d, spans);
     for (std::size_t k = 1; k < spans.size(); ++k) CHECK(spans[k].enter > spans[k - 1].exit);

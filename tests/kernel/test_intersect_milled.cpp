@@ -27,7 +27,8 @@ std::vector<Direction> random_program(std::mt19937& rng, const Aabb& stock, int 
     Aabb local = local_bounds(d.frame, stock);
     for (int k = 0; k < 8; ++k) {
       auto tip = [&] {
-        return Vec3(local.min.x + unit(rng) * (local.max.x - local.min.x), local.min.y + unit(rng) * (local.max.y - local.min.y),
+        return Vec3(local.min.x + unit(rng) * (local.max.x - local.min.x),
+                    local.min.y + unit(rng) * (local.max.y - local.min.y),
                     local.max.z - (0.1 + 0.4 * unit(rng)) * (local.max.z - local.min.z));
       };
       d.moves.push_back({Segment{tip(), tip()}, static_cast<std::uint32_t>(k % 3)});
@@ -39,7 +40,8 @@ std::vector<Direction> random_program(std::mt19937& rng, const Aabb& stock, int 
 
 // The reference: p is removed iff, in some direction, some move's swept cutter reaches down to
 // p's local height over p's local (x, y).
-bool removed(const std::vector<Direction>& program, const std::vector<Cutter>& cutters, const Vec3& p) {
+bool removed(const std::vector<Direction>& program, const std::vector<Cutter>& cutters,
+             const Vec3& p) {
   for (const Direction& d : program) {
     Vec3 q = d.frame.to_local(p);
     for (const CutMove& m : d.moves)
@@ -50,10 +52,13 @@ bool removed(const std::vector<Direction>& program, const std::vector<Cutter>& c
 
 }  // namespace
 
-TEST_CASE("intersect_milled: a box milled in several tilted directions matches the point-membership reference") {
+TEST_CASE(
+    "intersect_milled: a box milled in several tilted directions matches the point-membership "
+    "reference") {
   std::mt19937 rng(101);
   std::uniform_real_distribution<double> unit(0, 1);
-  const std::vector<Cutter> cutters{Cutter::ball(1.0), Cutter::flat(0.7), Cutter::bull_nose(0.9, 0.3)};
+  const std::vector<Cutter> cutters{Cutter::ball(1.0), Cutter::flat(0.7),
+                                    Cutter::bull_nose(0.9, 0.3)};
   for (int trial = 0; trial < 4; ++trial) {
     Aabb stock{Vec3(-3, -2, 0), Vec3(3 + unit(rng), 2 + unit(rng), 3 + unit(rng))};
     std::vector<Direction> program = random_program(rng, stock, 2 + trial % 2);
@@ -69,8 +74,15 @@ TEST_CASE("intersect_milled: a box milled in several tilted directions matches t
     // Away from every surface (the stock's faces and the cut) by the Z-map and dexel error
     // bands, the classification must agree.
     const double margin = 2 * spacing + 2 * cell;
-    const Vec3 offsets[] = {Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0), Vec3(0, 0, 1), Vec3(0, 0, -1),
-                            Vec3(1, 1, 1) / std::sqrt(3.0), Vec3(-1, -1, -1) / std::sqrt(3.0), Vec3(1, -1, 1) / std::sqrt(3.0),
+    const Vec3 offsets[] = {Vec3(1, 0, 0),
+                            Vec3(-1, 0, 0),
+                            Vec3(0, 1, 0),
+                            Vec3(0, -1, 0),
+                            Vec3(0, 0, 1),
+                            Vec3(0, 0, -1),
+                            Vec3(1, 1, 1) / std::sqrt(3.0),
+                            Vec3(-1, -1, -1) / std::sqrt(3.0),
+                            Vec3(1, -1, 1) / std::sqrt(3.0),
                             Vec3(-1, 1, -1) / std::sqrt(3.0)};
     int compared = 0, cut = 0;
     for (int k = 0; k < 6000; ++k) {
@@ -78,7 +90,8 @@ TEST_CASE("intersect_milled: a box milled in several tilted directions matches t
       Vec3 gap = glm::min(p - stock.min, stock.max - p);
       if (std::min({gap.x, gap.y, gap.z}) < margin) continue;
       bool expected = removed(program, cutters, p), stable = true;
-      for (const Vec3& o : offsets) stable = stable && removed(program, cutters, p + margin * o) == expected;
+      for (const Vec3& o : offsets)
+        stable = stable && removed(program, cutters, p + margin * o) == expected;
       if (!stable) continue;
       CHECK(contains(result, p) == !expected);
       ++compared, cut += expected;
@@ -86,12 +99,15 @@ TEST_CASE("intersect_milled: a box milled in several tilted directions matches t
     CHECK(compared > 1500);
     CHECK(cut > 100);
     // Removing material only: the result lies within the stock, and its volume is below it.
-    CHECK(volume(intersect(result, TripleDexel::box(lattice, stock))) == doctest::Approx(volume(result)));
+    CHECK(volume(intersect(result, TripleDexel::box(lattice, stock))) ==
+          doctest::Approx(volume(result)));
     CHECK(volume(result) < volume(TripleDexel::box(lattice, stock)));
   }
 }
 
-TEST_CASE("intersect_milled: independent of the order of directions and of the thread count; equals the Booleans") {
+TEST_CASE(
+    "intersect_milled: independent of the order of directions and of the thread count; equals the "
+    "Booleans") {
   std::mt19937 rng(7);
   const std::vector<Cutter> cutters{Cutter::ball(1.0), Cutter::flat(0.7), Cutter::ball(0.5)};
   Aabb stock{Vec3(0), Vec3(5, 4, 3)};
@@ -117,8 +133,10 @@ TEST_CASE("intersect_milled: independent of the order of directions and of the t
   for (const ZMap& m : maps) booleans = intersect(booleans, dexelize(m, lattice));
   CHECK(volume(a) == doctest::Approx(volume(booleans)).epsilon(1e-6));
   // From a stock mesh: the same solid.
-  TripleDexel from_mesh = intersect_milled(tridex_test::box_mesh(stock.min, stock.max), lattice, maps);
+  TripleDexel from_mesh =
+      intersect_milled(tridex_test::box_mesh(stock.min, stock.max), lattice, maps);
   CHECK(volume(from_mesh) == doctest::Approx(volume(a)).epsilon(1e-3));
   // No map: the stock itself.
-  CHECK(volume(intersect_milled(stock, lattice, {})) == doctest::Approx(volume(TripleDexel::box(lattice, stock))));
+  CHECK(volume(intersect_milled(stock, lattice, {})) ==
+        doctest::Approx(volume(TripleDexel::box(lattice, stock))));
 }

@@ -24,7 +24,8 @@ Mesh shuffled(const Mesh& m, std::mt19937& rng) {
   for (std::size_t i = 0; i < perm.size(); ++i) out.positions[perm[i]] = m.positions[i];
   for (const glm::uvec3& t : m.triangles) {
     glm::uvec3 r(perm[t.x], perm[t.y], perm[t.z]);
-    for (int k = std::uniform_int_distribution<int>(0, 2)(rng); k > 0; --k) r = glm::uvec3(r.y, r.z, r.x);
+    for (int k = std::uniform_int_distribution<int>(0, 2)(rng); k > 0; --k)
+      r = glm::uvec3(r.y, r.z, r.x);
     out.triangles.push_back(r);
   }
   std::shuffle(out.triangles.begin(), out.triangles.end(), rng);
@@ -72,7 +73,8 @@ TEST_CASE("check_mesh: removing triangles opens exactly their unshared edges") {
       Mesh m = shuffled(solid, rng);
       // Remove a random subset; an edge becomes boundary iff exactly one of its two triangles went.
       std::vector<bool> removed(m.triangles.size());
-      for (std::size_t k = 0; k < removed.size(); ++k) removed[k] = std::uniform_int_distribution<int>(0, 9)(rng) == 0;
+      for (std::size_t k = 0; k < removed.size(); ++k)
+        removed[k] = std::uniform_int_distribution<int>(0, 9)(rng) == 0;
       std::map<std::pair<std::uint32_t, std::uint32_t>, int> kept_uses;
       Mesh opened;
       opened.positions = m.positions;
@@ -105,9 +107,12 @@ TEST_CASE("check_mesh: flipped triangles make their edges misoriented") {
     for (glm::uvec3& t : m.triangles) {
       if (std::uniform_int_distribution<int>(0, 4)(rng) != 0) continue;
       bool free = true;
-      for (int e = 0; e < 3; ++e) free = free && !touched.count({std::min(t[e], t[(e + 1) % 3]), std::max(t[e], t[(e + 1) % 3])});
+      for (int e = 0; e < 3; ++e)
+        free = free &&
+               !touched.count({std::min(t[e], t[(e + 1) % 3]), std::max(t[e], t[(e + 1) % 3])});
       if (!free) continue;
-      for (int e = 0; e < 3; ++e) touched.insert({std::min(t[e], t[(e + 1) % 3]), std::max(t[e], t[(e + 1) % 3])});
+      for (int e = 0; e < 3; ++e)
+        touched.insert({std::min(t[e], t[(e + 1) % 3]), std::max(t[e], t[(e + 1) % 3])});
       std::swap(t.y, t.z);
       ++flipped;
     }
@@ -172,10 +177,14 @@ MeshCheck sorted_edges_reference(const Mesh& m) {
   MeshCheck c;
   for (std::size_t i = 0; i < edges.size();) {
     std::size_t j = i, forward = 0;
-    for (; j < edges.size() && edges[j].first == edges[i].first; ++j) forward += edges[j].second ? 1 : 0;
-    if (j - i == 1) ++c.boundary_edges;
-    else if (j - i > 2) ++c.non_manifold_edges;
-    else if (forward != 1) ++c.misoriented_edges;
+    for (; j < edges.size() && edges[j].first == edges[i].first; ++j)
+      forward += edges[j].second ? 1 : 0;
+    if (j - i == 1)
+      ++c.boundary_edges;
+    else if (j - i > 2)
+      ++c.non_manifold_edges;
+    else if (forward != 1)
+      ++c.misoriented_edges;
     i = j;
   }
   return c;
@@ -183,14 +192,17 @@ MeshCheck sorted_edges_reference(const Mesh& m) {
 
 }  // namespace
 
-TEST_CASE("check_mesh: random triangle sets (repeated, collapsed, both ways) counted as by sorting all edges") {
+TEST_CASE(
+    "check_mesh: random triangle sets (repeated, collapsed, both ways) counted as by sorting all "
+    "edges") {
   std::mt19937 rng(23);
   for (int trial = 0; trial < 200; ++trial) {
     // Few vertices for many triangles: edges used once, twice either way, and three or more times.
     const auto vertices = std::uniform_int_distribution<std::uint32_t>(1, 12)(rng);
     Mesh m;
     for (std::uint32_t v = 0; v < vertices; ++v)
-      m.positions.emplace_back(std::uniform_real_distribution<float>(-1, 1)(rng), std::uniform_real_distribution<float>(-1, 1)(rng),
+      m.positions.emplace_back(std::uniform_real_distribution<float>(-1, 1)(rng),
+                               std::uniform_real_distribution<float>(-1, 1)(rng),
                                std::uniform_real_distribution<float>(-1, 1)(rng));
     std::uniform_int_distribution<std::uint32_t> pick(0, vertices - 1);
     const int triangles = std::uniform_int_distribution<int>(0, 40)(rng);

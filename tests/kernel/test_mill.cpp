@@ -22,8 +22,10 @@ KindCase random_cutter(int kind, std::mt19937& rng) {
   std::uniform_real_distribution<double> u(0, 1);
   double r = 0.6 + 2.5 * u(rng);
   switch (kind % 6) {
-    case 0: return {Cutter::flat(r), test::flat_rho(r)};
-    case 1: return {Cutter::ball(r), test::ball_rho(r)};
+    case 0:
+      return {Cutter::flat(r), test::flat_rho(r)};
+    case 1:
+      return {Cutter::ball(r), test::ball_rho(r)};
     case 2: {
       double c = r * (0.1 + 0.8 * u(rng));
       return {Cutter::bull_nose(r, c), test::bull_rho(r, c)};
@@ -51,12 +53,23 @@ std::vector<Segment> random_segments(std::mt19937& rng, int count) {
   for (int k = 0; k < count; ++k) {
     Vec3 a(x(rng), y(rng), z(rng)), b(x(rng), y(rng), z(rng));
     switch (k % 6) {
-      case 0: b = Vec3(a.x, a.y, z(rng)); break;                     // plunge or retract
-      case 1: b = a; break;                                          // zero length
-      case 2: b.z = a.z; break;                                      // horizontal
-      case 3: b = a + Vec3(0.5 * u(rng), 0.5 * u(rng), 0.3 * u(rng)); break;  // short
-      case 4: b = Vec3(a.x + 1e-9, a.y, z(rng)); break;              // nearly vertical
-      default: break;
+      case 0:
+        b = Vec3(a.x, a.y, z(rng));
+        break;  // plunge or retract
+      case 1:
+        b = a;
+        break;  // zero length
+      case 2:
+        b.z = a.z;
+        break;  // horizontal
+      case 3:
+        b = a + Vec3(0.5 * u(rng), 0.5 * u(rng), 0.3 * u(rng));
+        break;  // short
+      case 4:
+        b = Vec3(a.x + 1e-9, a.y, z(rng));
+        break;  // nearly vertical
+      default:
+        break;
     }
     s.push_back({a, b});
   }
@@ -65,7 +78,8 @@ std::vector<Segment> random_segments(std::mt19937& rng, int count) {
 
 }  // namespace
 
-TEST_CASE("the ball end's vector form agrees with the scalar one, and its plane and across bound hold") {
+TEST_CASE(
+    "the ball end's vector form agrees with the scalar one, and its plane and across bound hold") {
   // BallLanes (one square root, kLanes points) against MoveGeometry (the closed form for t*):
   // heights, coverage, the supporting plane, and the quadratic rise across the move.
   std::mt19937 rng(41);
@@ -75,7 +89,7 @@ TEST_CASE("the ball end's vector form agrees with the scalar one, and its plane 
   int covered = 0, planes = 0;
   for (int trial = 0; trial < 4000; ++trial) {
     Segment s{Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng))};
-    if (trial % 4 == 0) s.b.z = s.a.z;  // level
+    if (trial % 4 == 0) s.b.z = s.a.z;                                               // level
     if (trial % 7 == 0) s.b = s.a + Vec3(0.01 * u(rng), 0.01 * u(rng), 2 * u(rng));  // steep
     detail::MoveGeometry m(ball, s);
     if (m.vertical) continue;
@@ -89,7 +103,8 @@ TEST_CASE("the ball end's vector form agrees with the scalar one, and its plane 
       CAPTURE(trial);
       if (!(expected < 1e300)) {
         // Not covered: the vector form agrees, unless the point is on the rim within rounding.
-        const double rim_gap = std::sqrt(distance2_point_segment(Vec2(x[l], y[l]), Vec2(s.a), Vec2(s.b))) - r;
+        const double rim_gap =
+            std::sqrt(distance2_point_segment(Vec2(x[l], y[l]), Vec2(s.a), Vec2(s.b))) - r;
         CHECK((z[l] > 1e300 || std::abs(rim_gap) < 1e-9));
         continue;
       }
@@ -104,8 +119,8 @@ TEST_CASE("the ball end's vector form agrees with the scalar one, and its plane 
         const double s_q = m.lowest_above(qx, qy);
         if (!(s_q < 1e300)) continue;
         const double across = (qx - x[l]) * lanes.nx + (qy - y[l]) * lanes.ny;
-        const double bound =
-            p.z[l] + p.gx[l] * (qx - x[l]) + p.gy[l] * (qy - y[l]) + across * across * lanes.inv_diameter;
+        const double bound = p.z[l] + p.gx[l] * (qx - x[l]) + p.gy[l] * (qy - y[l]) +
+                             across * across * lanes.inv_diameter;
         REQUIRE(s_q >= bound - 1e-9);
       }
     }
@@ -126,7 +141,7 @@ TEST_CASE("the flat end's and the bull nose's vector forms agree with the scalar
     const bool flat = trial % 3 == 0;
     const Cutter cutter = flat ? Cutter::flat(r) : Cutter::bull_nose(r, corner);
     Segment s{Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng))};
-    if (trial % 4 == 0) s.b.z = s.a.z;                                                  // level
+    if (trial % 4 == 0) s.b.z = s.a.z;                                               // level
     if (trial % 7 == 0) s.b = s.a + Vec3(0.01 * u(rng), 0.01 * u(rng), 2 * u(rng));  // steep
     if (trial % 11 == 0) s.b = s.a + Vec3(2 * u(rng), 2 * u(rng), 1e-4 * u(rng));    // nearly level
     detail::MoveGeometry m(cutter, s);
@@ -135,7 +150,8 @@ TEST_CASE("the flat end's and the bull nose's vector forms agree with the scalar
     detail::BullLanes bull_lanes(m);
     detail::DoubleN x{}, y{};
     detail::MaskN wanted{};
-    for (int l = 0; l < detail::kLanes; ++l) x[l] = 3 * u(rng), y[l] = 3 * u(rng), wanted[l] = l % 5 == 4 ? 0 : -1;
+    for (int l = 0; l < detail::kLanes; ++l)
+      x[l] = 3 * u(rng), y[l] = 3 * u(rng), wanted[l] = l % 5 == 4 ? 0 : -1;
     const detail::DoubleN z = flat ? flat_lanes.at(x - flat_lanes.ax, y - flat_lanes.ay)
                                    : bull_lanes.at(x - bull_lanes.ax, y - bull_lanes.ay, wanted);
     for (int l = 0; l < detail::kLanes; ++l) {
@@ -147,7 +163,8 @@ TEST_CASE("the flat end's and the bull nose's vector forms agree with the scalar
         continue;
       }
       if (!(expected < 1e300)) {
-        const double rim_gap = std::sqrt(distance2_point_segment(Vec2(x[l], y[l]), Vec2(s.a), Vec2(s.b))) - r;
+        const double rim_gap =
+            std::sqrt(distance2_point_segment(Vec2(x[l], y[l]), Vec2(s.a), Vec2(s.b))) - r;
         CHECK((z[l] > 1e300 || std::abs(rim_gap) < 1e-9));
         continue;
       }
@@ -166,9 +183,9 @@ TEST_CASE("the other profiles' vector form agrees with the scalar one") {
   // polyline profile, on rising, falling, level, steep and nearly level moves; only wanted lanes.
   std::mt19937 rng(17);
   std::uniform_real_distribution<double> u(-1, 1);
-  const std::array<Cutter, 4> cutters{Cutter::cone(1.7, 35), Cutter::chamfer(1.7, 0.6, 50),
-                                      Cutter::tapered_ball(1.7, 0.8, 12),
-                                      Cutter::from_profile({Vec2(0.4, 0), Vec2(0.9, 0.1), Vec2(1.4, 0.5), Vec2(1.7, 1.2)})};
+  const std::array<Cutter, 4> cutters{
+      Cutter::cone(1.7, 35), Cutter::chamfer(1.7, 0.6, 50), Cutter::tapered_ball(1.7, 0.8, 12),
+      Cutter::from_profile({Vec2(0.4, 0), Vec2(0.9, 0.1), Vec2(1.4, 0.5), Vec2(1.7, 1.2)})};
   std::array<int, 4> covered{};
   std::array<int, 4> inside{};  // minimiser strictly inside the move
   for (int trial = 0; trial < 8000; ++trial) {
@@ -176,7 +193,7 @@ TEST_CASE("the other profiles' vector form agrees with the scalar one") {
     const Cutter& cutter = cutters[kind];
     REQUIRE(detail::ProfileLanes::closed_form(cutter));
     Segment s{Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng))};
-    if (trial % 5 == 0) s.b.z = s.a.z;                                                  // level
+    if (trial % 5 == 0) s.b.z = s.a.z;                                               // level
     if (trial % 7 == 0) s.b = s.a + Vec3(0.01 * u(rng), 0.01 * u(rng), 2 * u(rng));  // steep
     if (trial % 11 == 0) s.b = s.a + Vec3(2 * u(rng), 2 * u(rng), 1e-4 * u(rng));    // nearly level
     detail::MoveGeometry m(cutter, s);
@@ -184,7 +201,8 @@ TEST_CASE("the other profiles' vector form agrees with the scalar one") {
     detail::ProfileLanes lanes(m);
     detail::DoubleN x{}, y{};
     detail::MaskN wanted{};
-    for (int l = 0; l < detail::kLanes; ++l) x[l] = 3 * u(rng), y[l] = 3 * u(rng), wanted[l] = l % 5 == 4 ? 0 : -1;
+    for (int l = 0; l < detail::kLanes; ++l)
+      x[l] = 3 * u(rng), y[l] = 3 * u(rng), wanted[l] = l % 5 == 4 ? 0 : -1;
     const detail::DoubleN z = lanes.at(x - lanes.ax, y - lanes.ay, wanted);
     for (int l = 0; l < detail::kLanes; ++l) {
       CAPTURE(trial);
@@ -195,7 +213,8 @@ TEST_CASE("the other profiles' vector form agrees with the scalar one") {
       }
       const detail::MoveGeometry::Lowest expected = m.lowest(x[l], y[l]);
       if (!(expected.z < 1e300)) {
-        const double rim_gap = std::sqrt(distance2_point_segment(Vec2(x[l], y[l]), Vec2(s.a), Vec2(s.b))) - 1.7;
+        const double rim_gap =
+            std::sqrt(distance2_point_segment(Vec2(x[l], y[l]), Vec2(s.a), Vec2(s.b))) - 1.7;
         CHECK((z[l] > 1e300 || std::abs(rim_gap) < 1e-9));
         continue;
       }
@@ -221,10 +240,13 @@ TEST_CASE("the bull nose's root: extreme slopes and corners, and each point's va
   const double r = 2;
   int inside = 0;
   for (int trial = 0; trial < 3000; ++trial) {
-    const double corner = r * std::array{0.01, 0.1, 0.5, 0.9, 0.99}[static_cast<std::size_t>(trial % 5)];
-    const double slope = std::pow(10.0, -6 + 9 * unit(rng)), angle = 6.3 * unit(rng), length = 0.2 + 3 * unit(rng);
+    const double corner =
+        r * std::array{0.01, 0.1, 0.5, 0.9, 0.99}[static_cast<std::size_t>(trial % 5)];
+    const double slope = std::pow(10.0, -6 + 9 * unit(rng)), angle = 6.3 * unit(rng),
+                 length = 0.2 + 3 * unit(rng);
     const Vec3 a(u(rng), u(rng), u(rng));
-    const Segment s{a, a + Vec3(length * std::cos(angle), length * std::sin(angle), (trial % 2 ? 1 : -1) * slope * length)};
+    const Segment s{a, a + Vec3(length * std::cos(angle), length * std::sin(angle),
+                                (trial % 2 ? 1 : -1) * slope * length)};
     const Cutter cutter = Cutter::bull_nose(r, corner);
     detail::MoveGeometry m(cutter, s);
     detail::BullLanes bull(m);
@@ -255,7 +277,9 @@ TEST_CASE("the bull nose's root: extreme slopes and corners, and each point's va
   CHECK(inside > 1000 * detail::kLanes);
 }
 
-TEST_CASE("the vector supporting planes (flat end, bull nose, other profiles): the scalar ones, and below S everywhere") {
+TEST_CASE(
+    "the vector supporting planes (flat end, bull nose, other profiles): the scalar ones, and "
+    "below S everywhere") {
   // FlatLanes::plane_at, BullLanes::plane_at and ProfileLanes::plane_at against
   // MoveGeometry::lowest_with_plane, and S(q) ≥ S(c) + g·(q − c) at random q around c (S is
   // convex; the flat end's plane is its tangent at the end disc's entry edge, the others'
@@ -267,7 +291,7 @@ TEST_CASE("the vector supporting planes (flat end, bull nose, other profiles): t
   auto check = [&](const Cutter& cutter, auto make_lanes, int& planes, int& sloped) {
     for (int trial = 0; trial < 4000; ++trial) {
       Segment s{Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng))};
-      if (trial % 4 == 0) s.b.z = s.a.z;                                                  // level
+      if (trial % 4 == 0) s.b.z = s.a.z;                                               // level
       if (trial % 7 == 0) s.b = s.a + Vec3(0.01 * u(rng), 0.01 * u(rng), 2 * u(rng));  // steep
       detail::MoveGeometry m(cutter, s);
       if (m.vertical) continue;
@@ -295,27 +319,34 @@ TEST_CASE("the vector supporting planes (flat end, bull nose, other profiles): t
         for (int k = 0; k < 20; ++k) {
           const double qx = x[l] + 0.5 * u(rng), qy = y[l] + 0.5 * u(rng);
           const double s_q = m.lowest_above(qx, qy);
-          if (s_q < 1e300) REQUIRE(s_q >= p.z[l] + p.gx[l] * (qx - x[l]) + p.gy[l] * (qy - y[l]) - 1e-9);
+          if (s_q < 1e300)
+            REQUIRE(s_q >= p.z[l] + p.gx[l] * (qx - x[l]) + p.gy[l] * (qy - y[l]) - 1e-9);
         }
       }
     }
   };
   int planes = 0, sloped = 0;
-  check(Cutter::flat(r), [](const detail::MoveGeometry& m) { return detail::FlatLanes(m); }, planes, sloped);
+  check(
+      Cutter::flat(r), [](const detail::MoveGeometry& m) { return detail::FlatLanes(m); }, planes,
+      sloped);
   CHECK(planes > 1000);
   CHECK(sloped > 300);
   int bull_planes = 0, bull_sloped = 0;
-  check(Cutter::bull_nose(r, 0.6), [](const detail::MoveGeometry& m) { return detail::BullLanes(m); }, bull_planes,
-        bull_sloped);
+  check(
+      Cutter::bull_nose(r, 0.6), [](const detail::MoveGeometry& m) { return detail::BullLanes(m); },
+      bull_planes, bull_sloped);
   CHECK(bull_planes > 1000);
   CHECK(bull_sloped > 1000);
-  const std::array<Cutter, 4> profiles{Cutter::cone(r, 35), Cutter::chamfer(r, 0.5, 50), Cutter::tapered_ball(r, 0.6, 12),
-                                       Cutter::from_profile({Vec2(0.3, 0), Vec2(0.7, 0.1), Vec2(1.0, 0.4), Vec2(r, 0.9)})};
+  const std::array<Cutter, 4> profiles{
+      Cutter::cone(r, 35), Cutter::chamfer(r, 0.5, 50), Cutter::tapered_ball(r, 0.6, 12),
+      Cutter::from_profile({Vec2(0.3, 0), Vec2(0.7, 0.1), Vec2(1.0, 0.4), Vec2(r, 0.9)})};
   for (const Cutter& cutter : profiles) {
     CAPTURE(cutter.name());
     REQUIRE(detail::ProfileLanes::closed_form(cutter));
     int profile_planes = 0, profile_sloped = 0;
-    check(cutter, [](const detail::MoveGeometry& m) { return detail::ProfileLanes(m); }, profile_planes, profile_sloped);
+    check(
+        cutter, [](const detail::MoveGeometry& m) { return detail::ProfileLanes(m); },
+        profile_planes, profile_sloped);
     CHECK(profile_planes > 1000);
     CHECK(profile_sloped > 1000);
   }
@@ -396,7 +427,8 @@ TEST_CASE("a tilted Z-map: a flat end plunge in the frame leaves a flat-bottomed
   ZMap map = ZMap::from_box(f, Aabb{Vec3(0), Vec3(10, 10, 10)}, 0.1);
   Vec3 centre_local = f.to_local(Vec3(10, 5, 5));
   std::vector<Cutter> cutters{Cutter::flat(2)};
-  std::vector<CutMove> moves{{Segment{centre_local + Vec3(0, 0, 5), centre_local - Vec3(0, 0, 3)}, 0}};
+  std::vector<CutMove> moves{
+      {Segment{centre_local + Vec3(0, 0, 5), centre_local - Vec3(0, 0, 3)}, 0}};
   mill(map, cutters, moves);
   int i = static_cast<int>(std::lround((centre_local.x - map.grid.x0) / map.grid.cell));
   int j = static_cast<int>(std::lround((centre_local.y - map.grid.y0) / map.grid.cell));
@@ -432,7 +464,9 @@ TEST_CASE("bad moves are rejected before anything is milled") {
 // A raster over a wavy surface, and a plunge: many moves reach every tile, so most are skipped
 // by the tile, row and plane bounds.
 std::vector<Segment> dense_raster() {
-  auto wavy = [](double x, double y) { return 2 + 0.8 * std::sin(x / 1.3) * std::cos(y / 1.7) + 0.05 * x; };
+  auto wavy = [](double x, double y) {
+    return 2 + 0.8 * std::sin(x / 1.3) * std::cos(y / 1.7) + 0.05 * x;
+  };
   std::vector<Segment> path;
   for (int line = 0; line <= 24; ++line) {
     double y = line * 0.25;
@@ -465,7 +499,8 @@ TEST_CASE("tile skipping never skips a point a move lowers (dense raster, every 
     for (int j = 0; j < g.ny; j += 3)
       for (int i = 0; i < g.nx; i += 3) {
         double expected = 4;
-        for (const detail::MoveGeometry& m : geometry) expected = std::min(expected, m.lowest_above(g.x(i), g.y(j)));
+        for (const detail::MoveGeometry& m : geometry)
+          expected = std::min(expected, m.lowest_above(g.x(i), g.y(j)));
         expected = std::max(expected, -1.0);
         if (std::abs(map.height(i, j) - expected) > 1e-5) ++mismatches;
       }
@@ -476,14 +511,17 @@ TEST_CASE("tile skipping never skips a point a move lowers (dense raster, every 
 TEST_CASE("moves of several cutters in one call: each point at the lowest of them all") {
   // The ball end's vector path and the scalar path of the others share tiles and bounds.
   const std::vector<Segment> path = dense_raster();
-  std::vector<Cutter> cutters{Cutter::ball(0.8), Cutter::bull_nose(1.1, 0.3), Cutter::flat(0.6), Cutter::ball(1.7)};
+  std::vector<Cutter> cutters{Cutter::ball(0.8), Cutter::bull_nose(1.1, 0.3), Cutter::flat(0.6),
+                              Cutter::ball(1.7)};
   ZMapGrid g;
   g.x0 = -0.5, g.y0 = -0.5, g.cell = 0.02, g.nx = 350, g.ny = 350;
   ZMap map(g, 4, -1);
   std::vector<CutMove> moves;
   for (std::size_t k = 0; k < path.size(); ++k) {
-    const Vec3 lift(0, 0, 0.1 * static_cast<double>(k % 3));  // so that every cutter shows somewhere
-    moves.push_back({Segment{path[k].a + lift, path[k].b + lift}, static_cast<std::uint32_t>(k % cutters.size())});
+    const Vec3 lift(0, 0,
+                    0.1 * static_cast<double>(k % 3));  // so that every cutter shows somewhere
+    moves.push_back({Segment{path[k].a + lift, path[k].b + lift},
+                     static_cast<std::uint32_t>(k % cutters.size())});
   }
   mill(map, cutters, moves);
   int mismatches = 0;
@@ -491,7 +529,8 @@ TEST_CASE("moves of several cutters in one call: each point at the lowest of the
     for (int i = 0; i < g.nx; i += 2) {
       double expected = 4;
       for (const CutMove& m : moves)
-        expected = std::min(expected, detail::MoveGeometry(cutters[m.cutter], m.tip).lowest_above(g.x(i), g.y(j)));
+        expected = std::min(
+            expected, detail::MoveGeometry(cutters[m.cutter], m.tip).lowest_above(g.x(i), g.y(j)));
       expected = std::max(expected, -1.0);
       if (std::abs(map.height(i, j) - expected) > 1e-5) ++mismatches;
     }
@@ -528,10 +567,12 @@ TEST_CASE("cut_depth: how deep a move would cut, equal to what milling it remove
   }
   CHECK(cutting >= 6);
   CHECK(cut_depth(ZMap(ZMapGrid{Frame{}, 0, 0, 1, 4, 4}, 0, -1), Cutter::ball(1),
-                  Segment{Vec3(100, 100, 0), Vec3(101, 100, 0)}).i == -1);
+                  Segment{Vec3(100, 100, 0), Vec3(101, 100, 0)})
+            .i == -1);
 }
 
-TEST_CASE("mixed cutters: random moves of every kind in one call, and roughing below or above a finish") {
+TEST_CASE(
+    "mixed cutters: random moves of every kind in one call, and roughing below or above a finish") {
   // Each point at the lowest of every move, evaluated everywhere (no bounds): the vector forms,
   // the scalar path and the tile, row and plane bounds of a tile whose first cut was any cutter.
   std::mt19937 rng(77);
@@ -542,14 +583,17 @@ TEST_CASE("mixed cutters: random moves of every kind in one call, and roughing b
   for (const Segment& s : random_segments(rng, 240)) random_moves.push_back({s, pick(rng)});
   // A flat end (1) or bull nose (2) raster 0.3 below or 0.2 above a ball end (0) raster.
   const std::vector<Segment> path = dense_raster();
-  std::vector<Cutter> raster_cutters{Cutter::ball(0.7), Cutter::flat(1.2), Cutter::bull_nose(1.1, 0.35)};
+  std::vector<Cutter> raster_cutters{Cutter::ball(0.7), Cutter::flat(1.2),
+                                     Cutter::bull_nose(1.1, 0.35)};
   std::vector<std::vector<CutMove>> raster_cases;
   for (std::uint32_t rough : {1u, 2u})
     for (double lift : {-0.3, 0.2}) {
       std::vector<CutMove> moves;
       for (std::size_t k = 0; k < path.size(); ++k) {
         moves.push_back({path[k], 0});
-        if (k % 2 == 0) moves.push_back({Segment{path[k].a + Vec3(0, 0, lift), path[k].b + Vec3(0, 0, lift)}, rough});
+        if (k % 2 == 0)
+          moves.push_back(
+              {Segment{path[k].a + Vec3(0, 0, lift), path[k].b + Vec3(0, 0, lift)}, rough});
       }
       raster_cases.push_back(moves);
     }
@@ -564,7 +608,8 @@ TEST_CASE("mixed cutters: random moves of every kind in one call, and roughing b
     for (int j = 0; j < g.ny; j += 2)
       for (int i = 0; i < g.nx; i += 2) {
         double expected = 4;
-        for (const detail::MoveGeometry& m : geometry) expected = std::min(expected, m.lowest_above(g.x(i), g.y(j)));
+        for (const detail::MoveGeometry& m : geometry)
+          expected = std::min(expected, m.lowest_above(g.x(i), g.y(j)));
         expected = std::max(expected, -1.0);
         if (std::abs(map.height(i, j) - expected) > 1e-5) ++mismatches;
         if (expected < 4) ++lowered;

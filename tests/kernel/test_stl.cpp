@@ -52,7 +52,8 @@ TEST_CASE("STL: binary write then read gives back the same closed mesh") {
   fs::path dir = scratch_dir();
   std::mt19937 rng(12);
   std::uniform_real_distribution<double> unit(-10, 10);
-  std::vector<Mesh> shapes{box_mesh(Vec3(unit(rng)), Vec3(11)), sphere_mesh(Vec3(unit(rng), unit(rng), unit(rng)), 3.3),
+  std::vector<Mesh> shapes{box_mesh(Vec3(unit(rng)), Vec3(11)),
+                           sphere_mesh(Vec3(unit(rng), unit(rng), unit(rng)), 3.3),
                            torus_mesh(Vec3(1, 2, 3), 4, 1.5), cylinder_mesh(Vec3(-1), 2, 5)};
   for (std::size_t k = 0; k < shapes.size(); ++k) {
     fs::path path = dir / ("shape" + std::to_string(k) + ".stl");
@@ -75,7 +76,8 @@ TEST_CASE("STL: binary write then read gives back the same closed mesh") {
     }
   }
   // No temporary files are left behind.
-  for (const auto& entry : fs::directory_iterator(dir)) CHECK(entry.path().string().find(".tmp-") == std::string::npos);
+  for (const auto& entry : fs::directory_iterator(dir))
+    CHECK(entry.path().string().find(".tmp-") == std::string::npos);
   fs::remove_all(dir);
 }
 
@@ -91,13 +93,17 @@ TEST_CASE("STL: a binary file whose header begins with 'solid' is read as binary
   CHECK(corner_set(back) == corner_set(cube));
   // Truncated by a few bytes: an error naming the file, for both header kinds.
   write_bytes(dir / "truncated.stl", bytes.substr(0, bytes.size() - 7));
-  CHECK_THROWS_WITH_AS(read_stl((dir / "truncated.stl").string()), doctest::Contains("truncated"), Error);
+  CHECK_THROWS_WITH_AS(read_stl((dir / "truncated.stl").string()), doctest::Contains("truncated"),
+                       Error);
   std::string plain = out.str();
   write_bytes(dir / "truncated2.stl", plain.substr(0, plain.size() - 50));
-  CHECK_THROWS_WITH_AS(read_stl((dir / "truncated2.stl").string()), doctest::Contains("truncated"), Error);
+  CHECK_THROWS_WITH_AS(read_stl((dir / "truncated2.stl").string()), doctest::Contains("truncated"),
+                       Error);
   write_bytes(dir / "short.stl", std::string(40, '\x01'));
-  CHECK_THROWS_WITH_AS(read_stl((dir / "short.stl").string()), doctest::Contains("too short"), Error);
-  CHECK_THROWS_WITH_AS(read_stl((dir / "missing.stl").string()), doctest::Contains("cannot open"), Error);
+  CHECK_THROWS_WITH_AS(read_stl((dir / "short.stl").string()), doctest::Contains("too short"),
+                       Error);
+  CHECK_THROWS_WITH_AS(read_stl((dir / "missing.stl").string()), doctest::Contains("cannot open"),
+                       Error);
   fs::remove_all(dir);
 }
 
@@ -115,19 +121,24 @@ TEST_CASE("STL: ASCII fixtures, CRLF and exponents; open meshes rejected when as
 
 TEST_CASE("STL: malformed ASCII names the line") {
   fs::path dir = scratch_dir();
-  const std::string good = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid t\n";
+  const std::string good =
+      "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 "
+      "0\nendloop\nendfacet\nendsolid t\n";
   write_bytes(dir / "good.stl", good);
   CHECK(read_stl((dir / "good.stl").string()).triangles.size() == 1);
   struct Case {
     std::string from, to, message;
   };
-  for (const Case& c : {Case{"vertex 0 1 0\n", "", "line 6"}, Case{"vertex 1 0 0", "vertex 1 x 0", "line 5"},
-                        Case{"vertex 1 0 0", "vertex 1 nan 0", "line 5"}, Case{"endsolid t\n", "", "without 'endsolid'"},
-                        Case{"outer loop", "outer", "line 4"}, Case{"endfacet", "endface", "line 8"}}) {
+  for (const Case& c :
+       {Case{"vertex 0 1 0\n", "", "line 6"}, Case{"vertex 1 0 0", "vertex 1 x 0", "line 5"},
+        Case{"vertex 1 0 0", "vertex 1 nan 0", "line 5"},
+        Case{"endsolid t\n", "", "without 'endsolid'"}, Case{"outer loop", "outer", "line 4"},
+        Case{"endfacet", "endface", "line 8"}}) {
     std::string text = good;
     text.replace(text.find(c.from), c.from.size(), c.to);
     write_bytes(dir / "bad.stl", text);
-    CHECK_THROWS_WITH_AS(read_stl((dir / "bad.stl").string()), doctest::Contains(c.message.c_str()), Error);
+    CHECK_THROWS_WITH_AS(read_stl((dir / "bad.stl").string()), doctest::Contains(c.message.c_str()),
+                         Error);
   }
   fs::remove_all(dir);
 }
@@ -140,7 +151,8 @@ TEST_CASE("STL: writing into a missing directory fails cleanly; an invalid mesh 
   bad.triangles.emplace_back(0u, 1u, 99u);
   CHECK_THROWS_AS(write_stl((dir / "bad.stl").string(), bad), Error);
   CHECK(!fs::exists(dir / "bad.stl"));
-  for (const auto& entry : fs::directory_iterator(dir)) CHECK(entry.path().string().find(".tmp-") == std::string::npos);
+  for (const auto& entry : fs::directory_iterator(dir))
+    CHECK(entry.path().string().find(".tmp-") == std::string::npos);
   // An existing file is replaced whole.
   write_stl((dir / "x.stl").string(), sphere_mesh(Vec3(0), 1));
   write_stl((dir / "x.stl").string(), cube);

@@ -52,7 +52,8 @@ Solid cylinder(const Vec3& c, double r, double half_height) {  // axis z
     Vec2 d(glm::length(Vec2(p.x - c.x, p.y - c.y)) - r, std::abs(p.z - c.z) - half_height);
     return std::min(std::max(d.x, d.y), 0.0) + glm::length(glm::max(d, Vec2(0)));
   };
-  return {"cylinder", sdf, kPi * r * r * 2 * half_height, 2 * kPi * r * r + 2 * kPi * r * 2 * half_height,
+  return {"cylinder", sdf, kPi * r * r * 2 * half_height,
+          2 * kPi * r * r + 2 * kPi * r * 2 * half_height,
           Aabb{c - Vec3(r, r, half_height), c + Vec3(r, r, half_height)}};
 }
 Solid torus(const Vec3& c, double major, double minor) {  // axis z
@@ -79,12 +80,14 @@ Solid two_spheres(const Vec3& c, double r, double a, const Vec3& dir) {
   double cap = kPi * cap_h * cap_h * (3 * r - cap_h) / 3;
   auto sdf = [=](const Vec3& p) { return std::min(sphere_sdf(p, c1, r), sphere_sdf(p, c2, r)); };
   Aabb b{glm::min(c1, c2) - Vec3(r), glm::max(c1, c2) + Vec3(r)};
-  return {"two spheres", sdf, 2 * (4.0 / 3.0 * kPi * r * r * r) - 2 * cap, 2 * (4 * kPi * r * r - 2 * kPi * r * cap_h), b};
+  return {"two spheres", sdf, 2 * (4.0 / 3.0 * kPi * r * r * r) - 2 * cap,
+          2 * (4 * kPi * r * r - 2 * kPi * r * cap_h), b};
 }
 
 // Intervals of {sdf < 0} along ray `a` through (pu, pv) over [lo, hi]: sign changes at steps of
 // step, refined by bisection.
-std::vector<DexelInterval> ray_intervals(const Solid& s, int a, double pu, double pv, double lo, double hi, double step) {
+std::vector<DexelInterval> ray_intervals(const Solid& s, int a, double pu, double pv, double lo,
+                                         double hi, double step) {
   int u = TripleDexel::u_axis(a), v = TripleDexel::v_axis(a);
   auto f = [&](double t) {
     Vec3 p;
@@ -108,8 +111,10 @@ std::vector<DexelInterval> ray_intervals(const Solid& s, int a, double pu, doubl
     bool in1 = f(t1) < 0;
     if (in1 != inside) {
       double x = root(t, t1);
-      if (in1) enter = x;
-      else out.push_back({float(enter), float(x)});
+      if (in1)
+        enter = x;
+      else
+        out.push_back({float(enter), float(x)});
       inside = in1;
     }
     t = t1;
@@ -119,8 +124,10 @@ std::vector<DexelInterval> ray_intervals(const Solid& s, int a, double pu, doubl
   std::vector<DexelInterval> clean;
   for (DexelInterval s2 : out) {
     if (!(s2.enter < s2.exit)) continue;
-    if (!clean.empty() && !(s2.enter > clean.back().exit)) clean.back().exit = std::max(clean.back().exit, s2.exit);
-    else clean.push_back(s2);
+    if (!clean.empty() && !(s2.enter > clean.back().exit))
+      clean.back().exit = std::max(clean.back().exit, s2.exit);
+    else
+      clean.push_back(s2);
   }
   return clean;
 }
@@ -130,11 +137,14 @@ TripleDexel dexelize_solid(const Solid& s, const DexelLattice& lattice) {
   for (int a = 0; a < 3; ++a) {
     DexelGrid& g = d.grids[a];
     int u = TripleDexel::u_axis(a), v = TripleDexel::v_axis(a);
-    double lo = lattice.origin[a] - lattice.spacing, hi = lattice.origin[a] + lattice.spacing * lattice.n[a];
+    double lo = lattice.origin[a] - lattice.spacing,
+           hi = lattice.origin[a] + lattice.spacing * lattice.n[a];
     for (int iv = 0; iv < g.nv; ++iv)
       for (int iu = 0; iu < g.nu; ++iu) {
-        double pu = lattice.origin[u] + lattice.spacing * iu, pv = lattice.origin[v] + lattice.spacing * iv;
-        for (DexelInterval x : ray_intervals(s, a, pu, pv, lo, hi, lattice.spacing / 16)) g.intervals.push_back(x);
+        double pu = lattice.origin[u] + lattice.spacing * iu,
+               pv = lattice.origin[v] + lattice.spacing * iv;
+        for (DexelInterval x : ray_intervals(s, a, pu, pv, lo, hi, lattice.spacing / 16))
+          g.intervals.push_back(x);
         g.offsets[g.ray_index(iu, iv) + 1] = static_cast<std::uint32_t>(g.intervals.size());
       }
   }
@@ -151,7 +161,8 @@ TripleDexel box_dexel(const DexelLattice& lattice, const Aabb& b) {
     int u = TripleDexel::u_axis(a), v = TripleDexel::v_axis(a);
     for (int iv = 0; iv < g.nv; ++iv)
       for (int iu = 0; iu < g.nu; ++iu) {
-        double pu = lattice.origin[u] + lattice.spacing * iu, pv = lattice.origin[v] + lattice.spacing * iv;
+        double pu = lattice.origin[u] + lattice.spacing * iu,
+               pv = lattice.origin[v] + lattice.spacing * iv;
         if (pu >= b.min[u] && pu < b.max[u] && pv >= b.min[v] && pv < b.max[v])
           g.intervals.push_back({float(b.min[a]), float(b.max[a])});
         g.offsets[g.ray_index(iu, iv) + 1] = static_cast<std::uint32_t>(g.intervals.size());
@@ -185,7 +196,8 @@ double point_triangle_distance(const Vec3& p, const Vec3& a, const Vec3& b, cons
 double distance_to_mesh(const Mesh& m, const Vec3& p) {
   double best = std::numeric_limits<double>::infinity();
   for (const glm::uvec3& t : m.triangles)
-    best = std::min(best, point_triangle_distance(p, Vec3(m.positions[t.x]), Vec3(m.positions[t.y]), Vec3(m.positions[t.z])));
+    best = std::min(best, point_triangle_distance(p, Vec3(m.positions[t.x]), Vec3(m.positions[t.y]),
+                                                  Vec3(m.positions[t.z])));
   return best;
 }
 
@@ -206,14 +218,16 @@ double mesh_to_surface(const Mesh& m, const Solid& s, std::mt19937& rng) {
 // Random points on the analytic surface (projected along the sdf gradient), farthest from the mesh.
 double surface_to_mesh(const Mesh& m, const Solid& s, std::mt19937& rng, int samples) {
   Aabb b = s.bounds.inflated(0.1 * glm::length(s.bounds.size()));
-  std::uniform_real_distribution<double> x(b.min.x, b.max.x), y(b.min.y, b.max.y), z(b.min.z, b.max.z);
+  std::uniform_real_distribution<double> x(b.min.x, b.max.x), y(b.min.y, b.max.y),
+      z(b.min.z, b.max.z);
   double worst = 0;
   int found = 0;
   for (int tries = 0; found < samples && tries < 100 * samples; ++tries) {
     Vec3 p(x(rng), y(rng), z(rng));
     for (int it = 0; it < 8; ++it) {
       const double e = 1e-6;
-      Vec3 g(s.sdf(p + Vec3(e, 0, 0)) - s.sdf(p - Vec3(e, 0, 0)), s.sdf(p + Vec3(0, e, 0)) - s.sdf(p - Vec3(0, e, 0)),
+      Vec3 g(s.sdf(p + Vec3(e, 0, 0)) - s.sdf(p - Vec3(e, 0, 0)),
+             s.sdf(p + Vec3(0, e, 0)) - s.sdf(p - Vec3(0, e, 0)),
              s.sdf(p + Vec3(0, 0, e)) - s.sdf(p - Vec3(0, 0, e)));
       if (glm::length(g) == 0) break;
       p -= s.sdf(p) * glm::normalize(g);
@@ -230,10 +244,16 @@ Solid random_solid(int kind, std::mt19937& rng) {
   std::uniform_real_distribution<double> c(-3, 3), r(2, 4), dir(-1, 1);
   Vec3 centre(c(rng), c(rng), c(rng));
   switch (kind) {
-    case 0: return sphere(centre, r(rng));
-    case 1: return box(centre - Vec3(r(rng), r(rng), r(rng)), centre + Vec3(r(rng), r(rng), r(rng)));
-    case 2: return cylinder(centre, r(rng), r(rng));
-    case 3: { double major = r(rng) + 1; return torus(centre, major, std::uniform_real_distribution<double>(1.0, major - 1.0)(rng)); }
+    case 0:
+      return sphere(centre, r(rng));
+    case 1:
+      return box(centre - Vec3(r(rng), r(rng), r(rng)), centre + Vec3(r(rng), r(rng), r(rng)));
+    case 2:
+      return cylinder(centre, r(rng), r(rng));
+    case 3: {
+      double major = r(rng) + 1;
+      return torus(centre, major, std::uniform_real_distribution<double>(1.0, major - 1.0)(rng));
+    }
     case 4: {
       Vec3 lo = centre - Vec3(4, 4, 3), hi = centre + Vec3(4, 4, 1.5);
       return pocketed_box(lo, hi, std::uniform_real_distribution<double>(1.5, 3.0)(rng));
@@ -242,7 +262,8 @@ Solid random_solid(int kind, std::mt19937& rng) {
       Vec3 d(dir(rng), dir(rng), dir(rng));
       if (glm::length(d) < 0.1) d = Vec3(1, 0, 0);
       double rad = r(rng);
-      return two_spheres(centre, rad, std::uniform_real_distribution<double>(0.2, 0.8)(rng) * rad, glm::normalize(d));
+      return two_spheres(centre, rad, std::uniform_real_distribution<double>(0.2, 0.8)(rng) * rad,
+                         glm::normalize(d));
     }
   }
 }
@@ -262,7 +283,8 @@ std::size_t non_manifold_vertices(const Mesh& m) {
     std::sort(l.begin(), l.end());
     auto next = [&](std::uint32_t a) {
       auto it = std::lower_bound(l.begin(), l.end(), std::make_pair(a, std::uint32_t(0)));
-      return it != l.end() && it->first == a ? std::optional<std::uint32_t>(it->second) : std::nullopt;
+      return it != l.end() && it->first == a ? std::optional<std::uint32_t>(it->second)
+                                             : std::nullopt;
     };
     std::uint32_t start = l[0].first, at = start;
     std::size_t steps = 0;
@@ -333,15 +355,18 @@ TEST_CASE("extract_surface: a full lattice gives its six faces with the exact vo
   }
 }
 
-TEST_CASE("extract_surface: analytic solids are closed, without degenerate triangles, with the right volume "
-          "and within one spacing of the surface") {
+TEST_CASE(
+    "extract_surface: analytic solids are closed, without degenerate triangles, with the right "
+    "volume "
+    "and within one spacing of the surface") {
   std::mt19937 rng(2026);
   for (int trial = 0; trial < 18; ++trial) {
     int kind = trial % 6;
     Solid s = random_solid(kind, rng);
     double h = std::uniform_real_distribution<double>(0.22, 0.45)(rng);
     DexelLattice lattice = DexelLattice::covering(s.bounds, h);
-    // Shift the lattice by a random fraction of a cell so nodes fall anywhere relative to the solid.
+    // Shift the lattice by a random fraction of a cell so nodes fall anywhere relative to the
+    // solid.
     std::uniform_real_distribution<double> frac(-0.5, 0.5);
     lattice.origin += h * Vec3(frac(rng), frac(rng), frac(rng));
     TripleDexel d = dexelize_solid(s, lattice);
@@ -387,7 +412,8 @@ TEST_CASE("extract_surface: vertices on lattice edges are the rays' end points")
       int u = TripleDexel::u_axis(off_node), v = TripleDexel::v_axis(off_node);
       double nearest = std::numeric_limits<double>::infinity();
       for (DexelInterval x : d.grids[off_node].ray(int(std::lround(g[u])), int(std::lround(g[v]))))
-        nearest = std::min({nearest, std::abs(double(x.enter) - p[off_node]), std::abs(double(x.exit) - p[off_node])});
+        nearest = std::min({nearest, std::abs(double(x.enter) - p[off_node]),
+                            std::abs(double(x.exit) - p[off_node])});
       // Exact up to float rounding, or moved by at most 1% of a spacing off a node.
       CHECK(nearest <= 0.011 * lattice.spacing);
     }
@@ -395,7 +421,8 @@ TEST_CASE("extract_surface: vertices on lattice edges are the rays' end points")
   }
 }
 
-TEST_CASE("extract_surface: one vertex per sign-changing lattice edge and per inside boundary node") {
+TEST_CASE(
+    "extract_surface: one vertex per sign-changing lattice edge and per inside boundary node") {
   // Brute force over every node and edge of the lattice, independent of the sparse traversal:
   // node states from the z rays (half-open), a crossing vertex on every edge whose two nodes
   // differ, a node vertex on every inside node of the lattice boundary.
@@ -425,7 +452,8 @@ TEST_CASE("extract_surface: one vertex per sign-changing lattice edge and per in
           if (i + 1 < n.x && in != inside(i + 1, j, k)) ++changing_edges;
           if (j + 1 < n.y && in != inside(i, j + 1, k)) ++changing_edges;
           if (k + 1 < n.z && in != inside(i, j, k + 1)) ++changing_edges;
-          bool boundary = i == 0 || j == 0 || k == 0 || i == n.x - 1 || j == n.y - 1 || k == n.z - 1;
+          bool boundary =
+              i == 0 || j == 0 || k == 0 || i == n.x - 1 || j == n.y - 1 || k == n.z - 1;
           if (boundary && in) ++boundary_inside;
         }
     Mesh m = extract_surface(d, {.sharp_features = false});
@@ -466,27 +494,34 @@ TEST_CASE("extract_surface: sharp features keep a box's edges and corners") {
     // Every box corner is a vertex of the sharp mesh (to float precision).
     for (const Vec3& corner : s.bounds.corners()) {
       double nearest = std::numeric_limits<double>::infinity();
-      for (const glm::vec3& p : sharp.positions) nearest = std::min(nearest, glm::length(Vec3(p) - corner));
+      for (const glm::vec3& p : sharp.positions)
+        nearest = std::min(nearest, glm::length(Vec3(p) - corner));
       CHECK(nearest < 1e-4 * h);
     }
   }
 }
 
-TEST_CASE("extract_surface: pockets from dexel Booleans, with faces between or exactly on lattice nodes") {
+TEST_CASE(
+    "extract_surface: pockets from dexel Booleans, with faces between or exactly on lattice "
+    "nodes") {
   // Box A minus box B (a pocket open at the top): concave edges and corners. With `snap`, every
   // face lies on a lattice plane, so rays run inside faces and end points sit on nodes.
   std::mt19937 rng(4);
   const double h = 0.25;
   DexelLattice lattice{Vec3(-0.5), h, glm::ivec3(30)};
-  auto volume_of = [](const Aabb& b) { return b.empty() ? 0.0 : b.size().x * b.size().y * b.size().z; };
+  auto volume_of = [](const Aabb& b) {
+    return b.empty() ? 0.0 : b.size().x * b.size().y * b.size().z;
+  };
   for (int trial = 0; trial < 16; ++trial) {
     bool snap = trial % 2;
     auto coord = [&](double lo, double hi) {
       double x = std::uniform_real_distribution<double>(lo, hi)(rng);
       return snap ? std::round((x + 0.5) / h) * h - 0.5 : x;
     };
-    Aabb a{Vec3(coord(0.3, 1.5), coord(0.3, 1.5), coord(0.3, 1.5)), Vec3(coord(4, 6.5), coord(4, 6.5), coord(4, 6.5))};
-    Aabb b{Vec3(coord(1.5, 3), coord(1.5, 3), coord(2.5, 3.8)), Vec3(coord(3.2, 5), coord(3.2, 5), coord(6.8, 6.9))};
+    Aabb a{Vec3(coord(0.3, 1.5), coord(0.3, 1.5), coord(0.3, 1.5)),
+           Vec3(coord(4, 6.5), coord(4, 6.5), coord(4, 6.5))};
+    Aabb b{Vec3(coord(1.5, 3), coord(1.5, 3), coord(2.5, 3.8)),
+           Vec3(coord(3.2, 5), coord(3.2, 5), coord(6.8, 6.9))};
     TripleDexel d = subtract(box_dexel(lattice, a), box_dexel(lattice, b));
     Aabb common{glm::max(a.min, b.min), glm::min(a.max, b.max)};
     double exact = volume_of(a) - volume_of(common);
@@ -517,14 +552,16 @@ TEST_CASE("extract_surface: a solid cut by the lattice boundary is closed by cap
     check_closed(m);
     // Reference: the solid ∩ lattice box by Monte Carlo integration with a fixed seed.
     Aabb box = lattice.bounds();
-    std::uniform_real_distribution<double> x(box.min.x, box.max.x), y(box.min.y, box.max.y), z(box.min.z, box.max.z);
+    std::uniform_real_distribution<double> x(box.min.x, box.max.x), y(box.min.y, box.max.y),
+        z(box.min.z, box.max.z);
     const int samples = 200000;
     int inside = 0;
     for (int q = 0; q < samples; ++q) inside += s.sdf(Vec3(x(rng), y(rng), z(rng))) < 0;
     Vec3 e = box.size();
     double reference = double(inside) / samples * e.x * e.y * e.z;
     double area = 2 * (e.x * e.y + e.y * e.z + e.z * e.x) + s.area;
-    CHECK(std::abs(m.signed_volume() - reference) <= 0.05 * area * h + 4 * std::sqrt(double(samples)) / samples * e.x * e.y * e.z);
+    CHECK(std::abs(m.signed_volume() - reference) <=
+          0.05 * area * h + 4 * std::sqrt(double(samples)) / samples * e.x * e.y * e.z);
   }
 }
 
@@ -535,7 +572,8 @@ TEST_CASE("extract_surface: far from the origin, float positions stay distinct")
   for (int trial = 0; trial < 3; ++trial) {
     double h = 0.1;
     std::uniform_real_distribution<double> far(-3000, 3000);
-    Solid s = trial == 0 ? sphere(Vec3(far(rng), far(rng), far(rng)), 0.9) : random_solid(trial, rng);
+    Solid s =
+        trial == 0 ? sphere(Vec3(far(rng), far(rng), far(rng)), 0.9) : random_solid(trial, rng);
     if (trial > 0) {  // move the solid far away
       Vec3 shift(far(rng), far(rng), far(rng));
       auto inner = s.sdf;
@@ -576,17 +614,20 @@ TEST_CASE("extract_surface: rays that disagree with each other still give a clos
     TripleDexel d = TripleDexel::empty(lattice);
     for (int a = 0; a < 3; ++a) {
       DexelGrid& g = d.grids[a];
-      double lo = lattice.origin[a] - 1, hi = lattice.origin[a] + lattice.spacing * lattice.n[a] + 1;
+      double lo = lattice.origin[a] - 1,
+             hi = lattice.origin[a] + lattice.spacing * lattice.n[a] + 1;
       std::uniform_int_distribution<int> steps(0, int((hi - lo) / 0.25));
       std::bernoulli_distribution on_node(0.5);
       for (std::size_t r = 0; r < g.ray_count(); ++r) {
         std::vector<double> ends;
         int m = std::uniform_int_distribution<int>(0, 3)(rng) * 2;
         for (int q = 0; q < m; ++q)
-          ends.push_back(on_node(rng) ? lo + 0.25 * steps(rng) : std::uniform_real_distribution<double>(lo, hi)(rng));
+          ends.push_back(on_node(rng) ? lo + 0.25 * steps(rng)
+                                      : std::uniform_real_distribution<double>(lo, hi)(rng));
         std::sort(ends.begin(), ends.end());
         ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
-        for (std::size_t q = 0; q + 1 < ends.size(); q += 2) g.intervals.push_back({float(ends[q]), float(ends[q + 1])});
+        for (std::size_t q = 0; q + 1 < ends.size(); q += 2)
+          g.intervals.push_back({float(ends[q]), float(ends[q + 1])});
         g.offsets[r + 1] = static_cast<std::uint32_t>(g.intervals.size());
       }
     }

@@ -20,7 +20,8 @@ using namespace tridex;
 TEST_CASE("extract_surface on a machined stock: closed, inside the stock, the stock itself exact") {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> unit(0, 1);
-  const std::vector<Cutter> cutters{Cutter::ball(1.0), Cutter::flat(0.7), Cutter::bull_nose(0.9, 0.3)};
+  const std::vector<Cutter> cutters{Cutter::ball(1.0), Cutter::flat(0.7),
+                                    Cutter::bull_nose(0.9, 0.3)};
   for (int trial = 0; trial < 3; ++trial) {
     Aabb stock{Vec3(-3, -2, 0), Vec3(3 + unit(rng), 2 + unit(rng), 3 + unit(rng))};
     std::vector<ZMap> maps;
@@ -30,10 +31,12 @@ TEST_CASE("extract_surface on a machined stock: closed, inside the stock, the st
       Aabb local = local_bounds(frame, stock);
       std::vector<CutMove> moves;
       auto tip = [&] {
-        return Vec3(local.min.x + unit(rng) * (local.max.x - local.min.x), local.min.y + unit(rng) * (local.max.y - local.min.y),
+        return Vec3(local.min.x + unit(rng) * (local.max.x - local.min.x),
+                    local.min.y + unit(rng) * (local.max.y - local.min.y),
                     local.max.z - (0.1 + 0.3 * unit(rng)) * (local.max.z - local.min.z));
       };
-      for (int k = 0; k < 6; ++k) moves.push_back({Segment{tip(), tip()}, static_cast<std::uint32_t>(k % 3)});
+      for (int k = 0; k < 6; ++k)
+        moves.push_back({Segment{tip(), tip()}, static_cast<std::uint32_t>(k % 3)});
       maps.push_back(ZMap::from_box(frame, stock, 0.05));
       mill(maps.back(), cutters, moves);
     }
@@ -66,7 +69,9 @@ TEST_CASE("extract_surface on a machined stock: closed, inside the stock, the st
   }
 }
 
-TEST_CASE("a machined box keeps its top edges on every side, when it is a whole number of spacings wide") {
+TEST_CASE(
+    "a machined box keeps its top edges on every side, when it is a whole number of spacings "
+    "wide") {
   // 10 × 8 × 5 at spacing 0.25: every face would lie on a row of rays, where the half-open
   // intervals keep the rows on the min faces and drop those on the max faces, and the top edge
   // along the max faces came out up to 1.3 spacings low. The lattice puts the rows nearest the
@@ -98,12 +103,14 @@ TEST_CASE("a machined box keeps its top edges on every side, when it is a whole 
   for (int axis = 0; axis < 2; ++axis)
     for (double face : {stock.min[axis], stock.max[axis]}) {
       const int along = 1 - axis;
-      std::vector<double> worst(static_cast<std::size_t>(stock.max[along] / lattice.spacing), std::numeric_limits<double>::infinity());
+      std::vector<double> worst(static_cast<std::size_t>(stock.max[along] / lattice.spacing),
+                                std::numeric_limits<double>::infinity());
       for (const auto& p : mesh.positions) {
         if (std::abs(p[axis] - face) > 1e-4) continue;
         const double below = plane(p.x, p.y) - p.z;
         CHECK(below > -1e-3);
-        double& w = worst[static_cast<std::size_t>(std::clamp(p[along] / lattice.spacing, 0.0, double(worst.size() - 1)))];
+        double& w = worst[static_cast<std::size_t>(
+            std::clamp(p[along] / lattice.spacing, 0.0, double(worst.size() - 1)))];
         w = std::min(w, below);
       }
       double dip = 0;

@@ -17,8 +17,8 @@ using namespace tridex;
 namespace {
 
 struct RotatedBox {
-  Frame frame;     // local → world
-  Vec3 half;       // half extents in the local frame
+  Frame frame;  // local → world
+  Vec3 half;    // half extents in the local frame
   double sdf(const Vec3& p) const {
     Vec3 q = glm::abs(frame.to_local(p)) - half;
     return glm::length(glm::max(q, Vec3(0))) + std::min(std::max({q.x, q.y, q.z}), 0.0);
@@ -28,8 +28,8 @@ struct RotatedBox {
   Mesh mesh() const {
     Mesh m;
     for (int c = 0; c < 8; ++c)
-      m.positions.emplace_back(frame.to_world(Vec3((c & 1) ? half.x : -half.x, (c & 2) ? half.y : -half.y,
-                                                   (c & 4) ? half.z : -half.z)));
+      m.positions.emplace_back(frame.to_world(Vec3(
+          (c & 1) ? half.x : -half.x, (c & 2) ? half.y : -half.y, (c & 4) ? half.z : -half.z)));
     for (int a = 0; a < 3; ++a) {
       int u = (a + 1) % 3, v = (a + 2) % 3;
       for (int s = 0; s < 2; ++s) {
@@ -67,17 +67,20 @@ double triangle_distance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3
   double nn = glm::dot(n, n);
   if (nn > 0) {
     Vec3 q = p - n * (glm::dot(p - a, n) / nn);  // projection onto the plane
-    bool inside = glm::dot(glm::cross(b - a, q - a), n) >= 0 && glm::dot(glm::cross(c - b, q - b), n) >= 0 &&
+    bool inside = glm::dot(glm::cross(b - a, q - a), n) >= 0 &&
+                  glm::dot(glm::cross(c - b, q - b), n) >= 0 &&
                   glm::dot(glm::cross(a - c, q - c), n) >= 0;
     if (inside) return glm::length(p - q);
   }
-  return std::min({segment_distance(p, a, b), segment_distance(p, b, c), segment_distance(p, c, a)});
+  return std::min(
+      {segment_distance(p, a, b), segment_distance(p, b, c), segment_distance(p, c, a)});
 }
 
 double distance_to(const Mesh& m, const Vec3& p) {
   double best = std::numeric_limits<double>::infinity();
   for (const glm::uvec3& t : m.triangles)
-    best = std::min(best, triangle_distance(p, Vec3(m.positions[t.x]), Vec3(m.positions[t.y]), Vec3(m.positions[t.z])));
+    best = std::min(best, triangle_distance(p, Vec3(m.positions[t.x]), Vec3(m.positions[t.y]),
+                                            Vec3(m.positions[t.z])));
   return best;
 }
 
@@ -90,7 +93,8 @@ RotatedBox random_box(std::mt19937& rng) {
 
 }  // namespace
 
-TEST_CASE("extract_surface after dexelize: a rotated box comes back closed and within one spacing") {
+TEST_CASE(
+    "extract_surface after dexelize: a rotated box comes back closed and within one spacing") {
   std::mt19937 rng(31);
   for (int trial = 0; trial < 6; ++trial) {
     RotatedBox box = random_box(rng);
@@ -108,7 +112,8 @@ TEST_CASE("extract_surface after dexelize: a rotated box comes back closed and w
       CHECK(std::abs(m.signed_volume() - box.volume()) <= 0.05 * box.area() * h);
       double out = 0, in = 0;
       for (const glm::vec3& p : m.positions) out = std::max(out, std::abs(box.sdf(Vec3(p))));
-      for (int q = 0; q < 100; ++q) in = std::max(in, distance_to(m, box.random_surface_point(rng)));
+      for (int q = 0; q < 100; ++q)
+        in = std::max(in, distance_to(m, box.random_surface_point(rng)));
       CHECK(out <= h);
       CHECK(in <= h);
     }

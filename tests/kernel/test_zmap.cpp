@@ -87,7 +87,8 @@ TEST_CASE("Z-map from a closed mesh equals the Z-map from the same box") {
   const Aabb box{Vec3(0, 0, 0), Vec3(10, 6, 3)};
   for (Vec3 axis : {Vec3(0, 0, 1), Vec3(1, 2, 3), Vec3(-1, 0.3, 0.2)}) {
     Frame f = Frame::from_axis(axis);
-    ZMap a = ZMap::from_box(f, box, 0.25), b = ZMap::from_mesh(f, tridex_test::box_mesh(box.min, box.max), 0.25);
+    ZMap a = ZMap::from_box(f, box, 0.25),
+         b = ZMap::from_mesh(f, tridex_test::box_mesh(box.min, box.max), 0.25);
     REQUIRE(a.grid.nx == b.grid.nx);
     REQUIRE(a.grid.ny == b.grid.ny);
     int differ = 0;
@@ -116,7 +117,9 @@ TEST_CASE("bad Z-map parameters are rejected") {
   CHECK_THROWS_AS(ZMap::from_mesh(Frame{}, Mesh{}, 0.1), Error);
 }
 
-TEST_CASE("raise_uncut: no fin of stock left between the last grid row and a face that falls between rows") {
+TEST_CASE(
+    "raise_uncut: no fin of stock left between the last grid row and a face that falls between "
+    "rows") {
   // A facing cut over the whole top, 1 mm down. Cell 0.3 puts the faces x = 10 and y = 8 between
   // grid rows: the strip beyond the last row inside interpolates towards the first row outside.
   // Raised above the stock, that row left a fin of uncut stock up to the old top in the strip.
@@ -126,7 +129,8 @@ TEST_CASE("raise_uncut: no fin of stock left between the last grid row and a fac
   ZMap milled = initial;
   std::vector<Cutter> cutters{Cutter::flat(2)};
   std::vector<CutMove> facing;
-  for (double y = -2; y <= 10; y += 1.5) facing.push_back({Segment{Vec3(-3, y, 4), Vec3(13, y, 4)}, 0});
+  for (double y = -2; y <= 10; y += 1.5)
+    facing.push_back({Segment{Vec3(-3, y, 4), Vec3(13, y, 4)}, 0});
   mill(milled, cutters, facing);
   raise_uncut(milled, initial);
   std::vector<ZMap> maps{milled};
@@ -159,7 +163,8 @@ TEST_CASE("raise_uncut: an uncut direction keeps the whole stock; cuts stay cut"
     if (axis.z != 1) CHECK(shaved < stock_volume * (1 - 1e-4));
     // ...raised, it keeps it all.
     raise_uncut(maps[0], initial);
-    CHECK(volume(intersect_milled(stock, lattice, maps)) == doctest::Approx(stock_volume).epsilon(1e-9));
+    CHECK(volume(intersect_milled(stock, lattice, maps)) ==
+          doctest::Approx(stock_volume).epsilon(1e-9));
     // A plunge through the middle stays: cut points keep their heights, cut-through stays low.
     ZMap milled = initial;
     Vec3 centre = f.to_local(stock.center());
@@ -173,7 +178,8 @@ TEST_CASE("raise_uncut: an uncut direction keeps the whole stock; cuts stay cut"
       if (milled.heights[p] != initial.heights[p]) kept += raised.heights[p] == milled.heights[p];
     CHECK(kept > 100);
     std::vector<ZMap> cut{raised};
-    CHECK(volume(intersect_milled(stock, lattice, cut)) < stock_volume - 0.5 * 3.14 * 1.5 * 1.5 * 5);
+    CHECK(volume(intersect_milled(stock, lattice, cut)) <
+          stock_volume - 0.5 * 3.14 * 1.5 * 1.5 * 5);
   }
   ZMap other = ZMap::from_box(Frame{}, stock, 0.5);
   ZMap mismatched = ZMap::from_box(Frame{}, stock, 0.25);
@@ -191,7 +197,8 @@ ZMap from_box_reference(const Frame& frame, const Aabb& stock, double cell) {
   for (int j = 0; j < g.ny; ++j)
     for (int i = 0; i < g.nx; ++i) {
       double s0, s1;
-      if (detail::line_box_interval(frame.to_world(Vec3(g.x(i), g.y(j), 0)), frame.axis(), stock, s0, s1))
+      if (detail::line_box_interval(frame.to_world(Vec3(g.x(i), g.y(j), 0)), frame.axis(), stock,
+                                    s0, s1))
         map.heights[g.index(i, j)] = static_cast<float>(s1);
     }
   return map;
@@ -203,8 +210,12 @@ void raise_uncut_reference(ZMap& milled, const ZMap& initial) {
   float top = milled.empty_height;
   for (float h : initial.heights) top = std::max(top, h);
   const float above = static_cast<float>(top + detail::empty_margin(a.cell));
-  auto inside = [&](int i, int j) { return i >= 0 && j >= 0 && i < a.nx && j < a.ny && initial.height(i, j) > initial.empty_height; };
-  auto cut = [&](int i, int j) { return inside(i, j) && milled.height(i, j) != initial.height(i, j); };
+  auto inside = [&](int i, int j) {
+    return i >= 0 && j >= 0 && i < a.nx && j < a.ny && initial.height(i, j) > initial.empty_height;
+  };
+  auto cut = [&](int i, int j) {
+    return inside(i, j) && milled.height(i, j) != initial.height(i, j);
+  };
   std::vector<std::pair<std::size_t, float>> continued;
   for (int j = 0; j < a.ny; ++j)
     for (int i = 0; i < a.nx; ++i) {
@@ -214,7 +225,8 @@ void raise_uncut_reference(ZMap& milled, const ZMap& initial) {
         for (int di = -1; di <= 1; ++di) {
           if ((di == 0 && dj == 0) || !cut(i + di, j + dj)) continue;
           const float near = milled.height(i + di, j + dj);
-          const float far = cut(i + 2 * di, j + 2 * dj) ? milled.height(i + 2 * di, j + 2 * dj) : near;
+          const float far =
+              cut(i + 2 * di, j + 2 * dj) ? milled.height(i + 2 * di, j + 2 * dj) : near;
           best = std::max(best, 2 * near - far);
         }
       if (best > -std::numeric_limits<float>::infinity())
@@ -227,29 +239,35 @@ void raise_uncut_reference(ZMap& milled, const ZMap& initial) {
 
 }  // namespace
 
-TEST_CASE("from_box and raise_uncut in row bands on any thread count match the old whole-map passes") {
+TEST_CASE(
+    "from_box and raise_uncut in row bands on any thread count match the old whole-map passes") {
   // Random tilted directions and random cuts, some leaving the stock's footprint; maps of more
   // than 64 rows, so that the bands' borders (and the rows each band reads beyond them) count.
   std::mt19937 rng(29);
   std::uniform_real_distribution<double> u(0, 1);
   const Aabb stock{Vec3(0, 0, 0), Vec3(12, 9, 8)};
-  const std::vector<Cutter> cutters{Cutter::ball(0.6), Cutter::flat(0.9), Cutter::bull_nose(1.0, 0.3)};
+  const std::vector<Cutter> cutters{Cutter::ball(0.6), Cutter::flat(0.9),
+                                    Cutter::bull_nose(1.0, 0.3)};
   for (int trial = 0; trial < 8; ++trial) {
     CAPTURE(trial);
-    const Vec3 axis = trial == 0 ? Vec3(0, 0, 1) : glm::normalize(Vec3(2 * u(rng) - 1, 2 * u(rng) - 1, 0.2 + u(rng)));
+    const Vec3 axis = trial == 0
+                          ? Vec3(0, 0, 1)
+                          : glm::normalize(Vec3(2 * u(rng) - 1, 2 * u(rng) - 1, 0.2 + u(rng)));
     const Frame f = Frame::from_axis(axis);
     const double cell = 0.03 + 0.03 * u(rng);
     const ZMap initial = from_box_reference(f, stock, cell);
-    for (unsigned threads : {1u, 2u, 3u}) CHECK(ZMap::from_box(f, stock, cell, {}, threads).heights == initial.heights);
+    for (unsigned threads : {1u, 2u, 3u})
+      CHECK(ZMap::from_box(f, stock, cell, {}, threads).heights == initial.heights);
     REQUIRE(initial.grid.ny > 2 * detail::kMapBandRows);
     const Aabb local = local_bounds(f, stock);
     auto at = [&](double depth) {
-      return Vec3(local.min.x - 1 + (local.size().x + 2) * u(rng), local.min.y - 1 + (local.size().y + 2) * u(rng),
-                  local.max.z - depth);
+      return Vec3(local.min.x - 1 + (local.size().x + 2) * u(rng),
+                  local.min.y - 1 + (local.size().y + 2) * u(rng), local.max.z - depth);
     };
     std::vector<CutMove> moves;
     for (int k = 0; k < 12; ++k)
-      moves.push_back({Segment{at(3 * u(rng)), at(3 * u(rng))}, static_cast<std::uint32_t>(k % cutters.size())});
+      moves.push_back({Segment{at(3 * u(rng)), at(3 * u(rng))},
+                       static_cast<std::uint32_t>(k % cutters.size())});
     ZMap milled = initial;
     mill(milled, cutters, moves, {.threads = 1});
     ZMap want = milled;
@@ -268,7 +286,9 @@ TEST_CASE("from_box and raise_uncut in row bands on any thread count match the o
   CHECK_THROWS_AS(raise_uncut(other, Aabb{Vec3(0), Vec3(12, 10, 8)}), Error);
 }
 
-TEST_CASE("raise_uncut for a mesh stock, row by row on any thread count, matches it against the stored map") {
+TEST_CASE(
+    "raise_uncut for a mesh stock, row by row on any thread count, matches it against the stored "
+    "map") {
   // A sphere and a tilted box as stocks, seen along random directions, with random cuts some of
   // which leave the footprint; maps of more than 64 rows, so that triangles cross bands.
   std::mt19937 rng(31);
@@ -281,7 +301,9 @@ TEST_CASE("raise_uncut for a mesh stock, row by row on any thread count, matches
   for (int trial = 0; trial < 6; ++trial) {
     CAPTURE(trial);
     const Mesh& stock = stocks[static_cast<std::size_t>(trial % 2)];
-    const Vec3 axis = trial < 2 ? Vec3(0, 0, 1) : glm::normalize(Vec3(2 * u(rng) - 1, 2 * u(rng) - 1, 0.2 + u(rng)));
+    const Vec3 axis = trial < 2
+                          ? Vec3(0, 0, 1)
+                          : glm::normalize(Vec3(2 * u(rng) - 1, 2 * u(rng) - 1, 0.2 + u(rng)));
     const Frame f = Frame::from_axis(axis);
     const double cell = 0.04 + 0.03 * u(rng);
     const ZMap initial = ZMap::from_mesh(f, stock, cell);
@@ -289,12 +311,13 @@ TEST_CASE("raise_uncut for a mesh stock, row by row on any thread count, matches
     Aabb local;
     for (const glm::vec3& p : stock.positions) local.extend(f.to_local(Vec3(p)));
     auto at = [&](double depth) {
-      return Vec3(local.min.x - 1 + (local.size().x + 2) * u(rng), local.min.y - 1 + (local.size().y + 2) * u(rng),
-                  local.max.z - depth);
+      return Vec3(local.min.x - 1 + (local.size().x + 2) * u(rng),
+                  local.min.y - 1 + (local.size().y + 2) * u(rng), local.max.z - depth);
     };
     std::vector<CutMove> moves;
     for (int k = 0; k < 12; ++k)
-      moves.push_back({Segment{at(4 * u(rng)), at(4 * u(rng))}, static_cast<std::uint32_t>(k % cutters.size())});
+      moves.push_back({Segment{at(4 * u(rng)), at(4 * u(rng))},
+                       static_cast<std::uint32_t>(k % cutters.size())});
     ZMap milled = initial;
     mill(milled, cutters, moves, {.threads = 1});
     ZMap want = milled;

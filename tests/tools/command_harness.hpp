@@ -42,7 +42,8 @@ inline void write_text(const fs::path& path, const std::string& text) {
 
 // A fresh scratch folder per test case.
 inline fs::path scratch(const std::string& name) {
-  fs::path dir = fs::temp_directory_path() / ("tridex-cmd-" + name + "-" + std::to_string(::getpid()));
+  fs::path dir =
+      fs::temp_directory_path() / ("tridex-cmd-" + name + "-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -83,7 +84,8 @@ inline Mesh read_binary_stl(const fs::path& path) {
     float v[12];
     std::memcpy(v, bytes.data() + 84 + 50 * static_cast<std::size_t>(t), 48);
     std::uint32_t base = static_cast<std::uint32_t>(mesh.positions.size());
-    for (int k = 0; k < 3; ++k) mesh.positions.emplace_back(v[3 + 3 * k], v[4 + 3 * k], v[5 + 3 * k]);
+    for (int k = 0; k < 3; ++k)
+      mesh.positions.emplace_back(v[3 + 3 * k], v[4 + 3 * k], v[5 + 3 * k]);
     mesh.triangles.emplace_back(base, base + 1, base + 2);
   }
   return mesh;

@@ -12,12 +12,14 @@ using nlohmann::json;
 
 TEST_CASE("simulate: every Z-map and dexel backend gives the same solid") {
   fs::path dir = scratch("backends");
-  const std::string example = std::string(TRIDEX_SOURCE_DIR) + "/gcode/examples/mold_3plus2.camotics";
+  const std::string example =
+      std::string(TRIDEX_SOURCE_DIR) + "/gcode/examples/mold_3plus2.camotics";
   auto volume_with = [&](const std::string& zmap, const std::string& dexel) {
     fs::path report = dir / (zmap + "-" + dexel + ".json");
-    CommandResult r = run_tridex({"simulate", example, "--dexel-res", "96", "--zmap-cell", "0.4", "--zmap-backend",
-                                  zmap, "--dexel-backend", dexel, "--report", report.string(), "--quiet"},
-                                 dir);
+    CommandResult r = run_tridex(
+        {"simulate", example, "--dexel-res", "96", "--zmap-cell", "0.4", "--zmap-backend", zmap,
+         "--dexel-backend", dexel, "--report", report.string(), "--quiet"},
+        dir);
     REQUIRE(r.status == 0);
     json j = json::parse(slurp(report));
     CHECK(j["backends"]["zmap"] == zmap);

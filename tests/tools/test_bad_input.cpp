@@ -23,11 +23,14 @@ using namespace tridex::test;
 
 namespace {
 
-const std::string kProgram = "G21 G90\nT1 M6\nS1000 M3\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X10 Y5\nG0 Z5\nM30\n";
-const std::string kTools = R"({"1": {"units": "mm", "shape": "ballnose", "diameter": 4, "length": 20}})";
+const std::string kProgram =
+    "G21 G90\nT1 M6\nS1000 M3\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X10 Y5\nG0 Z5\nM30\n";
+const std::string kTools =
+    R"({"1": {"units": "mm", "shape": "ballnose", "diameter": 4, "length": 20}})";
 // Nested subprogram loops: 9999 × 9999 passes over two moves from a few bytes.
 const std::string kMacroBomb =
-    "G21 G90\nT1 M6\nS1000 M3\nM98 P2 L9999\nM30\nO2\nM98 P3 L9999\nM99\nO3\nG1 X1 Y1 Z-1 F100\nG1 X0 Y0 Z-1\nM99\n";
+    "G21 G90\nT1 M6\nS1000 M3\nM98 P2 L9999\nM30\nO2\nM98 P3 L9999\nM99\nO3\nG1 X1 Y1 Z-1 F100\nG1 "
+    "X0 Y0 Z-1\nM99\n";
 
 // A closed box as ASCII STL, with `x_max` written as given (to put any text in a coordinate).
 std::string box_stl(double lo, double hi, const std::string& x_max = "") {
@@ -69,8 +72,8 @@ std::set<std::string> listing(const fs::path& dir) {
 // Text that only a library writes (nlohmann's "[json.exception…", libstdc++'s "basic_filebuf",
 // "std::" names, CLI11's bare "what()").
 bool has_library_text(const std::string& text) {
-  for (const char* marker : {"json.exception", "basic_filebuf", "basic_ios", "std::", "what()", "bad_alloc",
-                             "terminate called"})
+  for (const char* marker : {"json.exception", "basic_filebuf", "basic_ios", "std::", "what()",
+                             "bad_alloc", "terminate called"})
     if (text.find(marker) != std::string::npos) return true;
   return false;
 }
@@ -89,7 +92,8 @@ std::string at(const fs::path& dir, const char* name) { return (dir / name).stri
 std::vector<std::string> simulate_with(const fs::path& dir, std::vector<std::string> extra) {
   write_text(dir / "p.nc", kProgram);
   write_text(dir / "tools.json", kTools);
-  std::vector<std::string> args{"simulate", at(dir, "p.nc"), "--tools", at(dir, "tools.json"), "--dexel-res", "24"};
+  std::vector<std::string> args{
+      "simulate", at(dir, "p.nc"), "--tools", at(dir, "tools.json"), "--dexel-res", "24"};
   args.insert(args.end(), extra.begin(), extra.end());
   return args;
 }
@@ -109,14 +113,18 @@ std::vector<std::string> with_tools(const fs::path& dir, const std::string& tabl
 
 std::vector<std::string> with_project(const fs::path& dir, const std::string& workpiece) {
   write_text(dir / "p.nc", kProgram);
-  write_text(dir / "job.camotics", R"({"files": ["p.nc"], "tools": )" + kTools + R"(, "workpiece": )" + workpiece + "}");
+  write_text(dir / "job.camotics",
+             R"({"files": ["p.nc"], "tools": )" + kTools + R"(, "workpiece": )" + workpiece + "}");
   return {"simulate", at(dir, "job.camotics"), "--dexel-res", "24", "-o", at(dir, "out.stl")};
 }
 
 const std::vector<BadInput>& cases() {
   static const std::vector<BadInput> all = {
       // ---- options --------------------------------------------------------------------------
-      {"--zmap-cell nan", [](const fs::path& d) { return simulate_with(d, {"--zmap-cell", "nan", "-o", at(d, "o.stl")}); },
+      {"--zmap-cell nan",
+       [](const fs::path& d) {
+         return simulate_with(d, {"--zmap-cell", "nan", "-o", at(d, "o.stl")});
+       },
        {"--zmap-cell", "finite positive", "nan"}},
       {"--dexel-cell nan",
        [](const fs::path& d) {
@@ -125,15 +133,30 @@ const std::vector<BadInput>& cases() {
          return a;
        },
        {"--dexel-cell", "finite positive", "nan"}},
-      {"--arc-tolerance nan", [](const fs::path& d) { return simulate_with(d, {"--arc-tolerance", "nan"}); },
+      {"--arc-tolerance nan",
+       [](const fs::path& d) {
+         return simulate_with(d, {"--arc-tolerance", "nan"});
+       },
        {"--arc-tolerance", "finite positive", "nan"}},
-      {"--arc-tolerance inf", [](const fs::path& d) { return simulate_with(d, {"--arc-tolerance", "inf"}); },
+      {"--arc-tolerance inf",
+       [](const fs::path& d) {
+         return simulate_with(d, {"--arc-tolerance", "inf"});
+       },
        {"--arc-tolerance", "inf"}},
-      {"--tolerance nan", [](const fs::path& d) { return check_with(d, {"--design", at(d, "p.nc"), "--tolerance", "nan"}); },
+      {"--tolerance nan",
+       [](const fs::path& d) {
+         return check_with(d, {"--design", at(d, "p.nc"), "--tolerance", "nan"});
+       },
        {"--tolerance", "nan"}},
-      {"--stock ''", [](const fs::path& d) { return simulate_with(d, {"--stock", "", "-o", at(d, "o.stl")}); },
+      {"--stock ''",
+       [](const fs::path& d) {
+         return simulate_with(d, {"--stock", "", "-o", at(d, "o.stl")});
+       },
        {"--stock", "must not be empty"}},
-      {"--envelope ''", [](const fs::path& d) { return check_with(d, {"--design", at(d, "p.nc"), "--envelope", ""}); },
+      {"--envelope ''",
+       [](const fs::path& d) {
+         return check_with(d, {"--design", at(d, "p.nc"), "--envelope", ""});
+       },
        {"--envelope", "must not be empty"}},
       {"--envelope box with nan",
        [](const fs::path& d) {
@@ -141,35 +164,63 @@ const std::vector<BadInput>& cases() {
          return check_with(d, {"--design", at(d, "part.stl"), "--envelope", "box:0,0,0,nan,1,1"});
        },
        {"--envelope", "\"nan\" is not a number"}},
-      {"--max-memory nan", [](const fs::path& d) { return simulate_with(d, {"--max-memory", "nan"}); },
+      {"--max-memory nan",
+       [](const fs::path& d) {
+         return simulate_with(d, {"--max-memory", "nan"});
+       },
        {"--max-memory", "\"nan\" is not a size"}},
-      {"--max-memory 1e999M", [](const fs::path& d) { return simulate_with(d, {"--max-memory", "1e999M"}); },
+      {"--max-memory 1e999M",
+       [](const fs::path& d) {
+         return simulate_with(d, {"--max-memory", "1e999M"});
+       },
        {"--max-memory", "1e999"}},
-      {"--max-blocks 0", [](const fs::path& d) { return simulate_with(d, {"--max-blocks", "0"}); }, {"--max-blocks"}},
-      {"-o ''", [](const fs::path& d) { return simulate_with(d, {"-o", ""}); }, {"--output", "must not be empty"}},
-      {"--dump-zmaps ''", [](const fs::path& d) { return simulate_with(d, {"--dump-zmaps", ""}); },
+      {"--max-blocks 0",
+       [](const fs::path& d) {
+         return simulate_with(d, {"--max-blocks", "0"});
+       },
+       {"--max-blocks"}},
+      {"-o ''",
+       [](const fs::path& d) {
+         return simulate_with(d, {"-o", ""});
+       },
+       {"--output", "must not be empty"}},
+      {"--dump-zmaps ''",
+       [](const fs::path& d) {
+         return simulate_with(d, {"--dump-zmaps", ""});
+       },
        {"--dump-zmaps", "must not be empty"}},
       // ---- tool tables ------------------------------------------------------------------------
       {"tool keys 1 and 01",
        [](const fs::path& d) {
-         return with_tools(d, R"({"1": {"shape": "ballnose", "diameter": 4}, "01": {"shape": "cylindrical", "diameter": 6}})");
+         return with_tools(
+             d,
+             R"({"1": {"shape": "ballnose", "diameter": 4}, "01": {"shape": "cylindrical", "diameter": 6}})");
        },
        {"tools.json", "\"01\" and \"1\" are both tool 1"}},
       {"tool key ' 1'",
-       [](const fs::path& d) { return with_tools(d, R"({" 1": {"shape": "ballnose", "diameter": 4}})"); },
+       [](const fs::path& d) {
+         return with_tools(d, R"({" 1": {"shape": "ballnose", "diameter": 4}})");
+       },
        {"tools.json", "tool \" 1\"", "tool number"}},
       {"tool key given twice",
        [](const fs::path& d) {
-         return with_tools(d, R"({"1": {"shape": "ballnose", "diameter": 4}, "1": {"shape": "ballnose", "diameter": 8}})");
+         return with_tools(
+             d,
+             R"({"1": {"shape": "ballnose", "diameter": 4}, "1": {"shape": "ballnose", "diameter": 8}})");
        },
        {"tools.json", "key \"1\" appears twice"}},
       {"tool diameter 1e999",
-       [](const fs::path& d) { return with_tools(d, "{\"1\": {\"shape\": \"ballnose\",\n \"diameter\": 1e999}}"); },
+       [](const fs::path& d) {
+         return with_tools(d, "{\"1\": {\"shape\": \"ballnose\",\n \"diameter\": 1e999}}");
+       },
        {"tools.json:2:", "1e999", "out of range", "diameter"}},
       {"tool diameter a string",
-       [](const fs::path& d) { return with_tools(d, R"({"1": {"shape": "ballnose", "diameter": "4"}})"); },
+       [](const fs::path& d) {
+         return with_tools(d, R"({"1": {"shape": "ballnose", "diameter": "4"}})");
+       },
        {"tools.json: tool 1", "\"diameter\" must be a number, got a string"}},
-      {"tool table not JSON", [](const fs::path& d) { return with_tools(d, "{\"1\": {\"shape\": ballnose}}"); },
+      {"tool table not JSON",
+       [](const fs::path& d) { return with_tools(d, "{\"1\": {\"shape\": ballnose}}"); },
        {"tools.json:1:", "not valid JSON"}},
       {"tool table a directory",
        [](const fs::path& d) {
@@ -183,13 +234,16 @@ const std::vector<BadInput>& cases() {
       {"project automatic \"false\"",
        [](const fs::path& d) { return with_project(d, R"({"automatic": "false"})"); },
        {"job.camotics", "\"automatic\" must be true or false", "\"false\""}},
-      {"project automatic null", [](const fs::path& d) { return with_project(d, R"({"automatic": null})"); },
+      {"project automatic null",
+       [](const fs::path& d) { return with_project(d, R"({"automatic": null})"); },
        {"job.camotics", "\"automatic\"", "null"}},
-      {"project margin a string", [](const fs::path& d) { return with_project(d, R"({"margin": "5"})"); },
+      {"project margin a string",
+       [](const fs::path& d) { return with_project(d, R"({"margin": "5"})"); },
        {"job.camotics", "\"margin\"", "a string"}},
       {"project bounds min of strings",
        [](const fs::path& d) {
-         return with_project(d, R"({"automatic": false, "bounds": {"min": ["0", 0, 0], "max": [1, 1, 1]}})");
+         return with_project(
+             d, R"({"automatic": false, "bounds": {"min": ["0", 0, 0], "max": [1, 1, 1]}})");
        },
        {"job.camotics", "bounds min", "not a number"}},
       {"project files a number",
@@ -225,7 +279,10 @@ const std::vector<BadInput>& cases() {
        {"part", "is a directory"}},
       // ---- coordinates out of the exact range -----------------------------------------------
       {"box stock near 1e15 mm",
-       [](const fs::path& d) { return simulate_with(d, {"--stock", "box:1e15,1e15,1e15,1.0000001e15,1.0000001e15,1.0000001e15"}); },
+       [](const fs::path& d) {
+         return simulate_with(
+             d, {"--stock", "box:1e15,1e15,1e15,1.0000001e15,1.0000001e15,1.0000001e15"});
+       },
        {"the stock reaches", "represents exactly"}},
       {"design at 1e30 mm",
        [](const fs::path& d) {
@@ -236,7 +293,8 @@ const std::vector<BadInput>& cases() {
       {"box stock cut 1 km from the origin",
        [](const fs::path& d) {
          auto a = simulate_with(d, {"--stock", "box:999990,-10,-10,1000010,10,0"});
-         write_text(d / "p.nc", "G21 G90\nT1 M6\nG0 X1000000 Y0 Z5\nG1 Z-1 F100\nG1 X1000005\nM30\n");
+         write_text(d / "p.nc",
+                    "G21 G90\nT1 M6\nG0 X1000000 Y0 Z5\nG1 Z-1 F100\nG1 X1000005\nM30\n");
          return a;
        },
        {"the stock reaches", "represents exactly", "100000 spacings"}},
@@ -260,7 +318,9 @@ const std::vector<BadInput>& cases() {
        },
        {"--machine", "machine", "neither a bundled machine"}},
       {"--max-memory below what tridex holds before reading",
-       [](const fs::path& d) { return simulate_with(d, {"--max-memory", "4M", "-o", at(d, "o.stl")}); },
+       [](const fs::path& d) {
+         return simulate_with(d, {"--max-memory", "4M", "-o", at(d, "o.stl")});
+       },
        {"p.nc:", "before keeping any move", "--max-memory 4 MiB"}},
       // ---- programs that expand without bound -------------------------------------------------
       {"macro bomb through simulate",
@@ -273,34 +333,43 @@ const std::vector<BadInput>& cases() {
       {"macro bomb through moves",
        [](const fs::path& d) {
          write_text(d / "p.nc", kMacroBomb);
-         return std::vector<std::string>{"moves", at(d, "p.nc"), "--max-blocks", "50000", "-o", at(d, "m.jsonl")};
+         return std::vector<std::string>{"moves", at(d, "p.nc"), "--max-blocks",
+                                         "50000", "-o",          at(d, "m.jsonl")};
        },
        {"p.nc:", "more than 50000 blocks", "--max-blocks"}},
       {"macro bomb through groups",
        [](const fs::path& d) {
          write_text(d / "p.nc", kMacroBomb);
-         return std::vector<std::string>{"groups", at(d, "p.nc"), "--max-memory", "200M", "-o", at(d, "g.json")};
+         return std::vector<std::string>{"groups", at(d, "p.nc"), "--max-memory",
+                                         "200M",   "-o",          at(d, "g.json")};
        },
        {"p.nc:", "more than", "moves", "--max-memory"}},
       {"an arc of radius 1000 at --arc-tolerance 1e-10",
        [](const fs::path& d) {
-         auto a = simulate_with(d, {"--arc-tolerance", "1e-10", "--max-memory", "200M", "-o", at(d, "o.stl")});
-         write_text(d / "p.nc", "G21 G90\nT1 M6\nG0 X1000 Y0 Z0\nG2 X1000 Y0 I-1000 J0 F100\nM30\n");
+         auto a = simulate_with(
+             d, {"--arc-tolerance", "1e-10", "--max-memory", "200M", "-o", at(d, "o.stl")});
+         write_text(d / "p.nc",
+                    "G21 G90\nT1 M6\nG0 X1000 Y0 Z0\nG2 X1000 Y0 I-1000 J0 F100\nM30\n");
          return a;
        },
        {"p.nc:4", "more than", "moves", "--max-memory"}},
       // ---- outputs ----------------------------------------------------------------------------
       {"-o and --report the same file",
-       [](const fs::path& d) { return simulate_with(d, {"-o", at(d, "r"), "--report", at(d, "r")}); },
+       [](const fs::path& d) {
+         return simulate_with(d, {"-o", at(d, "r"), "--report", at(d, "r")});
+       },
        {"-o", "--report", "name the same file"}},
       {"-o and --png the same file through another spelling",
-       [](const fs::path& d) { return simulate_with(d, {"-o", at(d, "r.x"), "--png", (d / "." / "r.x").string()}); },
+       [](const fs::path& d) {
+         return simulate_with(d, {"-o", at(d, "r.x"), "--png", (d / "." / "r.x").string()});
+       },
        {"name the same file"}},
       {"--dump-zmaps over the stock",
        [](const fs::path& d) {
          fs::create_directories(d / "dump");
          write_text(d / "dump" / "zmap-1-+z.stl", box_stl(-20, 20));
-         return simulate_with(d, {"--stock", at(d, "dump/zmap-1-+z.stl"), "--dump-zmaps", at(d, "dump")});
+         return simulate_with(
+             d, {"--stock", at(d, "dump/zmap-1-+z.stl"), "--dump-zmaps", at(d, "dump")});
        },
        {"--dump-zmaps", "zmap-1-+z.stl", "would overwrite the input"}},
       {"--dump-zmaps over the program",
@@ -315,7 +384,8 @@ const std::vector<BadInput>& cases() {
       {"-o on a dump file",
        [](const fs::path& d) {
          fs::create_directories(d / "dump");
-         return simulate_with(d, {"--dump-zmaps", at(d, "dump"), "-o", at(d, "dump/zmap-1-+z.stl")});
+         return simulate_with(d,
+                              {"--dump-zmaps", at(d, "dump"), "-o", at(d, "dump/zmap-1-+z.stl")});
        },
        {"--dump-zmaps", "name the same file"}},
   };
@@ -324,7 +394,9 @@ const std::vector<BadInput>& cases() {
 
 }  // namespace
 
-TEST_CASE("bad input: exit status 2, the place and the value in the message, no library text, no file written") {
+TEST_CASE(
+    "bad input: exit status 2, the place and the value in the message, no library text, no file "
+    "written") {
   for (const BadInput& c : cases()) {
     CAPTURE(c.name);
     fs::path dir = scratch("bad-input");
@@ -352,8 +424,10 @@ TEST_CASE("a box stock that no move reaches comes out whole, with a warning, eve
     const double size = offset < 1e3 ? 20 : 100;
     std::ostringstream stock;
     stock.precision(17);
-    stock << "box:" << offset << "," << offset << ",-10," << offset + size << "," << offset + size << ",0";
-    std::vector<std::string> args = simulate_with(dir, {"--stock", stock.str(), "-o", at(dir, "out.stl")});
+    stock << "box:" << offset << "," << offset << ",-10," << offset + size << "," << offset + size
+          << ",0";
+    std::vector<std::string> args =
+        simulate_with(dir, {"--stock", stock.str(), "-o", at(dir, "out.stl")});
     if (offset > 1e3) args.erase(args.begin() + 4, args.begin() + 6);  // the default resolution
     CommandResult r = run_tridex(args, dir);
     CAPTURE(r.err);
@@ -377,7 +451,8 @@ TEST_CASE("an existing special file is written in place, never renamed over") {
   fs::path dir = scratch("special");
   fs::path node = dir / "null";
   REQUIRE(::mknod(node.c_str(), S_IFCHR | 0666, makedev(1, 3)) == 0);  // a copy of /dev/null
-  std::vector<std::string> args = simulate_with(dir, {"-o", node.string(), "--report", node.string()});
+  std::vector<std::string> args =
+      simulate_with(dir, {"-o", node.string(), "--report", node.string()});
   CommandResult r = run_tridex(args, dir);
   CHECK(r.status == 0);
   CHECK(fs::is_character_file(node));
@@ -413,13 +488,22 @@ namespace {
 // that wrote its output between two looks (the window is milliseconds) proves nothing: it is
 // run again, up to four times.
 void interrupt_while_writing(const std::string& command, const std::string& resolution,
-                             const std::vector<std::string>& extra, const std::string& output, int signal) {
+                             const std::vector<std::string>& extra, const std::string& output,
+                             int signal) {
   fs::path dir = scratch("interrupted");
-  const fs::path example = fs::path(TRIDEX_SOURCE_DIR) / "gcode" / "examples" / "mold_3plus2.camotics";
-  const std::set<std::string> inputs{"mold_3plus2.camotics", "mold_3plus2.nc", "mold_3plus2.tools.json"};
+  const fs::path example =
+      fs::path(TRIDEX_SOURCE_DIR) / "gcode" / "examples" / "mold_3plus2.camotics";
+  const std::set<std::string> inputs{"mold_3plus2.camotics", "mold_3plus2.nc",
+                                     "mold_3plus2.tools.json"};
   for (const std::string& name : inputs) fs::copy_file(example.parent_path() / name, dir / name);
-  std::vector<std::string> args{TRIDEX_COMMAND, command, (dir / "mold_3plus2.camotics").string(), "--dexel-res", resolution,
-                                "--threads", "2", "-q"};
+  std::vector<std::string> args{TRIDEX_COMMAND,
+                                command,
+                                (dir / "mold_3plus2.camotics").string(),
+                                "--dexel-res",
+                                resolution,
+                                "--threads",
+                                "2",
+                                "-q"};
   args.insert(args.end(), extra.begin(), extra.end());
   args.push_back(command == "check" ? "--ply" : "-o");
   args.push_back((dir / output).string());
@@ -443,8 +527,10 @@ void interrupt_while_writing(const std::string& command, const std::string& reso
     while (!seen && ::waitpid(child, &status, WNOHANG) == 0) {
       for (const std::string& name : listing(dir))
         if (name.rfind(temporary, 0) == 0) seen = true;
-      if (seen) ::kill(child, signal);
-      else std::this_thread::sleep_for(std::chrono::microseconds(100));
+      if (seen)
+        ::kill(child, signal);
+      else
+        std::this_thread::sleep_for(std::chrono::microseconds(100));
     }
     if (seen) ::waitpid(child, &status, 0);
   }
@@ -458,16 +544,22 @@ void interrupt_while_writing(const std::string& command, const std::string& reso
 
 }  // namespace
 
-TEST_CASE("SIGINT to a running simulate while it writes its STL leaves no temporary or partial file") {
+TEST_CASE(
+    "SIGINT to a running simulate while it writes its STL leaves no temporary or partial file") {
   interrupt_while_writing("simulate", "400", {}, "big.stl", SIGINT);
 }
 
-TEST_CASE("SIGTERM to a running check while it writes its PLY leaves no temporary or partial file") {
+TEST_CASE(
+    "SIGTERM to a running check while it writes its PLY leaves no temporary or partial file") {
   // The design is the bundled example's own result, written first (not interrupted).
   fs::path dir = scratch("design-for-check");
-  const fs::path example = fs::path(TRIDEX_SOURCE_DIR) / "gcode" / "examples" / "mold_3plus2.camotics";
-  REQUIRE(run_tridex({"simulate", example.string(), "--dexel-res", "64", "-q", "-o", (dir / "design.stl").string()}, dir)
+  const fs::path example =
+      fs::path(TRIDEX_SOURCE_DIR) / "gcode" / "examples" / "mold_3plus2.camotics";
+  REQUIRE(run_tridex({"simulate", example.string(), "--dexel-res", "64", "-q", "-o",
+                      (dir / "design.stl").string()},
+                     dir)
               .status == 0);
-  interrupt_while_writing("check", "200", {"--design", (dir / "design.stl").string()}, "big.ply", SIGTERM);
+  interrupt_while_writing("check", "200", {"--design", (dir / "design.stl").string()}, "big.ply",
+                          SIGTERM);
   fs::remove_all(dir);
 }

@@ -35,16 +35,19 @@ double segment_distance(const Vec3& p, const Vec3& a, const Vec3& b) {
 double triangle_distance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
   Vec3 n = glm::normalize(glm::cross(b - a, c - a));
   Vec3 foot = p - glm::dot(p - a, n) * n;
-  bool inside = glm::dot(glm::cross(b - a, foot - a), n) >= 0 && glm::dot(glm::cross(c - b, foot - b), n) >= 0 &&
+  bool inside = glm::dot(glm::cross(b - a, foot - a), n) >= 0 &&
+                glm::dot(glm::cross(c - b, foot - b), n) >= 0 &&
                 glm::dot(glm::cross(a - c, foot - c), n) >= 0;
   if (inside) return std::abs(glm::dot(p - a, n));
-  return std::min({segment_distance(p, a, b), segment_distance(p, b, c), segment_distance(p, c, a)});
+  return std::min(
+      {segment_distance(p, a, b), segment_distance(p, b, c), segment_distance(p, c, a)});
 }
 
 Mesh box_mesh(const Aabb& box) {
   Mesh m;
   for (const Vec3& c : box.corners()) m.positions.emplace_back(c);
-  const unsigned faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  const unsigned faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
   for (const auto& f : faces) {
     m.triangles.emplace_back(f[0], f[1], f[2]);
     m.triangles.emplace_back(f[0], f[2], f[3]);
@@ -52,18 +55,21 @@ Mesh box_mesh(const Aabb& box) {
   return m;
 }
 
-// ---- the planted-fault program -------------------------------------------------------------------
+// ---- the planted-fault program
+// -------------------------------------------------------------------
 
 const char* kStock = "box:0,0,0,20,20,10";
-const std::string kTools = R"({"1": {"units": "mm", "shape": "cylindrical", "diameter": 6, "length": 20}})";
+const std::string kTools =
+    R"({"1": {"units": "mm", "shape": "cylindrical", "diameter": 6, "length": 20}})";
 constexpr double kTilt = 20;  // G68.2 I0 J20 K0: the tool axis is Rx(20°)·z
 
 // One tilted direction: a groove 1 mm deep (lines 9-10), then a plunge (line 13) to `plunge_z`.
 // `extra` is inserted after line 6 (so the groove and plunge lines move down by its line count).
 std::string program(double plunge_z, const std::string& extra = "") {
   std::ostringstream p;
-  p << "%\nG21 G17 G90\nT1 M6\nS8000 M3\nG68.2 X10 Y10 Z10 I0 J" << kTilt << " K0\nG53.1\n" << extra
-    << "G0 X-3 Y0\nG0 Z5\nG1 Z-1 F500\nG1 X3\nG0 Z5\nG0 X0 Y4\nG1 Z" << plunge_z << "\nG0 Z5\nG28 G91 Z0.\nG69\nM30\n%\n";
+  p << "%\nG21 G17 G90\nT1 M6\nS8000 M3\nG68.2 X10 Y10 Z10 I0 J" << kTilt << " K0\nG53.1\n"
+    << extra << "G0 X-3 Y0\nG0 Z5\nG1 Z-1 F500\nG1 X3\nG0 Z5\nG0 X0 Y4\nG1 Z" << plunge_z
+    << "\nG0 Z5\nG28 G91 Z0.\nG69\nM30\n%\n";
   return p.str();
 }
 
@@ -75,22 +81,28 @@ Vec3 to_work(const Vec3& p) {
 
 struct Fixture {
   fs::path dir, tools, design;
-  explicit Fixture(const std::string& name) : dir(scratch(name)), tools(dir / "tools.json"), design(dir / "design.stl") {
+  explicit Fixture(const std::string& name)
+      : dir(scratch(name)), tools(dir / "tools.json"), design(dir / "design.stl") {
     write_text(tools, kTools);
     // The design is the correct program's own simulated result.
     write_text(dir / "good.nc", program(-2));
-    CommandResult made = run_tridex({"simulate", (dir / "good.nc").string(), "--tools", tools.string(), "--stock",
-                                     kStock, "--dexel-cell", "0.1", "-o", design.string(), "-q"},
-                                    dir);
+    CommandResult made =
+        run_tridex({"simulate", (dir / "good.nc").string(), "--tools", tools.string(), "--stock",
+                    kStock, "--dexel-cell", "0.1", "-o", design.string(), "-q"},
+                   dir);
     INFO(made.err);
     REQUIRE(made.status == 0);
   }
   ~Fixture() { fs::remove_all(dir); }
   CommandResult check(const std::string& text, std::vector<std::string> more = {}) const {
     write_text(dir / "p.nc", text);
-    std::vector<std::string> args{"check", (dir / "p.nc").string(), "--design", design.string(), "--tools",
-                                  tools.string(), "--stock", kStock, "--dexel-cell", "0.1", "--tolerance", "0.1",
-                                  "--report", (dir / "report.json").string()};
+    std::vector<std::string> args{"check",        (dir / "p.nc").string(),
+                                  "--design",     design.string(),
+                                  "--tools",      tools.string(),
+                                  "--stock",      kStock,
+                                  "--dexel-cell", "0.1",
+                                  "--tolerance",  "0.1",
+                                  "--report",     (dir / "report.json").string()};
     args.insert(args.end(), more.begin(), more.end());
     return run_tridex(args, dir);
   }
@@ -128,7 +140,8 @@ Ply read_ply(const fs::path& path) {
     float xyz[3];
     std::memcpy(xyz, bytes.data() + at, 12);
     ply.positions.emplace_back(xyz[0], xyz[1], xyz[2]);
-    ply.colours.push_back({static_cast<unsigned char>(bytes[at + 12]), static_cast<unsigned char>(bytes[at + 13]),
+    ply.colours.push_back({static_cast<unsigned char>(bytes[at + 12]),
+                           static_cast<unsigned char>(bytes[at + 13]),
                            static_cast<unsigned char>(bytes[at + 14])});
   }
   return ply;
@@ -144,7 +157,8 @@ std::size_t reddish_pixels(const fs::path& path) {
   std::vector<std::uint8_t> rgb(PNG_IMAGE_SIZE(image));
   REQUIRE(png_image_finish_read(&image, nullptr, rgb.data(), 0, nullptr));
   std::size_t red = 0;
-  for (std::size_t k = 0; k < rgb.size(); k += 3) red += rgb[k] > 150 && rgb[k + 1] < 90 && rgb[k + 2] < 90;
+  for (std::size_t k = 0; k < rgb.size(); k += 3)
+    red += rgb[k] > 150 && rgb[k + 1] < 90 && rgb[k + 2] < 90;
   return red;
 }
 
@@ -165,8 +179,9 @@ TEST_CASE("the distance tree matches brute force, and signs by the face or the i
     Vec3 p(1.5 * u(rng), 1.5 * u(rng), 1.5 * u(rng));
     double best = std::numeric_limits<double>::infinity();
     for (const glm::uvec3& t : soup.triangles)
-      best = std::min(best, triangle_distance(p, Vec3(soup.positions[t.x]), Vec3(soup.positions[t.y]),
-                                              Vec3(soup.positions[t.z])));
+      best =
+          std::min(best, triangle_distance(p, Vec3(soup.positions[t.x]), Vec3(soup.positions[t.y]),
+                                           Vec3(soup.positions[t.z])));
     CHECK(tree.nearest(p).distance == doctest::Approx(best).epsilon(1e-9));
   }
   // A box: the signed distance is the analytic one (negative inside), whichever way it is signed.
@@ -179,8 +194,8 @@ TEST_CASE("the distance tree matches brute force, and signs by the face or the i
     Vec3 outside = glm::max(glm::max(box.min - p, p - box.max), Vec3(0));
     double reference = glm::length(outside) > 0
                            ? glm::length(outside)
-                           : -std::min({p.x - box.min.x, box.max.x - p.x, p.y - box.min.y, box.max.y - p.y,
-                                        p.z - box.min.z, box.max.z - p.z});
+                           : -std::min({p.x - box.min.x, box.max.x - p.x, p.y - box.min.y,
+                                        box.max.y - p.y, p.z - box.min.z, box.max.z - p.z});
     CHECK(cube_tree.signed_distance(p, inside) == doctest::Approx(reference).epsilon(1e-9));
   }
   CHECK_THROWS_AS(cli::DistanceTree(Mesh{}), tridex::Error);
@@ -209,7 +224,8 @@ TEST_CASE("deviation regions are the connected components of the selected vertic
     // Flood fill over the mesh's edges.
     std::vector<std::vector<unsigned>> next(grid.positions.size());
     for (const glm::uvec3& t : grid.triangles)
-      for (int e = 0; e < 3; ++e) next[t[e]].push_back(t[(e + 1) % 3]), next[t[(e + 1) % 3]].push_back(t[e]);
+      for (int e = 0; e < 3; ++e)
+        next[t[e]].push_back(t[(e + 1) % 3]), next[t[(e + 1) % 3]].push_back(t[e]);
     std::vector<int> label(selected.size(), -1);
     std::vector<std::size_t> sizes;
     std::vector<double> depths;
@@ -239,7 +255,8 @@ TEST_CASE("deviation regions are the connected components of the selected vertic
       for (unsigned v : r.vertices) CHECK(label[v] == l);
       CHECK(r.depth == depths[static_cast<std::size_t>(l)]);
     }
-    for (std::size_t k = 1; k < regions.size(); ++k) CHECK(regions[k - 1].depth >= regions[k].depth);
+    for (std::size_t k = 1; k < regions.size(); ++k)
+      CHECK(regions[k - 1].depth >= regions[k].depth);
     CHECK(got == expected);
     // Each triangle (area 1/2) gives a third of its area per selected corner.
     for (const glm::uvec3& t : grid.triangles)
@@ -270,11 +287,14 @@ TEST_CASE("check: a program against its own result passes (exit 0), with a PLY a
   Ply mesh = read_ply(ply);
   CHECK(mesh.positions.size() == report["deviation"]["samples"].get<std::size_t>());
   CHECK(mesh.faces == report["result"]["triangles"].get<std::size_t>());
-  for (const auto& c : mesh.colours) CHECK((c[0] < 200 && c[2] < 200));  // neither gouge red nor excess blue
-  CHECK(reddish_pixels(png) < 400);  // the legend's swatch (14 x 14 pixels) only
+  for (const auto& c : mesh.colours)
+    CHECK((c[0] < 200 && c[2] < 200));  // neither gouge red nor excess blue
+  CHECK(reddish_pixels(png) < 400);     // the legend's swatch (14 x 14 pixels) only
 }
 
-TEST_CASE("check: a plunge 0.3 mm too deep in a tilted direction is a gouge of 0.3 mm at its place and line") {
+TEST_CASE(
+    "check: a plunge 0.3 mm too deep in a tilted direction is a gouge of 0.3 mm at its place and "
+    "line") {
   Fixture f("check-gouge");
   fs::path ply = f.dir / "gouge.ply", png = f.dir / "gouge.png";
   CommandResult r = f.check(program(-2.3), {"--ply", ply.string(), "--png", png.string()});
@@ -285,7 +305,8 @@ TEST_CASE("check: a plunge 0.3 mm too deep in a tilted direction is a gouge of 0
   CHECK(report["verdict"] == "fail");
   REQUIRE(report["gouges"].size() == 1);
   const json& gouge = report["gouges"][0];
-  CHECK(gouge["depth_mm"].get<double>() == doctest::Approx(0.3).epsilon(0.1 / 0.3));  // within a dexel cell
+  CHECK(gouge["depth_mm"].get<double>() ==
+        doctest::Approx(0.3).epsilon(0.1 / 0.3));  // within a dexel cell
   CHECK(gouge["lines"] == json::array({13}));
   CHECK(r.out.find("p.nc:13") != std::string::npos);
   // The deepest point lies on the faulty hole's floor: in the feature frame within the tool's
@@ -296,15 +317,18 @@ TEST_CASE("check: a plunge 0.3 mm too deep in a tilted direction is a gouge of 0
   Vec3 offset = deepest - floor_centre;
   CHECK(std::abs(glm::dot(offset, axis)) <= 0.3 + 0.15);
   CHECK(glm::length(offset - glm::dot(offset, axis) * axis) <= 3 + 0.15);
-  Vec3 centroid(gouge["centroid"][0].get<double>(), gouge["centroid"][1].get<double>(), gouge["centroid"][2].get<double>());
+  Vec3 centroid(gouge["centroid"][0].get<double>(), gouge["centroid"][1].get<double>(),
+                gouge["centroid"][2].get<double>());
   CHECK(glm::length(centroid - floor_centre) < 1.0);
   // The floor is a disc of radius 3 (area 28.3 mm²) and the extra wall is short.
   CHECK(gouge["area_mm2"].get<double>() > 20);
   CHECK(gouge["area_mm2"].get<double>() < 40);
-  CHECK(report["deviation"]["min_mm"].get<double>() == doctest::Approx(-gouge["depth_mm"].get<double>()));
+  CHECK(report["deviation"]["min_mm"].get<double>() ==
+        doctest::Approx(-gouge["depth_mm"].get<double>()));
   CHECK(report["excess"].empty());
   // From the design's side the correct floor is material missing, 0.3 mm from the machined one.
-  CHECK(report["design_side"]["missing"]["depth_mm"].get<double>() == doctest::Approx(0.3).epsilon(0.1 / 0.3));
+  CHECK(report["design_side"]["missing"]["depth_mm"].get<double>() ==
+        doctest::Approx(0.3).epsilon(0.1 / 0.3));
   Ply mesh = read_ply(ply);
   std::size_t red = 0;
   for (std::size_t v = 0; v < mesh.positions.size(); ++v)
@@ -340,7 +364,8 @@ TEST_CASE("check: a hole left out is excess, from the machined side and from the
   CHECK(glm::length(centroid - to_work(Vec3(0, 4, -1))) < 2.5);
   // The hole's floor and wall, seen from the design, lie inside the machined solid.
   CHECK(report["design_side"]["left"]["samples"].get<long long>() > 0);
-  CHECK(report["design_side"]["left"]["depth_mm"].get<double>() == doctest::Approx(deepest).epsilon(0.1 / deepest));
+  CHECK(report["design_side"]["left"]["depth_mm"].get<double>() ==
+        doctest::Approx(deepest).epsilon(0.1 / deepest));
   CHECK(report["design_side"]["missing"]["samples"] == 0);
 }
 
@@ -373,8 +398,9 @@ TEST_CASE("check and simulate: positions outside the machine's travel") {
   Fixture f("check-travel");
   // The bundled B/C trunnion with a Z travel that the program's retracts leave, in machine
   // coordinates (the tilt puts the part's points elsewhere on the machine than in the work frame).
-  write_text(f.dir / "m.json",
-             R"({"kinematics": {"profile": "bc-trunnion", "travel": {"X": [-200, 200], "Z": [-50, 5]}}})");
+  write_text(
+      f.dir / "m.json",
+      R"({"kinematics": {"profile": "bc-trunnion", "travel": {"X": [-200, 200], "Z": [-50, 5]}}})");
   std::string machine = (f.dir / "m.json").string();
   CommandResult r = f.check(program(-2), {"--machine", machine});
   INFO(r.err);
@@ -383,8 +409,10 @@ TEST_CASE("check and simulate: positions outside the machine's travel") {
   // The reference: every move of `tridex moves` whose machine position ends past a travel end,
   // leaving out the positions "far along the tool axis" that stand in for home returns.
   fs::path moves = f.dir / "moves.jsonl";
-  REQUIRE(run_tridex({"moves", (f.dir / "p.nc").string(), "--machine", machine, "-o", moves.string()}, f.dir)
-              .status == 0);
+  REQUIRE(
+      run_tridex({"moves", (f.dir / "p.nc").string(), "--machine", machine, "-o", moves.string()},
+                 f.dir)
+          .status == 0);
   std::vector<std::pair<int, double>> expected;  // (line, machine z)
   std::istringstream in(slurp(moves));
   for (std::string line; std::getline(in, line);) {
@@ -392,7 +420,8 @@ TEST_CASE("check and simulate: positions outside the machine's travel") {
     Vec3 end(m["end"][0].get<double>(), m["end"][1].get<double>(), m["end"][2].get<double>());
     double x = m["machine"][0].get<double>(), z = m["machine"][2].get<double>();
     CHECK(std::abs(x) < 200);
-    if (glm::length(end) < 5000 && (z > 5 || z < -50)) expected.emplace_back(m["line"].get<int>(), z);
+    if (glm::length(end) < 5000 && (z > 5 || z < -50))
+      expected.emplace_back(m["line"].get<int>(), z);
   }
   REQUIRE(!expected.empty());
   REQUIRE(report["travel"]["outside"].get<std::size_t>() == expected.size());
@@ -407,23 +436,26 @@ TEST_CASE("check and simulate: positions outside the machine's travel") {
   }
   CHECK(r.out.find("past the travel's end 5") != std::string::npos);
   // Within the travel: no finding, and the report still says how many were outside (none).
-  write_text(f.dir / "wide.json", R"({"kinematics": {"profile": "bc-trunnion", "travel": {"Z": [-50, 500]}}})");
+  write_text(f.dir / "wide.json",
+             R"({"kinematics": {"profile": "bc-trunnion", "travel": {"Z": [-50, 500]}}})");
   CHECK(f.check(program(-2), {"--machine", (f.dir / "wide.json").string()}).status == 0);
   CHECK(f.report()["travel"]["outside"] == 0);
   // simulate: one warning that counts them and names the first.
   fs::path sim_report = f.dir / "sim.json";
-  CommandResult s = run_tridex({"simulate", (f.dir / "p.nc").string(), "--tools", f.tools.string(), "--stock",
-                                kStock, "--dexel-cell", "0.2", "--machine", machine, "--report",
-                                sim_report.string(), "-q"},
-                               f.dir);
+  CommandResult s = run_tridex(
+      {"simulate", (f.dir / "p.nc").string(), "--tools", f.tools.string(), "--stock", kStock,
+       "--dexel-cell", "0.2", "--machine", machine, "--report", sim_report.string(), "-q"},
+      f.dir);
   REQUIRE(s.status == 0);
   std::string warning = cat_warnings(json::parse(slurp(sim_report)));
-  CHECK_MESSAGE(warning.find(std::to_string(expected.size()) + " position(s) outside the machine's travel (first " +
-                             (f.dir / "p.nc").string() + ":" + std::to_string(expected[0].first) + ": Z ") !=
-                    std::string::npos,
-                warning);
+  CHECK_MESSAGE(
+      warning.find(std::to_string(expected.size()) +
+                   " position(s) outside the machine's travel (first " + (f.dir / "p.nc").string() +
+                   ":" + std::to_string(expected[0].first) + ": Z ") != std::string::npos,
+      warning);
   // A bad travel is an input error naming the key.
-  write_text(f.dir / "bad.json", R"({"kinematics": {"profile": "bc-trunnion", "travel": {"Z": [5, -5]}}})");
+  write_text(f.dir / "bad.json",
+             R"({"kinematics": {"profile": "bc-trunnion", "travel": {"Z": [5, -5]}}})");
   CommandResult bad = f.check(program(-2), {"--machine", (f.dir / "bad.json").string()});
   CHECK(bad.status == 2);
   CHECK(bad.err.find("kinematics.travel.Z") != std::string::npos);
@@ -444,7 +476,8 @@ TEST_CASE("check: moves outside the envelope, bad designs and bad options") {
   // The reference: the lines of the interpreted moves (`tridex moves`) whose tip ends above
   // z = 14, leaving out the positions "far along the tool axis" that stand in for home returns.
   fs::path moves = f.dir / "moves.jsonl";
-  REQUIRE(run_tridex({"moves", (f.dir / "p.nc").string(), "-o", moves.string()}, f.dir).status == 0);
+  REQUIRE(run_tridex({"moves", (f.dir / "p.nc").string(), "-o", moves.string()}, f.dir).status ==
+          0);
   std::set<int> expected;
   std::istringstream in(slurp(moves));
   for (std::string line; std::getline(in, line);) {
@@ -460,11 +493,13 @@ TEST_CASE("check: moves outside the envelope, bad designs and bad options") {
 
   // A design that is not closed is an error that says so.
   fs::path open = f.dir / "open.stl";
-  write_text(open, "solid open\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n   vertex 0 1 0\n"
-                   "  endloop\n endfacet\nendsolid open\n");
+  write_text(open,
+             "solid open\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n   "
+             "vertex 0 1 0\n"
+             "  endloop\n endfacet\nendsolid open\n");
   write_text(f.dir / "p.nc", program(-2));
-  r = run_tridex({"check", (f.dir / "p.nc").string(), "--design", open.string(), "--tools", f.tools.string(),
-                  "--stock", kStock, "--report", (f.dir / "never.json").string()},
+  r = run_tridex({"check", (f.dir / "p.nc").string(), "--design", open.string(), "--tools",
+                  f.tools.string(), "--stock", kStock, "--report", (f.dir / "never.json").string()},
                  f.dir);
   CHECK(r.status == 2);
   CHECK(r.err.find("not closed") != std::string::npos);
@@ -472,7 +507,9 @@ TEST_CASE("check: moves outside the envelope, bad designs and bad options") {
   // Options: --tolerance excludes the split tolerances; --design is required; an output over an
   // input is refused; the rapid check needs the exact Z-map milling.
   CHECK(f.check(program(-2), {"--gouge-tol", "0.2"}).status == 2);
-  CHECK(run_tridex({"check", (f.dir / "p.nc").string(), "--tools", f.tools.string()}, f.dir).status == 2);
+  CHECK(
+      run_tridex({"check", (f.dir / "p.nc").string(), "--tools", f.tools.string()}, f.dir).status ==
+      2);
   CHECK(f.check(program(-2), {"--ply", f.design.string()}).status == 2);
   CHECK(f.check(program(-2), {"--zmap-backend", "gl"}).status == 2);
 }

@@ -21,7 +21,8 @@ using nlohmann::json;
 
 namespace {
 
-// ---- the brute-force reference -------------------------------------------------------------------
+// ---- the brute-force reference
+// -------------------------------------------------------------------
 
 // Height above the section's bottom of its lowest point at distance rho from the axis (+inf
 // beyond it), from the section's shape alone.
@@ -43,7 +44,8 @@ double point_segment_2d(Vec2 p, Vec2 a, Vec2 b) {
 double column_distance(const BodySection& s, double bottom, double rho, double top) {
   if (top >= bottom + section_low(s, rho)) return 0;
   const Vec2 corners[4] = {Vec2(-s.bottom_radius, bottom), Vec2(s.bottom_radius, bottom),
-                           Vec2(s.top_radius, bottom + s.length), Vec2(-s.top_radius, bottom + s.length)};
+                           Vec2(s.top_radius, bottom + s.length),
+                           Vec2(-s.top_radius, bottom + s.length)};
   const Vec2 end(rho, top);
   double best = std::numeric_limits<double>::infinity();
   for (int k = 0; k < 4; ++k) {
@@ -59,7 +61,7 @@ struct Reference {
   double depth_low = -std::numeric_limits<double>::infinity();   // sampled: never above the truth
   double depth_high = -std::numeric_limits<double>::infinity();  // widened by a step: never below
   double distance = std::numeric_limits<double>::infinity();     // sampled
-  double step = 0;                                                // the tip's travel per sample
+  double step = 0;                                               // the tip's travel per sample
 };
 
 Reference brute_force(const ZMap& map, const BodyPart& part, const Segment& tip) {
@@ -84,8 +86,8 @@ Reference brute_force(const ZMap& map, const BodyPart& part, const Segment& tip)
         const double h = map.height(i, j);
         const double rho = std::hypot(map.grid.x(i) - c.x, map.grid.y(j) - c.y);
         ref.depth_low = std::max(ref.depth_low, h - (c.z + part.bottom + section_low(s, rho)));
-        ref.depth_high =
-            std::max(ref.depth_high, h - (c.z - rise + part.bottom + section_low(s, std::max(0.0, rho - e))));
+        ref.depth_high = std::max(ref.depth_high, h - (c.z - rise + part.bottom +
+                                                       section_low(s, std::max(0.0, rho - e))));
         ref.distance = std::min(ref.distance, column_distance(s, c.z + part.bottom, rho, h));
       }
   }
@@ -103,20 +105,26 @@ TEST_CASE("swept shank and holder depths and near misses match the sampled swept
     Vec3 axis = glm::normalize(Vec3(unit(random) - 0.5, unit(random) - 0.5, 1.0));
     ZMapGrid grid{Frame::from_axis(axis), -1.0, -1.0, 0.5, 40, 40};
     ZMap map(grid, 0.0f, -20.0f);
-    for (float& h : map.heights) h = unit(random) < 0.1 ? -20.0f : static_cast<float>(10 * unit(random));
+    for (float& h : map.heights)
+      h = unit(random) < 0.1 ? -20.0f : static_cast<float>(10 * unit(random));
     BodyPart part;
     part.name = "holder section 1";
     part.bottom = 5 * unit(random);
     const double r0 = 1 + 3 * unit(random);
     const int kind = trial % 3;  // cylinder, widening frustum, narrowing frustum
-    part.shape = BodySection{r0, kind == 0 ? r0 : kind == 1 ? r0 + 0.5 + 2.5 * unit(random) : r0 * (0.5 + 0.5 * unit(random)),
+    part.shape = BodySection{r0,
+                             kind == 0   ? r0
+                             : kind == 1 ? r0 + 0.5 + 2.5 * unit(random)
+                                         : r0 * (0.5 + 0.5 * unit(random)),
                              2 + 6 * unit(random)};
     widening += kind == 1;
     // Moves in the work frame, given to the map in its frame (as the pipeline does).
     Vec3 a_local(3 + 13 * unit(random), 3 + 13 * unit(random), 6 + 8 * unit(random) - part.bottom);
-    Vec3 b_local = a_local + Vec3(8 * (unit(random) - 0.5), 8 * (unit(random) - 0.5), 4 * (unit(random) - 0.5));
+    Vec3 b_local = a_local + Vec3(8 * (unit(random) - 0.5), 8 * (unit(random) - 0.5),
+                                  4 * (unit(random) - 0.5));
     if (trial % 5 == 0) b_local = Vec3(a_local.x, a_local.y, b_local.z);  // a plunge
-    const Segment tip{grid.frame.to_local(grid.frame.to_world(a_local)), grid.frame.to_local(grid.frame.to_world(b_local))};
+    const Segment tip{grid.frame.to_local(grid.frame.to_world(a_local)),
+                      grid.frame.to_local(grid.frame.to_world(b_local))};
     const double clearance = 0.5 + 1.5 * unit(random);
     std::vector<ToolBody> bodies{ToolBody{{part}, 0}};
     BodyCheck check(map, bodies, clearance);
@@ -124,10 +132,11 @@ TEST_CASE("swept shank and holder depths and near misses match the sampled swept
     gcode::Move move;
     move.line = trial + 1;
     move.tool = 1;
-    check.check(map, move, CutMove{tip, 0}, axis, grid.frame, 0, true, [] {}, found);
+    check.check(
+        map, move, CutMove{tip, 0}, axis, grid.frame, 0, true, [] {}, found);
     const Reference ref = brute_force(map, part, tip);
-    INFO("trial ", trial, " kind ", kind, " depth in [", ref.depth_low, ", ", ref.depth_high, "], distance ",
-         ref.distance);
+    INFO("trial ", trial, " kind ", kind, " depth in [", ref.depth_low, ", ", ref.depth_high,
+         "], distance ", ref.distance);
     if (!found.collisions.empty()) {
       ++collisions;
       const double depth = found.collisions[0].depth_mm;
@@ -136,7 +145,8 @@ TEST_CASE("swept shank and holder depths and near misses match the sampled swept
       CHECK(found.near_misses.empty());
       // The reported point is a grid point with material, in the work frame.
       Vec3 local = grid.frame.to_local(found.collisions[0].where);
-      CHECK(std::abs(local.x - grid.x0 - grid.cell * std::round((local.x - grid.x0) / grid.cell)) < 1e-6);
+      CHECK(std::abs(local.x - grid.x0 - grid.cell * std::round((local.x - grid.x0) / grid.cell)) <
+            1e-6);
     } else {
       CHECK(ref.depth_low <= kCollisionTolerance + 1e-4);
       const double slack = ref.step + 0.005 * clearance + 2e-3;
@@ -157,19 +167,21 @@ TEST_CASE("swept shank and holder depths and near misses match the sampled swept
   CHECK(widening > 5);
 }
 
-// ---- planted faults, end to end ------------------------------------------------------------------
+// ---- planted faults, end to end
+// ------------------------------------------------------------------
 
 namespace {
 
 // T2 (no parts described) clears the stock 0..60 × 0..40 × 0..30 to z = 20 except a boss
-// beyond the round end of its first pass (x ≥ 30 + √(12² − (y − 8)²), y < 18). T1's holder (Ø30, 25 mm out) passes by the boss on line 16 with its face at
-// z1 + 25; T3's Ø8 shank, 3 mm above the tip of its Ø4 flutes, crosses the pocket's floor on line
-// 21 at z3 + 3.
+// beyond the round end of its first pass (x ≥ 30 + √(12² − (y − 8)²), y < 18). T1's holder (Ø30, 25
+// mm out) passes by the boss on line 16 with its face at z1 + 25; T3's Ø8 shank, 3 mm above the tip
+// of its Ø4 flutes, crosses the pocket's floor on line 21 at z3 + 3.
 std::string fault_program(double z1, double z3) {
   std::ostringstream p;
-  p << "%\nG21 G17 G90\nT2 M6\nS8000 M3\nG0 X-15 Y8 Z40\nG1 Z20 F500\nG1 X30\nG0 Z40\nG0 X-15 Y30\nG1 Z20\n"
-    << "G1 X75\nG0 Z40\nT1 M6\nG0 X30 Y45 Z40\nG1 Z" << z1 << " F300\nG1 Y-20\nG0 Z40\nT3 M6\nG0 X-10 Y30 Z40\nG1 Z"
-    << z3 << "\nG1 X70\nG0 Z40\nM30\n%\n";
+  p << "%\nG21 G17 G90\nT2 M6\nS8000 M3\nG0 X-15 Y8 Z40\nG1 Z20 F500\nG1 X30\nG0 Z40\nG0 X-15 "
+       "Y30\nG1 Z20\n"
+    << "G1 X75\nG0 Z40\nT1 M6\nG0 X30 Y45 Z40\nG1 Z" << z1
+    << " F300\nG1 Y-20\nG0 Z40\nT3 M6\nG0 X-10 Y30 Z40\nG1 Z" << z3 << "\nG1 X70\nG0 Z40\nM30\n%\n";
   return p.str();
 }
 
@@ -186,33 +198,38 @@ struct CheckRun {
 
 // Simulates the program into its own design, then checks the program against that design on
 // the stock 0..60 × 0..40 × 0..30: only the tools' non-cutting parts can fail the check.
-CheckRun simulate_then_check(const fs::path& dir, const std::string& program, const std::string& tools,
-                             const std::vector<std::string>& more = {}) {
+CheckRun simulate_then_check(const fs::path& dir, const std::string& program,
+                             const std::string& tools, const std::vector<std::string>& more = {}) {
   write_text(dir / "tools.json", tools);
   write_text(dir / "p.nc", program);
   fs::remove(dir / "report.json");
-  CommandResult made = run_tridex({"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(),
-                                   "--stock", "box:0,0,0,60,40,30", "--dexel-cell", "0.5", "-o",
-                                   (dir / "design.stl").string(), "-q"},
-                                  dir);
+  CommandResult made = run_tridex(
+      {"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(), "--stock",
+       "box:0,0,0,60,40,30", "--dexel-cell", "0.5", "-o", (dir / "design.stl").string(), "-q"},
+      dir);
   REQUIRE(made.status == 0);
-  std::vector<std::string> args{"check", (dir / "p.nc").string(), "--design", (dir / "design.stl").string(),
-                                "--tools", (dir / "tools.json").string(), "--stock", "box:0,0,0,60,40,30",
-                                "--dexel-cell", "0.5", "--tolerance", "0.6", "--report",
-                                (dir / "report.json").string()};
+  std::vector<std::string> args{"check",        (dir / "p.nc").string(),
+                                "--design",     (dir / "design.stl").string(),
+                                "--tools",      (dir / "tools.json").string(),
+                                "--stock",      "box:0,0,0,60,40,30",
+                                "--dexel-cell", "0.5",
+                                "--tolerance",  "0.6",
+                                "--report",     (dir / "report.json").string()};
   args.insert(args.end(), more.begin(), more.end());
   CheckRun run{run_tridex(args, dir), json()};
   if (fs::exists(dir / "report.json")) run.report = json::parse(slurp(dir / "report.json"));
   return run;
 }
 
-CheckRun run_faults(const fs::path& dir, double z1, double z3, const std::vector<std::string>& more = {}) {
+CheckRun run_faults(const fs::path& dir, double z1, double z3,
+                    const std::vector<std::string>& more = {}) {
   return simulate_then_check(dir, fault_program(z1, z3), kFaultTools, more);
 }
 
 }  // namespace
 
-TEST_CASE("check: a holder passing a boss and a shank on a pocket's floor are found at their lines") {
+TEST_CASE(
+    "check: a holder passing a boss and a shank on a pocket's floor are found at their lines") {
   fs::path dir = scratch("collisions");
   CheckRun run = run_faults(dir, 4, 16.5);
   INFO(run.result.out, run.result.err);
@@ -226,7 +243,8 @@ TEST_CASE("check: a holder passing a boss and a shank on a pocket's floor are fo
   CHECK(c[0]["depth_mm"].get<double>() == doctest::Approx(1.0).epsilon(0.001));
   CHECK(c[0]["point"][2].get<double>() == doctest::Approx(30));
   // On the boss: outside the round end of T2's first pass (centre (30, 8), radius 12).
-  CHECK(std::hypot(c[0]["point"][0].get<double>() - 30, c[0]["point"][1].get<double>() - 8) >= 12 - 0.1);
+  CHECK(std::hypot(c[0]["point"][0].get<double>() - 30, c[0]["point"][1].get<double>() - 8) >=
+        12 - 0.1);
   CHECK(c[0]["point"][1].get<double>() < 20);
   CHECK(c[0]["axis"] == json::array({0.0, 0.0, 1.0}));
   // The shank's bottom at z = 19.5, the floor at 20.
@@ -238,12 +256,16 @@ TEST_CASE("check: a holder passing a boss and a shank on a pocket's floor are fo
   // The holder must come out 1 mm further (and the tolerance).
   REQUIRE(run.report["stick_out"].size() == 1);
   CHECK(run.report["stick_out"][0]["tool"] == 1);
-  CHECK(run.report["stick_out"][0]["needed_mm"].get<double>() == doctest::Approx(26.0).epsilon(0.001));
-  CHECK(run.result.out.find("p.nc:16: tool 1's holder section 1 is 1.000 mm into the stock") != std::string::npos);
+  CHECK(run.report["stick_out"][0]["needed_mm"].get<double>() ==
+        doctest::Approx(26.0).epsilon(0.001));
+  CHECK(run.result.out.find("p.nc:16: tool 1's holder section 1 is 1.000 mm into the stock") !=
+        std::string::npos);
   fs::remove_all(dir);
 }
 
-TEST_CASE("check: a program whose holder and shank clear by a known margin passes, the margins as near misses") {
+TEST_CASE(
+    "check: a program whose holder and shank clear by a known margin passes, the margins as near "
+    "misses") {
   fs::path dir = scratch("near-misses");
   CheckRun run = run_faults(dir, 6, 17.5, {"--clearance", "2"});
   INFO(run.result.out, run.result.err);
@@ -267,7 +289,8 @@ TEST_CASE("check: a program whose holder and shank clear by a known margin passe
   fs::remove_all(dir);
 }
 
-TEST_CASE("check: a hole by the stock's edge buries the holder along +Z and clears it tilted away") {
+TEST_CASE(
+    "check: a hole by the stock's edge buries the holder along +Z and clears it tilted away") {
   fs::path dir = scratch("tilted-clear");
   const std::string tools = R"({"1": {"shape": "cylindrical", "diameter": 6, "stick-out": 20,
       "holder": [{"bottom-diameter": 30, "top-diameter": 30, "length": 20}]}})";
@@ -277,7 +300,8 @@ TEST_CASE("check: a hole by the stock's edge buries the holder along +Z and clea
     return std::make_pair(r.result.status, r.report);
   };
   // A hole 25 mm deep, 4 mm from the front face: the holder's face at z = 25 under the top at 30.
-  auto [status, report] = run("%\nG21 G17 G90\nT1 M6\nS8000 M3\nG0 X30 Y4 Z40\nG1 Z5 F300\nG0 Z40\nM30\n%\n");
+  auto [status, report] =
+      run("%\nG21 G17 G90\nT1 M6\nS8000 M3\nG0 X30 Y4 Z40\nG1 Z5 F300\nG0 Z40\nM30\n%\n");
   CHECK(status == 3);
   REQUIRE(!report["collisions"].empty());
   CHECK(report["collisions"][0]["line"] == 6);
@@ -292,7 +316,8 @@ TEST_CASE("check: a hole by the stock's edge buries the holder along +Z and clea
   // (centre entry + 5 mm back along the axis, radius 15) passes the top front edge at 2.172 mm
   // (its distance along the axis; the edge lies within the face's radius).
   std::tie(status, report) =
-      run("%\nG21 G17 G90\nT1 M6\nS8000 M3\nG68.2 X30 Y4 Z30 I0 J45 K0\nG53.1\nG0 X0 Y0 Z10\nG1 Z-15 F300\nG0 Z10\n"
+      run("%\nG21 G17 G90\nT1 M6\nS8000 M3\nG68.2 X30 Y4 Z30 I0 J45 K0\nG53.1\nG0 X0 Y0 Z10\nG1 "
+          "Z-15 F300\nG0 Z10\n"
           "G69\nM30\n%\n");
   CHECK(status == 0);
   CHECK(report["collisions"].empty());
@@ -301,7 +326,8 @@ TEST_CASE("check: a hole by the stock's edge buries the holder along +Z and clea
   const json& near = report["near_misses"]["moves"][0];
   CHECK(near["line"] == 8);
   CHECK(near["axis"][1].get<double>() == doctest::Approx(-std::sqrt(0.5)));
-  CHECK(std::abs(near["distance_mm"].get<double>() - 2.172) <= 0.08);  // one Z-map cell (diagonal / 1000)
+  CHECK(std::abs(near["distance_mm"].get<double>() - 2.172) <=
+        0.08);  // one Z-map cell (diagonal / 1000)
   fs::remove_all(dir);
 }
 
@@ -310,10 +336,11 @@ TEST_CASE("check: a shank working down its own slot meets only what the earlier 
   // the 10 mm flutes of the last pass stands where the first two passes cut. Checked against the
   // map before those passes are milled it would hit 5 mm of material; the check must see them.
   fs::path dir = scratch("own-slot");
-  CheckRun run = simulate_then_check(dir,
-                                     "%\nG21 G17 G90\nT1 M6\nS8000 M3\nG0 X10 Y20 Z35\nG1 Z25 F300\nG1 X50\nG1 Z20\n"
-                                     "G1 X10\nG1 Z15\nG1 X50\nG0 Z40\nM30\n%\n",
-                                     R"({"1": {"shape": "cylindrical", "diameter": 6, "flute-length": 10,
+  CheckRun run = simulate_then_check(
+      dir,
+      "%\nG21 G17 G90\nT1 M6\nS8000 M3\nG0 X10 Y20 Z35\nG1 Z25 F300\nG1 X50\nG1 Z20\n"
+      "G1 X10\nG1 Z15\nG1 X50\nG0 Z40\nM30\n%\n",
+      R"({"1": {"shape": "cylindrical", "diameter": 6, "flute-length": 10,
       "shank-diameter": 5.8, "stick-out": 30, "holder": [{"bottom-diameter": 30, "top-diameter": 30, "length": 20}]}})");
   INFO(run.result.out, run.result.err);
   CHECK(run.result.status == 0);
@@ -322,7 +349,8 @@ TEST_CASE("check: a shank working down its own slot meets only what the earlier 
   // The shank passes the slot's walls 0.1 mm away on the last pass.
   bool walls = false;
   for (const json& m : report["near_misses"]["moves"])
-    if (m["line"] == 11 && m["part"] == "shank") walls = std::abs(m["distance_mm"].get<double>() - 0.1) <= 0.08;
+    if (m["line"] == 11 && m["part"] == "shank")
+      walls = std::abs(m["distance_mm"].get<double>() - 0.1) <= 0.08;
   CHECK(walls);
   fs::remove_all(dir);
 }

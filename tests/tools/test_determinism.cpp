@@ -12,15 +12,16 @@ using namespace tridex::test;
 
 TEST_CASE("simulate and check: --threads 1, 2 and 8 give the same bytes and figures") {
   fs::path dir = scratch("threads");
-  const fs::path example = fs::path(TRIDEX_SOURCE_DIR) / "gcode" / "examples" / "mold_3plus2.camotics";
+  const fs::path example =
+      fs::path(TRIDEX_SOURCE_DIR) / "gcode" / "examples" / "mold_3plus2.camotics";
   std::string first_stl;
   nlohmann::json first_report, first_check;
   for (const char* threads : {"1", "2", "8"}) {
     CAPTURE(threads);
     const std::string stl = (dir / (std::string("t") + threads + ".stl")).string();
     const std::string report = (dir / (std::string("t") + threads + ".json")).string();
-    CommandResult r = run_tridex({"simulate", example.string(), "--dexel-res", "64", "--threads", threads, "-q", "-o",
-                                  stl, "--report", report},
+    CommandResult r = run_tridex({"simulate", example.string(), "--dexel-res", "64", "--threads",
+                                  threads, "-q", "-o", stl, "--report", report},
                                  dir);
     REQUIRE(r.status == 0);
     nlohmann::json figures = nlohmann::json::parse(slurp(report));
@@ -30,8 +31,8 @@ TEST_CASE("simulate and check: --threads 1, 2 and 8 give the same bytes and figu
     figures.erase("memory_estimate_mib");  // counts the peak so far, measured
     // check compares with a design: the machined result itself, so every finding is rounding.
     const std::string check_report = (dir / (std::string("c") + threads + ".json")).string();
-    CommandResult c = run_tridex({"check", example.string(), "--design", stl, "--dexel-res", "64", "--threads",
-                                  threads, "-q", "--report", check_report},
+    CommandResult c = run_tridex({"check", example.string(), "--design", stl, "--dexel-res", "64",
+                                  "--threads", threads, "-q", "--report", check_report},
                                  dir);
     REQUIRE((c.status == 0 || c.status == 3));
     nlohmann::json check = nlohmann::json::parse(slurp(check_report));

@@ -1,9 +1,9 @@
-// The --html page's writer (tools/cli/outputs/html_report.*): base64 against RFC 4648's vectors, the
-// display mesh against its budget and the triangles it must keep, the thinned toolpath against the
-// moves (every stop reachable in program order, every move within the tolerance of the segment that
-// stands for it), the program order across groups and files,
-// the page's data against the report, and pages that say when there is nothing to show. The page
-// in a browser: tests/html (CTest's html_report_browser).
+// The --html page's writer (tools/cli/outputs/html_report.*): base64 against RFC 4648's vectors,
+// the display mesh against its budget and the triangles it must keep, the thinned toolpath against
+// the moves (every stop reachable in program order, every move within the tolerance of the segment
+// that stands for it), the program order across groups and files, the page's data against the
+// report, and pages that say when there is nothing to show. The page in a browser: tests/html
+// (CTest's html_report_browser).
 #include <doctest/doctest.h>
 
 #include <array>
@@ -64,7 +64,8 @@ gcode::Move move(int line, gcode::MoveKind kind, Vec3 start, Vec3 end, int tool 
 
 double segment_distance(const Vec3& p, const Vec3& a, const Vec3& b) {
   const Vec3 ab = b - a;
-  const double t = glm::dot(ab, ab) > 0 ? std::clamp(glm::dot(p - a, ab) / glm::dot(ab, ab), 0.0, 1.0) : 0.0;
+  const double t =
+      glm::dot(ab, ab) > 0 ? std::clamp(glm::dot(p - a, ab) / glm::dot(ab, ab), 0.0, 1.0) : 0.0;
   return glm::length(p - (a + t * ab));
 }
 
@@ -113,7 +114,8 @@ TEST_CASE("the display mesh meets its budget and keeps every out-of-tolerance tr
   std::set<std::array<std::uint32_t, 3>> triangles;
   std::map<std::array<float, 3>, std::uint32_t> index_of;
   for (std::size_t v = 0; v < shown.positions.size(); ++v)
-    index_of[{shown.positions[v].x, shown.positions[v].y, shown.positions[v].z}] = static_cast<std::uint32_t>(v);
+    index_of[{shown.positions[v].x, shown.positions[v].y, shown.positions[v].z}] =
+        static_cast<std::uint32_t>(v);
   for (std::size_t k = 0; k < shown.indices.size(); k += 3)
     triangles.insert({shown.indices[k], shown.indices[k + 1], shown.indices[k + 2]});
   std::size_t flagged = 0;
@@ -137,7 +139,8 @@ TEST_CASE("the display mesh meets its budget and keeps every out-of-tolerance tr
   const std::size_t flat_shown = simplify_for_display(flat, {}, 0, 0, 1'000'000).indices.size() / 3;
   CHECK(flat_shown < 3200 / 10);
   // The same grid curved keeps more (the first error bound holds the curvature).
-  CHECK(simplify_for_display(heightfield(40), {}, 0, 0, 1'000'000).indices.size() / 3 > flat_shown + 100);
+  CHECK(simplify_for_display(heightfield(40), {}, 0, 0, 1'000'000).indices.size() / 3 >
+        flat_shown + 100);
 }
 
 TEST_CASE("the display mesh keeps sharp edges: every input vertex near the simplified surface") {
@@ -156,11 +159,14 @@ TEST_CASE("the display mesh keeps sharp edges: every input vertex near the simpl
   const DistanceTree tree(simplified);
   const double extent = glm::length(terraces.bounds().size());
   double farthest = 0;
-  for (const glm::vec3& p : terraces.positions) farthest = std::max(farthest, tree.nearest(Vec3(p)).distance);
+  for (const glm::vec3& p : terraces.positions)
+    farthest = std::max(farthest, tree.nearest(Vec3(p)).distance);
   CHECK(farthest <= 2 * 5e-4 * extent);
 }
 
-TEST_CASE("the thinned toolpath keeps every stop reachable in program order, every move within its tolerance") {
+TEST_CASE(
+    "the thinned toolpath keeps every stop reachable in program order, every move within its "
+    "tolerance") {
   using gcode::MoveKind;
   std::vector<gcode::MoveGroup> groups(2);
   groups[1].axis = Vec3(1, 0, 0);
@@ -188,7 +194,8 @@ TEST_CASE("the thinned toolpath keeps every stop reachable in program order, eve
     previous = next;
   }
   const int home_line = line++;
-  groups[0].moves.push_back(move(home_line, MoveKind::rapid, previous, Vec3(0, 0, gcode::MachineConfig::kDefaultFar)));
+  groups[0].moves.push_back(
+      move(home_line, MoveKind::rapid, previous, Vec3(0, 0, gcode::MachineConfig::kDefaultFar)));
   sub(2, 3);
   const std::vector<GroupRun> order = {{0, 51}, {1, 5}, {0, 201}, {1, 2}};
 
@@ -199,7 +206,8 @@ TEST_CASE("the thinned toolpath keeps every stop reachable in program order, eve
   for (const GroupRun& run : order)
     for (std::uint64_t k = 0; k < run.moves; ++k) {
       const gcode::Move& m = groups[run.group].moves[next[run.group]++];
-      if (stops.empty() || stops.back() != std::pair{m.file, m.line}) stops.emplace_back(m.file, m.line);
+      if (stops.empty() || stops.back() != std::pair{m.file, m.line})
+        stops.emplace_back(m.file, m.line);
       program.emplace_back(&m, run.group);
     }
 
@@ -210,9 +218,11 @@ TEST_CASE("the thinned toolpath keeps every stop reachable in program order, eve
   std::vector<std::pair<int, int>> decoded;
   for (std::size_t r = 0; r + 2 < path.stop_runs.size(); r += 3)
     for (std::uint32_t k = 0; k < path.stop_runs[r + 2]; ++k)
-      decoded.emplace_back(static_cast<int>(path.stop_runs[r]), static_cast<int>(path.stop_runs[r + 1] + k));
+      decoded.emplace_back(static_cast<int>(path.stop_runs[r]),
+                           static_cast<int>(path.stop_runs[r + 1] + k));
   CHECK(decoded == stops);
-  CHECK(path.stop_runs.size() == 3 * 4);  // file 0 from line 1, file 1 from 1, file 0 from 60, file 1 from 2
+  CHECK(path.stop_runs.size() ==
+        3 * 4);  // file 0 from line 1, file 1 from 1, file 0 from 60, file 1 from 2
   REQUIRE(path.ends.size() == 2 * path.stops.size());
   CHECK(path.stops.size() < 60);  // the straight feed is one segment, the circle a few dozen
   CHECK(std::is_sorted(path.stops.begin(), path.stops.end()));
@@ -224,7 +234,8 @@ TEST_CASE("the thinned toolpath keeps every stop reachable in program order, eve
     while (stops[stop] != std::pair{m->file, m->line}) ++stop;
     if (m->line == home_line) continue;
     const auto s = static_cast<std::size_t>(
-        std::lower_bound(path.stops.begin(), path.stops.end(), static_cast<std::uint32_t>(stop)) - path.stops.begin());
+        std::lower_bound(path.stops.begin(), path.stops.end(), static_cast<std::uint32_t>(stop)) -
+        path.stops.begin());
     REQUIRE(s < path.stops.size());
     const Vec3 a(path.ends[2 * s]), b(path.ends[2 * s + 1]);
     CHECK(segment_distance(m->start, a, b) <= tolerance + 1e-5);
@@ -243,19 +254,24 @@ TEST_CASE("the thinned toolpath keeps every stop reachable in program order, eve
   CHECK_THROWS_AS(thin_toolpath(groups, wrong, tolerance), std::logic_error);
 }
 
-TEST_CASE("the page holds the report, the listed source lines, and says when there is nothing to show") {
+TEST_CASE(
+    "the page holds the report, the listed source lines, and says when there is nothing to show") {
   fs::path dir = scratch("html-writer");
   // Two files with the same line numbers: a finding's lines come from its own file only.
   const fs::path program = dir / "p.nc", subprogram = dir / "O1001.nc";
   std::string text;
-  for (int k = 1; k <= 20; ++k) text += "G1 X" + std::to_string(k) + " ( line " + std::to_string(k) + " </script> )\n";
+  for (int k = 1; k <= 20; ++k)
+    text += "G1 X" + std::to_string(k) + " ( line " + std::to_string(k) + " </script> )\n";
   write_text(program, text);
   write_text(subprogram, text);
   HtmlPage page;
   page.title = "a <title> & more";
-  page.report = {{"rapid_cuts", json::array({{{"file", program.string()}, {"line", 10}, {"where", {1, 2, 3}}}})},
-                 {"gouges", json::array({{{"lines", {2, 18}}, {"files", {subprogram.string(), subprogram.string()}}}})},
-                 {"note", "</script><b>"}};
+  page.report = {
+      {"rapid_cuts",
+       json::array({{{"file", program.string()}, {"line", 10}, {"where", {1, 2, 3}}}})},
+      {"gouges",
+       json::array({{{"lines", {2, 18}}, {"files", {subprogram.string(), subprogram.string()}}}})},
+      {"note", "</script><b>"}};
   page.files = {program.string(), subprogram.string()};
   HtmlLimits limits;
   limits.max_source_bytes = 0;  // only the lines around findings
@@ -268,7 +284,9 @@ TEST_CASE("the page holds the report, the listed source lines, and says when the
   auto source_lines = [](std::initializer_list<std::pair<int, int>> ranges) {
     json source = json::object();
     for (const auto& [first, last] : ranges)
-      for (int k = first; k <= last; ++k) source[std::to_string(k)] = "G1 X" + std::to_string(k) + " ( line " + std::to_string(k) + " </script> )";
+      for (int k = first; k <= last; ++k)
+        source[std::to_string(k)] =
+            "G1 X" + std::to_string(k) + " ( line " + std::to_string(k) + " </script> )";
     return source;
   };
   REQUIRE(data["files"].size() == 2);
@@ -294,7 +312,8 @@ TEST_CASE("the page holds the report, the listed source lines, and says when the
   CHECK(data["mesh"]["triangles"] == mesh.triangles.size());
   CHECK(data["toolpath"]["segments"] == 1);
   const std::vector<std::uint32_t> runs = {0, 3, 1};  // file 0, line 3, one stop
-  CHECK(data["toolpath"]["stop_runs"] == base64({reinterpret_cast<const std::uint8_t*>(runs.data()), 12}));
+  CHECK(data["toolpath"]["stop_runs"] ==
+        base64({reinterpret_cast<const std::uint8_t*>(runs.data()), 12}));
   CHECK(data["toolpath"]["stop_count"] == 1);
   CHECK(!data.contains("design"));
   // check's design: its own mesh in the page, within its budget, over its own box.
@@ -310,20 +329,29 @@ TEST_CASE("the page holds the report, the listed source lines, and says when the
   CHECK(!data["design"].contains("deviation"));
   const Aabb design_box = design.bounds();
   for (int a = 0; a < 3; ++a) {
-    CHECK(data["design"]["box"]["min"][a].get<double>() == doctest::Approx(design_box.min[a]).epsilon(1e-6));
-    CHECK(data["design"]["box"]["max"][a].get<double>() == doctest::Approx(design_box.max[a]).epsilon(1e-6));
+    CHECK(data["design"]["box"]["min"][a].get<double>() ==
+          doctest::Approx(design_box.min[a]).epsilon(1e-6));
+    CHECK(data["design"]["box"]["max"][a].get<double>() ==
+          doctest::Approx(design_box.max[a]).epsilon(1e-6));
   }
   fs::remove_all(dir);
 }
 
-TEST_CASE("simulate --html: the page's report is the --report file; an unwritable page is refused up front") {
+TEST_CASE(
+    "simulate --html: the page's report is the --report file; an unwritable page is refused up "
+    "front") {
   fs::path dir = scratch("html-command");
-  write_text(dir / "p.nc", "%\nG21 G90\nT1 M6\nM3 S1000\nG0 X5 Y5 Z20\nG1 Z5 F100\nG1 X15\nG0 Z20\nM30\n%\n");
-  write_text(dir / "tools.json", R"({"1": {"units": "mm", "shape": "ballnose", "diameter": 4, "length": 20}})");
-  const std::vector<std::string> common = {"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(),
-                                           "--stock", "box:0,0,0,20,10,10", "--dexel-res", "64", "-q"};
+  write_text(dir / "p.nc",
+             "%\nG21 G90\nT1 M6\nM3 S1000\nG0 X5 Y5 Z20\nG1 Z5 F100\nG1 X15\nG0 Z20\nM30\n%\n");
+  write_text(dir / "tools.json",
+             R"({"1": {"units": "mm", "shape": "ballnose", "diameter": 4, "length": 20}})");
+  const std::vector<std::string> common = {
+      "simulate", (dir / "p.nc").string(), "--tools",     (dir / "tools.json").string(),
+      "--stock",  "box:0,0,0,20,10,10",    "--dexel-res", "64",
+      "-q"};
   std::vector<std::string> args = common;
-  args.insert(args.end(), {"--report", (dir / "r.json").string(), "--html", (dir / "r.html").string()});
+  args.insert(args.end(),
+              {"--report", (dir / "r.json").string(), "--html", (dir / "r.html").string()});
   CommandResult r = run_tridex(args, dir);
   INFO(r.err);
   REQUIRE(r.status == 0);
@@ -342,14 +370,19 @@ TEST_CASE("simulate --html: the page's report is the --report file; an unwritabl
   fs::remove_all(dir);
 }
 
-TEST_CASE("simulate --html with a subprogram file: each file's text, the stops in program order across the files") {
+TEST_CASE(
+    "simulate --html with a subprogram file: each file's text, the stops in program order across "
+    "the files") {
   fs::path dir = scratch("html-subprogram");
-  write_text(dir / "p.nc", "%\nG21 G90\nT1 M6\nM3 S1000\nG0 X5 Y5 Z20\nM98 P1001\nG0 Z20\nM30\n%\n");
+  write_text(dir / "p.nc",
+             "%\nG21 G90\nT1 M6\nM3 S1000\nG0 X5 Y5 Z20\nM98 P1001\nG0 Z20\nM30\n%\n");
   write_text(dir / "O1001.nc", "O1001\nG0 Z12\nG1 Z5 F100\nG1 X15\nM99\n");
-  write_text(dir / "tools.json", R"({"1": {"units": "mm", "shape": "ballnose", "diameter": 4, "length": 20}})");
-  CommandResult r = run_tridex({"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(), "--stock",
-                                "box:0,0,0,20,10,10", "--dexel-res", "64", "-q", "--html", (dir / "r.html").string()},
-                               dir);
+  write_text(dir / "tools.json",
+             R"({"1": {"units": "mm", "shape": "ballnose", "diameter": 4, "length": 20}})");
+  CommandResult r = run_tridex(
+      {"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(), "--stock",
+       "box:0,0,0,20,10,10", "--dexel-res", "64", "-q", "--html", (dir / "r.html").string()},
+      dir);
   INFO(r.err);
   REQUIRE(r.status == 0);
   json data = page_data(slurp(dir / "r.html"));
@@ -360,20 +393,25 @@ TEST_CASE("simulate --html with a subprogram file: each file's text, the stops i
   CHECK(data["files"][1]["source"]["4"] == "G1 X15");
   // Line 5 of p.nc, lines 2-4 of O1001.nc, line 7 of p.nc: (file, first line, count) runs.
   const std::vector<std::uint32_t> runs = {0, 5, 1, 1, 2, 3, 0, 7, 1};
-  CHECK(data["toolpath"]["stop_runs"] == base64({reinterpret_cast<const std::uint8_t*>(runs.data()), 4 * runs.size()}));
+  CHECK(data["toolpath"]["stop_runs"] ==
+        base64({reinterpret_cast<const std::uint8_t*>(runs.data()), 4 * runs.size()}));
   CHECK(data["toolpath"]["stop_count"] == 5);
   fs::remove_all(dir);
 }
 
-TEST_CASE("the findings name their file: a rapid into the stock in a subprogram file, both files with moves on its line") {
+TEST_CASE(
+    "the findings name their file: a rapid into the stock in a subprogram file, both files with "
+    "moves on its line") {
   fs::path dir = scratch("html-finding-file");
   write_text(dir / "p.nc", "%\nG21 G90 T1 M6\nM3 S1000 G0 X5 Y5 Z20\nM98 P1001\nG0 Z20\nM30\n%\n");
   write_text(dir / "O1001.nc", "O1001\nG0 X5 Y5 Z12\nG0 Z5\nG0 Z20\nM99\n");
-  write_text(dir / "tools.json", R"({"1": {"units": "mm", "shape": "ballnose", "diameter": 4, "length": 20}})");
-  CommandResult r = run_tridex({"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(), "--stock",
-                                "box:0,0,0,20,10,10", "--dexel-res", "64", "-q", "--report", (dir / "r.json").string(),
-                                "--html", (dir / "r.html").string()},
-                               dir);
+  write_text(dir / "tools.json",
+             R"({"1": {"units": "mm", "shape": "ballnose", "diameter": 4, "length": 20}})");
+  CommandResult r =
+      run_tridex({"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(),
+                  "--stock", "box:0,0,0,20,10,10", "--dexel-res", "64", "-q", "--report",
+                  (dir / "r.json").string(), "--html", (dir / "r.html").string()},
+                 dir);
   INFO(r.err);
   REQUIRE(r.status == 0);
   const json report = json::parse(slurp(dir / "r.json"));
@@ -385,7 +423,8 @@ TEST_CASE("the findings name their file: a rapid into the stock in a subprogram 
   CHECK(cut["line"] == 3);
   CHECK(fs::path(cut["file"].get<std::string>()).filename() == "O1001.nc");
   CHECK(cut["depth_mm"].get<double>() == doctest::Approx(5).epsilon(1e-3));
-  for (int a = 0; a < 3; ++a) CHECK(cut["where"][a].get<double>() == doctest::Approx(std::array{5.0, 5.0, 5.0}[a]));
+  for (int a = 0; a < 3; ++a)
+    CHECK(cut["where"][a].get<double>() == doctest::Approx(std::array{5.0, 5.0, 5.0}[a]));
   // The page names the same file: the finding's "file" is one of its files' names.
   const json data = page_data(slurp(dir / "r.html"));
   REQUIRE(data["files"].size() == 2);

@@ -23,8 +23,8 @@ std::string mapping_flags(const void* address) {
     std::uintptr_t begin = 0, end = 0;
     char dash = 0;
     std::istringstream header(line);
-    if (header >> std::hex >> begin >> dash >> end && dash == '-' && line.find(' ') != std::string::npos &&
-        line.find(':') > line.find(' ')) {
+    if (header >> std::hex >> begin >> dash >> end && dash == '-' &&
+        line.find(' ') != std::string::npos && line.find(':') > line.find(' ')) {
       inside = begin <= at && at < end;
     } else if (inside && line.rfind("VmFlags:", 0) == 0) {
       return line;

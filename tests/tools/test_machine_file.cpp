@@ -76,7 +76,8 @@ TEST_CASE("machine files: each key changes what the program means") {
 
   // Forbidden M-codes are errors with the line.
   write_text(dir / "strict.json", R"({"base": "linuxcnc", "forbidden_m_codes": [10]})");
-  r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "strict.json").string()}, dir);
+  r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "strict.json").string()},
+                 dir);
   CHECK(r.status == 2);
   CHECK(r.err.find("p.nc:6:1") != std::string::npos);
   fs::remove_all(dir);
@@ -85,8 +86,9 @@ TEST_CASE("machine files: each key changes what the program means") {
 TEST_CASE("machine files: \"variables\" are what the control holds when the program starts") {
   // A production program's feed in a persistent common, and an input it branches on.
   fs::path dir = scratch("machine-variables");
-  write_text(dir / "p.nc", "G21 G90\nT1 M6\nG0 X0 Y0 Z5\nIF [#1000 EQ 1] GOTO 9\nG1 Z-1 F#650\nN9 G0 Z5\n"
-                           "#901001 = 3\nG0 X#901001\nM30\n");
+  write_text(dir / "p.nc",
+             "G21 G90\nT1 M6\nG0 X0 Y0 Z5\nIF [#1000 EQ 1] GOTO 9\nG1 Z-1 F#650\nN9 G0 Z5\n"
+             "#901001 = 3\nG0 X#901001\nM30\n");
   CommandResult r = run_tridex({"moves", (dir / "p.nc").string()}, dir);
   CHECK(r.status == 2);  // #650 is vacant: no feed rate
   CHECK(r.err.find("p.nc:5:") != std::string::npos);
@@ -106,7 +108,8 @@ TEST_CASE("machine files: \"variables\" are what the control holds when the prog
   // LinuxCNC's global named parameters, as the operator sets them by MDI (case and spaces as
   // LinuxCNC reads names); a local name cannot be preset.
   write_text(dir / "n.ngc", "G21 G90\nG0 X0 Y0 Z1\nG1 X#<_td> Y#<_Tool_Dia> F100\nM2\n");
-  write_text(dir / "n.json", R"({"base": "linuxcnc", "variables": {"#<_td>": 6.35, "#<_tool_ dia>": 3}})");
+  write_text(dir / "n.json",
+             R"({"base": "linuxcnc", "variables": {"#<_td>": 6.35, "#<_tool_ dia>": 3}})");
   r = run_tridex({"moves", (dir / "n.ngc").string(), "--machine", (dir / "n.json").string()}, dir);
   INFO(r.err);
   REQUIRE(r.status == 0);
@@ -118,14 +121,17 @@ TEST_CASE("machine files: \"variables\" are what the control holds when the prog
   fs::remove_all(dir);
 }
 
-TEST_CASE("machine files: \"arc_radius_tolerance_mm\" is how far an arc's end may lie off its circle") {
+TEST_CASE(
+    "machine files: \"arc_radius_tolerance_mm\" is how far an arc's end may lie off its circle") {
   fs::path dir = scratch("machine-arc");
   // 0.00254 mm off (an inch program posted to 4 decimals): within the default 0.02 mm.
-  write_text(dir / "p.nc", "G20 G17 G90\nG0 X21.5179 Y2. Z0.1\nG3 X19.6618 I-0.928 J0. F10.\nM30\n");
+  write_text(dir / "p.nc",
+             "G20 G17 G90\nG0 X21.5179 Y2. Z0.1\nG3 X19.6618 I-0.928 J0. F10.\nM30\n");
   write_text(dir / "tight.json", R"({"arc_radius_tolerance_mm": 0.002})");
   write_text(dir / "bad.json", R"({"arc_radius_tolerance_mm": 0})");
   CHECK(run_tridex({"moves", (dir / "p.nc").string()}, dir).status == 0);
-  CommandResult r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "tight.json").string()}, dir);
+  CommandResult r = run_tridex(
+      {"moves", (dir / "p.nc").string(), "--machine", (dir / "tight.json").string()}, dir);
   CHECK(r.status == 2);
   CHECK(r.err.find("p.nc:3:") != std::string::npos);
   r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "bad.json").string()}, dir);
@@ -138,7 +144,8 @@ TEST_CASE("machine files: T alone loads the tool where the control does so") {
   fs::path dir = scratch("machine-t");
   write_text(dir / "p.nc", "T3\nG0 X0 Y0 Z5\nG1 Z0 F100\nM30\n");
   write_text(dir / "t.json", R"({"base": "linuxcnc", "tool_loads_on_t": true})");
-  CommandResult r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "t.json").string()}, dir);
+  CommandResult r =
+      run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "t.json").string()}, dir);
   REQUIRE(r.status == 0);
   CHECK(moves_of(r).back()["tool"] == 3);
   r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", "linuxcnc"}, dir);
@@ -157,7 +164,8 @@ TEST_CASE("machine files: \"g53\" says whether G53 Z retracts far or goes where 
   REQUIRE(m.size() == 4);
   CHECK(m[1]["end"] == nlohmann::json::array({1, 2, 50}));  // machine Z50, straight up
   CHECK(m[2]["end"] == nlohmann::json::array({4, 2, 50}));
-  r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "literal.json").string()}, dir);
+  r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "literal.json").string()},
+                 dir);
   REQUIRE(r.status == 0);
   CHECK(moves_of(r)[1]["end"] == nlohmann::json::array({1, 2, 50}));
   r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "far.json").string()}, dir);
@@ -181,7 +189,8 @@ TEST_CASE("machine files: --subprograms finds called programs") {
   CHECK(r.status == 2);
   CHECK(r.err.find("O9810") != std::string::npos);
   r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", "linuxcnc", "--subprograms",
-                  (dir / "macros").string()}, dir);
+                  (dir / "macros").string()},
+                 dir);
   REQUIRE(r.status == 0);
   CHECK(moves_of(r)[0]["end"] == nlohmann::json::array({4, 5, 1}));
   // The machine file's own folders, relative to the file.
@@ -210,10 +219,11 @@ TEST_CASE("machine files: kinematics by profile name or as an object") {
   CHECK(!cli::load_machine("default").kinematics.has_value());
 
   // moves: each move's rotary positions and machine coordinates; groups: each group's positions.
-  write_text(dir / "p.nc", "G0 X10 Y0 Z20\nG1 X12 F100\nG28 G91 Z0\nG90 G0 B90 C0\n"
-                           "G0 X5 Y0 Z20\nG1 X6 F100\nM30\n");
-  CommandResult r = run_tridex({"moves", (dir / "p.nc").string(), "--machine",
-                                (dir / "a.json").string()}, dir);
+  write_text(dir / "p.nc",
+             "G0 X10 Y0 Z20\nG1 X12 F100\nG28 G91 Z0\nG90 G0 B90 C0\n"
+             "G0 X5 Y0 Z20\nG1 X6 F100\nM30\n");
+  CommandResult r =
+      run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "a.json").string()}, dir);
   REQUIRE(r.status == 0);
   std::vector<nlohmann::json> moves = moves_of(r);
   REQUIRE(moves.size() == 5);  // G28's intermediate point is a zero-length rapid
@@ -240,13 +250,15 @@ TEST_CASE("machine files: kinematics by profile name or as an object") {
 
 TEST_CASE("machine files: a bundled kinematics profile is a --machine name on every command") {
   fs::path dir = scratch("machine-profile-names");
-  write_text(dir / "tools.json", R"({"1": {"units": "mm", "shape": "ballnose", "diameter": 6, "length": 30}})");
+  write_text(dir / "tools.json",
+             R"({"1": {"units": "mm", "shape": "ballnose", "diameter": 6, "length": 30}})");
   for (const std::string& name : gcode::kinematics_profile_names()) {
     INFO(name);
     CHECK(gcode::bundled_machine_names().find(name) != std::string::npos);  // --help lists it
     // The name is the default machine with that profile: as {"kinematics": NAME}.
     write_text(dir / "m.json", "{\"kinematics\": \"" + name + "\"}");
-    gcode::MachineConfig by_name = cli::load_machine(name), by_file = cli::load_machine((dir / "m.json").string());
+    gcode::MachineConfig by_name = cli::load_machine(name),
+                         by_file = cli::load_machine((dir / "m.json").string());
     REQUIRE(by_name.kinematics.has_value());
     CHECK(by_name.kinematics->axes.size() == by_file.kinematics->axes.size());
     CHECK(!by_name.start_position.has_value());  // the default machine's far start
@@ -267,8 +279,11 @@ TEST_CASE("machine files: a bundled kinematics profile is a --machine name on ev
     r = run_tridex({"groups", program, "--machine", name}, dir);
     REQUIRE(r.status == 0);
     CHECK(nlohmann::json::parse(r.out)["groups"].size() == 1);
-    const std::vector<std::string> mill{"--machine", name, "--tools", (dir / "tools.json").string(), "--stock",
-                                        "box:-20,-20,-20,20,20,0", "--dexel-cell", "1", "--quiet"};
+    const std::vector<std::string> mill{"--machine",    name,
+                                        "--tools",      (dir / "tools.json").string(),
+                                        "--stock",      "box:-20,-20,-20,20,20,0",
+                                        "--dexel-cell", "1",
+                                        "--quiet"};
     std::vector<std::string> args{"simulate", program, "-o", (dir / "out.stl").string()};
     args.insert(args.end(), mill.begin(), mill.end());
     r = run_tridex(args, dir);
@@ -277,7 +292,8 @@ TEST_CASE("machine files: a bundled kinematics profile is a --machine name on ev
     args = {"check", program, "--design", (dir / "out.stl").string()};
     args.insert(args.end(), mill.begin(), mill.end());
     r = run_tridex(args, dir);
-    CHECK((r.status == 0 || r.status == 3));  // read; its findings (a rapid, a near miss) are its own
+    CHECK(
+        (r.status == 0 || r.status == 3));  // read; its findings (a rapid, a near miss) are its own
   }
   // Without the name, the same program is refused at its rotary word.
   CommandResult r = run_tridex({"moves", (dir / "p.nc").string()}, dir);
@@ -294,14 +310,16 @@ TEST_CASE("rotary bad input through the command: file:line:col, exit 2; lenient 
     const char* at;  // file:line:col after the program's path
     const char* expected;
   } cases[] = {
-      {"G0 X0 Y0 Z50\nG0 A-130 C0\n", ":2:4: ", "outside the A axis's limits [-120, 120]"},  // ac-trunnion
+      {"G0 X0 Y0 Z50\nG0 A-130 C0\n",
+       ":2:4: ", "outside the A axis's limits [-120, 120]"},  // ac-trunnion
       {"G0 X0 Y0 Z50\nG0 C10 B5\n", ":2:8: ", "the machine has no B axis"},
-      {"G68.2 X0 Y0 Z0 I0 J150 K0\n G53.1\n", ":2:2: ", "G53.1"},                       // beyond A's limits
+      {"G68.2 X0 Y0 Z0 I0 J150 K0\n G53.1\n", ":2:2: ", "G53.1"},  // beyond A's limits
       {"G0 X0 Y0 Z0\nG1 X1 A10 F100\n", ":2:7: ", "during a cut"},
   };
   for (const Case& c : cases) {
     write_text(program, std::string(c.text) + "M30\n");
-    CommandResult r = run_tridex({"moves", program, "--machine", "ac-trunnion", "-o", (dir / "m.jsonl").string()}, dir);
+    CommandResult r = run_tridex(
+        {"moves", program, "--machine", "ac-trunnion", "-o", (dir / "m.jsonl").string()}, dir);
     INFO(c.text << " -> " << r.err);
     CHECK(r.status == 2);
     CHECK(r.err.find(program + c.at) != std::string::npos);
@@ -315,7 +333,8 @@ TEST_CASE("rotary bad input through the command: file:line:col, exit 2; lenient 
   REQUIRE(r.status == 0);
   CHECK(r.err.find(program + ":2:7: rotary motion during a cut") != std::string::npos);
   CHECK(r.err.find(program + ":3:7: rotary motion during a cut") != std::string::npos);
-  CHECK(r.err.find("lenient mode read 1 × rotary motion during a cut read as indexed along") != std::string::npos);
+  CHECK(r.err.find("lenient mode read 1 × rotary motion during a cut read as indexed along") !=
+        std::string::npos);
   CHECK(r.err.find("(lines 2)") != std::string::npos);
   CHECK(r.err.find("(lines 3)") != std::string::npos);
   std::vector<nlohmann::json> moves = moves_of(r);
@@ -371,7 +390,8 @@ TEST_CASE("machine files: bad files name the file, the key and the value") {
   write_text(dir / "p.nc", "G0 X0 Y0 Z0\nM30\n");
   write_text(dir / "m.json", "{\"dialect\": 3}");
   CommandResult r = run_tridex({"moves", (dir / "p.nc").string(), "--machine",
-                                (dir / "m.json").string(), "-o", (dir / "out.jsonl").string()}, dir);
+                                (dir / "m.json").string(), "-o", (dir / "out.jsonl").string()},
+                               dir);
   CHECK(r.status == 2);
   CHECK(!fs::exists(dir / "out.jsonl"));
   fs::remove_all(dir);
@@ -379,15 +399,17 @@ TEST_CASE("machine files: bad files name the file, the key and the value") {
 
 TEST_CASE("tools: G41/G42 D take the tool's diameter from --tools or the project's table") {
   fs::path dir = scratch("comp_tools");
-  write_text(dir / "p.ngc", "G21 G17 G90 F300\nT1 M6\nG0 X-10 Y-10 Z0\nG41 D1 G1 X0 Y0\nG1 X0 Y20\n"
-                            "G40 G1 X-10 Y30\nM2\n");
+  write_text(dir / "p.ngc",
+             "G21 G17 G90 F300\nT1 M6\nG0 X-10 Y-10 Z0\nG41 D1 G1 X0 Y0\nG1 X0 Y20\n"
+             "G40 G1 X-10 Y30\nM2\n");
   write_text(dir / "t.json", R"({"1": {"shape": "cylindrical", "diameter": 8, "length": 30}})");
   // Without a table the offset is unknown: exit 2 naming the tool.
   CommandResult r = run_tridex({"moves", (dir / "p.ngc").string(), "--machine", "linuxcnc"}, dir);
   CHECK(r.status == 2);
   CHECK(r.err.find("tool 1 is not in the tool table") != std::string::npos);
   r = run_tridex({"moves", (dir / "p.ngc").string(), "--machine", "linuxcnc", "--tools",
-                  (dir / "t.json").string()}, dir);
+                  (dir / "t.json").string()},
+                 dir);
   REQUIRE(r.status == 0);
   // The side X0 Y0 -> X0 Y20 runs one radius (4 mm) to its left: x = -4.
   bool side = false;
@@ -396,16 +418,21 @@ TEST_CASE("tools: G41/G42 D take the tool's diameter from --tools or the project
   CHECK(side);
 }
 
-TEST_CASE("machine files: the Haas dialect (\"dialect\": \"haas\", --machine haas) reads Haas's offset registers; \"d_offsets\"") {
+TEST_CASE(
+    "machine files: the Haas dialect (\"dialect\": \"haas\", --machine haas) reads Haas's offset "
+    "registers; \"d_offsets\"") {
   fs::path dir = scratch("haas-dialect");
   // #2001 is H1's geometry on Haas and its wear on Fanuc: the alarm says what the program read.
   write_text(dir / "p.nc", "G21 G90\n#2001 = 50.\n#3000 = #2001 + #2201\n");
-  write_text(dir / "t.json", R"({"1": {"shape": "cylindrical", "diameter": 6, "tool-length": 80}})");
+  write_text(dir / "t.json",
+             R"({"1": {"shape": "cylindrical", "diameter": 6, "tool-length": 80}})");
   write_text(dir / "haas.json", R"({"dialect": "haas"})");
-  for (const std::string& machine : {std::string("haas"), (dir / "haas.json").string(), std::string("default")}) {
+  for (const std::string& machine :
+       {std::string("haas"), (dir / "haas.json").string(), std::string("default")}) {
     CAPTURE(machine);
-    CommandResult r =
-        run_tridex({"moves", (dir / "p.nc").string(), "--machine", machine, "--tools", (dir / "t.json").string()}, dir);
+    CommandResult r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", machine, "--tools",
+                                  (dir / "t.json").string()},
+                                 dir);
     CHECK(r.status == 2);
     CHECK(r.err.find(machine == "default" ? "#3000 = 130" : "#3000 = 50") != std::string::npos);
   }
@@ -415,13 +442,16 @@ TEST_CASE("machine files: the Haas dialect (\"dialect\": \"haas\", --machine haa
   write_text(dir / "diameter.json", R"({"dialect": "haas", "d_offsets": "diameter"})");
   write_text(dir / "radius.json", R"({"base": "haas", "d_offsets": "radius"})");
   write_text(dir / "bad.json", R"({"base": "haas", "d_offsets": "diametre"})");
-  for (const auto& [machine, expected] : {std::pair<std::string, std::string>{"diameter.json", "#3000 = 6"},
-                                          {"radius.json", "#3000 = 3"},
-                                          {"haas", "\"d_offsets\""},
-                                          {"bad.json", "\"d_offsets\": \"radius\" or \"diameter\", got \"diametre\""}}) {
+  for (const auto& [machine, expected] :
+       {std::pair<std::string, std::string>{"diameter.json", "#3000 = 6"},
+        {"radius.json", "#3000 = 3"},
+        {"haas", "\"d_offsets\""},
+        {"bad.json", "\"d_offsets\": \"radius\" or \"diameter\", got \"diametre\""}}) {
     CAPTURE(machine);
     const std::string path = machine == "haas" ? machine : (dir / machine).string();
-    CommandResult r = run_tridex({"moves", (dir / "d.nc").string(), "--machine", path, "--tools", (dir / "t.json").string()}, dir);
+    CommandResult r = run_tridex(
+        {"moves", (dir / "d.nc").string(), "--machine", path, "--tools", (dir / "t.json").string()},
+        dir);
     CHECK(r.status == 2);
     CHECK(r.err.find(expected) != std::string::npos);
   }
@@ -431,11 +461,12 @@ TEST_CASE("--tools with tool lengths: G43 H names the tip, G49 the gauge point (
   fs::path dir = scratch("tool-lengths");
   write_text(dir / "p.ngc", "G21 G90\nG53 G0 Z0\nT1 M6\nG0 X1 Y1\nG43 H1\nG0 X2\nG0 Z5\nM2\n");
   write_text(dir / "t.tbl", "T1 P1 D0.125 Z+0.5 ;1/8 end mill\n");
-  write_text(dir / "t.json", R"({"1": {"shape": "cylindrical", "diameter": 3.175, "tool-length": 12.7}})");
+  write_text(dir / "t.json",
+             R"({"1": {"shape": "cylindrical", "diameter": 3.175, "tool-length": 12.7}})");
   for (const char* table : {"t.tbl", "t.json"}) {
     CAPTURE(table);
-    CommandResult r = run_tridex({"moves", (dir / "p.ngc").string(), "--machine", "linuxcnc", "--tools",
-                                  (dir / table).string()},
+    CommandResult r = run_tridex({"moves", (dir / "p.ngc").string(), "--machine", "linuxcnc",
+                                  "--tools", (dir / table).string()},
                                  dir);
     REQUIRE(r.status == 0);
     auto m = moves_of(r);
@@ -448,19 +479,22 @@ TEST_CASE("--tools with tool lengths: G43 H names the tip, G49 the gauge point (
   // A metric machine (LinuxCNC's LINEAR_UNITS = mm): the same .tbl written in mm.
   write_text(dir / "mm.tbl", "T1 P1 D3.175 Z+12.7 ;1/8 end mill\n");
   write_text(dir / "metric.json", R"({"base": "linuxcnc", "linear_units": "mm"})");
-  CommandResult metric = run_tridex({"moves", (dir / "p.ngc").string(), "--machine", (dir / "metric.json").string(),
-                                     "--tools", (dir / "mm.tbl").string()},
-                                    dir);
+  CommandResult metric =
+      run_tridex({"moves", (dir / "p.ngc").string(), "--machine", (dir / "metric.json").string(),
+                  "--tools", (dir / "mm.tbl").string()},
+                 dir);
   REQUIRE(metric.status == 0);
   auto mm = moves_of(metric);
   REQUIRE(mm.size() == 4);
   CHECK(mm[1]["end"] == nlohmann::json::array({1, 1, -12.7}));
   write_text(dir / "typo.json", R"({"base": "linuxcnc", "linear_units": "metric"})");
-  CommandResult typo = run_tridex({"moves", (dir / "p.ngc").string(), "--machine", (dir / "typo.json").string()}, dir);
+  CommandResult typo = run_tridex(
+      {"moves", (dir / "p.ngc").string(), "--machine", (dir / "typo.json").string()}, dir);
   CHECK(typo.status == 2);
   CHECK(typo.err.find("\"linear_units\": \"mm\" or \"inch\", got \"metric\"") != std::string::npos);
   write_text(dir / "bad.tbl", "T1 P1 D0.125 Z+0.5\nT2 P2 Dx\n");
-  CommandResult r = run_tridex({"moves", (dir / "p.ngc").string(), "--tools", (dir / "bad.tbl").string()}, dir);
+  CommandResult r =
+      run_tridex({"moves", (dir / "p.ngc").string(), "--tools", (dir / "bad.tbl").string()}, dir);
   CHECK(r.status == 2);
   CHECK(r.err.find("bad.tbl:2:7: \"Dx\"") != std::string::npos);
   fs::remove_all(dir);

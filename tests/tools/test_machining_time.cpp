@@ -23,7 +23,8 @@ using json = nlohmann::json;
 namespace {
 
 // The program's time as tridex reads it, with the tool starting at the origin.
-cli::MachiningTime time_of(const std::string& program, gcode::Dialect dialect = gcode::Dialect::linuxcnc,
+cli::MachiningTime time_of(const std::string& program,
+                           gcode::Dialect dialect = gcode::Dialect::linuxcnc,
                            gcode::MachineRates rates = {}) {
   gcode::MachineConfig machine;
   machine.dialect = dialect;
@@ -34,7 +35,8 @@ cli::MachiningTime time_of(const std::string& program, gcode::Dialect dialect = 
   cli::MachiningTimer timer(machine);
   std::istringstream in(program);
   interpreter.run(
-      in, "t.nc", [&](const gcode::Move& m) { timer.add(m); }, [&](const gcode::Dwell& d) { timer.add(d); });
+      in, "t.nc", [&](const gcode::Move& m) { timer.add(m); },
+      [&](const gcode::Dwell& d) { timer.add(d); });
   return timer.time();
 }
 
@@ -46,12 +48,12 @@ TEST_CASE("machining time: lines, an arc by its length and a dwell") {
   cli::MachiningTime t = time_of(
       "G21 G90 G17\n"
       "T1 M6\n"
-      "G0 X30 Y40\n"                 // 50 mm at the rapid rate
-      "G1 Z-5 F300\n"                // 5 mm at 300 mm/min: 1 s
-      "G1 X60 Y80 F600\n"            // 50 mm at 600: 5 s
-      "G4 P2.5\n"                    // 2.5 s (LinuxCNC: seconds)
-      "G2 X80 Y80 I10 J0 F100\n"     // half a circle of radius 10: 10π mm at 100
-      "G0 Z10\n");                   // 15 mm at the rapid rate
+      "G0 X30 Y40\n"              // 50 mm at the rapid rate
+      "G1 Z-5 F300\n"             // 5 mm at 300 mm/min: 1 s
+      "G1 X60 Y80 F600\n"         // 50 mm at 600: 5 s
+      "G4 P2.5\n"                 // 2.5 s (LinuxCNC: seconds)
+      "G2 X80 Y80 I10 J0 F100\n"  // half a circle of radius 10: 10π mm at 100
+      "G0 Z10\n");                // 15 mm at the rapid rate
   double arc = 60 * 10 * std::numbers::pi / 100;
   CHECK(t.rapid_s == doctest::Approx(60 * 65 / kRapid));
   // The arc's chords are within the arc tolerance (1 µm) of the arc: their length is within 1e-4.
@@ -75,7 +77,8 @@ TEST_CASE("machining time: inch feeds are converted") {
 TEST_CASE("machining time: a canned cycle by its pieces, with its dwell at each hole's bottom") {
   // From (0,0,10): hole 1 rapids 10 mm across and 8 down to R, feeds 7 mm, dwells, rapids 15 up to
   // the initial level; hole 2 the same. P is sticky.
-  cli::MachiningTime t = time_of("G21 G90 G17\nG0 Z10\nG98 G82 X10 Y0 Z-5 R2 P0.5 F120\nX20\nG80\n");
+  cli::MachiningTime t =
+      time_of("G21 G90 G17\nG0 Z10\nG98 G82 X10 Y0 Z-5 R2 P0.5 F120\nX20\nG80\n");
   CHECK(t.rapid_s == doctest::Approx(60 * (10 + 2 * (10 + 8 + 15)) / kRapid));
   CHECK(t.feed_s == doctest::Approx(2 * 3.5));
   CHECK(t.dwell_s == doctest::Approx(2 * 0.5));
@@ -139,8 +142,10 @@ TEST_CASE("machining time: rapids per axis, a max feed, per tool and per directi
 
 TEST_CASE("machining time: the machine file's rates, refused when bad, in the reports") {
   fs::path dir = scratch("machining-time");
-  write_text(dir / "p.nc", "G21 G90\nG0 X0 Y0 Z5\nT1 M6\nG1 Z-1 F60\nG1 X20 F1200\nG4 P2\nG0 Z25\nM30\n");
-  write_text(dir / "m.json", R"({"base": "linuxcnc", "rapid_rate_mm_per_min": 3000, "max_feed_mm_per_min": 600})");
+  write_text(dir / "p.nc",
+             "G21 G90\nG0 X0 Y0 Z5\nT1 M6\nG1 Z-1 F60\nG1 X20 F1200\nG4 P2\nG0 Z25\nM30\n");
+  write_text(dir / "m.json",
+             R"({"base": "linuxcnc", "rapid_rate_mm_per_min": 3000, "max_feed_mm_per_min": 600})");
   gcode::MachineRates rates = cli::load_machine((dir / "m.json").string()).rates;
   CHECK(rates.rapid_mm_per_min == Vec3(3000));
   CHECK(rates.max_feed_mm_per_min == 600);
@@ -148,7 +153,8 @@ TEST_CASE("machining time: the machine file's rates, refused when bad, in the re
 
   // From the origin: rapid 5 (tool 0) and 26 mm at 3000; feed 6 mm at 60 (6 s) and 20 mm capped at
   // 600 (2 s); dwell 2 s.
-  CommandResult r = run_tridex({"groups", (dir / "p.nc").string(), "--machine", (dir / "m.json").string()}, dir);
+  CommandResult r =
+      run_tridex({"groups", (dir / "p.nc").string(), "--machine", (dir / "m.json").string()}, dir);
   INFO(r.out, r.err);
   REQUIRE(r.status == 0);
   json mt = json::parse(r.out)["machining_time"];
@@ -166,25 +172,30 @@ TEST_CASE("machining time: the machine file's rates, refused when bad, in the re
 
   // simulate and check report the same object and print it.
   write_text(dir / "tools.json", R"({"1": {"shape": "cylindrical", "diameter": 6}})");
-  r = run_tridex({"simulate", (dir / "p.nc").string(), "--machine", (dir / "m.json").string(), "--tools",
-                  (dir / "tools.json").string(), "--stock", "box:-10,-10,-5,30,10,0", "--dexel-cell", "1",
-                  "--report", (dir / "report.json").string(), "-o", (dir / "made.stl").string()},
-                 dir);
+  r = run_tridex(
+      {"simulate", (dir / "p.nc").string(), "--machine", (dir / "m.json").string(), "--tools",
+       (dir / "tools.json").string(), "--stock", "box:-10,-10,-5,30,10,0", "--dexel-cell", "1",
+       "--report", (dir / "report.json").string(), "-o", (dir / "made.stl").string()},
+      dir);
   REQUIRE(r.status == 0);
   CHECK(json::parse(slurp(dir / "report.json"))["machining_time"] == mt);
-  const std::string line = "machining time 10.6 s (feed 8.0 s, rapid 0.6 s, dwell 2.0 s) with rapids at 3000 mm/min (from ";
+  const std::string line =
+      "machining time 10.6 s (feed 8.0 s, rapid 0.6 s, dwell 2.0 s) with rapids at 3000 mm/min "
+      "(from ";
   CHECK(r.out.find(line) != std::string::npos);
-  r = run_tridex({"check", (dir / "p.nc").string(), "--design", (dir / "made.stl").string(), "--machine",
-                  (dir / "m.json").string(), "--tools", (dir / "tools.json").string(), "--stock",
-                  "box:-10,-10,-5,30,10,0", "--dexel-cell", "1", "--report", (dir / "check.json").string()},
-                 dir);
+  r = run_tridex(
+      {"check", (dir / "p.nc").string(), "--design", (dir / "made.stl").string(), "--machine",
+       (dir / "m.json").string(), "--tools", (dir / "tools.json").string(), "--stock",
+       "box:-10,-10,-5,30,10,0", "--dexel-cell", "1", "--report", (dir / "check.json").string()},
+      dir);
   INFO(r.out, r.err);
   REQUIRE(r.status == 0);
   CHECK(json::parse(slurp(dir / "check.json"))["machining_time"] == mt);
   CHECK(r.out.find(line) != std::string::npos);
 
-  for (const char* bad : {R"({"rapid_rate_mm_per_min": -1})", R"({"rapid_rate_mm_per_min": [1000, 2000]})",
-                          R"({"rapid_rate_mm_per_min": "fast"})", R"({"max_feed_mm_per_min": 0})"}) {
+  for (const char* bad :
+       {R"({"rapid_rate_mm_per_min": -1})", R"({"rapid_rate_mm_per_min": [1000, 2000]})",
+        R"({"rapid_rate_mm_per_min": "fast"})", R"({"max_feed_mm_per_min": 0})"}) {
     write_text(dir / "bad.json", bad);
     try {
       cli::load_machine((dir / "bad.json").string());
@@ -224,13 +235,13 @@ TEST_CASE("machining time: rapids on a tilted plane move the machine's axes, not
   // The approach after the turn comes from far (not timed); the retract is 10 mm of machine Z.
   const std::string program =
       "G21 G90 G17\n"
-      "G0 X0 Y0 Z30\n"                        // 30 mm of Z at 1000: 1.8 s
+      "G0 X0 Y0 Z30\n"  // 30 mm of Z at 1000: 1.8 s
       "G68.2 X0 Y0 Z0 I0 J30 K0\n"
       "G53.1\n"
-      "G0 X0 Y0 Z10\n"                        // from far: not timed
-      "G0 Y40\n"                              // machine Y 40: 0.4 s
-      "G1 Z0 F600\n"                          // 10 mm at 600: 1 s
-      "G0 Z10\n";                             // machine Z 10 at 1000: 0.6 s
+      "G0 X0 Y0 Z10\n"  // from far: not timed
+      "G0 Y40\n"        // machine Y 40: 0.4 s
+      "G1 Z0 F600\n"    // 10 mm at 600: 1 s
+      "G0 Z10\n";       // machine Z 10 at 1000: 0.6 s
   cli::MachiningTime t = time_on(kTrunnion, program);
   CHECK(t.untimed_approaches == 1);
   CHECK(t.rapid_s == doctest::Approx(1.8 + 0.4 + 0.6));
@@ -245,16 +256,17 @@ TEST_CASE("machining time: rapids in raw rotary form, with the turn at the rotar
   // (A block that only turns makes no move: its turn is timed with the next rapid's.)
   const std::string program =
       "G21 G90\n"
-      "G0 X0 Y0 Z30\n"     // 1.8 s
-      "G0 Y100 A15\n"      // max(1 s, 0.25 s)
-      "G0 X12 C180\n";     // max(0.12 s, 1.5 s)
+      "G0 X0 Y0 Z30\n"  // 1.8 s
+      "G0 Y100 A15\n"   // max(1 s, 0.25 s)
+      "G0 X12 C180\n";  // max(0.12 s, 1.5 s)
   cli::MachiningTime t = time_on(kTrunnion, program);
   CHECK(t.rapid_s == doctest::Approx(1.8 + 1 + 1.5));
   CHECK(t.untimed_turns == 0);
 
   // Without a rotary rate the turns are not timed, and counted.
-  t = time_on(R"({"base": "ac-trunnion", "start": [0, 0, 0], "rapid_rate_mm_per_min": [6000, 6000, 1000]})",
-              program);
+  t = time_on(
+      R"({"base": "ac-trunnion", "start": [0, 0, 0], "rapid_rate_mm_per_min": [6000, 6000, 1000]})",
+      program);
   CHECK(t.rapid_s == doctest::Approx(1.8 + 1 + 0.12));
   CHECK(t.untimed_turns == 2);
 }
@@ -265,13 +277,15 @@ TEST_CASE("machining time: the rotary rates in the machine file") {
   CHECK(rates.rapid_deg_per_min == std::array<double, 3>{5400, 5400, 5400});
   // Read in either order with the linear rates (a JSON object's keys are unordered).
   gcode::MachineConfig machine = gcode::machine_from_json(
-      json::parse(R"({"rapid_rate_mm_per_min": 8000, "rapid_rate_deg_per_min": {"B": 900}})"), "m.json");
+      json::parse(R"({"rapid_rate_mm_per_min": 8000, "rapid_rate_deg_per_min": {"B": 900}})"),
+      "m.json");
   CHECK(machine.rates.rapid_deg_per_min == std::array<double, 3>{0, 900, 0});
   CHECK(machine.rates.rapid_mm_per_min == Vec3(8000));
   cli::MachiningTimer timer(machine);
   CHECK(cli::machining_time_json(timer)["rapid_rate_deg_per_min"] == json{{"B", 900.0}});
-  for (const char* bad : {R"({"rapid_rate_deg_per_min": 0})", R"({"rapid_rate_deg_per_min": {"X": 100}})",
-                          R"({"rapid_rate_deg_per_min": {"A": -5}})", R"({"rapid_rate_deg_per_min": [1, 2]})"}) {
+  for (const char* bad :
+       {R"({"rapid_rate_deg_per_min": 0})", R"({"rapid_rate_deg_per_min": {"X": 100}})",
+        R"({"rapid_rate_deg_per_min": {"A": -5}})", R"({"rapid_rate_deg_per_min": [1, 2]})"}) {
     try {
       gcode::machine_from_json(json::parse(bad), "bad.json");
       FAIL(bad);

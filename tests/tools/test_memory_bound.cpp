@@ -80,29 +80,32 @@ void check_bound(std::vector<std::string> args, const fs::path& dir, int success
   first.insert(first.end(), {"--report", report});
   Measured unbounded = run_measured(first);
   REQUIRE(unbounded.status == success_status);
-  const double estimate_mib = nlohmann::json::parse(slurp(report))["memory_estimate_mib"].get<double>();
+  const double estimate_mib =
+      nlohmann::json::parse(slurp(report))["memory_estimate_mib"].get<double>();
   const long long limit_mib = static_cast<long long>(std::ceil(estimate_mib)) + 1;
   std::vector<std::string> bounded = args;
   bounded.insert(bounded.end(), {"--max-memory", std::to_string(limit_mib) + "M"});
   Measured at_limit = run_measured(bounded);
   MESSAGE(args[0] << ": estimate " << estimate_mib << " MiB, limit " << limit_mib << " MiB, peak "
-                   << at_limit.peak_bytes / (1 << 20) << " MiB");
+                  << at_limit.peak_bytes / (1 << 20) << " MiB");
   CHECK(at_limit.status == success_status);
   CHECK(at_limit.peak_bytes <= static_cast<double>(limit_mib) * (1 << 20));
   bounded.back() = std::to_string(static_cast<long long>(std::floor(estimate_mib)) - 1) + "M";
   CHECK(run_measured(bounded).status == 2);
 }
 
-const std::string kTools = R"({"1": {"units": "mm", "shape": "ballnose", "diameter": 4, "length": 20}})";
+const std::string kTools =
+    R"({"1": {"units": "mm", "shape": "ballnose", "diameter": 4, "length": 20}})";
 
 // `directions` tilted planes around the Z axis, a small raster in each.
 std::string many_directions(int directions) {
   std::string p = "G21 G90\nT1 M6\nS1000 M3\n";
   for (int k = 0; k < directions; ++k) {
-    p += "G68.2 X0 Y0 Z0 I" + std::to_string(360.0 * k / directions) + " J" + std::to_string(20 + 25 * (k % 3)) +
-         " K0\nG53.1\nG0 X-10 Y-10 Z30\nG1 Z18 F300\n";
+    p += "G68.2 X0 Y0 Z0 I" + std::to_string(360.0 * k / directions) + " J" +
+         std::to_string(20 + 25 * (k % 3)) + " K0\nG53.1\nG0 X-10 Y-10 Z30\nG1 Z18 F300\n";
     for (int r = 0; r < 10; ++r)
-      p += "G1 X10 Y" + std::to_string(-10 + 2 * r) + "\nG1 X-10 Y" + std::to_string(-9 + 2 * r) + "\n";
+      p += "G1 X10 Y" + std::to_string(-10 + 2 * r) + "\nG1 X-10 Y" + std::to_string(-9 + 2 * r) +
+           "\n";
     p += "G0 Z40\nG69\n";
   }
   return p + "M30\n";
@@ -127,7 +130,8 @@ Mesh sphere(int nu, double radius, Vec3 centre) {
     for (int j = 0; j < nu; ++j) {
       double theta = std::numbers::pi * i / nv, phi = 2 * std::numbers::pi * j / nu;
       m.positions.emplace_back(centre + radius * Vec3(std::sin(theta) * std::cos(phi),
-                                                      std::sin(theta) * std::sin(phi), std::cos(theta)));
+                                                      std::sin(theta) * std::sin(phi),
+                                                      std::cos(theta)));
     }
   m.positions.emplace_back(centre - Vec3(0, 0, radius));
   auto ring = [&](int i, int j) { return static_cast<unsigned>(1 + (i - 1) * nu + (j % nu)); };
@@ -149,9 +153,10 @@ TEST_CASE("memory: the estimate bounds the peak of simulate with many directions
   fs::path dir = scratch("memory-directions");
   write_text(dir / "p.nc", many_directions(12));
   write_text(dir / "tools.json", kTools);
-  check_bound({"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(), "--stock",
-               "box:-30,-30,-40,30,30,20", "--dexel-res", "120", "-o", (dir / "out.stl").string()},
-              dir);
+  check_bound(
+      {"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(), "--stock",
+       "box:-30,-30,-40,30,30,20", "--dexel-res", "120", "-o", (dir / "out.stl").string()},
+      dir);
   fs::remove_all(dir);
 }
 
@@ -159,9 +164,10 @@ TEST_CASE("memory: the estimate bounds the peak of simulate at a fine resolution
   fs::path dir = scratch("memory-fine");
   write_text(dir / "p.nc", many_directions(2));
   write_text(dir / "tools.json", kTools);
-  check_bound({"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(), "--stock",
-               "box:-30,-30,-40,30,30,20", "--dexel-res", "256", "-o", (dir / "out.stl").string()},
-              dir);
+  check_bound(
+      {"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(), "--stock",
+       "box:-30,-30,-40,30,30,20", "--dexel-res", "256", "-o", (dir / "out.stl").string()},
+      dir);
   fs::remove_all(dir);
 }
 
@@ -170,9 +176,10 @@ TEST_CASE("memory: the estimate bounds the peak of simulate from a large STL sto
   write_text(dir / "p.nc", many_directions(3));
   write_text(dir / "tools.json", kTools);
   write_stl((dir / "stock.stl").string(), sphere(500, 25, Vec3(0, 0, -5)));  // 250,000 triangles
-  check_bound({"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(), "--stock",
-               (dir / "stock.stl").string(), "--dexel-res", "100", "-o", (dir / "out.stl").string()},
-              dir);
+  check_bound(
+      {"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(), "--stock",
+       (dir / "stock.stl").string(), "--dexel-res", "100", "-o", (dir / "out.stl").string()},
+      dir);
   fs::remove_all(dir);
 }
 
@@ -182,16 +189,17 @@ TEST_CASE("memory: the estimate bounds the peak of check with a large design") {
   write_text(dir / "tools.json", kTools);
   write_stl((dir / "design.stl").string(), sphere(300, 20, Vec3(0, 0, -10)));  // 90,000 triangles
   // The design is not what the program makes: findings, exit status 3.
-  check_bound({"check", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(), "--stock",
-               "box:-30,-30,-40,30,30,20", "--design", (dir / "design.stl").string(), "--dexel-res", "80",
-               "--ply", (dir / "out.ply").string()},
+  check_bound({"check", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(),
+               "--stock", "box:-30,-30,-40,30,30,20", "--design", (dir / "design.stl").string(),
+               "--dexel-res", "80", "--ply", (dir / "out.ply").string()},
               dir, 3);
   fs::remove_all(dir);
 }
 
-TEST_CASE("memory: the steep cells counted before refining are those refine_steep_cells makes fine") {
-  // Slots and a ball's groove in a tilted frame (walls off the grid), milled, raised, then refined: the
-  // count the memory check uses must be the refinement's, cell for cell in number.
+TEST_CASE(
+    "memory: the steep cells counted before refining are those refine_steep_cells makes fine") {
+  // Slots and a ball's groove in a tilted frame (walls off the grid), milled, raised, then refined:
+  // the count the memory check uses must be the refinement's, cell for cell in number.
   const Aabb stock{Vec3(0), Vec3(12, 9, 4)};
   const Frame frame = Frame::from_axis(glm::normalize(Vec3(0.2, 0.1, 1)));
   for (double cell : {0.07, 0.13}) {
@@ -203,10 +211,13 @@ TEST_CASE("memory: the steep cells counted before refining are those refine_stee
     std::vector<CutMove> moves;
     for (int k = 0; k < 5; ++k) {
       const double y = local.min.y + 1.5 + 1.6 * k;
-      moves.push_back({Segment{Vec3(local.min.x - 1, y, local.max.z - 2), Vec3(local.max.x + 1, y, local.max.z - 2)}, 0});
+      moves.push_back({Segment{Vec3(local.min.x - 1, y, local.max.z - 2),
+                               Vec3(local.max.x + 1, y, local.max.z - 2)},
+                       0});
     }
     moves.push_back({Segment{Vec3(local.min.x + 3, local.min.y + 3, local.max.z - 1),
-                             Vec3(local.min.x + 6, local.min.y + 5, local.max.z - 1)}, 1});
+                             Vec3(local.min.x + 6, local.min.y + 5, local.max.z - 1)},
+                     1});
     mill(map, cutters, moves, {.threads = 1});
     raise_uncut(map, initial);
     const std::size_t counted = steep_cells(map, WallOptions{}.steep_slope, 2).size();
@@ -214,30 +225,39 @@ TEST_CASE("memory: the steep cells counted before refining are those refine_stee
     CHECK(counted > 100);
     CHECK(counted == map.fine.cells.size());
     // The bytes counted cover what the refined map keeps.
-    CHECK(cli::fine_cell_bytes(static_cast<double>(counted), map.grid.ny, static_cast<double>(moves.size()), 1) >=
+    CHECK(cli::fine_cell_bytes(static_cast<double>(counted), map.grid.ny,
+                               static_cast<double>(moves.size()), 1) >=
           static_cast<double>((map.fine.cells.size() + map.fine.row_begin.size()) * 4 +
                               map.fine.heights.size() * sizeof(float)));
   }
 }
 
-TEST_CASE("memory: the estimate bounds the peak of simulate with many steep walls, and refuses their cells") {
+TEST_CASE(
+    "memory: the estimate bounds the peak of simulate with many steep walls, and refuses their "
+    "cells") {
   fs::path dir = scratch("memory-walls");
   write_text(dir / "p.nc", slot_field());
-  write_text(dir / "tools.json", R"({"1": {"units": "mm", "shape": "cylindrical", "diameter": 1, "length": 20}})");
-  const std::vector<std::string> args{"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(),
-                                      "--stock", "box:-30,-30,-10,30,30,0", "--dexel-res", "120",
-                                      "--zmap-cell", "0.05", "-o", (dir / "out.stl").string()};
+  write_text(dir / "tools.json",
+             R"({"1": {"units": "mm", "shape": "cylindrical", "diameter": 1, "length": 20}})");
+  const std::vector<std::string> args{"simulate",    (dir / "p.nc").string(),
+                                      "--tools",     (dir / "tools.json").string(),
+                                      "--stock",     "box:-30,-30,-10,30,30,0",
+                                      "--dexel-res", "120",
+                                      "--zmap-cell", "0.05",
+                                      "-o",          (dir / "out.stl").string()};
   check_bound(args, dir);
   // A limit that holds everything but the walls' sub-grids: refused once they are counted.
   std::vector<std::string> first = args;
   first.insert(first.end(), {"--report", (dir / "report.json").string()});
   REQUIRE(run_tridex(first, dir).status == 0);
   const nlohmann::json report = nlohmann::json::parse(slurp(dir / "report.json"));
-  const double total = report["memory_estimate_mib"].get<double>(), walls = report["memory_walls_mib"].get<double>();
+  const double total = report["memory_estimate_mib"].get<double>(),
+               walls = report["memory_walls_mib"].get<double>();
   MESSAGE("walls: " << walls << " MiB of " << total << " MiB");
   REQUIRE(walls > 4);
   std::vector<std::string> below = args;
-  below.insert(below.end(), {"--max-memory", std::to_string(static_cast<long long>(total - walls) + 2) + "M"});
+  below.insert(below.end(),
+               {"--max-memory", std::to_string(static_cast<long long>(total - walls) + 2) + "M"});
   fs::remove(dir / "out.stl");
   CommandResult refused = run_tridex(below, dir);
   CHECK(refused.status == 2);
@@ -250,9 +270,10 @@ TEST_CASE("memory: the estimate bounds the peak of simulate with --html and with
   fs::path dir = scratch("memory-outputs");
   write_text(dir / "p.nc", many_directions(5));
   write_text(dir / "tools.json", kTools);
-  const std::vector<std::string> args{"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(),
-                                      "--stock", "box:-30,-30,-40,30,30,20", "--dexel-res", "200",
-                                      "-o", (dir / "out.stl").string()};
+  const std::vector<std::string> args{
+      "simulate", (dir / "p.nc").string(),    "--tools",     (dir / "tools.json").string(),
+      "--stock",  "box:-30,-30,-40,30,30,20", "--dexel-res", "200",
+      "-o",       (dir / "out.stl").string()};
   std::vector<std::string> html = args;
   html.insert(html.end(), {"--html", (dir / "page.html").string()});
   check_bound(html, dir);
@@ -266,9 +287,11 @@ TEST_CASE("memory: the estimate bounds the peak of simulate with --html and with
 TEST_CASE("memory: groups holding many moves stays within --max-memory") {
   fs::path dir = scratch("memory-groups");
   // 400 × 1000 passes over two moves: 800,000 moves kept.
-  write_text(dir / "p.nc", "G21 G90\nT1 M6\nM98 P2 L400\nM30\nO2\nM98 P3 L1000\nM99\nO3\nG1 X1 Y1 Z-1 F100\n"
-                           "G1 X0 Y0 Z-1\nM99\n");
-  const std::vector<std::string> args{"groups", (dir / "p.nc").string(), "-o", (dir / "g.json").string()};
+  write_text(dir / "p.nc",
+             "G21 G90\nT1 M6\nM98 P2 L400\nM30\nO2\nM98 P3 L1000\nM99\nO3\nG1 X1 Y1 Z-1 F100\n"
+             "G1 X0 Y0 Z-1\nM99\n");
+  const std::vector<std::string> args{"groups", (dir / "p.nc").string(), "-o",
+                                      (dir / "g.json").string()};
   // The budget: what the process holds before reading (as much as `--help` needs, within 4 MiB),
   // and two moves' room for each move kept.
   if (kSanitized) {
@@ -282,7 +305,8 @@ TEST_CASE("memory: groups holding many moves stays within --max-memory") {
   std::vector<std::string> bounded = args;
   bounded.insert(bounded.end(), {"--max-memory", std::to_string(limit_mib) + "M"});
   Measured at_limit = run_measured(bounded);
-  MESSAGE("groups: limit " << limit_mib << " MiB, peak " << at_limit.peak_bytes / (1 << 20) << " MiB");
+  MESSAGE("groups: limit " << limit_mib << " MiB, peak " << at_limit.peak_bytes / (1 << 20)
+                           << " MiB");
   REQUIRE(at_limit.status == 0);
   CHECK(at_limit.peak_bytes <= static_cast<double>(limit_mib) * (1 << 20));
   bounded.back() = std::to_string(static_cast<long long>(help.peak_bytes / (1 << 20)) + 8) + "M";

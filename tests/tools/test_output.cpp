@@ -17,7 +17,8 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path scratch_dir(const std::string& name) {
-  fs::path dir = fs::temp_directory_path() / ("tridex-test-" + name + "-" + std::to_string(::getpid()));
+  fs::path dir =
+      fs::temp_directory_path() / ("tridex-test-" + name + "-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -31,7 +32,8 @@ std::string slurp(const fs::path& path) {
 }
 
 std::size_t entries(const fs::path& dir) {
-  return static_cast<std::size_t>(std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
+  return static_cast<std::size_t>(
+      std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
 }
 
 }  // namespace
@@ -66,15 +68,19 @@ TEST_CASE("output paths are checked before any work") {
   write_file_atomically(input, std::string("G0 X0\n"));
   std::vector<fs::path> inputs{input};
   CHECK_NOTHROW(check_output_path("-o", dir / "new.stl", inputs));
-  CHECK_THROWS_WITH_AS(check_output_path("-o", input, inputs), doctest::Contains("would overwrite the input"), InputError);
-  CHECK_THROWS_WITH_AS(check_output_path("-o", dir / "missing" / "a.stl", inputs), doctest::Contains("does not exist"), InputError);
-  CHECK_THROWS_WITH_AS(check_output_path("--png", dir, inputs), doctest::Contains("is a directory"), InputError);
+  CHECK_THROWS_WITH_AS(check_output_path("-o", input, inputs),
+                       doctest::Contains("would overwrite the input"), InputError);
+  CHECK_THROWS_WITH_AS(check_output_path("-o", dir / "missing" / "a.stl", inputs),
+                       doctest::Contains("does not exist"), InputError);
+  CHECK_THROWS_WITH_AS(check_output_path("--png", dir, inputs), doctest::Contains("is a directory"),
+                       InputError);
   // The same file through another spelling is still the input.
   CHECK_THROWS_AS(check_output_path("-o", dir / "." / "program.nc", inputs), InputError);
   if (::geteuid() != 0) {  // root may write anywhere
     fs::create_directories(dir / "locked");
     fs::permissions(dir / "locked", fs::perms::owner_read | fs::perms::owner_exec);
-    CHECK_THROWS_WITH_AS(check_output_path("-o", dir / "locked" / "a.stl", inputs), doctest::Contains("not writable"), InputError);
+    CHECK_THROWS_WITH_AS(check_output_path("-o", dir / "locked" / "a.stl", inputs),
+                         doctest::Contains("not writable"), InputError);
     fs::permissions(dir / "locked", fs::perms::owner_all);
   }
   fs::remove_all(dir);

@@ -42,7 +42,8 @@ Image decode_png(const std::vector<std::uint8_t>& bytes) {
 }
 
 const std::uint8_t* pixel(const Image& image, int x, int y) {
-  return &image.rgb[3 * (static_cast<std::size_t>(x) + static_cast<std::size_t>(image.width) * static_cast<std::size_t>(y))];
+  return &image.rgb[3 * (static_cast<std::size_t>(x) +
+                         static_cast<std::size_t>(image.width) * static_cast<std::size_t>(y))];
 }
 
 }  // namespace

@@ -30,7 +30,8 @@ TEST_CASE("the automatic stock contains every cutting point with its margin") {
   std::uniform_real_distribution<double> coordinate(-50, 50);
   for (int trial = 0; trial < 100; ++trial) {
     Aabb cuts;
-    for (int k = 0; k < 5; ++k) cuts.extend(Vec3(coordinate(random), coordinate(random), coordinate(random)));
+    for (int k = 0; k < 5; ++k)
+      cuts.extend(Vec3(coordinate(random), coordinate(random), coordinate(random)));
     StockSpec spec;
     spec.margin_mm = trial % 3 == 0 ? 0.0 : 1.5;
     Aabb stock = automatic_stock(cuts, spec);
@@ -52,9 +53,11 @@ TEST_CASE("--max-memory units and the memory estimate") {
   CHECK(parse_memory("2G") == 2ull << 30);
   CHECK(parse_memory("1.5GiB") == 3ull << 29);
   CHECK(parse_memory("64k") == 64ull << 10);
-  for (const char* bad : {"", "G", "-1G", "3T", "1e30G"}) CHECK_THROWS_AS(parse_memory(bad), InputError);
+  for (const char* bad : {"", "G", "-1G", "3T", "1e30G"})
+    CHECK_THROWS_AS(parse_memory(bad), InputError);
   // The estimate grows with every resolution it depends on.
-  MemoryEstimate small = estimate_memory(5e7, {.zmap_points = 1e6, .largest_map = 5e5, .rays = 3e4}),
+  MemoryEstimate small =
+                     estimate_memory(5e7, {.zmap_points = 1e6, .largest_map = 5e5, .rays = 3e4}),
                  big = estimate_memory(5e7, {.zmap_points = 4e6, .largest_map = 2e6, .rays = 12e4});
   CHECK(big.zmaps == doctest::Approx(4 * small.zmaps));
   CHECK(big.dexels == doctest::Approx(4 * small.dexels));
@@ -62,7 +65,9 @@ TEST_CASE("--max-memory units and the memory estimate") {
   CHECK(big.held == small.held);
   CHECK(big.total() > small.total());
   // Keeping or dumping the maps costs more.
-  CHECK(estimate_memory(0, {.zmap_points = 1e6, .largest_map = 5e5, .keep_maps = true}).zmaps > small.zmaps);
-  CHECK(estimate_memory(0, {.zmap_points = 1e6, .largest_map = 5e5, .dump_maps = true}).zmaps > small.zmaps);
+  CHECK(estimate_memory(0, {.zmap_points = 1e6, .largest_map = 5e5, .keep_maps = true}).zmaps >
+        small.zmaps);
+  CHECK(estimate_memory(0, {.zmap_points = 1e6, .largest_map = 5e5, .dump_maps = true}).zmaps >
+        small.zmaps);
   CHECK(physical_memory_bytes() > (64ull << 20));
 }

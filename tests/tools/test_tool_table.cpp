@@ -22,7 +22,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-ToolTable parse(const std::string& text) { return ToolTable::from_json(json::parse(text), "table"); }
+ToolTable parse(const std::string& text) {
+  return ToolTable::from_json(json::parse(text), "table");
+}
 
 std::string error_of(const std::string& text) {
   try {
@@ -48,10 +50,16 @@ TEST_CASE("every CAMotics shape maps to the cutter with its analytic lower surfa
     table["1"] = {{"shape", "cylindrical"}, {"diameter", d}, {"length", length}, {"units", units}};
     table["2"] = {{"shape", "ballnose"}, {"diameter", d}, {"length", length}, {"units", units}};
     table["3"] = {{"shape", "conical"}, {"diameter", d}, {"length", length}, {"units", units}};
-    table["4"] = {{"shape", "snubnose"}, {"diameter", d}, {"length", length}, {"units", units},
+    table["4"] = {{"shape", "snubnose"},
+                  {"diameter", d},
+                  {"length", length},
+                  {"units", units},
                   {"snub_diameter", snub}};
     table["5"] = {{"shape", "spheroid"}, {"diameter", d}, {"length", length}, {"units", units}};
-    table["6"] = {{"shape", "bullnose"}, {"diameter", d}, {"length", length}, {"units", units},
+    table["6"] = {{"shape", "bullnose"},
+                  {"diameter", d},
+                  {"length", length},
+                  {"units", units},
                   {"corner-radius", corner}};
     ToolTable tools = ToolTable::from_json(table, "random");
     REQUIRE(tools.tools().size() == 6);
@@ -72,7 +80,8 @@ TEST_CASE("every CAMotics shape maps to the cutter with its analytic lower surfa
       CHECK(h >= ellipse - 1e-9 * (1 + b));
       CHECK(h <= ellipse + 0.02 * b + 1e-9);
       double flat = R - rc;
-      double bull = x <= flat ? 0 : rc - std::sqrt(std::max(0.0, rc * rc - (x - flat) * (x - flat)));
+      double bull =
+          x <= flat ? 0 : rc - std::sqrt(std::max(0.0, rc * rc - (x - flat) * (x - flat)));
       CHECK(tools.find(6)->cutter.lower_height(x) == doctest::Approx(bull).epsilon(1e-9));
     }
   }
@@ -90,21 +99,32 @@ TEST_CASE("tool tables written by CAMotics load unchanged") {
 
 TEST_CASE("bad tool tables are refused with the tool and the key named") {
   CHECK(error_of("[1, 2]").find("JSON object keyed by tool number") != std::string::npos);
-  CHECK(error_of(R"({"x": {"shape": "ballnose", "diameter": 2}})").find("tool number") != std::string::npos);
-  CHECK(error_of(R"({"3": {"shape": "drill", "diameter": 2}})").find("tool 3: unknown shape \"drill\"") != std::string::npos);
-  CHECK(error_of(R"({"4": {"shape": "ballnose"}})").find("tool 4: missing \"diameter\"") != std::string::npos);
-  CHECK(error_of(R"({"5": {"shape": "ballnose", "diameter": "big"}})").find("\"diameter\" must be a number") != std::string::npos);
-  CHECK(error_of(R"({"6": {"shape": "ballnose", "diameter": 0}})").find("\"diameter\" must be positive") != std::string::npos);
-  CHECK(error_of(R"({"7": {"shape": "ballnose", "diameter": 2, "units": "cubits"}})").find("unknown \"units\"") != std::string::npos);
-  CHECK(error_of(R"({"8": {"shape": "conical", "diameter": 2}})").find("needs a positive \"length\"") != std::string::npos);
-  CHECK(error_of(R"({"9": {"shape": "bullnose", "diameter": 2}})").find("\"corner-radius\"") != std::string::npos);
-  CHECK(error_of(R"({"10": {"shape": "bullnose", "diameter": 2, "corner-radius": 3}})").find("tool 10") != std::string::npos);
-  CHECK(error_of(R"({"11": {"shape": "snubnose", "diameter": 2, "length": 3, "snub_diameter": 2}})").find("snub_diameter") != std::string::npos);
+  CHECK(error_of(R"({"x": {"shape": "ballnose", "diameter": 2}})").find("tool number") !=
+        std::string::npos);
+  CHECK(error_of(R"({"3": {"shape": "drill", "diameter": 2}})")
+            .find("tool 3: unknown shape \"drill\"") != std::string::npos);
+  CHECK(error_of(R"({"4": {"shape": "ballnose"}})").find("tool 4: missing \"diameter\"") !=
+        std::string::npos);
+  CHECK(error_of(R"({"5": {"shape": "ballnose", "diameter": "big"}})")
+            .find("\"diameter\" must be a number") != std::string::npos);
+  CHECK(error_of(R"({"6": {"shape": "ballnose", "diameter": 0}})")
+            .find("\"diameter\" must be positive") != std::string::npos);
+  CHECK(error_of(R"({"7": {"shape": "ballnose", "diameter": 2, "units": "cubits"}})")
+            .find("unknown \"units\"") != std::string::npos);
+  CHECK(error_of(R"({"8": {"shape": "conical", "diameter": 2}})")
+            .find("needs a positive \"length\"") != std::string::npos);
+  CHECK(error_of(R"({"9": {"shape": "bullnose", "diameter": 2}})").find("\"corner-radius\"") !=
+        std::string::npos);
+  CHECK(error_of(R"({"10": {"shape": "bullnose", "diameter": 2, "corner-radius": 3}})")
+            .find("tool 10") != std::string::npos);
+  CHECK(error_of(R"({"11": {"shape": "snubnose", "diameter": 2, "length": 3, "snub_diameter": 2}})")
+            .find("snub_diameter") != std::string::npos);
   CHECK(error_of(R"({"12": {"diameter": 2}})").find("missing \"shape\"") != std::string::npos);
 }
 
 TEST_CASE("the shank and holder keys give the tool's non-cutting parts") {
-  ToolTable tools = parse(R"({"1": {"shape": "cylindrical", "diameter": 0.25, "units": "inch", "flute-length": 0.5,
+  ToolTable tools = parse(
+      R"({"1": {"shape": "cylindrical", "diameter": 0.25, "units": "inch", "flute-length": 0.5,
       "shank-diameter": 0.375, "stick-out": 1.5,
       "holder": [{"bottom-diameter": 1, "top-diameter": 1, "length": 1}, {"bottom-diameter": 1, "top-diameter": 2, "length": 0.5}]},
       "2": {"shape": "ballnose", "diameter": 6, "flute-length": 12},
@@ -131,12 +151,18 @@ TEST_CASE("the shank and holder keys give the tool's non-cutting parts") {
   CHECK(!tools.find(2)->body.has_holder());
   CHECK(tools.find(3)->body.parts.empty());
 
-  CHECK(error_of(R"({"4": {"shape": "ballnose", "diameter": 2, "holder": [{"bottom-diameter": 9, "top-diameter": 9, "length": 9}]}})")
-            .find("tool 4: \"holder\" needs a positive \"stick-out\"") != std::string::npos);
-  CHECK(error_of(R"({"5": {"shape": "ballnose", "diameter": 2, "stick-out": 9, "holder": [{"bottom-diameter": 9, "length": 9}]}})")
-            .find("tool 5: \"holder\" section 1: missing \"top-diameter\"") != std::string::npos);
-  CHECK(error_of(R"({"6": {"shape": "ballnose", "diameter": 2, "flute-length": 10, "stick-out": 5}})")
-            .find("tool 6: \"flute-length\" 10 mm is longer than \"stick-out\" 5 mm") != std::string::npos);
+  CHECK(
+      error_of(
+          R"({"4": {"shape": "ballnose", "diameter": 2, "holder": [{"bottom-diameter": 9, "top-diameter": 9, "length": 9}]}})")
+          .find("tool 4: \"holder\" needs a positive \"stick-out\"") != std::string::npos);
+  CHECK(
+      error_of(
+          R"({"5": {"shape": "ballnose", "diameter": 2, "stick-out": 9, "holder": [{"bottom-diameter": 9, "length": 9}]}})")
+          .find("tool 5: \"holder\" section 1: missing \"top-diameter\"") != std::string::npos);
+  CHECK(
+      error_of(R"({"6": {"shape": "ballnose", "diameter": 2, "flute-length": 10, "stick-out": 5}})")
+          .find("tool 6: \"flute-length\" 10 mm is longer than \"stick-out\" 5 mm") !=
+      std::string::npos);
   CHECK(error_of(R"({"7": {"shape": "ballnose", "diameter": 2, "shank-diameter": 3}})")
             .find("tool 7: \"shank-diameter\" needs \"flute-length\"") != std::string::npos);
   CHECK(error_of(R"({"8": {"shape": "ballnose", "diameter": 2, "stick-out": 9, "holder": {}}})")
@@ -206,7 +232,8 @@ TEST_CASE("Fusion tool libraries: the cutting part, the shank and the holder") {
   CHECK(tools.find(4) == nullptr);
 
   // A library file is told from a CAMotics table by its "data" list.
-  fs::path file = fs::temp_directory_path() / ("tridex-fusion-" + std::to_string(::getpid()) + ".json");
+  fs::path file =
+      fs::temp_directory_path() / ("tridex-fusion-" + std::to_string(::getpid()) + ".json");
   std::ofstream(file) << fusion_library().dump(1);
   CHECK(ToolTable::read(file).find(3) != nullptr);
   fs::remove(file);
@@ -219,19 +246,26 @@ TEST_CASE("Fusion tool libraries: a missing or malformed field names the tool an
   };
   has(fusion_error([](json& l) { l["data"][0]["geometry"].erase("DC"); }),
       "lib.json: tool 1 (\"6mm flat\"): \"geometry\": missing \"DC\"");
-  has(fusion_error([](json& l) { l["data"][0]["geometry"].erase("LB"); }), "tool 1 (\"6mm flat\"): \"geometry\": missing \"LB\"");
+  has(fusion_error([](json& l) { l["data"][0]["geometry"].erase("LB"); }),
+      "tool 1 (\"6mm flat\"): \"geometry\": missing \"LB\"");
   has(fusion_error([](json& l) { l["data"][1]["geometry"]["LCF"] = "long"; }),
       "tool 2 (\"1/4 ball\"): \"geometry\": \"LCF\" must be a number, got a string");
-  has(fusion_error([](json& l) { l["data"][2]["geometry"].erase("RE"); }), "tool 3 (\"10R1\"): \"geometry\": missing \"RE\"");
+  has(fusion_error([](json& l) { l["data"][2]["geometry"].erase("RE"); }),
+      "tool 3 (\"10R1\"): \"geometry\": missing \"RE\"");
   has(fusion_error([](json& l) { l["data"][0]["holder"]["segments"][1].erase("height"); }),
       "tool 1 (\"6mm flat\"): \"holder\": \"segments\"[1]: missing \"height\"");
   has(fusion_error([](json& l) { l["data"][0]["holder"]["segments"][0]["lower-diameter"] = -3; }),
       "\"lower-diameter\" must be a finite non-negative number, got -3");
-  has(fusion_error([](json& l) { l["data"][0]["geometry"]["LB"] = 70; }), "\"LB\" 70 mm is longer than \"OAL\" 60 mm");
-  has(fusion_error([](json& l) { l["data"][0]["geometry"]["LCF"] = 40; }), "\"LCF\" 40 mm is longer than \"LB\" 30 mm");
-  has(fusion_error([](json& l) { l["data"][1].erase("post-process"); }), "\"data\"[1] (\"1/4 ball\"): missing \"post-process\"");
-  has(fusion_error([](json& l) { l["data"][1]["post-process"]["number"] = 1; }), "\"data\"[0] and \"data\"[1] are both tool 1");
-  has(fusion_error([](json& l) { l["data"][0]["unit"] = "cubits"; }), "unknown \"unit\" \"cubits\"");
+  has(fusion_error([](json& l) { l["data"][0]["geometry"]["LB"] = 70; }),
+      "\"LB\" 70 mm is longer than \"OAL\" 60 mm");
+  has(fusion_error([](json& l) { l["data"][0]["geometry"]["LCF"] = 40; }),
+      "\"LCF\" 40 mm is longer than \"LB\" 30 mm");
+  has(fusion_error([](json& l) { l["data"][1].erase("post-process"); }),
+      "\"data\"[1] (\"1/4 ball\"): missing \"post-process\"");
+  has(fusion_error([](json& l) { l["data"][1]["post-process"]["number"] = 1; }),
+      "\"data\"[0] and \"data\"[1] are both tool 1");
+  has(fusion_error([](json& l) { l["data"][0]["unit"] = "cubits"; }),
+      "unknown \"unit\" \"cubits\"");
   has(fusion_error([](json& l) { l["data"][0].erase("type"); }), "\"data\"[0]: missing \"type\"");
   has(fusion_error([](json& l) { l["data"] = 3; }), "must be a JSON object with a \"data\" list");
 }
@@ -277,8 +311,10 @@ TEST_CASE("LinuxCNC .tbl tool tables: bad lines name file, line, column and the 
   CHECK(error_of_tbl("T1 D0.1\nT2 Zfoo\n").find("t.tbl:2:4: \"Zfoo\"") != std::string::npos);
   CHECK(error_of_tbl("P1 D0.1\n").find("t.tbl:1: no tool number T") != std::string::npos);
   CHECK(error_of_tbl("T1.5 D0.1\n").find("t.tbl:1:1: T1.5") != std::string::npos);
-  CHECK(error_of_tbl("T1 D0.1\nT1 D0.2\n").find("tool 1 again (first at line 1)") != std::string::npos);
-  CHECK(error_of_tbl("T1 D0.1 Y0.2\n").find("t.tbl:1:9: tool 1 has a sideways offset Y0.2") != std::string::npos);
+  CHECK(error_of_tbl("T1 D0.1\nT1 D0.2\n").find("tool 1 again (first at line 1)") !=
+        std::string::npos);
+  CHECK(error_of_tbl("T1 D0.1 Y0.2\n").find("t.tbl:1:9: tool 1 has a sideways offset Y0.2") !=
+        std::string::npos);
   CHECK(error_of_tbl("T1 D0.1 Z1 Z2\n").find("repeated word Z") != std::string::npos);
   CHECK(error_of_tbl("T1 D-0.1\n").find("must not be negative") != std::string::npos);
 }
@@ -294,7 +330,8 @@ TEST_CASE("LinuxCNC .tbl tool tables: a missing file or a directory is an input 
     }
     return std::string();
   };
-  CHECK(error_of_read(dir / "folder.tbl").find("folder.tbl: is a directory, not a tool table") != std::string::npos);
+  CHECK(error_of_read(dir / "folder.tbl").find("folder.tbl: is a directory, not a tool table") !=
+        std::string::npos);
   CHECK(error_of_read(dir / "none.tbl").find("none.tbl: no such file") != std::string::npos);
   fs::remove_all(dir);
 }

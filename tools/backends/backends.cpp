@@ -12,17 +12,22 @@ namespace tridex::backends {
 
 const char* to_string(ZMapBackend backend) {
   switch (backend) {
-    case ZMapBackend::cpu: return "cpu";
-    case ZMapBackend::gl: return "gl";
+    case ZMapBackend::cpu:
+      return "cpu";
+    case ZMapBackend::gl:
+      return "gl";
   }
   return "?";
 }
 
 const char* to_string(DexelBackend backend) {
   switch (backend) {
-    case DexelBackend::tree: return "tree";
-    case DexelBackend::embree: return "embree";
-    case DexelBackend::scan: return "scan";
+    case DexelBackend::tree:
+      return "tree";
+    case DexelBackend::embree:
+      return "embree";
+    case DexelBackend::scan:
+      return "scan";
   }
   return "?";
 }
@@ -43,21 +48,28 @@ bool available(ZMapBackend backend) { return backend == ZMapBackend::cpu || gl_a
 
 bool available(DexelBackend) { return true; }
 
-void mill_with(ZMapBackend backend, ZMap& map, std::span<const Cutter> cutters, std::span<const CutMove> moves,
-               unsigned threads) {
+void mill_with(ZMapBackend backend, ZMap& map, std::span<const Cutter> cutters,
+               std::span<const CutMove> moves, unsigned threads) {
   switch (backend) {
-    case ZMapBackend::cpu: mill(map, cutters, moves, {.threads = threads}); return;
-    case ZMapBackend::gl: gl_mill(map, cutters, moves); return;
+    case ZMapBackend::cpu:
+      mill(map, cutters, moves, {.threads = threads});
+      return;
+    case ZMapBackend::gl:
+      gl_mill(map, cutters, moves);
+      return;
   }
   detail::fail("mill_with: invalid Z-map backend ", static_cast<int>(backend));
 }
 
-TripleDexel machine_with(DexelBackend backend, const TripleDexel& stock, std::span<const ZMap> milled,
-                         unsigned threads) {
+TripleDexel machine_with(DexelBackend backend, const TripleDexel& stock,
+                         std::span<const ZMap> milled, unsigned threads) {
   switch (backend) {
-    case DexelBackend::tree: return intersect_milled(stock, milled, threads);
-    case DexelBackend::embree: return embree_machine(stock, milled, threads);
-    case DexelBackend::scan: return scan_intersect_milled(stock, milled, threads);
+    case DexelBackend::tree:
+      return intersect_milled(stock, milled, threads);
+    case DexelBackend::embree:
+      return embree_machine(stock, milled, threads);
+    case DexelBackend::scan:
+      return scan_intersect_milled(stock, milled, threads);
   }
   detail::fail("machine_with: invalid dexel backend ", static_cast<int>(backend));
 }

@@ -80,7 +80,8 @@ class ZMapScene {
                                             sizeof(std::uint32_t) * 3, mesh.triangles.size());
     if (!vertices || !indices) {
       rtcReleaseGeometry(geometry);
-      detail::fail("embree: could not allocate the buffers of a mesh of ", mesh.triangles.size(), " triangles");
+      detail::fail("embree: could not allocate the buffers of a mesh of ", mesh.triangles.size(),
+                   " triangles");
     }
     std::memcpy(vertices, mesh.positions.data(), mesh.positions.size() * sizeof(glm::vec3));
     std::memcpy(indices, mesh.triangles.data(), mesh.triangles.size() * sizeof(glm::uvec3));
@@ -89,7 +90,8 @@ class ZMapScene {
     rtcAttachGeometry(scene_.get(), geometry);
     rtcReleaseGeometry(geometry);
     rtcCommitScene(scene_.get());
-    if (rtcGetDeviceError(device) != RTC_ERROR_NONE) detail::fail("embree: building the scene failed");
+    if (rtcGetDeviceError(device) != RTC_ERROR_NONE)
+      detail::fail("embree: building the scene failed");
   }
 
   // The spans of the lattice ray through (pu, pv) along `axis` inside the polyhedron, in
@@ -104,9 +106,11 @@ class ZMapScene {
     const double start = box_.min[axis] - 1, length = box_.max[axis] - box_.min[axis] + 2;
     RTCRayHit query{};
     float origin[3];
-    origin[axis] = static_cast<float>(start), origin[u] = static_cast<float>(pu), origin[v] = static_cast<float>(pv);
+    origin[axis] = static_cast<float>(start), origin[u] = static_cast<float>(pu),
+    origin[v] = static_cast<float>(pv);
     query.ray.org_x = origin[0], query.ray.org_y = origin[1], query.ray.org_z = origin[2];
-    query.ray.dir_x = axis == 0 ? 1.f : 0.f, query.ray.dir_y = axis == 1 ? 1.f : 0.f, query.ray.dir_z = axis == 2 ? 1.f : 0.f;
+    query.ray.dir_x = axis == 0 ? 1.f : 0.f, query.ray.dir_y = axis == 1 ? 1.f : 0.f,
+    query.ray.dir_z = axis == 2 ? 1.f : 0.f;
     query.ray.tnear = 0, query.ray.tfar = static_cast<float>(length);
     query.ray.mask = 0xFFFFFFFFu, query.ray.flags = 0;
     query.hit.geomID = RTC_INVALID_GEOMETRY_ID, query.hit.primID = RTC_INVALID_GEOMETRY_ID;
@@ -122,8 +126,9 @@ class ZMapScene {
     }
     std::sort(hits.begin(), hits.end(), [](const Hit& a, const Hit& b) { return a.t < b.t; });
     // Merge the hits of one crossing (several triangles around an edge or vertex).
-    const float merge = 4 * std::numeric_limits<float>::epsilon() *
-                        static_cast<float>(std::max({std::abs(box_.min[axis]), std::abs(box_.max[axis]), 1.0}));
+    const float merge =
+        4 * std::numeric_limits<float>::epsilon() *
+        static_cast<float>(std::max({std::abs(box_.min[axis]), std::abs(box_.max[axis]), 1.0}));
     std::size_t ray_start = out.size();
     bool inside = false;
     float enter = 0;
@@ -131,8 +136,10 @@ class ZMapScene {
       float t = hits[k].t;
       int net = 0;
       for (; k < hits.size() && hits[k].t - t <= merge; ++k) net += hits[k].direction;
-      if (net > 0 && !inside) inside = true, enter = t;
-      else if (net < 0 && inside) inside = false, detail::push_span(out, ray_start, enter, t);
+      if (net > 0 && !inside)
+        inside = true, enter = t;
+      else if (net < 0 && inside)
+        inside = false, detail::push_span(out, ray_start, enter, t);
     }
   }
 
@@ -168,14 +175,16 @@ TripleDexel embree_dexelize(const ZMap& map, const DexelLattice& lattice, unsign
   TripleDexel result;
   result.origin = lattice.origin, result.spacing = lattice.spacing, result.n = lattice.n;
   for (int axis = 0; axis < 3; ++axis)
-    result.grids[axis] = detail::build_grid(lattice, axis, threads, [&](std::size_t r, std::vector<DexelInterval>& out) {
-      Vec3 p = ray_position(lattice, axis, r);
-      scene.spans(axis, p[TripleDexel::u_axis(axis)], p[TripleDexel::v_axis(axis)], out);
-    });
+    result.grids[axis] = detail::build_grid(
+        lattice, axis, threads, [&](std::size_t r, std::vector<DexelInterval>& out) {
+          Vec3 p = ray_position(lattice, axis, r);
+          scene.spans(axis, p[TripleDexel::u_axis(axis)], p[TripleDexel::v_axis(axis)], out);
+        });
   return result;
 }
 
-TripleDexel embree_machine(const TripleDexel& stock, std::span<const ZMap> milled, unsigned threads) {
+TripleDexel embree_machine(const TripleDexel& stock, std::span<const ZMap> milled,
+                           unsigned threads) {
   validate(stock);
   for (const ZMap& map : milled) detail::require_solid_zmap(map, "embree machine");
   auto device = make_device(threads);
@@ -185,15 +194,16 @@ TripleDexel embree_machine(const TripleDexel& stock, std::span<const ZMap> mille
     const ZMapScene scene(device.get(), map);
     for (int axis = 0; axis < 3; ++axis) {
       const DexelGrid& current = result.grids[axis];
-      result.grids[axis] = detail::build_grid(lattice, axis, threads, [&](std::size_t r, std::vector<DexelInterval>& out) {
-        std::span<const DexelInterval> now = current.ray(r);
-        if (now.empty()) return;
-        thread_local std::vector<DexelInterval> cut;
-        cut.clear();
-        Vec3 p = ray_position(lattice, axis, r);
-        scene.spans(axis, p[TripleDexel::u_axis(axis)], p[TripleDexel::v_axis(axis)], cut);
-        detail::intersect_ray(now, cut, out);
-      });
+      result.grids[axis] = detail::build_grid(
+          lattice, axis, threads, [&](std::size_t r, std::vector<DexelInterval>& out) {
+            std::span<const DexelInterval> now = current.ray(r);
+            if (now.empty()) return;
+            thread_local std::vector<DexelInterval> cut;
+            cut.clear();
+            Vec3 p = ray_position(lattice, axis, r);
+            scene.spans(axis, p[TripleDexel::u_axis(axis)], p[TripleDexel::v_axis(axis)], cut);
+            detail::intersect_ray(now, cut, out);
+          });
     }
   }
   return result;

@@ -46,7 +46,8 @@ CutterCap tessellate(const Cutter& cutter, double tolerance) {
     int n = std::max(1, static_cast<int>(std::ceil((a1 - a0) / step)));
     for (int k = 1; k <= n; ++k) {
       double a = a0 + (a1 - a0) * k / n;
-      profile.emplace_back(k == n ? p.d1 : p.centre_d + p.radius * std::sin(a), p.centre_h - p.radius * std::cos(a));
+      profile.emplace_back(k == n ? p.d1 : p.centre_d + p.radius * std::sin(a),
+                           p.centre_h - p.radius * std::cos(a));
     }
   }
   // Drop repeated points (a piece starting where the last ended).
@@ -66,14 +67,17 @@ CutterCap tessellate(const Cutter& cutter, double tolerance) {
     }
     for (int m = 0; m < s; ++m) {
       double angle = 2 * 3.141592653589793 * m / s;
-      cap.vertices.emplace_back(rings[k].x * std::cos(angle), rings[k].x * std::sin(angle), rings[k].y);
+      cap.vertices.emplace_back(rings[k].x * std::cos(angle), rings[k].x * std::sin(angle),
+                                rings[k].y);
     }
   }
   if (!pointed) {  // a flat tip disc: a centre vertex fans it
     cap.vertices.emplace_back(0, 0, rings[0].y);
   }
   const auto centre = static_cast<std::uint32_t>(pointed ? 0 : cap.vertices.size() - 1);
-  auto ring_vertex = [&](std::size_t k, int m) { return first_of_ring[k] + static_cast<std::uint32_t>(m % s); };
+  auto ring_vertex = [&](std::size_t k, int m) {
+    return first_of_ring[k] + static_cast<std::uint32_t>(m % s);
+  };
   // Faces seen from below counter-clockwise... orientation does not matter (no culling); the
   // normals are made to point down.
   auto add_face = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
@@ -84,7 +88,8 @@ CutterCap tessellate(const Cutter& cutter, double tolerance) {
     cap.normals.push_back(glm::normalize(n));
   };
   const std::size_t first_ring = pointed ? 1 : 0;
-  for (int m = 0; m < s; ++m) add_face(centre, ring_vertex(first_ring, m), ring_vertex(first_ring, m + 1));
+  for (int m = 0; m < s; ++m)
+    add_face(centre, ring_vertex(first_ring, m), ring_vertex(first_ring, m + 1));
   for (std::size_t k = first_ring; k + 1 < rings.size(); ++k)
     for (int m = 0; m < s; ++m) {
       add_face(ring_vertex(k, m), ring_vertex(k + 1, m), ring_vertex(k + 1, m + 1));
@@ -104,7 +109,8 @@ CutterCap tessellate(const Cutter& cutter, double tolerance) {
   for (std::size_t k = 0; k < keyed.size();) {
     std::size_t end = k + 1;
     while (end < keyed.size() && keyed[end].first == keyed[k].first) ++end;
-    auto a = static_cast<std::uint32_t>(keyed[k].first >> 32), b = static_cast<std::uint32_t>(keyed[k].first & 0xFFFFFFFFu);
+    auto a = static_cast<std::uint32_t>(keyed[k].first >> 32),
+         b = static_cast<std::uint32_t>(keyed[k].first & 0xFFFFFFFFu);
     cap.edges.push_back({a, b, keyed[k].second, end - k > 1 ? keyed[k + 1].second : -1});
     k = end;
   }
@@ -138,9 +144,11 @@ class DepthTarget {
     glDrawBuffer(GL_NONE);
     glReadBuffer(GL_NONE);
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-      detail::fail("gl: a framebuffer with a 32-bit float depth buffer of ", side_, " x ", side_, " is not supported");
+      detail::fail("gl: a framebuffer with a 32-bit float depth buffer of ", side_, " x ", side_,
+                   " is not supported");
     GLint bits = 0;
-    glGetFramebufferAttachmentParameteriv(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE, &bits);
+    glGetFramebufferAttachmentParameteriv(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT,
+                                          GL_FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE, &bits);
     if (bits != GL_FLOAT) detail::fail("gl: the depth attachment is not floating point");
     glMatrixMode(GL_PROJECTION), glLoadIdentity();
     glMatrixMode(GL_MODELVIEW), glLoadIdentity();
@@ -179,22 +187,29 @@ bool gl_available() {
   }
 }
 
-void gl_mill(ZMap& map, std::span<const Cutter> cutters, std::span<const CutMove> moves, const GlMillOptions& options) {
+void gl_mill(ZMap& map, std::span<const Cutter> cutters, std::span<const CutMove> moves,
+             const GlMillOptions& options) {
   ZMap::validate(map.grid, {std::numeric_limits<std::size_t>::max()});
-  if (map.heights.size() != map.grid.size()) detail::fail("gl mill: Z-map holds ", map.heights.size(), " heights for ", map.grid.size(), " points");
+  if (map.heights.size() != map.grid.size())
+    detail::fail("gl mill: Z-map holds ", map.heights.size(), " heights for ", map.grid.size(),
+                 " points");
   const ZMapGrid& g = map.grid;
   const double tolerance = options.tolerance == 0 ? 0.25 * g.cell : options.tolerance;
   detail::require_positive(tolerance, "gl mill tolerance");
-  if (options.max_tile < 0) detail::fail("gl mill: max tile ", options.max_tile, " must be positive (or 0 for the limit)");
+  if (options.max_tile < 0)
+    detail::fail("gl mill: max tile ", options.max_tile, " must be positive (or 0 for the limit)");
   double z_lo = std::numeric_limits<double>::infinity();
   for (std::size_t k = 0; k < moves.size(); ++k) {
     const CutMove& m = moves[k];
-    if (m.cutter >= cutters.size()) detail::fail("gl mill: move ", k, " uses cutter ", m.cutter, " of ", cutters.size());
-    if (!is_finite(m.tip.a) || !is_finite(m.tip.b)) detail::fail("gl mill: move ", k, " is not finite");
+    if (m.cutter >= cutters.size())
+      detail::fail("gl mill: move ", k, " uses cutter ", m.cutter, " of ", cutters.size());
+    if (!is_finite(m.tip.a) || !is_finite(m.tip.b))
+      detail::fail("gl mill: move ", k, " is not finite");
     z_lo = std::min({z_lo, m.tip.a.z, m.tip.b.z});
   }
   if (moves.empty()) return;
-  z_lo -= 1.0 + 0.01 * std::abs(z_lo);  // below every tip: nothing drawn is clipped at the near plane
+  z_lo -=
+      1.0 + 0.01 * std::abs(z_lo);  // below every tip: nothing drawn is clipped at the near plane
   std::vector<CutterCap> caps;
   for (const Cutter& c : cutters) caps.push_back(tessellate(c, tolerance));
 
@@ -219,9 +234,12 @@ void gl_mill(ZMap& map, std::span<const Cutter> cutters, std::span<const CutMove
       const double sx = 2.0 / (w * g.cell), sy = 2.0 / (h * g.cell), sz = 2.0 / (z_hi - z_lo);
       const double ox = g.x(i0) - 0.5 * g.cell, oy = g.y(j0) - 0.5 * g.cell;
       const double x_lo = ox, x_hi = ox + w * g.cell, y_lo = oy, y_hi = oy + h * g.cell;
-      auto ndc = [&](const Vec3& p) { return Vec3((p.x - ox) * sx - 1, (p.y - oy) * sy - 1, (p.z - z_lo) * sz - 1); };
+      auto ndc = [&](const Vec3& p) {
+        return Vec3((p.x - ox) * sx - 1, (p.y - oy) * sy - 1, (p.z - z_lo) * sz - 1);
+      };
       auto push = [&](const Vec3& p) {
-        batch.push_back(static_cast<float>(p.x)), batch.push_back(static_cast<float>(p.y)), batch.push_back(static_cast<float>(p.z));
+        batch.push_back(static_cast<float>(p.x)), batch.push_back(static_cast<float>(p.y)),
+            batch.push_back(static_cast<float>(p.z));
       };
       auto flush = [&] {
         if (batch.empty()) return;
@@ -234,9 +252,10 @@ void gl_mill(ZMap& map, std::span<const Cutter> cutters, std::span<const CutMove
       for (const CutMove& m : moves) {
         const Cutter& cutter = cutters[m.cutter];
         const double r = cutter.radius();
-        if (std::max(m.tip.a.x, m.tip.b.x) + r < x_lo || std::min(m.tip.a.x, m.tip.b.x) - r > x_hi ||
-            std::max(m.tip.a.y, m.tip.b.y) + r < y_lo || std::min(m.tip.a.y, m.tip.b.y) - r > y_hi ||
-            std::min(m.tip.a.z, m.tip.b.z) >= z_hi)
+        if (std::max(m.tip.a.x, m.tip.b.x) + r < x_lo ||
+            std::min(m.tip.a.x, m.tip.b.x) - r > x_hi ||
+            std::max(m.tip.a.y, m.tip.b.y) + r < y_lo ||
+            std::min(m.tip.a.y, m.tip.b.y) - r > y_hi || std::min(m.tip.a.z, m.tip.b.z) >= z_hi)
           continue;
         const CutterCap& cap = caps[m.cutter];
         const Vec3 v = m.tip.b - m.tip.a;
@@ -256,7 +275,9 @@ void gl_mill(ZMap& map, std::span<const Cutter> cutters, std::span<const CutMove
         }
         if (glm::dot(v, v) > 0)
           for (const CutterCap::Edge& e : cap.edges) {
-            if (e.f1 >= 0 && side_of[static_cast<std::size_t>(e.f0)] == side_of[static_cast<std::size_t>(e.f1)]) continue;
+            if (e.f1 >= 0 &&
+                side_of[static_cast<std::size_t>(e.f0)] == side_of[static_cast<std::size_t>(e.f1)])
+              continue;
             push(moved_a[e.a]), push(moved_a[e.b]), push(moved_b[e.b]);
             push(moved_a[e.a]), push(moved_b[e.b]), push(moved_b[e.a]);
           }
@@ -265,10 +286,12 @@ void gl_mill(ZMap& map, std::span<const Cutter> cutters, std::span<const CutMove
       flush();
       glFinish();
       glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
-      if (glGetError() != GL_NO_ERROR) detail::fail("gl mill: reading the depth buffer back failed");
+      if (glGetError() != GL_NO_ERROR)
+        detail::fail("gl mill: reading the depth buffer back failed");
       for (int j = 0; j < h; ++j)
         for (int i = 0; i < w; ++i) {
-          float d = depth[static_cast<std::size_t>(i) + static_cast<std::size_t>(w) * static_cast<std::size_t>(j)];
+          float d = depth[static_cast<std::size_t>(i) +
+                          static_cast<std::size_t>(w) * static_cast<std::size_t>(j)];
           if (!(d < 1.0f)) continue;
           float z = static_cast<float>(z_lo + double(d) * (z_hi - z_lo));
           float& height = map.heights[g.index(i0 + i, j0 + j)];

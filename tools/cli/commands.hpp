@@ -13,17 +13,17 @@ namespace tridex::cli {
 constexpr long long kDefaultMaxBlocks = 20'000'000;
 
 struct CommonOptions {
-  std::string program;          // G-code file or CAMotics project
+  std::string program;           // G-code file or CAMotics project
   double arc_tolerance = 0.001;  // mm
   bool lenient = false;
-  std::string block_delete = "on";        // --block-delete on|off: the operator's switch
-  std::string machine;                    // --machine FILE|NAME (empty: the default machine)
-  std::vector<std::string> subprograms;   // --subprograms DIR (repeatable)
-  std::string tools;            // --tools FILE (overrides a project's table; G41/G42 D read it)
+  std::string block_delete = "on";       // --block-delete on|off: the operator's switch
+  std::string machine;                   // --machine FILE|NAME (empty: the default machine)
+  std::vector<std::string> subprograms;  // --subprograms DIR (repeatable)
+  std::string tools;  // --tools FILE (overrides a project's table; G41/G42 D read it)
   bool progress = false;
   bool quiet = false;
   long long max_blocks = kDefaultMaxBlocks;  // --max-blocks: executed blocks before exit status 2
-  std::string max_memory;      // --max-memory (simulate, check, groups); empty: 80 % of RAM
+  std::string max_memory;  // --max-memory (simulate, check, groups); empty: 80 % of RAM
 };
 
 struct ListOptions : CommonOptions {
@@ -31,14 +31,14 @@ struct ListOptions : CommonOptions {
 };
 
 struct SimulateOptions : CommonOptions {
-  std::string stock;            // --stock (overrides a project's workpiece); empty: auto
-  double zmap_cell = 0;         // 0: stock diagonal / 1000, at most half the dexel spacing
-  double dexel_cell = 0;        // 0: from dexel_res
-  int dexel_res = 0;            // 0: the default
+  std::string stock;      // --stock (overrides a project's workpiece); empty: auto
+  double zmap_cell = 0;   // 0: stock diagonal / 1000, at most half the dexel spacing
+  double dexel_cell = 0;  // 0: from dexel_res
+  int dexel_res = 0;      // 0: the default
   std::string output, png, report, dump_zmaps;
-  std::string html;             // --html OUT.html: the interactive report (html_report.hpp)
-  unsigned threads = 0;         // 0: every hardware thread
-  std::string zmap_backend = "cpu";   // --zmap-backend: cpu | gl (tools/backends)
+  std::string html;                    // --html OUT.html: the interactive report (html_report.hpp)
+  unsigned threads = 0;                // 0: every hardware thread
+  std::string zmap_backend = "cpu";    // --zmap-backend: cpu | gl (tools/backends)
   std::string dexel_backend = "scan";  // --dexel-backend: scan | tree | embree
 };
 
@@ -48,18 +48,18 @@ constexpr double kDefaultClearance = 1.0;
 // `check`: simulate's options (--report and --png are the check's own report and picture; -o still
 // writes the machined solid) and the design to compare with.
 struct CheckOptions : SimulateOptions {
-  std::string design;     // --design PART.stl (closed)
-  double tolerance = 0;   // --tolerance: both tolerances; 0: one dexel spacing
-  double gouge_tol = 0;   // --gouge-tol (overrides --tolerance)
-  double excess_tol = 0;  // --excess-tol (overrides --tolerance)
-  std::string ply;        // --ply OUT.ply: the machined mesh coloured by deviation
-  std::string envelope;   // --envelope box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX
+  std::string design;                    // --design PART.stl (closed)
+  double tolerance = 0;                  // --tolerance: both tolerances; 0: one dexel spacing
+  double gouge_tol = 0;                  // --gouge-tol (overrides --tolerance)
+  double excess_tol = 0;                 // --excess-tol (overrides --tolerance)
+  std::string ply;                       // --ply OUT.ply: the machined mesh coloured by deviation
+  std::string envelope;                  // --envelope box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX
   double clearance = kDefaultClearance;  // --clearance: near misses of shanks and holders, mm
 };
 
 constexpr int kDefaultDexelRes = 320;
 constexpr double kDefaultZmapCellFraction = 1.0 / 1000;  // of the stock's diagonal
-constexpr double kDefaultZmapCellOfSpacing = 0.5;      // at most this many dexel spacings
+constexpr double kDefaultZmapCellOfSpacing = 0.5;        // at most this many dexel spacings
 
 int run_moves(const ListOptions& options);
 int run_groups(const ListOptions& options);

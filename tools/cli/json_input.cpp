@@ -27,7 +27,9 @@ class CheckedSax {
   bool boolean(bool value) { return dom_.boolean(value); }
   bool number_integer(Json::number_integer_t value) { return dom_.number_integer(value); }
   bool number_unsigned(Json::number_unsigned_t value) { return dom_.number_unsigned(value); }
-  bool number_float(Json::number_float_t value, const Json::string_t& text) { return dom_.number_float(value, text); }
+  bool number_float(Json::number_float_t value, const Json::string_t& text) {
+    return dom_.number_float(value, text);
+  }
   bool string(Json::string_t& value) { return dom_.string(value); }
   bool binary(Json::binary_t& value) { return dom_.binary(value); }
   bool start_object(std::size_t size) {
@@ -48,7 +50,8 @@ class CheckedSax {
   }
   bool start_array(std::size_t size) { return dom_.start_array(size); }
   bool end_array() { return dom_.end_array(); }
-  bool parse_error(std::size_t position, const std::string& token, const nlohmann::detail::exception& error) {
+  bool parse_error(std::size_t position, const std::string& token,
+                   const nlohmann::detail::exception& error) {
     error_position = position;
     error_token = token;
     error_id = error.id;
@@ -98,12 +101,16 @@ Json parse_json_text(const std::string& text, const std::string& source) {
     std::size_t end = std::min(sax.error_position, text.size());
     std::size_t line = 1, column = 1;
     for (std::size_t k = 0; k + 1 < end; ++k) {
-      if (text[k] == '\n') ++line, column = 1;
-      else ++column;
+      if (text[k] == '\n')
+        ++line, column = 1;
+      else
+        ++column;
     }
     if (sax.error_id == 406)  // number overflow
-      input_error(source, ":", line, ":", column, ": the number ", shown(sax.error_token), " is out of range",
-                  sax.last_key.empty() ? std::string() : " (after key \"" + shown(sax.last_key) + "\")");
+      input_error(
+          source, ":", line, ":", column, ": the number ", shown(sax.error_token),
+          " is out of range",
+          sax.last_key.empty() ? std::string() : " (after key \"" + shown(sax.last_key) + "\")");
     input_error(source, ":", line, ":", column, ": not valid JSON",
                 sax.error_token.empty() ? std::string() : " at '" + shown(sax.error_token) + "'");
   }
@@ -130,18 +137,28 @@ std::string read_text_file(const fs::path& path, const std::string& kind) {
   return text;
 }
 
-Json read_json_file(const fs::path& path) { return parse_json_text(read_text_file(path, "a JSON file"), path.string()); }
+Json read_json_file(const fs::path& path) {
+  return parse_json_text(read_text_file(path, "a JSON file"), path.string());
+}
 
 std::string json_type_name(const Json& value) {
   switch (value.type()) {
-    case Json::value_t::null: return "null";
-    case Json::value_t::object: return "an object";
-    case Json::value_t::array: return "an array";
-    case Json::value_t::string: return "a string";
-    case Json::value_t::boolean: return "a boolean";
-    case Json::value_t::binary: return "binary data";
-    case Json::value_t::discarded: return "nothing";
-    default: return "a number";
+    case Json::value_t::null:
+      return "null";
+    case Json::value_t::object:
+      return "an object";
+    case Json::value_t::array:
+      return "an array";
+    case Json::value_t::string:
+      return "a string";
+    case Json::value_t::boolean:
+      return "a boolean";
+    case Json::value_t::binary:
+      return "binary data";
+    case Json::value_t::discarded:
+      return "nothing";
+    default:
+      return "a number";
   }
 }
 

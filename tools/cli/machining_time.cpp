@@ -21,7 +21,9 @@ MachiningTimer::MachiningTimer(const gcode::MachineConfig& machine)
 
 void MachiningTimer::charge(int tool, const Vec3& axis, double seconds) {
   time_.by_tool[tool] += seconds;
-  auto same = [&](std::size_t d) { return glm::dot(time_.by_direction[d].first, axis) >= kSameDirection; };
+  auto same = [&](std::size_t d) {
+    return glm::dot(time_.by_direction[d].first, axis) >= kSameDirection;
+  };
   std::size_t found = time_.by_direction.size();
   if (last_direction_ < found && same(last_direction_)) {
     found = last_direction_;
@@ -32,7 +34,8 @@ void MachiningTimer::charge(int tool, const Vec3& axis, double seconds) {
         break;
       }
   }
-  if (found == time_.by_direction.size()) time_.by_direction.emplace_back(glm::normalize(axis), 0.0);
+  if (found == time_.by_direction.size())
+    time_.by_direction.emplace_back(glm::normalize(axis), 0.0);
   time_.by_direction[found].second += seconds;
   last_direction_ = found;
 }
@@ -43,14 +46,16 @@ double MachiningTimer::rapid_minutes(const gcode::Move& move) {
   gcode::RotaryPositions turned{};
   if (kinematics_ && move.rotary_axes) {
     // The first move starts where the machine puts its start point at the current rotaries.
-    Vec3 start = have_last_ ? last_machine_ : gcode::machine_from_part(*kinematics_, move.start, move.rotary);
+    Vec3 start = have_last_ ? last_machine_
+                            : gcode::machine_from_part(*kinematics_, move.start, move.rotary);
     linear = move.machine - start;
     if (have_last_)
       for (std::size_t i = 0; i < 3; ++i) turned[i] = std::abs(move.rotary[i] - last_rotary_[i]);
   }
   double minutes = 0;
   if (rates_.rapid_per_axis) {
-    for (int a = 0; a < 3; ++a) minutes = std::max(minutes, std::abs(linear[a]) / rates_.rapid_mm_per_min[a]);
+    for (int a = 0; a < 3; ++a)
+      minutes = std::max(minutes, std::abs(linear[a]) / rates_.rapid_mm_per_min[a]);
   } else {
     minutes = glm::length(linear) / rates_.rapid_mm_per_min.x;
   }
@@ -107,14 +112,17 @@ Json machining_time_json(const MachiningTimer& timer) {
   Json by_tool = Json::array();
   for (const auto& [tool, s] : t.by_tool) by_tool.push_back({{"tool", tool}, {"s", s}});
   Json by_direction = Json::array();
-  for (const auto& [axis, s] : t.by_direction) by_direction.push_back({{"direction", to_json(axis)}, {"s", s}});
-  Json j = {{"total_s", t.total_s()}, {"feed_s", t.feed_s}, {"rapid_s", t.rapid_s}, {"dwell_s", t.dwell_s},
-            {"by_tool", by_tool}, {"by_direction", by_direction}};
-  j["rapid_rate_mm_per_min"] = rates.rapid_per_axis ? to_json(rates.rapid_mm_per_min) : Json(rates.rapid_mm_per_min.x);
+  for (const auto& [axis, s] : t.by_direction)
+    by_direction.push_back({{"direction", to_json(axis)}, {"s", s}});
+  Json j = {{"total_s", t.total_s()}, {"feed_s", t.feed_s}, {"rapid_s", t.rapid_s},
+            {"dwell_s", t.dwell_s},   {"by_tool", by_tool}, {"by_direction", by_direction}};
+  j["rapid_rate_mm_per_min"] =
+      rates.rapid_per_axis ? to_json(rates.rapid_mm_per_min) : Json(rates.rapid_mm_per_min.x);
   j["rapid_rate_source"] = rates.source;
   Json turn_rates = Json::object();
   for (std::size_t i = 0; i < 3; ++i)
-    if (rates.rapid_deg_per_min[i] > 0) turn_rates[std::string(1, static_cast<char>('A' + i))] = rates.rapid_deg_per_min[i];
+    if (rates.rapid_deg_per_min[i] > 0)
+      turn_rates[std::string(1, static_cast<char>('A' + i))] = rates.rapid_deg_per_min[i];
   if (!turn_rates.empty()) j["rapid_rate_deg_per_min"] = turn_rates;
   if (rates.max_feed_mm_per_min) j["max_feed_mm_per_min"] = *rates.max_feed_mm_per_min;
   j["feeds_capped"] = t.capped_feeds;
@@ -140,13 +148,14 @@ std::string machining_time_text(const MachiningTimer& timer) {
   const gcode::MachineRates& rates = timer.rates();
   char rate[96];
   if (rates.rapid_per_axis)
-    std::snprintf(rate, sizeof rate, "[%g, %g, %g]", rates.rapid_mm_per_min.x, rates.rapid_mm_per_min.y,
-                  rates.rapid_mm_per_min.z);
+    std::snprintf(rate, sizeof rate, "[%g, %g, %g]", rates.rapid_mm_per_min.x,
+                  rates.rapid_mm_per_min.y, rates.rapid_mm_per_min.z);
   else
     std::snprintf(rate, sizeof rate, "%g", rates.rapid_mm_per_min.x);
-  return "machining time " + duration_text(t.total_s()) + " (feed " + duration_text(t.feed_s) + ", rapid " +
-         duration_text(t.rapid_s) + ", dwell " + duration_text(t.dwell_s) + ") with rapids at " + rate +
-         " mm/min (" + (rates.source == "default" ? std::string("the default") : "from " + rates.source) + ")";
+  return "machining time " + duration_text(t.total_s()) + " (feed " + duration_text(t.feed_s) +
+         ", rapid " + duration_text(t.rapid_s) + ", dwell " + duration_text(t.dwell_s) +
+         ") with rapids at " + rate + " mm/min (" +
+         (rates.source == "default" ? std::string("the default") : "from " + rates.source) + ")";
 }
 
 }  // namespace tridex::cli

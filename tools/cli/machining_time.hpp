@@ -27,7 +27,7 @@ namespace tridex::cli {
 
 struct MachiningTime {
   double feed_s = 0, rapid_s = 0, dwell_s = 0;
-  std::map<int, double> by_tool;                  // tool number -> seconds
+  std::map<int, double> by_tool;                      // tool number -> seconds
   std::vector<std::pair<Vec3, double>> by_direction;  // in order of first appearance
   long long untimed_approaches = 0;  // moves back from "far": where they start is not known
   long long capped_feeds = 0;        // feed moves run at max_feed_mm_per_min instead

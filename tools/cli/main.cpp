@@ -45,34 +45,45 @@ const CLI::Validator kFiniteNonNegative(
 
 // An option given with an empty value (`--stock ''`, `-o ""`) is a mistake, not the default.
 const CLI::Validator kNotEmpty(
-    [](std::string& text) -> std::string { return text.empty() ? "must not be empty" : std::string(); }, "");
+    [](std::string& text) -> std::string {
+      return text.empty() ? "must not be empty" : std::string();
+    },
+    "");
 
 void add_common(CLI::App& command, CommonOptions& options) {
-  command.add_option("PROGRAM", options.program,
-                     "G-code file (.nc, .ngc, .tap, .gcode, any name) or CAMotics project (.camotics)")
+  command
+      .add_option("PROGRAM", options.program,
+                  "G-code file (.nc, .ngc, .tap, .gcode, any name) or CAMotics project (.camotics)")
       ->required();
-  command.add_option("--arc-tolerance", options.arc_tolerance,
-                     "largest chord error of linearised arcs, mm (default 0.001)")
+  command
+      .add_option("--arc-tolerance", options.arc_tolerance,
+                  "largest chord error of linearised arcs, mm (default 0.001)")
       ->check(kFinitePositive);
-  command.add_option("--max-blocks", options.max_blocks,
-                     "stop with exit status 2 after this many executed blocks (bounds M98 ... L loops; default " +
-                         std::to_string(kDefaultMaxBlocks) + ")")
+  command
+      .add_option("--max-blocks", options.max_blocks,
+                  "stop with exit status 2 after this many executed blocks (bounds M98 ... L "
+                  "loops; default " +
+                      std::to_string(kDefaultMaxBlocks) + ")")
       ->check(CLI::PositiveNumber);
   command.add_flag("--lenient", options.lenient,
                    "unsupported G-code words become warnings and are skipped");
-  command.add_option("--block-delete", options.block_delete,
-                     "the control's block delete switch: on skips the blocks that start with '/', off runs them\n"
-                     "(default on)")
+  command
+      .add_option("--block-delete", options.block_delete,
+                  "the control's block delete switch: on skips the blocks that start with '/', off "
+                  "runs them\n"
+                  "(default on)")
       ->check(CLI::IsMember({"on", "off"}));
   command.add_option("--machine", options.machine,
-                     std::string("machine file (JSON) or bundled machine: ") + tridex::gcode::bundled_machine_names() +
-                         " (README: Machine files)");
+                     std::string("machine file (JSON) or bundled machine: ") +
+                         tridex::gcode::bundled_machine_names() + " (README: Machine files)");
   command.add_option("--subprograms", options.subprograms,
                      "folder of subprogram files (O9810.nc, name.ngc) that M98/G65/o-call may "
                      "call (repeatable)");
-  command.add_option("--tools", options.tools,
-                     "tool table, JSON in the CAMotics schema, a Fusion tool library or a LinuxCNC .tbl (overrides a project's\n"
-                     "tools; G41/G42 D offset by half a tool's diameter, G43 H by its tool length)")
+  command
+      .add_option("--tools", options.tools,
+                  "tool table, JSON in the CAMotics schema, a Fusion tool library or a LinuxCNC "
+                  ".tbl (overrides a project's\n"
+                  "tools; G41/G42 D offset by half a tool's diameter, G43 H by its tool length)")
       ->check(kNotEmpty);
   command.add_flag("--progress", options.progress,
                    "show progress on stderr even when it is not a terminal");
@@ -80,44 +91,60 @@ void add_common(CLI::App& command, CommonOptions& options) {
 }
 
 void add_max_memory(CLI::App& command, std::string& max_memory) {
-  command.add_option("--max-memory", max_memory,
-                     "refuse a run whose estimated memory (the moves it keeps, the Z-maps, dexels and mesh)\n"
-                     "exceeds this (e.g. 4G; default 80 % of RAM)")
+  command
+      .add_option(
+          "--max-memory", max_memory,
+          "refuse a run whose estimated memory (the moves it keeps, the Z-maps, dexels and mesh)\n"
+          "exceeds this (e.g. 4G; default 80 % of RAM)")
       ->check(kNotEmpty);
 }
 
 // simulate's options, shared by check.
 void add_simulate(CLI::App& command, SimulateOptions& options) {
   add_common(command, options);
-  command.add_option("--stock", options.stock,
-                  "box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX | FILE.stl | auto[:MARGIN] (default auto: the box around\n"
+  command
+      .add_option("--stock", options.stock,
+                  "box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX | FILE.stl | auto[:MARGIN] (default auto: the "
+                  "box around\n"
                   "the cutting moves plus MARGIN mm, or 5 % of each side without one)")
       ->check(kNotEmpty);
-  command.add_option("--zmap-cell", options.zmap_cell,
-                  "Z-map grid spacing, mm (default: stock diagonal / 1000, at most half the dexel spacing)")
+  command
+      .add_option(
+          "--zmap-cell", options.zmap_cell,
+          "Z-map grid spacing, mm (default: stock diagonal / 1000, at most half the dexel spacing)")
       ->check(kFinitePositive);
-  auto* dexel_cell = command.add_option("--dexel-cell", options.dexel_cell, "triple-dexel spacing, mm")
-                         ->check(kFinitePositive);
-  command.add_option("--dexel-res", options.dexel_res,
+  auto* dexel_cell =
+      command.add_option("--dexel-cell", options.dexel_cell, "triple-dexel spacing, mm")
+          ->check(kFinitePositive);
+  command
+      .add_option("--dexel-res", options.dexel_res,
                   "triple-dexel cells along the stock's longest side (default " +
-                      std::to_string(kDefaultDexelRes) + ": the bundled example in seconds on 2 cores)")
+                      std::to_string(kDefaultDexelRes) +
+                      ": the bundled example in seconds on 2 cores)")
       ->check(CLI::Range(1, 1 << 20))
       ->excludes(dexel_cell);
-  command.add_option("--dump-zmaps", options.dump_zmaps,
+  command
+      .add_option("--dump-zmaps", options.dump_zmaps,
                   "write each direction's milled Z-map to DIR as STL and as a height picture")
       ->check(kNotEmpty);
-  command.add_option("--threads", options.threads, "worker threads (default: every hardware thread)")
+  command
+      .add_option("--threads", options.threads, "worker threads (default: every hardware thread)")
       ->check(CLI::Range(0u, 4096u));
-  command.add_option("--zmap-backend", options.zmap_backend,
-                     "Step 1: cpu (the kernel's exact milling, default) or gl (the swept cutters drawn into an\n"
-                     "OSMesa float depth buffer)")
+  command
+      .add_option("--zmap-backend", options.zmap_backend,
+                  "Step 1: cpu (the kernel's exact milling, default) or gl (the swept cutters "
+                  "drawn into an\n"
+                  "OSMesa float depth buffer)")
       ->check(CLI::IsMember({"cpu", "gl"}));
-  command.add_option("--dexel-backend", options.dexel_backend,
-                     "Steps 2-3: scan (scan conversion onto the ray grids, default), tree (the paper's grid\n"
-                     "AABB tree) or embree (Embree 3 ray casting)")
+  command
+      .add_option(
+          "--dexel-backend", options.dexel_backend,
+          "Steps 2-3: scan (scan conversion onto the ray grids, default), tree (the paper's grid\n"
+          "AABB tree) or embree (Embree 3 ray casting)")
       ->check(CLI::IsMember({"scan", "tree", "embree"}));
   command.add_option("--html", options.html,
-                     "write an interactive HTML report: the part in 3D, the toolpath, the findings and the figures\n"
+                     "write an interactive HTML report: the part in 3D, the toolpath, the findings "
+                     "and the figures\n"
                      "(one file that opens offline in a browser)");
   add_max_memory(command, options.max_memory);
 }
@@ -126,60 +153,81 @@ void add_simulate(CLI::App& command, SimulateOptions& options) {
 
 int main(int argc, char** argv) {
   remove_temporaries_on_signals();
-  CLI::App app{"tridex: simulate 3+2-axis milling (G68.2 tilted planes) from a G-code program to a\n"
-               "watertight STL, a picture and a report. Method: Inui, Chen and Umezu, CAD&A 19(4) 2022.",
-               "tridex"};
+  CLI::App app{
+      "tridex: simulate 3+2-axis milling (G68.2 tilted planes) from a G-code program to a\n"
+      "watertight STL, a picture and a report. Method: Inui, Chen and Umezu, CAD&A 19(4) 2022.",
+      "tridex"};
   app.set_version_flag("--version", "tridex " TRIDEX_VERSION);
   app.require_subcommand(1);
-  app.footer("Exit status: 0 success, 2 bad input (program, tool table, stock, options), 1 other failure;\n"
-             "`check` exits 3 when it finds a gouge, excess, a rapid into material, a move outside the envelope\n"
-             "or a shank or holder in the material.\n"
-             "Run `tridex COMMAND --help` for a command's options.");
+  app.footer(
+      "Exit status: 0 success, 2 bad input (program, tool table, stock, options), 1 other "
+      "failure;\n"
+      "`check` exits 3 when it finds a gouge, excess, a rapid into material, a move outside the "
+      "envelope\n"
+      "or a shank or holder in the material.\n"
+      "Run `tridex COMMAND --help` for a command's options.");
 
   SimulateOptions simulate;
-  CLI::App* sim = app.add_subcommand("simulate", "mill the program into its stock and write the machined solid");
+  CLI::App* sim = app.add_subcommand(
+      "simulate", "mill the program into its stock and write the machined solid");
   add_simulate(*sim, simulate);
-  sim->add_option("-o,--output", simulate.output, "write the result as binary STL")->check(kNotEmpty);
-  sim->add_option("--png", simulate.png, "write a shaded picture of the result (off-screen OSMesa)")->check(kNotEmpty);
+  sim->add_option("-o,--output", simulate.output, "write the result as binary STL")
+      ->check(kNotEmpty);
+  sim->add_option("--png", simulate.png, "write a shaded picture of the result (off-screen OSMesa)")
+      ->check(kNotEmpty);
   sim->add_option("--report", simulate.report, "write the JSON report")->check(kNotEmpty);
 
   CheckOptions check;
   CLI::App* chk = app.add_subcommand(
-      "check", "compare the machined result with a design: gouges, excess, rapids into stock, envelope,\n"
-               "shank and holder collisions;\n"
-               "exit status 3 when anything is found");
+      "check",
+      "compare the machined result with a design: gouges, excess, rapids into stock, envelope,\n"
+      "shank and holder collisions;\n"
+      "exit status 3 when anything is found");
   add_simulate(*chk, check);
-  chk->add_option("--design", check.design, "the designed part, a closed STL")->required()->check(kNotEmpty);
+  chk->add_option("--design", check.design, "the designed part, a closed STL")
+      ->required()
+      ->check(kNotEmpty);
   auto* tolerance = chk->add_option("--tolerance", check.tolerance,
                                     "gouge and excess tolerance, mm (default: one dexel spacing)")
                         ->check(kFinitePositive);
-  chk->add_option("--gouge-tol", check.gouge_tol, "material removed inside the design beyond this is a gouge, mm")
+  chk->add_option("--gouge-tol", check.gouge_tol,
+                  "material removed inside the design beyond this is a gouge, mm")
       ->check(kFinitePositive)
       ->excludes(tolerance);
-  chk->add_option("--excess-tol", check.excess_tol, "material left outside the design beyond this is excess, mm")
+  chk->add_option("--excess-tol", check.excess_tol,
+                  "material left outside the design beyond this is excess, mm")
       ->check(kFinitePositive)
       ->excludes(tolerance);
-  chk->add_option("--envelope", check.envelope,
-                  "box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX: every move whose tool tip ends outside is a finding")
+  chk->add_option(
+         "--envelope", check.envelope,
+         "box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX: every move whose tool tip ends outside is a finding")
       ->check(kNotEmpty);
-  chk->add_option("--clearance", check.clearance,
-                  "report moves whose shank or holder comes closer than this to the stock, mm (0: none)")
+  chk->add_option(
+         "--clearance", check.clearance,
+         "report moves whose shank or holder comes closer than this to the stock, mm (0: none)")
       ->check(kFiniteNonNegative);
-  chk->add_option("-o,--output", check.output, "write the machined result as binary STL")->check(kNotEmpty);
+  chk->add_option("-o,--output", check.output, "write the machined result as binary STL")
+      ->check(kNotEmpty);
   chk->add_option("--report", check.report, "write the JSON report of the check")->check(kNotEmpty);
-  chk->add_option("--png", check.png, "write a picture coloured by deviation, with a legend")->check(kNotEmpty);
-  chk->add_option("--ply", check.ply, "write the machined mesh as PLY with per-vertex colour by deviation")->check(kNotEmpty);
+  chk->add_option("--png", check.png, "write a picture coloured by deviation, with a legend")
+      ->check(kNotEmpty);
+  chk->add_option("--ply", check.ply,
+                  "write the machined mesh as PLY with per-vertex colour by deviation")
+      ->check(kNotEmpty);
 
   ListOptions moves;
-  CLI::App* mov = app.add_subcommand("moves", "print the interpreted moves as JSON Lines, one object per move");
+  CLI::App* mov =
+      app.add_subcommand("moves", "print the interpreted moves as JSON Lines, one object per move");
   add_common(*mov, moves);
-  mov->add_option("-o,--output", moves.output, "write to a file instead of stdout")->check(kNotEmpty);
+  mov->add_option("-o,--output", moves.output, "write to a file instead of stdout")
+      ->check(kNotEmpty);
 
   ListOptions groups;
   CLI::App* grp = app.add_subcommand("groups", "print the spindle-direction groups as JSON");
   add_common(*grp, groups);
   add_max_memory(*grp, groups.max_memory);
-  grp->add_option("-o,--output", groups.output, "write to a file instead of stdout")->check(kNotEmpty);
+  grp->add_option("-o,--output", groups.output, "write to a file instead of stdout")
+      ->check(kNotEmpty);
 
   try {
     app.parse(argc, argv);

@@ -14,7 +14,8 @@ namespace {
 
 void require_box(const tridex::Aabb& box) {
   for (int a = 0; a < 3; ++a)
-    if (!std::isfinite(box.min[a]) || !std::isfinite(box.max[a]) || !(box.min[a] < box.max[a])) std::abort();
+    if (!std::isfinite(box.min[a]) || !std::isfinite(box.max[a]) || !(box.min[a] < box.max[a]))
+      std::abort();
 }
 
 }  // namespace

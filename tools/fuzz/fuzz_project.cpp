@@ -13,7 +13,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     // Program files are looked up relative to the project's folder; /tmp holds none of the
     // seeds' names, so most inputs stop there, after the JSON has been read.
-    tridex::cli::project_from_json(tridex::cli::parse_json_text(text, "fuzz.camotics"), "/tmp/fuzz.camotics");
+    tridex::cli::project_from_json(tridex::cli::parse_json_text(text, "fuzz.camotics"),
+                                   "/tmp/fuzz.camotics");
   } catch (const tridex::cli::InputError&) {
   }
   return 0;

@@ -1,7 +1,8 @@
-// libFuzzer harness over the STL reader (binary and ASCII), clang -fsanitize=fuzzer,address,undefined
-// (run.sh). Any input must read into a mesh with valid indices and finite float positions, or
-// throw tridex::Error; with a memory limit, nothing may allocate beyond it. Crashes become named
-// cases in tests/tools/test_bad_input.cpp with their input under tests/data/.
+// libFuzzer harness over the STL reader (binary and ASCII), clang
+// -fsanitize=fuzzer,address,undefined (run.sh). Any input must read into a mesh with valid indices
+// and finite float positions, or throw tridex::Error; with a memory limit, nothing may allocate
+// beyond it. Crashes become named cases in tests/tools/test_bad_input.cpp with their input under
+// tests/data/.
 #include <unistd.h>
 
 #include <cmath>
@@ -21,11 +22,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   try {
     // require_closed runs the reader, the weld and check_mesh: everything a stock or design meets.
-    tridex::Mesh mesh = tridex::read_stl(path, tridex::StlOptions{.require_closed = true, .max_bytes = 64 << 20});
+    tridex::Mesh mesh =
+        tridex::read_stl(path, tridex::StlOptions{.require_closed = true, .max_bytes = 64 << 20});
     for (const glm::vec3& p : mesh.positions)
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) std::abort();
     for (const glm::uvec3& t : mesh.triangles)
-      if (t.x >= mesh.positions.size() || t.y >= mesh.positions.size() || t.z >= mesh.positions.size()) std::abort();
+      if (t.x >= mesh.positions.size() || t.y >= mesh.positions.size() ||
+          t.z >= mesh.positions.size())
+        std::abort();
   } catch (const tridex::Error&) {
   }
   return 0;

@@ -13,7 +13,8 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   std::string text(reinterpret_cast<const char*>(data), size);
   try {
-    tridex::cli::ToolTable table = tridex::cli::ToolTable::from_json(tridex::cli::parse_json_text(text, "fuzz"), "fuzz");
+    tridex::cli::ToolTable table =
+        tridex::cli::ToolTable::from_json(tridex::cli::parse_json_text(text, "fuzz"), "fuzz");
     for (int number = 0; number < 8; ++number)
       if (const tridex::cli::ToolSpec* spec = table.find(number))
         if (!(spec->cutter.radius() > 0) || !std::isfinite(spec->cutter.radius())) std::abort();

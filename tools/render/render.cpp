@@ -44,8 +44,8 @@ struct ContextDeleter {
 };
 
 // Draws one view into the current context's viewport.
-void draw_view(const Mesh& mesh, const MeshView& view, const MeshRenderOptions& options,
-               int width, int height) {
+void draw_view(const Mesh& mesh, const MeshView& view, const MeshRenderOptions& options, int width,
+               int height) {
   Aabb box = mesh.bounds();
   Vec3 centre = box.center();
   double radius = std::max(1e-9, 0.5 * glm::length(box.size()));
@@ -138,8 +138,8 @@ Image render_mesh(const Mesh& mesh, const MeshRenderOptions& options) {
   if (mesh.triangles.empty()) detail::fail("render: the mesh has no triangles");
   if (options.views.empty()) detail::fail("render: no view to draw");
   if (!options.vertex_colours.empty() && options.vertex_colours.size() != mesh.positions.size())
-    detail::fail("render: ", options.vertex_colours.size(), " vertex colours for ", mesh.positions.size(),
-                 " vertices");
+    detail::fail("render: ", options.vertex_colours.size(), " vertex colours for ",
+                 mesh.positions.size(), " vertices");
   if (options.panel_width < 1 || options.panel_height < 1 || options.panel_width > 8192 ||
       options.panel_height > 8192)
     detail::fail("render: panel size ", options.panel_width, " x ", options.panel_height,
@@ -155,7 +155,8 @@ Image render_mesh(const Mesh& mesh, const MeshRenderOptions& options) {
   Image image;
   image.width = options.panel_width * static_cast<int>(options.views.size());
   image.height = options.panel_height;
-  image.rgb.assign(static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 3, 0);
+  image.rgb.assign(
+      static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 3, 0);
   for (std::size_t v = 0; v < options.views.size(); ++v) {
     draw_view(mesh, options.views[v], options, w, h);
     // OSMesa's rows run bottom-up; average each 2×2 block into one output pixel.
@@ -166,10 +167,14 @@ Image render_mesh(const Mesh& mesh, const MeshRenderOptions& options) {
           for (int sy = 0; sy < kSupersample; ++sy)
             for (int sx = 0; sx < kSupersample; ++sx) {
               int bx = x * kSupersample + sx, by = h - 1 - (y * kSupersample + sy);
-              sum += buffer[4 * (static_cast<std::size_t>(bx) + static_cast<std::size_t>(w) * static_cast<std::size_t>(by)) + static_cast<std::size_t>(c)];
+              sum += buffer[4 * (static_cast<std::size_t>(bx) +
+                                 static_cast<std::size_t>(w) * static_cast<std::size_t>(by)) +
+                            static_cast<std::size_t>(c)];
             }
-          std::size_t ox = static_cast<std::size_t>(x) + v * static_cast<std::size_t>(options.panel_width);
-          image.rgb[3 * (ox + static_cast<std::size_t>(image.width) * static_cast<std::size_t>(y)) + static_cast<std::size_t>(c)] =
+          std::size_t ox =
+              static_cast<std::size_t>(x) + v * static_cast<std::size_t>(options.panel_width);
+          image.rgb[3 * (ox + static_cast<std::size_t>(image.width) * static_cast<std::size_t>(y)) +
+                    static_cast<std::size_t>(c)] =
               static_cast<std::uint8_t>(sum / (kSupersample * kSupersample));
         }
   }
@@ -180,8 +185,10 @@ namespace {
 
 // A perceptually ordered ramp (dark blue -> teal -> yellow), piecewise linear.
 glm::vec3 ramp(double t) {
-  static const glm::vec3 stops[] = {{0.27f, 0.00f, 0.33f}, {0.23f, 0.32f, 0.55f},
-                                    {0.13f, 0.57f, 0.55f}, {0.37f, 0.79f, 0.38f},
+  static const glm::vec3 stops[] = {{0.27f, 0.00f, 0.33f},
+                                    {0.23f, 0.32f, 0.55f},
+                                    {0.13f, 0.57f, 0.55f},
+                                    {0.37f, 0.79f, 0.38f},
                                     {0.99f, 0.91f, 0.14f}};
   t = std::clamp(t, 0.0, 1.0) * 4;
   int k = std::min(3, static_cast<int>(t));
@@ -199,7 +206,8 @@ Image render_heights(const ZMap& map, int max_side) {
   Image image;
   image.width = (g.nx + step - 1) / step;
   image.height = (g.ny + step - 1) / step;
-  image.rgb.assign(static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 3, 0);
+  image.rgb.assign(
+      static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 3, 0);
   float lo = std::numeric_limits<float>::infinity(), hi = -lo;
   for (float z : map.heights)
     if (z > map.empty_height) lo = std::min(lo, z), hi = std::max(hi, z);
@@ -220,7 +228,8 @@ Image render_heights(const ZMap& map, int max_side) {
         double light = std::max(0.0, glm::dot(normal, glm::normalize(Vec3(-1, 1, 1.5))));
         colour = ramp((at(i, j) - lo) / range) * static_cast<float>(0.35 + 0.65 * light);
       }
-      std::size_t o = 3 * (static_cast<std::size_t>(x) + static_cast<std::size_t>(image.width) * static_cast<std::size_t>(y));
+      std::size_t o = 3 * (static_cast<std::size_t>(x) +
+                           static_cast<std::size_t>(image.width) * static_cast<std::size_t>(y));
       for (int c = 0; c < 3; ++c)
         image.rgb[o + static_cast<std::size_t>(c)] =
             static_cast<std::uint8_t>(std::lround(255 * std::clamp(colour[c], 0.0f, 1.0f)));
@@ -258,7 +267,8 @@ void fill_rect(Image& image, int x0, int y0, int w, int h, glm::vec3 colour) {
   for (int y = std::max(0, y0); y < std::min(image.height, y0 + h); ++y)
     for (int x = std::max(0, x0); x < std::min(image.width, x0 + w); ++x)
       for (int c = 0; c < 3; ++c)
-        image.rgb[3 * (static_cast<std::size_t>(x) + static_cast<std::size_t>(image.width) * static_cast<std::size_t>(y)) +
+        image.rgb[3 * (static_cast<std::size_t>(x) +
+                       static_cast<std::size_t>(image.width) * static_cast<std::size_t>(y)) +
                   static_cast<std::size_t>(c)] =
             static_cast<std::uint8_t>(std::clamp(colour[c], 0.0f, 1.0f) * 255.0f + 0.5f);
 }
@@ -283,7 +293,8 @@ void draw_legend(Image& image, const std::vector<LegendEntry>& entries, int scal
       const std::uint8_t* glyph = kFont[code >= 32 && code <= 90 ? code - 32 : 0];
       for (int col = 0; col < 5; ++col)
         for (int row = 0; row < 7; ++row)
-          if (glyph[col] & (1 << row)) fill_rect(image, x + col * scale, top + row * scale, scale, scale, glm::vec3(0.1f));
+          if (glyph[col] & (1 << row))
+            fill_rect(image, x + col * scale, top + row * scale, scale, scale, glm::vec3(0.1f));
       x += 6 * scale;
     }
   }
@@ -291,7 +302,8 @@ void draw_legend(Image& image, const std::vector<LegendEntry>& entries, int scal
 
 std::vector<std::uint8_t> encode_png(const Image& image) {
   if (image.width < 1 || image.height < 1 ||
-      image.rgb.size() != static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 3)
+      image.rgb.size() !=
+          static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 3)
     detail::fail("png: image buffer does not match its size ", image.width, " x ", image.height);
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   if (!png) detail::fail("png: cannot create the encoder");
@@ -310,12 +322,14 @@ std::vector<std::uint8_t> encode_png(const Image& image) {
         out->insert(out->end(), data, data + length);
       },
       nullptr);
-  png_set_IHDR(png, info, static_cast<png_uint_32>(image.width), static_cast<png_uint_32>(image.height), 8,
-               PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
-               PNG_FILTER_TYPE_DEFAULT);
+  png_set_IHDR(png, info, static_cast<png_uint_32>(image.width),
+               static_cast<png_uint_32>(image.height), 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_write_info(png, info);
   for (int y = 0; y < image.height; ++y)
-    png_write_row(png, const_cast<png_bytep>(image.rgb.data() + 3 * static_cast<std::size_t>(image.width) * static_cast<std::size_t>(y)));
+    png_write_row(
+        png, const_cast<png_bytep>(image.rgb.data() + 3 * static_cast<std::size_t>(image.width) *
+                                                          static_cast<std::size_t>(y)));
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
   return bytes;

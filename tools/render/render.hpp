@@ -27,7 +27,7 @@ struct MeshView {
 };
 
 struct MeshRenderOptions {
-  int panel_width = 800;   // pixels per view
+  int panel_width = 800;  // pixels per view
   int panel_height = 800;
   // One panel per view, side by side. The default pair sees the top and all four sides.
   std::vector<MeshView> views{MeshView{{1, -1, 0.8}, {0, 0, 1}}, MeshView{{-1, 1, 0.8}, {0, 0, 1}}};

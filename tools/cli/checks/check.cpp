@@ -12,8 +12,9 @@
 //
 // The design side: a part feature cut away entirely (a thin rib) can leave a machined surface
 // that lies on the design everywhere, so points on the design's surface (its vertices and samples
-// about two dexel spacings apart, at most 4 million) are measured against the machined surface too (signed by the result's triple dexel): a design
-// sample outside the machined solid beyond --gouge-tol is material missing, one inside beyond
+// about two dexel spacings apart, at most 4 million) are measured against the machined surface too
+// (signed by the result's triple dexel): a design sample outside the machined solid beyond
+// --gouge-tol is material missing, one inside beyond
 // --excess-tol is material left. These are counted and bounded, not split into regions.
 #include <algorithm>
 #include <array>
@@ -51,11 +52,11 @@ using Clock = std::chrono::steady_clock;
 constexpr glm::vec3 kGougeColour{0.86f, 0.16f, 0.14f};
 constexpr glm::vec3 kOkColour{0.70f, 0.76f, 0.70f};
 constexpr glm::vec3 kExcessColour{0.18f, 0.40f, 0.90f};
-constexpr std::size_t kRegionsListed = 100;   // per kind, deepest first
+constexpr std::size_t kRegionsListed = 100;  // per kind, deepest first
 constexpr std::size_t kRegionsWithLines = 20;
 constexpr std::size_t kFindingsListed = 1000;  // envelope violations in the report, in line order
 constexpr std::size_t kFindingsPrinted = 20;   // of each kind on stdout
-constexpr std::size_t kProbesPerRegion = 16;  // deepest vertices tested against the moves
+constexpr std::size_t kProbesPerRegion = 16;   // deepest vertices tested against the moves
 constexpr int kHistogramBins = 20;
 constexpr std::size_t kMaxDesignSamples = 4'000'000;
 
@@ -87,7 +88,7 @@ Json statistics(std::vector<double> values) {
   s["max_mm"] = values.back();
   s["mean_mm"] = sum / n;
   s["rms_mm"] = std::sqrt(sum2 / n);
-  s["percentiles_mm"] = {{"p1", percentile(1)}, {"p5", percentile(5)}, {"p25", percentile(25)},
+  s["percentiles_mm"] = {{"p1", percentile(1)},   {"p5", percentile(5)},   {"p25", percentile(25)},
                          {"p50", percentile(50)}, {"p75", percentile(75)}, {"p95", percentile(95)},
                          {"p99", percentile(99)}};
   // Equal bins over [min, max]; the last bin includes max.
@@ -105,11 +106,13 @@ Json statistics(std::vector<double> values) {
 
 // Source lines of the moves whose swept cutter reaches the region's deepest vertices, as
 // (Move::file, line) pairs.
-std::vector<std::pair<int, int>> gouging_lines(const DeviationRegion& region, const Mesh& mesh, const std::vector<double>& deviation,
-                               const SimulationResult& r, double slack) {
+std::vector<std::pair<int, int>> gouging_lines(const DeviationRegion& region, const Mesh& mesh,
+                                               const std::vector<double>& deviation,
+                                               const SimulationResult& r, double slack) {
   std::vector<std::uint32_t> probes = region.vertices;
   std::size_t keep = std::min(kProbesPerRegion, probes.size());
-  std::partial_sort(probes.begin(), probes.begin() + static_cast<std::ptrdiff_t>(keep), probes.end(),
+  std::partial_sort(probes.begin(), probes.begin() + static_cast<std::ptrdiff_t>(keep),
+                    probes.end(),
                     [&](std::uint32_t a, std::uint32_t b) { return deviation[a] < deviation[b]; });
   probes.resize(keep);
   std::set<std::pair<int, int>> lines;
@@ -126,9 +129,10 @@ std::vector<std::pair<int, int>> gouging_lines(const DeviationRegion& region, co
       Segment tip{group.frame.to_local(m.start), group.frame.to_local(m.end)};
       const double radius = cutter.radius();
       for (const Vec3& p : local) {
-        if (p.x < std::min(tip.a.x, tip.b.x) - radius || p.x > std::max(tip.a.x, tip.b.x) + radius ||
-            p.y < std::min(tip.a.y, tip.b.y) - radius || p.y > std::max(tip.a.y, tip.b.y) + radius ||
-            p.z + slack < std::min(tip.a.z, tip.b.z))
+        if (p.x < std::min(tip.a.x, tip.b.x) - radius ||
+            p.x > std::max(tip.a.x, tip.b.x) + radius ||
+            p.y < std::min(tip.a.y, tip.b.y) - radius ||
+            p.y > std::max(tip.a.y, tip.b.y) + radius || p.z + slack < std::min(tip.a.z, tip.b.z))
           continue;
         detail::MoveGeometry::Lowest lowest = detail::MoveGeometry(cutter, tip).lowest(p.x, p.y);
         if (p.z + slack >= lowest.z && !(continues && lowest.t <= 1e-9)) {
@@ -141,7 +145,8 @@ std::vector<std::pair<int, int>> gouging_lines(const DeviationRegion& region, co
   return {lines.begin(), lines.end()};
 }
 
-Json region_json(const DeviationRegion& region, const Mesh& mesh, const std::vector<double>& deviation) {
+Json region_json(const DeviationRegion& region, const Mesh& mesh,
+                 const std::vector<double>& deviation) {
   return {{"depth_mm", region.depth},
           {"deepest_point", to_json(Vec3(mesh.positions[region.deepest]))},
           {"deviation_mm", deviation[region.deepest]},

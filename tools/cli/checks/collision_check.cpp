@@ -10,8 +10,8 @@ namespace tridex::cli {
 
 namespace {
 
-constexpr int kTile = 16;            // grid points along a tile's side
-constexpr int kBisections = 14;      // the closest distance to clearance / 2^14
+constexpr int kTile = 16;        // grid points along a tile's side
+constexpr int kBisections = 14;  // the closest distance to clearance / 2^14
 
 Segment raised(const Segment& tip, double by) {
   return Segment{tip.a + Vec3(0, 0, by), tip.b + Vec3(0, 0, by)};
@@ -52,7 +52,8 @@ void BodyCheck::will_mill(const ZMap& map, const Cutter& cutter, const CutMove& 
   if (points.empty()) return;
   for (int tj = points.j0 / kTile; tj <= points.j1 / kTile; ++tj)
     for (int ti = points.i0 / kTile; ti <= points.i1 / kTile; ++ti)
-      tile_pending_[static_cast<std::size_t>(ti) + static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(tj)] = 1;
+      tile_pending_[static_cast<std::size_t>(ti) +
+                    static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(tj)] = 1;
 }
 
 void BodyCheck::refresh_tiles(const ZMap& map, int i0, int i1, int j0, int j1) {
@@ -63,28 +64,36 @@ void BodyCheck::refresh_tiles(const ZMap& map, int i0, int i1, int j0, int j1) {
       for (int j = tj * kTile; j < std::min(g.ny, (tj + 1) * kTile); ++j)
         for (int i = ti * kTile; i < std::min(g.nx, (ti + 1) * kTile); ++i)
           if (!map.is_empty(i, j)) top = std::max(top, map.height(i, j));
-      const std::size_t t = static_cast<std::size_t>(ti) + static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(tj);
+      const std::size_t t = static_cast<std::size_t>(ti) +
+                            static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(tj);
       tile_top_[t] = top;
       tile_pending_[t] = 0;
     }
 }
 
-void BodyCheck::milled(const ZMap& map, std::span<const Cutter> cutters, std::span<const CutMove> batch) {
+void BodyCheck::milled(const ZMap& map, std::span<const Cutter> cutters,
+                       std::span<const CutMove> batch) {
   if (batch.empty()) return;
   const ZMapGrid& g = map.grid;
   double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
   for (const CutMove& m : batch) {
     const double r = cutters[m.cutter].radius();
-    x0 = std::min({x0, m.tip.a.x - r, m.tip.b.x - r}), x1 = std::max({x1, m.tip.a.x + r, m.tip.b.x + r});
-    y0 = std::min({y0, m.tip.a.y - r, m.tip.b.y - r}), y1 = std::max({y1, m.tip.a.y + r, m.tip.b.y + r});
+    x0 = std::min({x0, m.tip.a.x - r, m.tip.b.x - r}),
+    x1 = std::max({x1, m.tip.a.x + r, m.tip.b.x + r});
+    y0 = std::min({y0, m.tip.a.y - r, m.tip.b.y - r}),
+    y1 = std::max({y1, m.tip.a.y + r, m.tip.b.y + r});
   }
-  const double i0 = std::max(0.0, std::floor((x0 - g.x0) / g.cell)), i1 = std::min(g.nx - 1.0, std::ceil((x1 - g.x0) / g.cell));
-  const double j0 = std::max(0.0, std::floor((y0 - g.y0) / g.cell)), j1 = std::min(g.ny - 1.0, std::ceil((y1 - g.y0) / g.cell));
+  const double i0 = std::max(0.0, std::floor((x0 - g.x0) / g.cell)),
+               i1 = std::min(g.nx - 1.0, std::ceil((x1 - g.x0) / g.cell));
+  const double j0 = std::max(0.0, std::floor((y0 - g.y0) / g.cell)),
+               j1 = std::min(g.ny - 1.0, std::ceil((y1 - g.y0) / g.cell));
   if (i0 > i1 || j0 > j1) return;
-  refresh_tiles(map, static_cast<int>(i0), static_cast<int>(i1), static_cast<int>(j0), static_cast<int>(j1));
+  refresh_tiles(map, static_cast<int>(i0), static_cast<int>(i1), static_cast<int>(j0),
+                static_cast<int>(j1));
 }
 
-CutDepth BodyCheck::contact_depth(const ZMap& map, const Cutter& surface, const Segment& tip, bool* stale) const {
+CutDepth BodyCheck::contact_depth(const ZMap& map, const Cutter& surface, const Segment& tip,
+                                  bool* stale) const {
   const ZMapGrid& g = map.grid;
   const PointRange points = footprint_points(g, surface.radius(), tip);
   CutDepth deepest;
@@ -96,7 +105,8 @@ CutDepth BodyCheck::contact_depth(const ZMap& map, const Cutter& surface, const 
   std::optional<detail::MoveGeometry> geometry;
   for (int tj = ja / kTile; tj <= jb / kTile; ++tj)
     for (int ti = ia / kTile; ti <= ib / kTile; ++ti) {
-      const std::size_t t = static_cast<std::size_t>(ti) + static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(tj);
+      const std::size_t t = static_cast<std::size_t>(ti) +
+                            static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(tj);
       if (double(tile_top_[t]) <= floor_z) continue;
       if (!geometry) geometry.emplace(surface, tip);
       for (int j = std::max(ja, tj * kTile); j <= std::min(jb, tj * kTile + kTile - 1); ++j)
@@ -110,8 +120,8 @@ CutDepth BodyCheck::contact_depth(const ZMap& map, const Cutter& surface, const 
   return deepest;
 }
 
-void BodyCheck::check(const ZMap& map, const gcode::Move& move, const CutMove& cut, const Vec3& axis,
-                      const Frame& frame, std::size_t group, bool up_to_date,
+void BodyCheck::check(const ZMap& map, const gcode::Move& move, const CutMove& cut,
+                      const Vec3& axis, const Frame& frame, std::size_t group, bool up_to_date,
                       const std::function<void()>& flush, BodyFindings& found) {
   if (cut.cutter >= bodies_.size()) return;
   const ToolBody& body = bodies_[cut.cutter];
@@ -120,7 +130,9 @@ void BodyCheck::check(const ZMap& map, const gcode::Move& move, const CutMove& c
     const BodyPart& part = body.parts[k];
     const Cutter& grown = grown_[cut.cutter][k];
     bool stale = false;
-    if (contact_depth(map, grown, raised(cut.tip, part.bottom - clearance_), up_to_date ? nullptr : &stale).depth <= 0)
+    if (contact_depth(map, grown, raised(cut.tip, part.bottom - clearance_),
+                      up_to_date ? nullptr : &stale)
+            .depth <= 0)
       continue;
     // Every test below reaches a subset of these points (a smaller growth reaches less): where
     // none lies under a pending move, the map's heights there are the true ones.
@@ -129,7 +141,8 @@ void BodyCheck::check(const ZMap& map, const gcode::Move& move, const CutMove& c
       const auto paused = std::chrono::steady_clock::now();
       flush();
       up_to_date = true;
-      found.seconds -= std::chrono::duration<double>(std::chrono::steady_clock::now() - paused).count();
+      found.seconds -=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - paused).count();
       if (contact_depth(map, grown, raised(cut.tip, part.bottom - clearance_)).depth <= 0) continue;
     }
     const CutDepth plain = contact_depth(map, plain_[cut.cutter][k], raised(cut.tip, part.bottom));
@@ -137,7 +150,10 @@ void BodyCheck::check(const ZMap& map, const gcode::Move& move, const CutMove& c
       return frame.to_world(Vec3(map.grid.x(d.i), map.grid.y(d.j), map.height(d.i, d.j)));
     };
     if (plain.depth > kCollisionTolerance) {
-      record(found.collisions, BodyFinding{move.file, move.line, move.tool, part.name, plain.depth, located(plain), axis, group}, true);
+      record(found.collisions,
+             BodyFinding{move.file, move.line, move.tool, part.name, plain.depth, located(plain),
+                         axis, group},
+             true);
       if (body.has_holder() && part.bottom >= body.stick_out) {
         double& deepest = found.holder_depth[{move.tool, group}];
         deepest = std::max(deepest, plain.depth);
@@ -153,12 +169,18 @@ void BodyCheck::check(const ZMap& map, const gcode::Move& move, const CutMove& c
     } else {
       for (int step = 0; step < kBisections; ++step) {
         const double mid = 0.5 * (lo + hi);
-        CutDepth d = contact_depth(map, part_surface(part, mid), raised(cut.tip, part.bottom - mid));
-        if (d.depth > 0) hi = mid, closest = d;
-        else lo = mid;
+        CutDepth d =
+            contact_depth(map, part_surface(part, mid), raised(cut.tip, part.bottom - mid));
+        if (d.depth > 0)
+          hi = mid, closest = d;
+        else
+          lo = mid;
       }
     }
-    record(found.near_misses, BodyFinding{move.file, move.line, move.tool, part.name, hi, located(closest), axis, group}, false);
+    record(
+        found.near_misses,
+        BodyFinding{move.file, move.line, move.tool, part.name, hi, located(closest), axis, group},
+        false);
   }
   found.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }

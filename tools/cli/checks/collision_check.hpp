@@ -40,12 +40,12 @@ namespace tridex::cli {
 constexpr double kCollisionTolerance = 0.005;
 
 struct BodyFinding {
-  int file = 0;            // Move::file: an index into the program's files (SimulationResult::files)
+  int file = 0;  // Move::file: an index into the program's files (SimulationResult::files)
   int line = 0;
   int tool = 0;
-  std::string part;        // "shank", "holder section k" (k = 1 at the holder's face)
-  double depth_mm = 0;     // collision: how deep along the spindle; near miss: the closest distance
-  Vec3 where{0};           // the grid point of the material (work frame)
+  std::string part;     // "shank", "holder section k" (k = 1 at the holder's face)
+  double depth_mm = 0;  // collision: how deep along the spindle; near miss: the closest distance
+  Vec3 where{0};        // the grid point of the material (work frame)
   Vec3 axis{0, 0, 1};
   std::size_t group = 0;
 };
@@ -66,8 +66,8 @@ class BodyCheck {
   // Tests the move `cut` (its tip in the map's frame) of `move` against `map`. `up_to_date` says
   // whether the map holds every earlier move; if not, `flush` mills those (and must call milled).
   void check(const ZMap& map, const gcode::Move& move, const CutMove& cut, const Vec3& axis,
-             const Frame& frame, std::size_t group, bool up_to_date, const std::function<void()>& flush,
-             BodyFindings& found);
+             const Frame& frame, std::size_t group, bool up_to_date,
+             const std::function<void()>& flush, BodyFindings& found);
 
   // To be told of each move put in the batch (not yet milled): marks the tiles it may lower.
   void will_mill(const ZMap& map, const Cutter& cutter, const CutMove& move);
@@ -80,7 +80,8 @@ class BodyCheck {
   // points in tiles wholly below the tip are skipped, so a result ≤ 0 only says "no contact").
   // `stale`, where given, is set when a point of contact lies in a tile that a pending move (one
   // not yet milled) may lower.
-  CutDepth contact_depth(const ZMap& map, const Cutter& surface, const Segment& tip, bool* stale = nullptr) const;
+  CutDepth contact_depth(const ZMap& map, const Cutter& surface, const Segment& tip,
+                         bool* stale = nullptr) const;
 
  private:
   void refresh_tiles(const ZMap& map, int i0, int i1, int j0, int j1);

@@ -53,13 +53,16 @@ DistanceTree::DistanceTree(const Mesh& mesh) : mesh_(&mesh) {
   std::vector<Vec3> centroids(n);
   for (std::uint32_t t = 0; t < n; ++t) {
     const glm::uvec3& tri = mesh.triangles[t];
-    centroids[t] = (Vec3(mesh.positions[tri.x]) + Vec3(mesh.positions[tri.y]) + Vec3(mesh.positions[tri.z])) / 3.0;
+    centroids[t] =
+        (Vec3(mesh.positions[tri.x]) + Vec3(mesh.positions[tri.y]) + Vec3(mesh.positions[tri.z])) /
+        3.0;
   }
   nodes_.reserve(2 * (n / kLeafSize + 1));
   build(0, n, centroids);
 }
 
-std::uint32_t DistanceTree::build(std::uint32_t first, std::uint32_t count, std::vector<Vec3>& centroids) {
+std::uint32_t DistanceTree::build(std::uint32_t first, std::uint32_t count,
+                                  std::vector<Vec3>& centroids) {
   const auto index = static_cast<std::uint32_t>(nodes_.size());
   nodes_.push_back(Node{});
   Aabb box, centre_box;
@@ -77,8 +80,9 @@ std::uint32_t DistanceTree::build(std::uint32_t first, std::uint32_t count, std:
   }
   int axis = size.x >= size.y && size.x >= size.z ? 0 : (size.y >= size.z ? 1 : 2);
   std::uint32_t half = count / 2;
-  std::nth_element(order_.begin() + first, order_.begin() + first + half, order_.begin() + first + count,
-                   [&](std::uint32_t a, std::uint32_t b) { return centroids[a][axis] < centroids[b][axis]; });
+  std::nth_element(
+      order_.begin() + first, order_.begin() + first + half, order_.begin() + first + count,
+      [&](std::uint32_t a, std::uint32_t b) { return centroids[a][axis] < centroids[b][axis]; });
   std::uint32_t left = build(first, half, centroids);
   std::uint32_t right = build(first + half, count - half, centroids);
   nodes_[index].left = left;
@@ -96,9 +100,12 @@ DistanceTree::Nearest DistanceTree::nearest(const Vec3& p) const {
     if (box_distance2(node.box, p) >= best2) continue;
     if (node.count == 0) {
       // Nearer child last, so that it is searched first and tightens the bound.
-      double dl = box_distance2(nodes_[node.left].box, p), dr = box_distance2(nodes_[node.right].box, p);
-      if (dl < dr) stack.insert(stack.end(), {node.right, node.left});
-      else stack.insert(stack.end(), {node.left, node.right});
+      double dl = box_distance2(nodes_[node.left].box, p),
+             dr = box_distance2(nodes_[node.right].box, p);
+      if (dl < dr)
+        stack.insert(stack.end(), {node.right, node.left});
+      else
+        stack.insert(stack.end(), {node.left, node.right});
       continue;
     }
     for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
@@ -120,14 +127,16 @@ DistanceTree::Nearest DistanceTree::nearest(const Vec3& p) const {
   return best;
 }
 
-double DistanceTree::signed_distance(const Vec3& p, const std::function<bool(const Vec3&)>& inside) const {
+double DistanceTree::signed_distance(const Vec3& p,
+                                     const std::function<bool(const Vec3&)>& inside) const {
   Nearest n = nearest(p);
   if (n.distance == 0) return 0;
   bool in = n.on_face ? n.side < 0 : inside(p);
   return in ? -n.distance : n.distance;
 }
 
-std::vector<DeviationRegion> deviation_regions(const Mesh& mesh, const std::vector<double>& deviation,
+std::vector<DeviationRegion> deviation_regions(const Mesh& mesh,
+                                               const std::vector<double>& deviation,
                                                const std::vector<char>& selected) {
   const std::size_t n = mesh.positions.size();
   if (deviation.size() != n || selected.size() != n)
@@ -192,7 +201,9 @@ std::vector<Vec3> design_samples(const Mesh& design, double step, std::size_t ma
         continue;
       }
       const glm::uvec3& t = design.triangles[k - vertices];
-      samples.push_back((Vec3(design.positions[t.x]) + Vec3(design.positions[t.y]) + Vec3(design.positions[t.z])) / 3.0);
+      samples.push_back((Vec3(design.positions[t.x]) + Vec3(design.positions[t.y]) +
+                         Vec3(design.positions[t.z])) /
+                        3.0);
     }
     return samples;
   }
@@ -204,16 +215,17 @@ std::vector<Vec3> design_samples(const Mesh& design, double step, std::size_t ma
   }
   std::vector<Vec3> samples(design.positions.begin(), design.positions.end());
   for (const glm::uvec3& t : design.triangles) {
-    Vec3 a(design.positions[t.x]), ab = Vec3(design.positions[t.y]) - a, ac = Vec3(design.positions[t.z]) - a;
+    Vec3 a(design.positions[t.x]), ab = Vec3(design.positions[t.y]) - a,
+                                   ac = Vec3(design.positions[t.z]) - a;
     const auto n = static_cast<int>(splits(t, step));
     for (int i = 0; i < n; ++i)
       for (int j = 0; i + j < n; ++j) {
         samples.push_back(a + ((i + 1.0 / 3) / n) * ab + ((j + 1.0 / 3) / n) * ac);
-        if (i + j + 1 < n) samples.push_back(a + ((i + 2.0 / 3) / n) * ab + ((j + 2.0 / 3) / n) * ac);
+        if (i + j + 1 < n)
+          samples.push_back(a + ((i + 2.0 / 3) / n) * ab + ((j + 2.0 / 3) / n) * ac);
       }
   }
   return samples;
 }
-
 
 }  // namespace tridex::cli

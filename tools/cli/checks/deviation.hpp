@@ -61,7 +61,8 @@ struct DeviationRegion {
 };
 
 // The connected components of the vertices with `selected[v]`, largest depth first.
-std::vector<DeviationRegion> deviation_regions(const Mesh& mesh, const std::vector<double>& deviation,
+std::vector<DeviationRegion> deviation_regions(const Mesh& mesh,
+                                               const std::vector<double>& deviation,
                                                const std::vector<char>& selected);
 
 // Points on the design's surface about `step` apart: its vertices, and in each triangle split into

@@ -23,7 +23,8 @@ std::vector<double> parse_number_list(const std::string& text, const std::string
   std::size_t start = 0;
   while (true) {
     std::size_t comma = text.find(',', start);
-    std::string part = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    std::string part =
+        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
     values.push_back(parse_number(part, what));
     if (comma == std::string::npos) break;
     start = comma + 1;

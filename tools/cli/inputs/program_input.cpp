@@ -23,8 +23,8 @@ gcode::MachineConfig load_machine(const std::string& name_or_file,
   } else {
     std::error_code error;
     if (!fs::is_regular_file(name_or_file, error))
-      input_error("--machine ", name_or_file, ": neither a bundled machine (", gcode::bundled_machine_names(),
-                  ") nor a machine file");
+      input_error("--machine ", name_or_file, ": neither a bundled machine (",
+                  gcode::bundled_machine_names(), ") nor a machine file");
     nlohmann::json doc = read_json_file(name_or_file);
     try {
       machine = gcode::machine_from_json(doc, name_or_file);
@@ -46,9 +46,9 @@ ProgramInput resolve_program(const CommonOptions& options) {
   input.machine = load_machine(options.machine, options.subprograms);
   input.program = program;
   std::error_code error;
-  if (fs::is_directory(input.program, error)) input_error(program, ": is a directory, not a program file");
-  if (!fs::is_regular_file(input.program, error))
-    input_error(program, ": no such program file");
+  if (fs::is_directory(input.program, error))
+    input_error(program, ": is a directory, not a program file");
+  if (!fs::is_regular_file(input.program, error)) input_error(program, ": no such program file");
   if (is_project_file(input.program)) {
     Project project = read_project(input.program);
     input.files = std::move(project.files);
@@ -70,7 +70,8 @@ ProgramInput resolve_program(const CommonOptions& options) {
   if (!options.tools.empty())
     input.tools = ToolTable::read(options.tools, input.machine.tool_table_in_inches ? 25.4 : 1.0);
   if (input.tools) {  // cutter compensation (G41/G42 D) offsets by half a tool's diameter
-    for (const auto& [number, spec] : input.tools->tools()) input.machine.tool_diameters[number] = spec.diameter_mm;
+    for (const auto& [number, spec] : input.tools->tools())
+      input.machine.tool_diameters[number] = spec.diameter_mm;
     input.machine.tool_lengths = input.tools->tool_lengths();  // G43 H
   }
   return input;
@@ -88,15 +89,17 @@ gcode::InterpreterOptions interpreter_options(const CommonOptions& options) {
 void MoveBudget::keep(const gcode::Move& move, const std::string& file) {
   ++kept_;
   if (held_ > static_cast<double>(max_bytes_))
-    input_error(file, ":", move.line, ": tridex holds ", format_mib(held_), " before keeping any move (its libraries ",
-                "and the files read), more than --max-memory ", format_mib(static_cast<double>(max_bytes_)),
-                "; raise --max-memory");
+    input_error(file, ":", move.line, ": tridex holds ", format_mib(held_),
+                " before keeping any move (its libraries ",
+                "and the files read), more than --max-memory ",
+                format_mib(static_cast<double>(max_bytes_)), "; raise --max-memory");
   if (held_ + bytes() > static_cast<double>(max_bytes_))
-    input_error(file, ":", move.line, ": the program expands into more than ", kept_ - 1, " moves (",
-                format_mib(bytes()), " to keep them, with ", format_mib(held_),
-                " in use before reading), more than --max-memory ",
-                format_mib(static_cast<double>(max_bytes_)),
-                "; raise --max-memory, or give a larger --arc-tolerance if fine arcs make the moves");
+    input_error(
+        file, ":", move.line, ": the program expands into more than ", kept_ - 1, " moves (",
+        format_mib(bytes()), " to keep them, with ", format_mib(held_),
+        " in use before reading), more than --max-memory ",
+        format_mib(static_cast<double>(max_bytes_)),
+        "; raise --max-memory, or give a larger --arc-tolerance if fine arcs make the moves");
 }
 
 InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOptions& options,
@@ -111,26 +114,31 @@ InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOpt
     // The interpreter numbers the files of each run from 0: mapped into result.files as they come.
     std::vector<int> global;
     try {
-      interpreter.run(in, path.string(), [&](const gcode::Move& move) {
-        ++result.moves;
-        while (global.size() <= static_cast<std::size_t>(move.file)) {
-          const std::string& name = interpreter.files()[global.size()];
-          const auto known = std::find(result.files.begin(), result.files.end(), name);
-          global.push_back(static_cast<int>(known - result.files.begin()));
-          if (known == result.files.end()) result.files.push_back(name);
-        }
-        gcode::Move renumbered = move;
-        renumbered.file = global[static_cast<std::size_t>(move.file)];
-        sink(renumbered, f);
-      }, dwell_sink);
+      interpreter.run(
+          in, path.string(),
+          [&](const gcode::Move& move) {
+            ++result.moves;
+            while (global.size() <= static_cast<std::size_t>(move.file)) {
+              const std::string& name = interpreter.files()[global.size()];
+              const auto known = std::find(result.files.begin(), result.files.end(), name);
+              global.push_back(static_cast<int>(known - result.files.begin()));
+              if (known == result.files.end()) result.files.push_back(name);
+            }
+            gcode::Move renumbered = move;
+            renumbered.file = global[static_cast<std::size_t>(move.file)];
+            sink(renumbered, f);
+          },
+          dwell_sink);
     } catch (const gcode::GcodeError& e) {
       if (options.max_blocks <= 0 || interpreter.blocks() <= options.max_blocks) throw;
-      input_error(e.where.file, ":", e.where.line, ":", e.where.column, ": more than ", options.max_blocks,
-                  " blocks executed (--max-blocks ", options.max_blocks,
-                  "; an endless GOTO or WHILE loop, or nested M98 ... L repeats?); raise --max-blocks if the "
+      input_error(e.where.file, ":", e.where.line, ":", e.where.column, ": more than ",
+                  options.max_blocks, " blocks executed (--max-blocks ", options.max_blocks,
+                  "; an endless GOTO or WHILE loop, or nested M98 ... L repeats?); raise "
+                  "--max-blocks if the "
                   "program needs more");
     }
-    for (const gcode::Diagnostic& d : interpreter.warnings()) result.warnings.push_back(d.to_string());
+    for (const gcode::Diagnostic& d : interpreter.warnings())
+      result.warnings.push_back(d.to_string());
     for (const auto& [tool, line] : interpreter.tool_first_line())
       result.tool_first_line.try_emplace(tool, ToolSelection{path.string(), line});
   }

@@ -19,11 +19,11 @@
 namespace tridex::cli {
 
 struct ProgramInput {
-  std::filesystem::path program;              // what the user named
-  std::vector<std::filesystem::path> files;   // the G-code file(s), in order
-  std::optional<ToolTable> tools;             // --tools, else from a project
-  std::optional<StockSpec> stock;             // from a project
-  gcode::MachineConfig machine;               // --machine, --subprograms
+  std::filesystem::path program;             // what the user named
+  std::vector<std::filesystem::path> files;  // the G-code file(s), in order
+  std::optional<ToolTable> tools;            // --tools, else from a project
+  std::optional<StockSpec> stock;            // from a project
+  gcode::MachineConfig machine;              // --machine, --subprograms
 };
 
 // --machine NAME|FILE and --subprograms: a bundled machine (tridex/gcode/machine.hpp's registry)
@@ -42,7 +42,7 @@ struct ToolSelection {
 };
 
 struct InterpretResult {
-  std::vector<std::string> warnings;           // "file:line:col: message"
+  std::vector<std::string> warnings;  // "file:line:col: message"
   std::map<int, ToolSelection> tool_first_line;
   long long moves = 0;
   std::vector<std::string> files;  // Move::file's table over all runs: the program's files, then

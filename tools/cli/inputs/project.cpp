@@ -23,8 +23,7 @@ bool is_project_file(const fs::path& path) {
 namespace {
 
 Vec3 read_point(const nlohmann::json& value, const std::string& where) {
-  if (!value.is_array() || value.size() != 3)
-    input_error(where, ": expected [x, y, z]");
+  if (!value.is_array() || value.size() != 3) input_error(where, ": expected [x, y, z]");
   Vec3 p;
   for (int a = 0; a < 3; ++a) {
     const auto& v = value[static_cast<std::size_t>(a)];
@@ -37,9 +36,7 @@ Vec3 read_point(const nlohmann::json& value, const std::string& where) {
 
 }  // namespace
 
-Project read_project(const fs::path& path) {
-  return project_from_json(read_json_file(path), path);
-}
+Project read_project(const fs::path& path) { return project_from_json(read_json_file(path), path); }
 
 Project project_from_json(const nlohmann::json& json, const fs::path& path) {
   if (!json.is_object()) input_error(path.string(), ": a CAMotics project must be a JSON object");
@@ -52,9 +49,12 @@ Project project_from_json(const nlohmann::json& json, const fs::path& path) {
   for (const auto& f : *files) {
     // CAMotics writes plain strings; some versions write {"path": ...}.
     std::string name;
-    if (f.is_string()) name = f.get<std::string>();
-    else if (f.is_object() && f.contains("path") && f["path"].is_string()) name = f["path"].get<std::string>();
-    else input_error(source, ": \"files\" entries must be file names, got ", json_type_name(f));
+    if (f.is_string())
+      name = f.get<std::string>();
+    else if (f.is_object() && f.contains("path") && f["path"].is_string())
+      name = f["path"].get<std::string>();
+    else
+      input_error(source, ": \"files\" entries must be file names, got ", json_type_name(f));
     if (name.empty() || name.find('\0') != std::string::npos)
       input_error(source, ": \"files\" holds an empty or invalid file name");
     fs::path file = name;
@@ -72,8 +72,8 @@ Project project_from_json(const nlohmann::json& json, const fs::path& path) {
     bool automatic = true;
     if (auto flag = work->find("automatic"); flag != work->end()) {
       if (!flag->is_boolean())
-        input_error(source, ": workpiece \"automatic\" must be true or false, got ", json_type_name(*flag),
-                    flag->is_string() ? " " + flag->dump() : std::string());
+        input_error(source, ": workpiece \"automatic\" must be true or false, got ",
+                    json_type_name(*flag), flag->is_string() ? " " + flag->dump() : std::string());
       automatic = flag->get<bool>();
     }
     if (auto margin = work->find("margin"); margin != work->end()) {

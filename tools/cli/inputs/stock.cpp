@@ -17,8 +17,8 @@ Aabb parse_box(const std::string& numbers, const std::string& option) {
   const char* names = "XYZ";
   for (int a = 0; a < 3; ++a)
     if (!(box.min[a] < box.max[a]))
-      input_error(option, " box: ", names[a], "MIN ", box.min[a], " must be less than ", names[a], "MAX ",
-                  box.max[a]);
+      input_error(option, " box: ", names[a], "MIN ", box.min[a], " must be less than ", names[a],
+                  "MAX ", box.max[a]);
   return box;
 }
 
@@ -49,14 +49,16 @@ StockSpec parse_stock(const std::string& text) {
   spec.mesh_path = text;
   std::error_code error;
   if (!std::filesystem::is_regular_file(spec.mesh_path, error))
-    input_error("--stock ", text,
-                ": no such file (expected box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX, FILE.stl or auto[:MARGIN])");
+    input_error(
+        "--stock ", text,
+        ": no such file (expected box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX, FILE.stl or auto[:MARGIN])");
   return spec;
 }
 
 Aabb automatic_stock(const Aabb& cutting_bounds, const StockSpec& spec) {
   if (cutting_bounds.empty())
-    input_error("--stock auto: the program has no cutting moves to put a stock around; give --stock");
+    input_error(
+        "--stock auto: the program has no cutting moves to put a stock around; give --stock");
   Aabb box = cutting_bounds;
   if (box.min.z < 0) box.max.z = std::max(box.max.z, 0.0);
   if (box.max.z - box.min.z < 2) box.min.z = box.max.z - 2;

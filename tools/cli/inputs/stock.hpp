@@ -12,8 +12,8 @@ namespace tridex::cli {
 struct StockSpec {
   enum class Kind { box, mesh, automatic };
   Kind kind = Kind::automatic;
-  Aabb box;                          // Kind::box: the stock, mm, work frame
-  std::filesystem::path mesh_path;   // Kind::mesh: a closed STL
+  Aabb box;                         // Kind::box: the stock, mm, work frame
+  std::filesystem::path mesh_path;  // Kind::mesh: a closed STL
   // Kind::automatic: the margin added on every side of the box around the cutting moves, in mm;
   // unset means 5 % of each side (the CAMotics default), and then the top gets no margin.
   std::optional<double> margin_mm;

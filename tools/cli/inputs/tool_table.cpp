@@ -53,17 +53,21 @@ std::vector<Vec2> spheroid_profile(double a, double b) {
   return points;
 }
 
-// The holder's sections in the CAMotics-style table: [{"bottom-diameter", "top-diameter", "length"}].
-std::vector<BodySection> holder_sections(const nlohmann::json& tool, const std::string& where, double scale) {
+// The holder's sections in the CAMotics-style table: [{"bottom-diameter", "top-diameter",
+// "length"}].
+std::vector<BodySection> holder_sections(const nlohmann::json& tool, const std::string& where,
+                                         double scale) {
   std::vector<BodySection> sections;
   auto holder = tool.find("holder");
   if (holder == tool.end()) return sections;
   if (!holder->is_array() || holder->empty())
-    input_error(where, ": \"holder\" must be a non-empty list of sections, got ", json_type_name(*holder));
+    input_error(where, ": \"holder\" must be a non-empty list of sections, got ",
+                json_type_name(*holder));
   for (std::size_t k = 0; k < holder->size(); ++k) {
     const nlohmann::json& section = (*holder)[k];
     std::string at = where + ": \"holder\" section " + std::to_string(k + 1);
-    if (!section.is_object()) input_error(at, ": must be a JSON object, got ", json_type_name(section));
+    if (!section.is_object())
+      input_error(at, ": must be a JSON object, got ", json_type_name(section));
     sections.push_back(BodySection{scale * number_field(section, at, {"bottom-diameter"}, true) / 2,
                                    scale * number_field(section, at, {"top-diameter"}, true) / 2,
                                    scale * number_field(section, at, {"length"}, true)});
@@ -78,11 +82,13 @@ ToolBody make_body(const ToolSpec& spec, const std::string& where) {
   if (spec.flute_length_mm > 0) {
     double shank = spec.shank_diameter_mm > 0 ? spec.shank_diameter_mm : spec.diameter_mm;
     if (spec.stick_out_mm > 0 && spec.flute_length_mm > spec.stick_out_mm)
-      input_error(where, ": \"flute-length\" ", spec.flute_length_mm, " mm is longer than \"stick-out\" ",
-                  spec.stick_out_mm, " mm");
+      input_error(where, ": \"flute-length\" ", spec.flute_length_mm,
+                  " mm is longer than \"stick-out\" ", spec.stick_out_mm, " mm");
     double length = spec.stick_out_mm > 0 ? spec.stick_out_mm - spec.flute_length_mm
                                           : std::numeric_limits<double>::infinity();
-    if (length > 0) body.parts.push_back(BodyPart{"shank", spec.flute_length_mm, BodySection{shank / 2, shank / 2, length}});
+    if (length > 0)
+      body.parts.push_back(
+          BodyPart{"shank", spec.flute_length_mm, BodySection{shank / 2, shank / 2, length}});
   } else if (spec.shank_diameter_mm > 0) {
     input_error(where, ": \"shank-diameter\" needs \"flute-length\" (where the shank begins)");
   }
@@ -95,7 +101,8 @@ ToolBody make_body(const ToolSpec& spec, const std::string& where) {
     std::string name = "holder section " + std::to_string(k + 1);
     if (!(s.length > 0)) input_error(where, ": ", name, ": the length must be positive");
     if (!(s.bottom_radius > 0))
-      input_error(where, ": ", name, ": the bottom diameter must be positive (a holder has a face)");
+      input_error(where, ": ", name,
+                  ": the bottom diameter must be positive (a holder has a face)");
     body.parts.push_back(BodyPart{name, bottom, s});
     bottom += s.length;
   }
@@ -157,23 +164,31 @@ ToolTable ToolTable::from_json(const nlohmann::json& table, const std::string& s
         end != key.data() + key.size())
       input_error(where, ": the key must be a non-negative tool number (digits only)");
     if (auto [previous, inserted] = key_of.emplace(number, key); !inserted)
-      input_error(source, ": keys \"", previous->second, "\" and \"", key, "\" are both tool ", number);
+      input_error(source, ": keys \"", previous->second, "\" and \"", key, "\" are both tool ",
+                  number);
     where = source + ": tool " + std::to_string(number);
     const nlohmann::json& tool = it.value();
-    if (!tool.is_object()) input_error(where, ": must be a JSON object, got ", json_type_name(tool));
+    if (!tool.is_object())
+      input_error(where, ": must be a JSON object, got ", json_type_name(tool));
 
     double scale = 1;
     if (auto units = tool.find("units"); units != tool.end()) {
-      if (!units->is_string()) input_error(where, ": \"units\" must be a string, got ", json_type_name(*units));
+      if (!units->is_string())
+        input_error(where, ": \"units\" must be a string, got ", json_type_name(*units));
       std::string u = lower(units->get<std::string>());
-      if (u == "mm" || u == "metric") scale = 1;
-      else if (u == "inch" || u == "in" || u == "imperial") scale = 25.4;
-      else input_error(where, ": unknown \"units\" \"", u, "\" (expected mm, metric, inch or imperial)");
+      if (u == "mm" || u == "metric")
+        scale = 1;
+      else if (u == "inch" || u == "in" || u == "imperial")
+        scale = 25.4;
+      else
+        input_error(where, ": unknown \"units\" \"", u,
+                    "\" (expected mm, metric, inch or imperial)");
     }
     ToolSpec spec;
     spec.number = number;
     auto shape = tool.find("shape");
-    if (shape == tool.end() || !shape->is_string()) input_error(where, ": missing \"shape\" (a string)");
+    if (shape == tool.end() || !shape->is_string())
+      input_error(where, ": missing \"shape\" (a string)");
     spec.shape = lower(shape->get<std::string>());
     spec.diameter_mm = scale * number_field(tool, where, {"diameter"}, true);
     spec.length_mm = scale * number_field(tool, where, {"length"}, false);
@@ -183,8 +198,10 @@ ToolTable ToolTable::from_json(const nlohmann::json& table, const std::string& s
         scale * number_field(tool, where, {"snub_diameter", "snub-diameter"}, false);
     if (auto d = tool.find("description"); d != tool.end() && d->is_string())
       spec.description = d->get<std::string>();
-    spec.flute_length_mm = scale * number_field(tool, where, {"flute-length", "flute_length"}, false);
-    spec.shank_diameter_mm = scale * number_field(tool, where, {"shank-diameter", "shank_diameter"}, false);
+    spec.flute_length_mm =
+        scale * number_field(tool, where, {"flute-length", "flute_length"}, false);
+    spec.shank_diameter_mm =
+        scale * number_field(tool, where, {"shank-diameter", "shank_diameter"}, false);
     spec.stick_out_mm = scale * number_field(tool, where, {"stick-out", "stick_out"}, false);
     spec.holder = holder_sections(tool, where, scale);
     for (const char* name : {"tool-length", "tool_length"})
@@ -231,10 +248,12 @@ ToolTable ToolTable::from_tbl(const std::string& text, const std::string& source
       const char* first = word.data() + 1;
       if (*first == '+') ++first;  // LinuxCNC writes Z+0.511000
       auto [rest, error] = std::from_chars(first, word.data() + word.size(), value);
-      if (!std::isalpha(static_cast<unsigned char>(letter)) || word.size() < 2 || error != std::errc() ||
-          rest != word.data() + word.size() || !std::isfinite(value))
-        input_error(source, ":", line, ":", column, ": \"", word, "\" is not a tool table word (a letter and a number)");
-      if (words.count(letter)) input_error(source, ":", line, ":", column, ": repeated word ", letter);
+      if (!std::isalpha(static_cast<unsigned char>(letter)) || word.size() < 2 ||
+          error != std::errc() || rest != word.data() + word.size() || !std::isfinite(value))
+        input_error(source, ":", line, ":", column, ": \"", word,
+                    "\" is not a tool table word (a letter and a number)");
+      if (words.count(letter))
+        input_error(source, ":", line, ":", column, ": repeated word ", letter);
       words[letter] = {value, column};
     }
     if (words.empty()) continue;
@@ -245,16 +264,20 @@ ToolTable ToolTable::from_tbl(const std::string& text, const std::string& source
       input_error(source, ":", line, ":", tool_column, ": T", tool_value, " is not a tool number");
     const int number = static_cast<int>(tool_value);
     if (auto [previous, inserted] = line_of.emplace(number, line); !inserted)
-      input_error(source, ":", line, ": tool ", number, " again (first at line ", previous->second, ")");
+      input_error(source, ":", line, ": tool ", number, " again (first at line ", previous->second,
+                  ")");
     for (char c : {'X', 'Y'})
       if (auto it = words.find(c); it != words.end() && it->second.first != 0)
-        input_error(source, ":", line, ":", it->second.second, ": tool ", number, " has a sideways offset ", c,
-                    it->second.first, ", which tridex does not simulate");
-    if (auto z = words.find('Z'); z != words.end()) result.tool_lengths_[number] = unit_mm * z->second.first;
+        input_error(source, ":", line, ":", it->second.second, ": tool ", number,
+                    " has a sideways offset ", c, it->second.first,
+                    ", which tridex does not simulate");
+    if (auto z = words.find('Z'); z != words.end())
+      result.tool_lengths_[number] = unit_mm * z->second.first;
     auto d = words.find('D');
     if (d == words.end() || d->second.first == 0) continue;  // a length only: it cannot cut
     std::string where = source + ":" + std::to_string(line) + ": tool " + std::to_string(number);
-    if (d->second.first < 0) input_error(where, ": the diameter D must not be negative, got ", d->second.first);
+    if (d->second.first < 0)
+      input_error(where, ": the diameter D must not be negative, got ", d->second.first);
     ToolSpec spec;
     spec.number = number;
     spec.shape = "cylindrical";
@@ -281,30 +304,38 @@ ToolTable ToolTable::from_fusion_json(const nlohmann::json& library, const std::
   for (std::size_t k = 0; k < data->size(); ++k) {
     const nlohmann::json& tool = (*data)[k];
     std::string where = source + ": \"data\"[" + std::to_string(k) + "]";
-    if (!tool.is_object()) input_error(where, ": must be a JSON object, got ", json_type_name(tool));
+    if (!tool.is_object())
+      input_error(where, ": must be a JSON object, got ", json_type_name(tool));
     auto type = tool.find("type");
-    if (type == tool.end() || !type->is_string()) input_error(where, ": missing \"type\" (a string)");
+    if (type == tool.end() || !type->is_string())
+      input_error(where, ": missing \"type\" (a string)");
     auto shape = kShapes.find(lower(type->get<std::string>()));
     if (shape == kShapes.end()) continue;
     std::string description;
-    if (auto d = tool.find("description"); d != tool.end() && d->is_string()) description = d->get<std::string>();
+    if (auto d = tool.find("description"); d != tool.end() && d->is_string())
+      description = d->get<std::string>();
     if (!description.empty()) where += " (\"" + description + "\")";
     // The number the program calls it by.
     auto post = tool.find("post-process");
-    if (post == tool.end() || !post->is_object()) input_error(where, ": missing \"post-process\" (an object)");
+    if (post == tool.end() || !post->is_object())
+      input_error(where, ": missing \"post-process\" (an object)");
     auto number_key = post->find("number");
-    if (number_key == post->end() || !number_key->is_number_integer() || number_key->get<long long>() < 0 ||
-        number_key->get<long long>() > 1'000'000'000)
-      input_error(where, ": \"post-process\".\"number\" must be a non-negative integer tool number");
+    if (number_key == post->end() || !number_key->is_number_integer() ||
+        number_key->get<long long>() < 0 || number_key->get<long long>() > 1'000'000'000)
+      input_error(where,
+                  ": \"post-process\".\"number\" must be a non-negative integer tool number");
     const int number = static_cast<int>(number_key->get<long long>());
     if (auto [previous, inserted] = entry_of.emplace(number, k); !inserted)
-      input_error(source, ": \"data\"[", previous->second, "] and \"data\"[", k, "] are both tool ", number);
-    where = source + ": tool " + std::to_string(number) + (description.empty() ? "" : " (\"" + description + "\")");
+      input_error(source, ": \"data\"[", previous->second, "] and \"data\"[", k, "] are both tool ",
+                  number);
+    where = source + ": tool " + std::to_string(number) +
+            (description.empty() ? "" : " (\"" + description + "\")");
 
     auto unit_scale = [&](const nlohmann::json& object, const std::string& at, double fallback) {
       auto unit = object.find("unit");
       if (unit == object.end()) return fallback;
-      if (!unit->is_string()) input_error(at, ": \"unit\" must be a string, got ", json_type_name(*unit));
+      if (!unit->is_string())
+        input_error(at, ": \"unit\" must be a string, got ", json_type_name(*unit));
       std::string u = lower(unit->get<std::string>());
       if (u == "millimeters" || u == "mm") return 1.0;
       if (u == "inches" || u == "inch" || u == "in") return 25.4;
@@ -314,7 +345,8 @@ ToolTable ToolTable::from_fusion_json(const nlohmann::json& library, const std::
     if (unit == tool.end()) input_error(where, ": missing \"unit\"");
     const double scale = unit_scale(tool, where, 1.0);
     auto geometry = tool.find("geometry");
-    if (geometry == tool.end() || !geometry->is_object()) input_error(where, ": missing \"geometry\" (an object)");
+    if (geometry == tool.end() || !geometry->is_object())
+      input_error(where, ": missing \"geometry\" (an object)");
     const std::string at = where + ": \"geometry\"";
     ToolSpec spec;
     spec.number = number;
@@ -331,14 +363,17 @@ ToolTable ToolTable::from_fusion_json(const nlohmann::json& library, const std::
       if (spec.corner_radius_mm >= spec.diameter_mm / 2) spec.shape = "ballnose";
     }
     if (spec.stick_out_mm > overall)
-      input_error(at, ": \"LB\" ", spec.stick_out_mm, " mm is longer than \"OAL\" ", overall, " mm");
+      input_error(at, ": \"LB\" ", spec.stick_out_mm, " mm is longer than \"OAL\" ", overall,
+                  " mm");
     if (!(spec.flute_length_mm > 0)) input_error(at, ": \"LCF\" must be positive");
     if (spec.flute_length_mm > spec.stick_out_mm)
-      input_error(at, ": \"LCF\" ", spec.flute_length_mm, " mm is longer than \"LB\" ", spec.stick_out_mm, " mm");
+      input_error(at, ": \"LCF\" ", spec.flute_length_mm, " mm is longer than \"LB\" ",
+                  spec.stick_out_mm, " mm");
     if (!(spec.shank_diameter_mm > 0)) input_error(at, ": \"SFDM\" must be positive");
     if (auto holder = tool.find("holder"); holder != tool.end()) {
       const std::string hat = where + ": \"holder\"";
-      if (!holder->is_object()) input_error(hat, ": must be a JSON object, got ", json_type_name(*holder));
+      if (!holder->is_object())
+        input_error(hat, ": must be a JSON object, got ", json_type_name(*holder));
       const double holder_scale = unit_scale(*holder, hat, scale);
       auto segments = holder->find("segments");
       if (segments == holder->end() || !segments->is_array())
@@ -346,10 +381,12 @@ ToolTable ToolTable::from_fusion_json(const nlohmann::json& library, const std::
       for (std::size_t s = 0; s < segments->size(); ++s) {
         const nlohmann::json& segment = (*segments)[s];
         std::string sat = hat + ": \"segments\"[" + std::to_string(s) + "]";
-        if (!segment.is_object()) input_error(sat, ": must be a JSON object, got ", json_type_name(segment));
-        spec.holder.push_back(BodySection{holder_scale * number_field(segment, sat, {"lower-diameter"}, true) / 2,
-                                          holder_scale * number_field(segment, sat, {"upper-diameter"}, true) / 2,
-                                          holder_scale * number_field(segment, sat, {"height"}, true)});
+        if (!segment.is_object())
+          input_error(sat, ": must be a JSON object, got ", json_type_name(segment));
+        spec.holder.push_back(
+            BodySection{holder_scale * number_field(segment, sat, {"lower-diameter"}, true) / 2,
+                        holder_scale * number_field(segment, sat, {"upper-diameter"}, true) / 2,
+                        holder_scale * number_field(segment, sat, {"height"}, true)});
       }
     }
     spec.cutter = make_cutter(spec, where);

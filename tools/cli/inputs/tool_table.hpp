@@ -27,10 +27,10 @@
 // The third format, a LinuxCNC tool table (.tbl), is read by from_tbl: one tool a line,
 // `T1 P1 Z0.511 D0.125 ;comment`, T the tool number, Z its length, D its diameter (a flat end
 // mill), in the machine's units (LinuxCNC's [TRAJ]LINEAR_UNITS, the machine file's
-// "linear_units"): inches unless it says mm, as rs274 run standalone reads them; the comment is its description. X/Y
-// offsets other than 0 are an error (tridex does not simulate them); P, the pocket, and the
-// other axes' offsets and lathe entries (I J Q) are ignored. A tool without D keeps its length
-// (for G43) but cannot cut.
+// "linear_units"): inches unless it says mm, as rs274 run standalone reads them; the comment is its
+// description. X/Y offsets other than 0 are an error (tridex does not simulate them); P, the
+// pocket, and the other axes' offsets and lathe entries (I J Q) are ignored. A tool without D keeps
+// its length (for G43) but cannot cut.
 //
 // The second format, Autodesk Fusion's tool library export (`{"data": [tool, ...]}`), is read by
 // from_fusion_json: each tool's "post-process"."number" is its number, "unit" "millimeters" or
@@ -54,14 +54,14 @@ namespace tridex::cli {
 
 struct ToolSpec {
   int number = 0;
-  std::string shape;          // the table's shape name, lower case
+  std::string shape;  // the table's shape name, lower case
   double diameter_mm = 0;
-  double length_mm = 0;       // 0 when the table gives none
+  double length_mm = 0;  // 0 when the table gives none
   double corner_radius_mm = 0;
   double snub_diameter_mm = 0;
-  double flute_length_mm = 0;    // 0 when the table gives none (flutes all the way up)
-  double shank_diameter_mm = 0;  // 0: the cutting diameter
-  double stick_out_mm = 0;       // 0 when the table gives none
+  double flute_length_mm = 0;       // 0 when the table gives none (flutes all the way up)
+  double shank_diameter_mm = 0;     // 0: the cutting diameter
+  double stick_out_mm = 0;          // 0 when the table gives none
   std::vector<BodySection> holder;  // bottom (holder face) first; radii and lengths in mm
   std::string description;
   Cutter cutter = Cutter::flat(1);
@@ -76,7 +76,8 @@ class ToolTable {
   static ToolTable from_fusion_json(const nlohmann::json& library, const std::string& source);
   // Parses a LinuxCNC tool table; throws InputError naming source:line:column and the word.
   // `unit_mm`: millimetres per table unit (25.4: inches).
-  static ToolTable from_tbl(const std::string& text, const std::string& source, double unit_mm = 25.4);
+  static ToolTable from_tbl(const std::string& text, const std::string& source,
+                            double unit_mm = 25.4);
   // Reads any format (a .tbl file name: LinuxCNC, in `tbl_unit_mm`; a Fusion library is an object
   // with a "data" list).
   static ToolTable read(const std::filesystem::path& path, double tbl_unit_mm = 25.4);

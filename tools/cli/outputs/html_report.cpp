@@ -129,8 +129,8 @@ Json source_files(const HtmlPage& page, const HtmlLimits& limits) {
 }
 
 // A mesh as the page draws it: simplified to `budget` triangles, quantised points, base64.
-Json display_mesh_json(const Mesh* mesh, std::span<const double> deviation, double gouge_tol, double excess_tol,
-                       std::size_t budget) {
+Json display_mesh_json(const Mesh* mesh, std::span<const double> deviation, double gouge_tol,
+                       double excess_tol, std::size_t budget) {
   Json shown_json = {{"triangles", 0}, {"triangles_shown", 0}};
   if (!mesh || mesh->triangles.empty()) return shown_json;
   DisplayMesh shown = simplify_for_display(*mesh, deviation, gouge_tol, excess_tol, budget);
@@ -167,7 +167,8 @@ Json toolpath_json(const HtmlPage& page, const HtmlLimits& limits) {
   // many segments.
   double tolerance = std::max(1e-6, glm::length(drawn.size()) * limits.path_tolerance);
   DisplayPath thinned = thin_toolpath(*page.groups, page.order, tolerance);
-  while (thinned.stops.size() > limits.max_segments) thinned = thin_toolpath(*page.groups, page.order, tolerance *= 2);
+  while (thinned.stops.size() > limits.max_segments)
+    thinned = thin_toolpath(*page.groups, page.order, tolerance *= 2);
   path["moves"] = thinned.moves;
   path["segments"] = thinned.stops.size();
   path["tolerance_mm"] = thinned.tolerance;
@@ -187,11 +188,20 @@ std::string html_escaped(std::string_view text) {
   std::string out;
   for (char c : text) {
     switch (c) {
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '&': out += "&amp;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '&':
+        out += "&amp;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -200,16 +210,19 @@ std::string html_escaped(std::string_view text) {
 }  // namespace
 
 std::string base64(std::span<const std::uint8_t> bytes) {
-  static constexpr char kDigits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  static constexpr char kDigits[] =
+      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
   out.reserve((bytes.size() + 2) / 3 * 4);
   std::size_t i = 0;
   for (; i + 3 <= bytes.size(); i += 3) {
-    const std::uint32_t v = std::uint32_t{bytes[i]} << 16 | std::uint32_t{bytes[i + 1]} << 8 | bytes[i + 2];
+    const std::uint32_t v =
+        std::uint32_t{bytes[i]} << 16 | std::uint32_t{bytes[i + 1]} << 8 | bytes[i + 2];
     for (int shift = 18; shift >= 0; shift -= 6) out += kDigits[(v >> shift) & 63];
   }
   if (const std::size_t rest = bytes.size() - i; rest > 0) {
-    const std::uint32_t v = std::uint32_t{bytes[i]} << 16 | (rest > 1 ? std::uint32_t{bytes[i + 1]} << 8 : 0);
+    const std::uint32_t v =
+        std::uint32_t{bytes[i]} << 16 | (rest > 1 ? std::uint32_t{bytes[i + 1]} << 8 : 0);
     out += kDigits[(v >> 18) & 63];
     out += kDigits[(v >> 12) & 63];
     out += rest > 1 ? kDigits[(v >> 6) & 63] : '=';
@@ -218,8 +231,8 @@ std::string base64(std::span<const std::uint8_t> bytes) {
   return out;
 }
 
-DisplayMesh simplify_for_display(const Mesh& mesh, std::span<const double> deviation, double gouge_tol,
-                                 double excess_tol, std::size_t max_triangles) {
+DisplayMesh simplify_for_display(const Mesh& mesh, std::span<const double> deviation,
+                                 double gouge_tol, double excess_tol, std::size_t max_triangles) {
   if (!deviation.empty() && deviation.size() != mesh.positions.size())
     throw std::logic_error("simplify_for_display: one deviation per vertex expected");
   std::vector<std::uint32_t> locked, free;
@@ -247,14 +260,16 @@ DisplayMesh simplify_for_display(const Mesh& mesh, std::span<const double> devia
     std::vector<std::uint32_t> simplified(free.size());
     for (float error : {5e-4f, 2e-3f, 8e-3f, 3e-2f, 1e-1f, 1.0f}) {
       const std::size_t goal = error == 5e-4f ? 0 : target;  // as far as the first bound allows
-      simplified.resize(meshopt_simplify(simplified.data(), free.data(), free.size(), &mesh.positions[0].x,
-                                         mesh.positions.size(), sizeof(glm::vec3), goal, error, options));
+      simplified.resize(meshopt_simplify(simplified.data(), free.data(), free.size(),
+                                         &mesh.positions[0].x, mesh.positions.size(),
+                                         sizeof(glm::vec3), goal, error, options));
       if (simplified.size() <= target) break;
       simplified.resize(free.size());
     }
     if (simplified.size() > target)  // the locked border alone is over the budget
-      simplified.resize(meshopt_simplifySloppy(simplified.data(), free.data(), free.size(), &mesh.positions[0].x,
-                                               mesh.positions.size(), sizeof(glm::vec3), target, 1.0f, nullptr));
+      simplified.resize(meshopt_simplifySloppy(simplified.data(), free.data(), free.size(),
+                                               &mesh.positions[0].x, mesh.positions.size(),
+                                               sizeof(glm::vec3), target, 1.0f, nullptr));
     indices = std::move(locked);
     indices.insert(indices.end(), simplified.begin(), simplified.end());
   }
@@ -273,7 +288,8 @@ DisplayMesh simplify_for_display(const Mesh& mesh, std::span<const double> devia
   return shown;
 }
 
-DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups, std::span<const GroupRun> order, double tolerance) {
+DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups,
+                          std::span<const GroupRun> order, double tolerance) {
   struct Ref {
     const gcode::Move* move;
     std::uint8_t group;
@@ -281,14 +297,16 @@ DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups, std::span
   // The moves in program order: the groups keep it within each, `order` across them.
   std::vector<GroupRun> whole;
   if (order.empty())
-    for (std::size_t g = 0; g < groups.size(); ++g) whole.push_back({static_cast<std::uint32_t>(g), groups[g].moves.size()});
+    for (std::size_t g = 0; g < groups.size(); ++g)
+      whole.push_back({static_cast<std::uint32_t>(g), groups[g].moves.size()});
   std::vector<Ref> moves;
   std::vector<std::size_t> next(groups.size(), 0);
   for (const GroupRun& run : order.empty() ? std::span<const GroupRun>(whole) : order) {
     if (run.group >= groups.size() || next[run.group] + run.moves > groups[run.group].moves.size())
       throw std::logic_error("thin_toolpath: the program order does not match the groups");
     for (std::uint64_t k = 0; k < run.moves; ++k)
-      moves.push_back({&groups[run.group].moves[next[run.group]++], static_cast<std::uint8_t>(run.group % 128)});
+      moves.push_back({&groups[run.group].moves[next[run.group]++],
+                       static_cast<std::uint8_t>(run.group % 128)});
   }
 
   DisplayPath path;
@@ -297,14 +315,15 @@ DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups, std::span
   constexpr std::size_t kLongestRun = 64;  // bounds the quadratic check of a run
   std::vector<glm::vec3> run;              // the run's points: its start, then each move's end
   const Ref* first = nullptr;
-  std::uint32_t run_stop = 0;              // the stop of the run's last move
+  std::uint32_t run_stop = 0;  // the stop of the run's last move
   auto flush = [&] {
     if (run.size() < 2) return;
     path.ends.push_back(run.front());
     path.ends.push_back(run.back());
     path.stops.push_back(run_stop);
     path.tools.push_back(static_cast<std::uint16_t>(std::clamp(first->move->tool, 0, 65535)));
-    path.flags.push_back(static_cast<std::uint8_t>(first->group | (first->move->kind == gcode::MoveKind::rapid ? 128 : 0)));
+    path.flags.push_back(static_cast<std::uint8_t>(
+        first->group | (first->move->kind == gcode::MoveKind::rapid ? 128 : 0)));
     run.clear();
   };
   const gcode::Move* previous = nullptr;
@@ -313,9 +332,13 @@ DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups, std::span
     if (!previous || previous->file != m.file || previous->line != m.line) {
       // A new stop: it extends the last run when it is the next line of the same file.
       std::vector<std::uint32_t>& runs = path.stop_runs;
-      const auto file = static_cast<std::uint32_t>(m.file), line = static_cast<std::uint32_t>(m.line);
-      if (!runs.empty() && runs[runs.size() - 3] == file && runs[runs.size() - 2] + runs.back() == line) ++runs.back();
-      else runs.insert(runs.end(), {file, line, 1});
+      const auto file = static_cast<std::uint32_t>(m.file),
+                 line = static_cast<std::uint32_t>(m.line);
+      if (!runs.empty() && runs[runs.size() - 3] == file &&
+          runs[runs.size() - 2] + runs.back() == line)
+        ++runs.back();
+      else
+        runs.insert(runs.end(), {file, line, 1});
       ++path.stop_count;
     }
     previous = &m;
@@ -324,11 +347,14 @@ DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups, std::span
       continue;
     }
     const glm::vec3 start(m.start), end(m.end);
-    bool joins = !run.empty() && run.size() < kLongestRun && first->group == ref.group &&
-                 first->move->tool == m.tool && (first->move->kind == gcode::MoveKind::rapid) == (m.kind == gcode::MoveKind::rapid) &&
-                 glm::length(run.back() - start) <= 1e-6f;
+    bool joins =
+        !run.empty() && run.size() < kLongestRun && first->group == ref.group &&
+        first->move->tool == m.tool &&
+        (first->move->kind == gcode::MoveKind::rapid) == (m.kind == gcode::MoveKind::rapid) &&
+        glm::length(run.back() - start) <= 1e-6f;
     if (joins)
-      for (std::size_t k = 1; k < run.size() && joins; ++k) joins = distance_to_segment(run[k], run.front(), end) <= tolerance;
+      for (std::size_t k = 1; k < run.size() && joins; ++k)
+        joins = distance_to_segment(run[k], run.front(), end) <= tolerance;
     if (!joins) {
       flush();
       first = &ref;
@@ -347,13 +373,16 @@ Json html_page_data(const HtmlPage& page, const HtmlLimits& limits) {
   data["report"] = page.report;
   data["mesh"] = mesh_json(page, limits);
   data["toolpath"] = toolpath_json(page, limits);
-  if (page.design) data["design"] = display_mesh_json(page.design, {}, 0, 0, limits.max_design_triangles);
+  if (page.design)
+    data["design"] = display_mesh_json(page.design, {}, 0, 0, limits.max_design_triangles);
   Json directions = Json::array();
   if (page.groups)
     for (const gcode::MoveGroup& g : *page.groups) {
       Json tools = Json::array();
       for (int t : g.tools) tools.push_back(t);
-      directions.push_back({{"axis", to_json(g.axis)}, {"label", axis_label(g.axis)}, {"moves", g.moves.size()},
+      directions.push_back({{"axis", to_json(g.axis)},
+                            {"label", axis_label(g.axis)},
+                            {"moves", g.moves.size()},
                             {"tools", tools}});
     }
   data["directions"] = directions;
@@ -362,7 +391,8 @@ Json html_page_data(const HtmlPage& page, const HtmlLimits& limits) {
   data["listing_lines"] = 20;  // of a finding's lines, the first this many are listed
   Json messages = Json::array();
   if (data["mesh"]["triangles_shown"] == 0)
-    messages.push_back("No material is left: the machined result has no triangles, so there is no part to show.");
+    messages.push_back(
+        "No material is left: the machined result has no triangles, so there is no part to show.");
   if (!page.groups || data["toolpath"]["moves"] == 0)
     messages.push_back("The program has no moves: there is no toolpath to show.");
   data["messages"] = messages;
@@ -378,15 +408,20 @@ void write_html_report(const fs::path& path, const HtmlPage& page, const HtmlLim
   for (char c : data) c == '<' ? escaped += "\\u003c" : escaped += c;
 
   const std::string_view page_template = kTridexHtmlTemplate;
-  const std::array<std::pair<std::string_view, std::string_view>, 4> fills = {{
-      {"@TITLE@", {}}, {"@DATA@", escaped}, {"@THREE@", kTridexThreeJs}, {"@ORBIT@", kTridexOrbitControlsJs}}};
+  const std::array<std::pair<std::string_view, std::string_view>, 4> fills = {
+      {{"@TITLE@", {}},
+       {"@DATA@", escaped},
+       {"@THREE@", kTridexThreeJs},
+       {"@ORBIT@", kTridexOrbitControlsJs}}};
   const std::string title = html_escaped(page.title);
   AtomicOutput out(path);
   std::size_t at = 0;
   for (const auto& [marker, text] : fills) {
     const std::size_t found = page_template.find(marker, at);
-    if (found == std::string_view::npos) throw std::logic_error("html_report.html lacks " + std::string(marker));
-    out.stream() << page_template.substr(at, found - at) << (marker == "@TITLE@" ? std::string_view(title) : text);
+    if (found == std::string_view::npos)
+      throw std::logic_error("html_report.html lacks " + std::string(marker));
+    out.stream() << page_template.substr(at, found - at)
+                 << (marker == "@TITLE@" ? std::string_view(title) : text);
     at = found + marker.size();
   }
   out.stream() << page_template.substr(at);

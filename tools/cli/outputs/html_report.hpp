@@ -1,9 +1,10 @@
 // tridex command — `--html OUT.html` of simulate and check (issue 15): one self-contained page
 // with the machined part in a three.js view (for check, the design as a translucent ghost over
 // it on request), the toolpath with a slider over the program, the findings (choosing one flies
-// the camera to it and lists its G-code lines) and the report's figures. three.js and its OrbitControls (Debian's libjs-three, found by CMake) and the page
-// template (html_report.html) are embedded in the command and inlined into every page, so the page
-// opens offline and makes no request.
+// the camera to it and lists its G-code lines) and the report's figures. three.js and its
+// OrbitControls (Debian's libjs-three, found by CMake) and the page template (html_report.html) are
+// embedded in the command and inlined into every page, so the page opens offline and makes no
+// request.
 //
 // Large results are made small enough to open quickly: the part is simplified with meshoptimizer
 // (Kapoulkine's edge collapse under quadric error, meshopt_simplify) to a triangle budget, keeping
@@ -28,27 +29,28 @@
 namespace tridex::cli {
 
 struct HtmlLimits {
-  std::size_t max_triangles = 250'000;    // shown of the part (a budget; see simplify_for_display)
+  std::size_t max_triangles = 250'000;  // shown of the part (a budget; see simplify_for_display)
   std::size_t max_design_triangles = 100'000;  // of check's design ghost (drawn translucent)
-  std::size_t max_segments = 1'000'000;   // of the toolpath after thinning
-  double path_tolerance = 1.0 / 4000;     // thinning, as a fraction of the toolpath's box diagonal
+  std::size_t max_segments = 1'000'000;        // of the toolpath after thinning
+  double path_tolerance = 1.0 / 4000;  // thinning, as a fraction of the toolpath's box diagonal
   std::uintmax_t max_source_bytes = 4 << 20;  // the whole program text is inlined up to this size
-  int context = 3;                        // neighbouring lines shown around a finding's line
+  int context = 3;                            // neighbouring lines shown around a finding's line
 };
 
 struct HtmlPage {
   std::string title;
-  Json report;                                  // the report as --report writes it
-  const Mesh* mesh = nullptr;                   // the machined part; null or empty: none left
-  std::span<const double> deviation;            // check: signed deviation per mesh vertex
-  const Mesh* design = nullptr;                 // check: the design, shown as a ghost on request
+  Json report;                        // the report as --report writes it
+  const Mesh* mesh = nullptr;         // the machined part; null or empty: none left
+  std::span<const double> deviation;  // check: signed deviation per mesh vertex
+  const Mesh* design = nullptr;       // check: the design, shown as a ghost on request
   const std::vector<gcode::MoveGroup>* groups = nullptr;
-  std::span<const GroupRun> order;              // the groups' moves in program order (pipeline.hpp)
-  std::vector<std::string> files;               // Move::file's table: the G-code files, listed
+  std::span<const GroupRun> order;  // the groups' moves in program order (pipeline.hpp)
+  std::vector<std::string> files;   // Move::file's table: the G-code files, listed
 };
 
 // Writes the page atomically (output.hpp).
-void write_html_report(const std::filesystem::path& path, const HtmlPage& page, const HtmlLimits& limits = {});
+void write_html_report(const std::filesystem::path& path, const HtmlPage& page,
+                       const HtmlLimits& limits = {});
 
 // ---- the pieces, for the tests -------------------------------------------------------------
 
@@ -67,21 +69,21 @@ struct DisplayMesh {
 // around them locked (everything free only if those alone take half the budget), first within an
 // error of 5e-4 of the mesh's extent (merging flat faces), then with rising bounds until the
 // budget is met. Kept vertices keep their positions and deviations exactly.
-DisplayMesh simplify_for_display(const Mesh& mesh, std::span<const double> deviation, double gouge_tol,
-                                 double excess_tol, std::size_t max_triangles);
+DisplayMesh simplify_for_display(const Mesh& mesh, std::span<const double> deviation,
+                                 double gouge_tol, double excess_tol, std::size_t max_triangles);
 
 struct DisplayPath {
-  std::vector<glm::vec3> ends;           // two per segment, in program (execution) order
-  std::vector<std::uint32_t> stops;      // per segment: the last program stop it stands for
-  std::vector<std::uint16_t> tools;      // per segment
-  std::vector<std::uint8_t> flags;       // per segment: direction (group) index | 128 for rapids
+  std::vector<glm::vec3> ends;       // two per segment, in program (execution) order
+  std::vector<std::uint32_t> stops;  // per segment: the last program stop it stands for
+  std::vector<std::uint16_t> tools;  // per segment
+  std::vector<std::uint8_t> flags;   // per segment: direction (group) index | 128 for rapids
   // The program's stops in execution order: a stop is a move whose (file, line) differs from the
   // move before it. Stored as runs (file, first line, count) of stops in one file on consecutive
   // lines (a straight program is one run a file, a loop repeats its runs).
   std::vector<std::uint32_t> stop_runs;
   std::size_t stop_count = 0;
   std::size_t moves = 0;
-  double tolerance = 0;                  // mm, what the thinning used
+  double tolerance = 0;  // mm, what the thinning used
 };
 
 // The moves of all groups in program order (`order`; empty: each group in turn), each run of moves
@@ -89,6 +91,7 @@ struct DisplayPath {
 // straight segment from its first start to its last end drawn as that segment, carrying the run's
 // last stop. Positions "far along the tool axis" (tridex's stand-in for home returns) are left out
 // of the drawing; their lines are still stops.
-DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups, std::span<const GroupRun> order, double tolerance);
+DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups,
+                          std::span<const GroupRun> order, double tolerance);
 
 }  // namespace tridex::cli

@@ -60,38 +60,39 @@ int run_moves(const ListOptions& options) {
   write_output(options.output, [&](std::ostream& out) {
     std::string record;
     bool several_files = input.files.size() > 1;
-    result = interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t file) {
-      record.clear();
-      record += "{\"line\":";
-      record += std::to_string(m.line);
-      if (several_files) {
-        record += ",\"file\":";
-        record += Json(input.files[file].string()).dump();
-      }
-      record += ",\"kind\":\"";
-      record += gcode::to_string(m.kind);
-      record += "\",\"tool\":";
-      record += std::to_string(m.tool);
-      record += ",\"start\":";
-      append_vec3(record, m.start);
-      record += ",\"end\":";
-      append_vec3(record, m.end);
-      record += ",\"axis\":";
-      append_vec3(record, m.axis);
-      record += ",\"feed\":";
-      append_number(record, m.feed);
-      record += ",\"spindle\":";
-      append_number(record, m.spindle);
-      if (m.from_far) record += ",\"from_far\":true";
-      if (m.rotary_axes) {  // a kinematic model is in use (machine file)
-        record += ",\"rotary\":";
-        record += rotary_json(m).dump();
-        record += ",\"machine\":";
-        append_vec3(record, m.machine);
-      }
-      record += "}\n";
-      out << record;
-    });
+    result =
+        interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t file) {
+          record.clear();
+          record += "{\"line\":";
+          record += std::to_string(m.line);
+          if (several_files) {
+            record += ",\"file\":";
+            record += Json(input.files[file].string()).dump();
+          }
+          record += ",\"kind\":\"";
+          record += gcode::to_string(m.kind);
+          record += "\",\"tool\":";
+          record += std::to_string(m.tool);
+          record += ",\"start\":";
+          append_vec3(record, m.start);
+          record += ",\"end\":";
+          append_vec3(record, m.end);
+          record += ",\"axis\":";
+          append_vec3(record, m.axis);
+          record += ",\"feed\":";
+          append_number(record, m.feed);
+          record += ",\"spindle\":";
+          append_number(record, m.spindle);
+          if (m.from_far) record += ",\"from_far\":true";
+          if (m.rotary_axes) {  // a kinematic model is in use (machine file)
+            record += ",\"rotary\":";
+            record += rotary_json(m).dump();
+            record += ",\"machine\":";
+            append_vec3(record, m.machine);
+          }
+          record += "}\n";
+          out << record;
+        });
   });
   print_warnings(result.warnings, options.quiet);
   return kSuccess;
@@ -111,23 +112,27 @@ int run_groups(const ListOptions& options) {
   };
   std::vector<Extra> extras;
   MachiningTimer timer(input.machine);
-  InterpretResult result = interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t file) {
-    budget.keep(m, input.files[file].string());
-    timer.add(m);
-    std::size_t g = grouper.add(m);
-    if (g >= extras.size()) extras.resize(g + 1);
-    Extra& e = extras[g];
-    ++e.kinds[static_cast<int>(m.kind)];
-    if (e.first_line == 0) e.first_line = m.line;
-    e.last_line = m.line;
-    if (m.rotary_axes && std::find(e.rotary.begin(), e.rotary.end(), m.rotary) == e.rotary.end())
-      e.rotary.push_back(m.rotary);
-    if (m.kind != gcode::MoveKind::rapid) {
-      const Frame& frame = grouper.groups()[g].frame;
-      if (!m.from_far) e.local.extend(frame.to_local(m.start));
-      e.local.extend(frame.to_local(m.end));
-    }
-  }, [&](const gcode::Dwell& d) { timer.add(d); });
+  InterpretResult result = interpret(
+      input, interpreter_options(options),
+      [&](const gcode::Move& m, std::size_t file) {
+        budget.keep(m, input.files[file].string());
+        timer.add(m);
+        std::size_t g = grouper.add(m);
+        if (g >= extras.size()) extras.resize(g + 1);
+        Extra& e = extras[g];
+        ++e.kinds[static_cast<int>(m.kind)];
+        if (e.first_line == 0) e.first_line = m.line;
+        e.last_line = m.line;
+        if (m.rotary_axes &&
+            std::find(e.rotary.begin(), e.rotary.end(), m.rotary) == e.rotary.end())
+          e.rotary.push_back(m.rotary);
+        if (m.kind != gcode::MoveKind::rapid) {
+          const Frame& frame = grouper.groups()[g].frame;
+          if (!m.from_far) e.local.extend(frame.to_local(m.start));
+          e.local.extend(frame.to_local(m.end));
+        }
+      },
+      [&](const gcode::Dwell& d) { timer.add(d); });
   Json groups = Json::array();
   const auto& list = grouper.groups();
   for (std::size_t g = 0; g < list.size(); ++g) {
@@ -139,7 +144,8 @@ int run_groups(const ListOptions& options) {
                   {"y", to_json(group.frame.rotation[1])},
                   {"z", to_json(group.frame.rotation[2])}};
     j["moves"] = group.moves.size();
-    j["by_kind"] = {{"rapid", e.kinds[0]}, {"feed", e.kinds[1]}, {"arc", e.kinds[2]}, {"cycle", e.kinds[3]}};
+    j["by_kind"] = {
+        {"rapid", e.kinds[0]}, {"feed", e.kinds[1]}, {"arc", e.kinds[2]}, {"cycle", e.kinds[3]}};
     j["tools"] = group.tools;
     j["lines"] = {e.first_line, e.last_line};
     if (!group.moves.empty() && group.moves.front().rotary_axes) {

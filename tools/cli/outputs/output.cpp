@@ -165,15 +165,15 @@ void check_output_path(const std::string& option, const fs::path& path,
   std::error_code error;
   if (fs::is_directory(path, error)) input_error(option, " ", path.string(), ": is a directory");
   if (is_special_file(path)) {  // written in place
-    if (::access(path.c_str(), W_OK) != 0) input_error(option, " ", path.string(), ": is not writable");
+    if (::access(path.c_str(), W_OK) != 0)
+      input_error(option, " ", path.string(), ": is not writable");
     return;
   }
   fs::path directory = directory_of(path);
   if (!fs::is_directory(directory, error))
     input_error(option, " ", path.string(), ": directory ", directory.string(), " does not exist");
   if (::access(directory.c_str(), W_OK | X_OK) != 0)
-    input_error(option, " ", path.string(), ": directory ", directory.string(),
-                " is not writable");
+    input_error(option, " ", path.string(), ": directory ", directory.string(), " is not writable");
   if (fs::exists(path, error))
     for (const fs::path& input : inputs)
       if (fs::exists(input, error) && fs::equivalent(path, input, error))
@@ -189,7 +189,8 @@ void check_distinct_outputs(std::span<const std::pair<std::string, fs::path>> ou
     std::error_code error;
     if (fs::exists(a, error) && fs::exists(b, error)) return fs::equivalent(a, b, error);
     // Not written yet: compare the paths they will have (through any links in the directories).
-    return fs::weakly_canonical(fs::absolute(a), error) == fs::weakly_canonical(fs::absolute(b), error);
+    return fs::weakly_canonical(fs::absolute(a), error) ==
+           fs::weakly_canonical(fs::absolute(b), error);
   };
   for (std::size_t i = 0; i < outputs.size(); ++i)
     for (std::size_t j = i + 1; j < outputs.size(); ++j) {

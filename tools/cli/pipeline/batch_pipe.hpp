@@ -31,7 +31,8 @@ class BatchPipe {
   static constexpr std::size_t kBatchItems = 4096;
   static constexpr std::size_t kBatches = 4;
 
-  BatchPipe(std::function<void(const Item&)> consume, bool threaded) : consume_(std::move(consume)) {
+  BatchPipe(std::function<void(const Item&)> consume, bool threaded)
+      : consume_(std::move(consume)) {
     if (!threaded) return;
     current_.reserve(kBatchItems);
     worker_.start([this] { work(); });

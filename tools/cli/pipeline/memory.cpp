@@ -31,13 +31,18 @@ std::uint64_t parse_memory(const std::string& text) {
   while (end > 0 && std::isalpha(static_cast<unsigned char>(text[end - 1]))) --end;
   std::string suffix = text.substr(end);
   for (char& c : suffix) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  if (end == 0) input_error("--max-memory: \"", text, "\" is not a size (a number, then K, M or G)");
+  if (end == 0)
+    input_error("--max-memory: \"", text, "\" is not a size (a number, then K, M or G)");
   double value = parse_number(text.substr(0, end), "--max-memory");
   double scale = 0;
-  if (suffix.empty() || suffix == "M" || suffix == "MB" || suffix == "MIB") scale = 1 << 20;
-  else if (suffix == "G" || suffix == "GB" || suffix == "GIB") scale = 1 << 30;
-  else if (suffix == "K" || suffix == "KB" || suffix == "KIB") scale = 1 << 10;
-  else input_error("--max-memory: unknown unit \"", suffix, "\" (use K, M or G)");
+  if (suffix.empty() || suffix == "M" || suffix == "MB" || suffix == "MIB")
+    scale = 1 << 20;
+  else if (suffix == "G" || suffix == "GB" || suffix == "GIB")
+    scale = 1 << 30;
+  else if (suffix == "K" || suffix == "KB" || suffix == "KIB")
+    scale = 1 << 10;
+  else
+    input_error("--max-memory: unknown unit \"", suffix, "\" (use K, M or G)");
   if (!(value > 0)) input_error("--max-memory: must be positive, got ", text);
   double bytes = value * scale;
   if (!(bytes < 1e19)) input_error("--max-memory: ", text, " is too large");

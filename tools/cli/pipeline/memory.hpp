@@ -26,19 +26,20 @@ struct MemoryEstimate {
   double dexels = 0;  // the stock triple dexel, the result, the grid trees over the Z-maps
   double mesh = 0;    // the surface while it is extracted
   double after = 0;   // what the caller needs after the surface (check: trees, samples)
-  double walls = 0;   // the steep cells' sub-grids (fine_cells.hpp), counted once the maps are milled
+  double walls =
+      0;  // the steep cells' sub-grids (fine_cells.hpp), counted once the maps are milled
   double total() const { return held + zmaps + dexels + mesh + after + walls; }
 };
 
 struct MemoryShape {
-  double zmap_points = 0;     // the sum over directions of nx·ny
-  double largest_map = 0;     // nx·ny of the largest direction's map
-  double rays = 0;            // nx·ny + ny·nz + nz·nx of the triple dexel's lattice
-  bool keep_maps = false;     // the milled maps are copied and kept to the end
-  bool dump_maps = false;     // --dump-zmaps: each map's polyhedron is built and written
+  double zmap_points = 0;  // the sum over directions of nx·ny
+  double largest_map = 0;  // nx·ny of the largest direction's map
+  double rays = 0;         // nx·ny + ny·nz + nz·nx of the triple dexel's lattice
+  bool keep_maps = false;  // the milled maps are copied and kept to the end
+  bool dump_maps = false;  // --dump-zmaps: each map's polyhedron is built and written
 };
 
-inline constexpr double kTrianglesPerRay = 8;       // measured 3.9-5.1 on the example and 12 directions
+inline constexpr double kTrianglesPerRay = 8;  // measured 3.9-5.1 on the example and 12 directions
 inline constexpr double kSurfaceBytesPerTriangle = 80;  // measured 60-67 at extract_surface's peak
 
 MemoryEstimate estimate_memory(double held_bytes, const MemoryShape& shape);

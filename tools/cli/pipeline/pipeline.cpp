@@ -39,17 +39,20 @@ Stock load_stock(const StockSpec& spec, const Aabb& cutting_bounds, std::uint64_
   switch (spec.kind) {
     case StockSpec::Kind::box:
     case StockSpec::Kind::automatic: {
-      stock.box = spec.kind == StockSpec::Kind::box ? spec.box : automatic_stock(cutting_bounds, spec);
+      stock.box =
+          spec.kind == StockSpec::Kind::box ? spec.box : automatic_stock(cutting_bounds, spec);
       Vec3 size = stock.box.size();
       stock.volume = size.x * size.y * size.z;
       stock.description = {{"kind", spec.kind == StockSpec::Kind::box ? "box" : "auto"},
-                           {"min", to_json(stock.box.min)}, {"max", to_json(stock.box.max)}};
+                           {"min", to_json(stock.box.min)},
+                           {"max", to_json(stock.box.max)}};
       break;
     }
     case StockSpec::Kind::mesh: {
       try {
-        stock.mesh = read_stl(spec.mesh_path.string(), StlOptions{.require_closed = true, .max_bytes = max_memory,
-                                                           .limit_name = "--max-memory"});
+        stock.mesh = read_stl(spec.mesh_path.string(), StlOptions{.require_closed = true,
+                                                                  .max_bytes = max_memory,
+                                                                  .limit_name = "--max-memory"});
       } catch (const tridex::Error& e) {
         input_error("--stock ", spec.mesh_path.string(), ": ", e.what());
       }
@@ -58,8 +61,10 @@ Stock load_stock(const StockSpec& spec, const Aabb& cutting_bounds, std::uint64_
       if (!(stock.volume > 0))
         input_error("--stock ", spec.mesh_path.string(), ": the mesh encloses no volume (",
                     stock.volume, " mm^3); are its triangles inside out?");
-      stock.description = {{"kind", "stl"}, {"file", spec.mesh_path.string()},
-                           {"min", to_json(stock.box.min)}, {"max", to_json(stock.box.max)}};
+      stock.description = {{"kind", "stl"},
+                           {"file", spec.mesh_path.string()},
+                           {"min", to_json(stock.box.min)},
+                           {"max", to_json(stock.box.max)}};
       break;
     }
   }
@@ -67,8 +72,10 @@ Stock load_stock(const StockSpec& spec, const Aabb& cutting_bounds, std::uint64_
 }
 
 // A move of `group` as the kernel mills it: the tool tip in the group's frame.
-CutMove cut_move(const gcode::MoveGroup& group, const gcode::Move& m, const std::map<int, std::uint32_t>& cutter_of_tool) {
-  return CutMove{Segment{group.frame.to_local(m.start), group.frame.to_local(m.end)}, cutter_of_tool.at(m.tool)};
+CutMove cut_move(const gcode::MoveGroup& group, const gcode::Move& m,
+                 const std::map<int, std::uint32_t>& cutter_of_tool) {
+  return CutMove{Segment{group.frame.to_local(m.start), group.frame.to_local(m.end)},
+                 cutter_of_tool.at(m.tool)};
 }
 
 // Mills one group's moves into `map` in program order, checking each rapid with cut_depth against
@@ -78,7 +85,8 @@ void mill_in_program_order(ZMap& map, const gcode::MoveGroup& group, std::size_t
                            std::span<const Cutter> cutters,
                            const std::map<int, std::uint32_t>& cutter_of_tool,
                            backends::ZMapBackend backend, unsigned threads,
-                           std::vector<RapidFinding>& found, BodyCheck* bodies, BodyFindings& body_found) {
+                           std::vector<RapidFinding>& found, BodyCheck* bodies,
+                           BodyFindings& body_found) {
   // Heights only fall, so a rapid entirely above the initial top cuts nothing and needs no flush.
   float top = -std::numeric_limits<float>::infinity();
   for (float h : map.heights) top = std::max(top, h);
@@ -98,10 +106,12 @@ void mill_in_program_order(ZMap& map, const gcode::MoveGroup& group, std::size_t
       CutDepth deepest = cut_depth(map, cutters[cut.cutter], cut.tip);
       if (deepest.depth > kRapidTolerance) {
         Vec3 local(map.grid.x(deepest.i), map.grid.y(deepest.j), map.height(deepest.i, deepest.j));
-        found.push_back(RapidFinding{m.file, m.line, m.tool, group.axis, deepest.depth, group.frame.to_world(local), g});
+        found.push_back(RapidFinding{m.file, m.line, m.tool, group.axis, deepest.depth,
+                                     group.frame.to_world(local), g});
       }
     }
-    if (bodies) bodies->check(map, m, cut, group.axis, group.frame, g, batch.empty(), flush, body_found);
+    if (bodies)
+      bodies->check(map, m, cut, group.axis, group.frame, g, batch.empty(), flush, body_found);
     batch.push_back(cut);
     if (bodies) bodies->will_mill(map, cutters[cut.cutter], cut);
   }
@@ -110,8 +120,8 @@ void mill_in_program_order(ZMap& map, const gcode::MoveGroup& group, std::size_t
 
 std::string describe_box(const Aabb& box) {
   char text[160];
-  std::snprintf(text, sizeof text, "%g,%g,%g to %g,%g,%g", box.min.x, box.min.y, box.min.z, box.max.x,
-                box.max.y, box.max.z);
+  std::snprintf(text, sizeof text, "%g,%g,%g to %g,%g,%g", box.min.x, box.min.y, box.min.z,
+                box.max.x, box.max.y, box.max.z);
   return text;
 }
 
@@ -123,11 +133,13 @@ std::string describe_box(const Aabb& box) {
 constexpr double kMaxReachSpacings = 1e5;
 constexpr double kMaxUncutReachSpacings = 0x1p23;
 
-void check_reach(const std::string& what, const Aabb& box, double spacing, double limit = kMaxReachSpacings) {
+void check_reach(const std::string& what, const Aabb& box, double spacing,
+                 double limit = kMaxReachSpacings) {
   double reach = 0;
   for (int a = 0; a < 3; ++a) reach = std::max({reach, std::abs(box.min[a]), std::abs(box.max[a])});
   if (!(reach <= limit * spacing))
-    input_error(what, " reaches ", reach, " mm from the origin, beyond the coordinates tridex represents exactly at a ",
+    input_error(what, " reaches ", reach,
+                " mm from the origin, beyond the coordinates tridex represents exactly at a ",
                 "dexel spacing of ", spacing, " mm (", limit * spacing, " mm, ", limit,
                 " spacings); move it nearer the origin or use a larger --dexel-cell");
 }
@@ -137,12 +149,14 @@ void check_reach(const std::string& what, const Aabb& box, double spacing, doubl
 // by the largest cutter's radius, overlaps the stock across the spindle, and the stock rises above
 // its lowest tip. Then the result is the stock itself, and no cut arithmetic happens at its
 // coordinates.
-bool no_move_reaches(const std::vector<gcode::MoveGroup>& groups, std::span<const Cutter> cutters, const Aabb& stock) {
+bool no_move_reaches(const std::vector<gcode::MoveGroup>& groups, std::span<const Cutter> cutters,
+                     const Aabb& stock) {
   double radius = 0;
   for (const Cutter& c : cutters) radius = std::max(radius, c.radius());
   for (const gcode::MoveGroup& group : groups) {
     Aabb path;
-    for (const gcode::Move& m : group.moves) path.extend(group.frame.to_local(m.start)), path.extend(group.frame.to_local(m.end));
+    for (const gcode::Move& m : group.moves)
+      path.extend(group.frame.to_local(m.start)), path.extend(group.frame.to_local(m.end));
     if (path.empty()) continue;
     const Aabb local = local_bounds(group.frame, stock);
     const bool apart = path.min.x - radius > local.max.x || path.max.x + radius < local.min.x ||
@@ -153,10 +167,12 @@ bool no_move_reaches(const std::vector<gcode::MoveGroup>& groups, std::span<cons
 }
 
 // The files --dump-zmaps writes for the groups: DIR/zmap-<k>-<axis>.stl and .png.
-std::vector<fs::path> dump_names(const std::string& directory, const std::vector<gcode::MoveGroup>& groups) {
+std::vector<fs::path> dump_names(const std::string& directory,
+                                 const std::vector<gcode::MoveGroup>& groups) {
   std::vector<fs::path> names;
   for (std::size_t g = 0; g < groups.size(); ++g) {
-    fs::path base = fs::path(directory) / ("zmap-" + std::to_string(g + 1) + "-" + axis_label(groups[g].axis));
+    fs::path base =
+        fs::path(directory) / ("zmap-" + std::to_string(g + 1) + "-" + axis_label(groups[g].axis));
     names.push_back(base.string() + ".stl");
     names.push_back(base.string() + ".png");
   }
@@ -191,14 +207,19 @@ double fine_cell_bytes(double cells, double rows, double moves, double bands_per
 std::string travel_text(const TravelFinding& f) {
   bool linear = f.axis == 'X' || f.axis == 'Y' || f.axis == 'Z';
   char text[160];
-  std::snprintf(text, sizeof text, linear ? "%c %.6g mm, past the travel's end %.6g" : "%c %.6g°, past its limit %.6g",
+  std::snprintf(text, sizeof text,
+                linear ? "%c %.6g mm, past the travel's end %.6g" : "%c %.6g°, past its limit %.6g",
                 f.axis, f.value, f.limit);
   return text;
 }
 
 Json rapid_finding_json(const RapidFinding& f, const std::vector<std::string>& files) {
-  return {{"file", files.at(static_cast<std::size_t>(f.file))}, {"line", f.line}, {"tool", f.tool},
-          {"axis", to_json(f.axis)}, {"depth_mm", f.depth_mm}, {"where", to_json(f.where)}};
+  return {{"file", files.at(static_cast<std::size_t>(f.file))},
+          {"line", f.line},
+          {"tool", f.tool},
+          {"axis", to_json(f.axis)},
+          {"depth_mm", f.depth_mm},
+          {"where", to_json(f.where)}};
 }
 
 std::string axis_label(const Vec3& axis) {

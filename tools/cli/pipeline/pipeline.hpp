@@ -54,8 +54,9 @@ enum class RapidCheck {
 };
 
 struct PipelineRequest {
-  std::vector<std::pair<std::string, std::filesystem::path>> outputs;  // (option, path), checked first
-  std::vector<std::filesystem::path> extra_inputs;                     // never overwritten either
+  std::vector<std::pair<std::string, std::filesystem::path>>
+      outputs;                                      // (option, path), checked first
+  std::vector<std::filesystem::path> extra_inputs;  // never overwritten either
   // Other geometry that must lie within the exact range on the lattice (check's design), with
   // its name for the message.
   std::vector<std::pair<std::string, Aabb>> extra_bounds;
@@ -87,7 +88,7 @@ struct RapidFinding {
 // A move that ends outside the machine's travel (the kinematics' "travel" in machine
 // coordinates, or a rotary axis's limits): `check` lists these as findings, `simulate` warns.
 struct TravelFinding {
-  int file = 0;      // Move::file: an index into SimulationResult::files
+  int file = 0;  // Move::file: an index into SimulationResult::files
   int line = 0;
   char axis = 'X';
   double value = 0;  // mm (X Y Z, machine coordinates) or degrees (A B C)
@@ -154,7 +155,8 @@ std::string axis_label(const Vec3& axis);
 // "X 612.5 mm, past the travel's end 600" / "A -130°, past its limit -120".
 std::string travel_text(const TravelFinding& finding);
 
-// A rapid into the stock as simulate's and check's reports list it (`files`: SimulationResult::files).
+// A rapid into the stock as simulate's and check's reports list it (`files`:
+// SimulationResult::files).
 Json rapid_finding_json(const RapidFinding& finding, const std::vector<std::string>& files);
 
 }  // namespace tridex::cli

@@ -24,11 +24,63 @@ namespace tridex::cli {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// The JSON report (docs/reports.md), with the run's total time and the rapids that cut.
+Json simulate_report(const SimulateOptions& options, const SimulationResult& r,
+                     const Json& rapid_findings, double total_s) {
+  const ProgramInput& input = r.input;
+  const std::vector<gcode::MoveGroup>& groups = r.groups;
+  const Stock& stock = r.stock;
+  const DexelLattice& lattice = r.lattice;
+  const MeshCheck& check = r.mesh_check;
+  const double volume = r.volume;
+  Json report;
+  report["program"] = input.program.string();
+  if (input.files.size() != 1 || input.files[0] != input.program) {
+    Json files = Json::array();
+    for (const fs::path& f : input.files) files.push_back(f.string());
+    report["files"] = files;
+  }
+  report["stock"] = stock.description;
+  report["segments"] = r.segments;
+  Json group_list = Json::array();
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    group_list.push_back({{"axis", to_json(groups[g].axis)},
+                          {"moves", groups[g].moves.size()},
+                          {"tools", groups[g].tools},
+                          {"zmap", {r.grids[g].nx, r.grids[g].ny}},
+                          {"cell_mm", r.zmap_cell}});
+  report["groups"] = group_list;
+  report["dexel"] = {{"cell_mm", lattice.spacing},
+                     {"res", {lattice.n.x, lattice.n.y, lattice.n.z}}};
+  report["backends"] = {{"zmap", options.zmap_backend}, {"dexel", options.dexel_backend}};
+  report["memory_estimate_mib"] = r.memory.total() / (1 << 20);
+  report["memory_walls_mib"] = r.memory.walls / (1 << 20);
+  report["timings_s"] = {{"parse", r.timings.parse},       {"zmap", r.timings.zmap},
+                         {"dexelize", r.timings.dexelize}, {"intersect", r.timings.intersect},
+                         {"mesh", r.timings.mesh},         {"total", total_s}};
+  report["peak_rss_mib"] = peak_rss_mib();
+  report["result"] = {{"volume_mm3", volume},
+                      {"removed_mm3", stock.volume - volume},
+                      {"dexel_volume_mm3", tridex::volume(r.result)},
+                      {"triangles", r.mesh.triangles.size()},
+                      {"watertight", check.closed()}};
+  report["rapid_cuts"] = rapid_findings;
+  report["machining_time"] = machining_time_json(r.machining);
+  report["warnings"] = r.warnings;
+  return report;
+}
+
+}  // namespace
+
 int run_simulate(const SimulateOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   Progress progress(!options.quiet && (options.progress || stderr_is_terminal()));
   PipelineRequest request;
-  request.outputs = {{"-o", options.output}, {"--png", options.png}, {"--report", options.report},
+  request.outputs = {{"-o", options.output},
+                     {"--png", options.png},
+                     {"--report", options.report},
                      {"--html", options.html}};
   SimulationResult r = simulate_program(options, progress, request);
   const ProgramInput& input = r.input;
@@ -41,7 +93,8 @@ int run_simulate(const SimulateOptions& options) {
   const long long segments = r.segments;
   std::vector<std::string>& warnings = r.warnings;
   Json rapid_findings = Json::array();
-  for (const RapidFinding& f : r.rapid_cuts) rapid_findings.push_back(rapid_finding_json(f, r.files));
+  for (const RapidFinding& f : r.rapid_cuts)
+    rapid_findings.push_back(rapid_finding_json(f, r.files));
   if (!rapid_findings.empty()) {
     std::string lines;
     for (std::size_t k = 0; k < rapid_findings.size() && k < 10; ++k)
@@ -49,13 +102,15 @@ int run_simulate(const SimulateOptions& options) {
                std::to_string(rapid_findings[k]["line"].get<int>());
     warnings.push_back(std::to_string(rapid_findings.size()) +
                        " rapid move(s) cut material that no feed move removes (at " + lines +
-                       (rapid_findings.size() > 10 ? ", …" : "") + "; see \"rapid_cuts\" in the report)");
+                       (rapid_findings.size() > 10 ? ", …" : "") +
+                       "; see \"rapid_cuts\" in the report)");
   }
   if (r.travel_count > 0) {
     const TravelFinding& f = r.travel.front();
-    warnings.push_back(std::to_string(r.travel_count) + " position(s) outside the machine's travel (first " +
-                       r.files.at(static_cast<std::size_t>(f.file)) + ":" + std::to_string(f.line) + ": " + travel_text(f) +
-                       "; `tridex check` lists each)");
+    warnings.push_back(std::to_string(r.travel_count) +
+                       " position(s) outside the machine's travel (first " +
+                       r.files.at(static_cast<std::size_t>(f.file)) + ":" + std::to_string(f.line) +
+                       ": " + travel_text(f) + "; `tridex check` lists each)");
   }
 
   // ---- outputs ------------------------------------------------------------------------------
@@ -71,53 +126,28 @@ int run_simulate(const SimulateOptions& options) {
       write_file_atomically(options.png, render::encode_png(render::render_mesh(mesh)));
     }
   }
-  const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double total_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!check.closed())
-    warnings.push_back("the result mesh is not watertight (" + std::to_string(check.boundary_edges) +
-                       " boundary, " + std::to_string(check.non_manifold_edges) + " non-manifold edges)");
+    warnings.push_back("the result mesh is not watertight (" +
+                       std::to_string(check.boundary_edges) + " boundary, " +
+                       std::to_string(check.non_manifold_edges) + " non-manifold edges)");
 
-  Json report;
-  report["program"] = input.program.string();
-  if (input.files.size() != 1 || input.files[0] != input.program) {
-    Json files = Json::array();
-    for (const fs::path& f : input.files) files.push_back(f.string());
-    report["files"] = files;
-  }
-  report["stock"] = stock.description;
-  report["segments"] = segments;
-  Json group_list = Json::array();
-  for (std::size_t g = 0; g < groups.size(); ++g)
-    group_list.push_back({{"axis", to_json(groups[g].axis)},
-                          {"moves", groups[g].moves.size()},
-                          {"tools", groups[g].tools},
-                          {"zmap", {r.grids[g].nx, r.grids[g].ny}},
-                          {"cell_mm", r.zmap_cell}});
-  report["groups"] = group_list;
-  report["dexel"] = {{"cell_mm", lattice.spacing}, {"res", {lattice.n.x, lattice.n.y, lattice.n.z}}};
-  report["backends"] = {{"zmap", options.zmap_backend}, {"dexel", options.dexel_backend}};
-  report["memory_estimate_mib"] = r.memory.total() / (1 << 20);
-  report["memory_walls_mib"] = r.memory.walls / (1 << 20);
-  report["timings_s"] = {{"parse", r.timings.parse}, {"zmap", r.timings.zmap},
-                         {"dexelize", r.timings.dexelize}, {"intersect", r.timings.intersect},
-                         {"mesh", r.timings.mesh}, {"total", total_s}};
-  report["peak_rss_mib"] = peak_rss_mib();
-  report["result"] = {{"volume_mm3", volume},
-                      {"removed_mm3", stock.volume - volume},
-                      {"dexel_volume_mm3", tridex::volume(r.result)},
-                      {"triangles", mesh.triangles.size()},
-                      {"watertight", check.closed()}};
-  report["rapid_cuts"] = rapid_findings;
-  report["machining_time"] = machining_time_json(r.machining);
-  report["warnings"] = warnings;
+  const Json report = simulate_report(options, r, rapid_findings, total_s);
   if (!options.report.empty()) {
     progress.stage("writing " + options.report);
     write_file_atomically(options.report, report.dump(2) + "\n");
   }
   if (!options.html.empty()) {
     progress.stage("writing " + options.html);
-    write_html_report(options.html, {.title = "tridex simulate: " + input.program.filename().string(),
-                                     .report = report, .mesh = &mesh, .deviation = {}, .groups = &groups,
-                                     .order = r.order, .files = r.files});
+    write_html_report(options.html,
+                      {.title = "tridex simulate: " + input.program.filename().string(),
+                       .report = report,
+                       .mesh = &mesh,
+                       .deviation = {},
+                       .groups = &groups,
+                       .order = r.order,
+                       .files = r.files});
   }
   progress.finish();
 
@@ -126,12 +156,13 @@ int run_simulate(const SimulateOptions& options) {
     std::string written;
     for (const std::string& path : {options.output, options.png, options.report, options.html})
       if (!path.empty()) written += (written.empty() ? " -> " : ", ") + path;
-    std::printf("%s: %lld segment%s in %zu direction%s, %d x %d x %d dexels; %.1f mm^3 left, %.1f mm^3 "
-                "removed, %zu triangles, %s%s; %.2f s\n",
-                input.program.filename().string().c_str(), segments, segments == 1 ? "" : "s", groups.size(),
-                groups.size() == 1 ? "" : "s", lattice.n.x,
-                lattice.n.y, lattice.n.z, volume, stock.volume - volume, mesh.triangles.size(),
-                check.closed() ? "watertight" : "NOT watertight", written.c_str(), total_s);
+    std::printf(
+        "%s: %lld segment%s in %zu direction%s, %d x %d x %d dexels; %.1f mm^3 left, %.1f mm^3 "
+        "removed, %zu triangles, %s%s; %.2f s\n",
+        input.program.filename().string().c_str(), segments, segments == 1 ? "" : "s",
+        groups.size(), groups.size() == 1 ? "" : "s", lattice.n.x, lattice.n.y, lattice.n.z, volume,
+        stock.volume - volume, mesh.triangles.size(),
+        check.closed() ? "watertight" : "NOT watertight", written.c_str(), total_s);
     std::printf("  %s\n", machining_time_text(r.machining).c_str());
   }
   return kSuccess;

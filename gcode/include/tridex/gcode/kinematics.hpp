@@ -36,10 +36,10 @@ namespace tridex::gcode {
 enum class MachineType { table_table, head_table, head_head };
 
 struct RotaryAxis {
-  char letter = 'A';          // 'A', 'B' or 'C'
-  bool on_head = false;       // false: on the table
-  Vec3 direction{1, 0, 0};    // unit; a positive position turns right-handed about it (sense applied)
-  Vec3 pivot{0.0};            // a point on the axis line, mm, every rotary at 0
+  char letter = 'A';        // 'A', 'B' or 'C'
+  bool on_head = false;     // false: on the table
+  Vec3 direction{1, 0, 0};  // unit; a positive position turns right-handed about it (sense applied)
+  Vec3 pivot{0.0};          // a point on the axis line, mm, every rotary at 0
   std::optional<std::array<double, 2>> limits;  // degrees [min, max]; none: turns without end
 };
 

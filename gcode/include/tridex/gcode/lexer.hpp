@@ -34,9 +34,9 @@
 namespace tridex::gcode {
 
 struct Word {
-  char letter = 0;     // 'A'..'Z' upper case, or LinuxCNC's polar '@' and '^'
-  double value = 0;    // finite, |value| <= kMaxWordValue
-  int column = 0;      // 1-based column of the letter
+  char letter = 0;   // 'A'..'Z' upper case, or LinuxCNC's polar '@' and '^'
+  double value = 0;  // finite, |value| <= kMaxWordValue
+  int column = 0;    // 1-based column of the letter
 };
 
 // Larger magnitudes are rejected as out of range: no coordinate, feed or code is near it, and it
@@ -72,8 +72,21 @@ struct Assignment {
 
 // LinuxCNC o-word keywords.
 enum class OKeyword : std::uint8_t {
-  sub, endsub, call, if_, elseif, else_, endif, while_, endwhile, do_, repeat, endrepeat,
-  break_, continue_, return_
+  sub,
+  endsub,
+  call,
+  if_,
+  elseif,
+  else_,
+  endif,
+  while_,
+  endwhile,
+  do_,
+  repeat,
+  endrepeat,
+  break_,
+  continue_,
+  return_
 };
 const char* to_string(OKeyword keyword);
 
@@ -87,10 +100,10 @@ enum class ControlKind : std::uint8_t {
 
 struct Control {
   ControlKind kind = ControlKind::none;
-  int column = 0;           // 1-based column of the statement
-  long long number = 0;     // jump: target N; while_loop / end_loop: the loop's m
-  bool condition = true;    // while_loop
-  std::string label;        // o_word: "100" or the name, lower case
+  int column = 0;         // 1-based column of the statement
+  long long number = 0;   // jump: target N; while_loop / end_loop: the loop's m
+  bool condition = true;  // while_loop
+  std::string label;      // o_word: "100" or the name, lower case
   OKeyword keyword = OKeyword::sub;
   std::string_view arguments;  // o_word: the text after the keyword (a view into the line)
   int arguments_column = 0;
@@ -135,10 +148,10 @@ bool evaluate_arguments(std::string_view text, int column, ParameterReader& para
 // What a line means for control flow, read without evaluating anything (for skipping over
 // branches, loop bodies and subroutine definitions, and for finding GOTO targets).
 struct Skim {
-  long long sequence = -1;       // its N number, if it starts with one
+  long long sequence = -1;               // its N number, if it starts with one
   ControlKind kind = ControlKind::none;  // o_word, while_loop (WHILE/DO) or end_loop (END)
-  long long number = 0;          // while_loop / end_loop: m
-  std::string label;             // o_word
+  long long number = 0;                  // while_loop / end_loop: m
+  std::string label;                     // o_word
   OKeyword keyword = OKeyword::sub;
 };
 void skim_line(std::string_view line, Skim& skim);

@@ -120,11 +120,7 @@ class MoveList {
 
     Iterator() = default;
     Iterator(List* list, std::size_t index) : list_(list) { seek(index); }
-    operator Iterator<true>() const
-      requires(!Const)
-    {
-      return Iterator<true>(list_, index_);
-    }
+    operator Iterator<true>() const requires(!Const) { return Iterator<true>(list_, index_); }
 
     reference operator*() const { return *at_; }
     pointer operator->() const { return at_; }
@@ -186,7 +182,8 @@ class MoveList {
 
   // The doubling chunks hold kFirstChunk · (2^k − 1) moves before chunk k.
   static constexpr std::size_t kDoublingChunks = std::bit_width(kMaxChunk / kFirstChunk);  // 9
-  static constexpr std::size_t kDoublingMoves = kFirstChunk * ((std::size_t{1} << kDoublingChunks) - 1);
+  static constexpr std::size_t kDoublingMoves =
+      kFirstChunk * ((std::size_t{1} << kDoublingChunks) - 1);
 
   static constexpr std::size_t chunk_size(std::size_t chunk) {
     return chunk < kDoublingChunks ? kFirstChunk << chunk : kMaxChunk;

@@ -43,11 +43,11 @@ bool available(DexelBackend backend);
 
 // Step 1: lowers `map` by every move (tips in the map's frame, move.cutter indexing `cutters`).
 // threads = 0: every hardware thread (the gl backend draws on one context and ignores it).
-void mill_with(ZMapBackend backend, ZMap& map, std::span<const Cutter> cutters, std::span<const CutMove> moves,
-               unsigned threads = 0);
+void mill_with(ZMapBackend backend, ZMap& map, std::span<const Cutter> cutters,
+               std::span<const CutMove> moves, unsigned threads = 0);
 
 // Steps 2–3: W0 ∩ M1 ∩ … ∩ MN on the stock's lattice, Mi the polyhedron of milled[i].
-TripleDexel machine_with(DexelBackend backend, const TripleDexel& stock, std::span<const ZMap> milled,
-                         unsigned threads = 0);
+TripleDexel machine_with(DexelBackend backend, const TripleDexel& stock,
+                         std::span<const ZMap> milled, unsigned threads = 0);
 
 }  // namespace tridex::backends

@@ -24,6 +24,7 @@ namespace tridex::backends {
 TripleDexel embree_dexelize(const ZMap& map, const DexelLattice& lattice, unsigned threads = 0);
 
 // W0 ∩ M1 ∩ … ∩ MN on the stock's lattice; one Embree scene alive at a time.
-TripleDexel embree_machine(const TripleDexel& stock, std::span<const ZMap> milled, unsigned threads = 0);
+TripleDexel embree_machine(const TripleDexel& stock, std::span<const ZMap> milled,
+                           unsigned threads = 0);
 
 }  // namespace tridex::backends
