@@ -94,12 +94,14 @@ def functions(text):
     found = []
     stack = []  # one entry per open brace: "scope" (namespace/class/extern), "function", "other"
     stmt_start = 0  # where the current statement at this scope began
+    continued = None  # where the last outermost function began, while a `{` may still extend it
     i, n = 0, len(src)
     while i < n:
         c = src[i]
         if c in ";":
             if not any(k == "function" for k, _ in stack):
                 stmt_start = i + 1
+                continued = None
         elif c == "{":
             if any(k == "function" for k, _ in stack) or (stack and stack[-1][0] == "other"):
                 stack.append(("other", i))
@@ -113,14 +115,19 @@ def functions(text):
                         kind = "other"
                 elif "(" in stmt_nt and not re.search(r"=\s*$", stmt_nt) and not CONTROL.search(stmt_nt.split("(")[0]):
                     kind = "function"
-                elif stmt_nt == "" and stack and stack[-1][0] == "scope":
-                    kind = "other"
-                stack.append((kind, i if kind != "function" else stmt_start))
+                start = stmt_start
+                if kind == "other" and continued is not None and re.fullmatch(r"[\s,]*(\w+\s*)?", stmt_nt):
+                    # a constructor's body after a brace-initialised member: `: a_{x} {`
+                    kind, start = "function", continued
+                stack.append((kind, start))
+                continued = None
             if stack[-1][0] == "scope":
                 stmt_start = i + 1
         elif c == "}":
             if stack:
                 kind, start = stack.pop()
+                if kind == "function" and not any(k == "function" for k, _ in stack):
+                    continued = start  # until the next `;`: a constructor's initialiser list may go on
                 if kind == "function":
                     first = src.count("\n", 0, start) + 1
                     # the declaration starts at its first non-blank character
