@@ -7,7 +7,7 @@
 
 #include "command_harness.hpp"
 #include "errors.hpp"
-#include "program_input.hpp"
+#include "inputs/program_input.hpp"
 #include "tridex/gcode/machine.hpp"
 
 using namespace tridex;

@@ -12,7 +12,7 @@
 #include "command_harness.hpp"
 #include "errors.hpp"
 #include "machining_time.hpp"
-#include "program_input.hpp"
+#include "inputs/program_input.hpp"
 #include "tridex/gcode/interpreter.hpp"
 #include "tridex/gcode/machine.hpp"
 
