@@ -69,8 +69,8 @@ void Interpreter::State::cutter_comp_codes(int code, int column) {
     return;
   }
   std::string name = code_name('G', code);
-  if (plane != kG17 && plane != kG18)
-    error(column, name + " in " + code_name('G', plane) +
+  if (modal.plane != kG17 && modal.plane != kG18)
+    error(column, name + " in " + code_name('G', modal.plane) +
                       ": cutter compensation works in the XY (G17) or XZ (G18) plane only");
   const bool was_on = comp.side != 0;
   if (was_on && (machine.dialect == Dialect::linuxcnc || code == kG41_1 || code == kG42_1))
@@ -184,7 +184,7 @@ void Interpreter::State::comp_move_endpoint_and_flush(const Vec2& to) {
     if (q.kind == CompMove::arc) {
       double r1 = glm::length(plane_uv(q.end) - q.centre), r2 = glm::length(to - q.centre);
       double l2 = find_turn(comp.endpoint, q.centre, q.turn, to);
-      if (std::abs(r1 - r2) > 0.01 * unit)
+      if (std::abs(r1 - r2) > 0.01 * modal.unit)
         error(motion_column, "cutter compensation made an arc with mismatched radii " +
                                  format_number(r1) + " and " + format_number(r2) + " (a bug)");
       if (q.original_sweep != 0.0 && comp.endpoint_valid &&
@@ -371,9 +371,9 @@ void Interpreter::State::comp_arc_entry(CompMove& move, bool ccw, bool inside,
   Vec3 current = to_program(pos);
   Vec2 c = plane_uv(current);
   ArcData a = arc_data(current, ccw);
-  if (feed_mode == FeedMode::inverse_time)
+  if (modal.feed_mode == FeedMode::inverse_time)
     inverse_time_rate(arc_length(current, a, ccw, move.extra_turns));
-  move.feed = feed;
+  move.feed = modal.feed;
   Vec2 end = plane_uv(a.end);
   if (glm::length(end - c) <= r)
     error(motion_column,
@@ -414,7 +414,7 @@ void Interpreter::State::comp_arc(bool ccw) {
   move.kind = CompMove::arc;
   move.move_kind = MoveKind::arc;
   move.line = line;
-  move.feed = feed;
+  move.feed = modal.feed;
   move.turn = turn;
   move.extra_turns = arc_extra_turns();
   const std::string too_small = "the tool radius " + format_number(r) +
@@ -431,9 +431,9 @@ void Interpreter::State::comp_arc(bool ccw) {
   }
   const Vec2 op = plane_uv(comp.programmed);
   const Vec2 c = plane_uv(comp.current);
-  if (feed_mode == FeedMode::inverse_time)
+  if (modal.feed_mode == FeedMode::inverse_time)
     inverse_time_rate(arc_length(comp.programmed, a, ccw, move.extra_turns));
-  move.feed = feed;
+  move.feed = modal.feed;
   const Vec2 centre = a.centre, end = plane_uv(a.end);
   double arc_radius = glm::length(centre - end);
   double theta = angle_of(c - op) + (side > 0 ? -kHalfPi : kHalfPi);

@@ -78,8 +78,8 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
     s.parameters.named_globals[name] = Value{value, false};
   if (auto it = s.offsets.find(1); it != s.offsets.end()) s.work_offset = it->second;
   s.world_origin = s.work_offset;
-  s.unit = s.machine.inch_at_start ? 25.4 : 1.0;
-  s.retract_to_r = s.machine.g99_at_start;
+  s.modal.unit = s.machine.inch_at_start ? 25.4 : 1.0;
+  s.modal.retract_to_r = s.machine.g99_at_start;
   s.update_frame();
   if (s.machine.start_position) {
     s.pos = *s.machine.start_position;

@@ -67,26 +67,26 @@ void Interpreter::State::feed_mode_codes() {
     FeedMode next = code == kG93   ? FeedMode::inverse_time
                     : code == kG94 ? FeedMode::per_minute
                                    : FeedMode::per_revolution;
-    bool clears = machine.dialect == Dialect::linuxcnc ? code != kG93 : next != feed_mode;
-    if (clears) feed = feed_per_rev = 0;
-    feed_mode = next;
+    bool clears = machine.dialect == Dialect::linuxcnc ? code != kG93 : next != modal.feed_mode;
+    if (clears) modal.feed = modal.feed_per_rev = 0;
+    modal.feed_mode = next;
   }
   if (w.has('F')) {
     if (w.value[static_cast<std::size_t>(letter_index('F'))] < 0)
       error(w.col('F'), "feed rate F must not be negative");
-    if (feed_mode == FeedMode::inverse_time)
-      inverse_time = w.take('F');
-    else if (feed_mode == FeedMode::per_revolution)
-      feed_per_rev = length('F');
+    if (modal.feed_mode == FeedMode::inverse_time)
+      modal.inverse_time = w.take('F');
+    else if (modal.feed_mode == FeedMode::per_revolution)
+      modal.feed_per_rev = length('F');
     else
-      feed = length('F');
+      modal.feed = length('F');
   }
   if (w.has('S')) {
     double s = w.take('S');
     if (s < 0) error(w.col('S'), "spindle speed S must not be negative");
-    speed = s;
+    modal.speed = s;
   }
-  if (feed_mode == FeedMode::per_revolution) feed = feed_per_rev * speed;
+  if (modal.feed_mode == FeedMode::per_revolution) modal.feed = modal.feed_per_rev * modal.speed;
 }
 
 // LinuxCNC's G10 L1 / L10 / L11 P<tool> (interp_convert.cc convert_setup_tool): set the tool
@@ -155,17 +155,18 @@ void Interpreter::State::tool_length_entry(long long l, int column) {
   if (radius) {
     comp.d_set_at[number] = name + " at line " + std::to_string(line);
     double& value = (l == 12 ? comp.d_geometry : comp.d_wear)[number];
-    value = (incremental ? value : 0) + length('R');
+    value = (modal.incremental ? value : 0) + length('R');
     return;
   }
   for (char c : {'X', 'Y', 'Z', 'A', 'B', 'C'})
     if (w.has(c)) error(w.col(c), name + " " + c + ": a tool length offset takes R only");
   double value = length('R');
   if (l == 10) {
-    tool_table.lengths[number] = (incremental ? length_geometry(number).value_or(0) : 0) + value;
+    tool_table.lengths[number] =
+        (modal.incremental ? length_geometry(number).value_or(0) : 0) + value;
   } else {
     double& wear = tool_table.wear[number];
-    wear = (incremental ? wear : 0) + value;
+    wear = (modal.incremental ? wear : 0) + value;
   }
 }
 
@@ -250,8 +251,8 @@ void Interpreter::State::units_codes() {
     int column = w.find_g(code);
     if (!column) continue;
     double next = code == kG20 ? 25.4 : 1.0;
-    if (next != unit) comp_forbid(column, "changing units");
-    unit = next;
+    if (next != modal.unit) comp_forbid(column, "changing units");
+    modal.unit = next;
   }
 }
 
@@ -284,9 +285,9 @@ void Interpreter::State::tool_change_codes() {
 }
 
 void Interpreter::State::spindle_codes() {
-  if (w.find_m(kM3)) spindle_direction = 1;
-  if (w.find_m(kM4)) spindle_direction = -1;
-  if (w.find_m(kM5)) spindle_direction = 0;
+  if (w.find_m(kM3)) modal.spindle_direction = 1;
+  if (w.find_m(kM4)) modal.spindle_direction = -1;
+  if (w.find_m(kM5)) modal.spindle_direction = 0;
 }
 
 // G4: dwell P (seconds or ms) or, on Fanuc, X.
@@ -304,17 +305,17 @@ void Interpreter::State::dwell_code(const BlockCodes& codes) {
 void Interpreter::State::plane_codes() {
   for (int code : {kG17, kG18, kG19})
     if (int column = w.find_g(code)) {
-      if (code != plane) comp_forbid(column, "changing the plane");
-      plane = code;
+      if (code != modal.plane) comp_forbid(column, "changing the plane");
+      modal.plane = code;
     }
 }
 
 // G90/G91 (coordinates), G90.1/G91.1 (arc centres).
 void Interpreter::State::distance_mode_codes() {
-  if (w.find_g(kG90)) incremental = false;
-  if (w.find_g(kG91)) incremental = true;
-  if (w.find_g(kG90_1)) arc_absolute = true;
-  if (w.find_g(kG91_1)) arc_absolute = false;
+  if (w.find_g(kG90)) modal.incremental = false;
+  if (w.find_g(kG91)) modal.incremental = true;
+  if (w.find_g(kG90_1)) modal.arc_absolute = true;
+  if (w.find_g(kG91_1)) modal.arc_absolute = false;
 }
 
 // Look-ahead and smoothing modes change how the control follows the path, not the path: their
@@ -337,8 +338,8 @@ void Interpreter::State::smoothing_codes(const BlockCodes& codes) {
 }
 
 void Interpreter::State::return_mode_codes() {
-  if (w.find_g(kG98)) retract_to_r = false;
-  if (w.find_g(kG99)) retract_to_r = true;
+  if (w.find_g(kG98)) modal.retract_to_r = false;
+  if (w.find_g(kG99)) modal.retract_to_r = true;
 }
 
 // The work coordinate system: G54-G59, G54.1 P, Haas's G154 P.
@@ -416,7 +417,7 @@ void Interpreter::State::work_offset_entry(long long l, int column) {
     if (key == MachineConfig::g54_1_key(0)) key = 0;
   }
   if (key == 0) key = work_key;
-  if (incremental)
+  if (modal.incremental)
     error(column, "G10 under G91 is read differently by different controls; use G90");
   Vec3 value = offsets.count(key) ? offsets[key] : Vec3(0.0);
   bool relative_to_position = linuxcnc && l == 20;
@@ -461,12 +462,13 @@ void Interpreter::State::motion_mode_codes(const BlockCodes& codes) {
     error(motion_column,
           code_name('G', motion_code) + " in a block whose X/Y/Z belong to another code");
   if (motion_code == kG80 || !is_cycle(motion_code)) canned.active = false;
-  if (is_cycle(motion_code) && motion != motion_code) canned.active = false;
-  if (motion == kG5_2 && motion_code != kG5_2 && !splines.nurbs_points.empty())
+  if (is_cycle(motion_code) && modal.motion != motion_code) canned.active = false;
+  if (modal.motion == kG5_2 && motion_code != kG5_2 && !splines.nurbs_points.empty())
     warn(motion_column, "the G5.2 control points before this " + code_name('G', motion_code) +
                             " are dropped: no G5.3 ended them (LinuxCNC drops them too)");
-  if (motion_code == kG5_2 && motion != kG5_2) splines.nurbs_points.clear();  // a new curve starts
-  motion = motion_code;
+  if (motion_code == kG5_2 && modal.motion != kG5_2)
+    splines.nurbs_points.clear();  // a new curve starts
+  modal.motion = motion_code;
 }
 
 // The words beside X Y Z that a move reads: LinuxCNC's polar @ ^, the rotary A B C, U V W.
@@ -502,8 +504,8 @@ void Interpreter::State::block_move(const BlockCodes& codes) {
 // G53 X Y Z: a move in machine coordinates, under G0 or G1.
 void Interpreter::State::machine_coordinate_move() {
   comp_forbid(w.find_g(kG53), "G53");
-  if (motion != kG0 && motion != kG1) error(motion_column, "G53 needs G0 or G1 modal");
-  if (motion == kG1) require_feed();
+  if (modal.motion != kG0 && modal.motion != kG1) error(motion_column, "G53 needs G0 or G1 modal");
+  if (modal.motion == kG1) require_feed();
   Vec3 target(0.0);
   unsigned mask = 0;
   for (int i = 0; i < 3; ++i)
@@ -512,33 +514,35 @@ void Interpreter::State::machine_coordinate_move() {
       mask |= 1u << i;
     }
   if (mask)
-    machine_move(target, mask, motion == kG0 ? MoveKind::rapid : MoveKind::feed,
-                 motion == kG0 ? 0.0 : feed);
+    machine_move(target, mask, modal.motion == kG0 ? MoveKind::rapid : MoveKind::feed,
+                 modal.motion == kG0 ? 0.0 : modal.feed);
 }
 
 // The active motion mode's move, where the block gives it something to do: axis words, or a
 // motion code (`new_code`) or the words its mode reads without coordinates.
 void Interpreter::State::motion_mode_move(bool new_code) {
   bool axes = has_axis_words();
-  if (motion == kG0 || motion == kG1) {
+  if (modal.motion == kG0 || modal.motion == kG1) {
     if (axes) {
-      if (motion == kG1) require_feed();
-      linear(motion == kG0 ? MoveKind::rapid : MoveKind::feed, motion == kG0 ? 0.0 : feed);
+      if (modal.motion == kG1) require_feed();
+      linear(modal.motion == kG0 ? MoveKind::rapid : MoveKind::feed,
+             modal.motion == kG0 ? 0.0 : modal.feed);
     }
-  } else if (motion == kG2 || motion == kG3) {
-    char cu = kCenterLetter[plane_axes(plane)[0]], cv = kCenterLetter[plane_axes(plane)[1]];
-    if (axes || new_code || w.has(cu) || w.has(cv) || w.has('R')) arc(motion == kG3);
-  } else if (motion >= kG38_2 && motion <= kG38_5) {
-    if (axes || new_code) probe(motion);
-  } else if (motion == kG5 || motion == kG5_1) {
+  } else if (modal.motion == kG2 || modal.motion == kG3) {
+    char cu = kCenterLetter[plane_axes(modal.plane)[0]],
+         cv = kCenterLetter[plane_axes(modal.plane)[1]];
+    if (axes || new_code || w.has(cu) || w.has(cv) || w.has('R')) arc(modal.motion == kG3);
+  } else if (modal.motion >= kG38_2 && modal.motion <= kG38_5) {
+    if (axes || new_code) probe(modal.motion);
+  } else if (modal.motion == kG5 || modal.motion == kG5_1) {
     if (axes || new_code || w.has('I') || w.has('J') || w.has('P') || w.has('Q'))
-      spline(motion == kG5_1);
-  } else if (motion == kG5_2) {
+      spline(modal.motion == kG5_1);
+  } else if (modal.motion == kG5_2) {
     if (axes || new_code || w.has('P') || w.has('L')) nurbs_point();
-  } else if (is_cycle(motion)) {
+  } else if (is_cycle(modal.motion)) {
     if (axes || new_code || w.has('R')) {
       comp_forbid(motion_column, "a canned cycle");
-      cycle(motion);
+      cycle(modal.motion);
     }
   } else if (axes) {
     error(motion_column,

@@ -52,8 +52,8 @@ Interpreter::State::Target Interpreter::State::axis_word_target(const Vec3& curr
     char c = kAxisLetter[i];
     if (!w.has(c)) continue;
     double v = length(c);
-    t.point[i] = incremental ? current[i] + v : v;
-    t.set[static_cast<std::size_t>(i)] = !incremental;
+    t.point[i] = modal.incremental ? current[i] + v : v;
+    t.set[static_cast<std::size_t>(i)] = !modal.incremental;
   }
   return t;
 }
@@ -64,9 +64,9 @@ void Interpreter::State::linear(MoveKind kind, double move_feed) {
   Vec3 current = comp.programmed_current ? comp.programmed : to_program(pos);
   const auto [target, set] = axis_word_target(current);
   comp.programmed_current = false;
-  if (kind == MoveKind::feed && feed_mode == FeedMode::inverse_time) {
+  if (kind == MoveKind::feed && modal.feed_mode == FeedMode::inverse_time) {
     inverse_time_rate(glm::length(target - current));
-    move_feed = feed;
+    move_feed = modal.feed;
   }
   if (comp_active()) {
     comp_straight(kind, target, move_feed);
@@ -77,22 +77,23 @@ void Interpreter::State::linear(MoveKind kind, double move_feed) {
 }
 
 void Interpreter::State::require_feed() {
-  if (feed_mode == FeedMode::inverse_time) {  // LinuxCNC's checks (interp_convert.cc)
+  if (modal.feed_mode == FeedMode::inverse_time) {  // LinuxCNC's checks (interp_convert.cc)
     if (!w.has('F'))
       error(motion_column,
             "F word missing with inverse time (G93) feed move: every G1, G2 and G3 "
             "block needs its own F");
-    if (!(inverse_time > 0)) error(w.col('F'), "inverse time (G93) F0: the move would never end");
+    if (!(modal.inverse_time > 0))
+      error(w.col('F'), "inverse time (G93) F0: the move would never end");
     return;
   }
-  if (feed_mode == FeedMode::per_revolution) {
-    if (!(feed_per_rev > 0))
+  if (modal.feed_mode == FeedMode::per_revolution) {
+    if (!(modal.feed_per_rev > 0))
       error(motion_column, "feed move with no feed per revolution (F) set (G95)");
-    if (!(speed > 0))
+    if (!(modal.speed > 0))
       error(motion_column, "cannot feed with zero spindle speed in feed per revolution mode (G95)");
     return;
   }
-  if (!(feed > 0)) {
+  if (!(modal.feed > 0)) {
     std::string left_out;
     if (w.vacant_words)
       for (const std::string& word : *w.vacant_words)
@@ -108,14 +109,14 @@ void Interpreter::State::require_feed() {
 // and _arc measure it) takes 1/F minutes, so it runs at length × F mm/min. A block that does not
 // move takes no time at any rate; LinuxCNC gives it 0.1 units/min.
 void Interpreter::State::inverse_time_rate(double length) {
-  feed = length > 0 ? length * inverse_time : 0.1 * unit;
+  modal.feed = length > 0 ? length * modal.inverse_time : 0.1 * modal.unit;
 }
 
 // The length of the arc (a helix along the plane normal) from `start` (program frame) that
 // arc_data found, as LinuxCNC's find_arc_length: the start radius times the sweep, and the rise.
 double Interpreter::State::arc_length(const Vec3& start, const ArcData& a, bool ccw,
                                       int extra_turns) const {
-  const std::array<int, 3> axes = plane_axes(plane);
+  const std::array<int, 3> axes = plane_axes(modal.plane);
   double radius = glm::length(a.centre - Vec2(start[axes[0]], start[axes[1]]));
   double sweep = arc_sweep(start, a.end, a.centre, ccw) + 2 * kPi * extra_turns;
   return std::hypot(radius * sweep, a.end[axes[2]] - start[axes[2]]);
@@ -155,7 +156,7 @@ void Interpreter::State::arc(bool ccw) {
         error(w.col(c),
               "arc from a retracted position that also moves along the tool axis: the "
               "tool is far along its axis and its start is unknown; position it first");
-      target[i] = incremental ? target[i] + length(c) : length(c);
+      target[i] = modal.incremental ? target[i] + length(c) : length(c);
     }
     for (char c : {'I', 'J', 'K', 'R'})
       if (w.has(c)) w.take(c);
@@ -167,22 +168,22 @@ void Interpreter::State::arc(bool ccw) {
   Vec3 start = to_program(pos);
   ArcData a = arc_data(start, ccw);
   const int extra_turns = arc_extra_turns();
-  if (feed_mode == FeedMode::inverse_time)
+  if (modal.feed_mode == FeedMode::inverse_time)
     inverse_time_rate(arc_length(start, a, ccw, extra_turns));
   arc_chords(start, a.end, a.centre, ccw,
-             arc_sweep(start, a.end, a.centre, ccw) + 2 * kPi * extra_turns, feed);
+             arc_sweep(start, a.end, a.centre, ccw) + 2 * kPi * extra_turns, modal.feed);
   pos = to_machine(a.end);
 }
 
 // The end point and centre of the G2/G3 of this block from `start` (program frame), with
 // RS274/NGC's checks: I/J/K or R, radii that agree, a radius long enough for its chord.
 Interpreter::State::ArcData Interpreter::State::arc_data(const Vec3& start, bool ccw) {
-  const std::array<int, 3> axes = plane_axes(plane);
+  const std::array<int, 3> axes = plane_axes(modal.plane);
   const int u = axes[0], v = axes[1];
   Vec3 end = start;
   for (int i = 0; i < 3; ++i) {
     char c = kAxisLetter[i];
-    if (w.has(c)) end[i] = incremental ? start[i] + length(c) : length(c);
+    if (w.has(c)) end[i] = modal.incremental ? start[i] + length(c) : length(c);
   }
   char cu = kCenterLetter[u], cv = kCenterLetter[v];
   bool has_center = w.has(cu) || w.has(cv);
@@ -190,13 +191,13 @@ Interpreter::State::ArcData Interpreter::State::arc_data(const Vec3& start, bool
   if (has_center && has_radius)
     error(w.col('R'), "arc with both R and " + std::string(1, cu) + "/" + cv + " words");
   if (!has_center && !has_radius)
-    error(motion_column,
-          std::string("arc needs ") + cu + "/" + cv + " (in " + code_name('G', plane) + ") or R");
+    error(motion_column, std::string("arc needs ") + cu + "/" + cv + " (in " +
+                             code_name('G', modal.plane) + ") or R");
   Vec2 s(start[u], start[v]), e(end[u], end[v]), c;
   ArcData result;
   result.end = end;
   if (has_center) {
-    if (arc_absolute) {
+    if (modal.arc_absolute) {
       if (!w.has(cu) || !w.has(cv))
         error(motion_column, std::string("arc centre under G90.1 needs both ") + cu + " and " + cv);
       c = Vec2(length(cu), length(cv));
@@ -211,7 +212,7 @@ Interpreter::State::ArcData Interpreter::State::arc_data(const Vec3& start, bool
     if (machine.dialect == Dialect::linuxcnc) {
       // LinuxCNC 2.9 (interp_arc.cc arc_data_ijk) cuts a spiral where the radii differ by up to
       // 0.002·√2 in (0.02·√2 mm under G21), or by 100 times that within 0.1 % of the radius.
-      double spiral = (unit == 1.0 ? 0.02 : 0.002 * 25.4) * std::numbers::sqrt2;
+      double spiral = (modal.unit == 1.0 ? 0.02 : 0.002 * 25.4) * std::numbers::sqrt2;
       if (err > 100 * spiral || (err / std::max(r0, r1) > 0.001 && err > spiral))
         error(motion_column, "arc end radius " + format_number(r1) + " differs from start radius " +
                                  format_number(r0) + " by more than LinuxCNC's spiral tolerance (" +
@@ -247,7 +248,7 @@ Interpreter::State::ArcData Interpreter::State::arc_data(const Vec3& start, bool
 // (0, 2π], a full circle when the two points coincide.
 double Interpreter::State::arc_sweep(const Vec3& start, const Vec3& end, const Vec2& c,
                                      bool ccw) const {
-  const std::array<int, 3> axes = plane_axes(plane);
+  const std::array<int, 3> axes = plane_axes(modal.plane);
   const int u = axes[0], v = axes[1];
   Vec2 s(start[u], start[v]), e(end[u], end[v]);
   double a0 = std::atan2(s.y - c.y, s.x - c.x);
@@ -264,7 +265,7 @@ double Interpreter::State::arc_sweep(const Vec3& start, const Vec3& end, const V
 // change linearly (helices, and I/J/K arcs whose end radius differs slightly).
 void Interpreter::State::arc_chords(const Vec3& start, const Vec3& end, const Vec2& c, bool ccw,
                                     double sweep, double move_feed) {
-  const std::array<int, 3> axes = plane_axes(plane);
+  const std::array<int, 3> axes = plane_axes(modal.plane);
   const int u = axes[0], v = axes[1], n = axes[2];
   Vec2 s(start[u], start[v]), e(end[u], end[v]);
   double r0 = glm::length(s - c), r1 = glm::length(e - c);
@@ -309,9 +310,9 @@ void Interpreter::State::probe(int code) {
   const std::string name = code_name('G', code);
   if (comp.side != 0)
     error(motion_column, name + ": cannot probe with cutter radius compensation on");
-  if (feed_mode == FeedMode::per_revolution)
+  if (modal.feed_mode == FeedMode::per_revolution)
     error(motion_column, name + ": cannot probe in feed per revolution mode (G95)");
-  if (!(feed > 0)) error(motion_column, name + ": cannot probe with zero feed rate");
+  if (!(modal.feed > 0)) error(motion_column, name + ": cannot probe with zero feed rate");
   Vec3 current = comp.programmed_current ? comp.programmed : to_program(pos);
   const auto [target, set] = axis_word_target(current);
   comp.programmed_current = false;
@@ -326,13 +327,13 @@ void Interpreter::State::probe(int code) {
                             "programmed point and backs off 0.254 mm; where it really touches is "
                             "known only on the machine");
   }
-  move_to(target, set, rotation, origin, MoveKind::feed, feed);
-  for (int i = 0; i < 3; ++i) parameters.globals[5061 + i] = Value{target[i] / unit, false};
+  move_to(target, set, rotation, origin, MoveKind::feed, modal.feed);
+  for (int i = 0; i < 3; ++i) parameters.globals[5061 + i] = Value{target[i] / modal.unit, false};
   parameters.globals[5070] = Value{0, false};
   double distance = glm::length(target - current);
   if (far || !(distance > 0)) return;
   Vec3 back = to_machine(target + 0.254 * (current - target) / distance);
-  emit(MoveKind::feed, pos, back, feed);
+  emit(MoveKind::feed, pos, back, modal.feed);
   pos = back;
 }
 
@@ -347,11 +348,11 @@ bool cycle_dwells(int code) {
 // A canned cycle's block: its sticky words, the levels along its axis, then each hole (L or K
 // repeats) in turn.
 void Interpreter::State::cycle(int code) {
-  const std::array<int, 3> axes = plane_axes(plane);
+  const std::array<int, 3> axes = plane_axes(modal.plane);
   const int u = axes[0], v = axes[1], n = axes[2];
   Vec3 drill = rotation[n];  // cycle axis in machine coordinates
   if (glm::dot(drill, axis) < 1 - 1e-9)
-    error(motion_column, code_name('G', code) + " drills along the " + code_name('G', plane) +
+    error(motion_column, code_name('G', code) + " drills along the " + code_name('G', modal.plane) +
                              " plane normal, which is not the spindle direction");
   const long long repeats = cycle_words(code, kAxisLetter[n]);
 
@@ -361,8 +362,8 @@ void Interpreter::State::cycle(int code) {
   // Lateral target of the first hole; increments repeat under G91.
   double du = w.has(kAxisLetter[u]) ? length(kAxisLetter[u]) : 0.0;
   double dv = w.has(kAxisLetter[v]) ? length(kAxisLetter[v]) : 0.0;
-  double hole_u = incremental ? current[u] : (w.has(kAxisLetter[u]) ? du : current[u]);
-  double hole_v = incremental ? current[v] : (w.has(kAxisLetter[v]) ? dv : current[v]);
+  double hole_u = modal.incremental ? current[u] : (w.has(kAxisLetter[u]) ? du : current[u]);
+  double hole_v = modal.incremental ? current[v] : (w.has(kAxisLetter[v]) ? dv : current[v]);
   // LinuxCNC's polar words under G91 (polar_words() left them): each repeat moves the hole out
   // by @ and turns it by ^ about the program origin (CYCLE_MACRO, interp_cycles.cc).
   double step_radius = w.has('@') ? length('@') : 0.0;
@@ -371,7 +372,7 @@ void Interpreter::State::cycle(int code) {
   if (!far && current[n] < levels.r_level - 1e-9)
     cycle_rapid(cycle_point(current[u], current[v], levels.r_level));
   for (long long k = 0; k < repeats; ++k) {
-    if (incremental) {
+    if (modal.incremental) {
       hole_u += du;
       hole_v += dv;
     }
@@ -414,7 +415,7 @@ long long Interpreter::State::cycle_words(int code, char depth_letter) {
     if (p < 0) error(w.col('P'), "dwell P must not be negative");
     canned.dwell = dwell_seconds(p);
   }
-  if (feed_mode == FeedMode::inverse_time)
+  if (modal.feed_mode == FeedMode::inverse_time)
     error(motion_column, code_name('G', code) +
                              ": canned cycles cannot run in inverse time feed "
                              "(G93), as LinuxCNC requires; G94 first");
@@ -440,13 +441,13 @@ Interpreter::State::CycleLevels Interpreter::State::cycle_levels(int code, doubl
     canned.initial_far = far;
     canned.initial = current;
   }
-  if (far && incremental)
+  if (far && modal.incremental)
     error(motion_column, "incremental canned cycle from a retracted (far) position");
   // G91: R counts from the initial level of the cycle (kept while the cycle mode lasts, as
   // LinuxCNC's cycle_il and Fanuc's initial point), not from where the last hole left the tool.
   double incremental_base = canned.initial_far ? current : canned.initial;
-  double r_level = incremental ? incremental_base + canned.r : canned.r;
-  double bottom = incremental ? r_level + canned.z : canned.z;
+  double r_level = modal.incremental ? incremental_base + canned.r : canned.r;
+  double bottom = modal.incremental ? r_level + canned.z : canned.z;
   if (bottom > r_level)
     error(motion_column, "hole bottom " + format_number(bottom) + " is above the R plane " +
                              format_number(r_level));
@@ -461,15 +462,15 @@ Interpreter::State::CycleLevels Interpreter::State::cycle_levels(int code, doubl
                                format_number(bottom) + " by Q " + format_number(canned.q) +
                                "); at most 100000 per hole");
   }
-  bool clear_far = !retract_to_r && canned.initial_far;
-  double clear = retract_to_r ? r_level : std::max(canned.initial, r_level);
+  bool clear_far = !modal.retract_to_r && canned.initial_far;
+  double clear = modal.retract_to_r ? r_level : std::max(canned.initial, r_level);
   if (clear_far) clear = r_level;
   return CycleLevels{r_level, bottom, clear, clear_far};
 }
 
 // A point of the cycle: (u, v) in the plane and `depth` along its normal, program frame.
 Vec3 Interpreter::State::cycle_point(double u_coordinate, double v_coordinate, double depth) const {
-  const std::array<int, 3> axes = plane_axes(plane);
+  const std::array<int, 3> axes = plane_axes(modal.plane);
   Vec3 p;
   p[axes[0]] = u_coordinate;
   p[axes[1]] = v_coordinate;
@@ -483,7 +484,7 @@ void Interpreter::State::cycle_rapid(const Vec3& to) {
 }
 
 void Interpreter::State::cycle_cut(const Vec3& to) {
-  emit(MoveKind::cycle, pos, to, feed);
+  emit(MoveKind::cycle, pos, to, modal.feed);
   pos = to;
 }
 
@@ -491,7 +492,7 @@ void Interpreter::State::cycle_cut(const Vec3& to) {
 // level.
 void Interpreter::State::cycle_hole(int code, double hole_u, double hole_v,
                                     const CycleLevels& levels) {
-  const int n = plane_axes(plane)[2];
+  const int n = plane_axes(modal.plane)[2];
   const double r_level = levels.r_level, bottom = levels.bottom, clear = levels.clear;
   const bool clear_far = levels.clear_far;
   auto at = [&](double uu, double vv, double depth) { return cycle_point(uu, vv, depth); };
@@ -560,22 +561,22 @@ void Interpreter::State::polar_words(bool axis_consumer, int nonmodal) {
   if (machine.dialect != Dialect::linuxcnc)
     error(column, "'@' and '^' (polar coordinates) are LinuxCNC's words: use --machine linuxcnc");
   if (nonmodal == kG53) error(column, "polar coordinates cannot be used with G53");
-  bool moving =
-      motion == kG0 || motion == kG1 || motion == kG2 || motion == kG3 || is_cycle(motion);
+  bool moving = modal.motion == kG0 || modal.motion == kG1 || modal.motion == kG2 ||
+                modal.motion == kG3 || is_cycle(modal.motion);
   if (axis_consumer || nonmodal == kG28 || nonmodal == kG30 || !moving)
     error(column, "polar coordinates can only be used for motion (G0, G1, G2, G3 or a cycle)");
-  if (plane != kG17) error(column, "polar coordinates need the XY plane (G17)");
+  if (modal.plane != kG17) error(column, "polar coordinates need the XY plane (G17)");
   for (char c : {'X', 'Y'})
     if (w.has(c))
       error(w.col(c), std::string("polar coordinates and an ") + c + " word in the same block");
-  bool cycle_block = is_cycle(motion);
-  if (cycle_block && incremental) return;  // a step of every repeat: cycle() reads the words
-  Vec3 current = (comp.programmed_current ? comp.programmed : to_program(pos)) / unit;
+  bool cycle_block = is_cycle(modal.motion);
+  if (cycle_block && modal.incremental) return;  // a step of every repeat: cycle() reads the words
+  Vec3 current = (comp.programmed_current ? comp.programmed : to_program(pos)) / modal.unit;
   double x = current.x, y = current.y;
   bool has_radius = w.has('@'), has_angle = w.has('^');
   double radius = has_radius ? w.take('@') : 0, angle = has_angle ? glm::radians(w.take('^')) : 0;
   bool at_origin = x == 0 && y == 0;
-  if (!incremental) {
+  if (!modal.incremental) {
     if (!has_angle && at_origin && !cycle_block)
       error(column, "polar radius without an angle at the origin: the direction is unknown");
     if (!has_radius) radius = std::hypot(x, y);
@@ -591,7 +592,8 @@ void Interpreter::State::polar_words(bool axis_consumer, int nonmodal) {
   for (char c : {'X', 'Y'}) {
     std::size_t i = static_cast<std::size_t>(letter_index(c));
     w.present |= 1u << i;
-    w.value[i] = c == 'X' ? (incremental ? new_x - x : new_x) : (incremental ? new_y - y : new_y);
+    w.value[i] = c == 'X' ? (modal.incremental ? new_x - x : new_x)
+                          : (modal.incremental ? new_y - y : new_y);
     w.column[i] = column;
   }
 }
@@ -624,9 +626,9 @@ void Interpreter::State::machine_move(const Vec3& gauge, unsigned mask, MoveKind
     error(motion_column,
           "G53 X/Y with a tilted tool depends on the machine's kinematics; "
           "retract with G53 Z (or G28) first");
-  if (kind == MoveKind::feed && feed_mode == FeedMode::inverse_time) {
+  if (kind == MoveKind::feed && modal.feed_mode == FeedMode::inverse_time) {
     inverse_time_rate(glm::length(end - pos));
-    move_feed = feed;
+    move_feed = modal.feed;
   }
   emit(kind, pos, end, move_feed);
   pos = end;

@@ -15,9 +15,9 @@ namespace tridex::gcode {
 // DWO on and off. G43.5 I J K gives the tool direction on the part directly.
 void Interpreter::State::tool_center_codes() {
   bool was_tcp = tcp, was_dwo = dwo;
-  if (w.find_g(430) || w.find_g(440) || w.find_g(490)) tcp = false;
-  if (w.find_g(434)) tcp = true;
-  if (int column = w.find_g(435)) {
+  if (w.find_g(kG43) || w.find_g(kG44) || w.find_g(kG49)) tcp = false;
+  if (w.find_g(kG43_4)) tcp = true;
+  if (int column = w.find_g(kG43_5)) {
     tcp = true;
     if (w.has('I') || w.has('J') || w.has('K')) {
       Vec3 direction(w.has('I') ? w.take('I') : 0.0, w.has('J') ? w.take('J') : 0.0,
@@ -36,8 +36,8 @@ void Interpreter::State::tool_center_codes() {
       axis = direction;
     }
   }
-  if (w.find_g(2540)) dwo = true;
-  if (w.find_g(2550)) dwo = false;
+  if (w.find_g(kG254)) dwo = true;
+  if (w.find_g(kG255)) dwo = false;
   if (tcp != was_tcp || dwo != was_dwo) update_frame();  // the tip stays where it is on the part
 }
 
@@ -61,12 +61,13 @@ void Interpreter::State::extra_linear_words(bool track) {
     char c = "UVW"[i];
     if (!w.has(c)) continue;
     double v = length(c);
-    if (track) uvw_position[i] = incremental ? uvw_position[i] + v : v;
+    if (track) uvw_position[i] = modal.incremental ? uvw_position[i] + v : v;
   }
   if (!warned_uvw) {
     warned_uvw = true;
-    warn(first, "U/V/W read as plain axes, as LinuxCNC does on a machine that has them: they do not move "
-                "the tool tridex simulates");
+    warn(first,
+         "U/V/W read as plain axes, as LinuxCNC does on a machine that has them: they do not move "
+         "the tool tridex simulates");
   }
 }
 
@@ -85,13 +86,14 @@ void Interpreter::State::rotary_words() {
       if (w.has(c) && !((w.used >> letter_index(c)) & 1u)) w.take(c);
     if (!warned_plain_rotary) {
       warned_plain_rotary = true;
-      warn(first, "A/B/C read as plain axes, as LinuxCNC does on a machine without kinematics: the "
-                  "tool does not tilt (give the machine file \"kinematics\" to simulate them)");
+      warn(first,
+           "A/B/C read as plain axes, as LinuxCNC does on a machine without kinematics: the "
+           "tool does not tilt (give the machine file \"kinematics\" to simulate them)");
     }
     return;
   }
   const Kinematics& kin = *machine.kinematics;
-  if (motion != 0 && motion != 10)
+  if (modal.motion != kG0 && modal.motion != kG1)
     error(first, "A/B/C words need G0 or G1 (a rotary word on an arc or a cycle is a 5-axis move)");
   RotaryPositions next = rotary_position;
   for (char c : {'A', 'B', 'C'}) {
@@ -99,28 +101,32 @@ void Interpreter::State::rotary_words() {
     const RotaryAxis* a = kin.find(c);
     if (!a) {
       std::string letters;
-      for (const RotaryAxis& x : kin.axes) letters += (letters.empty() ? "" : ", ") + std::string(1, x.letter);
-      error(w.col(c), std::string("rotary word ") + c + format_number(w.value[static_cast<std::size_t>(letter_index(c))]) +
+      for (const RotaryAxis& x : kin.axes)
+        letters += (letters.empty() ? "" : ", ") + std::string(1, x.letter);
+      error(w.col(c), std::string("rotary word ") + c +
+                          format_number(w.value[static_cast<std::size_t>(letter_index(c))]) +
                           ": the machine has no " + c + " axis (its rotary axes: " + letters + ")");
     }
     double v = w.take(c);
     std::size_t i = static_cast<std::size_t>(rotary_index(c));
-    next[i] = incremental ? rotary_position[i] + v : v;
+    next[i] = modal.incremental ? rotary_position[i] + v : v;
     if (a->limits && (next[i] < (*a->limits)[0] || next[i] > (*a->limits)[1]))
-      error(w.col(c), std::string("rotary position ") + c + format_number(next[i]) + " is outside the " +
-                          c + " axis's limits [" + format_number((*a->limits)[0]) + ", " +
-                          format_number((*a->limits)[1]) + "] (machine file)");
+      error(w.col(c), std::string("rotary position ") + c + format_number(next[i]) +
+                          " is outside the " + c + " axis's limits [" +
+                          format_number((*a->limits)[0]) + ", " + format_number((*a->limits)[1]) +
+                          "] (machine file)");
   }
   if (next == rotary_position) return;
-  const bool cut = motion == 10;
-  const std::string message = "rotary motion during a cut (G1 turning A/B/C: simultaneous 5-axis) is "
-                              "outside 3+2";
+  const bool cut = modal.motion == kG1;
+  const std::string message =
+      "rotary motion during a cut (G1 turning A/B/C: simultaneous 5-axis) is "
+      "outside 3+2";
   if (cut && !options.lenient) error(first, message + "; index with G0 first");
   set_rotary(next);
   if (cut)  // lenient: said on the line and counted per direction for the run's summary
     lenient_read(first,
-                 message + "; read as indexed at its end orientation, direction " + direction_text(axis) +
-                     " (lenient mode)",
+                 message + "; read as indexed at its end orientation, direction " +
+                     direction_text(axis) + " (lenient mode)",
                  "rotary motion during a cut read as indexed along " + direction_text(axis));
   if (!cut && (tilted || tcp || dwo)) go_far();
 }

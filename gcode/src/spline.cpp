@@ -109,10 +109,11 @@ void Interpreter::State::spline(bool quadratic) {
                              " with cutter radius compensation on: LinuxCNC refuses "
                              "it (G40 first)");
   require_feed();
-  if (feed_mode == FeedMode::inverse_time)  // its length is known only once its biarcs are made
+  if (modal.feed_mode ==
+      FeedMode::inverse_time)  // its length is known only once its biarcs are made
     error(motion_column,
           std::string(name) + " in inverse time feed (G93) is not supported: G94 first");
-  if (plane != kG17)
+  if (modal.plane != kG17)
     error(motion_column, std::string(name) + " is a spline in the XY plane only (G17)");
   for (char c : {'Z', 'A', 'B', 'C'})
     if (w.has(c))
@@ -134,12 +135,12 @@ void Interpreter::State::spline(bool quadratic) {
             "previous G5's end)");
     first = Vec2(length('I'), length('J'));
   } else {
-    first = splines.mirror * unit;
+    first = splines.mirror * modal.unit;
   }
   Vec3 end = start;
   for (int i = 0; i < 2; ++i) {
     char c = kAxisLetter[i];
-    if (w.has(c)) end[i] = incremental ? start[i] + length(c) : length(c);
+    if (w.has(c)) end[i] = modal.incremental ? start[i] + length(c) : length(c);
   }
   control[1].p = control[0].p + first;
   if (quadratic) {
@@ -147,7 +148,7 @@ void Interpreter::State::spline(bool quadratic) {
   } else {
     if (!w.has('P') || !w.has('Q')) error(motion_column, "G5 needs both P and Q (the end tangent)");
     double p = w.take('P'), q = w.take('Q');
-    control[2].p = Vec2(end) + Vec2(p, q) * unit;
+    control[2].p = Vec2(end) + Vec2(p, q) * modal.unit;
     control[3].p = Vec2(end);
     splines.mirror = Vec2(-p, -q);
   }
@@ -171,7 +172,7 @@ void Interpreter::State::nurbs_point() {
   if (comp.side != 0)
     error(motion_column,
           "G5.2 with cutter radius compensation on: its curve is not offset (G40 first)");
-  if (plane != kG17) error(motion_column, "G5.2 is a NURBS in the XY plane only (G17)");
+  if (modal.plane != kG17) error(motion_column, "G5.2 is a NURBS in the XY plane only (G17)");
   for (char c : {'Z', 'A', 'B', 'C'})
     if (w.has(c))
       error(w.col(c), std::string("G5.2 may not move ") + c + " (its control points are in XY)");
@@ -201,14 +202,14 @@ void Interpreter::State::nurbs_point() {
   if (!w.has('P')) error(motion_column, "a G5.2 control point needs its weight P (positive)");
   Vec3 start = to_program(pos);
   Vec2 at(length('X'), length('Y'));
-  if (incremental) at += Vec2(start);
+  if (modal.incremental) at += Vec2(start);
   splines.nurbs_points.push_back({at, weight});
 }
 
 // G5.3: the NURBS of the G5.2 blocks before it is cut, as LinuxCNC's NURBS_FEED does, and the
 // tool stands at its last control point (Z unchanged). No motion mode is left active.
 void Interpreter::State::nurbs_end(int column) {
-  if (motion != kG5_2) error(column, "G5.3 without G5.2 before it (LinuxCNC refuses it)");
+  if (modal.motion != kG5_2) error(column, "G5.3 without G5.2 before it (LinuxCNC refuses it)");
   if (static_cast<int>(splines.nurbs_points.size()) < splines.nurbs_order)
     error(column,
           "G5.3: " + std::to_string(splines.nurbs_points.size()) +
@@ -218,7 +219,7 @@ void Interpreter::State::nurbs_end(int column) {
   if (!far) nurbs_feed(std::move(splines.nurbs_points), splines.nurbs_order, Vec2(end), start[2]);
   splines.nurbs_points.clear();
   pos = to_machine(end);
-  motion = -1;
+  modal.motion = -1;
 }
 
 // emccanon's NURBS_FEED: 4 × (control points) equal steps of u, a biarc each, the last ending
@@ -271,9 +272,9 @@ void Interpreter::State::spline_piece(const Vec2& from, const Vec2& to, const Ve
   if (glm::length(d) <= 1e-9) return;
   Vec3 end(to.x, to.y, z);
   double den = 2 * (d.y * tangent.x - d.x * tangent.y);
-  if (std::abs(den) <= 1e-6 * unit) {
+  if (std::abs(den) <= 1e-6 * modal.unit) {
     Vec3 m = to_machine(end);
-    emit(MoveKind::feed, pos, m, feed);
+    emit(MoveKind::feed, pos, m, modal.feed);
     pos = m;
     return;
   }
@@ -281,7 +282,7 @@ void Interpreter::State::spline_piece(const Vec2& from, const Vec2& to, const Ve
   Vec2 centre = from + rho * Vec2(-tangent.y, tangent.x);
   Vec3 start(from.x, from.y, z);
   bool ccw = rho > 0;
-  arc_chords(start, end, centre, ccw, arc_sweep(start, end, centre, ccw), feed);
+  arc_chords(start, end, centre, ccw, arc_sweep(start, end, centre, ccw), modal.feed);
 }
 
 }  // namespace tridex::gcode

@@ -56,28 +56,34 @@ struct Interpreter::State : ParameterReader {
   int line = 0;
   int motion_column = 1;
 
-  // Modal state.
-  double unit = 1.0;  // mm per program unit
-  bool incremental = false;
-  bool arc_absolute = false;
-  int plane = kG17;
-  int motion = -1;  // -1: none yet
-  bool retract_to_r = false;
-  int work_key = 1;
-  Vec3 work_offset{0.0};
-  std::map<int, Vec3> offsets;
-  double feed = 0;  // mm/min of the next feed move (under G93 and G95, worked out per move)
   // Feed modes (RS274/NGC group 5, NIST IR 6556 §3.5.19; LinuxCNC interp_inverse.cc): G94 F in
   // units per minute; G93 inverse time, F in 1/min, every feed block takes 1/F minutes (its rate
   // is its programmed length × F, set per move); G95 F in units per spindle revolution (× S).
   enum class FeedMode { per_minute, inverse_time, per_revolution };
-  FeedMode feed_mode = FeedMode::per_minute;
-  double inverse_time = 0;  // G93: the block's F (1/min)
-  double feed_per_rev = 0;  // G95: mm per revolution
+  // The modal state the block's codes set (modal.cpp; motion.cpp works out the G93 feed per move).
+  struct Modal {
+    double unit = 1.0;  // mm per program unit
+    bool incremental = false;
+    bool arc_absolute = false;
+    int plane = kG17;
+    int motion = -1;  // -1: none yet
+    bool retract_to_r = false;
+    double feed = 0;  // mm/min of the next feed move (under G93 and G95, worked out per move)
+    FeedMode feed_mode = FeedMode::per_minute;
+    double inverse_time = 0;  // G93: the block's F (1/min)
+    double feed_per_rev = 0;  // G95: mm per revolution
+    double speed = 0;
+    int spindle_direction = 0;
+  };
+  Modal modal;
+  int work_key = 1;
+  Vec3 work_offset{0.0};
+  std::map<int, Vec3> offsets;
   // The feed rate as LinuxCNC's #<_feed> reads it, in program units: per revolution under G95,
   // under G93 the rate of the last feed move.
   double programmed_feed() const {
-    return (feed_mode == FeedMode::per_revolution ? feed_per_rev : feed) / unit;
+    return (modal.feed_mode == FeedMode::per_revolution ? modal.feed_per_rev : modal.feed) /
+           modal.unit;
   }
   void feed_mode_codes();                 // G93, G94, G95, F and S (modal.cpp)
   void inverse_time_rate(double length);  // G93: feed for a block `length` mm long (motion.cpp)
@@ -93,8 +99,6 @@ struct Interpreter::State : ParameterReader {
     int nurbs_order = 3;
   };
   Splines splines;
-  double speed = 0;
-  int spindle_direction = 0;
   int tool_selected = 0;
   int tool = 0;
   // Tool length offset (G43 H, G43.1 Z, G44 H; 0 under G49), mm. The program names the point
@@ -417,7 +421,7 @@ struct Interpreter::State : ParameterReader {
     }
   }
 
-  double length(char c) { return w.take(c) * unit; }
+  double length(char c) { return w.take(c) * modal.unit; }
 
   long long integer(char c, const char* what, long long low, long long high) {
     double v = w.take(c);
@@ -491,7 +495,7 @@ struct Interpreter::State : ParameterReader {
     move.axis = axis;
     move.feed = move_feed;
     move.from_far = from_far;
-    move.spindle = speed * spindle_direction;
+    move.spindle = modal.speed * modal.spindle_direction;
     if (machine.kinematics) {
       for (const RotaryAxis& rotary_axis : machine.kinematics->axes)
         move.rotary_axes |= static_cast<unsigned char>(1u << rotary_index(rotary_axis.letter));
@@ -559,11 +563,11 @@ struct Interpreter::State : ParameterReader {
   // A program point's coordinates in the active plane, (u, v) of plane_axes (G17: X Y; G18: Z X,
   // LinuxCNC's order for compensation), and a point with those replaced.
   Vec2 plane_uv(const Vec3& p) const {
-    const std::array<int, 3> a = plane_axes(plane);
+    const std::array<int, 3> a = plane_axes(modal.plane);
     return Vec2(p[a[0]], p[a[1]]);
   }
   Vec3 with_plane_uv(Vec3 p, const Vec2& q) const {
-    const std::array<int, 3> a = plane_axes(plane);
+    const std::array<int, 3> a = plane_axes(modal.plane);
     p[a[0]] = q.x;
     p[a[1]] = q.y;
     return p;

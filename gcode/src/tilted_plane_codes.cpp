@@ -177,14 +177,15 @@ void Interpreter::State::tilted_plane(int code) {
     return;
   }
   int column = w.find_g(code);
-  if (incremental) error(column, code_name('G', code) + " under G91 is not supported; use G90");
+  if (modal.incremental)
+    error(column, code_name('G', code) + " under G91 is not supported; use G90");
   Frame feature;
   if (code == kG68) {
     // Fanuc's coordinate rotation G68 X Y R (G17; Fanuc 0i-MF operator's manual, "Coordinate
     // system rotation"): the program's points turn by R degrees, counter-clockwise, about the
     // centre X Y (where either is left out, the current point's): p = C + Rz(R)·(p' − C).
     if (tilted) error(column, "G68 while a rotation or tilted plane is active (G69 first)");
-    if (plane != kG17)
+    if (modal.plane != kG17)
       error(column, "G68 (coordinate rotation) is read in the XY plane (G17) only");
     if (w.has('Z'))
       error(w.col('Z'), "G68 Z: the rotation in G17 is about an axis along Z through X Y");
@@ -262,7 +263,7 @@ void Interpreter::State::orient_to_plane(int code) {
     go_far();  // the machine turns the tool: where the tip ends is the kinematics' business
   }
   update_frame();
-  if (machine.dialect == Dialect::linuxcnc) motion = kG0;
+  if (machine.dialect == Dialect::linuxcnc) modal.motion = kG0;
   if (code != kG53_3) return;
   // LinuxCNC's remap (g533remap.ngc) requires X, Y and Z, and hands them on to M530 as I J K.
   for (char c : {'I', 'J', 'K'})
