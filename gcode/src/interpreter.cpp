@@ -109,8 +109,8 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
                                                   " (lines " + lines + ")"});
     }
   };
-  summarize(s.skipped, "skipped");
-  summarize(s.read_as, "read");
+  summarize(s.summary.skipped, "skipped");
+  summarize(s.summary.read_as, "read");
 }
 
 std::vector<Move> read_moves(const std::string& path, InterpreterOptions options,

@@ -39,12 +39,21 @@ struct Interpreter::State : ParameterReader {
   InterpreterOptions options;
   MachineConfig machine;
 
-  // What the run tells its caller besides the moves (Interpreter::warnings, tools_used, ...).
+  // The words lenient mode skipped, or the blocks it read in a stated way, of one cause.
+  struct Skipped {
+    long long count = 0;
+    std::vector<int> lines;  // the first few
+    int last_line = 0;
+  };
+  // What the run tells its caller besides the moves (Interpreter::warnings, tools_used, ...; the
+  // lenient-mode counts in its summary warnings), gathered as the blocks execute.
   struct RunSummary {
     std::vector<Diagnostic> warnings;
     std::set<int> tools_used;
     std::map<int, int> tool_first_line;
     long long blocks = 0;
+    std::map<std::string, Skipped> skipped;  // by cause (unsupported)
+    std::map<std::string, Skipped> read_as;  // by cause (lenient_read)
   };
   RunSummary summary;
 
@@ -269,26 +278,19 @@ struct Interpreter::State : ParameterReader {
     if (!skippable)
       error(column, message + " (cannot be skipped in lenient mode: it changes the tool path)");
     warn(column, message + " (skipped: lenient mode)");
-    Skipped& s = skipped[cause];
+    Skipped& s = summary.skipped[cause];
     if (s.count++ < 5) s.lines.push_back(context.line);
   }
-  struct Skipped {
-    long long count = 0;
-    std::vector<int> lines;  // the first few
-    int last_line = 0;
-  };
-  std::map<std::string, Skipped> skipped;
   // Lenient mode reads a block it cannot take as written in a stated way (`cause`, which names
   // the direction it was read along): a warning for the line, and a count per cause for the
   // run's summary, however many (the warnings themselves stop at 1000).
   void lenient_read(int column, const std::string& message, const std::string& cause) {
-    Skipped& s = read_as[cause];
+    Skipped& s = summary.read_as[cause];
     if (s.count > 0 && s.last_line == context.line) return;  // one per line: an arc's chords
     s.last_line = context.line;
     warn(column, message);
     if (s.count++ < 5) s.lines.push_back(context.line);
   }
-  std::map<std::string, Skipped> read_as;
   static std::string direction_text(const Vec3& d) {
     char text[112];  // snprintf: GCC 12 warns falsely on "literal" + std::string chains
     std::snprintf(text, sizeof text, "(%.10g, %.10g, %.10g)", d.x, d.y, d.z);
