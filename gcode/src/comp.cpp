@@ -69,8 +69,8 @@ void Interpreter::State::cutter_comp_codes(int code, int column) {
     return;
   }
   std::string name = code_name('G', code);
-  if (plane != kG17 && plane != kG18)
-    error(column, name + " in " + code_name('G', plane) +
+  if (modal.plane != kG17 && modal.plane != kG18)
+    error(column, name + " in " + code_name('G', modal.plane) +
                       ": cutter compensation works in the XY (G17) or XZ (G18) plane only");
   const bool was_on = comp.side != 0;
   if (was_on && (machine.dialect == Dialect::linuxcnc || code == kG41_1 || code == kG42_1))
@@ -88,7 +88,7 @@ void Interpreter::State::cutter_comp_codes(int code, int column) {
     // is modal; before any D the control holds D0, no offset (Haas: "a nonzero D code must be
     // specified" to compensate).
     const bool fanuc = machine.dialect != Dialect::linuxcnc;
-    int number = comp.offset_d >= 0 ? comp.offset_d : fanuc ? 0 : tool;
+    int number = comp.offset_d >= 0 ? comp.offset_d : fanuc ? 0 : tool.number;
     if (w.has('D'))
       number = static_cast<int>(integer('D', (name + " D (a tool number)").c_str(), 0, 99'999'999));
     if (w.has('D') && fanuc) comp.offset_d = number;
@@ -158,21 +158,21 @@ double Interpreter::State::d_offset_radius(int number, int column, const std::st
 
 void Interpreter::State::comp_dequeue() {
   comp.endpoint_valid = false;
-  int saved_line = line;
+  int saved_line = context.line;
   for (const CompMove& q : comp.queue) {
-    line = q.line;
+    context.line = q.line;
     if (q.kind == CompMove::straight) {
       Vec3 end = to_machine(q.end);
-      emit(q.move_kind, pos, end, q.feed);
-      pos = end;
+      emit(q.move_kind, tool.pos, end, q.feed);
+      tool.pos = end;
     } else {
-      Vec3 start = to_program(pos);
+      Vec3 start = to_program(tool.pos);
       bool ccw = q.turn > 0;
       double sweep = std::abs(find_turn(plane_uv(start), q.centre, q.turn, plane_uv(q.end)));
       arc_chords(start, q.end, q.centre, ccw, sweep + 2 * kPi * q.extra_turns, q.feed);
     }
   }
-  line = saved_line;
+  context.line = saved_line;
   comp.queue.clear();
 }
 
@@ -184,18 +184,19 @@ void Interpreter::State::comp_move_endpoint_and_flush(const Vec2& to) {
     if (q.kind == CompMove::arc) {
       double r1 = glm::length(plane_uv(q.end) - q.centre), r2 = glm::length(to - q.centre);
       double l2 = find_turn(comp.endpoint, q.centre, q.turn, to);
-      if (std::abs(r1 - r2) > 0.01 * unit)
-        error(motion_column, "cutter compensation made an arc with mismatched radii " +
-                                 format_number(r1) + " and " + format_number(r2) + " (a bug)");
+      if (std::abs(r1 - r2) > 0.01 * modal.unit)
+        error(context.motion_column, "cutter compensation made an arc with mismatched radii " +
+                                         format_number(r1) + " and " + format_number(r2) +
+                                         " (a bug)");
       if (q.original_sweep != 0.0 && comp.endpoint_valid &&
           std::abs(l2) > std::abs(q.original_sweep) + 0.0254)
-        error(motion_column,
+        error(context.motion_column,
               "arc move in a concave corner cannot be reached by the tool without "
               "gouging (cutter compensation)");
     } else {
       double dot = glm::dot(q.direction, to - comp.endpoint);
       if (comp.endpoint_valid && dot < 0)
-        error(motion_column,
+        error(context.motion_column,
               std::string(q.move_kind == MoveKind::rapid ? "straight traverse" : "straight feed") +
                   " in a concave corner cannot be reached by the tool without gouging "
                   "(cutter compensation: the corner is too small for the tool radius " +
@@ -213,7 +214,7 @@ void Interpreter::State::comp_straight_entry(CompMove& move, const Vec3& target)
   const double r = comp.radius;
   const int side = comp.side;
   const Vec2 p = plane_uv(target);
-  Vec2 c = plane_uv(to_program(pos));
+  Vec2 c = plane_uv(to_program(tool.pos));
   double distance = glm::length(p - c);
   const bool fanuc_start = machine.dialect != Dialect::linuxcnc;
   if (fanuc_start && !(distance > kEqual)) {
@@ -221,13 +222,14 @@ void Interpreter::State::comp_straight_entry(CompMove& move, const Vec3& target)
     // no change made to cutter compensation until the next X or Y move": a plunge goes as
     // programmed, and the next move in the plane is the entry.
     const Vec3 end = to_machine(target);
-    emit(move.move_kind, pos, end, move.feed);
-    pos = end;
+    emit(move.move_kind, tool.pos, end, move.feed);
+    tool.pos = end;
     return;
   }
   if (!fanuc_start && distance <= r)
-    error(motion_column, "cutter compensation entry move of length " + format_number(distance) +
-                             " mm is not longer than the tool radius " + format_number(r) + " mm");
+    error(context.motion_column,
+          "cutter compensation entry move of length " + format_number(distance) +
+              " mm is not longer than the tool radius " + format_number(r) + " mm");
   comp.entry_pending = fanuc_start;
   double alpha = angle_of(p - c) + (side > 0 ? kHalfPi : -kHalfPi);
   Vec2 end = p + r * polar(alpha);
@@ -243,8 +245,8 @@ void Interpreter::State::comp_straight_entry(CompMove& move, const Vec3& target)
 }
 
 void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double move_feed) {
-  if (far)
-    error(motion_column,
+  if (tool.far)
+    error(context.motion_column,
           "cutter compensation from a retracted (far) position: the tool's position "
           "is unknown; position it with X, Y and Z first");
   const double r = comp.radius;
@@ -252,7 +254,7 @@ void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double
   const Vec2 p = plane_uv(target);
   CompMove move;
   move.move_kind = kind;
-  move.line = line;
+  move.line = context.line;
   move.feed = move_feed;
   if (comp.first) {
     comp_straight_entry(move, target);
@@ -309,7 +311,8 @@ void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double
       if (!front_arc) {  // line to line: back along the offset path to where they cross
         double half_corner = (beta + kPi) / 2;
         if (half_corner == 0.0)
-          error(motion_column, "a zero-degree inside corner is invalid for cutter compensation");
+          error(context.motion_column,
+                "a zero-degree inside corner is invalid for cutter compensation");
         double retreat = r / std::tan(half_corner);
         meet = c + retreat * polar(theta + gamma);
       } else {  // arc to line: where the offset arc meets the offset line
@@ -323,7 +326,7 @@ void Interpreter::State::comp_straight(MoveKind kind, const Vec3& target, double
         double d = programmed_radius * std::cos(th - phi);
         double l = (inside ? d - r : d + r) / old_radius;
         if (l > 1.0 || l < -1.0)
-          error(motion_column,
+          error(context.motion_column,
                 "arc to straight motion makes a corner the compensated tool can't "
                 "fit in without gouging (cutter compensation)");
         double turn_sign = (prev.turn > 0) == inside ? -1.0 : 1.0;
@@ -368,20 +371,20 @@ void Interpreter::State::comp_arc_entry(CompMove& move, bool ccw, bool inside,
                                         const std::string& too_small) {
   const double r = comp.radius;
   const int turn = move.turn;
-  Vec3 current = to_program(pos);
+  Vec3 current = to_program(tool.pos);
   Vec2 c = plane_uv(current);
   ArcData a = arc_data(current, ccw);
-  if (feed_mode == FeedMode::inverse_time)
+  if (modal.feed_mode == FeedMode::inverse_time)
     inverse_time_rate(arc_length(current, a, ccw, move.extra_turns));
-  move.feed = feed;
+  move.feed = modal.feed;
   Vec2 end = plane_uv(a.end);
   if (glm::length(end - c) <= r)
-    error(motion_column,
+    error(context.motion_column,
           "cutter compensation entry arc: its end is not farther than the tool "
           "radius " +
               format_number(r) + " mm from its start");
   double arc_radius = a.programmed_radius > 0 ? a.programmed_radius : glm::length(a.centre - c);
-  if (arc_radius <= r && inside) error(motion_column, too_small);
+  if (arc_radius <= r && inside) error(context.motion_column, too_small);
   double gamma = inside ? angle_of(a.centre - end) : angle_of(end - a.centre);
   comp.first = false;
   comp.programmed = a.end;
@@ -391,7 +394,7 @@ void Interpreter::State::comp_arc_entry(CompMove& move, bool ccw, bool inside,
   double b_len = glm::length(c - end) / 2;
   double ab = angle_of(a.centre - end);
   double a_angle = angle_of(c - end) - ab;
-  if (std::abs(std::cos(a_angle)) < kEqual) error(motion_column, too_small);
+  if (std::abs(std::cos(a_angle)) < kEqual) error(context.motion_column, too_small);
   Vec2 centre = end + (b_len / std::cos(a_angle)) * polar(ab);
   move.end = with_plane_uv(a.end, end);
   move.centre = centre;
@@ -402,8 +405,8 @@ void Interpreter::State::comp_arc_entry(CompMove& move, bool ccw, bool inside,
 }
 
 void Interpreter::State::comp_arc(bool ccw) {
-  if (far)
-    error(motion_column,
+  if (tool.far)
+    error(context.motion_column,
           "cutter compensation from a retracted (far) position: the tool's position "
           "is unknown; position it with X, Y and Z first");
   const double r = comp.radius;
@@ -413,8 +416,8 @@ void Interpreter::State::comp_arc(bool ccw) {
   CompMove move;
   move.kind = CompMove::arc;
   move.move_kind = MoveKind::arc;
-  move.line = line;
-  move.feed = feed;
+  move.line = context.line;
+  move.feed = modal.feed;
   move.turn = turn;
   move.extra_turns = arc_extra_turns();
   const std::string too_small = "the tool radius " + format_number(r) +
@@ -431,9 +434,9 @@ void Interpreter::State::comp_arc(bool ccw) {
   }
   const Vec2 op = plane_uv(comp.programmed);
   const Vec2 c = plane_uv(comp.current);
-  if (feed_mode == FeedMode::inverse_time)
+  if (modal.feed_mode == FeedMode::inverse_time)
     inverse_time_rate(arc_length(comp.programmed, a, ccw, move.extra_turns));
-  move.feed = feed;
+  move.feed = modal.feed;
   const Vec2 centre = a.centre, end = plane_uv(a.end);
   double arc_radius = glm::length(centre - end);
   double theta = angle_of(c - op) + (side > 0 ? -kHalfPi : kHalfPi);
@@ -447,7 +450,7 @@ void Interpreter::State::comp_arc(bool ccw) {
   double gamma;
   if (inside) {
     gamma = angle_of(centre - end);
-    if (arc_radius <= r) error(motion_column, too_small);
+    if (arc_radius <= r) error(context.motion_column, too_small);
   } else {
     gamma = angle_of(end - centre);
     delta += kPi;
@@ -467,7 +470,7 @@ void Interpreter::State::comp_arc(bool ccw) {
       double along = arc_radius * std::sin(beta - kHalfPi);
       double from_centre = inside ? arc_radius - r : arc_radius + r;
       double l = (inside ? along + r : along - r) / from_centre;
-      if (l > 1.0 || l < -1.0) error(motion_column, gouge);
+      if (l > 1.0 || l < -1.0) error(context.motion_column, gouge);
       double angle = inside ? (turn > 0 ? theta + std::asin(l) : theta - std::asin(l))
                             : (turn > 0 ? theta + kPi - std::asin(l) : theta + kPi + std::asin(l));
       meet = centre + from_centre * polar(angle);
@@ -477,14 +480,14 @@ void Interpreter::State::comp_arc(bool ccw) {
       double new_radius = inside ? arc_radius - r : arc_radius + r;
       double centres = glm::length(prev.centre - centre);
       if (old_radius == 0 || centres == 0)
-        error(motion_column,
+        error(context.motion_column,
               "arc to arc motion is invalid because the arcs have the same centre "
               "(cutter compensation)");
       double cos_pullback =
           (old_radius * old_radius + centres * centres - new_radius * new_radius) /
           (2 * old_radius * centres);
       if (cos_pullback > 1.0 || cos_pullback < -1.0)
-        error(motion_column,
+        error(context.motion_column,
               "arc to arc motion makes a corner the compensated tool can't fit in "
               "without gouging (cutter compensation)");
       double pullback = std::acos(cos_pullback);

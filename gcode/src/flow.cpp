@@ -86,9 +86,9 @@ class ProgramFlow {
   ProgramFlow(Interpreter::State& state, std::istream& program, const std::string& file_name)
       : s_(state) {
     sources_.push_back(std::make_unique<Source>(file_name, program));
-    s_.file = &sources_[0]->name;
+    s_.context.file = &sources_[0]->name;
     s_.files = {file_name};  // sources_ and s_.files share their indices
-    s_.file_index = 0;
+    s_.context.file_index = 0;
   }
 
   void run();
@@ -156,7 +156,7 @@ bool ProgramFlow::read(std::string_view& out) {
   bool too_long = false;
   if (!src.reader.next(out, too_long)) return false;
   ++line_;
-  s_.line = line_;
+  s_.context.line = line_;
   if (too_long) error(0, "line longer than 65535 characters");
   if (line_ == 1 && out.substr(0, 3) == "\xEF\xBB\xBF") out.remove_prefix(3);  // UTF-8 BOM
   if (at >= src.scanned_to) {  // first visit: note labels
@@ -184,8 +184,8 @@ void ProgramFlow::note_label(std::string_view text, const Position& after) {
 
 void ProgramFlow::jump(const Position& to) {
   current_ = to.source;
-  s_.file = &source().name;
-  s_.file_index = static_cast<int>(current_);
+  s_.context.file = &source().name;
+  s_.context.file_index = static_cast<int>(current_);
   if (!source().reader.seek(to.offset))
     error(0, "calls, loops and jumps need a seekable input stream");
   line_ = to.line;
@@ -202,7 +202,7 @@ void ProgramFlow::count_block(int column) {
 bool ProgramFlow::scan_for(const std::function<bool()>& found) {
   if (found()) return true;
   Position back = here();
-  int line = s_.line;
+  int line = s_.context.line;
   Source& src = source();
   jump(Position{current_, src.scanned_to, src.scanned_line});
   std::string_view skipped;
@@ -210,7 +210,7 @@ bool ProgramFlow::scan_for(const std::function<bool()>& found) {
   while (!(ok = found()) && read(skipped)) {
   }
   jump(back);
-  s_.line = line;
+  s_.context.line = line;
   return ok;
 }
 
@@ -325,7 +325,7 @@ void ProgramFlow::skip_until(const std::function<bool(const Skim&)>& stop, const
       return;
     }
   }
-  s_.line = from;
+  s_.context.line = from;
   error(column, "no " + what + " after this line");
 }
 
@@ -455,11 +455,11 @@ Position ProgramFlow::find_sequence(long long number, const std::string& what, i
     }
     if (!found) {
       jump(back);
-      s_.line = from;
+      s_.context.line = from;
       error(column, what + ": no block N" + std::to_string(number));
     }
     jump(back);
-    s_.line = from;
+    s_.context.line = from;
     it = src.sequences.emplace(number, Source::Label{found->offset, found->line}).first;
   }
   return Position{current_, it->second.body, it->second.line};

@@ -69,30 +69,31 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
   fresh->machine = state_->machine;
   state_ = std::move(fresh);
   State& s = *state_;
-  s.file = &file_name;
+  s.context.file = &file_name;
   s.sink = &sink;
   s.dwell_sink = &dwell_sink;
-  s.offsets = s.machine.work_offsets;
+  s.frame.offsets = s.machine.work_offsets;
   for (const auto& [n, value] : s.machine.variables) s.preset(n, value);
   for (const auto& [name, value] : s.machine.named_variables)
     s.parameters.named_globals[name] = Value{value, false};
-  if (auto it = s.offsets.find(1); it != s.offsets.end()) s.work_offset = it->second;
-  s.world_origin = s.work_offset;
-  s.unit = s.machine.inch_at_start ? 25.4 : 1.0;
-  s.retract_to_r = s.machine.g99_at_start;
+  if (auto it = s.frame.offsets.find(1); it != s.frame.offsets.end())
+    s.frame.work_offset = it->second;
+  s.frame.world_origin = s.frame.work_offset;
+  s.modal.unit = s.machine.inch_at_start ? 25.4 : 1.0;
+  s.modal.retract_to_r = s.machine.g99_at_start;
   s.update_frame();
   if (s.machine.start_position) {
-    s.pos = *s.machine.start_position;
-    s.far = false;
+    s.tool.pos = *s.machine.start_position;
+    s.tool.far = false;
   } else {
-    s.pos = s.world_origin;
-    s.far = true;
+    s.tool.pos = s.frame.world_origin;
+    s.tool.far = true;
   }
   run_program(s, program, file_name);
   s.comp_finish();  // compensated moves still waiting for a next move
   if (s.tilt.plane_blocks.code) {
-    s.file = &file_name;
-    s.line = s.tilt.plane_blocks.first_line;
+    s.context.file = &file_name;
+    s.context.line = s.tilt.plane_blocks.first_line;
     s.error(0, s.incomplete_plane());
   }
   // One line per kind of word lenient mode skipped or block it read otherwise, however many:
@@ -108,8 +109,8 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
                                                   " (lines " + lines + ")"});
     }
   };
-  summarize(s.skipped, "skipped");
-  summarize(s.read_as, "read");
+  summarize(s.summary.skipped, "skipped");
+  summarize(s.summary.read_as, "read");
 }
 
 std::vector<Move> read_moves(const std::string& path, InterpreterOptions options,

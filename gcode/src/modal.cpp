@@ -11,8 +11,8 @@ namespace tridex::gcode {
 // the two tools' lengths (no move: the tool changed, rs274's CHANGE_TOOL keeps the position).
 void Interpreter::State::load_tool(int number) {
   double before = loaded_length();
-  tool = number;
-  pos += (before - loaded_length()) * axis;
+  tool.number = number;
+  tool.pos += (before - loaded_length()) * tool.axis;
   update_frame();
 }
 
@@ -40,7 +40,7 @@ void Interpreter::State::tool_length_codes() {
     next = length('Z');
     w.present &= ~(1u << letter_index('Z'));  // an offset here, not a coordinate
   } else if (code != kG49) {
-    int number = tool;
+    int number = tool.number;
     if (w.has('H'))
       number = static_cast<int>(integer('H', "tool length offset number", 0, 99'999'999));
     if (std::optional<double> table = table_length(number)) {
@@ -52,8 +52,8 @@ void Interpreter::State::tool_length_codes() {
     }
   }
   if (machine.tool_lengths.empty()) next = 0;  // no lengths known: the programmed point is the tip
-  if (next != length_offset) comp_forbid(column, "changing the tool length offset");
-  length_offset = next;
+  if (next != tool.length_offset) comp_forbid(column, "changing the tool length offset");
+  tool.length_offset = next;
   update_frame();
 }
 
@@ -67,26 +67,26 @@ void Interpreter::State::feed_mode_codes() {
     FeedMode next = code == kG93   ? FeedMode::inverse_time
                     : code == kG94 ? FeedMode::per_minute
                                    : FeedMode::per_revolution;
-    bool clears = machine.dialect == Dialect::linuxcnc ? code != kG93 : next != feed_mode;
-    if (clears) feed = feed_per_rev = 0;
-    feed_mode = next;
+    bool clears = machine.dialect == Dialect::linuxcnc ? code != kG93 : next != modal.feed_mode;
+    if (clears) modal.feed = modal.feed_per_rev = 0;
+    modal.feed_mode = next;
   }
   if (w.has('F')) {
     if (w.value[static_cast<std::size_t>(letter_index('F'))] < 0)
       error(w.col('F'), "feed rate F must not be negative");
-    if (feed_mode == FeedMode::inverse_time)
-      inverse_time = w.take('F');
-    else if (feed_mode == FeedMode::per_revolution)
-      feed_per_rev = length('F');
+    if (modal.feed_mode == FeedMode::inverse_time)
+      modal.inverse_time = w.take('F');
+    else if (modal.feed_mode == FeedMode::per_revolution)
+      modal.feed_per_rev = length('F');
     else
-      feed = length('F');
+      modal.feed = length('F');
   }
   if (w.has('S')) {
     double s = w.take('S');
     if (s < 0) error(w.col('S'), "spindle speed S must not be negative");
-    speed = s;
+    modal.speed = s;
   }
-  if (feed_mode == FeedMode::per_revolution) feed = feed_per_rev * speed;
+  if (modal.feed_mode == FeedMode::per_revolution) modal.feed = modal.feed_per_rev * modal.speed;
 }
 
 // LinuxCNC's G10 L1 / L10 / L11 P<tool> (interp_convert.cc convert_setup_tool): set the tool
@@ -121,17 +121,18 @@ void Interpreter::State::tool_table_entry(long long l, int column) {
     tool_table.lengths[number] = length('Z');
     return;
   }
-  if (far)
+  if (tool.far)
     error(column, name + " with the tool retracted far along its axis: its position is unknown");
-  if (tilted || machine.kinematics || glm::dot(axis, Vec3(0, 0, 1)) < 1 - kSameDirection)
+  if (frame.tilted || machine.kinematics || glm::dot(tool.axis, Vec3(0, 0, 1)) < 1 - kSameDirection)
     error(column, name + " with a tilted frame or rotary axes is not simulated");
   // linear_axes(): the controlled point in machine coordinates; the control puts the gauge point
   // the active offset above it.
-  double gauge = linear_axes().z + length_offset;
+  double gauge = linear_axes().z + tool.length_offset;
   double system = 0;
   if (l == 10) {
-    system = work_offset.z + local_offset.z;
-  } else if (auto it = offsets.find(9); it != offsets.end()) {  // G59.3 (never set by tridex: 0)
+    system = frame.work_offset.z + frame.local_offset.z;
+  } else if (auto it = frame.offsets.find(9);
+             it != frame.offsets.end()) {  // G59.3 (never set by tridex: 0)
     system = it->second.z;
   }
   tool_table.lengths[number] = gauge - system - length('Z');
@@ -153,19 +154,20 @@ void Interpreter::State::tool_length_entry(long long l, int column) {
   const int number = static_cast<int>(
       integer('P', (name + " P (a " + offset + " offset number)").c_str(), 0, 99'999'999));
   if (radius) {
-    comp.d_set_at[number] = name + " at line " + std::to_string(line);
+    comp.d_set_at[number] = name + " at line " + std::to_string(context.line);
     double& value = (l == 12 ? comp.d_geometry : comp.d_wear)[number];
-    value = (incremental ? value : 0) + length('R');
+    value = (modal.incremental ? value : 0) + length('R');
     return;
   }
   for (char c : {'X', 'Y', 'Z', 'A', 'B', 'C'})
     if (w.has(c)) error(w.col(c), name + " " + c + ": a tool length offset takes R only");
   double value = length('R');
   if (l == 10) {
-    tool_table.lengths[number] = (incremental ? length_geometry(number).value_or(0) : 0) + value;
+    tool_table.lengths[number] =
+        (modal.incremental ? length_geometry(number).value_or(0) : 0) + value;
   } else {
     double& wear = tool_table.wear[number];
-    wear = (incremental ? wear : 0) + value;
+    wear = (modal.incremental ? wear : 0) + value;
   }
 }
 
@@ -217,27 +219,27 @@ Flow Interpreter::State::execute(const Block& block) {
 // motion or non-modal code, else its first coordinate, else the block's start.
 Interpreter::State::BlockCodes Interpreter::State::block_codes() {
   BlockCodes codes;
-  motion_column = 0;
+  context.motion_column = 0;
   for (int i = 0; i < w.g_count; ++i) {
     const Code& g = w.g[static_cast<std::size_t>(i)];
     int group = block_g_group(g.code);
     if (group == kMotion) {
       codes.motion = g.code;
-      motion_column = g.column;
+      context.motion_column = g.column;
     } else if (group == kNonModal) {
       codes.nonmodal = g.code;
-      if (g.code != kG4) motion_column = g.column;
+      if (g.code != kG4) context.motion_column = g.column;
     } else if (group == kTilt) {
       codes.tilt = g.code;
     } else if (group == kOrient) {
       codes.orient = g.code;
     }
   }
-  if (motion_column == 0) {
-    motion_column = 1;
+  if (context.motion_column == 0) {
+    context.motion_column = 1;
     for (char c : {'X', 'Y', 'Z'})
       if (w.has(c)) {
-        motion_column = w.col(c);
+        context.motion_column = w.col(c);
         break;
       }
   }
@@ -250,43 +252,43 @@ void Interpreter::State::units_codes() {
     int column = w.find_g(code);
     if (!column) continue;
     double next = code == kG20 ? 25.4 : 1.0;
-    if (next != unit) comp_forbid(column, "changing units");
-    unit = next;
+    if (next != modal.unit) comp_forbid(column, "changing units");
+    modal.unit = next;
   }
 }
 
 // T selects a tool; M6 (or T alone, on a machine whose T loads the tool) loads it, LinuxCNC's
 // M61 Q says which tool the spindle holds.
 void Interpreter::State::tool_change_codes() {
-  if (w.has('T')) tool_selected = static_cast<int>(integer('T', "tool number", 0, 99'999'999));
+  if (w.has('T')) tool.selected = static_cast<int>(integer('T', "tool number", 0, 99'999'999));
 
   if (w.find_m(kM6) || (w.has('T') && machine.tool_loads_on_t)) {
     comp_forbid(w.find_m(kM6) ? w.find_m(kM6) : w.col('T'), "a tool change");
     comp.programmed_current = false;  // LinuxCNC resynchronises with where the tool really is
-    load_tool(tool_selected);
-    summary.tool_first_line.emplace(tool, line);
+    load_tool(tool.selected);
+    summary.tool_first_line.emplace(tool.number, context.line);
     if (machine.tool_change == ToolChange::retract_far) go_far();
     if (machine.tool_change == ToolChange::to_position) {
-      if (glm::dot(axis, Vec3(0, 0, 1)) < 1 - kSameDirection)
+      if (glm::dot(tool.axis, Vec3(0, 0, 1)) < 1 - kSameDirection)
         error(w.find_m(kM6) ? w.find_m(kM6) : w.col('T'),
               "a tool change to the machine's tool-change position with a tilted tool depends on "
               "the kinematics; retract (G28 or G53 Z) and cancel the tilt first");
       Vec3 tip = tip_below(machine.tool_change_position);
-      if (!far) emit(MoveKind::rapid, pos, tip, 0.0);
-      pos = tip;
+      if (!tool.far) emit(MoveKind::rapid, tool.pos, tip, 0.0);
+      tool.pos = tip;
     }
   }
   if (int column = w.find_m(kM61)) {  // LinuxCNC: the tool in the spindle is Q (nothing moves)
     if (!w.has('Q')) error(column, "M61 needs Q (the tool number)");
-    tool_selected = static_cast<int>(integer('Q', "M61 tool number", 0, 99'999'999));
-    load_tool(tool_selected);
+    tool.selected = static_cast<int>(integer('Q', "M61 tool number", 0, 99'999'999));
+    load_tool(tool.selected);
   }
 }
 
 void Interpreter::State::spindle_codes() {
-  if (w.find_m(kM3)) spindle_direction = 1;
-  if (w.find_m(kM4)) spindle_direction = -1;
-  if (w.find_m(kM5)) spindle_direction = 0;
+  if (w.find_m(kM3)) modal.spindle_direction = 1;
+  if (w.find_m(kM4)) modal.spindle_direction = -1;
+  if (w.find_m(kM5)) modal.spindle_direction = 0;
 }
 
 // G4: dwell P (seconds or ms) or, on Fanuc, X.
@@ -304,17 +306,17 @@ void Interpreter::State::dwell_code(const BlockCodes& codes) {
 void Interpreter::State::plane_codes() {
   for (int code : {kG17, kG18, kG19})
     if (int column = w.find_g(code)) {
-      if (code != plane) comp_forbid(column, "changing the plane");
-      plane = code;
+      if (code != modal.plane) comp_forbid(column, "changing the plane");
+      modal.plane = code;
     }
 }
 
 // G90/G91 (coordinates), G90.1/G91.1 (arc centres).
 void Interpreter::State::distance_mode_codes() {
-  if (w.find_g(kG90)) incremental = false;
-  if (w.find_g(kG91)) incremental = true;
-  if (w.find_g(kG90_1)) arc_absolute = true;
-  if (w.find_g(kG91_1)) arc_absolute = false;
+  if (w.find_g(kG90)) modal.incremental = false;
+  if (w.find_g(kG91)) modal.incremental = true;
+  if (w.find_g(kG90_1)) modal.arc_absolute = true;
+  if (w.find_g(kG91_1)) modal.arc_absolute = false;
 }
 
 // Look-ahead and smoothing modes change how the control follows the path, not the path: their
@@ -337,8 +339,8 @@ void Interpreter::State::smoothing_codes(const BlockCodes& codes) {
 }
 
 void Interpreter::State::return_mode_codes() {
-  if (w.find_g(kG98)) retract_to_r = false;
-  if (w.find_g(kG99)) retract_to_r = true;
+  if (w.find_g(kG98)) modal.retract_to_r = false;
+  if (w.find_g(kG99)) modal.retract_to_r = true;
 }
 
 // The work coordinate system: G54-G59, G54.1 P, Haas's G154 P.
@@ -354,12 +356,12 @@ void Interpreter::State::work_system_codes() {
       if (!w.has('P')) error(column, "G154 needs P (1-99)");
       key = MachineConfig::g54_1_key(static_cast<int>(integer('P', "G154 number", 1, 99)));
     }
-    if (tilted && key != work_key)
+    if (frame.tilted && key != frame.work_key)
       error(column, "work coordinates change while a tilted plane is active (cancel it first)");
-    if (key != work_key) comp_forbid(column, "changing the work coordinate system");
-    work_key = key;
-    auto it = offsets.find(key);
-    work_offset = it == offsets.end() ? Vec3(0.0) : it->second;
+    if (key != frame.work_key) comp_forbid(column, "changing the work coordinate system");
+    frame.work_key = key;
+    auto it = frame.offsets.find(key);
+    frame.work_offset = it == frame.offsets.end() ? Vec3(0.0) : it->second;
     update_frame();
   }
 }
@@ -415,17 +417,18 @@ void Interpreter::State::work_offset_entry(long long l, int column) {
     key = MachineConfig::g54_1_key(static_cast<int>(integer('P', "G10 L20 P", 0, 300)));
     if (key == MachineConfig::g54_1_key(0)) key = 0;
   }
-  if (key == 0) key = work_key;
-  if (incremental)
+  if (key == 0) key = frame.work_key;
+  if (modal.incremental)
     error(column, "G10 under G91 is read differently by different controls; use G90");
-  Vec3 value = offsets.count(key) ? offsets[key] : Vec3(0.0);
+  Vec3 value = frame.offsets.count(key) ? frame.offsets[key] : Vec3(0.0);
   bool relative_to_position = linuxcnc && l == 20;
-  if (relative_to_position && far)
+  if (relative_to_position && tool.far)
     error(column, "G10 L20 with the tool retracted far along its axis: its position is unknown");
   for (int i = 0; i < 3; ++i)
     if (w.has(kAxisLetter[i]))
-      value[i] = relative_to_position ? linear_axes()[i] - local_offset[i] - length(kAxisLetter[i])
-                                      : length(kAxisLetter[i]);
+      value[i] = relative_to_position
+                     ? linear_axes()[i] - frame.local_offset[i] - length(kAxisLetter[i])
+                     : length(kAxisLetter[i]);
   // A rotary offset of 0 changes nothing, nor do LinuxCNC's plain A/B/C (no kinematics);
   // any other would turn the part under the program, which tridex does not model.
   for (char c : {'A', 'B', 'C'})
@@ -433,11 +436,11 @@ void Interpreter::State::work_offset_entry(long long l, int column) {
       error(w.col(c), std::string("G10 ") + c +
                           format_number(w.value[static_cast<std::size_t>(letter_index(c))]) +
                           ": a rotary work offset other than 0 is not simulated");
-  if (key == work_key) comp_forbid(column, "G10 on the active work offset");
-  offsets[key] = value;
-  if (key == work_key) {
-    if (tilted) error(column, "G10 changes the active work offset under a tilted plane");
-    work_offset = value;
+  if (key == frame.work_key) comp_forbid(column, "G10 on the active work offset");
+  frame.offsets[key] = value;
+  if (key == frame.work_key) {
+    if (frame.tilted) error(column, "G10 changes the active work offset under a tilted plane");
+    frame.work_offset = value;
     update_frame();
   }
 }
@@ -458,15 +461,17 @@ void Interpreter::State::motion_mode_codes(const BlockCodes& codes) {
   const int motion_code = codes.motion;
   if (motion_code < 0) return;
   if (codes.axis_consumer && motion_code != kG80)
-    error(motion_column,
+    error(context.motion_column,
           code_name('G', motion_code) + " in a block whose X/Y/Z belong to another code");
   if (motion_code == kG80 || !is_cycle(motion_code)) canned.active = false;
-  if (is_cycle(motion_code) && motion != motion_code) canned.active = false;
-  if (motion == kG5_2 && motion_code != kG5_2 && !splines.nurbs_points.empty())
-    warn(motion_column, "the G5.2 control points before this " + code_name('G', motion_code) +
-                            " are dropped: no G5.3 ended them (LinuxCNC drops them too)");
-  if (motion_code == kG5_2 && motion != kG5_2) splines.nurbs_points.clear();  // a new curve starts
-  motion = motion_code;
+  if (is_cycle(motion_code) && modal.motion != motion_code) canned.active = false;
+  if (modal.motion == kG5_2 && motion_code != kG5_2 && !splines.nurbs_points.empty())
+    warn(context.motion_column, "the G5.2 control points before this " +
+                                    code_name('G', motion_code) +
+                                    " are dropped: no G5.3 ended them (LinuxCNC drops them too)");
+  if (motion_code == kG5_2 && modal.motion != kG5_2)
+    splines.nurbs_points.clear();  // a new curve starts
+  modal.motion = motion_code;
 }
 
 // The words beside X Y Z that a move reads: LinuxCNC's polar @ ^, the rotary A B C, U V W.
@@ -485,15 +490,16 @@ void Interpreter::State::block_move(const BlockCodes& codes) {
   const int nonmodal = codes.nonmodal;
   if (nonmodal == kG28 || nonmodal == kG30) {
     if (codes.motion >= 0 && codes.motion != kG80)
-      error(motion_column, "G28/G30 with a motion code in the same block");
+      error(context.motion_column, "G28/G30 with a motion code in the same block");
     comp_forbid(w.find_g(nonmodal), code_name('G', nonmodal));
     home_return(nonmodal == kG30);
   } else if (nonmodal == kG53) {
     machine_coordinate_move();
   } else if (nonmodal == kG5_3) {  // G5.3: the NURBS of the G5.2 blocks before it (spline.cpp)
     if (codes.motion >= 0 || has_axis_words())
-      error(motion_column, "G5.3 ends a G5.2 NURBS: no motion code or coordinates in its block");
-    nurbs_end(motion_column);
+      error(context.motion_column,
+            "G5.3 ends a G5.2 NURBS: no motion code or coordinates in its block");
+    nurbs_end(context.motion_column);
   } else if (!codes.axis_consumer) {
     motion_mode_move(codes.motion >= 0);
   }
@@ -502,8 +508,9 @@ void Interpreter::State::block_move(const BlockCodes& codes) {
 // G53 X Y Z: a move in machine coordinates, under G0 or G1.
 void Interpreter::State::machine_coordinate_move() {
   comp_forbid(w.find_g(kG53), "G53");
-  if (motion != kG0 && motion != kG1) error(motion_column, "G53 needs G0 or G1 modal");
-  if (motion == kG1) require_feed();
+  if (modal.motion != kG0 && modal.motion != kG1)
+    error(context.motion_column, "G53 needs G0 or G1 modal");
+  if (modal.motion == kG1) require_feed();
   Vec3 target(0.0);
   unsigned mask = 0;
   for (int i = 0; i < 3; ++i)
@@ -512,36 +519,38 @@ void Interpreter::State::machine_coordinate_move() {
       mask |= 1u << i;
     }
   if (mask)
-    machine_move(target, mask, motion == kG0 ? MoveKind::rapid : MoveKind::feed,
-                 motion == kG0 ? 0.0 : feed);
+    machine_move(target, mask, modal.motion == kG0 ? MoveKind::rapid : MoveKind::feed,
+                 modal.motion == kG0 ? 0.0 : modal.feed);
 }
 
 // The active motion mode's move, where the block gives it something to do: axis words, or a
 // motion code (`new_code`) or the words its mode reads without coordinates.
 void Interpreter::State::motion_mode_move(bool new_code) {
   bool axes = has_axis_words();
-  if (motion == kG0 || motion == kG1) {
+  if (modal.motion == kG0 || modal.motion == kG1) {
     if (axes) {
-      if (motion == kG1) require_feed();
-      linear(motion == kG0 ? MoveKind::rapid : MoveKind::feed, motion == kG0 ? 0.0 : feed);
+      if (modal.motion == kG1) require_feed();
+      linear(modal.motion == kG0 ? MoveKind::rapid : MoveKind::feed,
+             modal.motion == kG0 ? 0.0 : modal.feed);
     }
-  } else if (motion == kG2 || motion == kG3) {
-    char cu = kCenterLetter[plane_axes(plane)[0]], cv = kCenterLetter[plane_axes(plane)[1]];
-    if (axes || new_code || w.has(cu) || w.has(cv) || w.has('R')) arc(motion == kG3);
-  } else if (motion >= kG38_2 && motion <= kG38_5) {
-    if (axes || new_code) probe(motion);
-  } else if (motion == kG5 || motion == kG5_1) {
+  } else if (modal.motion == kG2 || modal.motion == kG3) {
+    char cu = kCenterLetter[plane_axes(modal.plane)[0]],
+         cv = kCenterLetter[plane_axes(modal.plane)[1]];
+    if (axes || new_code || w.has(cu) || w.has(cv) || w.has('R')) arc(modal.motion == kG3);
+  } else if (modal.motion >= kG38_2 && modal.motion <= kG38_5) {
+    if (axes || new_code) probe(modal.motion);
+  } else if (modal.motion == kG5 || modal.motion == kG5_1) {
     if (axes || new_code || w.has('I') || w.has('J') || w.has('P') || w.has('Q'))
-      spline(motion == kG5_1);
-  } else if (motion == kG5_2) {
+      spline(modal.motion == kG5_1);
+  } else if (modal.motion == kG5_2) {
     if (axes || new_code || w.has('P') || w.has('L')) nurbs_point();
-  } else if (is_cycle(motion)) {
+  } else if (is_cycle(modal.motion)) {
     if (axes || new_code || w.has('R')) {
-      comp_forbid(motion_column, "a canned cycle");
-      cycle(motion);
+      comp_forbid(context.motion_column, "a canned cycle");
+      cycle(modal.motion);
     }
   } else if (axes) {
-    error(motion_column,
+    error(context.motion_column,
           "X/Y/Z without an active motion mode (G0, G1, G2, G3, G5, G5.1, G5.2 or a cycle)");
   }
 }
@@ -592,7 +601,7 @@ void Interpreter::State::check_words_used() {
       // A 4-axis post writes A0. at every tool start: with the tool along +Z (no G53.1 has
       // turned the axes) an axis that stays at zero turns nothing, whatever the machine. Any
       // other angle is never dropped, even lenient.
-      if (w.value[k] == 0 && glm::dot(axis, Vec3(0, 0, 1)) >= 1 - kSameDirection) {
+      if (w.value[k] == 0 && glm::dot(tool.axis, Vec3(0, 0, 1)) >= 1 - kSameDirection) {
         if (warned_once.rotary_at_zero.insert(c).second)
           warn(w.column[k],
                std::string("rotary word ") + c +
@@ -640,12 +649,12 @@ Flow Interpreter::State::macro_call(int column) {
 // position reads X Y Z; G92.1 clears it, G92.2 suspends it, G92.3 restores it. LinuxCNC keeps G52
 // and G92 in one register; Fanuc's G52 and G92 change the same program origin.
 void Interpreter::State::local_offsets(int code, int column) {
-  const Vec3 before = local_offset;
+  const Vec3 before = frame.local_offset;
   if (code == kG92_1 || code == kG92_2) {
-    saved_local_offset = code == kG92_2 ? local_offset : Vec3(0.0);
-    local_offset = Vec3(0.0);
+    frame.saved_local_offset = code == kG92_2 ? frame.local_offset : Vec3(0.0);
+    frame.local_offset = Vec3(0.0);
   } else if (code == kG92_3) {
-    local_offset = saved_local_offset;
+    frame.local_offset = frame.saved_local_offset;
   } else {
     bool any = false;
     for (int i = 0; i < 3; ++i) {
@@ -654,24 +663,24 @@ void Interpreter::State::local_offsets(int code, int column) {
       any = true;
       double v = length(c);
       if (code == kG52) {
-        local_offset[i] = v;
+        frame.local_offset[i] = v;
       } else {
         // In raw rotary form "far" is along the turned tool, which any linear axis may follow.
-        bool along_axis = std::abs(axis[i]) > kAxisEps || raw_rotary();
-        if (far && along_axis)
+        bool along_axis = std::abs(tool.axis[i]) > kAxisEps || raw_rotary();
+        if (tool.far && along_axis)
           error(w.col(c),
                 std::string("G92 ") +=
                 c + std::string(" with the tool retracted far along its axis: its position is "
                                 "unknown (a machine file can set the start position)"));
-        local_offset[i] = linear_axes()[i] - work_offset[i] - v;
+        frame.local_offset[i] = linear_axes()[i] - frame.work_offset[i] - v;
       }
     }
     if (!any) error(column, code_name('G', code) + " needs X, Y or Z");
-    saved_local_offset = local_offset;
+    frame.saved_local_offset = frame.local_offset;
   }
   // Under a tilted plane only a code that leaves the offset as it is (LinuxCNC's tilted-plane
   // demos clear G52 to zero in a subroutine) is read: a shift there has no agreed meaning.
-  if (tilted && local_offset != before)
+  if (frame.tilted && frame.local_offset != before)
     error(column, code_name('G', code) +
                       " changes the local offset under a tilted plane (cancel it first)");
   update_frame();

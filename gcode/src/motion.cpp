@@ -14,14 +14,14 @@ void Interpreter::State::move_to(Vec3 target, const std::array<bool, 3>& set_abs
                                  const Mat3& rot, const Vec3& org, MoveKind kind,
                                  double move_feed) {
   auto to_frame_machine = [&](const Vec3& p) { return org + rot * p; };
-  if (!far) {
+  if (!tool.far) {
     Vec3 end = to_frame_machine(target);
-    emit(kind, pos, end, move_feed);
-    pos = end;
+    emit(kind, tool.pos, end, move_feed);
+    tool.pos = end;
     return;
   }
-  Vec3 current = glm::transpose(rot) * (pos - org);
-  Vec3 along = glm::transpose(rot) * axis;
+  Vec3 current = glm::transpose(rot) * (tool.pos - org);
+  Vec3 along = glm::transpose(rot) * tool.axis;
   bool any = false, all = true;
   for (int i = 0; i < 3; ++i) {
     if (std::abs(along[i]) <= kAxisEps) continue;
@@ -33,17 +33,17 @@ void Interpreter::State::move_to(Vec3 target, const std::array<bool, 3>& set_abs
     }
   }
   if (!any) {  // still far: only the lateral position changes
-    pos = to_frame_machine(target);
+    tool.pos = to_frame_machine(target);
     return;
   }
   if (!all)
-    error(motion_column,
+    error(context.motion_column,
           "the tool is retracted far along its axis and this move sets only some of the "
           "coordinates along the tool axis; set all of X, Y and Z to bring it back");
   Vec3 end = to_frame_machine(target);
-  emit(kind, end + machine.far_distance * axis, end, move_feed, true);
-  pos = end;
-  far = false;
+  emit(kind, end + machine.far_distance * tool.axis, end, move_feed, true);
+  tool.pos = end;
+  tool.far = false;
 }
 
 Interpreter::State::Target Interpreter::State::axis_word_target(const Vec3& current) {
@@ -52,8 +52,8 @@ Interpreter::State::Target Interpreter::State::axis_word_target(const Vec3& curr
     char c = kAxisLetter[i];
     if (!w.has(c)) continue;
     double v = length(c);
-    t.point[i] = incremental ? current[i] + v : v;
-    t.set[static_cast<std::size_t>(i)] = !incremental;
+    t.point[i] = modal.incremental ? current[i] + v : v;
+    t.set[static_cast<std::size_t>(i)] = !modal.incremental;
   }
   return t;
 }
@@ -61,38 +61,40 @@ Interpreter::State::Target Interpreter::State::axis_word_target(const Vec3& curr
 void Interpreter::State::linear(MoveKind kind, double move_feed) {
   // Under cutter compensation the programmed point, not the offset tip, is where coordinates
   // count from (and, just after G40, until the next move).
-  Vec3 current = comp.programmed_current ? comp.programmed : to_program(pos);
+  Vec3 current = comp.programmed_current ? comp.programmed : to_program(tool.pos);
   const auto [target, set] = axis_word_target(current);
   comp.programmed_current = false;
-  if (kind == MoveKind::feed && feed_mode == FeedMode::inverse_time) {
+  if (kind == MoveKind::feed && modal.feed_mode == FeedMode::inverse_time) {
     inverse_time_rate(glm::length(target - current));
-    move_feed = feed;
+    move_feed = modal.feed;
   }
   if (comp_active()) {
     comp_straight(kind, target, move_feed);
     return;
   }
   comp.arc_forbidden = false;
-  move_to(target, set, rotation, origin, kind, move_feed);
+  move_to(target, set, frame.rotation, frame.origin, kind, move_feed);
 }
 
 void Interpreter::State::require_feed() {
-  if (feed_mode == FeedMode::inverse_time) {  // LinuxCNC's checks (interp_convert.cc)
+  if (modal.feed_mode == FeedMode::inverse_time) {  // LinuxCNC's checks (interp_convert.cc)
     if (!w.has('F'))
-      error(motion_column,
+      error(context.motion_column,
             "F word missing with inverse time (G93) feed move: every G1, G2 and G3 "
             "block needs its own F");
-    if (!(inverse_time > 0)) error(w.col('F'), "inverse time (G93) F0: the move would never end");
+    if (!(modal.inverse_time > 0))
+      error(w.col('F'), "inverse time (G93) F0: the move would never end");
     return;
   }
-  if (feed_mode == FeedMode::per_revolution) {
-    if (!(feed_per_rev > 0))
-      error(motion_column, "feed move with no feed per revolution (F) set (G95)");
-    if (!(speed > 0))
-      error(motion_column, "cannot feed with zero spindle speed in feed per revolution mode (G95)");
+  if (modal.feed_mode == FeedMode::per_revolution) {
+    if (!(modal.feed_per_rev > 0))
+      error(context.motion_column, "feed move with no feed per revolution (F) set (G95)");
+    if (!(modal.speed > 0))
+      error(context.motion_column,
+            "cannot feed with zero spindle speed in feed per revolution mode (G95)");
     return;
   }
-  if (!(feed > 0)) {
+  if (!(modal.feed > 0)) {
     std::string left_out;
     if (w.vacant_words)
       for (const std::string& word : *w.vacant_words)
@@ -100,7 +102,7 @@ void Interpreter::State::require_feed() {
           left_out = ": this block's " + word +
                      " was left out, its value vacant (a variable the control keeps, such "
                      "as #500-#999, is set at the start by the machine file's \"variables\")";
-    error(motion_column, "feed move with no feed rate (F) set" + left_out);
+    error(context.motion_column, "feed move with no feed rate (F) set" + left_out);
   }
 }
 
@@ -108,14 +110,14 @@ void Interpreter::State::require_feed() {
 // and _arc measure it) takes 1/F minutes, so it runs at length × F mm/min. A block that does not
 // move takes no time at any rate; LinuxCNC gives it 0.1 units/min.
 void Interpreter::State::inverse_time_rate(double length) {
-  feed = length > 0 ? length * inverse_time : 0.1 * unit;
+  modal.feed = length > 0 ? length * modal.inverse_time : 0.1 * modal.unit;
 }
 
 // The length of the arc (a helix along the plane normal) from `start` (program frame) that
 // arc_data found, as LinuxCNC's find_arc_length: the start radius times the sweep, and the rise.
 double Interpreter::State::arc_length(const Vec3& start, const ArcData& a, bool ccw,
                                       int extra_turns) const {
-  const std::array<int, 3> axes = plane_axes(plane);
+  const std::array<int, 3> axes = plane_axes(modal.plane);
   double radius = glm::length(a.centre - Vec2(start[axes[0]], start[axes[1]]));
   double sweep = arc_sweep(start, a.end, a.centre, ccw) + 2 * kPi * extra_turns;
   return std::hypot(radius * sweep, a.end[axes[2]] - start[axes[2]]);
@@ -135,7 +137,7 @@ int Interpreter::State::arc_extra_turns() {
 // ---- arcs ----
 void Interpreter::State::arc(bool ccw) {
   if (comp.arc_forbidden)
-    error(motion_column,
+    error(context.motion_column,
           "the move just after turning cutter compensation off (G40) must be straight, "
           "not an arc (as LinuxCNC requires)");
   if (comp_active()) {
@@ -143,11 +145,11 @@ void Interpreter::State::arc(bool ccw) {
     comp_arc(ccw);
     return;
   }
-  if (far) {
+  if (tool.far) {
     // The far rule: a move that leaves the coordinates along the tool axis unset stays far and
     // only changes the lateral position (a 2D program's arcs before any Z cut nothing).
-    Vec3 along = glm::transpose(rotation) * axis;
-    Vec3 target = to_program(pos);
+    Vec3 along = glm::transpose(frame.rotation) * tool.axis;
+    Vec3 target = to_program(tool.pos);
     for (int i = 0; i < 3; ++i) {
       char c = kAxisLetter[i];
       if (!w.has(c)) continue;
@@ -155,34 +157,34 @@ void Interpreter::State::arc(bool ccw) {
         error(w.col(c),
               "arc from a retracted position that also moves along the tool axis: the "
               "tool is far along its axis and its start is unknown; position it first");
-      target[i] = incremental ? target[i] + length(c) : length(c);
+      target[i] = modal.incremental ? target[i] + length(c) : length(c);
     }
     for (char c : {'I', 'J', 'K', 'R'})
       if (w.has(c)) w.take(c);
     arc_extra_turns();
-    pos = to_machine(target);
+    tool.pos = to_machine(target);
     return;
   }
   require_feed();
-  Vec3 start = to_program(pos);
+  Vec3 start = to_program(tool.pos);
   ArcData a = arc_data(start, ccw);
   const int extra_turns = arc_extra_turns();
-  if (feed_mode == FeedMode::inverse_time)
+  if (modal.feed_mode == FeedMode::inverse_time)
     inverse_time_rate(arc_length(start, a, ccw, extra_turns));
   arc_chords(start, a.end, a.centre, ccw,
-             arc_sweep(start, a.end, a.centre, ccw) + 2 * kPi * extra_turns, feed);
-  pos = to_machine(a.end);
+             arc_sweep(start, a.end, a.centre, ccw) + 2 * kPi * extra_turns, modal.feed);
+  tool.pos = to_machine(a.end);
 }
 
 // The end point and centre of the G2/G3 of this block from `start` (program frame), with
 // RS274/NGC's checks: I/J/K or R, radii that agree, a radius long enough for its chord.
 Interpreter::State::ArcData Interpreter::State::arc_data(const Vec3& start, bool ccw) {
-  const std::array<int, 3> axes = plane_axes(plane);
+  const std::array<int, 3> axes = plane_axes(modal.plane);
   const int u = axes[0], v = axes[1];
   Vec3 end = start;
   for (int i = 0; i < 3; ++i) {
     char c = kAxisLetter[i];
-    if (w.has(c)) end[i] = incremental ? start[i] + length(c) : length(c);
+    if (w.has(c)) end[i] = modal.incremental ? start[i] + length(c) : length(c);
   }
   char cu = kCenterLetter[u], cv = kCenterLetter[v];
   bool has_center = w.has(cu) || w.has(cv);
@@ -190,36 +192,40 @@ Interpreter::State::ArcData Interpreter::State::arc_data(const Vec3& start, bool
   if (has_center && has_radius)
     error(w.col('R'), "arc with both R and " + std::string(1, cu) + "/" + cv + " words");
   if (!has_center && !has_radius)
-    error(motion_column,
-          std::string("arc needs ") + cu + "/" + cv + " (in " + code_name('G', plane) + ") or R");
+    error(context.motion_column, std::string("arc needs ") + cu + "/" + cv + " (in " +
+                                     code_name('G', modal.plane) + ") or R");
   Vec2 s(start[u], start[v]), e(end[u], end[v]), c;
   ArcData result;
   result.end = end;
   if (has_center) {
-    if (arc_absolute) {
+    if (modal.arc_absolute) {
       if (!w.has(cu) || !w.has(cv))
-        error(motion_column, std::string("arc centre under G90.1 needs both ") + cu + " and " + cv);
+        error(context.motion_column,
+              std::string("arc centre under G90.1 needs both ") + cu + " and " + cv);
       c = Vec2(length(cu), length(cv));
     } else {
       c = s + Vec2(w.has(cu) ? length(cu) : 0.0, w.has(cv) ? length(cv) : 0.0);
     }
     double r0 = glm::length(s - c);
     double r1 = glm::length(e - c);
-    if (!(r0 > 1e-9)) error(motion_column, "zero-radius arc: the centre is the start point");
-    if (!(r1 > 1e-9)) error(motion_column, "zero-radius arc: the centre is the end point");
+    if (!(r0 > 1e-9))
+      error(context.motion_column, "zero-radius arc: the centre is the start point");
+    if (!(r1 > 1e-9)) error(context.motion_column, "zero-radius arc: the centre is the end point");
     double err = std::abs(r1 - r0);
     if (machine.dialect == Dialect::linuxcnc) {
       // LinuxCNC 2.9 (interp_arc.cc arc_data_ijk) cuts a spiral where the radii differ by up to
       // 0.002·√2 in (0.02·√2 mm under G21), or by 100 times that within 0.1 % of the radius.
-      double spiral = (unit == 1.0 ? 0.02 : 0.002 * 25.4) * std::numbers::sqrt2;
+      double spiral = (modal.unit == 1.0 ? 0.02 : 0.002 * 25.4) * std::numbers::sqrt2;
       if (err > 100 * spiral || (err / std::max(r0, r1) > 0.001 && err > spiral))
-        error(motion_column, "arc end radius " + format_number(r1) + " differs from start radius " +
-                                 format_number(r0) + " by more than LinuxCNC's spiral tolerance (" +
-                                 format_number(spiral) + " mm, or 0.1 % of the radius)");
+        error(context.motion_column, "arc end radius " + format_number(r1) +
+                                         " differs from start radius " + format_number(r0) +
+                                         " by more than LinuxCNC's spiral tolerance (" +
+                                         format_number(spiral) + " mm, or 0.1 % of the radius)");
     } else if (err > machine.arc_radius_tolerance) {
-      error(motion_column, "arc end radius " + format_number(r1) + " differs from start radius " +
-                               format_number(r0) + " by more than " +
-                               format_number(machine.arc_radius_tolerance) + " mm");
+      error(context.motion_column, "arc end radius " + format_number(r1) +
+                                       " differs from start radius " + format_number(r0) +
+                                       " by more than " +
+                                       format_number(machine.arc_radius_tolerance) + " mm");
     }
   } else {
     double r = length('R');
@@ -247,7 +253,7 @@ Interpreter::State::ArcData Interpreter::State::arc_data(const Vec3& start, bool
 // (0, 2π], a full circle when the two points coincide.
 double Interpreter::State::arc_sweep(const Vec3& start, const Vec3& end, const Vec2& c,
                                      bool ccw) const {
-  const std::array<int, 3> axes = plane_axes(plane);
+  const std::array<int, 3> axes = plane_axes(modal.plane);
   const int u = axes[0], v = axes[1];
   Vec2 s(start[u], start[v]), e(end[u], end[v]);
   double a0 = std::atan2(s.y - c.y, s.x - c.x);
@@ -264,7 +270,7 @@ double Interpreter::State::arc_sweep(const Vec3& start, const Vec3& end, const V
 // change linearly (helices, and I/J/K arcs whose end radius differs slightly).
 void Interpreter::State::arc_chords(const Vec3& start, const Vec3& end, const Vec2& c, bool ccw,
                                     double sweep, double move_feed) {
-  const std::array<int, 3> axes = plane_axes(plane);
+  const std::array<int, 3> axes = plane_axes(modal.plane);
   const int u = axes[0], v = axes[1], n = axes[2];
   Vec2 s(start[u], start[v]), e(end[u], end[v]);
   double r0 = glm::length(s - c), r1 = glm::length(e - c);
@@ -275,12 +281,12 @@ void Interpreter::State::arc_chords(const Vec3& start, const Vec3& end, const Ve
     double step = 2 * std::acos(1 - options.arc_tolerance / r);
     double count = std::ceil(sweep / step);
     if (!(count <= static_cast<double>(kMaxArcPieces)))
-      error(motion_column, "arc of radius " + format_number(r) + " needs more than " +
-                               std::to_string(kMaxArcPieces) + " pieces at this tolerance");
+      error(context.motion_column, "arc of radius " + format_number(r) + " needs more than " +
+                                       std::to_string(kMaxArcPieces) + " pieces at this tolerance");
     pieces = std::max(1LL, static_cast<long long>(count));
   }
   double sign = ccw ? 1.0 : -1.0;
-  Vec3 previous = pos;
+  Vec3 previous = tool.pos;
   for (long long k = 1; k <= pieces; ++k) {
     Vec3 p = end;
     if (k < pieces) {
@@ -295,7 +301,7 @@ void Interpreter::State::arc_chords(const Vec3& start, const Vec3& end, const Ve
     emit(MoveKind::arc, previous, m, move_feed);
     previous = m;
   }
-  pos = to_machine(end);
+  tool.pos = to_machine(end);
 }
 
 // ---- straight probes ----
@@ -308,32 +314,34 @@ void Interpreter::State::arc_chords(const Vec3& start, const Vec3& end, const Ve
 void Interpreter::State::probe(int code) {
   const std::string name = code_name('G', code);
   if (comp.side != 0)
-    error(motion_column, name + ": cannot probe with cutter radius compensation on");
-  if (feed_mode == FeedMode::per_revolution)
-    error(motion_column, name + ": cannot probe in feed per revolution mode (G95)");
-  if (!(feed > 0)) error(motion_column, name + ": cannot probe with zero feed rate");
-  Vec3 current = comp.programmed_current ? comp.programmed : to_program(pos);
+    error(context.motion_column, name + ": cannot probe with cutter radius compensation on");
+  if (modal.feed_mode == FeedMode::per_revolution)
+    error(context.motion_column, name + ": cannot probe in feed per revolution mode (G95)");
+  if (!(modal.feed > 0)) error(context.motion_column, name + ": cannot probe with zero feed rate");
+  Vec3 current = comp.programmed_current ? comp.programmed : to_program(tool.pos);
   const auto [target, set] = axis_word_target(current);
   comp.programmed_current = false;
   comp.arc_forbidden = false;
   const bool must_move = code == kG38_2 || code == kG38_4;  // G38.3/G38.5 may stand still
   if (must_move && target == current)
-    error(motion_column, name + ": start point too close to probe point (the probe does not move)");
+    error(context.motion_column,
+          name + ": start point too close to probe point (the probe does not move)");
   if (!warned_once.probe) {
     warned_once.probe = true;
-    warn(motion_column, name +
-                            " read as LinuxCNC's rs274 standalone does: the probe reaches the "
-                            "programmed point and backs off 0.254 mm; where it really touches is "
-                            "known only on the machine");
+    warn(context.motion_column,
+         name +
+             " read as LinuxCNC's rs274 standalone does: the probe reaches the "
+             "programmed point and backs off 0.254 mm; where it really touches is "
+             "known only on the machine");
   }
-  move_to(target, set, rotation, origin, MoveKind::feed, feed);
-  for (int i = 0; i < 3; ++i) parameters.globals[5061 + i] = Value{target[i] / unit, false};
+  move_to(target, set, frame.rotation, frame.origin, MoveKind::feed, modal.feed);
+  for (int i = 0; i < 3; ++i) parameters.globals[5061 + i] = Value{target[i] / modal.unit, false};
   parameters.globals[5070] = Value{0, false};
   double distance = glm::length(target - current);
-  if (far || !(distance > 0)) return;
+  if (tool.far || !(distance > 0)) return;
   Vec3 back = to_machine(target + 0.254 * (current - target) / distance);
-  emit(MoveKind::feed, pos, back, feed);
-  pos = back;
+  emit(MoveKind::feed, tool.pos, back, modal.feed);
+  tool.pos = back;
 }
 
 // ---- canned cycles ----
@@ -347,37 +355,38 @@ bool cycle_dwells(int code) {
 // A canned cycle's block: its sticky words, the levels along its axis, then each hole (L or K
 // repeats) in turn.
 void Interpreter::State::cycle(int code) {
-  const std::array<int, 3> axes = plane_axes(plane);
+  const std::array<int, 3> axes = plane_axes(modal.plane);
   const int u = axes[0], v = axes[1], n = axes[2];
-  Vec3 drill = rotation[n];  // cycle axis in machine coordinates
-  if (glm::dot(drill, axis) < 1 - 1e-9)
-    error(motion_column, code_name('G', code) + " drills along the " + code_name('G', plane) +
-                             " plane normal, which is not the spindle direction");
+  Vec3 drill = frame.rotation[n];  // cycle axis in machine coordinates
+  if (glm::dot(drill, tool.axis) < 1 - 1e-9)
+    error(context.motion_column, code_name('G', code) + " drills along the " +
+                                     code_name('G', modal.plane) +
+                                     " plane normal, which is not the spindle direction");
   const long long repeats = cycle_words(code, kAxisLetter[n]);
 
-  Vec3 current = to_program(pos);
+  Vec3 current = to_program(tool.pos);
   const CycleLevels levels = cycle_levels(code, current[n]);
 
   // Lateral target of the first hole; increments repeat under G91.
   double du = w.has(kAxisLetter[u]) ? length(kAxisLetter[u]) : 0.0;
   double dv = w.has(kAxisLetter[v]) ? length(kAxisLetter[v]) : 0.0;
-  double hole_u = incremental ? current[u] : (w.has(kAxisLetter[u]) ? du : current[u]);
-  double hole_v = incremental ? current[v] : (w.has(kAxisLetter[v]) ? dv : current[v]);
+  double hole_u = modal.incremental ? current[u] : (w.has(kAxisLetter[u]) ? du : current[u]);
+  double hole_v = modal.incremental ? current[v] : (w.has(kAxisLetter[v]) ? dv : current[v]);
   // LinuxCNC's polar words under G91 (polar_words() left them): each repeat moves the hole out
   // by @ and turns it by ^ about the program origin (CYCLE_MACRO, interp_cycles.cc).
   double step_radius = w.has('@') ? length('@') : 0.0;
   double step_angle = w.has('^') ? glm::radians(w.take('^')) : 0.0;
 
-  if (!far && current[n] < levels.r_level - 1e-9)
+  if (!tool.far && current[n] < levels.r_level - 1e-9)
     cycle_rapid(cycle_point(current[u], current[v], levels.r_level));
   for (long long k = 0; k < repeats; ++k) {
-    if (incremental) {
+    if (modal.incremental) {
       hole_u += du;
       hole_v += dv;
     }
     if (step_radius != 0 || step_angle != 0) {
       if (hole_u == 0 && hole_v == 0)
-        error(motion_column,
+        error(context.motion_column,
               "incremental (G91) polar coordinates at the origin: the direction is unknown");
       double radius = std::hypot(hole_u, hole_v) + step_radius;
       double angle = std::atan2(hole_v, hole_u) + step_angle;
@@ -405,7 +414,7 @@ long long Interpreter::State::cycle_words(int code, char depth_letter) {
       canned.has_q = true;
     }
     if (!canned.has_q || !(canned.q > 0))
-      error(motion_column, code_name('G', code) + " needs a positive peck depth Q");
+      error(context.motion_column, code_name('G', code) + " needs a positive peck depth Q");
   }
   // The cycles that dwell at the bottom read P. Fanuc and Haas keep P as modal cycle data in any
   // cycle (a post writes it on G81 too), for a later one that dwells.
@@ -414,13 +423,15 @@ long long Interpreter::State::cycle_words(int code, char depth_letter) {
     if (p < 0) error(w.col('P'), "dwell P must not be negative");
     canned.dwell = dwell_seconds(p);
   }
-  if (feed_mode == FeedMode::inverse_time)
-    error(motion_column, code_name('G', code) +
-                             ": canned cycles cannot run in inverse time feed "
-                             "(G93), as LinuxCNC requires; G94 first");
-  if (!canned.has_r) error(motion_column, code_name('G', code) + " needs R (retract plane)");
+  if (modal.feed_mode == FeedMode::inverse_time)
+    error(context.motion_column, code_name('G', code) +
+                                     ": canned cycles cannot run in inverse time feed "
+                                     "(G93), as LinuxCNC requires; G94 first");
+  if (!canned.has_r)
+    error(context.motion_column, code_name('G', code) + " needs R (retract plane)");
   if (!canned.has_z)
-    error(motion_column, code_name('G', code) + " needs " + depth_letter + " (hole bottom)");
+    error(context.motion_column,
+          code_name('G', code) + " needs " + depth_letter + " (hole bottom)");
   require_feed();
   if (w.has('L') && w.has('K')) error(w.col('K'), "repeat count given twice (L and K)");
   if (w.has('L') && (code == kG74 || code == kG84) && machine.dialect == Dialect::linuxcnc)
@@ -437,39 +448,39 @@ long long Interpreter::State::cycle_words(int code, char depth_letter) {
 Interpreter::State::CycleLevels Interpreter::State::cycle_levels(int code, double current) {
   if (!canned.active) {
     canned.active = true;
-    canned.initial_far = far;
+    canned.initial_far = tool.far;
     canned.initial = current;
   }
-  if (far && incremental)
-    error(motion_column, "incremental canned cycle from a retracted (far) position");
+  if (tool.far && modal.incremental)
+    error(context.motion_column, "incremental canned cycle from a retracted (far) position");
   // G91: R counts from the initial level of the cycle (kept while the cycle mode lasts, as
   // LinuxCNC's cycle_il and Fanuc's initial point), not from where the last hole left the tool.
   double incremental_base = canned.initial_far ? current : canned.initial;
-  double r_level = incremental ? incremental_base + canned.r : canned.r;
-  double bottom = incremental ? r_level + canned.z : canned.z;
+  double r_level = modal.incremental ? incremental_base + canned.r : canned.r;
+  double bottom = modal.incremental ? r_level + canned.z : canned.z;
   if (bottom > r_level)
-    error(motion_column, "hole bottom " + format_number(bottom) + " is above the R plane " +
-                             format_number(r_level));
+    error(context.motion_column, "hole bottom " + format_number(bottom) + " is above the R plane " +
+                                     format_number(r_level));
   if (code == kG73 || code == kG83) {
     // A real control pecks a hole a few hundred times at most; a tiny Q against a deep hole
     // (or a far R plane) would emit moves without end, and below one ulp would never finish.
     constexpr double kMaxPecks = 100000;
     double pecks = (r_level - bottom) / canned.q;
     if (!(pecks <= kMaxPecks))
-      error(motion_column, code_name('G', code) + " would peck " + format_number(pecks) +
-                               " times (R " + format_number(r_level) + " to " +
-                               format_number(bottom) + " by Q " + format_number(canned.q) +
-                               "); at most 100000 per hole");
+      error(context.motion_column, code_name('G', code) + " would peck " + format_number(pecks) +
+                                       " times (R " + format_number(r_level) + " to " +
+                                       format_number(bottom) + " by Q " + format_number(canned.q) +
+                                       "); at most 100000 per hole");
   }
-  bool clear_far = !retract_to_r && canned.initial_far;
-  double clear = retract_to_r ? r_level : std::max(canned.initial, r_level);
+  bool clear_far = !modal.retract_to_r && canned.initial_far;
+  double clear = modal.retract_to_r ? r_level : std::max(canned.initial, r_level);
   if (clear_far) clear = r_level;
   return CycleLevels{r_level, bottom, clear, clear_far};
 }
 
 // A point of the cycle: (u, v) in the plane and `depth` along its normal, program frame.
 Vec3 Interpreter::State::cycle_point(double u_coordinate, double v_coordinate, double depth) const {
-  const std::array<int, 3> axes = plane_axes(plane);
+  const std::array<int, 3> axes = plane_axes(modal.plane);
   Vec3 p;
   p[axes[0]] = u_coordinate;
   p[axes[1]] = v_coordinate;
@@ -478,31 +489,31 @@ Vec3 Interpreter::State::cycle_point(double u_coordinate, double v_coordinate, d
 }
 
 void Interpreter::State::cycle_rapid(const Vec3& to) {
-  emit(MoveKind::cycle, pos, to, 0.0);
-  pos = to;
+  emit(MoveKind::cycle, tool.pos, to, 0.0);
+  tool.pos = to;
 }
 
 void Interpreter::State::cycle_cut(const Vec3& to) {
-  emit(MoveKind::cycle, pos, to, feed);
-  pos = to;
+  emit(MoveKind::cycle, tool.pos, to, modal.feed);
+  tool.pos = to;
 }
 
 // One hole: onto its R plane, down (pecking for G73 and G83), the dwell, and out to the clear
 // level.
 void Interpreter::State::cycle_hole(int code, double hole_u, double hole_v,
                                     const CycleLevels& levels) {
-  const int n = plane_axes(plane)[2];
+  const int n = plane_axes(modal.plane)[2];
   const double r_level = levels.r_level, bottom = levels.bottom, clear = levels.clear;
   const bool clear_far = levels.clear_far;
   auto at = [&](double uu, double vv, double depth) { return cycle_point(uu, vv, depth); };
-  if (far) {
+  if (tool.far) {
     // Come back from far straight down the axis onto the R plane of the hole.
     Vec3 r_point = at(hole_u, hole_v, r_level);
-    emit(MoveKind::cycle, r_point + machine.far_distance * axis, r_point, 0.0, true);
-    pos = r_point;
-    far = false;
+    emit(MoveKind::cycle, r_point + machine.far_distance * tool.axis, r_point, 0.0, true);
+    tool.pos = r_point;
+    tool.far = false;
   } else {
-    Vec3 level = to_program(pos);
+    Vec3 level = to_program(tool.pos);
     cycle_rapid(at(hole_u, hole_v, level[n]));
     cycle_rapid(at(hole_u, hole_v, r_level));
   }
@@ -544,8 +555,8 @@ void Interpreter::State::cycle_hole(int code, double hole_u, double hole_v,
       break;
   }
   Vec3 out = at(hole_u, hole_v, clear);
-  if (out != pos) cycle_rapid(out);
-  if (clear_far) far = true;
+  if (out != tool.pos) cycle_rapid(out);
+  if (clear_far) tool.far = true;
 }
 
 // ---- LinuxCNC polar coordinates ----
@@ -560,22 +571,22 @@ void Interpreter::State::polar_words(bool axis_consumer, int nonmodal) {
   if (machine.dialect != Dialect::linuxcnc)
     error(column, "'@' and '^' (polar coordinates) are LinuxCNC's words: use --machine linuxcnc");
   if (nonmodal == kG53) error(column, "polar coordinates cannot be used with G53");
-  bool moving =
-      motion == kG0 || motion == kG1 || motion == kG2 || motion == kG3 || is_cycle(motion);
+  bool moving = modal.motion == kG0 || modal.motion == kG1 || modal.motion == kG2 ||
+                modal.motion == kG3 || is_cycle(modal.motion);
   if (axis_consumer || nonmodal == kG28 || nonmodal == kG30 || !moving)
     error(column, "polar coordinates can only be used for motion (G0, G1, G2, G3 or a cycle)");
-  if (plane != kG17) error(column, "polar coordinates need the XY plane (G17)");
+  if (modal.plane != kG17) error(column, "polar coordinates need the XY plane (G17)");
   for (char c : {'X', 'Y'})
     if (w.has(c))
       error(w.col(c), std::string("polar coordinates and an ") + c + " word in the same block");
-  bool cycle_block = is_cycle(motion);
-  if (cycle_block && incremental) return;  // a step of every repeat: cycle() reads the words
-  Vec3 current = (comp.programmed_current ? comp.programmed : to_program(pos)) / unit;
+  bool cycle_block = is_cycle(modal.motion);
+  if (cycle_block && modal.incremental) return;  // a step of every repeat: cycle() reads the words
+  Vec3 current = (comp.programmed_current ? comp.programmed : to_program(tool.pos)) / modal.unit;
   double x = current.x, y = current.y;
   bool has_radius = w.has('@'), has_angle = w.has('^');
   double radius = has_radius ? w.take('@') : 0, angle = has_angle ? glm::radians(w.take('^')) : 0;
   bool at_origin = x == 0 && y == 0;
-  if (!incremental) {
+  if (!modal.incremental) {
     if (!has_angle && at_origin && !cycle_block)
       error(column, "polar radius without an angle at the origin: the direction is unknown");
     if (!has_radius) radius = std::hypot(x, y);
@@ -591,7 +602,8 @@ void Interpreter::State::polar_words(bool axis_consumer, int nonmodal) {
   for (char c : {'X', 'Y'}) {
     std::size_t i = static_cast<std::size_t>(letter_index(c));
     w.present |= 1u << i;
-    w.value[i] = c == 'X' ? (incremental ? new_x - x : new_x) : (incremental ? new_y - y : new_y);
+    w.value[i] = c == 'X' ? (modal.incremental ? new_x - x : new_x)
+                          : (modal.incremental ? new_y - y : new_y);
     w.column[i] = column;
   }
 }
@@ -606,30 +618,30 @@ void Interpreter::State::polar_words(bool axis_consumer, int nonmodal) {
 void Interpreter::State::machine_move(const Vec3& gauge, unsigned mask, MoveKind kind,
                                       double move_feed) {
   Vec3 target = tip_below(gauge);
-  Vec3 end = pos;
+  Vec3 end = tool.pos;
   for (int i = 0; i < 3; ++i)
     if ((mask >> i) & 1u) end[i] = target[i];
-  bool along_z = glm::dot(axis, Vec3(0, 0, 1)) >= 1 - kSameDirection;
-  if (machine.g53_literal && along_z && far) {
-    pos = end;
-    if (mask & 4u) far = false;  // the height is now known
+  bool along_z = glm::dot(tool.axis, Vec3(0, 0, 1)) >= 1 - kSameDirection;
+  if (machine.g53_literal && along_z && tool.far) {
+    tool.pos = end;
+    if (mask & 4u) tool.far = false;  // the height is now known
     return;
   }
-  if (((mask & 4u) && !(machine.g53_literal && along_z)) || far) {
-    pos = end;
-    far = true;
+  if (((mask & 4u) && !(machine.g53_literal && along_z)) || tool.far) {
+    tool.pos = end;
+    tool.far = true;
     return;
   }
   if (!along_z)
-    error(motion_column,
+    error(context.motion_column,
           "G53 X/Y with a tilted tool depends on the machine's kinematics; "
           "retract with G53 Z (or G28) first");
-  if (kind == MoveKind::feed && feed_mode == FeedMode::inverse_time) {
-    inverse_time_rate(glm::length(end - pos));
-    move_feed = feed;
+  if (kind == MoveKind::feed && modal.feed_mode == FeedMode::inverse_time) {
+    inverse_time_rate(glm::length(end - tool.pos));
+    move_feed = modal.feed;
   }
-  emit(kind, pos, end, move_feed);
-  pos = end;
+  emit(kind, tool.pos, end, move_feed);
+  tool.pos = end;
 }
 
 void Interpreter::State::home_return(bool second) {
@@ -647,11 +659,12 @@ void Interpreter::State::home_return(bool second) {
   // the tool only when one of them was not at zero already; without one, only when the tool
   // was oriented off +Z (G53.1 and the like), which the return brings back. Otherwise the
   // linear axes return as if no rotary word were given (a 4-axis post's `G28 X0 Y0 A0`).
-  bool turns = rotary && !machine.kinematics && glm::dot(axis, Vec3(0, 0, 1)) < 1 - kSameDirection;
+  bool turns =
+      rotary && !machine.kinematics && glm::dot(tool.axis, Vec3(0, 0, 1)) < 1 - kSameDirection;
   for (char c : {'A', 'B', 'C'})
     if (w.has(c)) {
       w.take(c);
-      double& angle = rotary_position[static_cast<std::size_t>(rotary_index(c))];
+      double& angle = frame.rotary_position[static_cast<std::size_t>(rotary_index(c))];
       turns = turns || (machine.kinematics && angle != 0);
       angle = 0;
     }
@@ -672,33 +685,33 @@ void Interpreter::State::home_return(bool second) {
   // With the tool along +Z, returning X/Y only is a plain rapid at the current height (on any
   // machine). Anything else is a retract: the tip goes far along the tool axis, the homed
   // axes' coordinates kept for the lateral position.
-  if (mask && !(mask & 4u) && !turns && !far &&
-      glm::dot(axis, Vec3(0, 0, 1)) >= 1 - kSameDirection) {
+  if (mask && !(mask & 4u) && !turns && !tool.far &&
+      glm::dot(tool.axis, Vec3(0, 0, 1)) >= 1 - kSameDirection) {
     machine_move(target, mask, MoveKind::rapid, 0.0);
     return;
   }
   // A machine file that sets the position makes the return a known rapid (tool along +Z: the
   // machine's axes are the work's).
-  if (!is_default && !turns && glm::dot(axis, Vec3(0, 0, 1)) >= 1 - kSameDirection) {
-    Vec3 end = pos;
+  if (!is_default && !turns && glm::dot(tool.axis, Vec3(0, 0, 1)) >= 1 - kSameDirection) {
+    Vec3 end = tool.pos;
     for (int i = 0; i < 3; ++i)
       if ((mask >> i) & 1u) end[i] = tip_below(target)[i];
-    if (!far) {
-      emit(MoveKind::rapid, pos, end, 0.0);
-      pos = end;
+    if (!tool.far) {
+      emit(MoveKind::rapid, tool.pos, end, 0.0);
+      tool.pos = end;
       return;
     }
-    pos = end;
-    if (mask & 4u) far = false;  // the height is now known
+    tool.pos = end;
+    if (mask & 4u) tool.far = false;  // the height is now known
     return;
   }
   for (int i = 0; i < 3; ++i)
-    if ((mask >> i) & 1u) pos[i] = target[i];
-  far = true;
+    if ((mask >> i) & 1u) tool.pos[i] = target[i];
+  tool.far = true;
   if (turns) {
     // The tip goes far while the axes turn; the direction follows the kinematic model.
-    axis =
-        machine.kinematics ? tool_direction(*machine.kinematics, rotary_position) : Vec3(0, 0, 1);
+    tool.axis = machine.kinematics ? tool_direction(*machine.kinematics, frame.rotary_position)
+                                   : Vec3(0, 0, 1);
     update_frame();
   }
 }

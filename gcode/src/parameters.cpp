@@ -71,67 +71,67 @@ std::optional<OffsetRegister> offset_register(int n, Dialect dialect) {
 Value Interpreter::State::numbered(int n) {
   if (n == 0) return Value{0, true};
   if (n <= 33) return parameters.scopes.back().locals[static_cast<std::size_t>(n)];
-  Vec3 program = to_program(pos);  // the end of the last block: the tip is there
+  Vec3 program = to_program(tool.pos);  // the end of the last block: the tip is there
   switch (n) {
     // Fanuc modal information of the block before (#4001 + group − 1).
     case 4001:
-      return number(motion < 0 ? 0 : motion / 10.0);
+      return number(modal.motion < 0 ? 0 : modal.motion / 10.0);
     case 4002:
-      return number(plane / 10.0);
+      return number(modal.plane / 10.0);
     case 4003:
-      return number(incremental ? 91 : 90);
+      return number(modal.incremental ? 91 : 90);
     case 4005:
-      return number(feed_mode == FeedMode::inverse_time ? 93
-                    : feed_mode == FeedMode::per_minute ? 94
-                                                        : 95);
+      return number(modal.feed_mode == FeedMode::inverse_time ? 93
+                    : modal.feed_mode == FeedMode::per_minute ? 94
+                                                              : 95);
     case 4006:
-      return number(unit == 1.0 ? 21 : 20);
+      return number(modal.unit == 1.0 ? 21 : 20);
     case 4007:
       return number(comp.side == 0 ? 40 : comp.side > 0 ? 41 : 42);
     case 4008:
       return number(49);
     case 4009:
-      return number(is_cycle(motion) ? motion / 10.0 : 80);
+      return number(is_cycle(modal.motion) ? modal.motion / 10.0 : 80);
     case 4010:
-      return number(retract_to_r ? 99 : 98);
+      return number(modal.retract_to_r ? 99 : 98);
     case 4014:
-      return number(work_key >= 100 ? 54.1 : 53 + work_key);
+      return number(frame.work_key >= 100 ? 54.1 : 53 + frame.work_key);
     case 4109:
       return number(programmed_feed());
     case 4119:
-      return number(speed);
+      return number(modal.speed);
     case 4120:
-      return number(tool);
+      return number(tool.number);
     case 5001:
     case 5002:
     case 5003:
-      return number(program[n - 5001] / unit);
+      return number(program[n - 5001] / modal.unit);
     case 5041:
     case 5042:
     case 5043:
-      return number(program[n - 5041] / unit);
+      return number(program[n - 5041] / modal.unit);
     case 5021:
     case 5022:
     case 5023:
-      return number(pos[n - 5021] / unit);
+      return number(tool.pos[n - 5021] / modal.unit);
     // LinuxCNC: the active coordinate system (1 = G54), the tool, the current position.
     case 5220:
-      return number(work_key >= 100 ? 0 : work_key);
+      return number(frame.work_key >= 100 ? 0 : frame.work_key);
     case 5400:
-      return number(tool);
+      return number(tool.number);
     // The loaded tool's diameter as LinuxCNC's tool table holds it (rs274ngc_pre.cc,
     // set_tool_parameters: parameters[5410] = tool_table[0].diameter): in the table's units, the
     // machine's (inches for rs274 run standalone), not the program's; 0 with no tool or one the
     // table lacks. ngcgui's subroutines size their entry moves from it (#<tooldiam> = #5410).
     case 5410:
       if (machine.dialect != Dialect::linuxcnc) break;
-      if (auto d = machine.tool_diameters.find(tool); d != machine.tool_diameters.end())
+      if (auto d = machine.tool_diameters.find(tool.number); d != machine.tool_diameters.end())
         return number(d->second / (machine.tool_table_in_inches ? 25.4 : 1.0));
       return number(0);
     case 5420:
     case 5421:
     case 5422:
-      return number(program[n - 5420] / unit);
+      return number(program[n - 5420] / modal.unit);
     case 5423:
     case 5424:
     case 5425:
@@ -139,23 +139,24 @@ Value Interpreter::State::numbered(int n) {
     case 5426:
     case 5427:
     case 5428:
-      return number(uvw_position[n - 5426] / unit);
+      return number(tool.uvw_position[n - 5426] / modal.unit);
     default:
       break;
   }
   int component = 0;
   if (int key = offset_variable(n, component); key >= 0) {
-    auto it = offsets.find(key);
-    return number(it == offsets.end() ? 0.0 : it->second[component] / unit);
+    auto it = frame.offsets.find(key);
+    return number(it == frame.offsets.end() ? 0.0 : it->second[component] / modal.unit);
   }
   if (auto r = offset_register(n, machine.dialect)) {
     // H: what G43 reads (a geometry never set is the machine's length of that tool). D: what the
     // program wrote, else the tool table's radius or diameter, as the machine's D registers hold.
     if (r->length)
       return number((r->wear ? wear_of(r->number) : length_geometry(r->number).value_or(0.0)) /
-                    unit);
+                    modal.unit);
     const std::map<int, double>& written = r->wear ? comp.d_wear : comp.d_geometry;
-    if (auto it = written.find(r->number); it != written.end()) return number(it->second / unit);
+    if (auto it = written.find(r->number); it != written.end())
+      return number(it->second / modal.unit);
     if (r->wear) return number(0);
     const std::optional<double> scale = d_register_scale();
     if (!scale)
@@ -164,8 +165,9 @@ Value Interpreter::State::numbered(int n) {
                    "say which with \"d_offsets\" in the machine file, or set it in the program "
                    "before reading it");
     auto diameter = machine.tool_diameters.find(r->number);
-    return number(diameter == machine.tool_diameters.end() ? 0.0
-                                                           : diameter->second / 2 / *scale / unit);
+    return number(diameter == machine.tool_diameters.end()
+                      ? 0.0
+                      : diameter->second / 2 / *scale / modal.unit);
   }
   auto it = parameters.globals.find(n);
   if (it != parameters.globals.end()) return it->second;
@@ -176,29 +178,32 @@ Value Interpreter::State::numbered(int n) {
 std::optional<Value> Interpreter::State::named(std::string_view name) {
   std::string key(name);
   if (!key.empty() && key[0] == '_') {
-    Vec3 program = to_program(pos);
-    if (key == "_x" || key == "_y" || key == "_z") return number(program[key[1] - 'x'] / unit);
-    if (key == "_u" || key == "_v" || key == "_w") return number(uvw_position[key[1] - 'u'] / unit);
-    if (key == "_current_tool") return number(tool);
-    if (key == "_selected_tool") return number(tool_selected);
-    if (key == "_metric") return number(unit == 1.0 ? 1 : 0);
-    if (key == "_imperial") return number(unit == 1.0 ? 0 : 1);
-    if (key == "_absolute") return number(incremental ? 0 : 1);
-    if (key == "_incremental") return number(incremental ? 1 : 0);
+    Vec3 program = to_program(tool.pos);
+    if (key == "_x" || key == "_y" || key == "_z")
+      return number(program[key[1] - 'x'] / modal.unit);
+    if (key == "_u" || key == "_v" || key == "_w")
+      return number(tool.uvw_position[key[1] - 'u'] / modal.unit);
+    if (key == "_current_tool") return number(tool.number);
+    if (key == "_selected_tool") return number(tool.selected);
+    if (key == "_metric") return number(modal.unit == 1.0 ? 1 : 0);
+    if (key == "_imperial") return number(modal.unit == 1.0 ? 0 : 1);
+    if (key == "_absolute") return number(modal.incremental ? 0 : 1);
+    if (key == "_incremental") return number(modal.incremental ? 1 : 0);
     if (key == "_feed") return number(programmed_feed());
-    if (key == "_inverse_time") return number(feed_mode == FeedMode::inverse_time ? 1 : 0);
-    if (key == "_units_per_minute") return number(feed_mode == FeedMode::per_minute ? 1 : 0);
-    if (key == "_units_per_rev") return number(feed_mode == FeedMode::per_revolution ? 1 : 0);
-    if (key == "_rpm") return number(speed);
-    if (key == "_motion_mode") return number(motion < 0 ? 0 : motion);
-    if (key == "_plane") return number(plane);
-    if (key == "_coord_system") return number(work_key >= 100 ? 0 : kG53 + 10 * work_key);
+    if (key == "_inverse_time") return number(modal.feed_mode == FeedMode::inverse_time ? 1 : 0);
+    if (key == "_units_per_minute") return number(modal.feed_mode == FeedMode::per_minute ? 1 : 0);
+    if (key == "_units_per_rev") return number(modal.feed_mode == FeedMode::per_revolution ? 1 : 0);
+    if (key == "_rpm") return number(modal.speed);
+    if (key == "_motion_mode") return number(modal.motion < 0 ? 0 : modal.motion);
+    if (key == "_plane") return number(modal.plane);
+    if (key == "_coord_system")
+      return number(frame.work_key >= 100 ? 0 : kG53 + 10 * frame.work_key);
     if (key == "_call_level") return number(static_cast<double>(parameters.scopes.size() - 1));
-    if (key == "_line") return number(line);
+    if (key == "_line") return number(context.line);
     if (key == "_ccomp") return number(comp.side == 0 ? kG40 : comp.side > 0 ? kG41 : kG42);
-    if (key == "_spindle_on") return number(spindle_direction != 0 ? 1 : 0);
-    if (key == "_spindle_cw") return number(spindle_direction > 0 ? 1 : 0);
-    if (key == "_ijk_absolute_mode") return number(arc_absolute ? 1 : 0);
+    if (key == "_spindle_on") return number(modal.spindle_direction != 0 ? 1 : 0);
+    if (key == "_spindle_cw") return number(modal.spindle_direction > 0 ? 1 : 0);
+    if (key == "_ijk_absolute_mode") return number(modal.arc_absolute ? 1 : 0);
     // As LinuxCNC 2.9's interpreter run outside its task (a preview, rs274 standalone) reads
     // them: no remap under way, overrides at 100 %, a mill.
     if (key == "_task" || key == "_remap_level" || key == "_lathe_diameter_mode") return number(0);
@@ -247,13 +252,13 @@ void Interpreter::State::assign(const Assignment& a) {
   int component = 0;
   if (int key = offset_variable(n, component);
       key >= 0) {  // probing macros set work offsets this way
-    if (tilted && key == work_key)
+    if (frame.tilted && key == frame.work_key)
       error(a.column, "the active work offset changes under a tilted plane");
-    Vec3 value = offsets.count(key) ? offsets[key] : Vec3(0.0);
-    value[component] = offset_value() * unit;
-    offsets[key] = value;
-    if (key == work_key) {
-      work_offset = value;
+    Vec3 value = frame.offsets.count(key) ? frame.offsets[key] : Vec3(0.0);
+    value[component] = offset_value() * modal.unit;
+    frame.offsets[key] = value;
+    if (key == frame.work_key) {
+      frame.work_offset = value;
       update_frame();
     }
     return;
@@ -261,12 +266,13 @@ void Interpreter::State::assign(const Assignment& a) {
   if (auto r = offset_register(n, machine.dialect)) {  // tool setting and probing macros
     const double value = offset_value();
     if (r->length) {
-      (r->wear ? tool_table.wear : tool_table.lengths)[r->number] = value * unit;
+      (r->wear ? tool_table.wear : tool_table.lengths)[r->number] = value * modal.unit;
     } else {  // read back as written, and by a G41/G42 using it (comp.cpp)
-      (r->wear ? comp.d_wear : comp.d_geometry)[r->number] = value * unit;
+      (r->wear ? comp.d_wear : comp.d_geometry)[r->number] = value * modal.unit;
       std::string by(1, '#');
       by += std::to_string(n);
-      by += line > 0 ? " at line " + std::to_string(line) : " in the machine file's \"variables\"";
+      by += context.line > 0 ? " at line " + std::to_string(context.line)
+                             : " in the machine file's \"variables\"";
       comp.d_set_at[r->number] = std::move(by);
     }
     return;

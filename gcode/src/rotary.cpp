@@ -14,11 +14,11 @@ namespace tridex::gcode {
 // G43.4 / G43.5 switch TCP on (G43, G44 and G49 off: the same modal group); G254 / G255 switch
 // DWO on and off. G43.5 I J K gives the tool direction on the part directly.
 void Interpreter::State::tool_center_codes() {
-  bool was_tcp = tcp, was_dwo = dwo;
-  if (w.find_g(430) || w.find_g(440) || w.find_g(490)) tcp = false;
-  if (w.find_g(434)) tcp = true;
-  if (int column = w.find_g(435)) {
-    tcp = true;
+  bool was_tcp = frame.tcp, was_dwo = frame.dwo;
+  if (w.find_g(kG43) || w.find_g(kG44) || w.find_g(kG49)) frame.tcp = false;
+  if (w.find_g(kG43_4)) frame.tcp = true;
+  if (int column = w.find_g(kG43_5)) {
+    frame.tcp = true;
     if (w.has('I') || w.has('J') || w.has('K')) {
       Vec3 direction(w.has('I') ? w.take('I') : 0.0, w.has('J') ? w.take('J') : 0.0,
                      w.has('K') ? w.take('K') : 0.0);
@@ -27,18 +27,20 @@ void Interpreter::State::tool_center_codes() {
       direction = glm::normalize(direction);
       if (machine.kinematics) {
         try {
-          rotary_position = orient_tool(*machine.kinematics, direction, rotary_position);
+          frame.rotary_position =
+              orient_tool(*machine.kinematics, direction, frame.rotary_position);
         } catch (const Error& e) {
           error(column, std::string("G43.5: ") + e.what());
         }
       }
-      if (glm::dot(direction, axis) < 1 - kSameDirection) go_far();
-      axis = direction;
+      if (glm::dot(direction, tool.axis) < 1 - kSameDirection) go_far();
+      tool.axis = direction;
     }
   }
-  if (w.find_g(2540)) dwo = true;
-  if (w.find_g(2550)) dwo = false;
-  if (tcp != was_tcp || dwo != was_dwo) update_frame();  // the tip stays where it is on the part
+  if (w.find_g(kG254)) frame.dwo = true;
+  if (w.find_g(kG255)) frame.dwo = false;
+  if (frame.tcp != was_tcp || frame.dwo != was_dwo)
+    update_frame();  // the tip stays where it is on the part
 }
 
 // A B C on a G0/G1 block (or alone under G0/G1 modal): each letter an axis of the machine, within
@@ -61,10 +63,10 @@ void Interpreter::State::extra_linear_words(bool track) {
     char c = "UVW"[i];
     if (!w.has(c)) continue;
     double v = length(c);
-    if (track) uvw_position[i] = incremental ? uvw_position[i] + v : v;
+    if (track) tool.uvw_position[i] = modal.incremental ? tool.uvw_position[i] + v : v;
   }
-  if (!warned_uvw) {
-    warned_uvw = true;
+  if (!warned_once.uvw) {
+    warned_once.uvw = true;
     warn(first,
          "U/V/W read as plain axes, as LinuxCNC does on a machine that has them: they do not move "
          "the tool tridex simulates");
@@ -84,8 +86,8 @@ void Interpreter::State::rotary_words() {
     if (machine.dialect != Dialect::linuxcnc) return;
     for (char c : {'A', 'B', 'C'})
       if (w.has(c) && !((w.used >> letter_index(c)) & 1u)) w.take(c);
-    if (!warned_plain_rotary) {
-      warned_plain_rotary = true;
+    if (!warned_once.plain_rotary) {
+      warned_once.plain_rotary = true;
       warn(first,
            "A/B/C read as plain axes, as LinuxCNC does on a machine without kinematics: the "
            "tool does not tilt (give the machine file \"kinematics\" to simulate them)");
@@ -93,9 +95,9 @@ void Interpreter::State::rotary_words() {
     return;
   }
   const Kinematics& kin = *machine.kinematics;
-  if (motion != 0 && motion != 10)
+  if (modal.motion != kG0 && modal.motion != kG1)
     error(first, "A/B/C words need G0 or G1 (a rotary word on an arc or a cycle is a 5-axis move)");
-  RotaryPositions next = rotary_position;
+  RotaryPositions next = frame.rotary_position;
   for (char c : {'A', 'B', 'C'}) {
     if (!w.has(c) || ((w.used >> letter_index(c)) & 1u)) continue;
     const RotaryAxis* a = kin.find(c);
@@ -109,15 +111,15 @@ void Interpreter::State::rotary_words() {
     }
     double v = w.take(c);
     std::size_t i = static_cast<std::size_t>(rotary_index(c));
-    next[i] = incremental ? rotary_position[i] + v : v;
+    next[i] = modal.incremental ? frame.rotary_position[i] + v : v;
     if (a->limits && (next[i] < (*a->limits)[0] || next[i] > (*a->limits)[1]))
       error(w.col(c), std::string("rotary position ") + c + format_number(next[i]) +
                           " is outside the " + c + " axis's limits [" +
                           format_number((*a->limits)[0]) + ", " + format_number((*a->limits)[1]) +
                           "] (machine file)");
   }
-  if (next == rotary_position) return;
-  const bool cut = motion == 10;
+  if (next == frame.rotary_position) return;
+  const bool cut = modal.motion == kG1;
   const std::string message =
       "rotary motion during a cut (G1 turning A/B/C: simultaneous 5-axis) is "
       "outside 3+2";
@@ -126,19 +128,19 @@ void Interpreter::State::rotary_words() {
   if (cut)  // lenient: said on the line and counted per direction for the run's summary
     lenient_read(first,
                  message + "; read as indexed at its end orientation, direction " +
-                     direction_text(axis) + " (lenient mode)",
-                 "rotary motion during a cut read as indexed along " + direction_text(axis));
-  if (!cut && (tilted || tcp || dwo)) go_far();
+                     direction_text(tool.axis) + " (lenient mode)",
+                 "rotary motion during a cut read as indexed along " + direction_text(tool.axis));
+  if (!cut && (frame.tilted || frame.tcp || frame.dwo)) go_far();
 }
 
 // New rotary positions: the tool direction and the raw frame follow; the tip keeps its machine
 // coordinates in raw form and its place on the part under TCP/DWO (the caller decides on far).
 void Interpreter::State::set_rotary(const RotaryPositions& next) {
-  Vec3 program_point = to_program(pos);
-  rotary_position = next;
-  axis = tool_direction(*machine.kinematics, rotary_position);
+  Vec3 program_point = to_program(tool.pos);
+  frame.rotary_position = next;
+  tool.axis = tool_direction(*machine.kinematics, frame.rotary_position);
   update_frame();
-  pos = to_machine(program_point);
+  tool.pos = to_machine(program_point);
 }
 
 }  // namespace tridex::gcode

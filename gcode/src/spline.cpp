@@ -105,27 +105,28 @@ class Nurbs {
 void Interpreter::State::spline(bool quadratic) {
   const char* name = quadratic ? "G5.1" : "G5";
   if (comp.side != 0)
-    error(motion_column, std::string(name) +
-                             " with cutter radius compensation on: LinuxCNC refuses "
-                             "it (G40 first)");
+    error(context.motion_column, std::string(name) +
+                                     " with cutter radius compensation on: LinuxCNC refuses "
+                                     "it (G40 first)");
   require_feed();
-  if (feed_mode == FeedMode::inverse_time)  // its length is known only once its biarcs are made
-    error(motion_column,
+  if (modal.feed_mode ==
+      FeedMode::inverse_time)  // its length is known only once its biarcs are made
+    error(context.motion_column,
           std::string(name) + " in inverse time feed (G93) is not supported: G94 first");
-  if (plane != kG17)
-    error(motion_column, std::string(name) + " is a spline in the XY plane only (G17)");
+  if (modal.plane != kG17)
+    error(context.motion_column, std::string(name) + " is a spline in the XY plane only (G17)");
   for (char c : {'Z', 'A', 'B', 'C'})
     if (w.has(c))
       error(w.col(c),
             std::string(name) + " may not move " + c + " (LinuxCNC's splines stay in XY)");
 
-  Vec3 start = comp.programmed_current ? comp.programmed : to_program(pos);
+  Vec3 start = comp.programmed_current ? comp.programmed : to_program(tool.pos);
   comp.programmed_current = false;
   std::vector<NurbsPoint> control(quadratic ? 3 : 4);
   control[0].p = Vec2(start);
   Vec2 first(0.0);  // P1 − P0
   if (quadratic) {
-    if (!w.has('I') || !w.has('J')) error(motion_column, "G5.1 needs both I and J");
+    if (!w.has('I') || !w.has('J')) error(context.motion_column, "G5.1 needs both I and J");
     first = Vec2(length('I'), length('J'));
   } else if (w.has('I') || w.has('J')) {
     if (!w.has('I') || !w.has('J'))
@@ -134,32 +135,33 @@ void Interpreter::State::spline(bool quadratic) {
             "previous G5's end)");
     first = Vec2(length('I'), length('J'));
   } else {
-    first = splines.mirror * unit;
+    first = splines.mirror * modal.unit;
   }
   Vec3 end = start;
   for (int i = 0; i < 2; ++i) {
     char c = kAxisLetter[i];
-    if (w.has(c)) end[i] = incremental ? start[i] + length(c) : length(c);
+    if (w.has(c)) end[i] = modal.incremental ? start[i] + length(c) : length(c);
   }
   control[1].p = control[0].p + first;
   if (quadratic) {
     control[2].p = Vec2(end);
   } else {
-    if (!w.has('P') || !w.has('Q')) error(motion_column, "G5 needs both P and Q (the end tangent)");
+    if (!w.has('P') || !w.has('Q'))
+      error(context.motion_column, "G5 needs both P and Q (the end tangent)");
     double p = w.take('P'), q = w.take('Q');
-    control[2].p = Vec2(end) + Vec2(p, q) * unit;
+    control[2].p = Vec2(end) + Vec2(p, q) * modal.unit;
     control[3].p = Vec2(end);
     splines.mirror = Vec2(-p, -q);
   }
 
-  if (far) {  // the far rule, as for arcs: only the lateral position changes
-    pos = to_machine(end);
+  if (tool.far) {  // the far rule, as for arcs: only the lateral position changes
+    tool.pos = to_machine(end);
     return;
   }
 
   const int order = quadratic ? 3 : 4;
   nurbs_feed(std::move(control), order, Vec2(end), start[2]);
-  pos = to_machine(end);
+  tool.pos = to_machine(end);
 }
 
 // A G5.2 block: one control point (X Y, weight P) of the NURBS that G5.3 cuts. As LinuxCNC 2.9's
@@ -169,9 +171,10 @@ void Interpreter::State::spline(bool quadratic) {
 // default (LinuxCNC takes L only from 4 on).
 void Interpreter::State::nurbs_point() {
   if (comp.side != 0)
-    error(motion_column,
+    error(context.motion_column,
           "G5.2 with cutter radius compensation on: its curve is not offset (G40 first)");
-  if (plane != kG17) error(motion_column, "G5.2 is a NURBS in the XY plane only (G17)");
+  if (modal.plane != kG17)
+    error(context.motion_column, "G5.2 is a NURBS in the XY plane only (G17)");
   for (char c : {'Z', 'A', 'B', 'C'})
     if (w.has(c))
       error(w.col(c), std::string("G5.2 may not move ") + c + " (its control points are in XY)");
@@ -186,11 +189,11 @@ void Interpreter::State::nurbs_point() {
       error(w.col('P'), "G5.2 weight P" + format_number(weight) + " must be positive");
   }
   if (splines.nurbs_points.empty()) {
-    Vec3 start = comp.programmed_current ? comp.programmed : to_program(pos);
+    Vec3 start = comp.programmed_current ? comp.programmed : to_program(tool.pos);
     splines.nurbs_points.push_back({Vec2(start), !point && weight > 0 ? weight : 1.0});
     splines.nurbs_order = 3;
   } else if (!point) {
-    error(motion_column,
+    error(context.motion_column,
           "G5.2 needs X and Y (a control point): P alone weighs only the first point");
   }
   if (w.has('L')) {
@@ -198,27 +201,29 @@ void Interpreter::State::nurbs_point() {
     splines.nurbs_order = static_cast<int>(integer('L', "G5.2 order L", 3, kMaxNurbsOrder));
   }
   if (!point) return;
-  if (!w.has('P')) error(motion_column, "a G5.2 control point needs its weight P (positive)");
-  Vec3 start = to_program(pos);
+  if (!w.has('P'))
+    error(context.motion_column, "a G5.2 control point needs its weight P (positive)");
+  Vec3 start = to_program(tool.pos);
   Vec2 at(length('X'), length('Y'));
-  if (incremental) at += Vec2(start);
+  if (modal.incremental) at += Vec2(start);
   splines.nurbs_points.push_back({at, weight});
 }
 
 // G5.3: the NURBS of the G5.2 blocks before it is cut, as LinuxCNC's NURBS_FEED does, and the
 // tool stands at its last control point (Z unchanged). No motion mode is left active.
 void Interpreter::State::nurbs_end(int column) {
-  if (motion != kG5_2) error(column, "G5.3 without G5.2 before it (LinuxCNC refuses it)");
+  if (modal.motion != kG5_2) error(column, "G5.3 without G5.2 before it (LinuxCNC refuses it)");
   if (static_cast<int>(splines.nurbs_points.size()) < splines.nurbs_order)
     error(column,
           "G5.3: " + std::to_string(splines.nurbs_points.size()) +
               " control points, fewer than the order L = " + std::to_string(splines.nurbs_order));
-  Vec3 start = to_program(pos);
+  Vec3 start = to_program(tool.pos);
   Vec3 end(splines.nurbs_points.back().p, start[2]);
-  if (!far) nurbs_feed(std::move(splines.nurbs_points), splines.nurbs_order, Vec2(end), start[2]);
+  if (!tool.far)
+    nurbs_feed(std::move(splines.nurbs_points), splines.nurbs_order, Vec2(end), start[2]);
   splines.nurbs_points.clear();
-  pos = to_machine(end);
-  motion = -1;
+  tool.pos = to_machine(end);
+  modal.motion = -1;
 }
 
 // emccanon's NURBS_FEED: 4 × (control points) equal steps of u, a biarc each, the last ending
@@ -271,17 +276,17 @@ void Interpreter::State::spline_piece(const Vec2& from, const Vec2& to, const Ve
   if (glm::length(d) <= 1e-9) return;
   Vec3 end(to.x, to.y, z);
   double den = 2 * (d.y * tangent.x - d.x * tangent.y);
-  if (std::abs(den) <= 1e-6 * unit) {
+  if (std::abs(den) <= 1e-6 * modal.unit) {
     Vec3 m = to_machine(end);
-    emit(MoveKind::feed, pos, m, feed);
-    pos = m;
+    emit(MoveKind::feed, tool.pos, m, modal.feed);
+    tool.pos = m;
     return;
   }
   double rho = glm::dot(d, d) / den;  // signed radius: > 0 turns left (counter-clockwise)
   Vec2 centre = from + rho * Vec2(-tangent.y, tangent.x);
   Vec3 start(from.x, from.y, z);
   bool ccw = rho > 0;
-  arc_chords(start, end, centre, ccw, arc_sweep(start, end, centre, ccw), feed);
+  arc_chords(start, end, centre, ccw, arc_sweep(start, end, centre, ccw), modal.feed);
 }
 
 }  // namespace tridex::gcode

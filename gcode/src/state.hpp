@@ -3,8 +3,9 @@
 // returns; interpreter.cpp: reading and program flow). What one stage alone keeps between blocks
 // is a part of its own, named for it: ToolTable (modal.cpp), Splines (spline.cpp), TiltedPlane
 // (tilted_plane_codes.cpp), CannedCycle (motion.cpp), CallRequest (modal.cpp, read by flow.cpp),
-// Parameters (parameters.cpp), WarnedOnce and CutterComp (comp.cpp). The modal state, the tool
-// and the frame, which every stage reads, stay at the top.
+// Parameters (parameters.cpp), WarnedOnce and CutterComp (comp.cpp). What every stage reads is
+// a part too, its comment naming who changes it: BlockContext (flow.cpp), Modal (modal.cpp),
+// ToolState (modal.cpp and the motions), ProgramFrame (modal.cpp, rotary.cpp, update_frame).
 #pragma once
 
 #include <algorithm>
@@ -38,46 +39,62 @@ struct Interpreter::State : ParameterReader {
   InterpreterOptions options;
   MachineConfig machine;
 
-  // What the run tells its caller besides the moves (Interpreter::warnings, tools_used, ...).
+  // The words lenient mode skipped, or the blocks it read in a stated way, of one cause.
+  struct Skipped {
+    long long count = 0;
+    std::vector<int> lines;  // the first few
+    int last_line = 0;
+  };
+  // What the run tells its caller besides the moves (Interpreter::warnings, tools_used, ...; the
+  // lenient-mode counts in its summary warnings), gathered as the blocks execute.
   struct RunSummary {
     std::vector<Diagnostic> warnings;
     std::set<int> tools_used;
     std::map<int, int> tool_first_line;
     long long blocks = 0;
+    std::map<std::string, Skipped> skipped;  // by cause (unsupported)
+    std::map<std::string, Skipped> read_as;  // by cause (lenient_read)
   };
   RunSummary summary;
 
-  // Context of the block being executed.
-  const std::string* file = nullptr;
-  int file_index = 0;              // of `file` in `files` (Move::file)
+  // Where the block being executed stands (flow.cpp sets the file and line of each block,
+  // modal.cpp the column of its motion code): what diagnostics and moves name.
+  struct BlockContext {
+    const std::string* file = nullptr;
+    int file_index = 0;  // of `file` in `files` (Move::file)
+    int line = 0;
+    int motion_column = 1;
+  };
+  BlockContext context;
   std::vector<std::string> files;  // every file of the run, in the order first read
   const std::function<void(const Move&)>* sink = nullptr;
   const std::function<void(const Dwell&)>* dwell_sink = nullptr;  // may hold no function
-  int line = 0;
-  int motion_column = 1;
 
-  // Modal state.
-  double unit = 1.0;  // mm per program unit
-  bool incremental = false;
-  bool arc_absolute = false;
-  int plane = kG17;
-  int motion = -1;  // -1: none yet
-  bool retract_to_r = false;
-  int work_key = 1;
-  Vec3 work_offset{0.0};
-  std::map<int, Vec3> offsets;
-  double feed = 0;  // mm/min of the next feed move (under G93 and G95, worked out per move)
   // Feed modes (RS274/NGC group 5, NIST IR 6556 §3.5.19; LinuxCNC interp_inverse.cc): G94 F in
   // units per minute; G93 inverse time, F in 1/min, every feed block takes 1/F minutes (its rate
   // is its programmed length × F, set per move); G95 F in units per spindle revolution (× S).
   enum class FeedMode { per_minute, inverse_time, per_revolution };
-  FeedMode feed_mode = FeedMode::per_minute;
-  double inverse_time = 0;  // G93: the block's F (1/min)
-  double feed_per_rev = 0;  // G95: mm per revolution
+  // The modal state the block's codes set (modal.cpp; motion.cpp works out the G93 feed per move).
+  struct Modal {
+    double unit = 1.0;  // mm per program unit
+    bool incremental = false;
+    bool arc_absolute = false;
+    int plane = kG17;
+    int motion = -1;  // -1: none yet
+    bool retract_to_r = false;
+    double feed = 0;  // mm/min of the next feed move (under G93 and G95, worked out per move)
+    FeedMode feed_mode = FeedMode::per_minute;
+    double inverse_time = 0;  // G93: the block's F (1/min)
+    double feed_per_rev = 0;  // G95: mm per revolution
+    double speed = 0;
+    int spindle_direction = 0;
+  };
+  Modal modal;
   // The feed rate as LinuxCNC's #<_feed> reads it, in program units: per revolution under G95,
   // under G93 the rate of the last feed move.
   double programmed_feed() const {
-    return (feed_mode == FeedMode::per_revolution ? feed_per_rev : feed) / unit;
+    return (modal.feed_mode == FeedMode::per_revolution ? modal.feed_per_rev : modal.feed) /
+           modal.unit;
   }
   void feed_mode_codes();                 // G93, G94, G95, F and S (modal.cpp)
   void inverse_time_rate(double length);  // G93: feed for a block `length` mm long (motion.cpp)
@@ -93,20 +110,30 @@ struct Interpreter::State : ParameterReader {
     int nurbs_order = 3;
   };
   Splines splines;
-  double speed = 0;
-  int spindle_direction = 0;
-  int tool_selected = 0;
-  int tool = 0;
-  // Tool length offset (G43 H, G43.1 Z, G44 H; 0 under G49), mm. The program names the point
-  // this far below the spindle's gauge point, and the loaded tool's tip lies its own length
-  // below it: the tip is length_shift() from the programmed point (rs274ngc's tool_offset,
-  // interp_convert.cc convert_tool_length_offset). Without tool lengths both stay 0.
-  double length_offset = 0;
+  // The tool (modal.cpp: T, M6, M61, G43/G49; motion.cpp, comp.cpp, spline.cpp and rotary.cpp
+  // move it; update_frame says whether its direction is ambiguous): the tool selected and the one
+  // loaded, its spindle direction, its tip position (the part frame as it sits with every rotary
+  // at 0, which is machine coordinates without kinematics) and the far flag.
+  struct ToolState {
+    int selected = 0;
+    int number = 0;
+    // Tool length offset (G43 H, G43.1 Z, G44 H; 0 under G49), mm. The program names the point
+    // this far below the spindle's gauge point, and the loaded tool's tip lies its own length
+    // below it: the tip is length_shift() from the programmed point (rs274ngc's tool_offset,
+    // interp_convert.cc convert_tool_length_offset). Without tool lengths both stay 0.
+    double length_offset = 0;
+    Vec3 axis{0.0, 0.0, 1.0};
+    Vec3 pos{0.0};
+    bool far = true;
+    bool ambiguous = false;
+    Vec3 uvw_position{0.0};  // mm, where the U/V/W words put those axes (rotary.cpp)
+  };
+  ToolState tool;
   double loaded_length() const {
-    auto it = machine.tool_lengths.find(tool);
+    auto it = machine.tool_lengths.find(tool.number);
     return it == machine.tool_lengths.end() ? 0.0 : it->second;
   }
-  Vec3 length_shift() const { return (length_offset - loaded_length()) * axis; }
+  Vec3 length_shift() const { return (tool.length_offset - loaded_length()) * tool.axis; }
   // The control's tool table as LinuxCNC's G10 L1/L10/L11 or Fanuc's G10 L10/L11 rewrite it
   // (modal.cpp): the lengths G43 H reads (mm), geometry plus Fanuc's wear. The tool itself keeps
   // the machine's length (loaded_length): a program that sets a wrong length moves the tip as the
@@ -137,11 +164,27 @@ struct Interpreter::State : ParameterReader {
   // tool along +Z): the tip lies the loaded tool's length below it.
   Vec3 tip_below(const Vec3& gauge) const { return gauge - Vec3(0, 0, loaded_length()); }
 
-  // Tilted working plane and the active program frame (program point p -> machine
-  // origin + rotation·p).
-  bool tilted = false;
-  Mat3 rotation{1.0};
-  Vec3 origin{0.0};
+  // The active program frame (program point p -> machine origin + rotation·p, worked out by
+  // update_frame) and what makes it: the work offsets (modal.cpp: G54-G59, G10 L2/L20, G52, G92),
+  // whether a tilted plane is on (tilted_plane_codes.cpp) and the rotary axes (rotary.cpp; only
+  // with MachineConfig::kinematics): their positions and how X Y Z are read. raw: machine
+  // coordinates (the part frame is machine_to_part of the rotaries); dwo (Haas G254) and tcp
+  // (Fanuc G43.4/G43.5): the part frame, as the control computes it.
+  struct ProgramFrame {
+    Mat3 rotation{1.0};
+    Vec3 origin{0.0};
+    bool tilted = false;
+    int work_key = 1;
+    Vec3 work_offset{0.0};
+    std::map<int, Vec3> offsets;
+    Vec3 local_offset{0.0};        // G52 / G92 (one register, as LinuxCNC keeps it), machine axes
+    Vec3 saved_local_offset{0.0};  // G92.2 suspends, G92.3 restores
+    Vec3 world_origin{0.0};
+    RotaryPositions rotary_position{};
+    bool tcp = false;
+    bool dwo = false;
+  };
+  ProgramFrame frame;
   // G68.2 / G68.4 P2 (three points) and P3 (two vectors) are written over consecutive blocks,
   // one Q each (tilted_plane_codes.cpp); their words are gathered here until the last one
   // completes the plane.
@@ -163,20 +206,7 @@ struct Interpreter::State : ParameterReader {
   };
   TiltedPlane tilt;
 
-  // Rotary axes (rotary.cpp; only with MachineConfig::kinematics): their positions and how X Y Z
-  // are read. raw: machine coordinates (the part frame is machine_to_part of the rotaries);
-  // dwo (Haas G254) and tcp (Fanuc G43.4/G43.5): the part frame, as the control computes it.
-  RotaryPositions rotary_position{};
-  bool tcp = false;
-  bool dwo = false;
-
-  // Tool: spindle direction, tip position (the part frame as it sits with every rotary at 0,
-  // which is machine coordinates without kinematics) and the far flag.
-  Vec3 axis{0.0, 0.0, 1.0};
-  Vec3 pos{0.0};
-  bool far = true;
-  bool ambiguous = false;
-  // The warnings given once a run (each stage's own; rotary.cpp keeps its two below).
+  // The warnings given once a run (each stage's own).
   struct WarnedOnce {
     bool home = false;
     bool reference2 = false;
@@ -184,14 +214,10 @@ struct Interpreter::State : ParameterReader {
     std::set<char> rotary_at_zero;  // A/B/C words of 0 read on a machine without kinematics
     bool probe = false;             // G38.x read as rs274 standalone does
     bool comp_without_d = false;    // Fanuc/Haas G41/G42 with no D yet: D0
+    bool plain_rotary = false;      // A/B/C on a LinuxCNC machine without kinematics (rotary.cpp)
+    bool uvw = false;               // U/V/W on a LinuxCNC machine (rotary.cpp)
   };
   WarnedOnce warned_once;
-  bool warned_plain_rotary = false;  // A/B/C on a LinuxCNC machine without kinematics
-  bool warned_uvw = false;           // U/V/W on a LinuxCNC machine
-  Vec3 uvw_position{0.0};            // mm, where the U/V/W words put those axes
-  Vec3 local_offset{0.0};            // G52 / G92 (one register, as LinuxCNC keeps it), machine axes
-  Vec3 saved_local_offset{0.0};      // G92.2 suspends, G92.3 restores
-  Vec3 world_origin{0.0};
 
   // Canned cycle state (motion.cpp; sticky values, program units converted to mm, as written).
   struct CannedCycle {
@@ -236,12 +262,13 @@ struct Interpreter::State : ParameterReader {
 
   // ---- diagnostics ----
   [[noreturn]] void error(int column, std::string message) const {
-    throw GcodeError(Diagnostic{*file, line, column, std::move(message)});
+    throw GcodeError(Diagnostic{*context.file, context.line, column, std::move(message)});
   }
   void warn(int column, std::string message) {
     // Bounded: a warning per block of a long program would grow memory with its length.
     if (summary.warnings.size() < 1000)
-      summary.warnings.push_back(Diagnostic{*file, line, column, std::move(message)});
+      summary.warnings.push_back(
+          Diagnostic{*context.file, context.line, column, std::move(message)});
   }
   // Lenient mode may skip a word only where skipping cannot change the tool path; `cause` names
   // the kind of word (counted for the run's summary, however many there are).
@@ -251,26 +278,19 @@ struct Interpreter::State : ParameterReader {
     if (!skippable)
       error(column, message + " (cannot be skipped in lenient mode: it changes the tool path)");
     warn(column, message + " (skipped: lenient mode)");
-    Skipped& s = skipped[cause];
-    if (s.count++ < 5) s.lines.push_back(line);
+    Skipped& s = summary.skipped[cause];
+    if (s.count++ < 5) s.lines.push_back(context.line);
   }
-  struct Skipped {
-    long long count = 0;
-    std::vector<int> lines;  // the first few
-    int last_line = 0;
-  };
-  std::map<std::string, Skipped> skipped;
   // Lenient mode reads a block it cannot take as written in a stated way (`cause`, which names
   // the direction it was read along): a warning for the line, and a count per cause for the
   // run's summary, however many (the warnings themselves stop at 1000).
   void lenient_read(int column, const std::string& message, const std::string& cause) {
-    Skipped& s = read_as[cause];
-    if (s.count > 0 && s.last_line == line) return;  // one per line: an arc's chords
-    s.last_line = line;
+    Skipped& s = summary.read_as[cause];
+    if (s.count > 0 && s.last_line == context.line) return;  // one per line: an arc's chords
+    s.last_line = context.line;
     warn(column, message);
-    if (s.count++ < 5) s.lines.push_back(line);
+    if (s.count++ < 5) s.lines.push_back(context.line);
   }
-  std::map<std::string, Skipped> read_as;
   static std::string direction_text(const Vec3& d) {
     char text[112];  // snprintf: GCC 12 warns falsely on "literal" + std::string chains
     std::snprintf(text, sizeof text, "(%.10g, %.10g, %.10g)", d.x, d.y, d.z);
@@ -417,7 +437,7 @@ struct Interpreter::State : ParameterReader {
     }
   }
 
-  double length(char c) { return w.take(c) * unit; }
+  double length(char c) { return w.take(c) * modal.unit; }
 
   long long integer(char c, const char* what, long long low, long long high) {
     double v = w.take(c);
@@ -436,69 +456,74 @@ struct Interpreter::State : ParameterReader {
   // Where the linear axes stand, in the coordinates offsets are added in (G92, G10 L20): the tip
   // on the part, or in raw rotary form (kinematics without TCP or DWO) the machine coordinates,
   // which differ from the tip's place on the part as soon as a table axis is turned.
-  bool raw_rotary() const { return machine.kinematics && !tcp && !dwo && !tilted; }
-  Vec3 linear_axes() const {
-    return raw_rotary() ? machine_from_part(*machine.kinematics, pos, rotary_position)
-                        : pos - length_shift();
+  bool raw_rotary() const {
+    return machine.kinematics && !frame.tcp && !frame.dwo && !frame.tilted;
   }
-  Vec3 to_machine(const Vec3& p) const { return origin + rotation * p; }
-  Vec3 to_program(const Vec3& m) const { return glm::transpose(rotation) * (m - origin); }
+  Vec3 linear_axes() const {
+    return raw_rotary() ? machine_from_part(*machine.kinematics, tool.pos, frame.rotary_position)
+                        : tool.pos - length_shift();
+  }
+  Vec3 to_machine(const Vec3& p) const { return frame.origin + frame.rotation * p; }
+  Vec3 to_program(const Vec3& m) const {
+    return glm::transpose(frame.rotation) * (m - frame.origin);
+  }
 
   void update_frame() {
-    if (tilted) {
-      rotation = tilt.rotation;
-      origin = tilt.origin + length_shift();
+    if (frame.tilted) {
+      frame.rotation = tilt.rotation;
+      frame.origin = tilt.origin + length_shift();
     } else if (raw_rotary()) {
       // Raw rotary programs: X Y Z (after the work offset) are the machine's linear axes.
-      Frame m = machine_to_part(*machine.kinematics, rotary_position);
-      rotation = m.rotation;
-      origin = m.to_world(work_offset + local_offset);
+      Frame m = machine_to_part(*machine.kinematics, frame.rotary_position);
+      frame.rotation = m.rotation;
+      frame.origin = m.to_world(frame.work_offset + frame.local_offset);
     } else {
-      rotation = Mat3(1.0);
-      origin = work_offset + local_offset + length_shift();
+      frame.rotation = Mat3(1.0);
+      frame.origin = frame.work_offset + frame.local_offset + length_shift();
     }
-    ambiguous = tilted && glm::dot(tilt.rotation[2], axis) < 1 - kSameDirection;
+    tool.ambiguous = frame.tilted && glm::dot(tilt.rotation[2], tool.axis) < 1 - kSameDirection;
   }
 
   // ---- emitting ----
   void emit(MoveKind kind, const Vec3& a, const Vec3& b, double move_feed, bool from_far = false) {
-    if (ambiguous) {
+    if (tool.ambiguous) {
       std::string message = "spindle direction is ambiguous: the plane tilted at line " +
                             std::to_string(tilt.line) +
                             " is not normal to the tool and no G53.1/G53.6/G253 has oriented it";
-      if (!options.lenient) error(motion_column, message);
-      lenient_read(motion_column,
-                   message + "; read along the current direction " + direction_text(axis) +
+      if (!options.lenient) error(context.motion_column, message);
+      lenient_read(context.motion_column,
+                   message + "; read along the current direction " + direction_text(tool.axis) +
                        " (lenient mode)",
                    "move under an ambiguous tilted plane along the current direction " +
-                       direction_text(axis));
+                       direction_text(tool.axis));
     }
     if (machine.kinematics && length_shift() != Vec3(0.0))
-      error(motion_column,
-            "the tool length offset (" + format_number(length_offset) +
-                " mm) differs from the loaded tool " + std::to_string(tool) + "'s length (" +
+      error(context.motion_column,
+            "the tool length offset (" + format_number(tool.length_offset) +
+                " mm) differs from the loaded tool " + std::to_string(tool.number) + "'s length (" +
                 format_number(loaded_length()) +
                 " mm) on a machine with rotary axes, which tridex does not simulate: "
                 "use G43 H" +
-                std::to_string(tool) + " (or G43.4), or a tool table without tool lengths");
+                std::to_string(tool.number) + " (or G43.4), or a tool table without tool lengths");
     Move move;
-    move.line = line;
-    move.file = file_index;
+    move.line = context.line;
+    move.file = context.file_index;
     move.kind = kind;
-    move.tool = tool;
-    move.start = a - world_origin;
-    move.end = b - world_origin;
-    move.axis = axis;
+    move.tool = tool.number;
+    move.start = a - frame.world_origin;
+    move.end = b - frame.world_origin;
+    move.axis = tool.axis;
     move.feed = move_feed;
     move.from_far = from_far;
-    move.spindle = speed * spindle_direction;
+    move.spindle = modal.speed * modal.spindle_direction;
     if (machine.kinematics) {
       for (const RotaryAxis& rotary_axis : machine.kinematics->axes)
         move.rotary_axes |= static_cast<unsigned char>(1u << rotary_index(rotary_axis.letter));
-      move.rotary = rotary_position;
-      move.machine = machine_from_part(*machine.kinematics, b, rotary_position);
+      move.rotary = frame.rotary_position;
+      move.machine = machine_from_part(*machine.kinematics, b, frame.rotary_position);
     }
-    if (summary.tools_used.insert(tool).second) summary.tool_first_line.emplace(tool, line);
+    if (summary.tools_used.insert(tool.number).second)
+      summary.tool_first_line.emplace(tool.number, context.line);
     (*sink)(move);
   }
 
@@ -507,7 +532,8 @@ struct Interpreter::State : ParameterReader {
     return machine.dialect == Dialect::linuxcnc ? p : p / 1000.0;
   }
   void emit_dwell(double seconds) {
-    if (seconds > 0 && dwell_sink && *dwell_sink) (*dwell_sink)(Dwell{line, tool, axis, seconds});
+    if (seconds > 0 && dwell_sink && *dwell_sink)
+      (*dwell_sink)(Dwell{context.line, tool.number, tool.axis, seconds});
   }
 
   // ---- cutter radius compensation (comp.cpp) ----
@@ -559,11 +585,11 @@ struct Interpreter::State : ParameterReader {
   // A program point's coordinates in the active plane, (u, v) of plane_axes (G17: X Y; G18: Z X,
   // LinuxCNC's order for compensation), and a point with those replaced.
   Vec2 plane_uv(const Vec3& p) const {
-    const std::array<int, 3> a = plane_axes(plane);
+    const std::array<int, 3> a = plane_axes(modal.plane);
     return Vec2(p[a[0]], p[a[1]]);
   }
   Vec3 with_plane_uv(Vec3 p, const Vec2& q) const {
-    const std::array<int, 3> a = plane_axes(plane);
+    const std::array<int, 3> a = plane_axes(modal.plane);
     p[a[0]] = q.x;
     p[a[1]] = q.y;
     return p;
@@ -631,7 +657,7 @@ struct Interpreter::State : ParameterReader {
   void home_return(bool second);
   void tool_length_codes();    // G43 H, G43.1, G44 H, G49 (modal.cpp)
   void load_tool(int number);  // the tip moves with the tool's length (modal.cpp)
-  void go_far() { far = true; }
+  void go_far() { tool.far = true; }
   Flow macro_call(int column);               // G65 (modal.cpp)
   void local_offsets(int code, int column);  // G52, G92, G92.1, G92.2, G92.3 (modal.cpp)
 

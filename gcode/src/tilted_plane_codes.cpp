@@ -121,7 +121,7 @@ std::optional<Frame> Interpreter::State::several_block_plane(int code, int p) {
     error(q_column,
           form + " Q" + std::to_string(q) + ": this form's blocks are " + q_list(allowed));
   PlaneBlocks& b = tilt.plane_blocks;
-  if (b.code == 0) b = PlaneBlocks{code, p, line, 0, {}, {}, 0.0};
+  if (b.code == 0) b = PlaneBlocks{code, p, context.line, 0, {}, {}, 0.0};
   if (b.code != code || b.p != p)
     error(w.find_g(code), form + " while " + code_name('G', b.code) + " P" + std::to_string(b.p) +
                               " begun at line " + std::to_string(b.first_line) + " is incomplete");
@@ -172,33 +172,34 @@ std::string Interpreter::State::incomplete_plane() const {
 
 void Interpreter::State::tilted_plane(int code) {
   if (code == kG69 || code == kG269) {
-    tilted = false;
+    frame.tilted = false;
     update_frame();
     return;
   }
   int column = w.find_g(code);
-  if (incremental) error(column, code_name('G', code) + " under G91 is not supported; use G90");
+  if (modal.incremental)
+    error(column, code_name('G', code) + " under G91 is not supported; use G90");
   Frame feature;
   if (code == kG68) {
     // Fanuc's coordinate rotation G68 X Y R (G17; Fanuc 0i-MF operator's manual, "Coordinate
     // system rotation"): the program's points turn by R degrees, counter-clockwise, about the
     // centre X Y (where either is left out, the current point's): p = C + Rz(R)·(p' − C).
-    if (tilted) error(column, "G68 while a rotation or tilted plane is active (G69 first)");
-    if (plane != kG17)
+    if (frame.tilted) error(column, "G68 while a rotation or tilted plane is active (G69 first)");
+    if (modal.plane != kG17)
       error(column, "G68 (coordinate rotation) is read in the XY plane (G17) only");
     if (w.has('Z'))
       error(w.col('Z'), "G68 Z: the rotation in G17 is about an axis along Z through X Y");
     if (!w.has('R')) error(column, "G68 needs R (the angle of rotation, degrees)");
-    if ((!w.has('X') || !w.has('Y')) && far)
+    if ((!w.has('X') || !w.has('Y')) && tool.far)
       error(column,
             "G68 without X and Y turns about the current point, but the tool is retracted "
             "far along its axis: give X and Y");
-    Vec3 centre = far ? Vec3(0.0) : to_program(pos);
+    Vec3 centre = tool.far ? Vec3(0.0) : to_program(tool.pos);
     if (w.has('X')) centre.x = length('X');
     if (w.has('Y')) centre.y = length('Y');
     centre.z = 0;
     const Mat3 turn = rotation_z(w.take('R'));
-    feature = Frame{turn, centre - turn * centre + work_offset + local_offset};
+    feature = Frame{turn, centre - turn * centre + frame.work_offset + frame.local_offset};
   } else if (code == kG68_3) {
     // G68.3 X Y Z R (Fanuc B-79976E): Z along the tool; the origin is X Y Z, all three or none
     // (none: the tool tip where it stands).
@@ -208,22 +209,23 @@ void Interpreter::State::tilted_plane(int code) {
     Vec3 o(0.0);
     if (given == 3) {
       for (int i = 0; i < 3; ++i) o[i] = length(kAxisLetter[i]);
-      o += work_offset + local_offset;
+      o += frame.work_offset + frame.local_offset;
     } else {
-      if (far)
+      if (tool.far)
         error(column,
               "G68.3 without X Y Z takes the tool tip as the origin, but the tool is "
               "retracted far along its axis: give X, Y and Z");
-      o = pos;
+      o = tool.pos;
     }
     try {
-      feature = tool_axis_frame(o, axis, w.has('R') ? w.take('R') : 0.0);
+      feature = tool_axis_frame(o, tool.axis, w.has('R') ? w.take('R') : 0.0);
     } catch (const Error& e) {
       error(column, std::string("G68.3: ") + e.what());
     }
   } else if (code == kG68_4) {
     // G68.4: the same forms as G68.2, given in the active feature frame and composed with it.
-    if (!tilted) error(column, "G68.4 (incremental tilted plane) without an active tilted plane");
+    if (!frame.tilted)
+      error(column, "G68.4 (incremental tilted plane) without an active tilted plane");
     std::optional<Frame> incremental_frame = plane_words(kG68_4);
     if (!incremental_frame) return;
     feature = compose(Frame{tilt.rotation, tilt.origin}, *incremental_frame);
@@ -231,12 +233,13 @@ void Interpreter::State::tilted_plane(int code) {
     std::optional<Frame> written = plane_words(code);
     if (!written) return;
     feature = *written;
-    feature.origin += work_offset + local_offset;  // on the active work coordinate system
+    feature.origin +=
+        frame.work_offset + frame.local_offset;  // on the active work coordinate system
   }
   tilt.rotation = feature.rotation;
   tilt.origin = feature.origin;
-  tilted = true;
-  tilt.line = line;
+  frame.tilted = true;
+  tilt.line = context.line;
   update_frame();
 }
 
@@ -247,22 +250,22 @@ void Interpreter::State::tilted_plane(int code) {
 // mode: LinuxCNC's TWP demos (incremental_repetition_g533.ngc) move with bare X Y Z after G53.6.
 void Interpreter::State::orient_to_plane(int code) {
   int column = w.find_g(code);
-  if (!tilted) error(column, code_name('G', code) + " without an active tilted plane");
+  if (!frame.tilted) error(column, code_name('G', code) + " without an active tilted plane");
   if (code != kG253 && w.has('P')) integer('P', (code_name('G', code) + " P").c_str(), 0, 2);
   Vec3 direction = glm::normalize(tilt.rotation[2]);
   if (machine.kinematics) {  // the machine must reach it; the rotaries it picks are remembered
     try {
-      rotary_position = orient_tool(*machine.kinematics, direction, rotary_position);
+      frame.rotary_position = orient_tool(*machine.kinematics, direction, frame.rotary_position);
     } catch (const Error& e) {
       error(column, code_name('G', code) + ": " + e.what());
     }
   }
-  if (glm::dot(direction, axis) < 1 - kSameDirection) {
-    axis = direction;
+  if (glm::dot(direction, tool.axis) < 1 - kSameDirection) {
+    tool.axis = direction;
     go_far();  // the machine turns the tool: where the tip ends is the kinematics' business
   }
   update_frame();
-  if (machine.dialect == Dialect::linuxcnc) motion = kG0;
+  if (machine.dialect == Dialect::linuxcnc) modal.motion = kG0;
   if (code != kG53_3) return;
   // LinuxCNC's remap (g533remap.ngc) requires X, Y and Z, and hands them on to M530 as I J K.
   for (char c : {'I', 'J', 'K'})
@@ -273,7 +276,7 @@ void Interpreter::State::orient_to_plane(int code) {
   Vec3 target(length('X'), length('Y'), length('Z'));
   // The point is G53.3's own rapid, made here: the motion stage must not move to it again.
   for (char c : {'X', 'Y', 'Z'}) w.present &= ~(1u << letter_index(c));
-  move_to(target, {true, true, true}, rotation, origin, MoveKind::rapid, 0.0);
+  move_to(target, {true, true, true}, frame.rotation, frame.origin, MoveKind::rapid, 0.0);
 }
 
 }  // namespace tridex::gcode
