@@ -57,9 +57,11 @@ cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DTRIDEX_BUILD_TESTS=ON 
 cmake --build build -j "$jobs"
 ctest --test-dir build --output-on-failure --no-tests=error -j "$jobs" | tee build/ctest.log
 
+# -O1 -g1 (the level AddressSanitizer's documentation suggests): half the compile time of -O2 -g
+# on the kernel's tests (test_zmap.cpp: 27 s against 50 s of CPU); stack traces keep file and line.
 echo "== ASan+UBSan build"
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTRIDEX_SANITIZE=ON \
-  -DTRIDEX_BUILD_TESTS=ON -DTRIDEX_BUILD_BENCH=OFF
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DTRIDEX_BUILD_TESTS=ON -DTRIDEX_BUILD_BENCH=OFF
 cmake --build build-asan -j "$jobs"
 echo "== the fuzzers' build (clang, libFuzzer)"
 bash tools/fuzz/build.sh build-fuzz

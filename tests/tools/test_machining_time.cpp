@@ -11,7 +11,7 @@
 
 #include "command_harness.hpp"
 #include "errors.hpp"
-#include "machining_time.hpp"
+#include "checks/machining_time.hpp"
 #include "inputs/program_input.hpp"
 #include "tridex/gcode/interpreter.hpp"
 #include "tridex/gcode/machine.hpp"

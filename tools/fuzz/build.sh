@@ -12,7 +12,7 @@ mkdir -p "$objects_dir" "$build/inputs"
 
 flags=(-std=c++20 -O1 -g -fno-sanitize-recover=undefined -Iinclude -Igcode/include -Itools/cli)
 # The command's parsers that the input harnesses reach; the G-code library whole.
-cli_sources=(tools/cli/json_input.cpp tools/cli/inputs/numbers.cpp tools/cli/inputs/project.cpp
+cli_sources=(tools/cli/inputs/json_input.cpp tools/cli/inputs/numbers.cpp tools/cli/inputs/project.cpp
              tools/cli/inputs/stock.cpp tools/cli/inputs/tool_table.cpp tools/cli/pipeline/memory.cpp)
 gcode_sources=(gcode/src/*.cpp)
 

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "errors.hpp"
-#include "json_input.hpp"
+#include "inputs/json_input.hpp"
 #include "tridex/gcode/machine.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

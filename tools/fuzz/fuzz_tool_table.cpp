@@ -8,7 +8,7 @@
 
 #include "errors.hpp"
 #include "inputs/tool_table.hpp"
-#include "json_input.hpp"
+#include "inputs/json_input.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   std::string text(reinterpret_cast<const char*>(data), size);

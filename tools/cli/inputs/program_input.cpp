@@ -6,7 +6,7 @@
 
 #include "errors.hpp"
 #include "inputs/project.hpp"
-#include "json_input.hpp"
+#include "inputs/json_input.hpp"
 #include "pipeline/memory.hpp"
 
 namespace tridex::cli {

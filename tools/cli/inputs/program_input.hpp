@@ -12,7 +12,7 @@
 #include "commands.hpp"
 #include "inputs/stock.hpp"
 #include "inputs/tool_table.hpp"
-#include "machining_time.hpp"
+#include "checks/machining_time.hpp"
 #include "pipeline/memory.hpp"
 #include "tridex/gcode/interpreter.hpp"
 

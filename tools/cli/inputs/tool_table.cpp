@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "errors.hpp"
-#include "json_input.hpp"
+#include "inputs/json_input.hpp"
 
 namespace tridex::cli {
 

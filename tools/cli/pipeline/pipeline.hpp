@@ -19,7 +19,7 @@
 #include "commands.hpp"
 #include "inputs/program_input.hpp"
 #include "json_text.hpp"
-#include "machining_time.hpp"
+#include "checks/machining_time.hpp"
 #include "pipeline/memory.hpp"
 #include "pipeline/progress.hpp"
 #include "tridex/cutter.hpp"

@@ -1,4 +1,4 @@
-#include "json_input.hpp"
+#include "inputs/json_input.hpp"
 
 #include <cstdio>
 #include <fstream>

@@ -1,5 +1,5 @@
 // tridex command — the machining time (see machining_time.hpp).
-#include "machining_time.hpp"
+#include "checks/machining_time.hpp"
 
 #include <algorithm>
 #include <cmath>
