@@ -7,7 +7,8 @@
     function that holds them);
   - README.md at most 250 lines;
   - no std::thread (or jthread, async) outside include/tridex/parallel.hpp and the tests: one pool;
-  - the bundled machines' names spelled out in one source file only.
+  - the bundled machines' names spelled out in one source file only;
+  - no TEST_CASE in a test header (CTest runs each suite file by file).
 
 Usage: tools/check_structure.py [ROOT]   exit 0 when every rule holds, 1 with one line a breach.
 The function finder is a brace matcher over the source with comments, strings and preprocessor
@@ -160,6 +161,9 @@ def main():
             if rel.as_posix() != "include/tridex/parallel.hpp" and re.search(
                     r"std::(thread|jthread|async)\b(?!::hardware_concurrency)", blank_out(text)):
                 breaches.append(f"{rel}: starts threads of its own; use include/tridex/parallel.hpp")
+    for header in sorted((root / "tests").rglob("*.hpp")):
+        if "node_modules" not in header.parts and re.search(r"\bTEST_CASE\b", blank_out(header.read_text(encoding="utf-8", errors="replace"))):
+            breaches.append(f"{header.relative_to(root)}: a TEST_CASE in a header, which CTest's per-file runs never reach")
     readme = root / "README.md"
     if readme.exists() and readme.read_text(encoding="utf-8").count("\n") > MAX_README_LINES:
         breaches.append(f"README.md: {readme.read_text(encoding='utf-8').count(chr(10))} lines, at most {MAX_README_LINES}")
