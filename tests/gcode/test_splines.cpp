@@ -12,7 +12,7 @@ using namespace tridex;
 using namespace tridex::gcode;
 using namespace tridex::gcode::test;
 
-namespace {
+namespace test_splines {
 
 Vec2 bezier(const std::vector<Vec2>& p, double t) {
   double s = 1 - t;
@@ -52,7 +52,6 @@ void check_follows(const std::vector<Move>& pieces, const std::vector<Vec2>& con
 
 const MachineConfig kLinuxcnc = *MachineConfig::bundled("linuxcnc");
 
-}  // namespace
 
 TEST_CASE("G5: biarcs through the cubic Bezier's points, G1 continuous, end exact") {
   Result r =
@@ -125,3 +124,5 @@ TEST_CASE("G5/G5.1 errors as rs274 gives them, at the word") {
   Diagnostic no_feed = error_of("G21 G17 G90\nG0 X0 Y0 Z-1\nG5 I0 J1 P1 Q1 X2 Y2\n", {}, kLinuxcnc);
   CHECK(no_feed.message.find("feed") != std::string::npos);
 }
+
+}  // namespace test_splines

@@ -17,7 +17,7 @@ using namespace tridex;
 using namespace tridex::gcode;
 using namespace tridex::gcode::test;
 
-namespace {
+namespace test_tilted_words {
 
 // The tool direction and the moves of a program that defines a plane, orients the tool and cuts
 // a small square in the plane.
@@ -51,7 +51,6 @@ std::string num(double v) {
 std::string xyz(const Vec3& p) { return cat("X", num(p.x), " Y", num(p.y), " Z", num(p.z)); }
 std::string ijk(const Vec3& v) { return cat("I", num(v.x), " J", num(v.y), " K", num(v.z)); }
 
-}  // namespace
 
 TEST_CASE("G68.2 forms: one plane written five ways gives the same moves") {
   // A 90-degree turn about Y with the origin at (3, -3, -6), as in Hurco's example.
@@ -255,3 +254,5 @@ TEST_CASE("G68.2 P2 / P3: incomplete, repeated or misplaced blocks are errors") 
   d = error_of("G68.2 P2 Q1 X0 R5\n");  // R belongs to Q0
   CHECK_MESSAGE(d.message.find("R5") != std::string::npos, d.message);
 }
+
+}  // namespace test_tilted_words

@@ -8,7 +8,7 @@
 
 using namespace tridex;
 
-namespace {
+namespace test_intersect_milled {
 
 struct Direction {
   Frame frame;
@@ -50,7 +50,6 @@ bool removed(const std::vector<Direction>& program, const std::vector<Cutter>& c
   return false;
 }
 
-}  // namespace
 
 TEST_CASE(
     "intersect_milled: a box milled in several tilted directions matches the point-membership "
@@ -140,3 +139,5 @@ TEST_CASE(
   CHECK(volume(intersect_milled(stock, lattice, {})) ==
         doctest::Approx(volume(TripleDexel::box(lattice, stock))));
 }
+
+}  // namespace test_intersect_milled

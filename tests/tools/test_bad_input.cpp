@@ -21,7 +21,7 @@
 using namespace tridex;
 using namespace tridex::test;
 
-namespace {
+namespace test_bad_input {
 
 const std::string kProgram =
     "G21 G90\nT1 M6\nS1000 M3\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X10 Y5\nG0 Z5\nM30\n";
@@ -392,7 +392,6 @@ const std::vector<BadInput>& cases() {
   return all;
 }
 
-}  // namespace
 
 TEST_CASE(
     "bad input: exit status 2, the place and the value in the message, no library text, no file "
@@ -480,7 +479,6 @@ TEST_CASE("SIGTERM removes the temporary file of an output being written") {
   fs::remove_all(dir);
 }
 
-namespace {
 
 // Runs the bundled example through `command` (simulate or check) at `resolution` with `extra`
 // arguments, waits for the temporary file of `output` (a file in the scratch folder) to appear,
@@ -542,7 +540,6 @@ void interrupt_while_writing(const std::string& command, const std::string& reso
   fs::remove_all(dir);
 }
 
-}  // namespace
 
 TEST_CASE(
     "SIGINT to a running simulate while it writes its STL leaves no temporary or partial file") {
@@ -563,3 +560,5 @@ TEST_CASE(
                           SIGTERM);
   fs::remove_all(dir);
 }
+
+}  // namespace test_bad_input

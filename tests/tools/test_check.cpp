@@ -21,7 +21,7 @@ using namespace tridex;
 using namespace tridex::test;
 using nlohmann::json;
 
-namespace {
+namespace test_check {
 
 // ---- references --------------------------------------------------------------------------------
 
@@ -162,7 +162,6 @@ std::size_t reddish_pixels(const fs::path& path) {
   return red;
 }
 
-}  // namespace
 
 TEST_CASE("the distance tree matches brute force, and signs by the face or the inside test") {
   std::mt19937 rng(7);
@@ -513,3 +512,5 @@ TEST_CASE("check: moves outside the envelope, bad designs and bad options") {
   CHECK(f.check(program(-2), {"--ply", f.design.string()}).status == 2);
   CHECK(f.check(program(-2), {"--zmap-backend", "gl"}).status == 2);
 }
+
+}  // namespace test_check

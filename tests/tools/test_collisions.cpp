@@ -19,7 +19,7 @@ using namespace tridex::cli;
 using namespace tridex::test;
 using nlohmann::json;
 
-namespace {
+namespace test_collisions {
 
 // ---- the brute-force reference
 // -------------------------------------------------------------------
@@ -94,7 +94,6 @@ Reference brute_force(const ZMap& map, const BodyPart& part, const Segment& tip)
   return ref;
 }
 
-}  // namespace
 
 TEST_CASE("swept shank and holder depths and near misses match the sampled swept solid") {
   std::mt19937 random(14);
@@ -170,7 +169,6 @@ TEST_CASE("swept shank and holder depths and near misses match the sampled swept
 // ---- planted faults, end to end
 // ------------------------------------------------------------------
 
-namespace {
 
 // T2 (no parts described) clears the stock 0..60 × 0..40 × 0..30 to z = 20 except a boss
 // beyond the round end of its first pass (x ≥ 30 + √(12² − (y − 8)²), y < 18). T1's holder (Ø30, 25
@@ -226,7 +224,6 @@ CheckRun run_faults(const fs::path& dir, double z1, double z3,
   return simulate_then_check(dir, fault_program(z1, z3), kFaultTools, more);
 }
 
-}  // namespace
 
 TEST_CASE(
     "check: a holder passing a boss and a shank on a pocket's floor are found at their lines") {
@@ -354,3 +351,5 @@ TEST_CASE("check: a shank working down its own slot meets only what the earlier 
   CHECK(walls);
   fs::remove_all(dir);
 }
+
+}  // namespace test_collisions

@@ -29,7 +29,7 @@ extern char** environ;
 using namespace tridex;
 using namespace tridex::test;
 
-namespace {
+namespace test_memory_bound {
 
 #if defined(__SANITIZE_ADDRESS__)
 constexpr bool kSanitized = true;  // shadow memory and quarantine are no part of the estimate
@@ -147,7 +147,6 @@ Mesh sphere(int nu, double radius, Vec3 centre) {
   return m;
 }
 
-}  // namespace
 
 TEST_CASE("memory: the estimate bounds the peak of simulate with many directions") {
   fs::path dir = scratch("memory-directions");
@@ -313,3 +312,5 @@ TEST_CASE("memory: groups holding many moves stays within --max-memory") {
   CHECK(run_measured(bounded).status == 2);
   fs::remove_all(dir);
 }
+
+}  // namespace test_memory_bound

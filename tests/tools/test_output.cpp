@@ -14,7 +14,7 @@ using namespace tridex;
 using namespace tridex::cli;
 namespace fs = std::filesystem;
 
-namespace {
+namespace test_output {
 
 fs::path scratch_dir(const std::string& name) {
   fs::path dir =
@@ -36,7 +36,6 @@ std::size_t entries(const fs::path& dir) {
       std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
 }
 
-}  // namespace
 
 TEST_CASE("an output appears only when committed, and replaces the old file whole") {
   fs::path dir = scratch_dir("output");
@@ -85,3 +84,5 @@ TEST_CASE("output paths are checked before any work") {
   }
   fs::remove_all(dir);
 }
+
+}  // namespace test_output
