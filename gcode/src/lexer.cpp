@@ -484,6 +484,7 @@ class LineLexer : public Parser {
         first = false;
         continue;
       }
+      if (c == '<' && first && block_.words.empty() && program_name()) continue;
       if (!is_alpha(c)) {
         if (c == '[' || c == ']' || c == '=')
           fail(i_, describe(c) + (parameters_ ? " where a word was expected"
@@ -493,6 +494,7 @@ class LineLexer : public Parser {
       std::size_t start = i_;
       char letter = upper(c);
       bool sequence_only = block_.words.size() == 1 && block_.words[0].letter == 'N';
+      if (letter == 'O' && first && block_.words.empty() && program_name()) continue;
       if (i_ + 1 < n_ && is_alpha(text_[i_ + 1])) {  // a keyword: no word has a letter after it
         if ((first || sequence_only) && statement()) return;
         fail(start, "unexpected " + describe(c) + describe(text_[i_ + 1]) +
@@ -673,6 +675,34 @@ class LineLexer : public Parser {
         ++i_;
       }
     }
+  }
+
+  // A program name that is not a number, alone on its line but for comments: `O7997A`,
+  // `OCIRCLE` (letters and digits after O, at least one letter: no o-word or O number reads so)
+  // or Fanuc's `<NAME>` (FANUC Series 30i/0i-F program names, which stand where the O number
+  // did). False, reading nothing, for anything else.
+  bool program_name() {
+    const bool bracket = text_[i_] == '<';
+    std::size_t j = i_ + 1;
+    bool letter = bracket;
+    if (bracket) {
+      while (j < n_ && text_[j] != '>' && text_[j] != '(' && text_[j] != ';') ++j;
+      if (j == n_ || text_[j] != '>' || j == i_ + 1) return false;
+      ++j;
+    } else {
+      while (j < n_ && (is_alpha(text_[j]) || is_digit(text_[j]) || text_[j] == '_')) {
+        letter |= !is_digit(text_[j]);
+        ++j;
+      }
+    }
+    std::size_t end = j;
+    while (j < n_ && is_space(text_[j])) ++j;
+    if (!letter || (j < n_ && text_[j] != '(' && text_[j] != ';')) return false;
+    block_.program_name.assign(text_.substr(i_, end - i_));
+    if (!bracket) block_.program_name[0] = 'O';
+    block_.program_name_column = static_cast<int>(i_) + 1;
+    i_ = j;
+    return true;
   }
 
   // LinuxCNC `o<label> keyword …`; false for a Fanuc `O1234` program number.
