@@ -429,13 +429,26 @@ void Interpreter::State::work_offset_entry(long long l, int column) {
       value[i] = relative_to_position
                      ? linear_axes()[i] - frame.local_offset[i] - length(kAxisLetter[i])
                      : length(kAxisLetter[i]);
-  // A rotary offset of 0 changes nothing, nor do LinuxCNC's plain A/B/C (no kinematics);
-  // any other would turn the part under the program, which tridex does not model.
-  for (char c : {'A', 'B', 'C'})
-    if (w.has(c) && w.take(c) != 0 && !(linuxcnc && !machine.kinematics))
-      error(w.col(c), std::string("G10 ") + c +
-                          format_number(w.value[static_cast<std::size_t>(letter_index(c))]) +
-                          ": a rotary work offset other than 0 is not simulated");
+  // A rotary offset of 0 changes nothing, nor do LinuxCNC's plain A/B/C (no kinematics). On a
+  // machine whose kinematics has the axis it shifts that axis's zero, as X Y Z's (Fanuc's work
+  // offsets hold every axis: an HMC's `G10 L2 P1 X… Y… Z… B…` sets G54's B). Elsewhere it would
+  // turn the part under the program: an error.
+  RotaryPositions rotary =
+      frame.rotary_offsets.count(key) ? frame.rotary_offsets[key] : RotaryPositions{};
+  for (char c : {'A', 'B', 'C'}) {
+    if (!w.has(c)) continue;
+    const int col = w.col(c);
+    const double angle = w.take(c);
+    if (machine.kinematics && machine.kinematics->find(c) && !linuxcnc) {
+      rotary[static_cast<std::size_t>(rotary_index(c))] = angle;
+    } else if (angle != 0 && !(linuxcnc && !machine.kinematics)) {
+      error(col, std::string("G10 ") + c + format_number(angle) +
+                     ": a rotary work offset other than 0 is simulated only on a machine whose "
+                     "kinematics has that axis");
+    }
+  }
+  if (rotary != RotaryPositions{} || frame.rotary_offsets.count(key))
+    frame.rotary_offsets[key] = rotary;
   if (key == frame.work_key) comp_forbid(column, "G10 on the active work offset");
   frame.offsets[key] = value;
   if (key == frame.work_key) {

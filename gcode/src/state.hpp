@@ -184,6 +184,15 @@ struct Interpreter::State : ParameterReader {
     Vec3 saved_local_offset{0.0};  // G92.2 suspends, G92.3 restores
     Vec3 world_origin{0.0};
     RotaryPositions rotary_position{};
+    // Rotary work offsets (G10 L2/L20 A/B/C on a machine whose kinematics has the axis), keyed as
+    // `offsets`: the machine's angle is the program's plus the active one, as for X Y Z; the
+    // fixture sits turned by it on the table, so the part turns by the program's angle
+    // (rotary_position) and the axis limits meet the machine's (rotary.cpp).
+    std::map<int, RotaryPositions> rotary_offsets;
+    RotaryPositions rotary_offset() const {
+      auto it = rotary_offsets.find(work_key);
+      return it == rotary_offsets.end() ? RotaryPositions{} : it->second;
+    }
     bool tcp = false;
     bool dwo = false;
   };
