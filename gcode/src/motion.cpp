@@ -664,9 +664,12 @@ void Interpreter::State::home_return(bool second) {
   for (char c : {'A', 'B', 'C'})
     if (w.has(c)) {
       w.take(c);
-      double& angle = frame.rotary_position[static_cast<std::size_t>(rotary_index(c))];
-      turns = turns || (machine.kinematics && angle != 0);
-      angle = 0;
+      const std::size_t i = static_cast<std::size_t>(rotary_index(c));
+      // The machine's zero: a rotary work offset's fixture then stands turned back by it.
+      const double home_angle = -frame.rotary_offset()[i];
+      double& angle = frame.rotary_position[i];
+      turns = turns || (machine.kinematics && angle != home_angle);
+      angle = home_angle;
     }
   const Vec3& target = second ? machine.reference2 : machine.home;
   bool is_default = second ? machine.reference2_is_default : machine.home_is_default;

@@ -187,6 +187,12 @@ TEST_CASE("hmc-b-table: G10 L2 P1 with B shifts B's zero; M60/M71/M10/M11 pass q
   CHECK(r.moves.back().rotary[1] == doctest::Approx(0));
   CHECK(near(r.moves.back().axis, Vec3(0, 0, 1), 1e-12));
   CHECK(near(r.moves.back().machine, Vec3(15, 20, 130), 1e-9));
+  // G28 B0 returns the machine's B to its zero: the fixture then stands turned back by 0.25°.
+  Result home = run_program(
+      "G21 G90\nT1 M6\nG10 L2 P1 X10 Y20 Z30 B0.25\nG54\nG0 B90\n"
+      "G91 G28 B0\nG90 G0 X5 Y0 Z100\nM30\n",
+      {}, hmc);
+  CHECK(home.moves.back().rotary[1] == doctest::Approx(-0.25));
   // The machine's angle, offset added, meets the axis's limits.
   MachineConfig limited = hmc;
   limited.kinematics->axes[0].limits = std::array<double, 2>{-90, 90};

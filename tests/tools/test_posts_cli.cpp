@@ -46,9 +46,11 @@ TEST_CASE("moves: an HMC program runs with the shop's variables, M-codes and mac
   REQUIRE(!moves.empty());
   bool face = false;
   for (const json& m : moves)
-    face |= m["kind"] == "feed" && std::abs(m["end"][2].get<double>() - 49.984) < 1e-9 &&
+    face |= m["kind"] == "feed" && std::abs(m["machine"][0].get<double>() - 190.95) < 1e-9 &&
+            std::abs(m["machine"][2].get<double>() - 49.984) < 1e-9 &&
             std::abs(m["rotary"]["B"].get<double>() - 90) < 1e-9;
-  CHECK(face);  // the macro's cut, at B90 of the part (B90.25 on the machine)
+  // The macro's cut in G54 (X offset #901001 = 10), at B90 of the part (B90.25 on the machine).
+  CHECK(face);
 }
 
 // LinuxCNC reads a tool without a diameter (`D0`) as a tool that cuts nothing: G41 with it
