@@ -677,6 +677,24 @@ class LineLexer : public Parser {
     }
   }
 
+  // LinuxCNC's o-word keywords.
+  static constexpr std::pair<std::string_view, OKeyword> kOKeywords[] = {
+      {"ENDSUB", OKeyword::endsub},
+      {"SUB", OKeyword::sub},
+      {"CALL", OKeyword::call},
+      {"ELSEIF", OKeyword::elseif},
+      {"ELSE", OKeyword::else_},
+      {"ENDIF", OKeyword::endif},
+      {"IF", OKeyword::if_},
+      {"ENDWHILE", OKeyword::endwhile},
+      {"WHILE", OKeyword::while_},
+      {"DO", OKeyword::do_},
+      {"ENDREPEAT", OKeyword::endrepeat},
+      {"REPEAT", OKeyword::repeat},
+      {"BREAK", OKeyword::break_},
+      {"CONTINUE", OKeyword::continue_},
+      {"RETURN", OKeyword::return_}};
+
   // A program name that is not a number, alone on its line but for comments: `O7997A`,
   // `OCIRCLE` (letters and digits after O, at least one letter: no o-word or O number reads so)
   // or Fanuc's `<NAME>` (FANUC Series 30i/0i-F program names, which stand where the O number
@@ -698,6 +716,14 @@ class LineLexer : public Parser {
     std::size_t end = j;
     while (j < n_ && is_space(text_[j])) ++j;
     if (!letter || (j < n_ && text_[j] != '(' && text_[j] != ';')) return false;
+    if (!bracket) {  // `o100sub`: LinuxCNC's o-word written without its space
+      std::size_t k = i_ + 1;
+      while (k < end && is_digit(text_[k])) ++k;
+      std::string letters;
+      for (std::size_t m = k; m < end; ++m) letters.push_back(upper(text_[m]));
+      for (const auto& keyword : kOKeywords)
+        if (k > i_ + 1 && letters == keyword.first) return false;
+    }
     block_.program_name.assign(text_.substr(i_, end - i_));
     if (!bracket) block_.program_name[0] = 'O';
     block_.program_name_column = static_cast<int>(i_) + 1;
@@ -734,28 +760,12 @@ class LineLexer : public Parser {
         fail(at, "o-word o<" + label + "> needs a keyword (sub, call, if, while, …)");
       return false;
     }
-    static constexpr std::pair<std::string_view, OKeyword> kKeywords[] = {
-        {"ENDSUB", OKeyword::endsub},
-        {"SUB", OKeyword::sub},
-        {"CALL", OKeyword::call},
-        {"ELSEIF", OKeyword::elseif},
-        {"ELSE", OKeyword::else_},
-        {"ENDIF", OKeyword::endif},
-        {"IF", OKeyword::if_},
-        {"ENDWHILE", OKeyword::endwhile},
-        {"WHILE", OKeyword::while_},
-        {"DO", OKeyword::do_},
-        {"ENDREPEAT", OKeyword::endrepeat},
-        {"REPEAT", OKeyword::repeat},
-        {"BREAK", OKeyword::break_},
-        {"CONTINUE", OKeyword::continue_},
-        {"RETURN", OKeyword::return_}};
     // The keyword is the whole run of letters: `callsub` is not `call` followed by junk.
     std::size_t end = j;
     while (end < n_ && is_alpha(text_[end])) ++end;
     std::string_view name = text_.substr(j, end - j);
     i_ = j;
-    for (const auto& [word, kw] : kKeywords) {
+    for (const auto& [word, kw] : kOKeywords) {
       if (name.size() == word.size() && keyword(word)) {
         if (!parameters_) fail(at, "o-words are not supported here");
         Control& control = block_.control;

@@ -142,6 +142,10 @@ TEST_CASE("program names that are not numbers open a Fanuc or Haas program; Linu
   // Met later, the main program ran into another program, as with an O number.
   CHECK(contains(error_of("G0 X1\nOCIRCLE\nG0 X2\nM30\n", {}, at_origin()).message,
                  "runs into OCIRCLE without M2/M30"));
+  // LinuxCNC's o-word written without its space stays an o-word, as rs274 reads it.
+  const std::string osub = "o100sub\nG0 X1\no100endsub\no100call\nM2\n";
+  CHECK(run_program(osub, {}, linuxcnc_at_origin()).moves.back().end.x == doctest::Approx(1));
+  if (auto out = rs274_output(osub)) CHECK(contains(*out, "STRAIGHT_TRAVERSE(1.0000"));
   // Words after a name are no program name: refused as before.
   CHECK(contains(error_of("OCIRCLE G0 X1\nM30\n", {}, at_origin()).message, "unexpected"));
   if (auto out = rs274_output("OCIRCLE (Circle)\nG0 X1\nM2\n"))
