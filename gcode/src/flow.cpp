@@ -127,6 +127,8 @@ class ProgramFlow {
   void o_loop_end(const Control& control);
   void o_break(const Control& control);
   void linuxcnc_program_number(const Word& label);
+  bool own_top() const;
+  bool program_start(const std::string& name, int column);
   void loop_control(const Control& control);
   Position find_sequence(long long number, const std::string& what, int column);
   void jump_to_sequence(long long number, int column);
@@ -512,6 +514,30 @@ void ProgramFlow::loop_control(const Control& control) {
 // subprogram alike: pcb2gcode's Mach3 output runs from its main program into "O200" and ends at
 // that subprogram's M99, and rs274 cuts it so. Only inside an o-word call is it an error, as
 // rs274 reports it.
+// Whether the line just read is the first of a subprogram file being run from its top.
+bool ProgramFlow::own_top() const {
+  return !calls_.empty() && calls_.back().body.source == current_ && current_ != 0 &&
+         calls_.back().body.offset == sources_[current_]->start;
+}
+
+// An O number or a program name (`name`, as written) on Fanuc and Haas: it opens the main
+// program or a subprogram file; met later, a program ran into the next one. True when that ends
+// the main program (lenient).
+bool ProgramFlow::program_start(const std::string& name, int column) {
+  if (own_top()) return false;  // a subprogram file's own O number, run from its top
+  if (!calls_.empty())
+    error(column, "subprogram " + calls_.back().label + " runs into " + name + " without M99");
+  if (!started_) {
+    started_ = true;
+    return false;
+  }
+  std::string message = "the main program runs into " + name + " without M2/M30";
+  if (!s_.options.lenient) error(column, message);
+  s_.warn(column, message + "; treated as the end of the program");
+  ended_ = true;
+  return true;
+}
+
 void ProgramFlow::linuxcnc_program_number(const Word& label) {
   if (!calls_.empty() && calls_.back().kind == CallKind::o_call)
     error(label.column, "O" + format_number(label.value) +
@@ -749,6 +775,15 @@ void ProgramFlow::run() {
       }
       continue;
     }
+    if (!block_.program_name.empty()) {
+      if (s_.machine.dialect == Dialect::linuxcnc)
+        error(block_.program_name_column,
+              "program name " + block_.program_name +
+                  ": LinuxCNC has no program names; its O words are o-words, a number or <name> "
+                  "and a keyword (o100 sub, o<name> call)");
+      if (program_start(block_.program_name, block_.program_name_column)) break;
+      continue;
+    }
     if (block_.words.empty() && block_.assignments.empty()) continue;
     if (!block_.words.empty() && block_.words.front().letter == 'O') {
       const Word& label = block_.words.front();
@@ -756,26 +791,12 @@ void ProgramFlow::run() {
         error(block_.words[1].column, "an O number must be alone on its line");
       if (label.value < 0 || label.value != std::floor(label.value))
         error(label.column, "O number must be a non-negative integer");
-      if (!calls_.empty() && calls_.back().body.source == current_ && current_ != 0 &&
-          calls_.back().body.offset == sources_[current_]->start)
-        continue;  // a subprogram file's own O number, run from its top
-      if (s_.machine.dialect == Dialect::linuxcnc) {
+      if (s_.machine.dialect == Dialect::linuxcnc && !own_top()) {
         linuxcnc_program_number(label);
         continue;
       }
-      if (!calls_.empty())
-        error(label.column, "subprogram " + calls_.back().label + " runs into O" +
-                                format_number(label.value) + " without M99");
-      if (!started_) {
-        started_ = true;
-        continue;
-      }
-      std::string message =
-          "the main program runs into O" + format_number(label.value) + " without M2/M30";
-      if (!s_.options.lenient) error(label.column, message);
-      s_.warn(label.column, message + "; treated as the end of the program");
-      ended_ = true;
-      break;
+      if (program_start("O" + format_number(label.value), label.column)) break;
+      continue;
     }
     started_ = true;
     // The statement starts at its first word or assignment, whichever comes first on the line.

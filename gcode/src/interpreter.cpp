@@ -31,7 +31,8 @@ Interpreter::Interpreter(InterpreterOptions options, MachineConfig machine)
   detail::require_positive(options.arc_tolerance, "arc_tolerance");
   detail::require_positive(options.peck_clearance, "peck_clearance");
   detail::require_positive(machine.far_distance, "far_distance");
-  detail::require_positive(machine.arc_radius_tolerance, "arc_radius_tolerance");
+  if (machine.arc_radius_tolerance)
+    detail::require_positive(*machine.arc_radius_tolerance, "arc_radius_tolerance");
   if (machine.start_position && !is_finite(*machine.start_position))
     detail::fail("start_position must be finite");
   if (!is_finite(machine.tool_change_position)) detail::fail("tool_change_position must be finite");

@@ -484,6 +484,7 @@ class LineLexer : public Parser {
         first = false;
         continue;
       }
+      if (c == '<' && first && block_.words.empty() && program_name()) continue;
       if (!is_alpha(c)) {
         if (c == '[' || c == ']' || c == '=')
           fail(i_, describe(c) + (parameters_ ? " where a word was expected"
@@ -493,6 +494,7 @@ class LineLexer : public Parser {
       std::size_t start = i_;
       char letter = upper(c);
       bool sequence_only = block_.words.size() == 1 && block_.words[0].letter == 'N';
+      if (letter == 'O' && first && block_.words.empty() && program_name()) continue;
       if (i_ + 1 < n_ && is_alpha(text_[i_ + 1])) {  // a keyword: no word has a letter after it
         if ((first || sequence_only) && statement()) return;
         fail(start, "unexpected " + describe(c) + describe(text_[i_ + 1]) +
@@ -675,6 +677,60 @@ class LineLexer : public Parser {
     }
   }
 
+  // LinuxCNC's o-word keywords.
+  static constexpr std::pair<std::string_view, OKeyword> kOKeywords[] = {
+      {"ENDSUB", OKeyword::endsub},
+      {"SUB", OKeyword::sub},
+      {"CALL", OKeyword::call},
+      {"ELSEIF", OKeyword::elseif},
+      {"ELSE", OKeyword::else_},
+      {"ENDIF", OKeyword::endif},
+      {"IF", OKeyword::if_},
+      {"ENDWHILE", OKeyword::endwhile},
+      {"WHILE", OKeyword::while_},
+      {"DO", OKeyword::do_},
+      {"ENDREPEAT", OKeyword::endrepeat},
+      {"REPEAT", OKeyword::repeat},
+      {"BREAK", OKeyword::break_},
+      {"CONTINUE", OKeyword::continue_},
+      {"RETURN", OKeyword::return_}};
+
+  // A program name that is not a number, alone on its line but for comments: `O7997A`,
+  // `OCIRCLE` (letters and digits after O, at least one letter: no o-word or O number reads so)
+  // or Fanuc's `<NAME>` (FANUC Series 30i/0i-F program names, which stand where the O number
+  // did). False, reading nothing, for anything else.
+  bool program_name() {
+    const bool bracket = text_[i_] == '<';
+    std::size_t j = i_ + 1;
+    bool letter = bracket;
+    if (bracket) {
+      while (j < n_ && text_[j] != '>' && text_[j] != '(' && text_[j] != ';') ++j;
+      if (j == n_ || text_[j] != '>' || j == i_ + 1) return false;
+      ++j;
+    } else {
+      while (j < n_ && (is_alpha(text_[j]) || is_digit(text_[j]) || text_[j] == '_')) {
+        letter |= !is_digit(text_[j]);
+        ++j;
+      }
+    }
+    std::size_t end = j;
+    while (j < n_ && is_space(text_[j])) ++j;
+    if (!letter || (j < n_ && text_[j] != '(' && text_[j] != ';')) return false;
+    if (!bracket) {  // `o100sub`: LinuxCNC's o-word written without its space
+      std::size_t k = i_ + 1;
+      while (k < end && is_digit(text_[k])) ++k;
+      std::string letters;
+      for (std::size_t m = k; m < end; ++m) letters.push_back(upper(text_[m]));
+      for (const auto& keyword : kOKeywords)
+        if (k > i_ + 1 && letters == keyword.first) return false;
+    }
+    block_.program_name.assign(text_.substr(i_, end - i_));
+    if (!bracket) block_.program_name[0] = 'O';
+    block_.program_name_column = static_cast<int>(i_) + 1;
+    i_ = j;
+    return true;
+  }
+
   // LinuxCNC `o<label> keyword …`; false for a Fanuc `O1234` program number.
   bool o_word() {
     std::size_t at = i_;
@@ -704,28 +760,12 @@ class LineLexer : public Parser {
         fail(at, "o-word o<" + label + "> needs a keyword (sub, call, if, while, …)");
       return false;
     }
-    static constexpr std::pair<std::string_view, OKeyword> kKeywords[] = {
-        {"ENDSUB", OKeyword::endsub},
-        {"SUB", OKeyword::sub},
-        {"CALL", OKeyword::call},
-        {"ELSEIF", OKeyword::elseif},
-        {"ELSE", OKeyword::else_},
-        {"ENDIF", OKeyword::endif},
-        {"IF", OKeyword::if_},
-        {"ENDWHILE", OKeyword::endwhile},
-        {"WHILE", OKeyword::while_},
-        {"DO", OKeyword::do_},
-        {"ENDREPEAT", OKeyword::endrepeat},
-        {"REPEAT", OKeyword::repeat},
-        {"BREAK", OKeyword::break_},
-        {"CONTINUE", OKeyword::continue_},
-        {"RETURN", OKeyword::return_}};
     // The keyword is the whole run of letters: `callsub` is not `call` followed by junk.
     std::size_t end = j;
     while (end < n_ && is_alpha(text_[end])) ++end;
     std::string_view name = text_.substr(j, end - j);
     i_ = j;
-    for (const auto& [word, kw] : kKeywords) {
+    for (const auto& [word, kw] : kOKeywords) {
       if (name.size() == word.size() && keyword(word)) {
         if (!parameters_) fail(at, "o-words are not supported here");
         Control& control = block_.control;

@@ -105,12 +105,24 @@ MachineConfig head_head() {
        make_axis('A', true, {1, 0, 0}, {0, 0, 150}, std::array<double, 2>{-100, 100})});
 }
 
+// Horizontal machining centre: the spindle along machine Z (horizontal, Y vertical, as on any
+// HMC), a B table (the pallet's rotary) turning about Y through the origin, endless (indexing and
+// full rotary tables turn past 360°), Fanuc's dialect. Its pallet changer (M60 change, M71 a
+// pallet code an HMC's programs write) and B table clamp (M10 clamp, M11 unclamp) move no axis
+// tridex simulates: declared, so that they pass without a warning.
+MachineConfig hmc_b_table() {
+  MachineConfig m = rotary_machine(MachineType::table_table,
+                                   {make_axis('B', false, {0, 1, 0}, {0, 0, 0}, Limits{})});
+  m.m_codes = {10, 11, 60, 71};
+  return m;
+}
+
 // The registry, in the order the names are listed.
 struct BundledMachine {
   std::string_view name;
   MachineConfig (*build)();
 };
-constexpr std::array<BundledMachine, 7> kBundled{{
+constexpr std::array<BundledMachine, 8> kBundled{{
     {"default", default_machine},
     {"haas", haas_machine},
     {"linuxcnc", linuxcnc_machine},
@@ -118,6 +130,7 @@ constexpr std::array<BundledMachine, 7> kBundled{{
     {"bc-trunnion", bc_trunnion},
     {"b-head-c-table", b_head_c_table},
     {"head-head", head_head},
+    {"hmc-b-table", hmc_b_table},
 }};
 
 // ---- the machine file's "kinematics" key -------------------------------------------------

@@ -429,13 +429,26 @@ void Interpreter::State::work_offset_entry(long long l, int column) {
       value[i] = relative_to_position
                      ? linear_axes()[i] - frame.local_offset[i] - length(kAxisLetter[i])
                      : length(kAxisLetter[i]);
-  // A rotary offset of 0 changes nothing, nor do LinuxCNC's plain A/B/C (no kinematics);
-  // any other would turn the part under the program, which tridex does not model.
-  for (char c : {'A', 'B', 'C'})
-    if (w.has(c) && w.take(c) != 0 && !(linuxcnc && !machine.kinematics))
-      error(w.col(c), std::string("G10 ") + c +
-                          format_number(w.value[static_cast<std::size_t>(letter_index(c))]) +
-                          ": a rotary work offset other than 0 is not simulated");
+  // A rotary offset of 0 changes nothing, nor do LinuxCNC's plain A/B/C (no kinematics). On a
+  // machine whose kinematics has the axis it shifts that axis's zero, as X Y Z's (Fanuc's work
+  // offsets hold every axis: an HMC's `G10 L2 P1 X… Y… Z… B…` sets G54's B). Elsewhere it would
+  // turn the part under the program: an error.
+  RotaryPositions rotary =
+      frame.rotary_offsets.count(key) ? frame.rotary_offsets[key] : RotaryPositions{};
+  for (char c : {'A', 'B', 'C'}) {
+    if (!w.has(c)) continue;
+    const int col = w.col(c);
+    const double angle = w.take(c);
+    if (machine.kinematics && machine.kinematics->find(c) && !linuxcnc) {
+      rotary[static_cast<std::size_t>(rotary_index(c))] = angle;
+    } else if (angle != 0 && !(linuxcnc && !machine.kinematics)) {
+      error(col, std::string("G10 ") + c + format_number(angle) +
+                     ": a rotary work offset other than 0 is simulated only on a machine whose "
+                     "kinematics has that axis");
+    }
+  }
+  if (rotary != RotaryPositions{} || frame.rotary_offsets.count(key))
+    frame.rotary_offsets[key] = rotary;
   if (key == frame.work_key) comp_forbid(column, "G10 on the active work offset");
   frame.offsets[key] = value;
   if (key == frame.work_key) {
@@ -471,7 +484,14 @@ void Interpreter::State::motion_mode_codes(const BlockCodes& codes) {
                                     " are dropped: no G5.3 ended them (LinuxCNC drops them too)");
   if (motion_code == kG5_2 && modal.motion != kG5_2)
     splines.nurbs_points.clear();  // a new curve starts
-  modal.motion = motion_code;
+  if (motion_code != kG80 && !is_cycle(motion_code)) modal.group01 = motion_code;
+  // Fanuc and Haas keep the canned cycles in group 09 and G0-G3 in group 01 (FANUC 0i-MF
+  // operator's manual B-64604EN, "G code list": G80-G89 group 09; Haas mill operator's manual,
+  // "G80 Canned Cycle Cancel (Group 09)"): G80 ends the cycle and leaves the group-01 mode that
+  // was in force, so a bare `Z0.5` after it moves in that mode. LinuxCNC's cycles are motion
+  // modes: G80 leaves none, and rs274 refuses axis words until one is given.
+  modal.motion =
+      motion_code == kG80 && machine.dialect != Dialect::linuxcnc ? modal.group01 : motion_code;
 }
 
 // The words beside X Y Z that a move reads: LinuxCNC's polar @ ^, the rotary A B C, U V W.
@@ -501,16 +521,22 @@ void Interpreter::State::block_move(const BlockCodes& codes) {
             "G5.3 ends a G5.2 NURBS: no motion code or coordinates in its block");
     nurbs_end(context.motion_column);
   } else if (!codes.axis_consumer) {
-    motion_mode_move(codes.motion >= 0);
+    motion_mode_move(codes.motion >= 0 && codes.motion != kG80);  // G80 starts no move
   }
 }
 
-// G53 X Y Z: a move in machine coordinates, under G0 or G1.
+// G53 X Y Z: a move in machine coordinates. LinuxCNC moves under G0 or G1 and refuses any other
+// mode (rs274: "Must use G0 or G1 with G53"). Fanuc's and Haas's G53 is a one-shot positioning
+// at rapid traverse whatever the group-01 mode (FANUC 0i-MF operator's manual B-64604EN,
+// "Machine coordinate system": "the tool moves to the specified position at rapid traverse";
+// Haas mill operator's manual, "G53 Non-Modal Machine Coordinate Selection (Group 00)").
 void Interpreter::State::machine_coordinate_move() {
   comp_forbid(w.find_g(kG53), "G53");
-  if (modal.motion != kG0 && modal.motion != kG1)
+  const bool fanuc = machine.dialect != Dialect::linuxcnc;
+  if (!fanuc && modal.motion != kG0 && modal.motion != kG1)
     error(context.motion_column, "G53 needs G0 or G1 modal");
-  if (modal.motion == kG1) require_feed();
+  const bool rapid = fanuc || modal.motion == kG0;
+  if (!rapid) require_feed();
   Vec3 target(0.0);
   unsigned mask = 0;
   for (int i = 0; i < 3; ++i)
@@ -519,8 +545,7 @@ void Interpreter::State::machine_coordinate_move() {
       mask |= 1u << i;
     }
   if (mask)
-    machine_move(target, mask, modal.motion == kG0 ? MoveKind::rapid : MoveKind::feed,
-                 modal.motion == kG0 ? 0.0 : modal.feed);
+    machine_move(target, mask, rapid ? MoveKind::rapid : MoveKind::feed, rapid ? 0.0 : modal.feed);
 }
 
 // The active motion mode's move, where the block gives it something to do: axis words, or a
@@ -626,9 +651,32 @@ void Interpreter::State::check_words_used() {
 // G65 P<program> L<repeats> <arguments>: a macro call. Argument words become the callee's locals
 // by Fanuc's argument specification I: A B C I J K D E F H M Q R S T U V W X Y Z are #1 #2 #3 #4
 // #5 #6 #7 #8 #9 #11 #13 #17 #18 #19 #20 #21 #22 #23 #24 #25 #26 (G, L, N, O, P are not arguments).
+//
+// Fanuc wants G65 before its arguments (FANUC Series 0i-MF operator's manual B-64604EN, "Custom
+// macro", "Argument specification": "G65 must be specified before any argument"), and G is no
+// argument. A code written before G65 is a code of the block, which a Fanuc control reads before
+// it calls (the programs of a Fanuc HMC start their macro calls with `G54 G65 P…`): the modal
+// codes that only set a mode (plane, units, distance, work system, cycle return) are read so;
+// any other code beside G65 (one that moves, or reads the words G65 takes as arguments) stays an
+// error, even lenient.
 Flow Interpreter::State::macro_call(int column) {
-  if (w.g_count > 1 || w.m_count > 0)
-    error(column, "G65 must be the only G or M code of its block");
+  static constexpr int kSettings[] = {kG17, kG18, kG19, kG20, kG21, kG54, kG55, kG56,
+                                      kG57, kG58, kG59, kG90, kG91, kG98, kG99};
+  for (int i = 0; i < w.g_count; ++i) {
+    const Code& g = w.g[static_cast<std::size_t>(i)];
+    if (g.code == kG65) continue;
+    if (machine.dialect == Dialect::linuxcnc || g.column > column ||
+        std::find(std::begin(kSettings), std::end(kSettings), g.code) == std::end(kSettings))
+      error(g.column, code_name('G', g.code) +
+                          " beside G65: only codes that set a mode (G17-G19, G20/G21, G54-G59, "
+                          "G90/G91, G98/G99) may stand in a G65 block, before G65");
+  }
+  if (w.m_count > 0) error(column, "G65 must be the only G or M code of its block");
+  units_codes();
+  plane_codes();
+  distance_mode_codes();
+  return_mode_codes();
+  work_system_codes();
   if (!w.has('P')) error(column, "G65 needs P (the O number of the macro)");
   call_request.label = static_cast<int>(integer('P', "G65 P", 0, 999'999'999));
   call_request.repeats = w.has('L') ? integer('L', "G65 repeat count", 0, 9999) : 1;

@@ -212,7 +212,7 @@ Interpreter::State::ArcData Interpreter::State::arc_data(const Vec3& start, bool
       error(context.motion_column, "zero-radius arc: the centre is the start point");
     if (!(r1 > 1e-9)) error(context.motion_column, "zero-radius arc: the centre is the end point");
     double err = std::abs(r1 - r0);
-    if (machine.dialect == Dialect::linuxcnc) {
+    if (machine.dialect == Dialect::linuxcnc && !machine.arc_radius_tolerance) {
       // LinuxCNC 2.9 (interp_arc.cc arc_data_ijk) cuts a spiral where the radii differ by up to
       // 0.002·√2 in (0.02·√2 mm under G21), or by 100 times that within 0.1 % of the radius.
       double spiral = (modal.unit == 1.0 ? 0.02 : 0.002 * 25.4) * std::numbers::sqrt2;
@@ -221,11 +221,11 @@ Interpreter::State::ArcData Interpreter::State::arc_data(const Vec3& start, bool
                                          " differs from start radius " + format_number(r0) +
                                          " by more than LinuxCNC's spiral tolerance (" +
                                          format_number(spiral) + " mm, or 0.1 % of the radius)");
-    } else if (err > machine.arc_radius_tolerance) {
+    } else if (err > arc_radius_tolerance()) {
       error(context.motion_column, "arc end radius " + format_number(r1) +
                                        " differs from start radius " + format_number(r0) +
-                                       " by more than " +
-                                       format_number(machine.arc_radius_tolerance) + " mm");
+                                       " by more than " + format_number(arc_radius_tolerance()) +
+                                       " mm (" + arc_tolerance_source() + ")");
     }
   } else {
     double r = length('R');
@@ -233,7 +233,7 @@ Interpreter::State::ArcData Interpreter::State::arc_data(const Vec3& start, bool
     if (!(std::abs(r) > 1e-9)) error(w.col('R'), "zero-radius arc (R0)");
     if (!(d > 1e-9))
       error(w.col('R'), "R-form arc with the same start and end point (a full circle needs I/J/K)");
-    if (d > 2 * std::abs(r) + machine.arc_radius_tolerance)
+    if (d > 2 * std::abs(r) + arc_radius_tolerance())
       error(w.col('R'), "arc radius " + format_number(std::abs(r)) +
                             " is too small for its chord of " + format_number(d));
     result.programmed_radius = std::abs(r);
@@ -664,9 +664,12 @@ void Interpreter::State::home_return(bool second) {
   for (char c : {'A', 'B', 'C'})
     if (w.has(c)) {
       w.take(c);
-      double& angle = frame.rotary_position[static_cast<std::size_t>(rotary_index(c))];
-      turns = turns || (machine.kinematics && angle != 0);
-      angle = 0;
+      const std::size_t i = static_cast<std::size_t>(rotary_index(c));
+      // The machine's zero: a rotary work offset's fixture then stands turned back by it.
+      const double home_angle = -frame.rotary_offset()[i];
+      double& angle = frame.rotary_position[i];
+      turns = turns || (machine.kinematics && angle != home_angle);
+      angle = home_angle;
     }
   const Vec3& target = second ? machine.reference2 : machine.home;
   bool is_default = second ? machine.reference2_is_default : machine.home_is_default;

@@ -74,7 +74,9 @@ Value Interpreter::State::numbered(int n) {
   Vec3 program = to_program(tool.pos);  // the end of the last block: the tip is there
   switch (n) {
     // Fanuc modal information of the block before (#4001 + group − 1).
-    case 4001:
+    case 4001:  // group 01: under a cycle (group 09 there), the mode G80 returns to
+      if (machine.dialect != Dialect::linuxcnc && is_cycle(modal.motion))
+        return number(modal.group01 < 0 ? 0 : modal.group01 / 10.0);
       return number(modal.motion < 0 ? 0 : modal.motion / 10.0);
     case 4002:
       return number(modal.plane / 10.0);

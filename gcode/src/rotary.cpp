@@ -112,8 +112,12 @@ void Interpreter::State::rotary_words() {
     double v = w.take(c);
     std::size_t i = static_cast<std::size_t>(rotary_index(c));
     next[i] = modal.incremental ? frame.rotary_position[i] + v : v;
-    if (a->limits && (next[i] < (*a->limits)[0] || next[i] > (*a->limits)[1]))
-      error(w.col(c), std::string("rotary position ") + c + format_number(next[i]) +
+    // A rotary work offset (G10 … B) says how far the fixture sits turned on the table: the
+    // program's angle turns the part (the kinematics), the machine's, offset added, meets the
+    // axis's limits.
+    const double machine_angle = next[i] + frame.rotary_offset()[i];
+    if (a->limits && (machine_angle < (*a->limits)[0] || machine_angle > (*a->limits)[1]))
+      error(w.col(c), std::string("rotary position ") + c + format_number(machine_angle) +
                           " is outside the " + c + " axis's limits [" +
                           format_number((*a->limits)[0]) + ", " + format_number((*a->limits)[1]) +
                           "] (machine file)");

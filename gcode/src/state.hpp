@@ -81,6 +81,9 @@ struct Interpreter::State : ParameterReader {
     bool arc_absolute = false;
     int plane = kG17;
     int motion = -1;  // -1: none yet
+    // Fanuc and Haas: the group-01 code (G0-G3, a spline) the canned cycles, group 09 there,
+    // leave in force; G80 returns to it (docs/gcode.md, "Canned cycles"). -1: none yet.
+    int group01 = -1;
     bool retract_to_r = false;
     double feed = 0;  // mm/min of the next feed move (under G93 and G95, worked out per move)
     FeedMode feed_mode = FeedMode::per_minute;
@@ -181,6 +184,15 @@ struct Interpreter::State : ParameterReader {
     Vec3 saved_local_offset{0.0};  // G92.2 suspends, G92.3 restores
     Vec3 world_origin{0.0};
     RotaryPositions rotary_position{};
+    // Rotary work offsets (G10 L2/L20 A/B/C on a machine whose kinematics has the axis), keyed as
+    // `offsets`: the machine's angle is the program's plus the active one, as for X Y Z; the
+    // fixture sits turned by it on the table, so the part turns by the program's angle
+    // (rotary_position) and the axis limits meet the machine's (rotary.cpp).
+    std::map<int, RotaryPositions> rotary_offsets;
+    RotaryPositions rotary_offset() const {
+      auto it = rotary_offsets.find(work_key);
+      return it == rotary_offsets.end() ? RotaryPositions{} : it->second;
+    }
     bool tcp = false;
     bool dwo = false;
   };
@@ -446,6 +458,20 @@ struct Interpreter::State : ParameterReader {
       error(w.col(c), std::string(what) + ": " + c + format_number(v) + " must be an integer in [" +
                           std::to_string(low) + ", " + std::to_string(high) + "]");
     return static_cast<long long>(std::llround(v));
+  }
+
+  // How far an arc's end may lie off its circle, mm: the machine's, else Fanuc's parameter 3410
+  // as tridex assumes it, 20 least input increments of IS-B (0.020 mm, or 0.0020 in under G20).
+  // LinuxCNC's own rule (motion.cpp) replaces it for I/J/K arcs under its dialect.
+  double arc_radius_tolerance() const {
+    if (machine.arc_radius_tolerance) return *machine.arc_radius_tolerance;
+    if (machine.dialect == Dialect::linuxcnc) return 0.02;  // R-form arcs only (as before)
+    return modal.unit == 1.0 ? 0.02 : 0.002 * 25.4;
+  }
+  std::string arc_tolerance_source() const {
+    return machine.arc_radius_tolerance ? "the machine file's arc_radius_tolerance_mm"
+                                        : "Fanuc's parameter 3410 as tridex assumes it; a machine "
+                                          "file's arc_radius_tolerance_mm sets this machine's";
   }
 
   bool has_axis_words() const {

@@ -62,6 +62,7 @@ Vec3 tip_by_hand(const char* name, const Vec3& x, const RotaryPositions& r) {
     Vec3 tip = x + pb + about(kY, b) * (-pb);  // the tip swung about the head's pivot
     return about(kZ, -c) * tip;
   }
+  if (n == "hmc-b-table") return about(kY, -b) * x;  // the B table about Y through the origin
   // head-head: A's pivot turns with C about the spindle line.
   Vec3 pa(0, 0, 150);
   return x + about(kZ, c) * (pa + about(kX, a) * (-pa));
@@ -174,6 +175,8 @@ TEST_CASE("G53.1 reachability: every profile turns the tool to a G68.2 plane it 
     Kinematics kin = profile(name.c_str());
     for (int n = 0; n < 100; ++n) {
       Frame plane = fanuc_euler(Vec3(0), angle(rng), tilt(rng), angle(rng));
+      // One axis reaches the planes it turns to: an HMC's B table, the vertical sides.
+      if (kin.axes.size() == 1) plane = fanuc_euler(Vec3(0), 90, tilt(rng) * 3, 0);
       RotaryPositions r = orient_tool(kin, plane.rotation[2], {0, 0, 0});
       CHECK_MESSAGE(near(tool_direction(kin, r), plane.rotation[2], 1e-9), name);
     }

@@ -72,6 +72,7 @@ ProgramInput resolve_program(const CommonOptions& options) {
   if (input.tools) {  // cutter compensation (G41/G42 D) offsets by half a tool's diameter
     for (const auto& [number, spec] : input.tools->tools())
       input.machine.tool_diameters[number] = spec.diameter_mm;
+    for (int number : input.tools->zero_diameter()) input.machine.tool_diameters[number] = 0;
     input.machine.tool_lengths = input.tools->tool_lengths();  // G43 H
   }
   return input;

@@ -274,7 +274,12 @@ ToolTable ToolTable::from_tbl(const std::string& text, const std::string& source
     if (auto z = words.find('Z'); z != words.end())
       result.tool_lengths_[number] = unit_mm * z->second.first;
     auto d = words.find('D');
-    if (d == words.end() || d->second.first == 0) continue;  // a length only: it cannot cut
+    if (d == words.end() || d->second.first == 0) {
+      // D0 or no D (LinuxCNC's diameter then is 0): a probe, an engraver or a tool not measured
+      // yet. It cuts nothing, but it is in the table: G41/G42 with it offset by 0, as LinuxCNC.
+      result.zero_diameter_.insert(number);
+      continue;
+    }
     std::string where = source + ":" + std::to_string(line) + ": tool " + std::to_string(number);
     if (d->second.first < 0)
       input_error(where, ": the diameter D must not be negative, got ", d->second.first);

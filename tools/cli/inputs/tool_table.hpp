@@ -43,6 +43,7 @@
 
 #include <filesystem>
 #include <map>
+#include <set>
 #include <string>
 
 #include <nlohmann/json_fwd.hpp>
@@ -90,10 +91,14 @@ class ToolTable {
   bool empty() const { return tools_.empty(); }
   // Tool lengths (mm, gauge point to tip) of the tools whose entry gives one.
   const std::map<int, double>& tool_lengths() const { return tool_lengths_; }
+  // The tools of a LinuxCNC table with D0 or no D: in the table, with no cutter (tools() lacks
+  // them), a diameter of 0 for G41/G42.
+  const std::set<int>& zero_diameter() const { return zero_diameter_; }
 
  private:
   std::map<int, ToolSpec> tools_;
   std::map<int, double> tool_lengths_;
+  std::set<int> zero_diameter_;
 };
 
 // The cutter a tool description stands for (the mapping above); throws InputError.

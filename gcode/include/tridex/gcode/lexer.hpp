@@ -4,7 +4,9 @@
 // A word is a letter and a value: `G1`, `X-2.5`, `g53.1`, `X#1`, `Y-[#2 * 2]`, `Z SIN[30]`.
 // Spaces between words are optional (`G1X10.Y-2.5F300`), letters may be lower case, `( )` and
 // `;` comments are dropped, a leading `/` marks a block-delete block, a line holding only `%` is a
-// tape delimiter and `:1234` is a Fanuc ISO program number (read as `O1234`). Numbers have an
+// tape delimiter and `:1234` is a Fanuc ISO program number (read as `O1234`). A line holding only
+// a program name that is not a number (`O7997A`, `OCIRCLE`, Fanuc's `<NAME>`) is read as a name
+// (Block::program_name); the interpreter says where one may stand. Numbers have an
 // optional sign, digits and at most one point, no exponent (`1e3` is not a G-code number); they
 // are parsed by fast_float.
 //
@@ -115,6 +117,9 @@ struct Block {
   Control control;
   bool block_delete = false;  // the block starts with '/'
   bool percent = false;       // the line is a '%' tape delimiter
+  // A program name alone on its line (Fanuc's `O7997A`, `OCIRCLE`, `<NAME>`): as written.
+  std::string program_name;
+  int program_name_column = 0;
   // Fanuc: words left out because their value was vacant, as written ("F#650"), for messages.
   std::vector<std::string> vacant_words;
   void clear() {
@@ -124,6 +129,8 @@ struct Block {
     control = Control{};
     block_delete = false;
     percent = false;
+    program_name.clear();
+    program_name_column = 0;
   }
 };
 

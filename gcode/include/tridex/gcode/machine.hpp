@@ -105,11 +105,12 @@ struct MachineConfig {
   ToolChange tool_change = ToolChange::retract_far;
   Vec3 tool_change_position{0.0};  // machine coordinates, for ToolChange::to_position
   bool tool_loads_on_t = false;    // the control loads a tool on T alone (no M6 needed)
-  // Fanuc and Haas: how far an I/J/K arc's end may lie off its circle (mm; Fanuc's parameter
-  // 3410) before the control alarms; within it the arc is cut as a spiral. The default passes a
-  // program posted to 4 decimals of an inch (0.0001 in = 0.00254 mm off). LinuxCNC's own rule
-  // replaces it under its dialect.
-  double arc_radius_tolerance = 0.02;
+  // How far an I/J/K arc's end may lie off its circle (mm) before the control alarms; within it
+  // the arc is cut as a spiral. Unset: the dialect's rule (docs/gcode.md, "Arcs"): Fanuc and
+  // Haas 0.020 mm under G21 and 0.0020 in under G20 (Fanuc's parameter 3410, in the input unit,
+  // at 20 increments of IS-B), LinuxCNC its interpreter's (interp_arc.cc). Set (the machine
+  // file's "arc_radius_tolerance_mm", this machine's parameter 3410): that, in every dialect.
+  std::optional<double> arc_radius_tolerance;
   DOffsets d_offsets = DOffsets::dialect;
   bool inch_at_start = false;  // units before any G20/G21: inch (true) or mm
   // G53 with the tool along +Z: false, a G53 Z is a retract (the tip goes far along the tool, as
