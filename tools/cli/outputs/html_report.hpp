@@ -40,10 +40,9 @@ struct HtmlLimits {
   int context = 3;                            // neighbouring lines shown around a finding's line
   // Playback (the stock as it stands at the slider): cells of the stock's box, at most this many,
   // and of them at most max_playback_removed removed ones (coarser cells until both hold). Each
-  // removed cell costs 2 bytes, each cell 1 or 2 bits: about 1 MiB of page at most
-  // (docs/reports.md).
-  std::size_t max_playback_cells = 1 << 21;
-  std::size_t max_playback_removed = 400'000;
+  // removed cell costs 2 bytes, each cell 1 or 2 bits: at most 0.6 MB of page (docs/reports.md).
+  std::size_t max_playback_cells = 1 << 20;
+  std::size_t max_playback_removed = 150'000;
 };
 
 struct HtmlPage {
