@@ -1,7 +1,10 @@
-// tridex command — `--html OUT.html` of simulate and check (issue 15): one self-contained page
-// with the machined part in a three.js view (for check, the design as a translucent ghost over
-// it on request), the toolpath with a slider over the program, the findings (choosing one flies
-// the camera to it and lists its G-code lines) and the report's figures. three.js and its
+// tridex command — `--html OUT.html` of simulate and check (issues 15 and 32): one self-contained
+// page with the machined part in a three.js view (for check, the design as a translucent ghost
+// over it on request), the toolpath with a slider over the program that plays the cut back (the
+// stock still to be cut and the tool at each step: Playback below), the findings grouped by
+// cause (choosing one turns the camera so that its spot is in view and lists its G-code lines)
+// and the report's figures in the shop's words. docs/reports.md describes the page and its test
+// contract (data-finding, window.tridexView). three.js and its
 // OrbitControls (Debian's libjs-three, found by CMake) and the page template (html_report.html) are
 // embedded in the command and inlined into every page, so the page opens offline and makes no
 // request.
