@@ -294,6 +294,9 @@ TEST_CASE(
   CHECK(data["files"][0]["source"] == source_lines({{7, 13}}));
   CHECK(data["files"][1]["name"] == subprogram.string());
   CHECK(data["files"][1]["source"] == source_lines({{1, 5}, {15, 20}}));
+  // Each large file's whole text as one block too: the slider shows any line's text (issue 32).
+  CHECK(data["files"][0]["text"] == text);
+  CHECK(data["files"][1]["text"] == text);
   CHECK(data["mesh"]["triangles_shown"] == 0);
   CHECK(data["toolpath"]["segments"] == 0);
   REQUIRE(data["messages"].size() == 2);
