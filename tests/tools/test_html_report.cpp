@@ -294,6 +294,9 @@ TEST_CASE(
   CHECK(data["files"][0]["source"] == source_lines({{7, 13}}));
   CHECK(data["files"][1]["name"] == subprogram.string());
   CHECK(data["files"][1]["source"] == source_lines({{1, 5}, {15, 20}}));
+  // Each large file's whole text as one block too: the slider shows any line's text (issue 32).
+  CHECK(data["files"][0]["text"] == text);
+  CHECK(data["files"][1]["text"] == text);
   CHECK(data["mesh"]["triangles_shown"] == 0);
   CHECK(data["toolpath"]["segments"] == 0);
   REQUIRE(data["messages"].size() == 2);
@@ -432,4 +435,64 @@ TEST_CASE(
   CHECK(data["files"][0]["source"]["3"] == "M3 S1000 G0 X5 Y5 Z20");
   CHECK(data["files"][1]["source"]["3"] == "G0 Z5");
   fs::remove_all(dir);
+}
+
+TEST_CASE("playback: each stock cell is removed at the first stop whose cutter passes below it") {
+  // A 10 mm cube of stock; a Ø4 flat end mill plunges at (5, 5) to z = 5 (stop 1: line 2), slots
+  // to x = 9 (stop 2: line 3) and retracts (stop 3). The part is the slab below z = 3 (a closed
+  // box mesh); what lies between it and the cut is removed at the last stop.
+  Stock stock;
+  stock.box = Aabb{Vec3(0), Vec3(10)};
+  std::vector<gcode::MoveGroup> groups(1);
+  groups[0].moves.push_back(move(1, gcode::MoveKind::rapid, {5, 5, 20}, {5, 5, 12}));
+  groups[0].moves.push_back(move(2, gcode::MoveKind::feed, {5, 5, 12}, {5, 5, 5}));
+  groups[0].moves.push_back(move(3, gcode::MoveKind::feed, {5, 5, 5}, {9, 5, 5}));
+  groups[0].moves.push_back(move(4, gcode::MoveKind::rapid, {9, 5, 5}, {9, 5, 12}));
+  Mesh part;
+  const Aabb slab{Vec3(0), Vec3(10, 10, 3)};
+  for (const Vec3& c : slab.corners()) part.positions.emplace_back(c);
+  // The corners are numbered x + 2y + 4z: two triangles per face.
+  for (const std::array<unsigned, 4>& f : std::array<std::array<unsigned, 4>, 6>{
+           {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}}}) {
+    part.triangles.emplace_back(f[0], f[1], f[2]);
+    part.triangles.emplace_back(f[0], f[2], f[3]);
+  }
+  const std::vector<Cutter> cutters = {Cutter::flat(2)};
+  const std::map<int, std::uint32_t> cutter_of_tool = {{1, 0}};
+  HtmlPage page;
+  page.mesh = &part;
+  page.groups = &groups;
+  page.stock = &stock;
+  page.cutters = cutters;
+  page.cutter_of_tool = &cutter_of_tool;
+  const Playback p = playback_cells(page, 0.5);
+  REQUIRE(p.n == std::array<int, 3>{20, 20, 20});
+  CHECK(p.stop_count == 4);
+  CHECK(p.stock_mask.empty());  // a box: every cell is stock
+  // Walk the cells as the writer does: part cells are skipped, the others take the next stop.
+  std::size_t removed = 0, in_part = 0;
+  std::map<std::uint32_t, int> by_stop;
+  for (int k = 0, index = 0; k < 20; ++k)
+    for (int j = 0; j < 20; ++j)
+      for (int i = 0; i < 20; ++i, ++index) {
+        const bool is_part = (p.part_mask[index / 8] >> (index % 8)) & 1;
+        CHECK(is_part == (k < 6));  // centres below z = 3
+        if (is_part) {
+          ++in_part;
+          continue;
+        }
+        const std::uint32_t stop = p.removed_at.at(removed++);
+        const Vec3 c(0.25 + 0.5 * i, 0.25 + 0.5 * j, 0.25 + 0.5 * k);
+        const double plunge = std::hypot(c.x - 5, c.y - 5),
+                     slot = std::hypot(c.x - std::clamp(c.x, 5.0, 9.0), c.y - 5);
+        const std::uint32_t expected = c.z > 5 && plunge <= 2 ? 1 : c.z > 5 && slot <= 2 ? 2 : 3;
+        CHECK(stop == expected);
+        ++by_stop[stop];
+      }
+  CHECK(removed == p.removed_at.size());
+  CHECK(in_part == 20 * 20 * 6);
+  CHECK(by_stop[1] > 0);
+  CHECK(by_stop[2] > 0);
+  CHECK(by_stop[1] + by_stop[2] + by_stop[3] == static_cast<int>(removed));
+  CHECK(by_stop.count(0) == 0);  // the rapid above the stock removes nothing
 }

@@ -496,7 +496,11 @@ void write_reports(const CheckOptions& options, const SimulationResult& r, const
                        .design = &design,
                        .groups = &r.groups,
                        .order = r.order,
-                       .files = r.files});
+                       .files = r.files,
+                       .stock = &r.stock,
+                       .cutters = r.cutters,
+                       .bodies = r.bodies,
+                       .cutter_of_tool = &r.cutter_of_tool});
   }
 }
 

@@ -17,6 +17,7 @@
 
 #include "outputs/output.hpp"
 #include "pipeline/pipeline.hpp"
+#include "tridex/detail/move_geometry.hpp"
 #include "tridex/gcode/interpreter.hpp"
 
 // The page template and libjs-three's files, embedded at build time (cmake/embed_text.cmake).
@@ -114,15 +115,19 @@ Json source_files(const HtmlPage& page, const HtmlLimits& limits) {
     } else {
       if (!wanted) wanted = listed_lines(page.report, limits.context);
       lines = &(*wanted)[name];
-      file["note"] = "the program is large: only the lines around findings are included";
+      file["note"] = "the program is large: its text is kept as one block";
     }
     Json& source = file["source"];
-    std::string text;
+    std::string text, whole;
     for (int line = 1; std::getline(in, text); ++line) {
-      if (lines && !lines->count(line)) continue;
       if (!text.empty() && text.back() == '\r') text.pop_back();
+      if (lines) (whole += text) += '\n';
+      if (lines && !lines->count(line)) continue;
       source[std::to_string(line)] = text;
     }
+    // A large file's text as one block too (far smaller than a line -> text object): the slider
+    // shows the text of any line, whatever the program's size.
+    if (lines) file["text"] = std::move(whole);
     files.push_back(std::move(file));
   }
   return files;
@@ -184,6 +189,65 @@ Json toolpath_json(const HtmlPage& page, const HtmlLimits& limits) {
   return path;
 }
 
+// The playback cells (playback_cells) within the limits: cells as fine as max_playback_cells
+// allows, coarser while more than max_playback_removed are removed. Removal stops are shipped as
+// 16-bit codes: the stop itself up to 65535 stops, else stop × 65535 / stops (the page maps the
+// slider's stop the same way).
+Json playback_json(const HtmlPage& page, const HtmlLimits& limits) {
+  if (!page.stock || !page.groups || !page.cutter_of_tool || page.stock->box.empty())
+    return nullptr;
+  const Vec3 size = page.stock->box.size();
+  double cell =
+      std::cbrt(size.x * size.y * size.z / static_cast<double>(limits.max_playback_cells));
+  cell = std::max({cell, 1e-3, std::max({size.x, size.y, size.z}) / 1024});
+  Playback p = playback_cells(page, cell);
+  for (int attempt = 0; attempt < 4 && p.removed_at.size() > limits.max_playback_removed; ++attempt)
+    p = playback_cells(page,
+                       cell *= 1.05 * std::cbrt(static_cast<double>(p.removed_at.size()) /
+                                                static_cast<double>(limits.max_playback_removed)));
+  std::vector<std::uint16_t> codes(p.removed_at.size());
+  const std::uint64_t stops = std::max<std::size_t>(p.stop_count, 1);
+  for (std::size_t k = 0; k < codes.size(); ++k)
+    codes[k] = static_cast<std::uint16_t>(stops <= 65535 ? p.removed_at[k]
+                                                         : p.removed_at[k] * 65535ull / stops);
+  Json json = {{"box", box_json(p.box)},
+               {"n", {p.n[0], p.n[1], p.n[2]}},
+               {"cell_mm", p.cell},
+               {"stop_count", p.stop_count},
+               {"part_mask", base64_of(p.part_mask)},
+               {"removed", p.removed_at.size()},
+               {"removed_at", base64_of(codes)}};
+  if (!p.stock_mask.empty()) json["stock_mask"] = base64_of(p.stock_mask);
+  return json;
+}
+
+// The tools as the page draws them at the slider: the cutter's radius and each shank or holder
+// section (its bottom above the tip, its radii and length; an unbounded one drawn 3 radii long).
+Json tools_json(const HtmlPage& page) {
+  Json tools = Json::object();
+  if (!page.cutter_of_tool) return tools;
+  for (const auto& [tool, index] : *page.cutter_of_tool) {
+    if (index >= page.cutters.size()) continue;
+    Json parts = Json::array();
+    if (index < page.bodies.size())
+      for (const BodyPart& part : page.bodies[index].parts) {
+        const BodySection& s = part.shape;
+        const double length = std::isfinite(s.length) ? s.length : 3 * s.bottom_radius;
+        parts.push_back({{"name", part.name},
+                         {"bottom", part.bottom},
+                         {"r0", s.bottom_radius},
+                         {"r1", std::isfinite(s.top_radius) ? s.top_radius : s.bottom_radius},
+                         {"length", length}});
+      }
+    const double stick_out = index < page.bodies.size() ? page.bodies[index].stick_out : 0;
+    tools[std::to_string(tool)] = {{"radius", page.cutters[index].radius()},
+                                   {"name", page.cutters[index].name()},
+                                   {"stick_out", stick_out},
+                                   {"parts", parts}};
+  }
+  return tools;
+}
+
 std::string html_escaped(std::string_view text) {
   std::string out;
   for (char c : text) {
@@ -205,6 +269,132 @@ std::string html_escaped(std::string_view text) {
     }
   }
   return out;
+}
+
+// ---- playback ------------------------------------------------------------------------------
+
+// Per column (i, j) of centres (x0 + (i + ½)c, y0 + (j + ½)c), the heights where `mesh` crosses
+// the vertical line through it, sorted: a point is inside where an odd number lie below it. The
+// centres are nudged by an irrational fraction of a cell so that no line meets an edge exactly.
+std::vector<std::vector<float>> column_crossings(const Mesh& mesh, double x0, double y0, double c,
+                                                 int nx, int ny) {
+  std::vector<std::vector<float>> columns(static_cast<std::size_t>(nx) * ny);
+  const double nudge_x = 0.5 + 1.37e-5, nudge_y = 0.5 + 2.91e-5;
+  auto edge = [](const Vec3& u, const Vec3& v, double px, double py) {
+    return (v.x - u.x) * (py - u.y) - (v.y - u.y) * (px - u.x);
+  };
+  for (const glm::uvec3& t : mesh.triangles) {
+    const Vec3 a(mesh.positions[t.x]), b(mesh.positions[t.y]), d(mesh.positions[t.z]);
+    const double area = edge(a, b, d.x, d.y);
+    if (std::abs(area) < 1e-30) continue;
+    const int i0 =
+        std::max(0, static_cast<int>(std::ceil((std::min({a.x, b.x, d.x}) - x0) / c - nudge_x)));
+    const int i1 = std::min(
+        nx - 1, static_cast<int>(std::floor((std::max({a.x, b.x, d.x}) - x0) / c - nudge_x)));
+    const int j0 =
+        std::max(0, static_cast<int>(std::ceil((std::min({a.y, b.y, d.y}) - y0) / c - nudge_y)));
+    const int j1 = std::min(
+        ny - 1, static_cast<int>(std::floor((std::max({a.y, b.y, d.y}) - y0) / c - nudge_y)));
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        const double px = x0 + (i + nudge_x) * c, py = y0 + (j + nudge_y) * c;
+        const double w0 = edge(b, d, px, py) / area, w1 = edge(d, a, px, py) / area,
+                     w2 = edge(a, b, px, py) / area;
+        if (w0 < 0 || w1 < 0 || w2 < 0) continue;
+        columns[static_cast<std::size_t>(j) * nx + i].push_back(
+            static_cast<float>(w0 * a.z + w1 * b.z + w2 * d.z));
+      }
+  }
+  for (std::vector<float>& column : columns) std::sort(column.begin(), column.end());
+  return columns;
+}
+
+bool inside_column(const std::vector<float>& crossings, double z) {
+  return (std::upper_bound(crossings.begin(), crossings.end(), static_cast<float>(z)) -
+          crossings.begin()) %
+             2 ==
+         1;
+}
+
+// One direction's columns (in its frame) and, per column, where its height fell: (stop, height)
+// in program order, the heights falling.
+struct DirectionColumns {
+  const Frame* frame = nullptr;
+  double x0 = 0, y0 = 0, cell = 1;
+  int nx = 0, ny = 0;
+  std::vector<std::vector<std::pair<std::uint32_t, float>>> falls;
+};
+
+// Mills every move in program order on each direction's columns, recording where heights fall.
+std::vector<DirectionColumns> milled_columns(const HtmlPage& page, const Aabb& box, double cell,
+                                             std::size_t& stop_count) {
+  const std::vector<gcode::MoveGroup>& groups = *page.groups;
+  std::vector<DirectionColumns> columns(groups.size());
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    DirectionColumns& dc = columns[g];
+    dc.frame = &groups[g].frame;
+    Aabb local;
+    for (const Vec3& corner : box.corners()) local.extend(dc.frame->to_local(corner));
+    dc.x0 = local.min.x, dc.y0 = local.min.y, dc.cell = cell;
+    dc.nx = std::max(1, static_cast<int>(std::ceil(local.size().x / cell)));
+    dc.ny = std::max(1, static_cast<int>(std::ceil(local.size().y / cell)));
+    dc.falls.resize(static_cast<std::size_t>(dc.nx) * dc.ny);
+  }
+  std::vector<GroupRun> whole;
+  if (page.order.empty())
+    for (std::size_t g = 0; g < groups.size(); ++g)
+      whole.push_back({static_cast<std::uint32_t>(g), groups[g].moves.size()});
+  std::vector<std::size_t> next(groups.size(), 0);
+  const gcode::Move* previous = nullptr;
+  std::uint32_t stop = 0;
+  for (const GroupRun& run : page.order.empty() ? std::span<const GroupRun>(whole) : page.order)
+    for (std::uint64_t k = 0; k < run.moves; ++k) {
+      const gcode::Move& m = groups[run.group].moves[next[run.group]++];
+      if (previous && (previous->file != m.file || previous->line != m.line)) ++stop;
+      previous = &m;
+      const auto cutter = page.cutter_of_tool->find(m.tool);
+      if (cutter == page.cutter_of_tool->end() || cutter->second >= page.cutters.size() ||
+          glm::length(m.start) >= kFar || glm::length(m.end) >= kFar)
+        continue;
+      DirectionColumns& dc = columns[run.group];
+      const Segment tip{dc.frame->to_local(m.start), dc.frame->to_local(m.end)};
+      const Cutter& c = page.cutters[cutter->second];
+      const detail::MoveGeometry geometry(c, tip);
+      const double r = c.radius();
+      const int i0 = std::max(
+          0, static_cast<int>(std::floor((std::min(tip.a.x, tip.b.x) - r - dc.x0) / cell)));
+      const int i1 = std::min(
+          dc.nx - 1, static_cast<int>(std::floor((std::max(tip.a.x, tip.b.x) + r - dc.x0) / cell)));
+      const int j0 = std::max(
+          0, static_cast<int>(std::floor((std::min(tip.a.y, tip.b.y) - r - dc.y0) / cell)));
+      const int j1 = std::min(
+          dc.ny - 1, static_cast<int>(std::floor((std::max(tip.a.y, tip.b.y) + r - dc.y0) / cell)));
+      for (int j = j0; j <= j1; ++j)
+        for (int i = i0; i <= i1; ++i) {
+          const double z = geometry.lowest(dc.x0 + (i + 0.5) * cell, dc.y0 + (j + 0.5) * cell).z;
+          auto& falls = dc.falls[static_cast<std::size_t>(j) * dc.nx + i];
+          if (z < (falls.empty() ? kFar : double(falls.back().second)))
+            falls.push_back({stop, static_cast<float>(z)});
+        }
+    }
+  stop_count = previous ? stop + 1 : 0;
+  return columns;
+}
+
+// The first stop at which a direction's column through `p` falls below it; UINT32_MAX: none.
+std::uint32_t removal_stop(const std::vector<DirectionColumns>& columns, const Vec3& p) {
+  std::uint32_t first = UINT32_MAX;
+  for (const DirectionColumns& dc : columns) {
+    const Vec3 q = dc.frame->to_local(p);
+    const int i = static_cast<int>(std::floor((q.x - dc.x0) / dc.cell)),
+              j = static_cast<int>(std::floor((q.y - dc.y0) / dc.cell));
+    if (i < 0 || j < 0 || i >= dc.nx || j >= dc.ny) continue;
+    const auto& falls = dc.falls[static_cast<std::size_t>(j) * dc.nx + i];
+    const auto below = std::partition_point(falls.begin(), falls.end(),
+                                            [&](const auto& f) { return double(f.second) >= q.z; });
+    if (below != falls.end()) first = std::min(first, below->first);
+  }
+  return first;
 }
 
 }  // namespace
@@ -367,6 +557,43 @@ DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups,
   return path;
 }
 
+Playback playback_cells(const HtmlPage& page, double cell) {
+  Playback p;
+  if (!page.stock || !page.groups || !page.cutter_of_tool || page.stock->box.empty()) return p;
+  p.box = page.stock->box;
+  p.cell = cell;
+  for (int a = 0; a < 3; ++a)
+    p.n[a] = std::max(1, static_cast<int>(std::ceil(p.box.size()[a] / cell - 1e-9)));
+  const std::size_t nx = p.n[0], ny = p.n[1], nz = p.n[2], cells = nx * ny * nz;
+  const std::vector<DirectionColumns> columns = milled_columns(page, p.box, cell, p.stop_count);
+  const std::uint32_t last = static_cast<std::uint32_t>(std::max<std::size_t>(p.stop_count, 1) - 1);
+  std::vector<std::vector<float>> part, stock;
+  if (page.mesh)
+    part = column_crossings(*page.mesh, p.box.min.x, p.box.min.y, cell, p.n[0], p.n[1]);
+  if (page.stock->mesh)
+    stock = column_crossings(*page.stock->mesh, p.box.min.x, p.box.min.y, cell, p.n[0], p.n[1]);
+  p.part_mask.assign((cells + 7) / 8, 0);
+  if (!stock.empty()) p.stock_mask.assign((cells + 7) / 8, 0);
+  for (std::size_t k = 0, index = 0; k < nz; ++k)
+    for (std::size_t j = 0; j < ny; ++j)
+      for (std::size_t i = 0; i < nx; ++i, ++index) {
+        const Vec3 centre =
+            p.box.min + cell * Vec3(static_cast<double>(i) + 0.5, static_cast<double>(j) + 0.5,
+                                    static_cast<double>(k) + 0.5);
+        const std::size_t column = j * nx + i;
+        if (!stock.empty()) {
+          if (!inside_column(stock[column], centre.z)) continue;
+          p.stock_mask[index / 8] |= static_cast<std::uint8_t>(1 << (index % 8));
+        }
+        if (!part.empty() && inside_column(part[column], centre.z)) {
+          p.part_mask[index / 8] |= static_cast<std::uint8_t>(1 << (index % 8));
+          continue;
+        }
+        p.removed_at.push_back(std::min(removal_stop(columns, centre), last));
+      }
+  return p;
+}
+
 Json html_page_data(const HtmlPage& page, const HtmlLimits& limits) {
   Json data;
   data["title"] = page.title;
@@ -380,12 +607,22 @@ Json html_page_data(const HtmlPage& page, const HtmlLimits& limits) {
     for (const gcode::MoveGroup& g : *page.groups) {
       Json tools = Json::array();
       for (int t : g.tools) tools.push_back(t);
+      // The machine's rotary positions of the direction's first move, when it has a kinematic
+      // model: the page names the direction by them (else by G68.2 angles).
+      Json rotary = Json::object();
+      if (!g.moves.empty())
+        for (int a = 0; a < 3; ++a)
+          if (g.moves.front().rotary_axes & (1 << a))
+            rotary[std::string(1, "ABC"[a])] = g.moves.front().rotary[static_cast<std::size_t>(a)];
       directions.push_back({{"axis", to_json(g.axis)},
                             {"label", axis_label(g.axis)},
+                            {"rotary", rotary},
                             {"moves", g.moves.size()},
                             {"tools", tools}});
     }
   data["directions"] = directions;
+  data["playback"] = playback_json(page, limits);
+  data["tools"] = tools_json(page);
   data["files"] = source_files(page, limits);
   data["context"] = limits.context;
   data["listing_lines"] = 20;  // of a finding's lines, the first this many are listed

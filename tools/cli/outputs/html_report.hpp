@@ -1,7 +1,10 @@
-// tridex command — `--html OUT.html` of simulate and check (issue 15): one self-contained page
-// with the machined part in a three.js view (for check, the design as a translucent ghost over
-// it on request), the toolpath with a slider over the program, the findings (choosing one flies
-// the camera to it and lists its G-code lines) and the report's figures. three.js and its
+// tridex command — `--html OUT.html` of simulate and check (issues 15 and 32): one self-contained
+// page with the machined part in a three.js view (for check, the design as a translucent ghost
+// over it on request), the toolpath with a slider over the program that plays the cut back (the
+// stock still to be cut and the tool at each step: Playback below), the findings grouped by
+// cause (choosing one turns the camera so that its spot is in view and lists its G-code lines)
+// and the report's figures in the shop's words. docs/reports.md describes the page and its test
+// contract (data-finding, window.tridexView). three.js and its
 // OrbitControls (Debian's libjs-three, found by CMake) and the page template (html_report.html) are
 // embedded in the command and inlined into every page, so the page opens offline and makes no
 // request.
@@ -17,6 +20,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <span>
 #include <string>
 #include <vector>
@@ -24,7 +28,9 @@
 #include "json_text.hpp"
 #include "pipeline/pipeline.hpp"
 #include "tridex/gcode/grouping.hpp"
+#include "tridex/cutter.hpp"
 #include "tridex/mesh.hpp"
+#include "tridex/tool_body.hpp"
 
 namespace tridex::cli {
 
@@ -35,6 +41,11 @@ struct HtmlLimits {
   double path_tolerance = 1.0 / 4000;  // thinning, as a fraction of the toolpath's box diagonal
   std::uintmax_t max_source_bytes = 4 << 20;  // the whole program text is inlined up to this size
   int context = 3;                            // neighbouring lines shown around a finding's line
+  // Playback (the stock as it stands at the slider): cells of the stock's box, at most this many,
+  // and of them at most max_playback_removed removed ones (coarser cells until both hold). Each
+  // removed cell costs 2 bytes, each cell 1 or 2 bits: at most 0.6 MB of page (docs/reports.md).
+  std::size_t max_playback_cells = 1 << 20;
+  std::size_t max_playback_removed = 150'000;
 };
 
 struct HtmlPage {
@@ -46,6 +57,12 @@ struct HtmlPage {
   const std::vector<gcode::MoveGroup>* groups = nullptr;
   std::span<const GroupRun> order;  // the groups' moves in program order (pipeline.hpp)
   std::vector<std::string> files;   // Move::file's table: the G-code files, listed
+  // Playback and the tool drawn at the slider: the raw stock, the cutters and their shanks and
+  // holders (parallel), and which cutter each tool number is. Absent: no playback, no tool drawn.
+  const Stock* stock = nullptr;
+  std::span<const Cutter> cutters;
+  std::span<const ToolBody> bodies;
+  const std::map<int, std::uint32_t>* cutter_of_tool = nullptr;
 };
 
 // Writes the page atomically (output.hpp).
@@ -93,5 +110,23 @@ struct DisplayPath {
 // of the drawing; their lines are still stops.
 DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups,
                           std::span<const GroupRun> order, double tolerance);
+
+// The in-process stock for playback: cells of `cell` mm over the stock's box, each either outside
+// the stock, inside the final part (the result mesh), or removed at a program stop (the stop index
+// of thin_toolpath's slider). A cell's removal stop is the first stop whose move lowers, in some
+// direction's frame, the swept cutter's lowest point (detail::MoveGeometry, as the Z-maps are
+// milled) below the cell's centre on the direction's column of `cell` mm through it; a cell no
+// move reaches that way (rounding at the part's skin) is removed at the last stop, so that the
+// last stop shows the final part exactly and stop 0 the raw stock less what its moves cut.
+struct Playback {
+  Aabb box;  // the cells' box: the stock's bounds
+  std::array<int, 3> n{};
+  double cell = 0;
+  std::vector<std::uint8_t> stock_mask;   // bit per cell (x fastest, then y, z); empty: all stock
+  std::vector<std::uint8_t> part_mask;    // bit per cell: inside the result mesh
+  std::vector<std::uint32_t> removed_at;  // per stock cell not in the part, in cell order
+  std::size_t stop_count = 0;
+};
+Playback playback_cells(const HtmlPage& page, double cell);
 
 }  // namespace tridex::cli

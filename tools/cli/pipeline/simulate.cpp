@@ -147,7 +147,11 @@ int run_simulate(const SimulateOptions& options) {
                        .deviation = {},
                        .groups = &groups,
                        .order = r.order,
-                       .files = r.files});
+                       .files = r.files,
+                       .stock = &r.stock,
+                       .cutters = r.cutters,
+                       .bodies = r.bodies,
+                       .cutter_of_tool = &r.cutter_of_tool});
   }
   progress.finish();
 
