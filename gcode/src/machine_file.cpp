@@ -187,10 +187,12 @@ MachineConfig parse(const json& doc, const std::string& file) {
       std::string u = string_value(value, where).get<std::string>();
       if (u != "mm" && u != "inch") machine_error(where, ": \"mm\" or \"inch\", got \"", u, "\"");
       m.inch_at_start = u == "inch";
+      m.units_stated = true;
     } else if (key == "linear_units") {  // LinuxCNC's [TRAJ]LINEAR_UNITS: a .tbl's units
       std::string u = string_value(value, where).get<std::string>();
       if (u != "mm" && u != "inch") machine_error(where, ": \"mm\" or \"inch\", got \"", u, "\"");
       m.tool_table_in_inches = u == "inch";
+      m.linear_units_stated = true;
     } else if (key == "start") {
       if (value.is_string() && value.get<std::string>() == "far")
         m.start_position.reset();
@@ -210,6 +212,12 @@ MachineConfig parse(const json& doc, const std::string& file) {
     } else if (key == "tool_loads_on_t") {
       if (!value.is_boolean()) machine_error(where, ": must be true or false, got ", value.dump());
       m.tool_loads_on_t = value.get<bool>();
+    } else if (key == "initial_tool") {  // the tool in the spindle at start (CAMotics: 1)
+      if (!value.is_number_integer() || value.get<long long>() < 0 ||
+          value.get<long long>() > 1'000'000'000)
+        machine_error(where, ": must be a tool number (0: none), got ", value.dump());
+      m.initial_tool = static_cast<int>(value.get<long long>());
+      m.initial_tool_stated = true;
     } else if (key == "arc_radius_tolerance_mm") {  // Fanuc's parameter 3410
       m.arc_radius_tolerance = positive(value, where, "mm");
     } else if (key == "d_offsets") {  // what the D registers hold (Haas: its setting 40)
@@ -260,12 +268,13 @@ MachineConfig parse(const json& doc, const std::string& file) {
       for (const json& dir : value)
         m.subprogram_dirs.push_back((base / string_value(dir, where).get<std::string>()).string());
     } else {
-      machine_error(where,
-                    ": unknown key (known: name, description, base, dialect, units, start, "
-                    "tool_change, tool_loads_on_t, arc_radius_tolerance_mm, d_offsets, home, "
-                    "reference2, work_offsets, m_codes, "
-                    "forbidden_m_codes, variables, far_distance, subprograms, kinematics, "
-                    "rapid_rate_mm_per_min, rapid_rate_deg_per_min, max_feed_mm_per_min)");
+      machine_error(
+          where,
+          ": unknown key (known: name, description, base, dialect, units, start, "
+          "tool_change, tool_loads_on_t, initial_tool, arc_radius_tolerance_mm, d_offsets, home, "
+          "reference2, work_offsets, m_codes, "
+          "forbidden_m_codes, variables, far_distance, subprograms, kinematics, "
+          "rapid_rate_mm_per_min, rapid_rate_deg_per_min, max_feed_mm_per_min)");
     }
   }
   for (int code : m.m_codes)

@@ -90,10 +90,17 @@ class ToolTable {
   bool empty() const { return tools_.empty(); }
   // Tool lengths (mm, gauge point to tip) of the tools whose entry gives one.
   const std::map<int, double>& tool_lengths() const { return tool_lengths_; }
+  // Why a tool the table holds cannot cut (a Fusion probe, a form mill), naming it and its type;
+  // nullptr for a tool that can, or that the table does not hold.
+  const std::string* unusable(int number) const {
+    auto it = unusable_.find(number);
+    return it == unusable_.end() ? nullptr : &it->second;
+  }
 
  private:
   std::map<int, ToolSpec> tools_;
   std::map<int, double> tool_lengths_;
+  std::map<int, std::string> unusable_;
 };
 
 // The cutter a tool description stands for (the mapping above); throws InputError.
