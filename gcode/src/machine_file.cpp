@@ -158,6 +158,20 @@ void read_variables(const json& value, const std::string& where, MachineConfig& 
   }
 }
 
+// "mm" or "inch": true for inch.
+bool is_inch(const json& value, const std::string& where) {
+  std::string u = string_value(value, where).get<std::string>();
+  if (u != "mm" && u != "inch") machine_error(where, ": \"mm\" or \"inch\", got \"", u, "\"");
+  return u == "inch";
+}
+
+int tool_number(const json& value, const std::string& where) {
+  if (!value.is_number_integer() || value.get<long long>() < 0 ||
+      value.get<long long>() > 1'000'000'000)
+    machine_error(where, ": must be a tool number (0: none), got ", value.dump());
+  return static_cast<int>(value.get<long long>());
+}
+
 MachineConfig parse(const json& doc, const std::string& file) {
   if (!doc.is_object()) machine_error(file, ": a machine file is a JSON object");
   MachineConfig m;
@@ -184,14 +198,10 @@ MachineConfig parse(const json& doc, const std::string& file) {
       else
         machine_error(where, ": \"fanuc\", \"haas\" or \"linuxcnc\", got \"", d, "\"");
     } else if (key == "units") {
-      std::string u = string_value(value, where).get<std::string>();
-      if (u != "mm" && u != "inch") machine_error(where, ": \"mm\" or \"inch\", got \"", u, "\"");
-      m.inch_at_start = u == "inch";
+      m.inch_at_start = is_inch(value, where);
       m.units_stated = true;
     } else if (key == "linear_units") {  // LinuxCNC's [TRAJ]LINEAR_UNITS: a .tbl's units
-      std::string u = string_value(value, where).get<std::string>();
-      if (u != "mm" && u != "inch") machine_error(where, ": \"mm\" or \"inch\", got \"", u, "\"");
-      m.tool_table_in_inches = u == "inch";
+      m.tool_table_in_inches = is_inch(value, where);
       m.linear_units_stated = true;
     } else if (key == "start") {
       if (value.is_string() && value.get<std::string>() == "far")
@@ -213,10 +223,7 @@ MachineConfig parse(const json& doc, const std::string& file) {
       if (!value.is_boolean()) machine_error(where, ": must be true or false, got ", value.dump());
       m.tool_loads_on_t = value.get<bool>();
     } else if (key == "initial_tool") {  // the tool in the spindle at start (CAMotics: 1)
-      if (!value.is_number_integer() || value.get<long long>() < 0 ||
-          value.get<long long>() > 1'000'000'000)
-        machine_error(where, ": must be a tool number (0: none), got ", value.dump());
-      m.initial_tool = static_cast<int>(value.get<long long>());
+      m.initial_tool = tool_number(value, where);
       m.initial_tool_stated = true;
     } else if (key == "arc_radius_tolerance_mm") {  // Fanuc's parameter 3410
       m.arc_radius_tolerance = positive(value, where, "mm");

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command_harness.hpp"
+#include "pipeline/plausibility.hpp"
 
 using namespace tridex;
 using namespace tridex::test;
@@ -181,5 +182,34 @@ TEST_CASE("plausibility: the bundled example warns of nothing, and says its tool
   REQUIRE(twin.status == 0);
   CHECK(twin.err.empty());
   CHECK(has(twin.out, "(B90 C"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("plausibility: G20/G21 are found outside comments, and in every program of the corpus") {
+  fs::path dir = scratch("plaus-scan");
+  auto sets = [&](const std::string& text) {
+    write_text(dir / "p.nc", text);
+    return cli::program_sets_units(dir / "p.nc");
+  };
+  CHECK(sets("G90 G21\n"));
+  CHECK(sets("n10 g 2 1 x0\n"));  // spaces inside a word, lower case
+  CHECK(sets("G020\n"));
+  CHECK(sets("G0X0G20\n"));
+  CHECK(!sets("G90 (G21 in a comment)\n"));
+  CHECK(!sets("G90 ; G20 after a semicolon\n"));
+  CHECK(!sets("G210 G2 X1 Y1 I1\n"));
+  CHECK(!sets("G21.1\n"));
+  // The rs274 corpus and the public programs state their units: no warning on any of them.
+  int programs = 0;
+  for (const char* folder : {"linuxcnc", "public"})
+    for (const auto& entry :
+         fs::recursive_directory_iterator(fs::path(TRIDEX_TEST_DATA) / "gcode" / folder)) {
+      const std::string ext = entry.path().extension().string();
+      if (ext != ".ngc" && ext != ".nc") continue;
+      CAPTURE(entry.path().string());
+      CHECK(cli::program_sets_units(entry.path()));
+      ++programs;
+    }
+  CHECK(programs >= 20);
   fs::remove_all(dir);
 }

@@ -100,9 +100,10 @@ void warn_tool_sizes(const Aabb& cutting, SimulationResult& r) {
   for (const auto& [tool, index] : r.cutter_of_tool) {
     const double diameter = 2 * r.cutters[index].radius();
     std::string against;
+    // A stock given bounds the work; one made up from the moves says nothing, so the moves do.
     if (!stock_is_automatic(r) && diameter > stock_width)
       against = "wider than the " + size_text(stock) + " stock";
-    else if (reach > 0 && diameter > 2 * reach)
+    else if (stock_is_automatic(r) && reach > 0 && diameter > 2 * reach)
       against = "more than twice the " + size_text(moves) + " its moves span";
     if (against.empty()) continue;
     char text[64];
