@@ -200,7 +200,7 @@ int main(int argc, char** argv) {
       ->required()
       ->check(kNotEmpty);
   auto* tolerance = chk->add_option("--tolerance", check.tolerance,
-                                    "gouge and excess tolerance, mm (default: one dexel spacing)")
+                                    "gouge and excess tolerance, mm (default 0.02)")
                         ->check(kFinitePositive);
   chk->add_option("--gouge-tol", check.gouge_tol,
                   "material removed inside the design beyond this is a gouge, mm")
