@@ -50,8 +50,9 @@ MachineConfig haas_machine() {
 }
 
 // rs274 run standalone (its default configuration): start at the origin, M6 in place, G28/G30
-// at the origin, G53 literal, G99, LinuxCNC's dialect.
-MachineConfig linuxcnc_machine() {
+// at the origin, G53 literal, G99, LinuxCNC's dialect. The differential tests compare with it
+// (tests/gcode/test_linuxcnc_diff.cpp).
+MachineConfig rs274_machine() {
   MachineConfig m;
   m.dialect = Dialect::linuxcnc;
   m.start_position = Vec3(0.0);
@@ -59,6 +60,20 @@ MachineConfig linuxcnc_machine() {
   m.set_home(Vec3(0.0));
   m.set_reference2(Vec3(0.0));
   m.g53_literal = true;
+  m.g99_at_start = true;
+  return m;
+}
+
+// LinuxCNC as a user runs it: LinuxCNC's dialect and G99 at start as rs274, but the machine is
+// homed, Z at the top of its travel (the LinuxCNC User Manual, "Homing": HOME usually 0 at the
+// top of Z), far above a work offset touched off on the part, so the tip starts far along +Z;
+// M6 lifts the quill to Z's home first (the [EMCIO] TOOL_CHANGE_QUILL_UP or
+// TOOL_CHANGE_POSITION of the sample configurations), and G28/G30 and G53 go to machine
+// positions above the work whose place tridex cannot know: far along the tool, as the default
+// machine's. Tool length offsets are applied from G43 on, as in LinuxCNC.
+MachineConfig linuxcnc_machine() {
+  MachineConfig m;
+  m.dialect = Dialect::linuxcnc;
   m.g99_at_start = true;
   return m;
 }
@@ -126,6 +141,7 @@ constexpr std::array<BundledMachine, 8> kBundled{{
     {"default", default_machine},
     {"haas", haas_machine},
     {"linuxcnc", linuxcnc_machine},
+    {"rs274", rs274_machine},
     {"ac-trunnion", ac_trunnion},
     {"bc-trunnion", bc_trunnion},
     {"b-head-c-table", b_head_c_table},

@@ -158,6 +158,20 @@ void read_variables(const json& value, const std::string& where, MachineConfig& 
   }
 }
 
+// "mm" or "inch": true for inch.
+bool is_inch(const json& value, const std::string& where) {
+  std::string u = string_value(value, where).get<std::string>();
+  if (u != "mm" && u != "inch") machine_error(where, ": \"mm\" or \"inch\", got \"", u, "\"");
+  return u == "inch";
+}
+
+int tool_number(const json& value, const std::string& where) {
+  if (!value.is_number_integer() || value.get<long long>() < 0 ||
+      value.get<long long>() > 1'000'000'000)
+    machine_error(where, ": must be a tool number (0: none), got ", value.dump());
+  return static_cast<int>(value.get<long long>());
+}
+
 MachineConfig parse(const json& doc, const std::string& file) {
   if (!doc.is_object()) machine_error(file, ": a machine file is a JSON object");
   MachineConfig m;
@@ -184,13 +198,11 @@ MachineConfig parse(const json& doc, const std::string& file) {
       else
         machine_error(where, ": \"fanuc\", \"haas\" or \"linuxcnc\", got \"", d, "\"");
     } else if (key == "units") {
-      std::string u = string_value(value, where).get<std::string>();
-      if (u != "mm" && u != "inch") machine_error(where, ": \"mm\" or \"inch\", got \"", u, "\"");
-      m.inch_at_start = u == "inch";
+      m.inch_at_start = is_inch(value, where);
+      m.units_stated = true;
     } else if (key == "linear_units") {  // LinuxCNC's [TRAJ]LINEAR_UNITS: a .tbl's units
-      std::string u = string_value(value, where).get<std::string>();
-      if (u != "mm" && u != "inch") machine_error(where, ": \"mm\" or \"inch\", got \"", u, "\"");
-      m.tool_table_in_inches = u == "inch";
+      m.tool_table_in_inches = is_inch(value, where);
+      m.linear_units_stated = true;
     } else if (key == "start") {
       if (value.is_string() && value.get<std::string>() == "far")
         m.start_position.reset();
@@ -210,6 +222,9 @@ MachineConfig parse(const json& doc, const std::string& file) {
     } else if (key == "tool_loads_on_t") {
       if (!value.is_boolean()) machine_error(where, ": must be true or false, got ", value.dump());
       m.tool_loads_on_t = value.get<bool>();
+    } else if (key == "initial_tool") {  // the tool in the spindle at start (CAMotics: 1)
+      m.initial_tool = tool_number(value, where);
+      m.initial_tool_stated = true;
     } else if (key == "arc_radius_tolerance_mm") {  // Fanuc's parameter 3410
       m.arc_radius_tolerance = positive(value, where, "mm");
     } else if (key == "d_offsets") {  // what the D registers hold (Haas: its setting 40)
@@ -260,12 +275,13 @@ MachineConfig parse(const json& doc, const std::string& file) {
       for (const json& dir : value)
         m.subprogram_dirs.push_back((base / string_value(dir, where).get<std::string>()).string());
     } else {
-      machine_error(where,
-                    ": unknown key (known: name, description, base, dialect, units, start, "
-                    "tool_change, tool_loads_on_t, arc_radius_tolerance_mm, d_offsets, home, "
-                    "reference2, work_offsets, m_codes, "
-                    "forbidden_m_codes, variables, far_distance, subprograms, kinematics, "
-                    "rapid_rate_mm_per_min, rapid_rate_deg_per_min, max_feed_mm_per_min)");
+      machine_error(
+          where,
+          ": unknown key (known: name, description, base, dialect, units, start, "
+          "tool_change, tool_loads_on_t, initial_tool, arc_radius_tolerance_mm, d_offsets, home, "
+          "reference2, work_offsets, m_codes, "
+          "forbidden_m_codes, variables, far_distance, subprograms, kinematics, "
+          "rapid_rate_mm_per_min, rapid_rate_deg_per_min, max_feed_mm_per_min)");
     }
   }
   for (int code : m.m_codes)

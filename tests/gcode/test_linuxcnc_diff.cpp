@@ -192,7 +192,7 @@ std::vector<Point> run_tridex(const fs::path& program,
   std::vector<Point> points;
   std::ifstream in(program, std::ios::binary);
   REQUIRE(in);
-  MachineConfig machine = *MachineConfig::bundled("linuxcnc");
+  MachineConfig machine = *MachineConfig::bundled("rs274");
   machine.tool_diameters = tool_diameters;
   machine.tool_lengths = tool_lengths;
   Interpreter interpreter(options, machine);
@@ -597,7 +597,7 @@ TEST_CASE("differential: feed rates in G93, G94 and G95 agree with rs274") {
   std::vector<double> ours;
   {
     std::ifstream in(program);
-    Interpreter interpreter({}, *MachineConfig::bundled("linuxcnc"));
+    Interpreter interpreter({}, *MachineConfig::bundled("rs274"));
     int last_line = 0;
     interpreter.run(in, program.string(), [&](const Move& m) {
       if (m.kind == MoveKind::rapid || m.line == last_line) return;

@@ -78,7 +78,7 @@ void check_follows(const std::vector<Move>& pieces, const std::vector<ControlPoi
   }
 }
 
-const MachineConfig kLinuxcnc = *MachineConfig::bundled("linuxcnc");
+const MachineConfig kLinuxcnc = *MachineConfig::bundled("rs274");
 
 }  // namespace
 

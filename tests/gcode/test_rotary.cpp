@@ -250,7 +250,7 @@ TEST_CASE("rotary 3+2, lenient: every line read otherwise is counted, past the 1
 TEST_CASE(
     "A/B/C on a LinuxCNC machine without kinematics are plain axes, as in rs274; elsewhere "
     "errors") {
-  MachineConfig linuxcnc = *MachineConfig::bundled("linuxcnc");
+  MachineConfig linuxcnc = *MachineConfig::bundled("rs274");
   Result r = run_program(
       "G21 G90 F100\nG0 X1 Y2 Z3 A90\nG1 X4 B45 C10\nG0 A0\nG2 X6 Y2 I1 J0 C5\nM2\n", {}, linuxcnc);
   REQUIRE(r.moves.size() >= 3);
@@ -272,7 +272,7 @@ TEST_CASE(
     "G28/G30 with X Y and a rotary word at zero return X and Y too (a 4-axis post's G28 X0. Y0. "
     "A0.)") {
   // LinuxCNC without kinematics (as rs274: STRAIGHT_TRAVERSE to the origin), in G90 and G91.
-  MachineConfig linuxcnc = *MachineConfig::bundled("linuxcnc");
+  MachineConfig linuxcnc = *MachineConfig::bundled("rs274");
   Result r =
       run_program("G20 G90 G17\nG0 X1 Y1 Z.5 A0\nG91 G28 Z0\nG28 X0 Y0 A0\nM2\n", {}, linuxcnc);
   REQUIRE(!r.moves.empty());

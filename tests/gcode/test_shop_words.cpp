@@ -60,7 +60,7 @@ TEST_CASE("Haas G103 (look-ahead) and G154 P (extra work offsets, as G54.1 P)") 
 }
 
 TEST_CASE("M-codes with arguments of their own: M19 R, LinuxCNC's M62-M68, user M100-M199") {
-  MachineConfig linuxcnc = *MachineConfig::bundled("linuxcnc");
+  MachineConfig linuxcnc = *MachineConfig::bundled("rs274");
   Result io = run_program(
       "G21 G90\nM62 P0\nM65 P1\nM66 P0 L0 Q1\nM68 E0 Q0\nM19 R45\nM52 P1\nG0 X1 Y2 Z3\nM2\n", {},
       linuxcnc);
@@ -97,7 +97,7 @@ TEST_CASE(
   CHECK(at_zero);
   REQUIRE(!no_d.warnings.empty());
   CHECK(no_d.warnings.front().message.find("D0") != std::string::npos);
-  MachineConfig linuxcnc = *MachineConfig::bundled("linuxcnc");
+  MachineConfig linuxcnc = *MachineConfig::bundled("rs274");
   linuxcnc.tool_diameters = machine.tool_diameters;
   CHECK(error_of("G21 G90\nT1 D4 M6\n", {}, linuxcnc).message.find("word D4 is not used") !=
         std::string::npos);
@@ -129,7 +129,7 @@ TEST_CASE("G10 L2/L20 with rotary words: 0 changes nothing; LinuxCNC's plain axe
   same_moves(with_b, without);
   REQUIRE(!with_b.moves.empty());
   CHECK(near(with_b.moves.back().end, Vec3(6, 2, -1)));
-  MachineConfig linuxcnc = *MachineConfig::bundled("linuxcnc");
+  MachineConfig linuxcnc = *MachineConfig::bundled("rs274");
   same_moves(run_program("G21 G90\nG10 L20 P1 X0 A30 C5\n" + after, {}, linuxcnc),
              run_program("G21 G90\nG10 L20 P1 X0\n" + after, {}, linuxcnc));
   Diagnostic d = error_of("G21 G90\nG10 L2 P1 X0 B15\n", {}, at_origin());

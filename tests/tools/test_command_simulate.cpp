@@ -53,8 +53,16 @@ TEST_CASE("simulate: a feed move with no tool loaded is named by the file that h
   write_text(
       dir / "bare.camotics",
       R"({"files": ["second.nc", "first.nc"], "tools": {"1": {"shape": "cylindrical", "diameter": 2}}})");
-  CommandResult project = run_tridex(
+  // A CAMotics project starts with tool 1, as CAMotics runs it (issue 31); --initial-tool 0 says
+  // the spindle is empty.
+  CommandResult started = run_tridex(
       {"simulate", (dir / "bare.camotics").string(), "-o", (dir / "out.stl").string()}, dir);
+  CHECK(started.status == 0);
+  CHECK(started.err.find("were cut with tool 1") != std::string::npos);
+  fs::remove(dir / "out.stl");
+  CommandResult project = run_tridex({"simulate", (dir / "bare.camotics").string(),
+                                      "--initial-tool", "0", "-o", (dir / "out.stl").string()},
+                                     dir);
   CHECK(project.status == 2);
   CHECK(project.err.find("second.nc:4:") != std::string::npos);
   CHECK(project.err.find("bare.camotics:4") == std::string::npos);

@@ -49,7 +49,7 @@ TEST_CASE("machine files: each key changes what the program means") {
   CHECK(r.err.find("M10") != std::string::npos);
 
   // linuxcnc: starts at the origin, M6 in place, G28 to the origin.
-  r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", "linuxcnc"}, dir);
+  r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", "rs274"}, dir);
   REQUIRE(r.status == 0);
   m = moves_of(r);
   REQUIRE(m.size() == 3);
@@ -148,7 +148,7 @@ TEST_CASE("machine files: T alone loads the tool where the control does so") {
       run_tridex({"moves", (dir / "p.nc").string(), "--machine", (dir / "t.json").string()}, dir);
   REQUIRE(r.status == 0);
   CHECK(moves_of(r).back()["tool"] == 3);
-  r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", "linuxcnc"}, dir);
+  r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", "rs274"}, dir);
   CHECK(moves_of(r).back()["tool"] == 0);
   fs::remove_all(dir);
 }
@@ -156,9 +156,9 @@ TEST_CASE("machine files: T alone loads the tool where the control does so") {
 TEST_CASE("machine files: \"g53\" says whether G53 Z retracts far or goes where it says") {
   fs::path dir = scratch("machine-g53");
   write_text(dir / "p.nc", "G21 G90\nG0 X1 Y2 Z3\nG53 G0 Z50\nG0 X4\nG1 Z1 F100\nM30\n");
-  write_text(dir / "far.json", R"({"base": "linuxcnc", "g53": "far"})");
+  write_text(dir / "far.json", R"({"base": "rs274", "g53": "far"})");
   write_text(dir / "literal.json", R"({"g53": "literal", "start": [0, 0, 100]})");
-  CommandResult r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", "linuxcnc"}, dir);
+  CommandResult r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", "rs274"}, dir);
   REQUIRE(r.status == 0);
   auto m = moves_of(r);
   REQUIRE(m.size() == 4);
@@ -185,10 +185,10 @@ TEST_CASE("machine files: --subprograms finds called programs") {
   fs::create_directories(dir / "macros");
   write_text(dir / "macros" / "O9810.nc", "O9810\nG0 X#24 Y#25 Z1\nM99\n");
   write_text(dir / "p.nc", "G65 P9810 X4 Y5\nM30\n");
-  CommandResult r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", "linuxcnc"}, dir);
+  CommandResult r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", "rs274"}, dir);
   CHECK(r.status == 2);
   CHECK(r.err.find("O9810") != std::string::npos);
-  r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", "linuxcnc", "--subprograms",
+  r = run_tridex({"moves", (dir / "p.nc").string(), "--machine", "rs274", "--subprograms",
                   (dir / "macros").string()},
                  dir);
   REQUIRE(r.status == 0);
@@ -404,10 +404,10 @@ TEST_CASE("tools: G41/G42 D take the tool's diameter from --tools or the project
              "G40 G1 X-10 Y30\nM2\n");
   write_text(dir / "t.json", R"({"1": {"shape": "cylindrical", "diameter": 8, "length": 30}})");
   // Without a table the offset is unknown: exit 2 naming the tool.
-  CommandResult r = run_tridex({"moves", (dir / "p.ngc").string(), "--machine", "linuxcnc"}, dir);
+  CommandResult r = run_tridex({"moves", (dir / "p.ngc").string(), "--machine", "rs274"}, dir);
   CHECK(r.status == 2);
   CHECK(r.err.find("tool 1 is not in the tool table") != std::string::npos);
-  r = run_tridex({"moves", (dir / "p.ngc").string(), "--machine", "linuxcnc", "--tools",
+  r = run_tridex({"moves", (dir / "p.ngc").string(), "--machine", "rs274", "--tools",
                   (dir / "t.json").string()},
                  dir);
   REQUIRE(r.status == 0);
@@ -465,7 +465,7 @@ TEST_CASE("--tools with tool lengths: G43 H names the tip, G49 the gauge point (
              R"({"1": {"shape": "cylindrical", "diameter": 3.175, "tool-length": 12.7}})");
   for (const char* table : {"t.tbl", "t.json"}) {
     CAPTURE(table);
-    CommandResult r = run_tridex({"moves", (dir / "p.ngc").string(), "--machine", "linuxcnc",
+    CommandResult r = run_tridex({"moves", (dir / "p.ngc").string(), "--machine", "rs274",
                                   "--tools", (dir / table).string()},
                                  dir);
     REQUIRE(r.status == 0);
@@ -478,7 +478,7 @@ TEST_CASE("--tools with tool lengths: G43 H names the tip, G49 the gauge point (
   }
   // A metric machine (LinuxCNC's LINEAR_UNITS = mm): the same .tbl written in mm.
   write_text(dir / "mm.tbl", "T1 P1 D3.175 Z+12.7 ;1/8 end mill\n");
-  write_text(dir / "metric.json", R"({"base": "linuxcnc", "linear_units": "mm"})");
+  write_text(dir / "metric.json", R"({"base": "rs274", "linear_units": "mm"})");
   CommandResult metric =
       run_tridex({"moves", (dir / "p.ngc").string(), "--machine", (dir / "metric.json").string(),
                   "--tools", (dir / "mm.tbl").string()},

@@ -145,7 +145,7 @@ TEST_CASE("machining time: the machine file's rates, refused when bad, in the re
   write_text(dir / "p.nc",
              "G21 G90\nG0 X0 Y0 Z5\nT1 M6\nG1 Z-1 F60\nG1 X20 F1200\nG4 P2\nG0 Z25\nM30\n");
   write_text(dir / "m.json",
-             R"({"base": "linuxcnc", "rapid_rate_mm_per_min": 3000, "max_feed_mm_per_min": 600})");
+             R"({"base": "rs274", "rapid_rate_mm_per_min": 3000, "max_feed_mm_per_min": 600})");
   gcode::MachineRates rates = cli::load_machine((dir / "m.json").string()).rates;
   CHECK(rates.rapid_mm_per_min == Vec3(3000));
   CHECK(rates.max_feed_mm_per_min == 600);

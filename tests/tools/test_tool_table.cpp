@@ -187,7 +187,10 @@ json fusion_library() {
     {"type": "bull nose end mill", "unit": "millimeters", "description": "10R1",
      "geometry": {"DC": 10, "LCF": 20, "LB": 35, "OAL": 75, "SFDM": 10, "RE": 1},
      "post-process": {"number": 3}},
-    {"type": "drill", "unit": "millimeters", "geometry": {"DC": 5, "SIG": 118}, "post-process": {"number": 4}},
+    {"type": "drill", "unit": "millimeters", "description": "5mm jobber",
+     "geometry": {"DC": 5, "SIG": 118, "LCF": 30, "LB": 40, "OAL": 80, "SFDM": 5},
+     "post-process": {"number": 4}},
+    {"type": "probe", "unit": "millimeters", "geometry": {"DC": 2}, "post-process": {"number": 5}},
     {"type": "holder", "unit": "millimeters", "segments": []}
   ]})");
 }
@@ -207,7 +210,7 @@ std::string fusion_error(const std::function<void(json&)>& spoil) {
 
 TEST_CASE("Fusion tool libraries: the cutting part, the shank and the holder") {
   ToolTable tools = ToolTable::from_fusion_json(fusion_library(), "lib.json");
-  CHECK(tools.tools().size() == 3);  // the drill and the lone holder are skipped
+  CHECK(tools.tools().size() == 4);  // the probe and the lone holder cannot cut
   const ToolSpec& flat = *tools.find(1);
   CHECK(flat.cutter.shape() == CutterShape::flat);
   CHECK(flat.cutter.radius() == doctest::Approx(3));
@@ -229,7 +232,15 @@ TEST_CASE("Fusion tool libraries: the cutting part, the shank and the holder") {
   CHECK(!tools.find(2)->body.has_holder());
   CHECK(tools.find(3)->cutter.shape() == CutterShape::bull_nose);
   CHECK(tools.find(3)->cutter.corner_radius() == doctest::Approx(1));
-  CHECK(tools.find(4) == nullptr);
+  // The drill: a cone of half its point angle (issue 31: it was skipped, and then "missing").
+  REQUIRE(tools.find(4) != nullptr);
+  CHECK(tools.find(4)->cutter.radius() == doctest::Approx(2.5));
+  CHECK(tools.find(4)->cutter.lower_height(2.5) ==
+        doctest::Approx(2.5 / std::tan(glm::radians(59.0))));
+  // The probe is held, to be named with its type if a program uses it.
+  CHECK(tools.find(5) == nullptr);
+  REQUIRE(tools.unusable(5) != nullptr);
+  CHECK(tools.unusable(5)->find("tool 5 is a Fusion \"probe\", not a cutter") != std::string::npos);
 
   // A library file is told from a CAMotics table by its "data" list.
   fs::path file =

@@ -19,7 +19,9 @@ struct CommonOptions {
   std::string block_delete = "on";       // --block-delete on|off: the operator's switch
   std::string machine;                   // --machine FILE|NAME (empty: the default machine)
   std::vector<std::string> subprograms;  // --subprograms DIR (repeatable)
-  std::string tools;  // --tools FILE (overrides a project's table; G41/G42 D read it)
+  std::string tools;       // --tools FILE (overrides a project's table; G41/G42 D read it)
+  std::string tool_units;  // --tool-units mm|inch: a .tbl's units (empty: the machine's)
+  int initial_tool = -1;   // --initial-tool N (-1: the machine file's, else 1 for a project)
   bool progress = false;
   bool quiet = false;
   long long max_blocks = kDefaultMaxBlocks;  // --max-blocks: executed blocks before exit status 2
@@ -49,13 +51,17 @@ constexpr double kDefaultClearance = 1.0;
 // writes the machined solid) and the design to compare with.
 struct CheckOptions : SimulateOptions {
   std::string design;                    // --design PART.stl (closed)
-  double tolerance = 0;                  // --tolerance: both tolerances; 0: one dexel spacing
+  double tolerance = 0;                  // --tolerance: both tolerances; 0: kShopTolerance
   double gouge_tol = 0;                  // --gouge-tol (overrides --tolerance)
   double excess_tol = 0;                 // --excess-tol (overrides --tolerance)
   std::string ply;                       // --ply OUT.ply: the machined mesh coloured by deviation
   std::string envelope;                  // --envelope box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX
   double clearance = kDefaultClearance;  // --clearance: near misses of shanks and holders, mm
 };
+
+// check's default verdict tolerance, mm: a shop's usual ±0.02 mm on a milled surface (ISO 2768-f
+// allows ±0.05 mm on features up to 6 mm; a finish pass is held well inside it).
+constexpr double kShopTolerance = 0.02;
 
 constexpr int kDefaultDexelRes = 320;
 constexpr double kDefaultZmapCellFraction = 1.0 / 1000;  // of the stock's diagonal

@@ -85,6 +85,18 @@ void add_common(CLI::App& command, CommonOptions& options) {
                   ".tbl (overrides a project's\n"
                   "tools; G41/G42 D offset by half a tool's diameter, G43 H by its tool length)")
       ->check(kNotEmpty);
+  command
+      .add_option("--tool-units", options.tool_units,
+                  "units of a LinuxCNC .tbl tool table, mm or inch (default: the machine file's\n"
+                  "\"linear_units\", else inch as rs274 reads it, with a warning)")
+      ->check(CLI::IsMember({"mm", "inch"}));
+  command
+      .add_option(
+          "--initial-tool", options.initial_tool,
+          "the tool in the spindle when the program starts: moves before the first tool\n"
+          "change cut with it (0: none; default: the machine file's \"initial_tool\", else\n"
+          "1 for a CAMotics project, as CAMotics runs it, else none)")
+      ->check(CLI::Range(0, 1'000'000'000));
   command.add_flag("--progress", options.progress,
                    "show progress on stderr even when it is not a terminal");
   command.add_flag("-q,--quiet", options.quiet, "print nothing but errors")->excludes("--progress");
@@ -188,7 +200,7 @@ int main(int argc, char** argv) {
       ->required()
       ->check(kNotEmpty);
   auto* tolerance = chk->add_option("--tolerance", check.tolerance,
-                                    "gouge and excess tolerance, mm (default: one dexel spacing)")
+                                    "gouge and excess tolerance, mm (default 0.02)")
                         ->check(kFinitePositive);
   chk->add_option("--gouge-tol", check.gouge_tol,
                   "material removed inside the design beyond this is a gouge, mm")

@@ -34,6 +34,7 @@
 #include "outputs/result_files.hpp"
 #include "pipeline/memory.hpp"
 #include "pipeline/pipeline.hpp"
+#include "pipeline/shop_summary.hpp"
 #include "render.hpp"
 #include "tridex/dexel_ops.hpp"
 #include "tridex/dexelize.hpp"
@@ -222,6 +223,7 @@ PipelineRequest check_request(const CheckOptions& options, const Mesh& design) {
 // What check finds, filled stage by stage and read by the files, the report and the summary.
 struct CheckFindings {
   double gouge_tol = 0, excess_tol = 0;  // mm
+  std::string tolerance_source;          // where they came from, for the summary and report
   std::vector<double> deviation;         // per vertex of the machined mesh
   std::vector<glm::vec3> colours;        // per vertex: gouge, within tolerance or excess
   std::vector<DeviationRegion> gouges, excesses;
@@ -440,6 +442,7 @@ Json check_report(const CheckOptions& options, const SimulationResult& r,
   report["design"] = options.design;
   report["verdict"] = failed ? "fail" : "pass";
   report["tolerances_mm"] = {{"gouge", f.gouge_tol}, {"excess", f.excess_tol}};
+  report["tolerance_source"] = f.tolerance_source;
   report["stock"] = r.stock.description;
   report["segments"] = r.segments;
   report["dexel"] = {{"cell_mm", r.lattice.spacing},
@@ -526,6 +529,13 @@ void print_summary(const CheckOptions& options, const SimulationResult& r, const
       r.travel_count, r.body.collisions.size(), r.body.near_misses.size(), options.clearance,
       failed ? "FAIL" : "pass", total_s);
   std::printf("  %s\n", machining_time_text(r.machining).c_str());
+  if (f.gouge_tol == f.excess_tol)
+    std::printf("  verdict: %s at ±%g mm (%s)\n", failed ? "FAIL" : "pass", f.gouge_tol,
+                f.tolerance_source.c_str());
+  else
+    std::printf("  verdict: %s at -%g/+%g mm (%s)\n", failed ? "FAIL" : "pass", f.gouge_tol,
+                f.excess_tol, f.tolerance_source.c_str());
+  std::printf("  %s\n  %s\n", tools_text(r).c_str(), directions_text(r).c_str());
   std::size_t printed = 0;
   for (const Json& g : f.gouge_list)
     if (g.contains("lines") && printed++ < kFindingsPrinted) {
@@ -578,14 +588,16 @@ int run_check(const CheckOptions& options) {
   Progress progress(!options.quiet && (options.progress || stderr_is_terminal()));
   const CheckInputs in = read_check_inputs(options, progress);
   SimulationResult r = simulate_program(options, progress, check_request(options, in.design));
-  const double spacing = r.lattice.spacing;
   CheckFindings f;
   f.gouge_tol = options.gouge_tol > 0   ? options.gouge_tol
                 : options.tolerance > 0 ? options.tolerance
-                                        : spacing;
+                                        : kShopTolerance;
   f.excess_tol = options.excess_tol > 0  ? options.excess_tol
                  : options.tolerance > 0 ? options.tolerance
-                                         : spacing;
+                                         : kShopTolerance;
+  f.tolerance_source = options.gouge_tol > 0 || options.excess_tol > 0 || options.tolerance > 0
+                           ? "given"
+                           : "the default shop tolerance; --tolerance to change";
 
   const Clock::time_point t = Clock::now();
   measure_deviation(options, r, in.design, progress, f);

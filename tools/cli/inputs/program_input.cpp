@@ -54,6 +54,7 @@ ProgramInput resolve_program(const CommonOptions& options) {
     input.files = std::move(project.files);
     input.tools = std::move(project.tools);
     input.stock = project.stock;
+    input.project = true;
   } else {
     input.files.push_back(input.program);
   }
@@ -66,6 +67,18 @@ ProgramInput resolve_program(const CommonOptions& options) {
     if (extension == ".tpl")
       input_error(file.string(), ": a CAMotics TPL program (JavaScript that writes G-code), not ",
                   "G-code; run it with CAMotics' tplang and give tridex the G-code it writes");
+  }
+  if (!options.tool_units.empty()) {  // --tool-units states a .tbl's units, as "linear_units"
+    input.machine.tool_table_in_inches = options.tool_units == "inch";
+    input.machine.linear_units_stated = true;
+  }
+  // The tool in the spindle at start: --initial-tool, else the machine file's, else CAMotics'
+  // tool 1 for a CAMotics project (CAMotics cuts a program with no tool change with it).
+  if (options.initial_tool >= 0) {
+    input.machine.initial_tool = options.initial_tool;
+    input.machine.initial_tool_stated = true;
+  } else if (!input.machine.initial_tool_stated && input.project) {
+    input.machine.initial_tool = 1;
   }
   if (!options.tools.empty())
     input.tools = ToolTable::read(options.tools, input.machine.tool_table_in_inches ? 25.4 : 1.0);

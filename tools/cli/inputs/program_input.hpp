@@ -24,6 +24,7 @@ struct ProgramInput {
   std::optional<ToolTable> tools;            // --tools, else from a project
   std::optional<StockSpec> stock;            // from a project
   gcode::MachineConfig machine;              // --machine, --subprograms
+  bool project = false;                      // a CAMotics project
 };
 
 // --machine NAME|FILE and --subprograms: a bundled machine (tridex/gcode/machine.hpp's registry)

@@ -75,6 +75,125 @@ std::vector<BodySection> holder_sections(const nlohmann::json& tool, const std::
   return sections;
 }
 
+// Fusion's tool types (its library's "type"), by the solid tridex mills for them.
+enum class FusionKind { flat, ball, bull_nose, drill, chamfer, countersink, tapered, unusable };
+
+FusionKind fusion_kind(const std::string& type) {
+  static const std::map<std::string, FusionKind> kKinds = {
+      {"flat end mill", FusionKind::flat},
+      {"face mill", FusionKind::flat},
+      {"slot mill", FusionKind::flat},
+      {"dovetail mill", FusionKind::flat},
+      {"thread mill", FusionKind::flat},
+      {"tap right hand", FusionKind::flat},
+      {"tap left hand", FusionKind::flat},
+      {"reamer", FusionKind::flat},
+      {"counter bore", FusionKind::flat},
+      {"boring bar", FusionKind::flat},
+      {"ball end mill", FusionKind::ball},
+      {"lollipop mill", FusionKind::ball},
+      {"bull nose end mill", FusionKind::bull_nose},
+      {"drill", FusionKind::drill},
+      {"spot drill", FusionKind::drill},
+      {"center drill", FusionKind::drill},
+      {"chamfer mill", FusionKind::chamfer},
+      {"counter sink", FusionKind::countersink},
+      {"countersink", FusionKind::countersink},
+      {"tapered mill", FusionKind::tapered},
+  };
+  auto it = kKinds.find(type);
+  return it == kKinds.end() ? FusionKind::unusable : it->second;
+}
+
+std::string fusion_unusable_reason(const std::string& type) {
+  if (type == "radius mill" || type == "form mill")
+    return "whose profile is concave: tridex mills convex cutters only (tridex/cutter.hpp)";
+  if (type == "probe" || type.find("holder") != std::string::npos) return "not a cutter";
+  return "not a milling cutter tridex knows (docs/tool-tables.md lists the Fusion types)";
+}
+
+// An angle field in degrees within (0, 180) (a point angle) or (0, 90) (a half angle).
+double angle_field(const nlohmann::json& geometry, const std::string& at, const char* key,
+                   double below) {
+  const double angle = number_field(geometry, at, {key}, true);
+  if (!(angle > 0 && angle < below))
+    input_error(at, ": \"", key, "\" ", angle, " must lie in (0, ", below, ") degrees");
+  return angle;
+}
+
+// A bull nose or tapered profile's corner: the arc of radius `corner` from the flat tip of radius
+// `flat` up to where its tangent makes `half_angle_deg` with the axis, as a fine polyline, then
+// the taper up to `radius` (ρ, h from the tip).
+std::vector<Vec2> tapered_corner_profile(double radius, double flat, double corner,
+                                         double half_angle_deg) {
+  std::vector<Vec2> points{Vec2(0, 0)};
+  if (flat > 0) points.emplace_back(flat, 0);
+  const double end = M_PI / 2 - glm::radians(half_angle_deg);  // the arc's turn from the tip
+  const int pieces = 32;
+  for (int k = 1; k <= pieces; ++k) {
+    const double theta = end * k / pieces;
+    points.emplace_back(flat + corner * std::sin(theta), corner - corner * std::cos(theta));
+  }
+  const Vec2 last = points.back();
+  points.emplace_back(radius, last.y + (radius - last.x) / std::tan(glm::radians(half_angle_deg)));
+  return points;
+}
+
+// The cutter of a Fusion tool (docs/tool-tables.md): what a tool of the kind sweeps, as a convex
+// solid of revolution continued upward at full radius (the Z-map model, tridex/cutter.hpp).
+Cutter fusion_cutter(FusionKind kind, const nlohmann::json& geometry, double scale,
+                     const std::string& at, ToolSpec& spec) {
+  const double radius = spec.diameter_mm / 2;
+  if (!(radius > 0)) input_error(at, ": \"DC\" must be positive, got ", spec.diameter_mm);
+  try {
+    switch (kind) {
+      case FusionKind::flat:
+        return Cutter::flat(radius);
+      case FusionKind::ball:
+        return Cutter::ball(radius);
+      case FusionKind::bull_nose: {
+        spec.corner_radius_mm = scale * number_field(geometry, at, {"RE"}, true);
+        // Fusion keeps "bull nose" with RE equal to the radius for what is a ball.
+        if (spec.corner_radius_mm >= radius) return Cutter::ball(radius);
+        if (!(spec.corner_radius_mm > 0)) return Cutter::flat(radius);
+        return Cutter::bull_nose(radius, spec.corner_radius_mm);
+      }
+      case FusionKind::drill:  // SIG: the point angle, 118° on a jobber drill
+        return Cutter::cone(radius, angle_field(geometry, at, "SIG", 180) / 2);
+      case FusionKind::chamfer:
+      case FusionKind::countersink: {
+        // A chamfer mill's TA is its half angle (45 for a 90° tool); a countersink's SIG its
+        // included angle. Either key is read for either type.
+        const bool half =
+            geometry.contains("TA") && (kind == FusionKind::chamfer || !geometry.contains("SIG"));
+        const double angle =
+            half ? angle_field(geometry, at, "TA", 90) : angle_field(geometry, at, "SIG", 180) / 2;
+        const double tip = scale * number_field(geometry, at, {"tip-diameter"}, false) / 2;
+        return Cutter::chamfer(radius, tip, angle);
+      }
+      case FusionKind::tapered: {
+        // DC is the tip's diameter, TA the taper's half angle, RE the tip's corner radius; the
+        // flutes widen to DC + 2·LCF·tan(TA) at their top.
+        const double angle = angle_field(geometry, at, "TA", 90);
+        const double corner = scale * number_field(geometry, at, {"RE"}, false);
+        const double top = radius + spec.flute_length_mm * std::tan(glm::radians(angle));
+        spec.corner_radius_mm = corner;
+        if (corner >= radius) return Cutter::tapered_ball(top, radius, angle);
+        if (corner > 0)
+          return Cutter::from_profile(tapered_corner_profile(top, radius - corner, corner, angle));
+        return Cutter::chamfer(top, radius, angle);
+      }
+      case FusionKind::unusable:
+        break;
+    }
+  } catch (const InputError&) {
+    throw;
+  } catch (const tridex::Error& e) {
+    input_error(at, ": ", e.what());
+  }
+  input_error(at, ": not a cutter");
+}
+
 }  // namespace
 
 ToolBody make_body(const ToolSpec& spec, const std::string& where) {
@@ -299,11 +418,6 @@ ToolTable ToolTable::from_fusion_json(const nlohmann::json& library, const std::
   auto data = library.is_object() ? library.find("data") : library.end();
   if (data == library.end() || !data->is_array())
     input_error(source, ": a Fusion tool library must be a JSON object with a \"data\" list");
-  // Fusion's types that tridex simulates; the others are skipped.
-  static const std::map<std::string, std::string> kShapes = {{"flat end mill", "cylindrical"},
-                                                             {"face mill", "cylindrical"},
-                                                             {"ball end mill", "ballnose"},
-                                                             {"bull nose end mill", "bullnose"}};
   ToolTable result;
   std::map<int, std::size_t> entry_of;  // tool number -> its index in "data"
   for (std::size_t k = 0; k < data->size(); ++k) {
@@ -314,14 +428,17 @@ ToolTable ToolTable::from_fusion_json(const nlohmann::json& library, const std::
     auto type = tool.find("type");
     if (type == tool.end() || !type->is_string())
       input_error(where, ": missing \"type\" (a string)");
-    auto shape = kShapes.find(lower(type->get<std::string>()));
-    if (shape == kShapes.end()) continue;
+    const std::string type_name = lower(type->get<std::string>());
     std::string description;
     if (auto d = tool.find("description"); d != tool.end() && d->is_string())
       description = d->get<std::string>();
     if (!description.empty()) where += " (\"" + description + "\")";
     // The number the program calls it by.
     auto post = tool.find("post-process");
+    // An entry that cannot cut and that no program can call (a lone holder) is not a tool.
+    if (fusion_kind(type_name) == FusionKind::unusable &&
+        (post == tool.end() || !post->is_object() || !post->contains("number")))
+      continue;
     if (post == tool.end() || !post->is_object())
       input_error(where, ": missing \"post-process\" (an object)");
     auto number_key = post->find("number");
@@ -335,6 +452,13 @@ ToolTable ToolTable::from_fusion_json(const nlohmann::json& library, const std::
                   number);
     where = source + ": tool " + std::to_string(number) +
             (description.empty() ? "" : " (\"" + description + "\")");
+    const FusionKind kind = fusion_kind(type_name);
+    if (kind == FusionKind::unusable) {
+      // Kept, so that a program that uses it is told what it is (pipeline.cpp, load_cutters).
+      result.unusable_[number] =
+          where + " is a Fusion \"" + type_name + "\", " + fusion_unusable_reason(type_name);
+      continue;
+    }
 
     auto unit_scale = [&](const nlohmann::json& object, const std::string& at, double fallback) {
       auto unit = object.find("unit");
@@ -355,18 +479,13 @@ ToolTable ToolTable::from_fusion_json(const nlohmann::json& library, const std::
     const std::string at = where + ": \"geometry\"";
     ToolSpec spec;
     spec.number = number;
-    spec.shape = shape->second;
+    spec.shape = type_name;
     spec.description = description;
     spec.diameter_mm = scale * number_field(*geometry, at, {"DC"}, true);
     spec.flute_length_mm = scale * number_field(*geometry, at, {"LCF"}, true);
     spec.stick_out_mm = scale * number_field(*geometry, at, {"LB"}, true);
     const double overall = scale * number_field(*geometry, at, {"OAL"}, true);
     spec.shank_diameter_mm = scale * number_field(*geometry, at, {"SFDM"}, true);
-    if (spec.shape == "bullnose") {
-      spec.corner_radius_mm = scale * number_field(*geometry, at, {"RE"}, true);
-      // Fusion keeps "bull nose" with RE equal to the radius for what is a ball.
-      if (spec.corner_radius_mm >= spec.diameter_mm / 2) spec.shape = "ballnose";
-    }
     if (spec.stick_out_mm > overall)
       input_error(at, ": \"LB\" ", spec.stick_out_mm, " mm is longer than \"OAL\" ", overall,
                   " mm");
@@ -394,7 +513,7 @@ ToolTable ToolTable::from_fusion_json(const nlohmann::json& library, const std::
                         holder_scale * number_field(segment, sat, {"height"}, true)});
       }
     }
-    spec.cutter = make_cutter(spec, where);
+    spec.cutter = fusion_cutter(kind, *geometry, scale, at, spec);
     spec.body = make_body(spec, where);
     result.tools_.emplace(number, std::move(spec));
   }

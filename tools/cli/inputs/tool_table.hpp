@@ -94,11 +94,18 @@ class ToolTable {
   // The tools of a LinuxCNC table with D0 or no D: in the table, with no cutter (tools() lacks
   // them), a diameter of 0 for G41/G42.
   const std::set<int>& zero_diameter() const { return zero_diameter_; }
+  // Why a tool the table holds cannot cut (a Fusion probe, a form mill), naming it and its type;
+  // nullptr for a tool that can, or that the table does not hold.
+  const std::string* unusable(int number) const {
+    auto it = unusable_.find(number);
+    return it == unusable_.end() ? nullptr : &it->second;
+  }
 
  private:
   std::map<int, ToolSpec> tools_;
   std::map<int, double> tool_lengths_;
   std::set<int> zero_diameter_;
+  std::map<int, std::string> unusable_;
 };
 
 // The cutter a tool description stands for (the mapping above); throws InputError.

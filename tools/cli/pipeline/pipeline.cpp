@@ -11,6 +11,7 @@
 #include "outputs/output.hpp"
 #include "outputs/result_files.hpp"
 #include "pipeline/batch_pipe.hpp"
+#include "pipeline/plausibility.hpp"
 #include "render.hpp"
 #include "tridex/backends/backends.hpp"
 #include "tridex/dexel_ops.hpp"
@@ -257,7 +258,8 @@ RunInputs check_inputs_and_outputs(const SimulateOptions& options, const Pipelin
   RunInputs run;
   r.input = resolve_program(options);
   const ProgramInput& input = r.input;
-  if (r.input.tools) run.table = std::move(r.input.tools);  // --tools, else the project's
+  // --tools, else the project's; the input keeps its copy for the summary and the warnings.
+  if (r.input.tools) run.table = r.input.tools;
   if (!options.stock.empty())
     run.stock_spec = parse_stock(options.stock);
   else if (input.stock)
@@ -370,9 +372,52 @@ void load_cutters(const SimulateOptions& options, const std::optional<ToolTable>
       if (!table)
         input_error(location, ": tool ", tool,
                     " is used but there is no tool table (give --tools FILE)");
+      if (const std::string* why = table->unusable(tool))
+        input_error(location, ": tool ", tool, " is used, but ", *why);
+      // LinuxCNC reads a D0 row (a probe, an engraver, a table written before diameters were
+      // measured), and so does `moves`; a cut needs the cutter's size.
+      if (table->zero_diameter().count(tool))
+        input_error(location, ": tool ", tool,
+                    " cuts, but its diameter in the tool table is 0 (D0 or no D): give its "
+                    "diameter to simulate its cuts");
       input_error(location, ": tool ", tool, " is used but missing from the tool table ",
                   options.tools.empty() ? input.program.string() : options.tools);
     }
+}
+
+// The tool a control starts with (MachineConfig::initial_tool: --initial-tool, the machine
+// file's "initial_tool", CAMotics' tool 1 for a project): when a feed move comes before any tool
+// change, every move before it is cut with that tool, with a warning. A program that changes
+// tools before it cuts keeps its positioning rapids dropped (drop_toolless_moves).
+void load_initial_tool(const std::optional<ToolTable>& table, SimulationResult& r) {
+  const gcode::MachineConfig& machine = r.input.machine;
+  const int tool = machine.initial_tool;
+  if (tool <= 0) return;
+  long long toolless = 0;
+  bool feeds = false;
+  for (const gcode::MoveGroup& group : r.groups)
+    for (const gcode::Move& m : group.moves)
+      if (m.tool == 0) ++toolless, feeds = feeds || m.kind != gcode::MoveKind::rapid;
+  if (!feeds) return;
+  if (!table || !table->find(tool))
+    input_error(r.input.program.string(), ": the program cuts before any tool change, with tool ",
+                tool, ", the tool the control starts with, which is ",
+                table ? "not in the tool table" : "in no tool table (give --tools FILE)",
+                "; give --initial-tool N for another");
+  for (gcode::MoveGroup& group : r.groups) {
+    bool had = false;
+    for (gcode::Move& m : group.moves)
+      if (m.tool == 0) m.tool = tool, had = true;
+    if (had) group.tools.erase(0), group.tools.insert(tool);
+  }
+  const std::string source = machine.initial_tool_stated
+                                 ? "--initial-tool or the machine file's \"initial_tool\""
+                                 : "CAMotics' convention for a project";
+  r.warnings.push_back(std::to_string(toolless) +
+                       " move(s) before any tool change were cut with tool " +
+                       std::to_string(tool) + ", the tool the control starts with (" + source +
+                       "); give the program a tool change (T" + std::to_string(tool) +
+                       " M6), or --initial-tool 0 to refuse such moves");
 }
 
 // Without a tool in the spindle nothing cuts; rapids before the first tool change are only
@@ -404,7 +449,8 @@ void drop_toolless_moves(SimulationResult& r) {
               r.files.at(static_cast<std::size_t>(m.file)), ":", m.line, ": a ",
               gcode::to_string(m.kind),
               " move with no tool loaded (T… M6; on a machine that loads the tool on T alone, give "
-              "--machine a file with \"tool_loads_on_t\": true)");
+              "--machine a file with \"tool_loads_on_t\": true; for a control that starts with "
+              "a tool in the spindle, --initial-tool N)");
         ++toolless;
       }
       if (toolless > 0) erase_if(group.moves, [](const gcode::Move& m) { return m.tool == 0; });
@@ -631,8 +677,10 @@ void intersect_directions(const SimulateOptions& options, const PipelineRequest&
   // stock given far from where the program works, say). Not an error, but surely not meant.
   const double stock_dexel_volume = tridex::volume(stock_dexel);
   if (tridex::volume(r.result) >= stock_dexel_volume * (1 - 1e-12))
-    r.warnings.push_back("nothing was cut: no move reaches the stock (" + describe_box(stock.box) +
-                         "); the result is the whole stock");
+    r.warnings.push_back(
+        "nothing was cut: no move reaches the stock (" + describe_box(stock.box) +
+        "); the result is the whole stock: check --stock against the program's work offsets and "
+        "units");
   stock_dexel = TripleDexel{};
   maps = std::move(kept_maps);
   maps.shrink_to_fit();
@@ -659,9 +707,11 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   // The dump files are named by the directions, known only now.
   if (!options.dump_zmaps.empty())
     check_dump_names(options.dump_zmaps, r.groups, request.outputs, run.inputs);
+  load_initial_tool(run.table, r);
   load_cutters(options, run.table, parsed.interpreted.tool_first_line, r);
   drop_toolless_moves(r);
   size_the_run(options, request, run, parsed, r);
+  warn_implausible_setup(options, parsed.cutting_bounds, r);
   mill_directions(options, request, progress, r);
   if (!options.dump_zmaps.empty()) dump_zmaps(options.dump_zmaps, r, progress);
   intersect_directions(options, request, run.max_memory, progress, r);

@@ -17,6 +17,7 @@
 #include "pipeline/memory.hpp"
 #include "pipeline/pipeline.hpp"
 #include "pipeline/progress.hpp"
+#include "pipeline/shop_summary.hpp"
 #include "render.hpp"
 #include "tridex/dexel_ops.hpp"
 
@@ -114,6 +115,7 @@ int run_simulate(const SimulateOptions& options) {
   }
 
   // ---- outputs ------------------------------------------------------------------------------
+  bool png_written = !options.png.empty();
   if (!options.output.empty()) {
     progress.stage("writing " + options.output);
     write_stl_file(options.output, mesh);
@@ -122,6 +124,7 @@ int run_simulate(const SimulateOptions& options) {
     progress.stage("rendering " + options.png);
     if (mesh.triangles.empty()) {
       warnings.push_back("no material is left: " + options.png + " was not written");
+      png_written = false;
     } else {
       write_file_atomically(options.png, render::encode_png(render::render_mesh(mesh)));
     }
@@ -158,7 +161,9 @@ int run_simulate(const SimulateOptions& options) {
   if (!options.quiet) {
     for (const std::string& w : warnings) std::cerr << "warning: " << w << '\n';
     std::string written;
-    for (const std::string& path : {options.output, options.png, options.report, options.html})
+    // Only what was written: a picture of nothing is not.
+    for (const std::string& path :
+         {options.output, png_written ? options.png : std::string(), options.report, options.html})
       if (!path.empty()) written += (written.empty() ? " -> " : ", ") + path;
     std::printf(
         "%s: %lld segment%s in %zu direction%s, %d x %d x %d dexels; %.1f mm^3 left, %.1f mm^3 "
@@ -168,6 +173,7 @@ int run_simulate(const SimulateOptions& options) {
         stock.volume - volume, mesh.triangles.size(),
         check.closed() ? "watertight" : "NOT watertight", written.c_str(), total_s);
     std::printf("  %s\n", machining_time_text(r.machining).c_str());
+    std::printf("  %s\n  %s\n", tools_text(r).c_str(), directions_text(r).c_str());
   }
   return kSuccess;
 }

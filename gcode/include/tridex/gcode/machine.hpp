@@ -6,10 +6,10 @@
 //
 // The machine file is a JSON object; every key is optional: "name", "description", "base" (a
 // bundled machine to start from), "dialect", "units", "linear_units", "start", "tool_change",
-// "tool_loads_on_t", "arc_radius_tolerance_mm", "d_offsets", "g53", "home", "reference2",
-// "work_offsets", "m_codes", "forbidden_m_codes", "variables", "far_distance", "subprograms"
-// (folders relative to the file), "kinematics" and the speeds "rapid_rate_mm_per_min",
-// "rapid_rate_deg_per_min", "max_feed_mm_per_min".
+// "tool_loads_on_t", "initial_tool", "arc_radius_tolerance_mm", "d_offsets", "g53", "home",
+// "reference2", "work_offsets", "m_codes", "forbidden_m_codes", "variables", "far_distance",
+// "subprograms" (folders relative to the file), "kinematics" and the speeds
+// "rapid_rate_mm_per_min", "rapid_rate_deg_per_min", "max_feed_mm_per_min".
 //
 // Key "kinematics" (issue 11's machine file; see gcode/README.md, "Machine kinematics"): either
 // the name of a bundled machine that has rotary axes (a profile), or an object:
@@ -113,6 +113,7 @@ struct MachineConfig {
   std::optional<double> arc_radius_tolerance;
   DOffsets d_offsets = DOffsets::dialect;
   bool inch_at_start = false;  // units before any G20/G21: inch (true) or mm
+  bool units_stated = false;   // a machine file's "units" said so (no warning about G20/G21)
   // G53 with the tool along +Z: false, a G53 Z is a retract (the tip goes far along the tool, as
   // G28 with the default position); true, G53 goes to the machine coordinates it names, because
   // this machine's zero is known (the work offsets and G28/G30 positions are measured from it).
@@ -153,6 +154,12 @@ struct MachineConfig {
   // The units of a LinuxCNC tool table (.tbl) for this machine: LinuxCNC reads it in machine
   // units, its INI's [TRAJ]LINEAR_UNITS; rs274 run standalone, with no INI, in inches.
   bool tool_table_in_inches = true;
+  bool linear_units_stated = false;  // a machine file's "linear_units" said so
+  // The tool in the spindle when the program starts ("initial_tool"; 0: none, the default):
+  // CAMotics runs a program with no tool change with tool 1. Moves before the first tool change
+  // are cut with it (the command warns when it does).
+  int initial_tool = 0;
+  bool initial_tool_stated = false;
 
   void set_home(const Vec3& p) {
     home = p;
