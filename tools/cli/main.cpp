@@ -54,7 +54,8 @@ void add_common(CLI::App& command, CommonOptions& options) {
   command
       .add_option("PROGRAM", options.program,
                   "G-code file (.nc, .ngc, .tap, .gcode, any name) or CAMotics project (.camotics)")
-      ->required();
+      ->required()
+      ->check(kNotEmpty);
   command
       .add_option("--arc-tolerance", options.arc_tolerance,
                   "largest chord error of linearised arcs, mm (default 0.001)")
@@ -73,12 +74,16 @@ void add_common(CLI::App& command, CommonOptions& options) {
                   "runs them\n"
                   "(default on)")
       ->check(CLI::IsMember({"on", "off"}));
-  command.add_option("--machine", options.machine,
-                     std::string("machine file (JSON) or bundled machine: ") +
-                         tridex::gcode::bundled_machine_names() + " (README: Machine files)");
-  command.add_option("--subprograms", options.subprograms,
-                     "folder of subprogram files (O9810.nc, name.ngc) that M98/G65/o-call may "
-                     "call (repeatable)");
+  command
+      .add_option("--machine", options.machine,
+                  std::string("machine file (JSON) or bundled machine: ") +
+                      tridex::gcode::bundled_machine_names() + " (README: Machine files)")
+      ->check(kNotEmpty);
+  command
+      .add_option("--subprograms", options.subprograms,
+                  "folder of subprogram files (O9810.nc, name.ngc) that M98/G65/o-call may "
+                  "call (repeatable)")
+      ->check(kNotEmpty);
   command
       .add_option("--tools", options.tools,
                   "tool table, JSON in the CAMotics schema, a Fusion tool library or a LinuxCNC "
@@ -142,10 +147,12 @@ void add_simulate(CLI::App& command, SimulateOptions& options) {
           "Steps 2-3: scan (scan conversion onto the ray grids, default), tree (the paper's grid\n"
           "AABB tree) or embree (Embree 3 ray casting)")
       ->check(CLI::IsMember({"scan", "tree", "embree"}));
-  command.add_option("--html", options.html,
-                     "write an interactive HTML report: the part in 3D, the toolpath, the findings "
-                     "and the figures\n"
-                     "(one file that opens offline in a browser)");
+  command
+      .add_option("--html", options.html,
+                  "write an interactive HTML report: the part in 3D, the toolpath, the findings "
+                  "and the figures\n"
+                  "(one file that opens offline in a browser)")
+      ->check(kNotEmpty);
   add_max_memory(command, options.max_memory);
 }
 

@@ -77,6 +77,15 @@ ProgramInput resolve_program(const CommonOptions& options) {
   return input;
 }
 
+std::vector<fs::path> files_read(const CommonOptions& options, const ProgramInput& input) {
+  std::vector<fs::path> files(input.files.begin(), input.files.end());
+  files.push_back(input.program);
+  if (!options.machine.empty() && !gcode::MachineConfig::bundled(options.machine))
+    files.push_back(options.machine);
+  if (!options.tools.empty()) files.push_back(options.tools);
+  return files;
+}
+
 gcode::InterpreterOptions interpreter_options(const CommonOptions& options) {
   gcode::InterpreterOptions o;
   o.arc_tolerance = options.arc_tolerance;
@@ -137,6 +146,9 @@ InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOpt
                   "--max-blocks if the "
                   "program needs more");
     }
+    for (const std::string& name : interpreter.files())
+      if (std::find(result.read.begin(), result.read.end(), name) == result.read.end())
+        result.read.push_back(name);
     for (const gcode::Diagnostic& d : interpreter.warnings())
       result.warnings.push_back(d.to_string());
     for (const auto& [tool, line] : interpreter.tool_first_line())

@@ -39,11 +39,15 @@ void write_output(const std::string& path, Write&& write) {
   out.commit();
 }
 
-void check_output(const std::string& path, const ProgramInput& input) {
-  if (path == "-") return;
-  std::vector<std::filesystem::path> inputs(input.files.begin(), input.files.end());
-  inputs.push_back(input.program);
-  check_output_path("-o", path, inputs);
+void check_output(const ListOptions& options, const ProgramInput& input) {
+  if (options.output == "-") return;
+  check_output_path("-o", options.output, files_read(options, input));
+}
+
+// The subprograms the program called, known once it ran: none may be the output.
+void check_output_after(const ListOptions& options, const InterpretResult& result) {
+  const std::pair<std::string, std::filesystem::path> output{"-o", options.output};
+  check_outputs_not_read({&output, 1}, result.read);
 }
 
 void print_warnings(const std::vector<std::string>& warnings, bool quiet) {
@@ -55,7 +59,7 @@ void print_warnings(const std::vector<std::string>& warnings, bool quiet) {
 
 int run_moves(const ListOptions& options) {
   ProgramInput input = resolve_program(options);
-  check_output(options.output, input);
+  check_output(options, input);
   InterpretResult result;
   write_output(options.output, [&](std::ostream& out) {
     std::string record;
@@ -93,6 +97,7 @@ int run_moves(const ListOptions& options) {
           record += "}\n";
           out << record;
         });
+    check_output_after(options, result);
   });
   print_warnings(result.warnings, options.quiet);
   return kSuccess;
@@ -100,7 +105,7 @@ int run_moves(const ListOptions& options) {
 
 int run_groups(const ListOptions& options) {
   ProgramInput input = resolve_program(options);
-  check_output(options.output, input);
+  check_output(options, input);
   // The groups hold every move, each once (MoveList).
   MoveBudget budget(max_memory_bytes(options.max_memory), sizeof(gcode::Move));
   gcode::DirectionGrouper grouper;
@@ -133,6 +138,7 @@ int run_groups(const ListOptions& options) {
         }
       },
       [&](const gcode::Dwell& d) { timer.add(d); });
+  check_output_after(options, result);
   Json groups = Json::array();
   const auto& list = grouper.groups();
   for (std::size_t g = 0; g < list.size(); ++g) {

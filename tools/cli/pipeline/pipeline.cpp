@@ -265,9 +265,7 @@ RunInputs check_inputs_and_outputs(const SimulateOptions& options, const Pipelin
   run.max_memory = max_memory_bytes(options.max_memory);
 
   std::vector<fs::path>& inputs = run.inputs;
-  inputs.assign(input.files.begin(), input.files.end());
-  inputs.push_back(input.program);
-  if (!options.tools.empty()) inputs.push_back(options.tools);
+  inputs = files_read(options, input);
   if (run.stock_spec.kind == StockSpec::Kind::mesh) inputs.push_back(run.stock_spec.mesh_path);
   inputs.insert(inputs.end(), request.extra_inputs.begin(), request.extra_inputs.end());
   for (const auto& [option, path] : request.outputs)
@@ -656,6 +654,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   SimulationResult r;
   const RunInputs run = check_inputs_and_outputs(options, request, r);
   ParsedProgram parsed = parse_grouped(options, run.max_memory, progress, r);
+  check_outputs_not_read(request.outputs, parsed.interpreted.read);  // the subprograms it called
   // The dump files are named by the directions, known only now.
   if (!options.dump_zmaps.empty())
     check_dump_names(options.dump_zmaps, r.groups, request.outputs, run.inputs);
