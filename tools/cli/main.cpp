@@ -23,12 +23,16 @@ namespace {
 
 using namespace tridex::cli;
 
-// CLI11's PositiveNumber lets "nan" and "inf" through; every length here must be finite.
+// CLI11's PositiveNumber lets "nan" and "inf" through; every length here must be finite, and at
+// most a kilometre (kMaxLengthOption): past any machine, and far from overflow in the grids and
+// distances computed from it (--zmap-cell 1e300 made the Z-map's heights infinite).
+constexpr double kMaxLengthOption = 1e6;
 const CLI::Validator kFinitePositive(
     [](std::string& text) -> std::string {
       double value = 0;
-      if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0))
-        return "must be a finite positive number, got \"" + text + "\"";
+      if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0) ||
+          value > kMaxLengthOption)
+        return "must be a positive number of mm up to 1e6, got \"" + text + "\"";
       return {};
     },
     "POSITIVE");
@@ -37,8 +41,9 @@ const CLI::Validator kFinitePositive(
 const CLI::Validator kFiniteNonNegative(
     [](std::string& text) -> std::string {
       double value = 0;
-      if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value >= 0))
-        return "must be a finite number, zero or more, got \"" + text + "\"";
+      if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value >= 0) ||
+          value > kMaxLengthOption)
+        return "must be a number of mm from 0 to 1e6, got \"" + text + "\"";
       return {};
     },
     "NONNEGATIVE");
@@ -240,7 +245,8 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
-    std::cerr << "tridex: " << e.what() << "\n(run `tridex --help` or `tridex COMMAND --help`)\n";
+    std::cerr << "tridex: " << terminal_safe(e.what())
+              << "\n(run `tridex --help` or `tridex COMMAND --help`)\n";
     return kBadInput;
   }
 
@@ -250,16 +256,16 @@ int main(int argc, char** argv) {
     if (mov->parsed()) return run_moves(moves);
     if (grp->parsed()) return run_groups(groups);
   } catch (const tridex::gcode::GcodeError& e) {
-    std::cerr << e.what() << '\n';
+    std::cerr << terminal_safe(e.what()) << '\n';
     return kBadInput;
   } catch (const InputError& e) {
-    std::cerr << "tridex: " << e.what() << '\n';
+    std::cerr << "tridex: " << terminal_safe(e.what()) << '\n';
     return kBadInput;
   } catch (const std::bad_alloc&) {
     std::cerr << "tridex: out of memory (lower the resolution or --max-memory)\n";
     return kFailure;
   } catch (const std::exception& e) {
-    std::cerr << "tridex: " << e.what() << '\n';
+    std::cerr << "tridex: " << terminal_safe(e.what()) << '\n';
     return kFailure;
   }
   return kFailure;

@@ -9,6 +9,13 @@
 
 namespace tridex::cli {
 
+// The largest coordinate (mm) a stock box, an envelope or a project's workpiece may have, and the
+// largest margin: a kilometre is past any machine, and the lattice and Z-map arithmetic on such
+// values stays finite. Values beyond are bad input (exit status 2), not a failure of the run.
+constexpr double kMaxStockCoordinate = 1e6;
+// A project's automatic margin, percent of the cutting moves' box.
+constexpr double kMaxMarginPercent = 1e4;
+
 struct StockSpec {
   enum class Kind { box, mesh, automatic };
   Kind kind = Kind::automatic;

@@ -52,7 +52,7 @@ void check_output_after(const ListOptions& options, const InterpretResult& resul
 
 void print_warnings(const std::vector<std::string>& warnings, bool quiet) {
   if (quiet) return;
-  for (const std::string& w : warnings) std::cerr << "warning: " << w << '\n';
+  for (const std::string& w : warnings) std::cerr << "warning: " << terminal_safe(w) << '\n';
 }
 
 }  // namespace
@@ -71,7 +71,7 @@ int run_moves(const ListOptions& options) {
           record += std::to_string(m.line);
           if (several_files) {
             record += ",\"file\":";
-            record += Json(input.files[file].string()).dump();
+            record += dump_json(Json(input.files[file].string()));
           }
           record += ",\"kind\":\"";
           record += gcode::to_string(m.kind);
@@ -174,7 +174,7 @@ int run_groups(const ListOptions& options) {
   document["groups"] = std::move(groups);
   document["machining_time"] = machining_time_json(timer);
   document["warnings"] = result.warnings;
-  write_output(options.output, [&](std::ostream& out) { out << document.dump(2) << '\n'; });
+  write_output(options.output, [&](std::ostream& out) { out << dump_json(document, 2) << '\n'; });
   print_warnings(result.warnings, options.quiet);
   return kSuccess;
 }

@@ -136,7 +136,7 @@ int run_simulate(const SimulateOptions& options) {
   const Json report = simulate_report(options, r, rapid_findings, total_s);
   if (!options.report.empty()) {
     progress.stage("writing " + options.report);
-    write_file_atomically(options.report, report.dump(2) + "\n");
+    write_file_atomically(options.report, dump_json(report, 2) + "\n");
   }
   if (!options.html.empty()) {
     progress.stage("writing " + options.html);
@@ -152,7 +152,7 @@ int run_simulate(const SimulateOptions& options) {
   progress.finish();
 
   if (!options.quiet) {
-    for (const std::string& w : warnings) std::cerr << "warning: " << w << '\n';
+    for (const std::string& w : warnings) std::cerr << "warning: " << terminal_safe(w) << '\n';
     std::string written;
     for (const std::string& path : {options.output, options.png, options.report, options.html})
       if (!path.empty()) written += (written.empty() ? " -> " : ", ") + path;
