@@ -32,7 +32,7 @@ const CLI::Validator kFinitePositive(
       double value = 0;
       if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0) ||
           value > kMaxLengthOption)
-        return "must be a positive number of mm up to 1e6, got \"" + text + "\"";
+        return "must be a finite positive number of mm up to 1e6, got \"" + text + "\"";
       return {};
     },
     "POSITIVE");
@@ -43,7 +43,7 @@ const CLI::Validator kFiniteNonNegative(
       double value = 0;
       if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value >= 0) ||
           value > kMaxLengthOption)
-        return "must be a number of mm from 0 to 1e6, got \"" + text + "\"";
+        return "must be a finite number of mm from 0 to 1e6, got \"" + text + "\"";
       return {};
     },
     "NONNEGATIVE");
