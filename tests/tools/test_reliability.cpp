@@ -279,3 +279,14 @@ TEST_CASE("moves writes strict JSON Lines") {
   CHECK(json_lines(r.out));
   fs::remove_all(d);
 }
+
+TEST_CASE("row 9: --max-moves bounds a loop of huge arcs, for moves too") {
+  fs::path d = setup("row9");
+  write_text(d / "loop.nc",
+             "G21 G90 G17\nT1 M6\nG0 X0 Y0 Z0\n#1=0\nWHILE[#1LT1000000]DO1\nG2 X0 Y0 I1000000 J0 "
+             "F100\n#1=#1+1\nEND1\nM30\n");
+  refused(d, {"moves", at(d, "loop.nc"), "--max-moves", "300000", "-o", at(d, "m.jsonl")},
+          {"loop.nc:6", "--max-moves 300000"});
+  refused(d, {"groups", at(d, "loop.nc"), "--max-moves", "300000"}, {"--max-moves"});
+  fs::remove_all(d);
+}

@@ -71,6 +71,12 @@ void add_common(CLI::App& command, CommonOptions& options) {
                   "loops; default " +
                       std::to_string(kDefaultMaxBlocks) + ")")
       ->check(CLI::PositiveNumber);
+  command
+      .add_option("--max-moves", options.max_moves,
+                  "stop with exit status 2 after this many generated moves, arc chords included "
+                  "(bounds loops of arcs; default " +
+                      std::to_string(kDefaultMaxMoves) + ")")
+      ->check(CLI::PositiveNumber);
   command.add_flag("--lenient", options.lenient,
                    "unsupported G-code words become warnings and are skipped");
   command

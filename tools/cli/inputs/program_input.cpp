@@ -113,7 +113,8 @@ void MoveBudget::keep(const gcode::Move& move, const std::string& file) {
 
 InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOptions& options,
                           const std::function<void(const gcode::Move&, std::size_t file)>& sink,
-                          const std::function<void(const gcode::Dwell&)>& dwell_sink) {
+                          const std::function<void(const gcode::Dwell&)>& dwell_sink,
+                          long long max_moves) {
   InterpretResult result;
   gcode::Interpreter interpreter(options, input.machine);
   for (std::size_t f = 0; f < input.files.size(); ++f) {
@@ -126,7 +127,11 @@ InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOpt
       interpreter.run(
           in, path.string(),
           [&](const gcode::Move& move) {
-            ++result.moves;
+            if (++result.moves > max_moves && max_moves > 0)
+              input_error(path.string(), ":", move.line, ": more than ", max_moves,
+                          " moves generated (--max-moves ", max_moves,
+                          "; a loop of arcs at a fine --arc-tolerance?); raise --max-moves if the "
+                          "program needs more");
             while (global.size() <= static_cast<std::size_t>(move.file)) {
               const std::string& name = interpreter.files()[global.size()];
               const auto known = std::find(result.files.begin(), result.files.end(), name);

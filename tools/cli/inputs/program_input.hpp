@@ -86,8 +86,10 @@ class MoveBudget {
 // InterpretResult::files (one table for all the runs), and dwells to `dwell_sink` where given.
 // GcodeError propagates (exit status 2); running past options.max_blocks is an InputError that
 // names --max-blocks.
+// More than `max_moves` moves (0: no bound) is an InputError that names --max-moves.
 InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOptions& options,
                           const std::function<void(const gcode::Move&, std::size_t file)>& sink,
-                          const std::function<void(const gcode::Dwell&)>& dwell_sink = {});
+                          const std::function<void(const gcode::Dwell&)>& dwell_sink = {},
+                          long long max_moves = 0);
 
 }  // namespace tridex::cli

@@ -64,8 +64,9 @@ int run_moves(const ListOptions& options) {
   write_output(options.output, [&](std::ostream& out) {
     std::string record;
     bool several_files = input.files.size() > 1;
-    result =
-        interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t file) {
+    result = interpret(
+        input, interpreter_options(options),
+        [&](const gcode::Move& m, std::size_t file) {
           record.clear();
           record += "{\"line\":";
           record += std::to_string(m.line);
@@ -96,7 +97,8 @@ int run_moves(const ListOptions& options) {
           }
           record += "}\n";
           out << record;
-        });
+        },
+        {}, options.max_moves);
     check_output_after(options, result);
   });
   print_warnings(result.warnings, options.quiet);
@@ -137,7 +139,7 @@ int run_groups(const ListOptions& options) {
           e.local.extend(frame.to_local(m.end));
         }
       },
-      [&](const gcode::Dwell& d) { timer.add(d); });
+      [&](const gcode::Dwell& d) { timer.add(d); }, options.max_moves);
   check_output_after(options, result);
   Json groups = Json::array();
   const auto& list = grouper.groups();

@@ -333,7 +333,7 @@ ParsedProgram parse_grouped(const SimulateOptions& options, std::uint64_t max_me
         r.machining.add(m);
         grouping.push(m);
       },
-      [&](const gcode::Dwell& d) { r.machining.add(d); });
+      [&](const gcode::Dwell& d) { r.machining.add(d); }, options.max_moves);
   grouping.finish();
   r.groups = grouper.take();
   r.files = std::move(parsed.interpreted.files);
