@@ -627,10 +627,22 @@ void intersect_directions(const SimulateOptions& options, const PipelineRequest&
   r.timings.intersect = seconds_since(t);
   // The result is the stock less the cuts: the same volume means no move reached the stock (a
   // stock given far from where the program works, say). Not an error, but surely not meant.
-  const double stock_dexel_volume = tridex::volume(stock_dexel);
-  if (tridex::volume(r.result) >= stock_dexel_volume * (1 - 1e-12))
-    r.warnings.push_back("nothing was cut: no move reaches the stock (" + describe_box(stock.box) +
-                         "); the result is the whole stock");
+  r.stock_dexel_volume = tridex::volume(stock_dexel);
+  r.result_dexel_volume = tridex::volume(r.result);
+  if (r.result_dexel_volume >= r.stock_dexel_volume * (1 - 1e-12)) {
+    // Only when no move can reach the stock is "nothing was cut" a fact; otherwise the cuts are
+    // finer than the lattice resolves (a large stock around a small toolpath), and saying so
+    // tells the user what to change.
+    if (no_move_reaches(r.groups, r.cutters, stock.box))
+      r.warnings.push_back("nothing was cut: no move reaches the stock (" +
+                           describe_box(stock.box) + "); the result is the whole stock");
+    else
+      r.warnings.push_back("the moves reach the stock (" + describe_box(stock.box) +
+                           ") but remove less than the dexel spacing of " +
+                           std::to_string(r.lattice.spacing) +
+                           " mm resolves: give a smaller --dexel-cell, or a stock nearer the "
+                           "toolpath");
+  }
   stock_dexel = TripleDexel{};
   maps = std::move(kept_maps);
   maps.shrink_to_fit();
