@@ -159,7 +159,8 @@ constexpr std::array<BundledMachine, 8> kBundled{{
 double json_number(const nlohmann::json& j, const std::string& path) {
   if (!j.is_number()) json_fail(path, "must be a number", j);
   double v = j.get<double>();
-  if (!std::isfinite(v)) json_fail(path, "must be finite", j);
+  // Within ±1e9 (mm, degrees): far past any machine, and far from overflow once squared.
+  if (!(std::abs(v) <= 1e9)) json_fail(path, "must be a finite number within ±1e9", j);
   return v;
 }
 

@@ -9,6 +9,8 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "tridex/error.hpp"
 #include "tridex/gcode/machine.hpp"
@@ -35,14 +37,22 @@ std::string cat(const Parts&... parts) {
   return out.str();
 }
 
+// Every number of a machine file lies within ±kMaxValue (mm, mm/min, a variable's value): a
+// kilometre-scale machine is far inside, and positions, distances and times computed from such
+// values stay finite (a home at 1e308 made every machining time null).
+constexpr double kMaxValue = 1e9;
+
+bool in_range(const json& c) { return c.is_number() && std::abs(c.get<double>()) <= kMaxValue; }
+
 Vec3 point(const json& value, const std::string& where) {
   if (!value.is_array() || value.size() != 3)
     machine_error(where, ": must be [x, y, z] in mm, got ", value.dump());
   Vec3 p;
   for (int i = 0; i < 3; ++i) {
     const json& c = value[static_cast<std::size_t>(i)];
-    if (!c.is_number() || !std::isfinite(c.get<double>()))
-      machine_error(where, ": must be [x, y, z] of finite numbers, got ", value.dump());
+    if (!in_range(c))
+      machine_error(where, ": must be [x, y, z] of numbers within ±", kMaxValue, " mm, got ",
+                    value.dump());
     p[i] = c.get<double>();
   }
   return p;
@@ -83,8 +93,9 @@ int work_offset_key(const std::string& name, const std::string& where) {
 
 // A positive, finite number of `unit` (mm, mm/min).
 double positive(const json& value, const std::string& where, const char* unit) {
-  if (!value.is_number() || !(value.get<double>() > 0) || !std::isfinite(value.get<double>()))
-    machine_error(where, ": must be a positive number of ", unit, ", got ", value.dump());
+  if (!in_range(value) || !(value.get<double>() > 0))
+    machine_error(where, ": must be a positive number of ", unit, " up to ", kMaxValue, ", got ",
+                  value.dump());
   return value.get<double>();
 }
 double rate(const json& value, const std::string& where) {
@@ -117,12 +128,12 @@ std::array<double, 3> rotary_rates(const json& value, const std::string& where) 
     for (const auto& [letter, r] : value.items()) {
       if (letter != "A" && letter != "B" && letter != "C")
         machine_error(where, ": \"", letter, "\" is not a rotary axis (A, B or C)");
-      if (!r.is_number() || !(r.get<double>() > 0) || !std::isfinite(r.get<double>()))
+      if (!in_range(r) || !(r.get<double>() > 0))
         machine_error(where, ": \"", letter,
                       "\" must be a positive number of degrees per minute, got ", r.dump());
       rates[static_cast<std::size_t>(letter[0] - 'A')] = r.get<double>();
     }
-  } else if (value.is_number() && value.get<double>() > 0 && std::isfinite(value.get<double>())) {
+  } else if (in_range(value) && value.get<double>() > 0) {
     rates.fill(value.get<double>());
   } else {
     machine_error(
@@ -136,9 +147,12 @@ std::array<double, 3> rotary_rates(const json& value, const std::string& where) 
 // "variables": {"#650": 2000, "#<_name>": 1}: what the control holds when the program starts.
 void read_variables(const json& value, const std::string& where, MachineConfig& m) {
   if (!value.is_object()) machine_error(where, ": must be an object such as {\"#650\": 2000}");
+  std::set<long> seen;  // this file's keys, normalised (a base machine's may be overridden)
+  std::set<std::string> named_seen;
   for (const auto& [name, number] : value.items()) {
-    if (!number.is_number() || !std::isfinite(number.get<double>()))
-      machine_error(where, ": \"", name, "\": must be a number, got ", number.dump());
+    if (!in_range(number))
+      machine_error(where, ": \"", name, "\": must be a number within ±", kMaxValue, ", got ",
+                    number.dump());
     if (name.starts_with("#<")) {  // LinuxCNC's named global, case and spaces as it reads them
       std::string global;
       for (char c : name.substr(2, name.size() > 3 ? name.size() - 3 : 0))
@@ -146,15 +160,25 @@ void read_variables(const json& value, const std::string& where, MachineConfig& 
           global.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(c))));
       if (!name.ends_with(">") || global.size() < 2 || global[0] != '_')
         machine_error(where, ": \"", name, "\" is not a global named parameter (#<_name>)");
+      // "#<_a>" and "#<_A>" are one parameter to the control: given twice, one would win silently.
       m.named_variables[global] = number.get<double>();
+      if (!named_seen.insert(global).second)
+        machine_error(where, ": \"", name, "\" names #<", global,
+                      ">, as another key does (one variable given twice)");
       continue;
     }
     std::string digits = name.starts_with("#") ? name.substr(1) : name;
-    char* end = nullptr;
-    const long n = digits.empty() ? -1 : std::strtol(digits.c_str(), &end, 10);
-    if (n < 1 || n > 999999 || *end != '\0')
-      machine_error(where, ": \"", name, "\" is not a variable number (#1 to #999999) or #<_name>");
+    const bool all_digits = !digits.empty() && digits.size() <= 9 &&
+                            digits.find_first_not_of("0123456789") == std::string::npos;
+    const long n = all_digits ? std::strtol(digits.c_str(), nullptr, 10) : -1;
+    if (n < 1 || n > 999999)
+      machine_error(where, ": \"", name,
+                    "\" is not a variable number (#1 to #999999, digits only) or #<_name>");
+    // "#5" and "#05" are one variable.
     m.variables[static_cast<int>(n)] = number.get<double>();
+    if (!seen.insert(n).second)
+      machine_error(where, ": \"", name, "\" names #", n,
+                    ", as another key does (one variable given twice)");
   }
 }
 
@@ -293,6 +317,18 @@ MachineConfig parse(const json& doc, const std::string& file) {
 }  // namespace
 
 MachineConfig machine_from_json(const json& doc, const std::string& file) {
+  // The reader of "kinematics" recurses into "profile" objects: a bound on the nesting keeps a
+  // hostile file from exhausting the stack (the command's JSON reader refuses deeper files first).
+  constexpr std::size_t kMaxDepth = 64;
+  std::vector<std::pair<const json*, std::size_t>> pending{{&doc, 1}};
+  while (!pending.empty()) {
+    auto [value, depth] = pending.back();
+    pending.pop_back();
+    if (!value->is_structured()) continue;
+    if (depth > kMaxDepth)
+      machine_error(file, ": objects and arrays nested more than ", kMaxDepth, " deep");
+    for (const json& child : *value) pending.emplace_back(&child, depth + 1);
+  }
   try {
     return parse(doc, file);
   } catch (const json::exception& e) {

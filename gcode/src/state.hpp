@@ -356,13 +356,15 @@ struct Interpreter::State : ParameterReader {
         int code = integral ? static_cast<int>(rounded) : -1;
         if (word.letter == 'M' && code % 10) integral = false;
         int group = !integral ? -1 : word.letter == 'G' ? block_g_group(code) : m_group(code / 10);
+        // A machine may forbid any M-code, the ones tridex acts on (M0-M9, M30, M98, M99)
+        // included: the machine file's "forbidden_m_codes".
+        if (integral && word.letter == 'M' && machine.forbidden_m_codes.count(code / 10))
+          error(word.column,
+                code_name('M', code) + " is not allowed on this machine (machine file)");
         if (group < 0 && integral && word.letter == 'M') {
           // An M-code moves no axis: accepted (once a warning per code unless the machine
-          // declares it), an error where the machine forbids it.
+          // declares it).
           int m = code / 10;
-          if (machine.forbidden_m_codes.count(m))
-            error(word.column,
-                  code_name('M', code) + " is not allowed on this machine (machine file)");
           if (!machine.m_codes.count(m) && warned_once.m_codes.insert(m).second)
             warn(word.column,
                  code_name('M', code) +

@@ -371,7 +371,7 @@ const std::vector<BadInput>& cases() {
          return simulate_with(
              d, {"--stock", at(d, "dump/zmap-1-+z.stl"), "--dump-zmaps", at(d, "dump")});
        },
-       {"--dump-zmaps", "zmap-1-+z.stl", "would overwrite the input"}},
+       {"--dump-zmaps", "zmap-1-+z.stl", "would overwrite an input"}},
       {"--dump-zmaps over the program",
        [](const fs::path& d) {
          fs::create_directories(d / "dump");
@@ -380,7 +380,7 @@ const std::vector<BadInput>& cases() {
          a[1] = at(d, "dump/zmap-1-+z.png");
          return a;
        },
-       {"--dump-zmaps", "would overwrite the input"}},
+       {"--dump-zmaps", "would overwrite an input"}},
       {"-o on a dump file",
        [](const fs::path& d) {
          fs::create_directories(d / "dump");

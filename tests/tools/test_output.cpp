@@ -68,7 +68,7 @@ TEST_CASE("output paths are checked before any work") {
   std::vector<fs::path> inputs{input};
   CHECK_NOTHROW(check_output_path("-o", dir / "new.stl", inputs));
   CHECK_THROWS_WITH_AS(check_output_path("-o", input, inputs),
-                       doctest::Contains("would overwrite the input"), InputError);
+                       doctest::Contains("would overwrite an input"), InputError);
   CHECK_THROWS_WITH_AS(check_output_path("-o", dir / "missing" / "a.stl", inputs),
                        doctest::Contains("does not exist"), InputError);
   CHECK_THROWS_WITH_AS(check_output_path("--png", dir, inputs), doctest::Contains("is a directory"),

@@ -12,6 +12,11 @@ namespace tridex::cli {
 // with a message instead of running on without bound.
 constexpr long long kDefaultMaxBlocks = 20'000'000;
 
+// Moves (chords of arcs and cycles included) a run may generate: one block can expand into
+// millions of chords, so --max-blocks alone does not bound the work of a loop of arcs. Far above
+// real programs (a 20-million-line file of moves), low enough that such a loop stops in minutes.
+constexpr long long kDefaultMaxMoves = 200'000'000;
+
 struct CommonOptions {
   std::string program;           // G-code file or CAMotics project
   double arc_tolerance = 0.001;  // mm
@@ -25,6 +30,7 @@ struct CommonOptions {
   bool progress = false;
   bool quiet = false;
   long long max_blocks = kDefaultMaxBlocks;  // --max-blocks: executed blocks before exit status 2
+  long long max_moves = kDefaultMaxMoves;    // --max-moves: generated moves before exit status 2
   std::string max_memory;  // --max-memory (simulate, check, groups); empty: 80 % of RAM
 };
 

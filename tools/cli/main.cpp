@@ -23,12 +23,16 @@ namespace {
 
 using namespace tridex::cli;
 
-// CLI11's PositiveNumber lets "nan" and "inf" through; every length here must be finite.
+// CLI11's PositiveNumber lets "nan" and "inf" through; every length here must be finite, and at
+// most a kilometre (kMaxLengthOption): past any machine, and far from overflow in the grids and
+// distances computed from it (--zmap-cell 1e300 made the Z-map's heights infinite).
+constexpr double kMaxLengthOption = 1e6;
 const CLI::Validator kFinitePositive(
     [](std::string& text) -> std::string {
       double value = 0;
-      if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0))
-        return "must be a finite positive number, got \"" + text + "\"";
+      if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0) ||
+          value > kMaxLengthOption)
+        return "must be a finite positive number of mm up to 1e6, got \"" + text + "\"";
       return {};
     },
     "POSITIVE");
@@ -37,8 +41,9 @@ const CLI::Validator kFinitePositive(
 const CLI::Validator kFiniteNonNegative(
     [](std::string& text) -> std::string {
       double value = 0;
-      if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value >= 0))
-        return "must be a finite number, zero or more, got \"" + text + "\"";
+      if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value >= 0) ||
+          value > kMaxLengthOption)
+        return "must be a finite number of mm from 0 to 1e6, got \"" + text + "\"";
       return {};
     },
     "NONNEGATIVE");
@@ -54,7 +59,8 @@ void add_common(CLI::App& command, CommonOptions& options) {
   command
       .add_option("PROGRAM", options.program,
                   "G-code file (.nc, .ngc, .tap, .gcode, any name) or CAMotics project (.camotics)")
-      ->required();
+      ->required()
+      ->check(kNotEmpty);
   command
       .add_option("--arc-tolerance", options.arc_tolerance,
                   "largest chord error of linearised arcs, mm (default 0.001)")
@@ -65,6 +71,12 @@ void add_common(CLI::App& command, CommonOptions& options) {
                   "loops; default " +
                       std::to_string(kDefaultMaxBlocks) + ")")
       ->check(CLI::PositiveNumber);
+  command
+      .add_option("--max-moves", options.max_moves,
+                  "stop with exit status 2 after this many generated moves, arc chords included "
+                  "(bounds loops of arcs; default " +
+                      std::to_string(kDefaultMaxMoves) + ")")
+      ->check(CLI::PositiveNumber);
   command.add_flag("--lenient", options.lenient,
                    "unsupported G-code words become warnings and are skipped");
   command
@@ -73,12 +85,16 @@ void add_common(CLI::App& command, CommonOptions& options) {
                   "runs them\n"
                   "(default on)")
       ->check(CLI::IsMember({"on", "off"}));
-  command.add_option("--machine", options.machine,
-                     std::string("machine file (JSON) or bundled machine: ") +
-                         tridex::gcode::bundled_machine_names() + " (README: Machine files)");
-  command.add_option("--subprograms", options.subprograms,
-                     "folder of subprogram files (O9810.nc, name.ngc) that M98/G65/o-call may "
-                     "call (repeatable)");
+  command
+      .add_option("--machine", options.machine,
+                  std::string("machine file (JSON) or bundled machine: ") +
+                      tridex::gcode::bundled_machine_names() + " (README: Machine files)")
+      ->check(kNotEmpty);
+  command
+      .add_option("--subprograms", options.subprograms,
+                  "folder of subprogram files (O9810.nc, name.ngc) that M98/G65/o-call may "
+                  "call (repeatable)")
+      ->check(kNotEmpty);
   command
       .add_option("--tools", options.tools,
                   "tool table, JSON in the CAMotics schema, a Fusion tool library or a LinuxCNC "
@@ -154,10 +170,12 @@ void add_simulate(CLI::App& command, SimulateOptions& options) {
           "Steps 2-3: scan (scan conversion onto the ray grids, default), tree (the paper's grid\n"
           "AABB tree) or embree (Embree 3 ray casting)")
       ->check(CLI::IsMember({"scan", "tree", "embree"}));
-  command.add_option("--html", options.html,
-                     "write an interactive HTML report: the part in 3D, the toolpath, the findings "
-                     "and the figures\n"
-                     "(one file that opens offline in a browser)");
+  command
+      .add_option("--html", options.html,
+                  "write an interactive HTML report: the part in 3D, the toolpath, the findings "
+                  "and the figures\n"
+                  "(one file that opens offline in a browser)")
+      ->check(kNotEmpty);
   add_max_memory(command, options.max_memory);
 }
 
@@ -245,7 +263,8 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
-    std::cerr << "tridex: " << e.what() << "\n(run `tridex --help` or `tridex COMMAND --help`)\n";
+    std::cerr << "tridex: " << terminal_safe(e.what())
+              << "\n(run `tridex --help` or `tridex COMMAND --help`)\n";
     return kBadInput;
   }
 
@@ -255,16 +274,16 @@ int main(int argc, char** argv) {
     if (mov->parsed()) return run_moves(moves);
     if (grp->parsed()) return run_groups(groups);
   } catch (const tridex::gcode::GcodeError& e) {
-    std::cerr << e.what() << '\n';
+    std::cerr << terminal_safe(e.what()) << '\n';
     return kBadInput;
   } catch (const InputError& e) {
-    std::cerr << "tridex: " << e.what() << '\n';
+    std::cerr << "tridex: " << terminal_safe(e.what()) << '\n';
     return kBadInput;
   } catch (const std::bad_alloc&) {
     std::cerr << "tridex: out of memory (lower the resolution or --max-memory)\n";
     return kFailure;
   } catch (const std::exception& e) {
-    std::cerr << "tridex: " << e.what() << '\n';
+    std::cerr << "tridex: " << terminal_safe(e.what()) << '\n';
     return kFailure;
   }
   return kFailure;

@@ -20,11 +20,18 @@ share=$(( seconds / ${#harnesses[@]} ))
 [ "$share" -ge 1 ] || share=1
 bash tools/fuzz/build.sh "$build"
 # A fixed seed (FUZZ_SEED, default 1) makes CI explore the same inputs in the same order.
+# The structured formats get a larger -max_len (deep nesting, long holder lists) and a dictionary of
+# the classes the issue-36 audit found (tools/fuzz/*.dict).
 for h in "${harnesses[@]}"; do
   mkdir -p "$build/inputs/corpus_$h"
+  case "$h" in
+    tool_table|project|machine) extra=(-max_len=65536 -dict=tools/fuzz/json.dict) ;;
+    options) extra=(-max_len=4096 -dict=tools/fuzz/options.dict) ;;
+    *) extra=(-max_len=4096) ;;
+  esac
   echo "== fuzz_$h: ${share} s"
   if ! "$build/inputs/fuzz_$h" -seed="${FUZZ_SEED:-1}" -max_total_time="$share" -timeout=10 -rss_limit_mb=2048 \
-      -max_len=4096 -artifact_prefix="$build/$h-" -print_final_stats=1 \
+      "${extra[@]}" -artifact_prefix="$build/$h-" -print_final_stats=1 \
       "$build/inputs/corpus_$h" "tools/fuzz/seeds/$h" >"$build/inputs/fuzz_$h.log" 2>&1; then
     tail -n 40 "$build/inputs/fuzz_$h.log" >&2
     echo "fuzz_$h found a crash: its input is $build/$h-crash-* (or -leak-, -timeout-, -oom-)" >&2

@@ -486,7 +486,7 @@ void write_reports(const CheckOptions& options, const SimulationResult& r, const
                    const Json& report, const CheckFindings& f, Progress& progress) {
   if (!options.report.empty()) {
     progress.stage("writing " + options.report);
-    write_file_atomically(options.report, report.dump(2) + "\n");
+    write_file_atomically(options.report, dump_json(report, 2) + "\n");
   }
   if (!options.html.empty()) {
     progress.stage("writing " + options.html);
@@ -510,7 +510,7 @@ void write_reports(const CheckOptions& options, const SimulationResult& r, const
 // The warnings on stderr, then the verdict line and the first findings of each kind on stdout.
 void print_summary(const CheckOptions& options, const SimulationResult& r, const Json& report,
                    const CheckFindings& f, bool failed, double total_s) {
-  for (const std::string& w : r.warnings) std::cerr << "warning: " << w << '\n';
+  for (const std::string& w : r.warnings) std::cerr << "warning: " << terminal_safe(w) << '\n';
   const Json& d = report["deviation"];
   char range[96] = "not measured (no material left)";
   if (d.contains("min_mm"))

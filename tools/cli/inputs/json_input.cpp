@@ -16,6 +16,8 @@ namespace {
 
 using Json = nlohmann::json;
 
+constexpr int kMaxJsonDepth = 64;
+
 // nlohmann's SAX interface, passed through to its DOM builder, with two additions: a key that an
 // object already holds stops the parse (the library would keep the last silently), and a parse
 // error is recorded with its byte position instead of thrown as library text.
@@ -33,6 +35,7 @@ class CheckedSax {
   bool string(Json::string_t& value) { return dom_.string(value); }
   bool binary(Json::binary_t& value) { return dom_.binary(value); }
   bool start_object(std::size_t size) {
+    if (!deeper()) return false;
     keys_.emplace_back();
     return dom_.start_object(size);
   }
@@ -46,10 +49,14 @@ class CheckedSax {
   }
   bool end_object() {
     keys_.pop_back();
+    --depth_;
     return dom_.end_object();
   }
-  bool start_array(std::size_t size) { return dom_.start_array(size); }
-  bool end_array() { return dom_.end_array(); }
+  bool start_array(std::size_t size) { return deeper() && dom_.start_array(size); }
+  bool end_array() {
+    --depth_;
+    return dom_.end_array();
+  }
   bool parse_error(std::size_t position, const std::string& token,
                    const nlohmann::detail::exception& error) {
     error_position = position;
@@ -65,8 +72,18 @@ class CheckedSax {
   int error_id = 0;
   std::string duplicate;
   std::string last_key;  // the key most recently read, where a fault most likely is
+  bool too_deep = false;
 
  private:
+  // No file tridex reads nests deeper than a few levels; a bound keeps every reader of the
+  // document (recursive ones included, such as a machine's "profile") from deep recursion.
+  bool deeper() {
+    if (++depth_ <= kMaxJsonDepth) return true;
+    too_deep = true;
+    return false;
+  }
+  int depth_ = 0;
+
   nlohmann::detail::json_sax_dom_parser<Json> dom_;
   std::vector<std::set<std::string>> keys_;
 };
@@ -96,6 +113,10 @@ Json parse_json_text(const std::string& text, const std::string& source) {
   bool ok = Json::sax_parse(text, &sax);
   if (!sax.duplicate.empty())
     input_error(source, ": key \"", shown(sax.duplicate), "\" appears twice in one object");
+  if (sax.too_deep)
+    input_error(source, ": objects and arrays nested more than ", kMaxJsonDepth,
+                " deep (no tridex input needs that)",
+                sax.last_key.empty() ? std::string() : " (at key \"" + shown(sax.last_key) + "\")");
   if (!ok || sax.failed) {
     // The position counts the bytes read, the offending one included.
     std::size_t end = std::min(sax.error_position, text.size());

@@ -91,6 +91,15 @@ ProgramInput resolve_program(const CommonOptions& options) {
   return input;
 }
 
+std::vector<fs::path> files_read(const CommonOptions& options, const ProgramInput& input) {
+  std::vector<fs::path> files(input.files.begin(), input.files.end());
+  files.push_back(input.program);
+  if (!options.machine.empty() && !gcode::MachineConfig::bundled(options.machine))
+    files.push_back(options.machine);
+  if (!options.tools.empty()) files.push_back(options.tools);
+  return files;
+}
+
 gcode::InterpreterOptions interpreter_options(const CommonOptions& options) {
   gcode::InterpreterOptions o;
   o.arc_tolerance = options.arc_tolerance;
@@ -118,7 +127,8 @@ void MoveBudget::keep(const gcode::Move& move, const std::string& file) {
 
 InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOptions& options,
                           const std::function<void(const gcode::Move&, std::size_t file)>& sink,
-                          const std::function<void(const gcode::Dwell&)>& dwell_sink) {
+                          const std::function<void(const gcode::Dwell&)>& dwell_sink,
+                          long long max_moves) {
   InterpretResult result;
   gcode::Interpreter interpreter(options, input.machine);
   for (std::size_t f = 0; f < input.files.size(); ++f) {
@@ -131,7 +141,11 @@ InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOpt
       interpreter.run(
           in, path.string(),
           [&](const gcode::Move& move) {
-            ++result.moves;
+            if (++result.moves > max_moves && max_moves > 0)
+              input_error(path.string(), ":", move.line, ": more than ", max_moves,
+                          " moves generated (--max-moves ", max_moves,
+                          "; a loop of arcs at a fine --arc-tolerance?); raise --max-moves if the "
+                          "program needs more");
             while (global.size() <= static_cast<std::size_t>(move.file)) {
               const std::string& name = interpreter.files()[global.size()];
               const auto known = std::find(result.files.begin(), result.files.end(), name);
@@ -151,6 +165,9 @@ InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOpt
                   "--max-blocks if the "
                   "program needs more");
     }
+    for (const std::string& name : interpreter.files())
+      if (std::find(result.read.begin(), result.read.end(), name) == result.read.end())
+        result.read.push_back(name);
     for (const gcode::Diagnostic& d : interpreter.warnings())
       result.warnings.push_back(d.to_string());
     for (const auto& [tool, line] : interpreter.tool_first_line())

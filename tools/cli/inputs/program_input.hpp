@@ -36,6 +36,13 @@ gcode::MachineConfig load_machine(const std::string& name_or_file,
 // Throws InputError if the file is missing, the project is malformed or the machine unknown.
 ProgramInput resolve_program(const CommonOptions& options);
 
+// Every file the run reads that is known before it interprets the program: the program (or
+// project) and its G-code files, the machine file and the tool table. No output may name one of
+// them (output.hpp: check_output_path); the subprograms the program calls are checked once known
+// (check_outputs_not_read), and the stock and design by the commands that read them.
+std::vector<std::filesystem::path> files_read(const CommonOptions& options,
+                                              const ProgramInput& input);
+
 // Where each tool was first selected, for messages: "file:line".
 struct ToolSelection {
   std::string file;
@@ -48,6 +55,7 @@ struct InterpretResult {
   long long moves = 0;
   std::vector<std::string> files;  // Move::file's table over all runs: the program's files, then
                                    // the subprogram files they called, each once
+  std::vector<std::string> read;   // every file the runs read, moves or not: no output may be one
 };
 
 // The interpreter's options from the command's: arc tolerance, --lenient, --block-delete and
@@ -79,8 +87,10 @@ class MoveBudget {
 // InterpretResult::files (one table for all the runs), and dwells to `dwell_sink` where given.
 // GcodeError propagates (exit status 2); running past options.max_blocks is an InputError that
 // names --max-blocks.
+// More than `max_moves` moves (0: no bound) is an InputError that names --max-moves.
 InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOptions& options,
                           const std::function<void(const gcode::Move&, std::size_t file)>& sink,
-                          const std::function<void(const gcode::Dwell&)>& dwell_sink = {});
+                          const std::function<void(const gcode::Dwell&)>& dwell_sink = {},
+                          long long max_moves = 0);
 
 }  // namespace tridex::cli

@@ -30,7 +30,8 @@ Vec3 read_point(const nlohmann::json& value, const std::string& where) {
     if (!v.is_number()) input_error(where, ": coordinate ", a, " is not a number");
     p[a] = v.get<double>();
   }
-  if (!is_finite(p)) input_error(where, ": coordinates must be finite");
+  if (!is_finite(p) || glm::any(glm::greaterThan(glm::abs(p), Vec3(kMaxStockCoordinate))))
+    input_error(where, ": coordinates must be finite and within ±", kMaxStockCoordinate, " mm");
   return p;
 }
 
@@ -77,8 +78,10 @@ Project project_from_json(const nlohmann::json& json, const fs::path& path) {
       automatic = flag->get<bool>();
     }
     if (auto margin = work->find("margin"); margin != work->end()) {
-      if (!margin->is_number() || !(margin->get<double>() >= 0))
-        input_error(source, ": workpiece \"margin\" must be a non-negative number (percent), got ",
+      if (!margin->is_number() || !(margin->get<double>() >= 0) ||
+          !(margin->get<double>() <= kMaxMarginPercent))
+        input_error(source, ": workpiece \"margin\" must be a number (percent) from 0 to ",
+                    kMaxMarginPercent, ", got ",
                     margin->is_number() ? margin->dump() : json_type_name(*margin));
       stock.margin_percent = margin->get<double>();
     }

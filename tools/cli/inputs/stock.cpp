@@ -14,6 +14,9 @@ Aabb parse_box(const std::string& numbers, const std::string& option) {
   if (v.size() != 6)
     input_error(option, " box: expected XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX (6 numbers), got ", v.size());
   Aabb box{Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5])};
+  for (double value : v)
+    if (!(std::abs(value) <= kMaxStockCoordinate))
+      input_error(option, " box: ", value, " mm is beyond ±", kMaxStockCoordinate, " mm");
   const char* names = "XYZ";
   for (int a = 0; a < 3; ++a)
     if (!(box.min[a] < box.max[a]))
@@ -40,6 +43,9 @@ StockSpec parse_stock(const std::string& text) {
     if (text.size() > 4) {
       double margin = parse_number(text.substr(5), "--stock auto margin");
       if (margin < 0) input_error("--stock auto: the margin must not be negative, got ", margin);
+      if (margin > kMaxStockCoordinate)
+        input_error("--stock auto: the margin ", margin, " mm is beyond ", kMaxStockCoordinate,
+                    " mm");
       spec.margin_mm = margin;
     }
     return spec;

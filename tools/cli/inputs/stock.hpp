@@ -9,6 +9,14 @@
 
 namespace tridex::cli {
 
+// The largest coordinate (mm) a stock box, an envelope or a project's workpiece may have, and the
+// largest margin: far past any machine (the lattice refuses a stock beyond 2^23 spacings with its
+// own message), and within the float range of the kernel's Z-map heights (3.4e38: ±1e200 made the
+// Z-map heights infinite). Values beyond are bad input (exit status 2), not a failure of the run.
+constexpr double kMaxStockCoordinate = 1e30;
+// A project's automatic margin, percent of the cutting moves' box.
+constexpr double kMaxMarginPercent = 1e4;
+
 struct StockSpec {
   enum class Kind { box, mesh, automatic };
   Kind kind = Kind::automatic;

@@ -153,7 +153,11 @@ Cutter fusion_cutter(FusionKind kind, const nlohmann::json& geometry, double sca
         return Cutter::ball(radius);
       case FusionKind::bull_nose: {
         spec.corner_radius_mm = scale * number_field(geometry, at, {"RE"}, true);
-        // Fusion keeps "bull nose" with RE equal to the radius for what is a ball.
+        // Fusion keeps "bull nose" with RE equal to the radius for what is a ball; a larger RE is
+        // no tool (docs/tool-tables.md).
+        if (spec.corner_radius_mm > radius * (1 + 1e-9))
+          input_error(at, ": \"RE\" ", spec.corner_radius_mm, " mm is larger than the radius ",
+                      radius, " mm");
         if (spec.corner_radius_mm >= radius) return Cutter::ball(radius);
         if (!(spec.corner_radius_mm > 0)) return Cutter::flat(radius);
         return Cutter::bull_nose(radius, spec.corner_radius_mm);
@@ -228,7 +232,52 @@ ToolBody make_body(const ToolSpec& spec, const std::string& where) {
   return body;
 }
 
+namespace {
+
+// Every length of a tool, after its unit is applied (a value that passes in inches may overflow
+// in mm), must be finite and below this: 100 m is past any machine, and the lengths stay far from
+// overflow when the kernel squares and sums them.
+constexpr double kMaxToolLengthMm = 1e5;
+// A holder of more sections than this is no real holder; each costs a part checked per move.
+constexpr std::size_t kMaxHolderSections = 1000;
+
+void check_length(const std::string& where, const char* key, double mm) {
+  if (!(std::abs(mm) <= kMaxToolLengthMm))
+    input_error(where, ": \"", key, "\" is ", mm, " mm after unit conversion, beyond ",
+                kMaxToolLengthMm, " mm");
+}
+
+void check_tool_ranges(const ToolSpec& spec, const std::string& where) {
+  check_length(where, "diameter", spec.diameter_mm);
+  check_length(where, "length", spec.length_mm);
+  check_length(where, "corner-radius", spec.corner_radius_mm);
+  check_length(where, "snub-diameter", spec.snub_diameter_mm);
+  check_length(where, "flute-length", spec.flute_length_mm);
+  check_length(where, "shank-diameter", spec.shank_diameter_mm);
+  check_length(where, "stick-out", spec.stick_out_mm);
+  if (spec.holder.size() > kMaxHolderSections)
+    input_error(where, ": the holder has ", spec.holder.size(), " sections, more than ",
+                kMaxHolderSections);
+  double total = 0;
+  for (std::size_t k = 0; k < spec.holder.size(); ++k) {
+    const std::string at = where + ": holder section " + std::to_string(k + 1);
+    check_length(at, "bottom diameter", 2 * spec.holder[k].bottom_radius);
+    check_length(at, "top diameter", 2 * spec.holder[k].top_radius);
+    check_length(at, "length", spec.holder[k].length);
+    total += spec.holder[k].length;
+  }
+  check_length(where, "holder length", total);
+}
+
+double tool_length_mm(double mm, const std::string& where, const char* key) {
+  check_length(where, key, mm);
+  return mm;
+}
+
+}  // namespace
+
 Cutter make_cutter(const ToolSpec& spec, const std::string& where) {
+  check_tool_ranges(spec, where);
   double radius = spec.diameter_mm / 2;
   if (!(radius > 0)) input_error(where, ": \"diameter\" must be positive, got ", spec.diameter_mm);
   auto need_length = [&] {
@@ -327,7 +376,7 @@ ToolTable ToolTable::from_json(const nlohmann::json& table, const std::string& s
       if (auto length = tool.find(name); length != tool.end()) {
         if (!length->is_number() || !std::isfinite(length->get<double>()))
           input_error(where, ": \"", name, "\" must be a finite number, got ", length->dump());
-        result.tool_lengths_[number] = scale * length->get<double>();
+        result.tool_lengths_[number] = tool_length_mm(scale * length->get<double>(), where, name);
       }
     spec.cutter = make_cutter(spec, where);
     spec.body = make_body(spec, where);
@@ -341,10 +390,11 @@ ToolTable ToolTable::from_tbl(const std::string& text, const std::string& source
   std::map<int, int> line_of;  // tool number -> its line, to name both of a duplicate
   int line = 0;
   for (std::size_t at = 0; at < text.size();) {
-    std::size_t end = text.find('\n', at);
+    // LF, CR LF and a lone CR (old Mac editors) each end a line.
+    std::size_t end = text.find_first_of("\r\n", at);
     if (end == std::string::npos) end = text.size();
     std::string row = text.substr(at, end - at);
-    at = end + 1;
+    at = end + (text.compare(end, 2, "\r\n") == 0 ? 2 : 1);
     ++line;
     std::string description;
     if (std::size_t semicolon = row.find(';'); semicolon != std::string::npos) {
@@ -391,7 +441,9 @@ ToolTable ToolTable::from_tbl(const std::string& text, const std::string& source
                     " has a sideways offset ", c, it->second.first,
                     ", which tridex does not simulate");
     if (auto z = words.find('Z'); z != words.end())
-      result.tool_lengths_[number] = unit_mm * z->second.first;
+      result.tool_lengths_[number] = tool_length_mm(
+          unit_mm * z->second.first,
+          source + ":" + std::to_string(line) + ": tool " + std::to_string(number), "Z");
     auto d = words.find('D');
     if (d == words.end() || d->second.first == 0) {
       // D0 or no D (LinuxCNC's diameter then is 0): a probe, an engraver or a tool not measured

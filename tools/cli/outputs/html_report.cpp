@@ -639,7 +639,7 @@ Json html_page_data(const HtmlPage& page, const HtmlLimits& limits) {
 void write_html_report(const fs::path& path, const HtmlPage& page, const HtmlLimits& limits) {
   // The data goes inside a <script> element: no '<' may appear in it ("</script>" would end the
   // element), and JSON allows "\u003c" wherever a '<' could be (inside strings).
-  std::string data = html_page_data(page, limits).dump();
+  std::string data = dump_json(html_page_data(page, limits));
   std::string escaped;
   escaped.reserve(data.size());
   for (char c : data) c == '<' ? escaped += "\\u003c" : escaped += c;

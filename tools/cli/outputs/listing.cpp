@@ -39,35 +39,40 @@ void write_output(const std::string& path, Write&& write) {
   out.commit();
 }
 
-void check_output(const std::string& path, const ProgramInput& input) {
-  if (path == "-") return;
-  std::vector<std::filesystem::path> inputs(input.files.begin(), input.files.end());
-  inputs.push_back(input.program);
-  check_output_path("-o", path, inputs);
+void check_output(const ListOptions& options, const ProgramInput& input) {
+  if (options.output == "-") return;
+  check_output_path("-o", options.output, files_read(options, input));
+}
+
+// The subprograms the program called, known once it ran: none may be the output.
+void check_output_after(const ListOptions& options, const InterpretResult& result) {
+  const std::pair<std::string, std::filesystem::path> output{"-o", options.output};
+  check_outputs_not_read({&output, 1}, result.read);
 }
 
 void print_warnings(const std::vector<std::string>& warnings, bool quiet) {
   if (quiet) return;
-  for (const std::string& w : warnings) std::cerr << "warning: " << w << '\n';
+  for (const std::string& w : warnings) std::cerr << "warning: " << terminal_safe(w) << '\n';
 }
 
 }  // namespace
 
 int run_moves(const ListOptions& options) {
   ProgramInput input = resolve_program(options);
-  check_output(options.output, input);
+  check_output(options, input);
   InterpretResult result;
   write_output(options.output, [&](std::ostream& out) {
     std::string record;
     bool several_files = input.files.size() > 1;
-    result =
-        interpret(input, interpreter_options(options), [&](const gcode::Move& m, std::size_t file) {
+    result = interpret(
+        input, interpreter_options(options),
+        [&](const gcode::Move& m, std::size_t file) {
           record.clear();
           record += "{\"line\":";
           record += std::to_string(m.line);
           if (several_files) {
             record += ",\"file\":";
-            record += Json(input.files[file].string()).dump();
+            record += dump_json(Json(input.files[file].string()));
           }
           record += ",\"kind\":\"";
           record += gcode::to_string(m.kind);
@@ -92,7 +97,9 @@ int run_moves(const ListOptions& options) {
           }
           record += "}\n";
           out << record;
-        });
+        },
+        {}, options.max_moves);
+    check_output_after(options, result);
   });
   print_warnings(result.warnings, options.quiet);
   return kSuccess;
@@ -100,7 +107,7 @@ int run_moves(const ListOptions& options) {
 
 int run_groups(const ListOptions& options) {
   ProgramInput input = resolve_program(options);
-  check_output(options.output, input);
+  check_output(options, input);
   // The groups hold every move, each once (MoveList).
   MoveBudget budget(max_memory_bytes(options.max_memory), sizeof(gcode::Move));
   gcode::DirectionGrouper grouper;
@@ -132,7 +139,8 @@ int run_groups(const ListOptions& options) {
           e.local.extend(frame.to_local(m.end));
         }
       },
-      [&](const gcode::Dwell& d) { timer.add(d); });
+      [&](const gcode::Dwell& d) { timer.add(d); }, options.max_moves);
+  check_output_after(options, result);
   Json groups = Json::array();
   const auto& list = grouper.groups();
   for (std::size_t g = 0; g < list.size(); ++g) {
@@ -168,7 +176,7 @@ int run_groups(const ListOptions& options) {
   document["groups"] = std::move(groups);
   document["machining_time"] = machining_time_json(timer);
   document["warnings"] = result.warnings;
-  write_output(options.output, [&](std::ostream& out) { out << document.dump(2) << '\n'; });
+  write_output(options.output, [&](std::ostream& out) { out << dump_json(document, 2) << '\n'; });
   print_warnings(result.warnings, options.quiet);
   return kSuccess;
 }

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <pthread.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -159,6 +160,49 @@ void write_file_atomically(const fs::path& path, const std::string& text) {
   out.commit();
 }
 
+namespace {
+
+// The same file as `input` (device and inode): a hard link or another spelling of its path counts.
+bool same_file(const fs::path& path, const fs::path& input) {
+  struct stat a {
+  }, b{};
+  if (::stat(path.c_str(), &a) != 0 || ::stat(input.c_str(), &b) != 0) return false;
+  return a.st_dev == b.st_dev && a.st_ino == b.st_ino;
+}
+
+// The name and the temporary file's must fit the folder's NAME_MAX; then a temporary file is
+// created and removed, as AtomicOutput will, so that the file system's refusal shows before the
+// run.
+void check_name_fits(const std::string& option, const fs::path& path, const fs::path& directory) {
+  long name_max = ::pathconf(directory.c_str(), _PC_NAME_MAX);
+  if (name_max <= 0) name_max = 255;
+  const std::string name = path.filename().string();
+  const std::size_t temporary_length = name.size() + std::string(".").size() + 11;  // .tmp-XXXXXX
+  if (name.size() > static_cast<std::size_t>(name_max) ||
+      temporary_length > static_cast<std::size_t>(name_max))
+    input_error(option, " ", path.string(), ": the file name is ", name.size(),
+                " bytes long, too long for this file system (", name_max, " bytes at most, ",
+                temporary_length - name.size(),
+                " fewer for the temporary file it is written through)");
+  std::string pattern = (directory / ("." + name + ".tmp-XXXXXX")).string();
+  sigset_t cleanup_signals, previous;
+  sigemptyset(&cleanup_signals);
+  for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&cleanup_signals, signal_number);
+  ::pthread_sigmask(SIG_BLOCK, &cleanup_signals, &previous);
+  int fd = ::mkstemp(pattern.data());
+  const int failure = errno;
+  if (fd >= 0) {
+    ::close(fd);
+    ::unlink(pattern.c_str());
+  }
+  ::pthread_sigmask(SIG_SETMASK, &previous, nullptr);
+  if (fd < 0)
+    input_error(option, " ", path.string(),
+                ": cannot create a file there: ", std::strerror(failure));
+}
+
+}  // namespace
+
 void check_output_path(const std::string& option, const fs::path& path,
                        std::span<const fs::path> inputs) {
   if (path.empty()) input_error(option, ": empty file name");
@@ -169,15 +213,26 @@ void check_output_path(const std::string& option, const fs::path& path,
       input_error(option, " ", path.string(), ": is not writable");
     return;
   }
+  for (const fs::path& input : inputs)
+    if (!input.empty() && same_file(path, input))
+      input_error(option, " ", path.string(), ": would overwrite an input (", input.string(), ")");
   fs::path directory = directory_of(path);
   if (!fs::is_directory(directory, error))
     input_error(option, " ", path.string(), ": directory ", directory.string(), " does not exist");
   if (::access(directory.c_str(), W_OK | X_OK) != 0)
     input_error(option, " ", path.string(), ": directory ", directory.string(), " is not writable");
-  if (fs::exists(path, error))
-    for (const fs::path& input : inputs)
-      if (fs::exists(input, error) && fs::equivalent(path, input, error))
-        input_error(option, " ", path.string(), ": would overwrite the input ", input.string());
+  check_name_fits(option, path, directory);
+}
+
+void check_outputs_not_read(std::span<const std::pair<std::string, fs::path>> outputs,
+                            std::span<const std::string> files_read) {
+  for (const auto& [option, path] : outputs) {
+    if (path.empty() || path == "-" || is_special_file(path)) continue;
+    for (const std::string& input : files_read)
+      if (same_file(path, input))
+        input_error(option, " ", path.string(), ": would overwrite an input (", input,
+                    ", read while the program ran); nothing was written");
+  }
 }
 
 }  // namespace tridex::cli
@@ -185,7 +240,7 @@ void check_output_path(const std::string& option, const fs::path& path,
 namespace tridex::cli {
 
 void check_distinct_outputs(std::span<const std::pair<std::string, fs::path>> outputs) {
-  auto same_file = [](const fs::path& a, const fs::path& b) {
+  auto same_output = [](const fs::path& a, const fs::path& b) {
     std::error_code error;
     if (fs::exists(a, error) && fs::exists(b, error)) return fs::equivalent(a, b, error);
     // Not written yet: compare the paths they will have (through any links in the directories).
@@ -197,7 +252,7 @@ void check_distinct_outputs(std::span<const std::pair<std::string, fs::path>> ou
       const auto& [first_option, first] = outputs[i];
       const auto& [second_option, second] = outputs[j];
       if (first.empty() || second.empty() || is_special_file(first)) continue;
-      if (same_file(first, second))
+      if (same_output(first, second))
         input_error(first_option, " ", first.string(), " and ", second_option, " ", second.string(),
                     " name the same file: one output would replace the other");
     }

@@ -46,10 +46,19 @@ void write_file_atomically(const std::filesystem::path& path, std::span<const st
 void write_file_atomically(const std::filesystem::path& path, const std::string& text);
 
 // Checks up front, before any work, that `path` can be written: its directory exists and is
-// writable, it is not a directory, and it is none of `inputs` (a run never overwrites an input).
+// writable, it is not a directory, its name and its temporary file's name fit the file system's
+// NAME_MAX (a temporary file is created there and removed again, so that any other refusal of the
+// file system shows now rather than after the run), and it is none of `inputs`, compared by
+// identity (device and inode: a run never overwrites an input, whatever path names it).
 // Throws InputError naming `option` and the path.
 void check_output_path(const std::string& option, const std::filesystem::path& path,
                        std::span<const std::filesystem::path> inputs);
+
+// After the program is interpreted: throws InputError when an output names a file the run read
+// that the up-front check could not know of (a subprogram found by O number or name while the
+// program ran). Outputs are committed only after this, so such an input is never replaced.
+void check_outputs_not_read(std::span<const std::pair<std::string, std::filesystem::path>> outputs,
+                            std::span<const std::string> files_read);
 
 // Throws InputError when two of (option, path) name the same file (special files excepted:
 // they are written in place, and /dev/null may take several outputs).

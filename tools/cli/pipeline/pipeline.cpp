@@ -267,9 +267,7 @@ RunInputs check_inputs_and_outputs(const SimulateOptions& options, const Pipelin
   run.max_memory = max_memory_bytes(options.max_memory);
 
   std::vector<fs::path>& inputs = run.inputs;
-  inputs.assign(input.files.begin(), input.files.end());
-  inputs.push_back(input.program);
-  if (!options.tools.empty()) inputs.push_back(options.tools);
+  inputs = files_read(options, input);
   if (run.stock_spec.kind == StockSpec::Kind::mesh) inputs.push_back(run.stock_spec.mesh_path);
   inputs.insert(inputs.end(), request.extra_inputs.begin(), request.extra_inputs.end());
   for (const auto& [option, path] : request.outputs)
@@ -337,7 +335,7 @@ ParsedProgram parse_grouped(const SimulateOptions& options, std::uint64_t max_me
         r.machining.add(m);
         grouping.push(m);
       },
-      [&](const gcode::Dwell& d) { r.machining.add(d); });
+      [&](const gcode::Dwell& d) { r.machining.add(d); }, options.max_moves);
   grouping.finish();
   r.groups = grouper.take();
   r.files = std::move(parsed.interpreted.files);
@@ -675,12 +673,24 @@ void intersect_directions(const SimulateOptions& options, const PipelineRequest&
   r.timings.intersect = seconds_since(t);
   // The result is the stock less the cuts: the same volume means no move reached the stock (a
   // stock given far from where the program works, say). Not an error, but surely not meant.
-  const double stock_dexel_volume = tridex::volume(stock_dexel);
-  if (tridex::volume(r.result) >= stock_dexel_volume * (1 - 1e-12))
-    r.warnings.push_back(
-        "nothing was cut: no move reaches the stock (" + describe_box(stock.box) +
-        "); the result is the whole stock: check --stock against the program's work offsets and "
-        "units");
+  r.stock_dexel_volume = tridex::volume(stock_dexel);
+  r.result_dexel_volume = tridex::volume(r.result);
+  if (r.result_dexel_volume >= r.stock_dexel_volume * (1 - 1e-12)) {
+    // Only when no move can reach the stock is "nothing was cut" a fact; otherwise the cuts are
+    // finer than the lattice resolves (a large stock around a small toolpath), and saying so
+    // tells the user what to change.
+    if (no_move_reaches(r.groups, r.cutters, stock.box))
+      r.warnings.push_back("nothing was cut: no move reaches the stock (" +
+                           describe_box(stock.box) +
+                           "); the result is the whole stock: check --stock against the "
+                           "program's work offsets and units");
+    else
+      r.warnings.push_back("the moves reach the stock (" + describe_box(stock.box) +
+                           ") but remove less than the dexel spacing of " +
+                           std::to_string(r.lattice.spacing) +
+                           " mm resolves: give a smaller --dexel-cell, or a stock nearer the "
+                           "toolpath");
+  }
   stock_dexel = TripleDexel{};
   maps = std::move(kept_maps);
   maps.shrink_to_fit();
@@ -704,6 +714,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   SimulationResult r;
   const RunInputs run = check_inputs_and_outputs(options, request, r);
   ParsedProgram parsed = parse_grouped(options, run.max_memory, progress, r);
+  check_outputs_not_read(request.outputs, parsed.interpreted.read);  // the subprograms it called
   // The dump files are named by the directions, known only now.
   if (!options.dump_zmaps.empty())
     check_dump_names(options.dump_zmaps, r.groups, request.outputs, run.inputs);

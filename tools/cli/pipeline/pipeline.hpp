@@ -125,6 +125,10 @@ struct SimulationResult {
   Mesh mesh;
   MeshCheck mesh_check;
   double volume = 0;
+  // The stock's and the result's volume on the dexel lattice: what the lattice resolves as
+  // removed, never negative (the surface's volume may exceed the stock's by its rounding when
+  // the cuts are finer than the lattice).
+  double stock_dexel_volume = 0, result_dexel_volume = 0;
   long long segments = 0;
   std::vector<RapidFinding> rapid_cuts;
   std::vector<TravelFinding> travel;  // the first kTravelListed, in program order

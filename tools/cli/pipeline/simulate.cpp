@@ -1,6 +1,7 @@
 // tridex simulate — the paper's pipeline from a program to a solid (Inui, Chen and Umezu,
 // "Visualization of 3+2 Axis Machining Result by Combining Multiple Z-map Models", CAD&A 19(4)
 // 2022, §3), run by pipeline.cpp; this file writes the STL, the picture and the report.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -26,6 +27,14 @@ namespace tridex::cli {
 namespace fs = std::filesystem;
 
 namespace {
+
+// The stock less the result surface's volume. Where the surface's rounding makes that negative
+// (cuts finer than the lattice around a large stock), what the lattice resolves as removed: never
+// a negative removal.
+double removed_mm3(const SimulationResult& r) {
+  const double removed = r.stock.volume - r.volume;
+  return removed >= 0 ? removed : std::max(0.0, r.stock_dexel_volume - r.result_dexel_volume);
+}
 
 // The JSON report (docs/reports.md), with the run's total time and the rapids that cut.
 Json simulate_report(const SimulateOptions& options, const SimulationResult& r,
@@ -63,7 +72,7 @@ Json simulate_report(const SimulateOptions& options, const SimulationResult& r,
                          {"mesh", r.timings.mesh},         {"total", total_s}};
   report["peak_rss_mib"] = peak_rss_mib();
   report["result"] = {{"volume_mm3", volume},
-                      {"removed_mm3", stock.volume - volume},
+                      {"removed_mm3", removed_mm3(r)},
                       {"dexel_volume_mm3", tridex::volume(r.result)},
                       {"triangles", r.mesh.triangles.size()},
                       {"watertight", check.closed()}};
@@ -86,7 +95,6 @@ int run_simulate(const SimulateOptions& options) {
   SimulationResult r = simulate_program(options, progress, request);
   const ProgramInput& input = r.input;
   const std::vector<gcode::MoveGroup>& groups = r.groups;
-  const Stock& stock = r.stock;
   const DexelLattice& lattice = r.lattice;
   const Mesh& mesh = r.mesh;
   const MeshCheck& check = r.mesh_check;
@@ -139,7 +147,7 @@ int run_simulate(const SimulateOptions& options) {
   const Json report = simulate_report(options, r, rapid_findings, total_s);
   if (!options.report.empty()) {
     progress.stage("writing " + options.report);
-    write_file_atomically(options.report, report.dump(2) + "\n");
+    write_file_atomically(options.report, dump_json(report, 2) + "\n");
   }
   if (!options.html.empty()) {
     progress.stage("writing " + options.html);
@@ -159,7 +167,7 @@ int run_simulate(const SimulateOptions& options) {
   progress.finish();
 
   if (!options.quiet) {
-    for (const std::string& w : warnings) std::cerr << "warning: " << w << '\n';
+    for (const std::string& w : warnings) std::cerr << "warning: " << terminal_safe(w) << '\n';
     std::string written;
     // Only what was written: a picture of nothing is not.
     for (const std::string& path :
@@ -170,8 +178,8 @@ int run_simulate(const SimulateOptions& options) {
         "removed, %zu triangles, %s%s; %.2f s\n",
         input.program.filename().string().c_str(), segments, segments == 1 ? "" : "s",
         groups.size(), groups.size() == 1 ? "" : "s", lattice.n.x, lattice.n.y, lattice.n.z, volume,
-        stock.volume - volume, mesh.triangles.size(),
-        check.closed() ? "watertight" : "NOT watertight", written.c_str(), total_s);
+        removed_mm3(r), mesh.triangles.size(), check.closed() ? "watertight" : "NOT watertight",
+        written.c_str(), total_s);
     std::printf("  %s\n", machining_time_text(r.machining).c_str());
     std::printf("  %s\n  %s\n", tools_text(r).c_str(), directions_text(r).c_str());
   }
