@@ -52,7 +52,6 @@ void check_follows(const std::vector<Move>& pieces, const std::vector<Vec2>& con
 
 const MachineConfig kLinuxcnc = *MachineConfig::bundled("linuxcnc");
 
-
 TEST_CASE("G5: biarcs through the cubic Bezier's points, G1 continuous, end exact") {
   Result r =
       run_program("G21 G17 G90 F100\nG0 X1 Y1 Z-1\nG5 I0 J6 P8 Q-6 X3 Y3\nG1 Z0\n", {}, kLinuxcnc);

@@ -51,7 +51,6 @@ std::string num(double v) {
 std::string xyz(const Vec3& p) { return cat("X", num(p.x), " Y", num(p.y), " Z", num(p.z)); }
 std::string ijk(const Vec3& v) { return cat("I", num(v.x), " J", num(v.y), " K", num(v.z)); }
 
-
 TEST_CASE("G68.2 forms: one plane written five ways gives the same moves") {
   // A 90-degree turn about Y with the origin at (3, -3, -6), as in Hurco's example.
   Result hurco = square_in("G68.2 X3 Y-3 Z-6 I0 J0 K-1 U0 V1 W0");

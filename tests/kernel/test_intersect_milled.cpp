@@ -50,7 +50,6 @@ bool removed(const std::vector<Direction>& program, const std::vector<Cutter>& c
   return false;
 }
 
-
 TEST_CASE(
     "intersect_milled: a box milled in several tilted directions matches the point-membership "
     "reference") {

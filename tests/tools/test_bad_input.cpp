@@ -392,7 +392,6 @@ const std::vector<BadInput>& cases() {
   return all;
 }
 
-
 TEST_CASE(
     "bad input: exit status 2, the place and the value in the message, no library text, no file "
     "written") {
@@ -479,7 +478,6 @@ TEST_CASE("SIGTERM removes the temporary file of an output being written") {
   fs::remove_all(dir);
 }
 
-
 // Runs the bundled example through `command` (simulate or check) at `resolution` with `extra`
 // arguments, waits for the temporary file of `output` (a file in the scratch folder) to appear,
 // sends `signal`, and checks that the process died of it leaving only the inputs behind. A run
@@ -539,7 +537,6 @@ void interrupt_while_writing(const std::string& command, const std::string& reso
   CHECK(left == inputs);
   fs::remove_all(dir);
 }
-
 
 TEST_CASE(
     "SIGINT to a running simulate while it writes its STL leaves no temporary or partial file") {

@@ -162,7 +162,6 @@ std::size_t reddish_pixels(const fs::path& path) {
   return red;
 }
 
-
 TEST_CASE("the distance tree matches brute force, and signs by the face or the inside test") {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-5, 5);

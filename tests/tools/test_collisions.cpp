@@ -94,7 +94,6 @@ Reference brute_force(const ZMap& map, const BodyPart& part, const Segment& tip)
   return ref;
 }
 
-
 TEST_CASE("swept shank and holder depths and near misses match the sampled swept solid") {
   std::mt19937 random(14);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -169,7 +168,6 @@ TEST_CASE("swept shank and holder depths and near misses match the sampled swept
 // ---- planted faults, end to end
 // ------------------------------------------------------------------
 
-
 // T2 (no parts described) clears the stock 0..60 × 0..40 × 0..30 to z = 20 except a boss
 // beyond the round end of its first pass (x ≥ 30 + √(12² − (y − 8)²), y < 18). T1's holder (Ø30, 25
 // mm out) passes by the boss on line 16 with its face at z1 + 25; T3's Ø8 shank, 3 mm above the tip
@@ -223,7 +221,6 @@ CheckRun run_faults(const fs::path& dir, double z1, double z3,
                     const std::vector<std::string>& more = {}) {
   return simulate_then_check(dir, fault_program(z1, z3), kFaultTools, more);
 }
-
 
 TEST_CASE(
     "check: a holder passing a boss and a shank on a pocket's floor are found at their lines") {

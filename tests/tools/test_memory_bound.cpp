@@ -147,7 +147,6 @@ Mesh sphere(int nu, double radius, Vec3 centre) {
   return m;
 }
 
-
 TEST_CASE("memory: the estimate bounds the peak of simulate with many directions") {
   fs::path dir = scratch("memory-directions");
   write_text(dir / "p.nc", many_directions(12));

@@ -36,7 +36,6 @@ std::size_t entries(const fs::path& dir) {
       std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
 }
 
-
 TEST_CASE("an output appears only when committed, and replaces the old file whole") {
   fs::path dir = scratch_dir("output");
   fs::path target = dir / "result.stl";
