@@ -52,19 +52,35 @@ echo "== formatting (.clang-format, clang-format $(clang-format --version | grep
 
 # -DTRIDEX_BUILD_TESTS=ON even where build/ was configured by the demo without tests, and
 # --no-tests=error: a build with no tests must not pass.
-echo "== release build and tests"
+echo "== release build"
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DTRIDEX_BUILD_TESTS=ON -DTRIDEX_BUILD_BENCH=ON
 cmake --build build -j "$jobs"
-ctest --test-dir build --output-on-failure --no-tests=error -j "$jobs" | tee build/ctest.log
 
+# The release suites and the fuzzers' build run beside the ASan+UBSan build: a build leaves cores
+# idle while it links, and a test run while its longest suite finishes; the machine's time is the
+# same, the wait shorter. Their output is shown once the build is done.
+echo "== release tests and the fuzzers' build (clang, libFuzzer), beside the ASan+UBSan build"
+ctest --test-dir build --output-on-failure --no-tests=error -j "$jobs" > build/ctest.log 2>&1 &
+release_tests=$!
+bash tools/fuzz/build.sh build-fuzz > build/fuzz-build.log 2>&1 &
+fuzz_build=$!
 # -O1 -g1 (the level AddressSanitizer's documentation suggests): half the compile time of -O2 -g
 # on the kernel's tests (test_zmap.cpp: 27 s against 50 s of CPU); stack traces keep file and line.
-echo "== ASan+UBSan build"
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTRIDEX_SANITIZE=ON \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DTRIDEX_BUILD_TESTS=ON -DTRIDEX_BUILD_BENCH=OFF
 cmake --build build-asan -j "$jobs"
-echo "== the fuzzers' build (clang, libFuzzer)"
-bash tools/fuzz/build.sh build-fuzz
+release_status=0
+wait "$release_tests" || release_status=$?
+echo "== release tests"
+cat build/ctest.log
+[ "$release_status" -eq 0 ] || exit "$release_status"
+fuzz_build_status=0
+wait "$fuzz_build" || fuzz_build_status=$?
+if [ "$fuzz_build_status" -ne 0 ]; then
+  cat build/fuzz-build.log >&2
+  echo "the fuzzers' build failed (its log above)" >&2
+  exit 1
+fi
 
 # The fuzzers are bounded in time, not in work: they run on one core beside the sanitizer
 # suites, which leave a core idle while their longest suite finishes.

@@ -137,7 +137,7 @@ struct BundledMachine {
   std::string_view name;
   MachineConfig (*build)();
 };
-constexpr std::array<BundledMachine, 8> kBundled{{
+constexpr std::array<BundledMachine, 9> kBundled{{
     {"default", default_machine},
     {"haas", haas_machine},
     {"linuxcnc", linuxcnc_machine},
