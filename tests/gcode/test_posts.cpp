@@ -16,7 +16,7 @@ using namespace tridex::gcode;
 using namespace tridex::gcode::test;
 namespace fs = std::filesystem;
 
-namespace {
+namespace test_posts {
 
 bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
@@ -44,8 +44,6 @@ MachineConfig haas_at_origin() {
   m.dialect = Dialect::haas;
   return m;
 }
-
-}  // namespace
 
 // Fanuc (0i-MF operator's manual B-64604EN, "G code list") puts G80-G89 in group 09 and G00-G03
 // in group 01; Haas's manual lists "G80 Canned Cycle Cancel (Group 09)". So G80 leaves the
@@ -205,3 +203,5 @@ TEST_CASE("hmc-b-table: G10 L2 P1 with B shifts B's zero; M60/M71/M10/M11 pass q
   CHECK(
       contains(error_of("G10 L2 P1 B0.25\nM30\n", {}, at_origin()).message, "rotary work offset"));
 }
+
+}  // namespace test_posts

@@ -12,7 +12,7 @@ using namespace tridex;
 using namespace tridex::test;
 using nlohmann::json;
 
-namespace {
+namespace test_check_tolerance {
 
 // A closed box as an ASCII STL, outward normals.
 std::string box_stl(double x0, double y0, double z0, double x1, double y1, double z1) {
@@ -60,8 +60,6 @@ Outcome check_against(const fs::path& dir, double design_top) {
   fs::remove(dir / "report.json");
   return o;
 }
-
-}  // namespace
 
 TEST_CASE("check: the default tolerance is the shop's ±0.02 mm, and finds 0.05 mm") {
   fs::path dir = scratch("check-shop-tolerance");
@@ -131,3 +129,5 @@ TEST_CASE("check: the bundled example passes against its design; a 4.1 mm T3 gou
   CHECK(gouge.out.find("  gouge 0.0") != std::string::npos);
   fs::remove_all(dir);
 }
+
+}  // namespace test_check_tolerance

@@ -14,7 +14,7 @@ using namespace tridex;
 using namespace tridex::test;
 using nlohmann::json;
 
-namespace {
+namespace test_fusion_tools {
 
 constexpr double kDepth = 4;  // mm below the block's top
 
@@ -82,8 +82,6 @@ std::vector<Case> cases() {
   };
 }
 
-}  // namespace
-
 TEST_CASE("Fusion tool types: a plunge removes the volume of the solid the tool sweeps") {
   fs::path dir = scratch("fusion-types");
   write_text(dir / "plunge.nc",
@@ -124,3 +122,5 @@ TEST_CASE("Fusion tool types: a tool tridex cannot mill is named with its type, 
   }
   fs::remove_all(dir);
 }
+
+}  // namespace test_fusion_tools

@@ -12,7 +12,7 @@ using namespace tridex;
 using namespace tridex::test;
 using nlohmann::json;
 
-namespace {
+namespace test_plausibility {
 
 const char* kTools = R"({"1": {"shape": "cylindrical", "diameter": 6}})";
 
@@ -26,8 +26,6 @@ std::string inch_program(bool units) {
 bool has(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
-
-}  // namespace
 
 TEST_CASE("plausibility: a program that sets no units is read in mm, and said to be tiny") {
   fs::path dir = scratch("plaus-units");
@@ -213,3 +211,5 @@ TEST_CASE("plausibility: G20/G21 are found outside comments, and in every progra
   CHECK(programs >= 20);
   fs::remove_all(dir);
 }
+
+}  // namespace test_plausibility

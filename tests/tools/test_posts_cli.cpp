@@ -12,7 +12,7 @@ using namespace tridex::test;
 using namespace tridex::cli;
 using nlohmann::json;
 
-namespace {
+namespace test_posts_cli {
 
 std::vector<json> move_lines(const std::string& out) {
   std::vector<json> moves;
@@ -21,8 +21,6 @@ std::vector<json> move_lines(const std::string& out) {
     if (!line.empty()) moves.push_back(json::parse(line));
   return moves;
 }
-
-}  // namespace
 
 TEST_CASE("moves: an HMC program runs with the shop's variables, M-codes and macro folder") {
   fs::path dir = scratch("posts-hmc");
@@ -73,3 +71,5 @@ TEST_CASE("moves: a LinuxCNC table's D0 tool is in the table, G41 with it offset
   CHECK(moves[1]["end"][0].get<double>() == doctest::Approx(25.4));  // no offset
   CHECK(moves[2]["end"][1].get<double>() == doctest::Approx(25.4));
 }
+
+}  // namespace test_posts_cli

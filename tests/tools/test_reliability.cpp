@@ -16,7 +16,7 @@
 
 using namespace tridex::test;
 
-namespace {
+namespace test_reliability {
 
 const std::string kProgram =
     "G21 G90\nT1 M6\nS1000 M3\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X10 Y5\nG0 Z5\nM30\n";
@@ -70,8 +70,6 @@ bool json_lines(const std::string& text) {
   }
   return lines > 0;
 }
-
-}  // namespace
 
 TEST_CASE("row 1: an output naming the machine file, the tool table or the program is refused") {
   fs::path d = setup("row1");
@@ -305,3 +303,5 @@ TEST_CASE("row 15 (in part): a stock around the whole toolpath never reports a n
   CHECK(r.err.find("dexel spacing") != std::string::npos);
   fs::remove_all(d);
 }
+
+}  // namespace test_reliability
