@@ -565,6 +565,7 @@ ToolTable ToolTable::from_fusion_json(const nlohmann::json& library, const std::
                         holder_scale * number_field(segment, sat, {"height"}, true)});
       }
     }
+    check_tool_ranges(spec, where);  // as make_cutter does for the other formats
     spec.cutter = fusion_cutter(kind, *geometry, scale, at, spec);
     spec.body = make_body(spec, where);
     result.tools_.emplace(number, std::move(spec));
