@@ -9,6 +9,9 @@ cd "$(dirname "$0")/.."
 mode=${1:-demo}
 case "$mode" in demo|test) ;; *) echo "usage: $0 demo|test" >&2; exit 2 ;; esac
 
+# Each stage's header says when it began (seconds since the start), so a slow stage shows in the log.
+stage() { echo "== $* [${SECONDS} s]"; }
+
 sudo=""
 [ "$(id -u)" -eq 0 ] || sudo="sudo"
 lists=(tools/deps/build.txt)
@@ -19,7 +22,7 @@ for p in "${wanted[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 if [ ${#missing[@]} -gt 0 ]; then
-  echo "== installing: ${missing[*]}"
+  stage "installing: ${missing[*]}"
   $sudo apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
@@ -31,35 +34,44 @@ if [ "$mode" = test ]; then
     $sudo apt-get update -qq
     DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends nodejs npm
   fi
-  echo "== npm ci (tests/html)"
+  stage "npm ci (tests/html)"
   (cd tests/html && npm ci --no-audit --no-fund --loglevel=error)
 fi
 
 jobs=$(nproc)
+# ccache, where installed (the test mode installs it): a second run on the same machine compiles
+# only what changed. CCACHE_BASEDIR makes the compile commands relative to this clone, so another
+# clone of the same sources hits the same cache; with NOHASHDIR the debug info's build folder is
+# not part of the key (stack traces still name the sources).
+cache=()
+if command -v ccache > /dev/null; then
+  cache=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=1
+fi
 if [ "$mode" = demo ]; then
-  cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DTRIDEX_BUILD_TESTS=OFF -DTRIDEX_BUILD_BENCH=OFF
+  cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DTRIDEX_BUILD_TESTS=OFF -DTRIDEX_BUILD_BENCH=OFF "${cache[@]}"
   cmake --build build -j "$jobs"
   exec bash tools/demo.sh
 fi
 
 # The house rules first: they take seconds and name the file and line of every breach.
-echo "== house rules: lengths, one thread pool, one machine registry (tools/check_structure.py)"
+stage "house rules: lengths, one thread pool, one machine registry (tools/check_structure.py)"
 python3 tools/check_structure.py
-echo "== formatting (.clang-format, clang-format $(clang-format --version | grep -o '[0-9][0-9.]*' | head -1))"
+stage "formatting (.clang-format, clang-format $(clang-format --version | grep -o '[0-9][0-9.]*' | head -1))"
 { git ls-files -z '*.hpp' '*.cpp' '*.h' 2> /dev/null ||
   find include gcode tools tests bench \( -name '*.hpp' -o -name '*.cpp' -o -name '*.h' \) -print0; } |
   xargs -0 -r clang-format --dry-run --Werror
 
 # -DTRIDEX_BUILD_TESTS=ON even where build/ was configured by the demo without tests, and
 # --no-tests=error: a build with no tests must not pass.
-echo "== release build"
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DTRIDEX_BUILD_TESTS=ON -DTRIDEX_BUILD_BENCH=ON
+stage "release build"
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DTRIDEX_BUILD_TESTS=ON -DTRIDEX_BUILD_BENCH=ON "${cache[@]}"
 cmake --build build -j "$jobs"
 
 # The release suites and the fuzzers' build run beside the ASan+UBSan build: a build leaves cores
 # idle while it links, and a test run while its longest suite finishes; the machine's time is the
 # same, the wait shorter. Their output is shown once the build is done.
-echo "== release tests and the fuzzers' build (clang, libFuzzer), beside the ASan+UBSan build"
+stage "release tests and the fuzzers' build (clang, libFuzzer), beside the ASan+UBSan build"
 ctest --test-dir build --output-on-failure --no-tests=error -j "$jobs" > build/ctest.log 2>&1 &
 release_tests=$!
 bash tools/fuzz/build.sh build-fuzz > build/fuzz-build.log 2>&1 &
@@ -67,11 +79,11 @@ fuzz_build=$!
 # -O1 -g1 (the level AddressSanitizer's documentation suggests): half the compile time of -O2 -g
 # on the kernel's tests (test_zmap.cpp: 27 s against 50 s of CPU); stack traces keep file and line.
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTRIDEX_SANITIZE=ON \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DTRIDEX_BUILD_TESTS=ON -DTRIDEX_BUILD_BENCH=OFF
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DTRIDEX_BUILD_TESTS=ON -DTRIDEX_BUILD_BENCH=OFF "${cache[@]}"
 cmake --build build-asan -j "$jobs"
 release_status=0
 wait "$release_tests" || release_status=$?
-echo "== release tests"
+stage "release tests"
 cat build/ctest.log
 [ "$release_status" -eq 0 ] || exit "$release_status"
 fuzz_build_status=0
@@ -84,7 +96,7 @@ fi
 
 # The fuzzers are bounded in time, not in work: they run on one core beside the sanitizer
 # suites, which leave a core idle while their longest suite finishes.
-echo "== ASan+UBSan tests, beside the bounded fuzzers (G-code front end; STL, tool table, project, options, machine file)"
+stage "ASan+UBSan tests, beside the bounded fuzzers (G-code front end; STL, tool table, project, options, machine file)"
 ( bash gcode/fuzz/run.sh 60 build-fuzz > build-fuzz/gcode.log 2>&1 && bash tools/fuzz/run.sh 60 build-fuzz > build-fuzz/inputs.log 2>&1 ) &
 fuzzers=$!
 status=0
@@ -102,4 +114,4 @@ fi
 
 # One closing line for both suites (ctest's own summaries are further up).
 total=$(( $(cat build/ctest.log build-asan/ctest.log | sed -n 's/.*tests failed out of \([0-9]*\).*/\1/p' | paste -sd+) ))
-echo "tests: $total passed, 0 failed"
+echo "tests: $total passed, 0 failed [${SECONDS} s]"

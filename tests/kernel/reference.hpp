@@ -38,9 +38,10 @@ inline RadiusFunction tapered_ball_rho(double r, double tip, double half_angle_d
   double a = half_angle_deg * M_PI / 180;
   double h_tangent = tip - tip * std::sin(a);  // where the cone leaves the ball
   double d_tangent = tip * std::cos(a);
+  double slope = std::tan(a);
   return {r, [=](double h) {
             if (h <= h_tangent) return std::sqrt(std::max(0.0, tip * tip - (tip - h) * (tip - h)));
-            return std::min(r, d_tangent + (h - h_tangent) * std::tan(a));
+            return std::min(r, d_tangent + (h - h_tangent) * slope);
           }};
 }
 
@@ -100,7 +101,10 @@ inline double refined_lowest(const RadiusFunction& f, const Segment& s, double x
   double hi = covered_edge(t_best, std::min(1.0, t_best + 1.0 / samples));
   for (int k = 0; k < 200 && hi - lo > 1e-13; ++k) {
     double m1 = lo + (hi - lo) / 3, m2 = hi - (hi - lo) / 3;
-    (value(m1) > value(m2) ? lo : hi) = (value(m1) > value(m2) ? m1 : m2);
+    if (value(m1) > value(m2))
+      lo = m1;
+    else
+      hi = m2;
   }
   return std::min({best, value(lo), value(hi), value(0.5 * (lo + hi))});
 }

@@ -1,6 +1,7 @@
 #include "checks/deviation.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -65,26 +66,39 @@ std::uint32_t DistanceTree::build(std::uint32_t first, std::uint32_t count,
                                   std::vector<Vec3>& centroids) {
   const auto index = static_cast<std::uint32_t>(nodes_.size());
   nodes_.push_back(Node{});
-  Aabb box, centre_box;
-  for (std::uint32_t k = first; k < first + count; ++k) {
-    const glm::uvec3& tri = mesh_->triangles[order_[k]];
-    for (std::uint32_t v : {tri.x, tri.y, tri.z}) box.extend(Vec3(mesh_->positions[v]));
-    centre_box.extend(centroids[order_[k]]);
-  }
-  nodes_[index].box = box;
+  // `centroids` is kept in the order of `order_`, so that this scan reads memory in sequence.
+  Aabb centre_box;
+  for (std::uint32_t k = first; k < first + count; ++k) centre_box.extend(centroids[k]);
   Vec3 size = centre_box.size();
   if (count <= kLeafSize || std::max({size.x, size.y, size.z}) <= 0) {
+    Aabb box;
+    for (std::uint32_t k = first; k < first + count; ++k) {
+      const glm::uvec3& tri = mesh_->triangles[order_[k]];
+      for (std::uint32_t v : {tri.x, tri.y, tri.z}) box.extend(Vec3(mesh_->positions[v]));
+    }
+    nodes_[index].box = box;
     nodes_[index].first = first;
     nodes_[index].count = count;
     return index;
   }
   int axis = size.x >= size.y && size.x >= size.z ? 0 : (size.y >= size.z ? 1 : 2);
   std::uint32_t half = count / 2;
-  std::nth_element(
-      order_.begin() + first, order_.begin() + first + half, order_.begin() + first + count,
-      [&](std::uint32_t a, std::uint32_t b) { return centroids[a][axis] < centroids[b][axis]; });
+  // Partition the triangle numbers and their centroids together (a permutation of positions).
+  std::vector<std::uint32_t> at(count);
+  std::iota(at.begin(), at.end(), first);
+  std::nth_element(at.begin(), at.begin() + half, at.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return centroids[a][axis] < centroids[b][axis];
+  });
+  std::vector<std::uint32_t> ordered(count);
+  std::vector<Vec3> moved(count);
+  for (std::uint32_t k = 0; k < count; ++k) ordered[k] = order_[at[k]], moved[k] = centroids[at[k]];
+  std::copy(ordered.begin(), ordered.end(), order_.begin() + first);
+  std::copy(moved.begin(), moved.end(), centroids.begin() + first);
   std::uint32_t left = build(first, half, centroids);
   std::uint32_t right = build(first + half, count - half, centroids);
+  // A node's box is the union of its children's: the same box as over its triangles.
+  nodes_[index].box = nodes_[left].box;
+  nodes_[index].box.extend(nodes_[right].box);
   nodes_[index].left = left;
   nodes_[index].right = right;
   return index;
@@ -93,19 +107,27 @@ std::uint32_t DistanceTree::build(std::uint32_t first, std::uint32_t count,
 DistanceTree::Nearest DistanceTree::nearest(const Vec3& p) const {
   Nearest best;
   double best2 = std::numeric_limits<double>::infinity();
-  std::vector<std::uint32_t> stack{0};
-  while (!stack.empty()) {
-    const Node& node = nodes_[stack.back()];
-    stack.pop_back();
-    if (box_distance2(node.box, p) >= best2) continue;
+  // The nodes to visit with their box distances, on a fixed stack: the tree is a median split, so
+  // its depth is at most log2(triangles) + 1 and one entry per level plus one suffices.
+  struct Pending {
+    std::uint32_t node;
+    double d2;
+  };
+  std::array<Pending, 2 * 64> stack;
+  std::size_t top = 0;
+  stack[top++] = {0, box_distance2(nodes_[0].box, p)};
+  while (top > 0) {
+    const Pending pending = stack[--top];
+    if (pending.d2 >= best2) continue;
+    const Node& node = nodes_[pending.node];
     if (node.count == 0) {
       // Nearer child last, so that it is searched first and tightens the bound.
       double dl = box_distance2(nodes_[node.left].box, p),
              dr = box_distance2(nodes_[node.right].box, p);
       if (dl < dr)
-        stack.insert(stack.end(), {node.right, node.left});
+        stack[top++] = {node.right, dr}, stack[top++] = {node.left, dl};
       else
-        stack.insert(stack.end(), {node.left, node.right});
+        stack[top++] = {node.left, dl}, stack[top++] = {node.right, dr};
       continue;
     }
     for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
