@@ -88,7 +88,7 @@ struct Reference {
   // Moves bucketed by a uniform grid over the stock, each in every cell its removal region
   // (everything within the cutter radius of the segment and above it along the axis) can reach.
   Aabb box;
-  double cell = 4;
+  double cell = 2;
   glm::ivec3 n;
   std::vector<std::vector<std::uint32_t>> buckets;
 
