@@ -28,9 +28,13 @@ for source in "${cli_sources[@]}" "${gcode_sources[@]}"; do
   fi
 done
 export objects_dir
+# ccache where installed (tools/quickstart.sh exports its base folder): a new clone of the same
+# sources compiles nothing again.
+launcher=$(command -v ccache || true)
+export launcher
 compile() {
   local source=$1 s=${1//\//_}
-  clang++ "${@:2}" -fsanitize=fuzzer-no-link,address,undefined -c "$source" -o "$objects_dir/${s%.cpp}.o"
+  $launcher clang++ "${@:2}" -fsanitize=fuzzer-no-link,address,undefined -c "$source" -o "$objects_dir/${s%.cpp}.o"
 }
 export -f compile
 if [ ${#stale[@]} -gt 0 ]; then
@@ -40,10 +44,11 @@ fi
 gcode_objects=() cli_objects=()
 for source in "${gcode_sources[@]}"; do gcode_objects+=("$(object_of "$source")"); done
 for source in "${cli_sources[@]}"; do cli_objects+=("$(object_of "$source")"); done
-link() {  # OUTPUT HARNESS OBJECTS...
+link() {  # OUTPUT HARNESS OBJECTS...: the harness compiled on its own (so ccache keeps it), then linked
   local output=$1 harness=$2
   shift 2
-  clang++ "${flags[@]}" -fsanitize=fuzzer,address,undefined "$harness" "$@" -o "$output"
+  $launcher clang++ "${flags[@]}" -fsanitize=fuzzer,address,undefined -c "$harness" -o "$output.o"
+  clang++ "${flags[@]}" -fsanitize=fuzzer,address,undefined "$output.o" "$@" -o "$output"
 }
 harnesses=("$build/fuzz_gcode gcode/fuzz/fuzz_gcode.cpp")
 for h in stl tool_table project options machine; do harnesses+=("$build/inputs/fuzz_$h tools/fuzz/fuzz_$h.cpp"); done
