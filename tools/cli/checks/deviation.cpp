@@ -49,31 +49,33 @@ Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3
 DistanceTree::DistanceTree(const Mesh& mesh) : mesh_(&mesh) {
   if (mesh.triangles.empty()) detail::fail("distance tree: the mesh has no triangles");
   const auto n = static_cast<std::uint32_t>(mesh.triangles.size());
-  order_.resize(n);
-  std::iota(order_.begin(), order_.end(), 0u);
-  std::vector<Vec3> centroids(n);
+  std::vector<Item> items(n);
   for (std::uint32_t t = 0; t < n; ++t) {
     const glm::uvec3& tri = mesh.triangles[t];
-    centroids[t] =
+    items[t].centroid =
         (Vec3(mesh.positions[tri.x]) + Vec3(mesh.positions[tri.y]) + Vec3(mesh.positions[tri.z])) /
         3.0;
+    items[t].triangle = t;
   }
   nodes_.reserve(2 * (n / kLeafSize + 1));
-  build(0, n, centroids);
+  build(0, n, items);
+  order_.resize(n);
+  for (std::uint32_t k = 0; k < n; ++k) order_[k] = items[k].triangle;
 }
 
+// The triangles and their centroids move together, so that each level reads them in sequence.
 std::uint32_t DistanceTree::build(std::uint32_t first, std::uint32_t count,
-                                  std::vector<Vec3>& centroids) {
+                                  std::vector<Item>& items) {
   const auto index = static_cast<std::uint32_t>(nodes_.size());
   nodes_.push_back(Node{});
-  // `centroids` is kept in the order of `order_`, so that this scan reads memory in sequence.
+  const auto begin = items.begin() + first, end = begin + count;
   Aabb centre_box;
-  for (std::uint32_t k = first; k < first + count; ++k) centre_box.extend(centroids[k]);
+  for (auto it = begin; it != end; ++it) centre_box.extend(it->centroid);
   Vec3 size = centre_box.size();
   if (count <= kLeafSize || std::max({size.x, size.y, size.z}) <= 0) {
     Aabb box;
-    for (std::uint32_t k = first; k < first + count; ++k) {
-      const glm::uvec3& tri = mesh_->triangles[order_[k]];
+    for (auto it = begin; it != end; ++it) {
+      const glm::uvec3& tri = mesh_->triangles[it->triangle];
       for (std::uint32_t v : {tri.x, tri.y, tri.z}) box.extend(Vec3(mesh_->positions[v]));
     }
     nodes_[index].box = box;
@@ -83,19 +85,11 @@ std::uint32_t DistanceTree::build(std::uint32_t first, std::uint32_t count,
   }
   int axis = size.x >= size.y && size.x >= size.z ? 0 : (size.y >= size.z ? 1 : 2);
   std::uint32_t half = count / 2;
-  // Partition the triangle numbers and their centroids together (a permutation of positions).
-  std::vector<std::uint32_t> at(count);
-  std::iota(at.begin(), at.end(), first);
-  std::nth_element(at.begin(), at.begin() + half, at.end(), [&](std::uint32_t a, std::uint32_t b) {
-    return centroids[a][axis] < centroids[b][axis];
+  std::nth_element(begin, begin + half, end, [axis](const Item& a, const Item& b) {
+    return a.centroid[axis] < b.centroid[axis];
   });
-  std::vector<std::uint32_t> ordered(count);
-  std::vector<Vec3> moved(count);
-  for (std::uint32_t k = 0; k < count; ++k) ordered[k] = order_[at[k]], moved[k] = centroids[at[k]];
-  std::copy(ordered.begin(), ordered.end(), order_.begin() + first);
-  std::copy(moved.begin(), moved.end(), centroids.begin() + first);
-  std::uint32_t left = build(first, half, centroids);
-  std::uint32_t right = build(first + half, count - half, centroids);
+  std::uint32_t left = build(first, half, items);
+  std::uint32_t right = build(first + half, count - half, items);
   // A node's box is the union of its children's: the same box as over its triangles.
   nodes_[index].box = nodes_[left].box;
   nodes_[index].box.extend(nodes_[right].box);

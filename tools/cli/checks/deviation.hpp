@@ -43,7 +43,11 @@ class DistanceTree {
     std::uint32_t first = 0, count = 0;  // leaf: triangles order_[first, first + count)
     std::uint32_t left = 0, right = 0;   // inner: children (count == 0)
   };
-  std::uint32_t build(std::uint32_t first, std::uint32_t count, std::vector<Vec3>& centroids);
+  struct Item {
+    Vec3 centroid;
+    std::uint32_t triangle;
+  };
+  std::uint32_t build(std::uint32_t first, std::uint32_t count, std::vector<Item>& items);
 
   const Mesh* mesh_;
   std::vector<std::uint32_t> order_;
