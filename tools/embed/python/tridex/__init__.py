@@ -24,10 +24,13 @@ _HERE = os.path.dirname(os.path.abspath(__file__))
 
 def _load():
     names = ["libtridex_c.so", "libtridex_c.so.0"]
-    for name in names:
-        path = os.path.join(_HERE, name)
-        if os.path.exists(path):
-            return ctypes.CDLL(path)
+    # Beside this file in the build folder; in the installed layout, PREFIX/lib/libtridex_c.so.0
+    # three levels up from PREFIX/lib/python3/dist-packages/tridex.
+    for folder in (_HERE, os.path.join(_HERE, "..", "..", "..")):
+        for name in names:
+            path = os.path.join(folder, name)
+            if os.path.exists(path):
+                return ctypes.CDLL(path)
     # An installed package may sit apart from the library: the loader's search path.
     return ctypes.CDLL("libtridex_c.so.0")
 
