@@ -21,14 +21,16 @@ typedef enum tridex_status {
 typedef struct tridex_session tridex_session;
 
 typedef struct tridex_session_options {
-  double stock[6];     /* xmin, ymin, zmin, xmax, ymax, zmax (mm, work frame) */
-  const char* tools;   /* tool table file (CAMotics JSON, Fusion library, LinuxCNC .tbl); NULL: none */
+  double stock[6]; /* xmin, ymin, zmin, xmax, ymax, zmax (mm, work frame) */
+  const char*
+      tools; /* tool table file (CAMotics JSON, Fusion library, LinuxCNC .tbl); NULL: none */
   const char* machine; /* as --machine: a bundled machine's name or a machine file; NULL: default */
   double cell;         /* dexel spacing (mm), as --dexel-cell; 0: the default resolution */
   unsigned threads;    /* 0: every hardware thread */
 } tridex_session_options;
 
-/* The message of the calling thread's last failed call ("" when none); valid until its next call. */
+/* The message of the calling thread's last failed call ("" when none); valid until its next call.
+ */
 const char* tridex_last_error(void);
 /* The library's version, "major.minor.patch". */
 const char* tridex_version(void);
