@@ -92,6 +92,8 @@ class ProgramFlow {
   }
 
   void run();
+  // One piece of a longer program (Interpreter::feed): starts where the last piece stopped.
+  void run_piece();
 
  private:
   Source& source() { return *sources_[current_]; }
@@ -145,6 +147,7 @@ class ProgramFlow {
   Block block_;
   LexError lex_error_;
   bool started_ = false, percent_seen_ = false, ended_ = false;
+  bool piece_ = false;                  // run_piece(): one piece of a program fed in pieces
   std::uint64_t statement_offset_ = 0;  // where the line being executed starts
   std::string_view skipped_;            // the line skip_until stopped at (until the next read)
   std::vector<Value> o_arguments_;      // an o-word call's arguments
@@ -833,6 +836,7 @@ void ProgramFlow::run() {
       give_back(s_.w.find_m(kM99));
     }
   }
+  if (piece_) return;  // Interpreter::finish() checks the end
   if (!ended_) {
     if (!calls_.empty())
       error(0, "end of file inside subprogram " + calls_.back().label + " (missing M99/endsub)");
@@ -840,8 +844,31 @@ void ProgramFlow::run() {
   }
 }
 
+void ProgramFlow::run_piece() {
+  Interpreter::State::Continuation& c = s_.continuation;
+  piece_ = true;
+  line_ = c.line;
+  started_ = c.started;
+  percent_seen_ = c.percent_seen;
+  run();
+  if (!ended_ && !calls_.empty())
+    error(0, "the piece ends inside subprogram " + calls_.back().label +
+                 ": feed a call and its body in one piece");
+  if (!ended_ && !loops_.empty())
+    error(0, "the piece ends inside a loop: feed a loop in one piece");
+  c.line = line_;
+  c.started = started_;
+  c.percent_seen = percent_seen_;
+  c.ended = ended_;
+}
+
 void run_program(Interpreter::State& state, std::istream& program, const std::string& file_name) {
   ProgramFlow(state, program, file_name).run();
+}
+
+void run_program_piece(Interpreter::State& state, std::istream& piece,
+                       const std::string& file_name) {
+  ProgramFlow(state, piece, file_name).run_piece();
 }
 
 }  // namespace tridex::gcode

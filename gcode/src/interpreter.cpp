@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <istream>
 #include <numbers>
 #include <string_view>
@@ -45,6 +46,19 @@ Interpreter::Interpreter(InterpreterOptions options, MachineConfig machine)
 }
 
 Interpreter::~Interpreter() = default;
+
+void Interpreter::resume() {
+  state_->continuation.ended = false;
+  state_->continuation.percent_seen = false;
+}
+
+Interpreter Interpreter::clone() const {
+  Interpreter copy(state_->options, state_->machine);
+  copy.state_ = std::make_unique<State>(*state_);
+  copy.state_->sink = nullptr;
+  copy.state_->dwell_sink = nullptr;
+  return copy;
+}
 Interpreter::Interpreter(Interpreter&&) noexcept = default;
 Interpreter& Interpreter::operator=(Interpreter&&) noexcept = default;
 
@@ -61,18 +75,15 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
   run(program, file_name, sink, {});
 }
 
-void Interpreter::run(std::istream& program, const std::string& file_name,
-                      const std::function<void(const Move&)>& sink,
-                      const std::function<void(const Dwell&)>& dwell_sink) {
-  // A fresh machine for every run.
-  auto fresh = std::make_unique<State>();
-  fresh->options = state_->options;
-  fresh->machine = state_->machine;
-  state_ = std::move(fresh);
-  State& s = *state_;
-  s.context.file = &file_name;
-  s.sink = &sink;
-  s.dwell_sink = &dwell_sink;
+namespace {
+
+// A fresh machine: the options and the machine configuration kept, everything else as at power-on.
+void fresh_machine(std::unique_ptr<Interpreter::State>& state) {
+  auto fresh = std::make_unique<Interpreter::State>();
+  fresh->options = state->options;
+  fresh->machine = state->machine;
+  state = std::move(fresh);
+  Interpreter::State& s = *state;
   s.frame.offsets = s.machine.work_offsets;
   for (const auto& [n, value] : s.machine.variables) s.preset(n, value);
   for (const auto& [name, value] : s.machine.named_variables)
@@ -90,7 +101,11 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
     s.tool.pos = s.frame.world_origin;
     s.tool.far = true;
   }
-  run_program(s, program, file_name);
+}
+
+// The end of a program: the moves cutter compensation still holds, an unfinished tilted plane,
+// and what lenient mode skipped, summarised.
+void end_program(Interpreter::State& s, const std::string& file_name) {
   s.comp_finish();  // compensated moves still waiting for a next move
   if (s.tilt.plane_blocks.code) {
     s.context.file = &file_name;
@@ -99,7 +114,8 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
   }
   // One line per kind of word lenient mode skipped or block it read otherwise, however many:
   // never silent.
-  auto summarize = [&](const std::map<std::string, State::Skipped>& causes, const char* verb) {
+  auto summarize = [&](const std::map<std::string, Interpreter::State::Skipped>& causes,
+                       const char* verb) {
     for (const auto& [cause, skipped] : causes) {
       std::string lines;
       for (int l : skipped.lines) lines += (lines.empty() ? "" : ", ") + std::to_string(l);
@@ -112,6 +128,66 @@ void Interpreter::run(std::istream& program, const std::string& file_name,
   };
   summarize(s.summary.skipped, "skipped");
   summarize(s.summary.read_as, "read");
+}
+
+}  // namespace
+
+void Interpreter::run(std::istream& program, const std::string& file_name,
+                      const std::function<void(const Move&)>& sink,
+                      const std::function<void(const Dwell&)>& dwell_sink) {
+  fresh_machine(state_);  // a fresh machine for every run
+  State& s = *state_;
+  s.context.file = &file_name;
+  s.sink = &sink;
+  s.dwell_sink = &dwell_sink;
+  run_program(s, program, file_name);
+  end_program(s, file_name);
+}
+
+void Interpreter::feed(std::istream& piece, const std::string& file_name,
+                       const std::function<void(const Move&)>& sink,
+                       const std::function<void(const Dwell&)>& dwell_sink) {
+  if (!state_->continuation.begun) {
+    fresh_machine(state_);
+    state_->continuation.begun = true;
+  }
+  State& s = *state_;
+  s.context.file = &file_name;
+  s.sink = &sink;
+  s.dwell_sink = &dwell_sink;
+  if (s.continuation.ended) {
+    // As run() reads nothing after the end; said once, never silently.
+    std::string rest{std::istreambuf_iterator<char>(piece), std::istreambuf_iterator<char>()};
+    if (rest.find_first_not_of(" \t\r\n%") != std::string::npos &&
+        !s.continuation.warned_after_end) {
+      s.continuation.warned_after_end = true;
+      s.summary.warnings.push_back(
+          Diagnostic{file_name, s.continuation.line, 0,
+                     "text fed after the end of the program (M2, M30, M99 or '%') is not run"});
+    }
+    return;
+  }
+  run_program_piece(s, piece, file_name);
+  s.sink = nullptr;
+  s.dwell_sink = nullptr;
+}
+
+void Interpreter::finish(const std::string& file_name,
+                         const std::function<void(const Move&)>& sink) {
+  State& s = *state_;
+  if (!s.continuation.begun) return;
+  std::function<void(const Dwell&)> no_dwells;
+  s.sink = &sink;
+  s.dwell_sink = &no_dwells;
+  s.context.file = &file_name;
+  if (!s.continuation.ended) {
+    s.context.line = s.continuation.line;
+    s.warn(0, "the program ends without M2, M30 or '%' (truncated?)");
+  }
+  end_program(s, file_name);
+  s.sink = nullptr;
+  s.dwell_sink = nullptr;
+  s.continuation = {};
 }
 
 std::vector<Move> read_moves(const std::string& path, InterpreterOptions options,

@@ -67,6 +67,15 @@ struct Interpreter::State : ParameterReader {
   };
   BlockContext context;
   std::vector<std::string> files;  // every file of the run, in the order first read
+  // Where a program fed in pieces (Interpreter::feed) stands between pieces: the flow's own state
+  // that must outlive one piece. Control structures (calls, loops) stay within one piece.
+  struct Continuation {
+    bool begun = false;  // the machine state is set up (the first piece ran)
+    int line = 0;        // lines read so far: the next piece's first line is line + 1
+    bool started = false, percent_seen = false, ended = false;
+    bool warned_after_end = false;
+  };
+  Continuation continuation;
   const std::function<void(const Move&)>* sink = nullptr;
   const std::function<void(const Dwell&)>* dwell_sink = nullptr;  // may hold no function
 
@@ -737,5 +746,9 @@ struct Interpreter::State : ParameterReader {
 
 // Runs a whole program through `state` (flow.cpp).
 void run_program(Interpreter::State& state, std::istream& program, const std::string& file_name);
+// One piece of a program fed in pieces: continues from state.continuation, updates it, and leaves
+// the end-of-program checks to Interpreter::finish().
+void run_program_piece(Interpreter::State& state, std::istream& piece,
+                       const std::string& file_name);
 
 }  // namespace tridex::gcode

@@ -40,6 +40,29 @@ gcode::MachineConfig load_machine(const std::string& name_or_file,
   return machine;
 }
 
+void apply_tool_options(const CommonOptions& options, ProgramInput& input) {
+  if (!options.tool_units.empty()) {  // --tool-units states a .tbl's units, as "linear_units"
+    input.machine.tool_table_in_inches = options.tool_units == "inch";
+    input.machine.linear_units_stated = true;
+  }
+  // The tool in the spindle at start: --initial-tool, else the machine file's, else CAMotics'
+  // tool 1 for a CAMotics project (CAMotics cuts a program with no tool change with it).
+  if (options.initial_tool >= 0) {
+    input.machine.initial_tool = options.initial_tool;
+    input.machine.initial_tool_stated = true;
+  } else if (!input.machine.initial_tool_stated && input.project) {
+    input.machine.initial_tool = 1;
+  }
+  if (!options.tools.empty())
+    input.tools = ToolTable::read(options.tools, input.machine.tool_table_in_inches ? 25.4 : 1.0);
+  if (input.tools) {  // cutter compensation (G41/G42 D) offsets by half a tool's diameter
+    for (const auto& [number, spec] : input.tools->tools())
+      input.machine.tool_diameters[number] = spec.diameter_mm;
+    for (int number : input.tools->zero_diameter()) input.machine.tool_diameters[number] = 0;
+    input.machine.tool_lengths = input.tools->tool_lengths();  // G43 H
+  }
+}
+
 ProgramInput resolve_program(const CommonOptions& options) {
   const std::string& program = options.program;
   ProgramInput input;
@@ -68,26 +91,7 @@ ProgramInput resolve_program(const CommonOptions& options) {
       input_error(file.string(), ": a CAMotics TPL program (JavaScript that writes G-code), not ",
                   "G-code; run it with CAMotics' tplang and give tridex the G-code it writes");
   }
-  if (!options.tool_units.empty()) {  // --tool-units states a .tbl's units, as "linear_units"
-    input.machine.tool_table_in_inches = options.tool_units == "inch";
-    input.machine.linear_units_stated = true;
-  }
-  // The tool in the spindle at start: --initial-tool, else the machine file's, else CAMotics'
-  // tool 1 for a CAMotics project (CAMotics cuts a program with no tool change with it).
-  if (options.initial_tool >= 0) {
-    input.machine.initial_tool = options.initial_tool;
-    input.machine.initial_tool_stated = true;
-  } else if (!input.machine.initial_tool_stated && input.project) {
-    input.machine.initial_tool = 1;
-  }
-  if (!options.tools.empty())
-    input.tools = ToolTable::read(options.tools, input.machine.tool_table_in_inches ? 25.4 : 1.0);
-  if (input.tools) {  // cutter compensation (G41/G42 D) offsets by half a tool's diameter
-    for (const auto& [number, spec] : input.tools->tools())
-      input.machine.tool_diameters[number] = spec.diameter_mm;
-    for (int number : input.tools->zero_diameter()) input.machine.tool_diameters[number] = 0;
-    input.machine.tool_lengths = input.tools->tool_lengths();  // G43 H
-  }
+  apply_tool_options(options, input);
   return input;
 }
 

@@ -35,6 +35,9 @@ gcode::MachineConfig load_machine(const std::string& name_or_file,
 
 // Throws InputError if the file is missing, the project is malformed or the machine unknown.
 ProgramInput resolve_program(const CommonOptions& options);
+// resolve_program's last step, for a program that comes without a file (embed/session.hpp):
+// --tool-units, --initial-tool and --tools into `input` and its machine (G41/G42 D, G43 H).
+void apply_tool_options(const CommonOptions& options, ProgramInput& input);
 
 // Every file the run reads that is known before it interprets the program: the program (or
 // project) and its G-code files, the machine file and the tool table. No output may name one of

@@ -75,11 +75,29 @@ class Interpreter {
            const std::function<void(const Move&)>& sink,
            const std::function<void(const Dwell&)>& dwell_sink);
 
+  // A program fed in pieces, as a controller receives it: each call runs one more piece of the
+  // same program, keeping the machine state (modes, position, tool, offsets, parameters, line
+  // numbers) from the last; moves go to `sink` as they are read. A call, its subprogram body and
+  // a loop must lie within one piece (M98 finds bodies only in the piece or in other files).
+  // Text after the program's end (M2, M30, '%') is not run (one warning). finish() ends the
+  // program: the moves cutter compensation still holds go to `sink`, a program that did not end
+  // is warned about, and the next feed() starts a fresh machine. run() is unaffected.
+  void feed(std::istream& piece, const std::string& file_name,
+            const std::function<void(const Move&)>& sink,
+            const std::function<void(const Dwell&)>& dwell_sink = {});
+  void finish(const std::string& file_name, const std::function<void(const Move&)>& sink);
+  // An interpreter in this one's state: what a piece would do can be tried on the copy.
+  Interpreter clone() const;
+  // Lets a fed program that ended (M2, M30, '%') take more pieces in the state it ended in: a
+  // block tried after the end (Session::would_cut) runs instead of being ignored.
+  void resume();
+
   const std::vector<Diagnostic>& warnings() const;
   const std::set<int>& tools_used() const;            // tools of the emitted moves
   const std::map<int, int>& tool_first_line() const;  // tool -> line of the M6 that loaded it
                                                       // (its first move's line if none)
   long long blocks() const;                           // blocks executed by the last run
+                                                      // (or the pieces fed so far)
   // The files of the current (or last) run, Move::file's table: the program given to run(), then
   // each subprogram file in the order it was first called (its path as found). Grows during a run.
   const std::vector<std::string>& files() const;

@@ -1,0 +1,99 @@
+#!/usr/bin/env python3
+"""The Python module (tools/embed/python/tridex) as a CAM script uses it, against the command.
+
+Feeds the bundled example in pieces, checks the removed volume after each against the volume of
+the STL the session writes, would_cut into the stock and in the air, inside on both sides of a
+cut, and the final STL against `tridex simulate` on the whole program (the same bytes).
+
+usage: test_python.py TRIDEX_COMMAND SOURCE_DIR SCRATCH_DIR   (PYTHONPATH: the build folder)
+"""
+
+import os
+import random
+import struct
+import subprocess
+import sys
+
+import tridex
+
+COMMAND, SOURCE, SCRATCH = sys.argv[1:4]
+EXAMPLES = os.path.join(SOURCE, "gcode", "examples")
+PROGRAM = os.path.join(EXAMPLES, "mold_3plus2.nc")
+TOOLS = os.path.join(EXAMPLES, "mold_3plus2.tools.json")
+STOCK = (0, 0, 0, 100, 80, 50)
+CELL = 2.0
+failures = []
+
+
+def check(condition, what):
+    if not condition:
+        failures.append(what)
+        print("FAILED:", what, file=sys.stderr)
+
+
+def stl_volume(path):
+    """The signed volume of a binary STL, as the mesh's divergence sum."""
+    with open(path, "rb") as f:
+        data = f.read()
+    (count,) = struct.unpack_from("<I", data, 80)
+    six = 0.0
+    for v in struct.iter_unpack("<12fH", data[84:84 + 50 * count]):
+        ax, ay, az, bx, by, bz, cx, cy, cz = v[3:12]
+        six += ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx)
+    return six / 6
+
+
+os.makedirs(SCRATCH, exist_ok=True)
+whole = os.path.join(SCRATCH, "python_whole.stl")
+subprocess.run([COMMAND, "simulate", PROGRAM, "--tools", TOOLS, "--stock",
+                "box:" + ",".join(str(v) for v in STOCK), "--dexel-cell", str(CELL), "-q",
+                "-o", whole], check=True)
+
+with open(PROGRAM) as f:
+    lines = f.read().splitlines(keepends=True)
+random.seed(38)
+cuts = sorted({0, len(lines), 40, 400, *random.sample(range(1, len(lines)), 2)})
+s = tridex.Session(stock=STOCK, tools=TOOLS, machine=None, cell=CELL)
+stock_volume = 100 * 80 * 50
+piece_stl = os.path.join(SCRATCH, "python_piece.stl")
+last = 0.0
+for a, b in zip(cuts, cuts[1:]):
+    s.feed("".join(lines[a:b]))
+    removed = s.removed_volume()
+    s.write_stl(piece_stl)
+    mesh_removed = stock_volume - stl_volume(piece_stl)
+    check(abs(removed - mesh_removed) <= 1e-6 * stock_volume,
+          "lines %d-%d: removed %.3f, the mesh says %.3f" % (a, b, removed, mesh_removed))
+    check(removed >= last - 1e-6, "the removed volume fell at line %d" % b)
+    last = removed
+    if a == 0:  # after the +z facing at Z48 (lines 9-40)
+        check(s.inside((50, 40, 47)), "below the faced top is stock")
+        check(not s.inside((50, 40, 49)), "above the faced top is air")
+        check(s.would_cut("G1 X50 Y40 Z45") > 2.5, "a feed into the stock cuts")
+        check(s.would_cut("G0 X50 Y40 Z60") == 0, "a rapid in the air cuts nothing")
+        check(s.removed_volume() == removed, "would_cut cut nothing")
+
+s.write_stl(piece_stl)
+with open(whole, "rb") as f1, open(piece_stl, "rb") as f2:
+    check(f1.read() == f2.read(), "the pieces' STL is simulate's, byte for byte")
+
+# Bad input raises BadInput (status 2) with the line, and changes nothing.
+moves = s.moves()
+try:
+    s.would_cut("G1 X10 Q\n")
+    check(False, "bad G-code raises")
+except tridex.BadInput as e:
+    check(e.status == 2 and "<fed>:" in str(e), "the error names the line: %s" % e)
+# The program ended (M30): more text is not run, and a warning says so.
+s.feed("G1 X50 Y40 Z10\n")
+check(s.moves() == moves, "text after the end is not run")
+check(any("after the end" in w for w in s.warnings()), "a warning says so")
+try:
+    tridex.Session(stock=(0, 0, 0, 1, 1, 1), tools=os.path.join(SCRATCH, "none.json"), cell=1)
+    check(False, "a missing tool table raises")
+except tridex.BadInput:
+    pass
+
+if failures:
+    sys.exit("%d check(s) failed" % len(failures))
+print("python: all passed (tridex %s, %d pieces)" % (tridex.version(), len(cuts) - 1))

@@ -1,0 +1,182 @@
+// The embedded session (tools/embed/session.hpp, issue 38): the bundled example fed in pieces
+// gives simulate's solid, whatever the split; the removed volume against analytic solids; would_cut
+// and inside against what the moves leave, worked out by hand, across directions.
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "errors.hpp"
+#include "pipeline/pipeline.hpp"
+#include "session.hpp"
+#include "tridex/gcode/diagnostic.hpp"
+
+namespace test_session {
+
+namespace fs = std::filesystem;
+using namespace tridex;
+
+const fs::path kExamples = fs::path(TRIDEX_SOURCE_DIR) / "gcode" / "examples";
+
+std::vector<std::string> lines_of(const fs::path& path) {
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line + "\n");
+  return lines;
+}
+
+std::string join(const std::vector<std::string>& lines, std::size_t a, std::size_t b) {
+  std::string text;
+  for (std::size_t k = a; k < b; ++k) text += lines[k];
+  return text;
+}
+
+embed::SessionOptions session_options(const Aabb& stock, const std::string& tools, double cell) {
+  embed::SessionOptions o;
+  o.stock = stock;
+  o.tools = tools;
+  o.cell = cell;
+  return o;
+}
+
+bool same_mesh(const Mesh& a, const Mesh& b) {
+  return a.positions == b.positions && a.triangles == b.triangles;
+}
+
+TEST_CASE("session: the example fed in pieces is simulate's solid, for any split") {
+  const fs::path program = kExamples / "mold_3plus2.nc";
+  const fs::path tools = kExamples / "mold_3plus2.tools.json";
+  cli::SimulateOptions options;
+  options.program = program.string();
+  options.tools = tools.string();
+  options.stock = "box:0,0,0,100,80,50";
+  options.dexel_cell = 3;  // coarse: the test's time
+  options.quiet = true;
+  cli::Progress progress(false);
+  const cli::SimulationResult whole = cli::simulate_program(options, progress);
+  REQUIRE(whole.groups.size() == 5);
+
+  const std::vector<std::string> lines = lines_of(program);
+  const std::size_t n = lines.size();
+  std::mt19937 random(38);
+  const std::vector<std::vector<std::size_t>> splits = {
+      {0, 1, 20, 373, 5962, 21560, 21936, 22300, n},  // at tool changes and tilted planes
+      {0, n / 7, n / 3, n / 2 + 11, n - 40, n}};
+  for (const std::vector<std::size_t>& cuts : splits) {
+    CAPTURE(cuts.size());
+    embed::Session s(session_options(Aabb{Vec3(0), Vec3(100, 80, 50)}, tools.string(), 3));
+    CHECK(s.zmap_cell() == doctest::Approx(whole.zmap_cell));
+    for (std::size_t k = 0; k + 1 < cuts.size(); ++k) s.feed(join(lines, cuts[k], cuts[k + 1]));
+    CHECK(s.moves() == whole.segments);
+    CHECK(same_mesh(s.mesh(), whole.mesh));
+    CHECK(s.removed_volume() == doctest::Approx(whole.stock.volume - whole.volume).epsilon(1e-12));
+  }
+}
+
+// A 10 mm flat end mill (T1) and the stock 0..40 x 0..40 x 0..20.
+std::string flat_table(const fs::path& dir) {
+  const fs::path path = dir / "flat.json";
+  std::ofstream(path) << R"({"1": {"units": "mm", "shape": "cylindrical", "length": 50,
+                                  "diameter": 10}})";
+  return path.string();
+}
+
+fs::path scratch(const char* name) {
+  fs::path dir = fs::temp_directory_path() / ("tridex_test_session_" + std::string(name));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// Facing from +z down to `z` across the whole stock (passes 8 mm apart, 10 mm tool).
+std::string facing(double z) {
+  std::ostringstream g;
+  g << "G0 X-10 Y-8\nG0 Z" << z + 5 << "\nG1 Z" << z << " F500\n";
+  for (int row = 0; row <= 6; ++row)
+    g << "G1 X" << (row % 2 ? -10 : 50) << "\nG1 Y" << -8 + 8 * (row + 1) << "\n";
+  g << "G0 Z30\n";
+  return g.str();
+}
+
+// Facing from -x (tool axis -x: G68.2 I-90 J90, as the example's -x side) down to world x = `x`.
+std::string side_facing(double x) {
+  std::ostringstream g;
+  g << "G68.2 X0 Y20 Z10 I-90 J90 K0\nG53.1\nG0 X-40 Y-40\nG0 Z5\nG1 Z" << -x << " F500\n";
+  for (int row = 0; row <= 10; ++row)
+    g << "G1 X" << (row % 2 ? -40 : 40) << "\nG1 Y" << -40 + 8 * (row + 1) << "\n";
+  // Back upright: G69 alone keeps the tool along -x (docs/gcode.md).
+  g << "G0 Z30\nG68.2 X0 Y0 Z0 I0 J0 K0\nG53.1\nG69\n";
+  return g.str();
+}
+
+const char* kStart = "G21 G90 G17\nT1 M6\nS8000 M3\n";
+
+TEST_CASE("session: removed volume against analytic solids, piece by piece") {
+  const fs::path dir = scratch("volume");
+  embed::Session s(session_options(Aabb{Vec3(0), Vec3(40, 40, 20)}, flat_table(dir), 0.5));
+  s.feed(kStart);
+  CHECK(s.removed_volume() == doctest::Approx(0).epsilon(1e-9));
+  s.feed(facing(15));  // 40 x 40 x 5
+  CHECK(s.removed_volume() == doctest::Approx(8000).epsilon(5e-4));
+  s.feed(side_facing(12));  // 12 x 40 x 15 more
+  CHECK(s.removed_volume() == doctest::Approx(8000 + 7200).epsilon(5e-4));
+  // A slot 10 wide, 3 deep along y at x = 20: its walls parallel to the spindle lie inside cells.
+  s.feed("G0 X26 Y-10\nG1 Z12 F300\nG1 Y50\nG0 Z30\n");
+  CHECK(s.removed_volume() == doctest::Approx(15200 + 10 * 40 * 3).epsilon(2e-3));
+}
+
+TEST_CASE("session: would_cut and inside see every direction's cuts") {
+  const fs::path dir = scratch("queries");
+  embed::Session s(session_options(Aabb{Vec3(0), Vec3(40, 40, 20)}, flat_table(dir), 0.5));
+  s.feed(kStart);
+  s.feed(facing(15));
+  s.feed(side_facing(12));
+  // A plunge from +z: material under the whole disc down to it, above 15 none.
+  CHECK(s.would_cut("G0 X20 Y20\nG1 Z10 F300") == doctest::Approx(5).epsilon(0.01));
+  CHECK(s.would_cut("G0 X20 Y20\nG1 Z16 F300") == 0);
+  CHECK(s.would_cut("G0 X-20 Y20\nG1 Z2 F300") == 0);  // beside the stock
+  // Over the band the -x facing removed (x < 12): a +z Z-map alone still holds material there.
+  CHECK(s.would_cut("G0 X6 Y20\nG1 Z2 F300") == 0);
+  CHECK(s.would_cut("G0 X8 Y20\nG1 Z2 F300") == doctest::Approx(13).epsilon(0.01));
+  // Asking cut nothing and left the interpreter where it was.
+  CHECK(s.removed_volume() == doctest::Approx(15200).epsilon(5e-4));
+  // inside against the solid worked out by hand, at random points off its faces.
+  std::mt19937 random(38);
+  std::uniform_real_distribution<double> u(-5, 45);
+  int checked = 0;
+  for (int k = 0; k < 400; ++k) {
+    const Vec3 p(u(random), u(random), u(random) * 0.5);
+    const bool in = p.x > 12 && p.x < 40 && p.y > 0 && p.y < 40 && p.z > 0 && p.z < 15;
+    const double margin = std::min({std::abs(p.x - 12), std::abs(p.x - 40), std::abs(p.y),
+                                    std::abs(p.y - 40), std::abs(p.z), std::abs(p.z - 15)});
+    if (margin < 0.5) continue;  // within a dexel spacing of a face
+    CAPTURE(p);
+    CHECK(s.inside(p) == in);
+    ++checked;
+  }
+  CHECK(checked > 300);
+}
+
+TEST_CASE("session: a piece that fails changes nothing; state carries over") {
+  const fs::path dir = scratch("errors");
+  embed::Session s(session_options(Aabb{Vec3(0), Vec3(40, 40, 20)}, flat_table(dir), 1));
+  s.feed(kStart);
+  s.feed("G0 X20 Y20 Z25\nF400\n");
+  CHECK_THROWS_AS(s.feed("G1 Z10\nT7 M6\nG1 Z5\n"), cli::InputError);  // T7: not in the table
+  CHECK_THROWS_AS(s.feed("G1 Z10\nG1 Q\n"), gcode::GcodeError);
+  CHECK(s.moves() == 1);
+  CHECK(s.removed_volume() == 0);
+  s.feed("G1 Z18\n");  // F400 from an earlier piece
+  CHECK(s.removed_volume() == doctest::Approx(25 * 3.14159265 * 2).epsilon(0.05));  // cell 1
+  CHECK_THROWS_AS(embed::Session(session_options(Aabb{Vec3(0), Vec3(0, 40, 20)}, "", 0)),
+                  cli::InputError);
+  CHECK_THROWS_AS(embed::Session(session_options(Aabb{Vec3(0), Vec3(40, 40, 20)},
+                                                 (dir / "none.json").string(), 0)),
+                  cli::InputError);
+}
+
+}  // namespace test_session

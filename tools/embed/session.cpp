@@ -1,0 +1,288 @@
+// tridex embedded — the session (session.hpp). The stages follow `tridex simulate`'s
+// (tools/cli/pipeline/pipeline.cpp): a change there must be made here too, and the session-vs-
+// simulate tests (tests/embed) say when they part.
+#include "session.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <span>
+#include <sstream>
+
+#include "commands.hpp"
+#include "errors.hpp"
+#include "outputs/result_files.hpp"
+#include "tridex/backends/backends.hpp"
+#include "tridex/dexel_ops.hpp"
+#include "tridex/fine_cells.hpp"
+#include "tridex/mill.hpp"
+#include "tridex/surface.hpp"
+
+namespace tridex::embed {
+
+namespace {
+
+// The name a fed program's diagnostics and moves carry.
+const std::string kFedProgram = "<fed>";
+
+std::string where_text(const gcode::Move& m) { return kFedProgram + ":" + std::to_string(m.line); }
+
+// Whether the ray p + t·d (t > 0) crosses triangle (a, b, c) (Möller and Trumbore, "Fast, minimum
+// storage ray-triangle intersection", JGT 2(1) 1997).
+bool ray_crosses(const Vec3& p, const Vec3& d, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 e1 = b - a, e2 = c - a;
+  const Vec3 q = glm::cross(d, e2);
+  const double det = glm::dot(e1, q);
+  if (std::abs(det) < 1e-300) return false;
+  const Vec3 s = p - a;
+  const double u = glm::dot(s, q) / det;
+  if (u < 0 || u > 1) return false;
+  const Vec3 r = glm::cross(s, e1);
+  const double v = glm::dot(d, r) / det;
+  if (v < 0 || u + v > 1) return false;
+  return glm::dot(e2, r) / det > 0;
+}
+
+}  // namespace
+
+Session::Session(const SessionOptions& options) : options_(options) {
+  stock_ = options.stock;
+  const Vec3 size = stock_.size();
+  if (!is_finite(stock_.min) || !is_finite(stock_.max) || !(size.x > 0) || !(size.y > 0) ||
+      !(size.z > 0))
+    cli::input_error("stock: give xmin, ymin, zmin, xmax, ymax, zmax with each max above its min");
+  stock_volume_ = size.x * size.y * size.z;
+  if (!(options.cell >= 0) || !std::isfinite(options.cell))
+    cli::input_error("cell: the dexel spacing must be a positive number of mm (", options.cell,
+                     ")");
+  cli::CommonOptions common;
+  common.machine = options.machine;
+  common.tools = options.tools;
+  common.tool_units = options.tool_units;
+  common.initial_tool = options.initial_tool;
+  common.arc_tolerance = options.arc_tolerance;
+  common.lenient = options.lenient;
+  input_.machine = cli::load_machine(options.machine);
+  cli::apply_tool_options(common, input_);
+  interpreter_ = gcode::Interpreter(cli::interpreter_options(common), input_.machine);
+  try {  // as simulate sizes the run (pipeline.cpp, size_the_run)
+    lattice_ = options.cell > 0 ? DexelLattice::covering(stock_, options.cell)
+                                : DexelLattice::covering_resolution(stock_, cli::kDefaultDexelRes);
+  } catch (const tridex::Error& e) {
+    cli::input_error("dexel resolution: ", e.what());
+  }
+  zmap_cell_ = std::min(glm::length(size) * cli::kDefaultZmapCellFraction,
+                        cli::kDefaultZmapCellOfSpacing * lattice_.spacing);
+}
+
+std::vector<gcode::Move> Session::run_piece(gcode::Interpreter& interpreter,
+                                            std::string_view text) {
+  std::vector<gcode::Move> moves;
+  std::istringstream in{std::string(text)};
+  interpreter.feed(in, kFedProgram, [&](const gcode::Move& m) { moves.push_back(m); });
+  return moves;
+}
+
+// The cutter of `tool` (loaded from the table when `add`), as simulate's load_cutters finds it.
+std::uint32_t Session::cutter_for(int tool, const gcode::Move& m, bool add) {
+  if (auto it = cutter_of_tool_.find(tool); it != cutter_of_tool_.end()) return it->second;
+  const std::optional<cli::ToolTable>& table = input_.tools;
+  if (const cli::ToolSpec* spec = table ? table->find(tool) : nullptr) {
+    if (!add) return std::numeric_limits<std::uint32_t>::max();
+    cutter_of_tool_[tool] = static_cast<std::uint32_t>(cutters_.size());
+    cutters_.push_back(spec->cutter);
+    return cutter_of_tool_[tool];
+  }
+  if (!table)
+    cli::input_error(where_text(m), ": tool ", tool,
+                     " is used but there is no tool table (give the session a tool table)");
+  if (const std::string* why = table->unusable(tool))
+    cli::input_error(where_text(m), ": tool ", tool, " is used, but ", *why);
+  if (table->zero_diameter().count(tool))
+    cli::input_error(where_text(m), ": tool ", tool,
+                     " cuts, but its diameter in the tool table is 0 (D0 or no D)");
+  cli::input_error(where_text(m), ": tool ", tool, " is used but missing from the tool table ",
+                   options_.tools);
+}
+
+void Session::feed(std::string_view text) {
+  gcode::Interpreter trial = interpreter_.clone();
+  std::vector<gcode::Move> moves = run_piece(trial, text);
+  // Tools first, so that a piece that fails changes nothing (simulate's load_initial_tool,
+  // load_cutters and drop_toolless_moves, move by move).
+  const int initial = input_.machine.initial_tool;
+  const bool tool_zero_cuts = input_.tools && input_.tools->find(0);
+  std::vector<gcode::Move> cut;
+  std::vector<gcode::Move> toolless = toolless_rapids_;
+  bool initial_cuts = initial_tool_cuts_;
+  long long dropped = 0;
+  for (gcode::Move m : moves) {
+    if (m.tool == 0 && !tool_zero_cuts) {
+      const bool rapid = m.kind == gcode::MoveKind::rapid;
+      if (initial > 0 && !initial_cuts && !rapid) {
+        if (!input_.tools || !input_.tools->find(initial))
+          cli::input_error(where_text(m), ": the program cuts before any tool change, with tool ",
+                           initial, ", the tool the control starts with, which is not in the ",
+                           "tool table");
+        initial_cuts = true;
+        for (gcode::Move& t : toolless) t.tool = initial, cut.push_back(t);
+        toolless.clear();
+      }
+      if (initial_cuts) {
+        m.tool = initial;
+      } else if (rapid) {
+        toolless.push_back(m);
+        ++dropped;
+        continue;
+      } else {
+        cli::input_error(where_text(m), ": a ", gcode::to_string(m.kind),
+                         " move with no tool loaded (T… M6)");
+      }
+    }
+    cut.push_back(m);
+  }
+  std::map<int, const gcode::Move*> first_use;
+  for (const gcode::Move& m : cut) first_use.emplace(m.tool, &m);
+  for (const auto& [tool, m] : first_use) cutter_for(tool, *m, false);
+  // Committed from here on.
+  for (const auto& [tool, m] : first_use) cutter_for(tool, *m, true);
+  interpreter_ = std::move(trial);
+  toolless_rapids_ = std::move(toolless);
+  initial_tool_cuts_ = initial_cuts;
+  if (dropped > 0)
+    own_warnings_.push_back(
+        std::to_string(dropped) +
+        " rapid move(s) before the first tool change were not simulated (no tool)");
+  warnings_ = own_warnings_;
+  for (const gcode::Diagnostic& d : interpreter_.warnings()) warnings_.push_back(d.to_string());
+  mill(cut);
+}
+
+// Step 1, incrementally: each direction's new moves milled into its live map.
+void Session::mill(const std::vector<gcode::Move>& moves) {
+  std::vector<std::size_t> fed(cuts_.size());
+  for (std::size_t g = 0; g < cuts_.size(); ++g) fed[g] = cuts_[g].size();
+  for (const gcode::Move& m : moves) {
+    const std::size_t g = grouper_.add(m);
+    const gcode::MoveGroup& group = grouper_.groups()[g];
+    if (g == maps_.size()) {
+      ZMapLimits limits;
+      limits.max_points = std::numeric_limits<std::size_t>::max();
+      maps_.push_back(ZMap::from_box(group.frame, stock_, zmap_cell_, limits, options_.threads));
+      cuts_.emplace_back();
+      fed.push_back(0);
+    }
+    cuts_[g].push_back(CutMove{Segment{group.frame.to_local(m.start), group.frame.to_local(m.end)},
+                               cutter_of_tool_.at(m.tool)});
+  }
+  for (std::size_t g = 0; g < cuts_.size(); ++g) {
+    const std::span<const CutMove> batch = std::span<const CutMove>(cuts_[g]).subspan(fed[g]);
+    if (batch.empty()) continue;
+    backends::mill_with(backends::ZMapBackend::cpu, maps_[g], cutters_, batch,
+                        batch.size() < 64 ? 1u : options_.threads);
+  }
+  moves_ += static_cast<long long>(moves.size());
+  if (!moves.empty()) {
+    solid_valid_ = false;
+    probes_.clear();
+  }
+}
+
+// Steps 2-3 and the surface on copies of the live maps (pipeline.cpp: intersect_directions,
+// refine_walls, extract_result_surface).
+void Session::ensure_solid() {
+  if (solid_valid_) return;
+  const unsigned threads = options_.threads;
+  std::vector<ZMap> maps = maps_;
+  for (ZMap& map : maps) raise_uncut(map, stock_, threads);
+  for (std::size_t g = 0; g < maps.size(); ++g)
+    refine_steep_cells(maps[g], cutters_, cuts_[g], {.threads = threads});
+  const TripleDexel stock_dexel = TripleDexel::box(lattice_, stock_);
+  solid_ = backends::machine_with(backends::DexelBackend::scan, stock_dexel, maps, threads);
+  mesh_ = extract_surface(solid_, {.threads = threads});
+  volume_ = mesh_.signed_volume();
+  removed_ = stock_volume_ - volume_;
+  // As simulate's removed_mm3: the surface's rounding never makes a negative removal.
+  if (removed_ < 0) removed_ = std::max(0.0, tridex::volume(stock_dexel) - tridex::volume(solid_));
+  solid_valid_ = true;
+}
+
+double Session::removed_volume() {
+  ensure_solid();
+  return removed_;
+}
+
+const Mesh& Session::mesh() {
+  ensure_solid();
+  return mesh_;
+}
+
+void Session::write_stl(const std::filesystem::path& path) {
+  ensure_solid();
+  cli::write_stl_file(path, mesh_);
+}
+
+// The solid's top seen along `axis` (its Z-map from the surface), kept until the next piece.
+const ZMap& Session::probe_map(const Vec3& axis) {
+  for (const auto& [a, map] : probes_)
+    if (glm::dot(a, axis) > 1 - 1e-12) return map;
+  Frame frame = Frame::from_axis(axis);
+  for (const gcode::MoveGroup& group : grouper_.groups())
+    if (glm::dot(group.axis, axis) > 1 - 1e-12) frame = group.frame;
+  ZMapLimits limits;
+  limits.max_points = std::numeric_limits<std::size_t>::max();
+  probes_.emplace_back(axis, ZMap::from_mesh(frame, mesh_, zmap_cell_, limits));
+  return probes_.back().second;
+}
+
+double Session::would_cut(std::string_view block) {
+  gcode::Interpreter trial = interpreter_.clone();
+  trial.resume();  // a block asked about after the program's end still runs
+  const std::vector<gcode::Move> moves = run_piece(trial, block);
+  ensure_solid();
+  if (mesh_.triangles.empty()) return 0;
+  double deepest = 0;
+  for (const gcode::Move& m : moves) {
+    int tool = m.tool;
+    if (tool == 0 && !(input_.tools && input_.tools->find(0))) {
+      if (input_.machine.initial_tool <= 0) {
+        if (m.kind == gcode::MoveKind::rapid) continue;  // nothing in the spindle: nothing cuts
+        cli::input_error(where_text(m), ": a ", gcode::to_string(m.kind),
+                         " move with no tool loaded (T… M6)");
+      }
+      tool = input_.machine.initial_tool;
+    }
+    std::uint32_t index = cutter_for(tool, m, false);
+    const Cutter& cutter =
+        index < cutters_.size() ? cutters_[index] : input_.tools->find(tool)->cutter;
+    const ZMap& top = probe_map(m.axis);
+    const Segment tip{top.grid.frame.to_local(m.start), top.grid.frame.to_local(m.end)};
+    deepest = std::max(deepest, cut_depth(top, cutter, tip).depth);
+  }
+  return deepest > kCutTolerance ? deepest : 0;
+}
+
+bool Session::inside(const Vec3& point) {
+  ensure_solid();
+  if (!is_finite(point)) cli::input_error("inside: the point must be finite");
+  const Aabb box = mesh_.bounds();
+  for (int a = 0; a < 3; ++a)
+    if (point[a] < box.min[a] || point[a] > box.max[a]) return false;
+  // The parity of the surface's crossings along three skew rays, by majority: a ray that grazes
+  // an edge of the lattice-aligned surface miscounts, and no two of these meet the same edge.
+  static const std::array<Vec3, 3> rays = {glm::normalize(Vec3(0.5377, 0.3141, 0.7826)),
+                                           glm::normalize(Vec3(-0.2718, 0.8413, -0.4669)),
+                                           glm::normalize(Vec3(0.6931, -0.5772, -0.4142))};
+  int votes = 0;
+  for (const Vec3& d : rays) {
+    int crossings = 0;
+    for (const glm::uvec3& t : mesh_.triangles)
+      crossings += ray_crosses(point, d, Vec3(mesh_.positions[t.x]), Vec3(mesh_.positions[t.y]),
+                               Vec3(mesh_.positions[t.z]));
+    votes += crossings % 2;
+  }
+  return votes >= 2;
+}
+
+}  // namespace tridex::embed

@@ -1,0 +1,106 @@
+// tridex embedded — a session: a stock and a tool table, a program fed in pieces as a controller or
+// a CAM system produces it, and questions about the stock as it stands (docs/embedding.md).
+//
+// Moves are milled into one live Z-map per spindle direction as they are read (Step 1 of Inui,
+// Chen and Umezu, CAD&A 19(4) 2022, §3, incrementally: a Z-map's milling is a minimum over the
+// moves, so pieces give the same heights as the whole program). The solid (Steps 2-3 and the
+// surface) is made from copies of the live maps when a question needs it and kept until the next
+// piece: the same stages as `tridex simulate` (tools/cli/pipeline/pipeline.cpp), so the session's
+// solid equals simulate's on the same program, stock, tools and --dexel-cell.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "inputs/program_input.hpp"
+#include "tridex/cutter.hpp"
+#include "tridex/dexel.hpp"
+#include "tridex/gcode/grouping.hpp"
+#include "tridex/gcode/interpreter.hpp"
+#include "tridex/mill.hpp"
+#include "tridex/mesh.hpp"
+#include "tridex/zmap.hpp"
+
+namespace tridex::embed {
+
+struct SessionOptions {
+  Aabb stock;                    // the stock box, work frame (mm)
+  std::string tools;             // tool table file, as --tools (CAMotics JSON, Fusion, .tbl)
+  std::string machine;           // as --machine: a bundled name or a machine file; empty: default
+  double cell = 0;               // dexel spacing (mm), as --dexel-cell; 0: --dexel-res's default
+  unsigned threads = 0;          // 0: every hardware thread (parallel.hpp's pool)
+  std::string tool_units;        // as --tool-units: a .tbl's units (empty: the machine's)
+  int initial_tool = -1;         // as --initial-tool (-1: the machine's)
+  double arc_tolerance = 0.001;  // mm
+  bool lenient = false;
+};
+
+class Session {
+ public:
+  // Throws cli::InputError (a bad stock, cell, tool table or machine).
+  explicit Session(const SessionOptions& options);
+
+  // Runs one more piece of the program and mills its moves. A piece that fails (GcodeError,
+  // InputError: a tool missing from the table, a feed move with no tool) leaves the session as
+  // it was, interpreter state included.
+  void feed(std::string_view text);
+
+  // mm³ removed so far: the stock's volume less the solid's (its surface's volume, as simulate's
+  // "removed_mm3"). A piece's removal is the difference across its feed().
+  double removed_volume();
+  // The depth (mm, along each move's spindle) the block's moves would cut into the stock as it
+  // stands, every direction's cuts counted, without cutting it or changing the interpreter's
+  // state; 0 when they cut nothing (within kCutTolerance).
+  double would_cut(std::string_view block);
+  // Whether a point (work frame) lies inside the stock as it stands (the solid's surface).
+  bool inside(const Vec3& point);
+  const Mesh& mesh();
+  void write_stl(const std::filesystem::path& path);
+
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  long long moves() const { return moves_; }
+  double dexel_spacing() const { return lattice_.spacing; }
+  double zmap_cell() const { return zmap_cell_; }
+
+  static constexpr double kCutTolerance = 0.005;  // mm: simulate's rapid tolerance
+
+ private:
+  std::vector<gcode::Move> run_piece(gcode::Interpreter& interpreter, std::string_view text);
+  std::uint32_t cutter_for(int tool, const gcode::Move& m, bool add);
+  void mill(const std::vector<gcode::Move>& moves);
+  void ensure_solid();
+  const ZMap& probe_map(const Vec3& axis);
+
+  SessionOptions options_;
+  cli::ProgramInput input_;
+  gcode::Interpreter interpreter_;
+  Aabb stock_;
+  double stock_volume_ = 0;
+  DexelLattice lattice_;
+  double zmap_cell_ = 0;
+  std::vector<Cutter> cutters_;
+  std::map<int, std::uint32_t> cutter_of_tool_;
+  gcode::DirectionGrouper grouper_;
+  std::vector<ZMap> maps_;                    // live, one per direction (grouper_'s groups)
+  std::vector<std::vector<CutMove>> cuts_;    // every move of each direction (the fine cells)
+  std::vector<gcode::Move> toolless_rapids_;  // before any tool, cut if the initial tool is
+  bool initial_tool_cuts_ = false;
+  long long moves_ = 0;
+  std::vector<std::string> own_warnings_;  // the session's; warnings_ adds the interpreter's
+  std::vector<std::string> warnings_;
+
+  // The solid as it stands, kept until the next piece.
+  bool solid_valid_ = false;
+  TripleDexel solid_;
+  Mesh mesh_;
+  double volume_ = 0;
+  double removed_ = 0;
+  std::vector<std::pair<Vec3, ZMap>> probes_;  // the solid's top along each axis asked
+};
+
+}  // namespace tridex::embed

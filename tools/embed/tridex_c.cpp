@@ -1,0 +1,138 @@
+// tridex embedded — the C API (include/tridex.h) over the session (session.hpp). Every entry point
+// catches what the session throws and turns it into a status and tridex_last_error()'s text, as
+// the command maps them to exit statuses (cli/main.cpp): G-code and input errors are bad input,
+// anything else a failure.
+#include "tridex.h"
+
+#include <exception>
+#include <memory>
+#include <new>
+#include <string>
+
+#include "errors.hpp"
+#include "session.hpp"
+#include "tridex/gcode/diagnostic.hpp"
+
+#ifndef TRIDEX_VERSION
+#define TRIDEX_VERSION "unknown"
+#endif
+
+struct tridex_session {
+  std::unique_ptr<tridex::embed::Session> session;
+};
+
+namespace {
+
+thread_local std::string last_error;
+
+template <class Body>
+tridex_status guarded(Body&& body) {
+  last_error.clear();
+  try {
+    body();
+    return TRIDEX_OK;
+  } catch (const tridex::gcode::GcodeError& e) {
+    last_error = e.what();
+    return TRIDEX_BAD_INPUT;
+  } catch (const tridex::cli::InputError& e) {
+    last_error = e.what();
+    return TRIDEX_BAD_INPUT;
+  } catch (const std::bad_alloc&) {
+    last_error = "out of memory (use a larger cell)";
+    return TRIDEX_ERROR;
+  } catch (const std::exception& e) {
+    last_error = e.what();
+    return TRIDEX_ERROR;
+  } catch (...) {
+    last_error = "unknown failure";
+    return TRIDEX_ERROR;
+  }
+}
+
+tridex_status bad_call(const char* what) {
+  last_error = std::string(what) + " is null";
+  return TRIDEX_BAD_CALL;
+}
+
+}  // namespace
+
+extern "C" {
+
+const char* tridex_last_error(void) { return last_error.c_str(); }
+const char* tridex_version(void) { return TRIDEX_VERSION; }
+
+tridex_status tridex_session_new(const tridex_session_options* options, tridex_session** out) {
+  if (!options) return bad_call("options");
+  if (!out) return bad_call("out");
+  *out = nullptr;
+  return guarded([&] {
+    tridex::embed::SessionOptions o;
+    o.stock = tridex::Aabb{tridex::Vec3(options->stock[0], options->stock[1], options->stock[2]),
+                           tridex::Vec3(options->stock[3], options->stock[4], options->stock[5])};
+    o.tools = options->tools ? options->tools : "";
+    o.machine = options->machine ? options->machine : "";
+    o.cell = options->cell;
+    o.threads = options->threads;
+    auto handle = std::make_unique<tridex_session>();
+    handle->session = std::make_unique<tridex::embed::Session>(o);
+    *out = handle.release();
+  });
+}
+
+void tridex_session_free(tridex_session* session) { delete session; }
+
+tridex_status tridex_session_feed(tridex_session* session, const char* text) {
+  if (!session) return bad_call("session");
+  if (!text) return bad_call("text");
+  return guarded([&] { session->session->feed(text); });
+}
+
+tridex_status tridex_session_removed_volume(tridex_session* session, double* out) {
+  if (!session) return bad_call("session");
+  if (!out) return bad_call("out");
+  return guarded([&] { *out = session->session->removed_volume(); });
+}
+
+tridex_status tridex_session_would_cut(tridex_session* session, const char* block, double* out) {
+  if (!session) return bad_call("session");
+  if (!block) return bad_call("block");
+  if (!out) return bad_call("out");
+  return guarded([&] { *out = session->session->would_cut(block); });
+}
+
+tridex_status tridex_session_inside(tridex_session* session, const double point[3], int* out) {
+  if (!session) return bad_call("session");
+  if (!point) return bad_call("point");
+  if (!out) return bad_call("out");
+  return guarded(
+      [&] { *out = session->session->inside(tridex::Vec3(point[0], point[1], point[2])) ? 1 : 0; });
+}
+
+tridex_status tridex_session_write_stl(tridex_session* session, const char* path) {
+  if (!session) return bad_call("session");
+  if (!path) return bad_call("path");
+  return guarded([&] { session->session->write_stl(path); });
+}
+
+tridex_status tridex_session_moves(tridex_session* session, long long* out) {
+  if (!session) return bad_call("session");
+  if (!out) return bad_call("out");
+  *out = session->session->moves();
+  return TRIDEX_OK;
+}
+
+tridex_status tridex_session_warning_count(tridex_session* session, int* out) {
+  if (!session) return bad_call("session");
+  if (!out) return bad_call("out");
+  *out = static_cast<int>(session->session->warnings().size());
+  return TRIDEX_OK;
+}
+
+const char* tridex_session_warning(tridex_session* session, int index) {
+  if (!session || index < 0 ||
+      static_cast<std::size_t>(index) >= session->session->warnings().size())
+    return nullptr;
+  return session->session->warnings()[static_cast<std::size_t>(index)].c_str();
+}
+
+}  // extern "C"
