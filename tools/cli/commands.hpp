@@ -65,6 +65,18 @@ struct CheckOptions : SimulateOptions {
   double clearance = kDefaultClearance;  // --clearance: near misses of shanks and holders, mm
 };
 
+// `diff` (issue 39): simulate's options for both programs (PROGRAM is A), B's solid compared
+// with A's on A's stock and lattice.
+struct DiffOptions : SimulateOptions {
+  std::string program_b;
+  double tolerance = 0;  // --tolerance, mm; 0: half the dexel spacing
+};
+
+// `lint`: the post lint of a program (checks/lint.hpp).
+struct LintOptions : CommonOptions {
+  std::string report;  // --report FILE: the findings as JSON
+};
+
 // check's default verdict tolerance, mm: a shop's usual ±0.02 mm on a milled surface (ISO 2768-f
 // allows ±0.05 mm on features up to 6 mm; a finish pass is held well inside it).
 constexpr double kShopTolerance = 0.02;
@@ -77,5 +89,7 @@ int run_moves(const ListOptions& options);
 int run_groups(const ListOptions& options);
 int run_simulate(const SimulateOptions& options);
 int run_check(const CheckOptions& options);
+int run_diff(const DiffOptions& options);
+int run_lint(const LintOptions& options);
 
 }  // namespace tridex::cli

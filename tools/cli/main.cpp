@@ -259,6 +259,32 @@ int main(int argc, char** argv) {
   grp->add_option("-o,--output", groups.output, "write to a file instead of stdout")
       ->check(kNotEmpty);
 
+  // issue 39: diff, lint.
+  DiffOptions diff;
+  CLI::App* dif = app.add_subcommand(
+      "diff",
+      "simulate two programs on A's stock, lattice and tools and compare the solids: regions that\n"
+      "differ with their lines in each program, and the post lint of B; exit status 3 when they\n"
+      "differ");
+  add_simulate(*dif, diff);
+  dif->add_option("PROGRAM_B", diff.program_b, "the program to compare with PROGRAM")
+      ->required()
+      ->check(kNotEmpty);
+  dif->add_option("--tolerance", diff.tolerance,
+                  "a span of material longer than this along a dexel ray is a difference, mm\n"
+                  "(default: half the dexel spacing)")
+      ->check(kFinitePositive);
+  dif->add_option("--report", diff.report, "write the JSON report of the comparison")
+      ->check(kNotEmpty);
+  LintOptions lint;
+  CLI::App* lnt = app.add_subcommand(
+      "lint",
+      "post-processor mistakes at file:line: units changed mid-program, G43 H missing or not\n"
+      "the tool's, integer coordinates, arc centres of the other G90.1/G91.1 mode; exit status 3\n"
+      "when any is found");
+  add_common(*lnt, lint);
+  lnt->add_option("--report", lint.report, "write the findings as JSON")->check(kNotEmpty);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -273,6 +299,8 @@ int main(int argc, char** argv) {
     if (chk->parsed()) return run_check(check);
     if (mov->parsed()) return run_moves(moves);
     if (grp->parsed()) return run_groups(groups);
+    if (dif->parsed()) return run_diff(diff);
+    if (lnt->parsed()) return run_lint(lint);
   } catch (const tridex::gcode::GcodeError& e) {
     std::cerr << terminal_safe(e.what()) << '\n';
     return kBadInput;
