@@ -306,19 +306,43 @@ void attribute_region(DiffRegion& region, DiffRun& run, const std::map<int, int>
   region.lines_b.insert(region.changed_b.begin(), region.changed_b.end());
 }
 
+// Each line's normalized text (line_alignment.hpp), line k at k - 1.
+std::vector<std::string> text_lines(std::string_view text) {
+  std::vector<std::string> lines;
+  std::size_t at = 0;
+  while (at <= text.size()) {
+    std::size_t end = text.find('\n', at);
+    if (end == std::string_view::npos) end = text.size();
+    lines.push_back(normalized_block(text.substr(at, end - at)));
+    at = end + 1;
+  }
+  return lines;
+}
+
 // The lint of both programs; B's findings that A shares (same kind, aligned line) are dropped.
 void lint_both(DiffRun& run, const gcode::MachineConfig& machine) {
   LintSettings settings;
   settings.decimal_point_input = machine.decimal_point_input;
   settings.expect_g43 = program_uses_g43(run.text_a);
+  settings.strict = true;
   run.lint_a = lint_text(run.text_a, run.file_a, settings);
   std::vector<LintFinding> all_b = lint_text(run.text_b, run.file_b, settings);
-  std::set<std::pair<std::string, int>> in_a;
-  for (const LintFinding& f : run.lint_a)
+  // Shared: the same kind at the aligned line, or on a block of the same text (a moved block).
+  const std::vector<std::string> lines_a = text_lines(run.text_a), lines_b = text_lines(run.text_b);
+  std::set<std::pair<std::string, int>> at_line;
+  std::set<std::pair<std::string, std::string>> on_text;
+  for (const LintFinding& f : run.lint_a) {
     if (f.line < static_cast<int>(run.alignment.a_to_b.size()))
-      in_a.insert({f.code, run.alignment.a_to_b[static_cast<std::size_t>(f.line)]});
-  for (LintFinding& f : all_b)
-    if (!in_a.count({f.code, f.line})) run.lint_b.push_back(std::move(f));
+      at_line.insert({f.code, run.alignment.a_to_b[static_cast<std::size_t>(f.line)]});
+    if (f.line >= 1 && f.line <= static_cast<int>(lines_a.size()))
+      on_text.insert({f.code, lines_a[static_cast<std::size_t>(f.line - 1)]});
+  }
+  for (LintFinding& f : all_b) {
+    const bool shared = at_line.count({f.code, f.line}) ||
+                        (f.line >= 1 && f.line <= static_cast<int>(lines_b.size()) &&
+                         on_text.count({f.code, lines_b[static_cast<std::size_t>(f.line - 1)]}));
+    if (!shared) run.lint_b.push_back(std::move(f));
+  }
 }
 
 Json diff_lines_json(const std::set<int>& lines) {

@@ -94,22 +94,61 @@ std::vector<LintBlock> lint_blocks(std::string_view text) {
   return blocks;
 }
 
+// Median size of the XYZ coordinates a section of blocks writes, mm (0: fewer than 20).
+double lint_coordinate_size(const std::vector<LintBlock>& blocks, std::size_t from, std::size_t to,
+                            double unit) {
+  std::vector<double> sizes;
+  for (std::size_t k = from; k < to; ++k) {
+    const LintBlock& b = blocks[k];
+    if (b.parametric || b.has_code('G', 100) || b.has_code('G', 920) || b.has_code('G', 530) ||
+        b.has_code('G', 280) || b.has_code('G', 300))
+      continue;
+    for (const LintWord& w : b.words)
+      if ((w.letter == 'X' || w.letter == 'Y' || w.letter == 'Z') && w.value != 0)
+        sizes.push_back(std::abs(w.value) * unit);
+  }
+  // A few coordinates say nothing about a section's unit (a test of G20 moving to X1 Y1).
+  if (sizes.size() < 20) return 0;
+  std::nth_element(sizes.begin(), sizes.begin() + static_cast<std::ptrdiff_t>(sizes.size() / 2),
+                   sizes.end());
+  return sizes[sizes.size() / 2];
+}
+
 // G20/G21 after the program chose its units: every later coordinate is read 25.4 times too large
-// or too small.
-void lint_units(const std::vector<LintBlock>& blocks, const std::string& file,
+// or too small. `strict` (diff) flags every switch; otherwise a switch whose section writes
+// coordinates more than 4 times larger or smaller (in mm) than the program's first section, as
+// a stray G20 in a millimetre program does (a deliberate inch section writes inch-sized numbers).
+void lint_units(const std::vector<LintBlock>& blocks, const std::string& file, bool strict,
                 std::vector<LintFinding>& out) {
-  int units = 0, units_line = 0;  // 200 (G20) or 210 (G21)
-  for (const LintBlock& b : blocks)
+  struct Switch {
+    std::size_t block;
+    int code;
+  };
+  std::vector<Switch> switches;
+  int units = 0;  // 200 (G20) or 210 (G21)
+  for (std::size_t k = 0; k < blocks.size(); ++k)
     for (int code : {200, 210})
-      if (b.has_code('G', code)) {
-        if (units != 0 && units != code)
-          out.push_back({file, b.line, "units_change",
-                         std::string(code == 200 ? "G20 (inch)" : "G21 (mm)") +
-                             " changes the units mid-program (" + (units == 200 ? "G20" : "G21") +
-                             " since line " + std::to_string(units_line) +
-                             "): every later coordinate is read in the other unit"});
-        if (units != code) units = code, units_line = b.line;
+      if (blocks[k].has_code('G', code) && units != code) {
+        switches.push_back({k, code});
+        units = code;
       }
+  double reference = 0;
+  for (std::size_t s = 0; s < switches.size(); ++s) {
+    const std::size_t from = s == 0 ? 0 : switches[s].block;
+    const std::size_t to = s + 1 < switches.size() ? switches[s + 1].block : blocks.size();
+    const double size = lint_coordinate_size(blocks, from, to, switches[s].code == 200 ? 25.4 : 1);
+    if (s > 0) {
+      const bool odd = reference > 0 && size > 0 && (size > 4 * reference || size * 4 < reference);
+      if (strict || odd)
+        out.push_back({file, blocks[switches[s].block].line, "units_change",
+                       std::string(switches[s].code == 200 ? "G20 (inch)" : "G21 (mm)") +
+                           " changes the units mid-program (" +
+                           (switches[s - 1].code == 200 ? "G20" : "G21") + " since line " +
+                           std::to_string(blocks[switches[s - 1].block].line) +
+                           "): every later coordinate is read in the other unit"});
+    }
+    if (reference == 0) reference = size;
+  }
 }
 
 // A block that moves Z as a programmed position (not a reference return, machine coordinates,
@@ -124,7 +163,7 @@ bool lint_moves_z(const LintBlock& b) {
 // G43 H after each tool change, before the tool moves along Z; and H matching the tool (when the
 // program elsewhere numbers H as its tools: some shops keep lengths in other registers).
 void lint_length_offsets(const std::vector<LintBlock>& blocks, const std::string& file, bool expect,
-                         std::vector<LintFinding>& out) {
+                         bool strict, std::vector<LintFinding>& out) {
   int selected = -1, loaded = -1, change_line = 0, matches = 0;
   bool needed = false;
   std::vector<LintFinding> mismatches;
@@ -136,7 +175,6 @@ void lint_length_offsets(const std::vector<LintBlock>& blocks, const std::string
       change_line = b.line;
     }
     const bool g43 = b.has_code('G', 430) || b.has_code('G', 434) || b.has_code('G', 435);
-    if (b.has_code('G', 490)) needed = expect && loaded >= 0;
     if (g43) {
       needed = false;
       const LintWord* h = b.find('H');
@@ -157,7 +195,8 @@ void lint_length_offsets(const std::vector<LintBlock>& blocks, const std::string
       needed = false;
     }
   }
-  if (matches > 0) out.insert(out.end(), mismatches.begin(), mismatches.end());
+  if (strict || (matches >= 2 && mismatches.size() * 3 <= static_cast<std::size_t>(matches)))
+    out.insert(out.end(), mismatches.begin(), mismatches.end());
 }
 
 // Coordinates written without a decimal point in a program that otherwise writes them: on a
@@ -212,11 +251,11 @@ std::vector<LintFinding> lint_text(std::string_view text, const std::string& fil
                                    const LintSettings& settings) {
   const std::vector<LintBlock> blocks = lint_blocks(text);
   std::vector<LintFinding> out;
-  lint_units(blocks, file, out);
+  lint_units(blocks, file, settings.strict, out);
   bool uses_g43 = settings.expect_g43;
   for (const LintBlock& b : blocks)
     uses_g43 = uses_g43 || b.has_code('G', 430) || b.has_code('G', 434) || b.has_code('G', 435);
-  lint_length_offsets(blocks, file, uses_g43, out);
+  lint_length_offsets(blocks, file, uses_g43, settings.strict, out);
   lint_decimal_points(blocks, file, settings, out);
   std::stable_sort(out.begin(), out.end(),
                    [](const LintFinding& a, const LintFinding& b) { return a.line < b.line; });

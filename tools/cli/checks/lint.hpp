@@ -26,6 +26,10 @@ struct LintSettings {
   // The machine file's "decimal_point_input": true (calculator input: X102 is 102 mm), false
   // (X102 is 102 least increments, 0.102 mm), unset (not known: integers are only warned about).
   std::optional<bool> decimal_point_input;
+  // Every units switch and every G43 H that is not the loaded tool's (diff, where findings the
+  // reference program shares are dropped); otherwise only those that look like mistakes (a
+  // switch whose coordinates keep the other unit's sizes; an H unlike the program's other G43s).
+  bool strict = false;
 };
 
 // What the program text says about itself (no interpretation): also used by diff to expect
