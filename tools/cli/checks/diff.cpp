@@ -323,6 +323,7 @@ std::vector<std::string> text_lines(std::string_view text) {
 void lint_both(DiffRun& run, const gcode::MachineConfig& machine) {
   LintSettings settings;
   settings.decimal_point_input = machine.decimal_point_input;
+  settings.linuxcnc = machine.dialect == gcode::Dialect::linuxcnc;
   settings.expect_g43 = program_uses_g43(run.text_a);
   settings.strict = true;
   run.lint_a = lint_text(run.text_a, run.file_a, settings);
@@ -506,6 +507,7 @@ int run_lint(const LintOptions& options) {
     check_output_path("--report", options.report, files_read(options, input));
   LintSettings settings;
   settings.decimal_point_input = input.machine.decimal_point_input;
+  settings.linuxcnc = input.machine.dialect == gcode::Dialect::linuxcnc;
   std::vector<LintFinding> findings;
   for (const fs::path& file : input.files) {
     std::vector<LintFinding> own =

@@ -171,7 +171,7 @@ void lint_length_offsets(const std::vector<LintBlock>& blocks, const std::string
     if (const LintWord* t = b.find('T'); t && !b.parametric) selected = static_cast<int>(t->value);
     if (b.has_code('M', 60) && selected >= 0) {
       loaded = selected;
-      needed = expect;
+      needed = expect && loaded > 0;  // T0 M6 empties the spindle
       change_line = b.line;
     }
     const bool g43 = b.has_code('G', 430) || b.has_code('G', 434) || b.has_code('G', 435);
@@ -204,7 +204,7 @@ void lint_length_offsets(const std::vector<LintBlock>& blocks, const std::string
 // increments, 0.102 mm. Zero means the same either way; K is a repeat count in a canned cycle.
 void lint_decimal_points(const std::vector<LintBlock>& blocks, const std::string& file,
                          const LintSettings& settings, std::vector<LintFinding>& out) {
-  if (settings.decimal_point_input == true) return;
+  if (settings.decimal_point_input == true || settings.linuxcnc) return;
   constexpr std::string_view kCoordinates = "XYZIJKRABCUVW";
   std::vector<std::pair<int, std::string>> integers;
   long long decimals = 0;
@@ -225,8 +225,9 @@ void lint_decimal_points(const std::vector<LintBlock>& blocks, const std::string
         integers.emplace_back(b.line, w.text);
     }
   }
-  // "Otherwise writes decimals": at least 20 coordinates with a point for each without one.
-  if (decimals < 20 || static_cast<double>(integers.size()) * 20 > static_cast<double>(decimals))
+  // "Otherwise writes decimals": at least 100 coordinates with a point for each without one (a
+  // post formats every coordinate alike; a hand-written program mixes Z1 with X1.25).
+  if (decimals < 100 || static_cast<double>(integers.size()) * 100 > static_cast<double>(decimals))
     return;
   for (const auto& [line, text] : integers)
     out.push_back(

@@ -30,6 +30,8 @@ struct LintSettings {
   // reference program shares are dropped); otherwise only those that look like mistakes (a
   // switch whose coordinates keep the other unit's sizes; an H unlike the program's other G43s).
   bool strict = false;
+  // LinuxCNC reads X102 as 102 units always (no decimal-point-input setting): integers are fine.
+  bool linuxcnc = false;
 };
 
 // What the program text says about itself (no interpretation): also used by diff to expect
