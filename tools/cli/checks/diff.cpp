@@ -285,7 +285,9 @@ struct DiffRun {
 
 void attribute_region(DiffRegion& region, DiffRun& run, const std::map<int, int>& tools_a,
                       const std::map<int, int>& tools_b) {
-  const double slack = run.a.lattice.spacing;
+  // The probes lie inside the region, so the moves that cut it reach them; the slack absorbs
+  // the Z-map's grid only.
+  const double slack = 0.25 * run.a.lattice.spacing;
   const SimulationResult& cutter = region.removed ? run.b : run.a;
   const std::map<int, int> cut = reaching_lines(region.probes, cutter, slack);
   std::set<int>& own = region.removed ? region.lines_b : region.lines_a;
