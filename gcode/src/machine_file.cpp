@@ -243,12 +243,10 @@ MachineConfig parse(const json& doc, const std::string& file) {
       } else {
         machine_error(where, ": \"far\", \"in_place\" or [x, y, z], got ", value.dump());
       }
-    } else if (key == "tool_loads_on_t") {
+    } else if (key == "tool_loads_on_t" || key == "decimal_point_input") {  // DPI: param. 3401
       if (!value.is_boolean()) machine_error(where, ": must be true or false, got ", value.dump());
-      m.tool_loads_on_t = value.get<bool>();
-    } else if (key == "decimal_point_input") {  // Fanuc parameter 3401 bit 0 (DPI)
-      if (!value.is_boolean()) machine_error(where, ": must be true or false, got ", value.dump());
-      m.decimal_point_input = value.get<bool>();
+      (key == "tool_loads_on_t" ? m.tool_loads_on_t : m.decimal_point_input.emplace()) =
+          value.get<bool>();
     } else if (key == "initial_tool") {  // the tool in the spindle at start (CAMotics: 1)
       m.initial_tool = tool_number(value, where);
       m.initial_tool_stated = true;

@@ -179,6 +179,34 @@ void add_simulate(CLI::App& command, SimulateOptions& options) {
   add_max_memory(command, options.max_memory);
 }
 
+// issue 39: `diff` (simulate's options for both programs) and `lint`.
+std::pair<CLI::App*, CLI::App*> add_diff_and_lint(CLI::App& app, DiffOptions& diff,
+                                                  LintOptions& lint) {
+  CLI::App* dif = app.add_subcommand(
+      "diff",
+      "simulate two programs on A's stock, lattice and tools and compare the solids: regions that\n"
+      "differ with their lines in each program, and the post lint of B; exit status 3 when they\n"
+      "differ");
+  add_simulate(*dif, diff);
+  dif->add_option("PROGRAM_B", diff.program_b, "the program to compare with PROGRAM")
+      ->required()
+      ->check(kNotEmpty);
+  dif->add_option("--tolerance", diff.tolerance,
+                  "a span of material longer than this along a dexel ray is a difference, mm\n"
+                  "(default: half the dexel spacing)")
+      ->check(kFinitePositive);
+  dif->add_option("--report", diff.report, "write the JSON report of the comparison")
+      ->check(kNotEmpty);
+  CLI::App* lnt = app.add_subcommand(
+      "lint",
+      "post-processor mistakes at file:line: units changed mid-program, G43 H missing or not\n"
+      "the tool's, integer coordinates, arc centres of the other G90.1/G91.1 mode; exit status 3\n"
+      "when any is found");
+  add_common(*lnt, lint);
+  lnt->add_option("--report", lint.report, "write the findings as JSON")->check(kNotEmpty);
+  return {dif, lnt};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -259,31 +287,9 @@ int main(int argc, char** argv) {
   grp->add_option("-o,--output", groups.output, "write to a file instead of stdout")
       ->check(kNotEmpty);
 
-  // issue 39: diff, lint.
   DiffOptions diff;
-  CLI::App* dif = app.add_subcommand(
-      "diff",
-      "simulate two programs on A's stock, lattice and tools and compare the solids: regions that\n"
-      "differ with their lines in each program, and the post lint of B; exit status 3 when they\n"
-      "differ");
-  add_simulate(*dif, diff);
-  dif->add_option("PROGRAM_B", diff.program_b, "the program to compare with PROGRAM")
-      ->required()
-      ->check(kNotEmpty);
-  dif->add_option("--tolerance", diff.tolerance,
-                  "a span of material longer than this along a dexel ray is a difference, mm\n"
-                  "(default: half the dexel spacing)")
-      ->check(kFinitePositive);
-  dif->add_option("--report", diff.report, "write the JSON report of the comparison")
-      ->check(kNotEmpty);
   LintOptions lint;
-  CLI::App* lnt = app.add_subcommand(
-      "lint",
-      "post-processor mistakes at file:line: units changed mid-program, G43 H missing or not\n"
-      "the tool's, integer coordinates, arc centres of the other G90.1/G91.1 mode; exit status 3\n"
-      "when any is found");
-  add_common(*lnt, lint);
-  lnt->add_option("--report", lint.report, "write the findings as JSON")->check(kNotEmpty);
+  const auto [dif, lnt] = add_diff_and_lint(app, diff, lint);
 
   try {
     app.parse(argc, argv);
