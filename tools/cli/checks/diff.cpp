@@ -14,6 +14,7 @@
 // lint (lint.hpp), counted when program B has them and A does not.
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <cstdio>
 #include <iostream>
 #include <map>
@@ -473,6 +474,12 @@ int run_diff(const DiffOptions& options) {
     run.b = simulate_program(for_b, progress, request);
   } catch (const gcode::GcodeError& e) {
     run.error_b = lint_error_finding(e.where.file, e.where.line, e.where.message);
+  } catch (const InputError& e) {  // B names a tool the table lacks, runs past --max-moves, …
+    const std::string message = e.what();
+    const std::size_t at = message.find(run.file_b + ":");  // "bug.nc:63: tool 7 is …"
+    const int line =
+        at == std::string::npos ? 0 : std::atoi(message.c_str() + at + run.file_b.size() + 1);
+    run.error_b = LintFinding{run.file_b, line, "program_error", message};
   }
   run.tolerance = options.tolerance > 0 ? options.tolerance : 0.5 * run.a.lattice.spacing;
   run.tolerance_source = options.tolerance > 0 ? "given" : "half the dexel spacing; --tolerance";

@@ -178,6 +178,12 @@ void lint_length_offsets(const std::vector<LintBlock>& blocks, const std::string
     if (g43) {
       needed = false;
       const LintWord* h = b.find('H');
+      // G43 without H: LinuxCNC applies the loaded tool's length, a Fanuc no new one; only diff
+      // (strict), where the reference program writes an H here, calls it missing.
+      if (!h && strict && loaded > 0)
+        out.push_back({file, b.line, "g43_missing",
+                       "G43 without H after the tool change at line " +
+                           std::to_string(change_line) + " (T" + std::to_string(loaded) + ")"});
       if (h && loaded > 0 && !b.parametric) {
         if (static_cast<int>(h->value) == loaded)
           ++matches;
@@ -227,7 +233,11 @@ void lint_decimal_points(const std::vector<LintBlock>& blocks, const std::string
   }
   // "Otherwise writes decimals": at least 100 coordinates with a point for each without one (a
   // post formats every coordinate alike; a hand-written program mixes Z1 with X1.25).
-  if (decimals < 100 || static_cast<double>(integers.size()) * 100 > static_cast<double>(decimals))
+  // In diff (strict) the reference's own integers are not counted against B, so a program with
+  // one integer in ten coordinates is still checked.
+  const double ratio = settings.strict ? 10 : 100;
+  if (decimals < (settings.strict ? 20 : 100) ||
+      static_cast<double>(integers.size()) * ratio > static_cast<double>(decimals))
     return;
   for (const auto& [line, text] : integers)
     out.push_back(
