@@ -228,6 +228,48 @@ TEST_CASE("lint: a stray G20 in a millimetre program, H of another tool, decimal
   CHECK(cli::lint_text(join(lines), "p.nc", calculator).size() == 2);
 }
 
+// `moves A --diff B`'s JSON lines.
+std::vector<json> moves_diff(const fs::path& dir, const std::vector<std::string>& b, int status) {
+  write_text(dir / "clean.nc", join(example_excerpt()));
+  write_text(dir / "other.nc", join(b));
+  CommandResult r =
+      run_tridex({"moves", (dir / "clean.nc").string(), "--diff", (dir / "other.nc").string(),
+                  "--tools", (kExamples / "mold_3plus2.tools.json").string()},
+                 dir);
+  CHECK(r.status == status);
+  std::vector<json> records;
+  for (const std::string& line : split(r.out)) records.push_back(json::parse(line));
+  return records;
+}
+
+TEST_CASE("moves --diff: a swapped block is one move, a split arc none") {
+  const fs::path dir = scratch("moves-diff");
+  std::vector<json> same = moves_diff(dir, example_excerpt(), 0);
+  REQUIRE(same.size() == 1);
+  CHECK(same[0]["summary"]["changes"] == 0);
+
+  std::vector<std::string> b = example_excerpt();
+  const std::size_t slot = find_line(b, "(+X TILTED 20 DEG SLOT, 8 MM BALL END)");
+  const std::size_t groove = find_line(b, "(+X TILTED 20 DEG CIRCULAR GROOVE, 4 MM BALL END)");
+  const std::size_t wave = find_line(b, "(+X TILTED 20 DEG ENGRAVE A WAVE, 2 MM BALL END)");
+  std::rotate(b.begin() + static_cast<std::ptrdiff_t>(slot),
+              b.begin() + static_cast<std::ptrdiff_t>(groove),
+              b.begin() + static_cast<std::ptrdiff_t>(wave));
+  std::vector<json> swapped = moves_diff(dir, b, 3);
+  REQUIRE(swapped.size() == 2);
+  CHECK(swapped[0]["change"] == "moved");
+  CHECK(swapped[1]["summary"]["changes"] == 1);
+
+  b = example_excerpt();
+  const std::size_t arc = find_line(b, "G2 X22.56 Y6.5 I-4.08 J0. F1800");
+  b[arc] = "G2 X26.64 Y2.42 I-4.08 J0. F1800";
+  b.insert(b.begin() + static_cast<std::ptrdiff_t>(arc) + 1, "G2 X22.56 Y6.5 I0. J4.08");
+  std::vector<json> split_arc = moves_diff(dir, b, 0);
+  REQUIRE(split_arc.size() == 1);
+  CHECK(split_arc[0]["summary"]["splits"] == 1);
+  fs::remove_all(dir);
+}
+
 TEST_CASE("line alignment: a moved line is one deletion and one insertion") {
   const cli::LineAlignment a = cli::align_lines("A\nB\nC\nD\nE\n", "A\nC\nD\nB\nE\n");
   CHECK(a.changed_a == std::vector<char>{0, 0, 1, 0, 0, 0});

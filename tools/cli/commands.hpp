@@ -36,6 +36,7 @@ struct CommonOptions {
 
 struct ListOptions : CommonOptions {
   std::string output = "-";  // "-" for stdout
+  std::string diff;          // moves --diff B: the moves aligned with B's (issue 39)
 };
 
 struct SimulateOptions : CommonOptions {
@@ -90,6 +91,7 @@ int run_groups(const ListOptions& options);
 int run_simulate(const SimulateOptions& options);
 int run_check(const CheckOptions& options);
 int run_diff(const DiffOptions& options);
+int run_moves_diff(const ListOptions& options);
 int run_lint(const LintOptions& options);
 
 }  // namespace tridex::cli

@@ -279,6 +279,10 @@ int main(int argc, char** argv) {
   add_common(*mov, moves);
   mov->add_option("-o,--output", moves.output, "write to a file instead of stdout")
       ->check(kNotEmpty);
+  mov->add_option("--diff", moves.diff,
+                  "align the moves with program B's by geometry and order: one JSON line per "
+                  "change\n(moved, added, removed, changed) and a summary; exit status 3 on any")
+      ->check(kNotEmpty);
 
   ListOptions groups;
   CLI::App* grp = app.add_subcommand("groups", "print the spindle-direction groups as JSON");

@@ -69,6 +69,24 @@ bool myers_match(const std::vector<int>& x, const std::vector<int>& y, std::vect
 
 }  // namespace
 
+std::vector<int> align_sequences(const std::vector<int>& x, const std::vector<int>& y,
+                                 bool* exact) {
+  const int n = static_cast<int>(x.size()), m = static_cast<int>(y.size());
+  std::vector<int> x_to_y(x.size(), -1);
+  int head = 0;
+  while (head < n && head < m && x[head] == y[head]) x_to_y[head] = head, ++head;
+  int tail = 0;
+  while (tail < n - head && tail < m - head && x[n - 1 - tail] == y[m - 1 - tail])
+    x_to_y[n - 1 - tail] = m - 1 - tail, ++tail;
+  std::vector<int> mx(x.begin() + head, x.end() - tail), my(y.begin() + head, y.end() - tail);
+  std::vector<int> middle(mx.size(), -1);
+  const bool found = myers_match(mx, my, middle);
+  if (exact) *exact = found;
+  for (std::size_t i = 0; i < middle.size(); ++i)
+    if (middle[i] >= 0) x_to_y[head + i] = middle[i] + head;
+  return x_to_y;
+}
+
 std::string normalized_block(std::string_view line) {
   std::string out;
   bool comment = false;
@@ -104,18 +122,8 @@ LineAlignment align_lines(std::string_view a_text, std::string_view b_text) {
     y.push_back(ids.emplace(normalized_block(line), ids.size()).first->second);
   const int blank = ids.emplace("", ids.size()).first->second;
   const int n = static_cast<int>(x.size()), m = static_cast<int>(y.size());
-  std::vector<int> x_to_y(x.size(), -1);
-  int head = 0;
-  while (head < n && head < m && x[head] == y[head]) x_to_y[head] = head, ++head;
-  int tail = 0;
-  while (tail < n - head && tail < m - head && x[n - 1 - tail] == y[m - 1 - tail])
-    x_to_y[n - 1 - tail] = m - 1 - tail, ++tail;
-  std::vector<int> mx(x.begin() + head, x.end() - tail), my(y.begin() + head, y.end() - tail);
-  std::vector<int> middle(mx.size(), -1);
   LineAlignment out;
-  out.exact = myers_match(mx, my, middle);
-  for (std::size_t i = 0; i < middle.size(); ++i)
-    if (middle[i] >= 0) x_to_y[head + i] = middle[i] + head;
+  const std::vector<int> x_to_y = align_sequences(x, y, &out.exact);
   out.a_to_b.assign(a.size() + 1, 0);
   out.b_to_a.assign(b.size() + 1, 0);
   out.changed_a.assign(a.size() + 1, 0);

@@ -21,6 +21,11 @@ struct LineAlignment {
 // A line as compared: comments, spaces and a leading N number dropped, letters upper-cased.
 std::string normalized_block(std::string_view line);
 
+// Myers on two sequences of ids: for each entry of x the index of its match in y, or -1.
+// `exact` (optional): false when they differ by more than the edit budget (the middle unmatched).
+std::vector<int> align_sequences(const std::vector<int>& x, const std::vector<int>& y,
+                                 bool* exact = nullptr);
+
 LineAlignment align_lines(std::string_view a, std::string_view b);
 
 // The changed B line nearest before-or-at `line`, and the first after it (0: none).
