@@ -180,8 +180,15 @@ void add_simulate(CLI::App& command, SimulateOptions& options) {
 }
 
 // issue 39: `diff` (simulate's options for both programs) and `lint`.
+// issue 39 also adds `moves --diff B`.
 std::pair<CLI::App*, CLI::App*> add_diff_and_lint(CLI::App& app, DiffOptions& diff,
-                                                  LintOptions& lint) {
+                                                  LintOptions& lint, CLI::App& mov,
+                                                  ListOptions& moves) {
+  mov.add_option("--diff", moves.diff,
+                 "align the moves with program B's by geometry and order: one JSON line per "
+                 "change\n(moved, added, removed, changed) and a summary; exit status 3 on any")
+      ->check(kNotEmpty);
+
   CLI::App* dif = app.add_subcommand(
       "diff",
       "simulate two programs on A's stock, lattice and tools and compare the solids: regions that\n"
@@ -264,6 +271,10 @@ int main(int argc, char** argv) {
          "--clearance", check.clearance,
          "report moves whose shank or holder comes closer than this to the stock, mm (0: none)")
       ->check(kFiniteNonNegative);
+  chk->add_option("--allowance", check.allowance,
+                  "stock to leave on the design, mm: the surface must stand this far outside it,\n"
+                  "within the tolerances (a roughing program; default 0)")
+      ->check(kFiniteNonNegative);
   chk->add_option("-o,--output", check.output, "write the machined result as binary STL")
       ->check(kNotEmpty);
   chk->add_option("--report", check.report, "write the JSON report of the check")->check(kNotEmpty);
@@ -279,10 +290,6 @@ int main(int argc, char** argv) {
   add_common(*mov, moves);
   mov->add_option("-o,--output", moves.output, "write to a file instead of stdout")
       ->check(kNotEmpty);
-  mov->add_option("--diff", moves.diff,
-                  "align the moves with program B's by geometry and order: one JSON line per "
-                  "change\n(moved, added, removed, changed) and a summary; exit status 3 on any")
-      ->check(kNotEmpty);
 
   ListOptions groups;
   CLI::App* grp = app.add_subcommand("groups", "print the spindle-direction groups as JSON");
@@ -293,7 +300,7 @@ int main(int argc, char** argv) {
 
   DiffOptions diff;
   LintOptions lint;
-  const auto [dif, lnt] = add_diff_and_lint(app, diff, lint);
+  const auto [dif, lnt] = add_diff_and_lint(app, diff, lint, *mov, moves);
 
   try {
     app.parse(argc, argv);
