@@ -243,9 +243,10 @@ MachineConfig parse(const json& doc, const std::string& file) {
       } else {
         machine_error(where, ": \"far\", \"in_place\" or [x, y, z], got ", value.dump());
       }
-    } else if (key == "tool_loads_on_t") {
+    } else if (key == "tool_loads_on_t" || key == "decimal_point_input") {  // DPI: param. 3401
       if (!value.is_boolean()) machine_error(where, ": must be true or false, got ", value.dump());
-      m.tool_loads_on_t = value.get<bool>();
+      (key == "tool_loads_on_t" ? m.tool_loads_on_t : m.decimal_point_input.emplace()) =
+          value.get<bool>();
     } else if (key == "initial_tool") {  // the tool in the spindle at start (CAMotics: 1)
       m.initial_tool = tool_number(value, where);
       m.initial_tool_stated = true;
@@ -299,13 +300,13 @@ MachineConfig parse(const json& doc, const std::string& file) {
       for (const json& dir : value)
         m.subprogram_dirs.push_back((base / string_value(dir, where).get<std::string>()).string());
     } else {
-      machine_error(
-          where,
-          ": unknown key (known: name, description, base, dialect, units, start, "
-          "tool_change, tool_loads_on_t, initial_tool, arc_radius_tolerance_mm, d_offsets, home, "
-          "reference2, work_offsets, m_codes, "
-          "forbidden_m_codes, variables, far_distance, subprograms, kinematics, "
-          "rapid_rate_mm_per_min, rapid_rate_deg_per_min, max_feed_mm_per_min)");
+      machine_error(where,
+                    ": unknown key (known: name, description, base, dialect, units, start, "
+                    "tool_change, tool_loads_on_t, decimal_point_input, initial_tool, "
+                    "arc_radius_tolerance_mm, "
+                    "d_offsets, home, reference2, work_offsets, m_codes, "
+                    "forbidden_m_codes, variables, far_distance, subprograms, kinematics, "
+                    "rapid_rate_mm_per_min, rapid_rate_deg_per_min, max_feed_mm_per_min)");
     }
   }
   for (int code : m.m_codes)

@@ -211,21 +211,36 @@ Interpreter::State::ArcData Interpreter::State::arc_data(const Vec3& start, bool
     if (!(r0 > 1e-9))
       error(context.motion_column, "zero-radius arc: the centre is the start point");
     if (!(r1 > 1e-9)) error(context.motion_column, "zero-radius arc: the centre is the end point");
-    double err = std::abs(r1 - r0);
-    if (machine.dialect == Dialect::linuxcnc && !machine.arc_radius_tolerance) {
-      // LinuxCNC 2.9 (interp_arc.cc arc_data_ijk) cuts a spiral where the radii differ by up to
-      // 0.002·√2 in (0.02·√2 mm under G21), or by 100 times that within 0.1 % of the radius.
-      double spiral = (modal.unit == 1.0 ? 0.02 : 0.002 * 25.4) * std::numbers::sqrt2;
-      if (err > 100 * spiral || (err / std::max(r0, r1) > 0.001 && err > spiral))
-        error(context.motion_column, "arc end radius " + format_number(r1) +
-                                         " differs from start radius " + format_number(r0) +
-                                         " by more than LinuxCNC's spiral tolerance (" +
-                                         format_number(spiral) + " mm, or 0.1 % of the radius)");
-    } else if (err > arc_radius_tolerance()) {
-      error(context.motion_column, "arc end radius " + format_number(r1) +
-                                       " differs from start radius " + format_number(r0) +
-                                       " by more than " + format_number(arc_radius_tolerance()) +
-                                       " mm (" + arc_tolerance_source() + ")");
+    // LinuxCNC 2.9 (interp_arc.cc arc_data_ijk) cuts a spiral where the radii differ by up to
+    // 0.002·√2 in (0.02·√2 mm under G21), or by 100 times that within 0.1 % of the radius.
+    const bool linuxcnc = machine.dialect == Dialect::linuxcnc && !machine.arc_radius_tolerance;
+    const double spiral = (modal.unit == 1.0 ? 0.02 : 0.002 * 25.4) * std::numbers::sqrt2;
+    auto radii_disagree = [&](const Vec2& centre) {
+      const double a = glm::length(s - centre), b = glm::length(e - centre);
+      const double d = std::abs(b - a);
+      return linuxcnc ? d > 100 * spiral || (d / std::max(a, b) > 0.001 && d > spiral)
+                      : d > arc_radius_tolerance();
+    };
+    if (radii_disagree(c)) {
+      // A post that writes absolute centres without G90.1 (or incremental ones under it) makes
+      // the radii disagree; say so when the words fit as the other mode's centre (issue 39).
+      std::string hint;
+      if (!modal.arc_absolute && w.has(cu) && w.has(cv) &&
+          !radii_disagree(Vec2(length(cu), length(cv))))
+        hint = "; the " + std::string(1, cu) + "/" + cv +
+               " words fit as absolute centres: is G90.1 missing?";
+      if (modal.arc_absolute &&
+          !radii_disagree(s + Vec2(w.has(cu) ? length(cu) : 0.0, w.has(cv) ? length(cv) : 0.0)))
+        hint = "; the " + std::string(1, cu) + "/" + cv +
+               " words fit as incremental centres: is G91.1 missing?";
+      error(context.motion_column,
+            "arc end radius " + format_number(r1) + " differs from start radius " +
+                format_number(r0) + " by more than " +
+                (linuxcnc ? "LinuxCNC's spiral tolerance (" + format_number(spiral) +
+                                " mm, or 0.1 % of the radius)"
+                          : format_number(arc_radius_tolerance()) + " mm (" +
+                                arc_tolerance_source() + ")") +
+                hint);
     }
   } else {
     double r = length('R');

@@ -130,4 +130,37 @@ TEST_CASE("check: the bundled example passes against its design; a 4.1 mm T3 gou
   fs::remove_all(dir);
 }
 
+// --allowance (issue 39): a roughing pass that leaves 0.3 mm on a faced plane passes with
+// --allowance 0.3, and fails without it (excess) or with 0.5 (less left than asked: a gouge).
+TEST_CASE("check --allowance: a faced plane left 0.3 mm high") {
+  fs::path dir = scratch("check-allowance");
+  write_text(dir / "tools.json", R"({"1": {"shape": "cylindrical", "diameter": 10}})");
+  write_text(dir / "face.nc", facing_program());
+  write_text(dir / "design.stl", box_stl(0, 0, -10, 40, 40, -1.3));
+  auto run = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args = {"check",       (dir / "face.nc").string(),
+                                     "--tools",     (dir / "tools.json").string(),
+                                     "--stock",     "box:0,0,-10,40,40,0",
+                                     "--design",    (dir / "design.stl").string(),
+                                     "--dexel-res", "100",
+                                     "--report",    (dir / "report.json").string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    CommandResult r = run_tridex(args, dir);
+    json report = json::parse(slurp(dir / "report.json"));
+    fs::remove(dir / "report.json");
+    return std::pair(r.status, report);
+  };
+  const auto [plain, plain_report] = run({});
+  CHECK(plain == 3);
+  CHECK(!plain_report["excess"].empty());
+  CHECK(!plain_report.contains("allowance_mm"));
+  const auto [left, left_report] = run({"--allowance", "0.3"});
+  CHECK(left == 0);
+  CHECK(left_report["allowance_mm"].get<double>() == doctest::Approx(0.3));
+  const auto [short_of, short_report] = run({"--allowance", "0.5"});
+  CHECK(short_of == 3);
+  CHECK(!short_report["gouges"].empty());
+  fs::remove_all(dir);
+}
+
 }  // namespace test_check_tolerance

@@ -36,6 +36,7 @@ struct CommonOptions {
 
 struct ListOptions : CommonOptions {
   std::string output = "-";  // "-" for stdout
+  std::string diff;          // moves --diff B: the moves aligned with B's (issue 39)
 };
 
 struct SimulateOptions : CommonOptions {
@@ -63,6 +64,19 @@ struct CheckOptions : SimulateOptions {
   std::string ply;                       // --ply OUT.ply: the machined mesh coloured by deviation
   std::string envelope;                  // --envelope box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX
   double clearance = kDefaultClearance;  // --clearance: near misses of shanks and holders, mm
+  double allowance = 0;                  // --allowance: stock to leave on the design, mm (issue 39)
+};
+
+// `diff` (issue 39): simulate's options for both programs (PROGRAM is A), B's solid compared
+// with A's on A's stock and lattice.
+struct DiffOptions : SimulateOptions {
+  std::string program_b;
+  double tolerance = 0;  // --tolerance, mm; 0: half the dexel spacing
+};
+
+// `lint`: the post lint of a program (checks/lint.hpp).
+struct LintOptions : CommonOptions {
+  std::string report;  // --report FILE: the findings as JSON
 };
 
 // check's default verdict tolerance, mm: a shop's usual ±0.02 mm on a milled surface (ISO 2768-f
@@ -77,5 +91,8 @@ int run_moves(const ListOptions& options);
 int run_groups(const ListOptions& options);
 int run_simulate(const SimulateOptions& options);
 int run_check(const CheckOptions& options);
+int run_diff(const DiffOptions& options);
+int run_moves_diff(const ListOptions& options);
+int run_lint(const LintOptions& options);
 
 }  // namespace tridex::cli

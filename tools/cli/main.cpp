@@ -179,6 +179,41 @@ void add_simulate(CLI::App& command, SimulateOptions& options) {
   add_max_memory(command, options.max_memory);
 }
 
+// issue 39: `diff` (simulate's options for both programs) and `lint`.
+// issue 39 also adds `moves --diff B`.
+std::pair<CLI::App*, CLI::App*> add_diff_and_lint(CLI::App& app, DiffOptions& diff,
+                                                  LintOptions& lint, CLI::App& mov,
+                                                  ListOptions& moves) {
+  mov.add_option("--diff", moves.diff,
+                 "align the moves with program B's by geometry and order: one JSON line per "
+                 "change\n(moved, added, removed, changed) and a summary; exit status 3 on any")
+      ->check(kNotEmpty);
+
+  CLI::App* dif = app.add_subcommand(
+      "diff",
+      "simulate two programs on A's stock, lattice and tools and compare the solids: regions that\n"
+      "differ with their lines in each program, and the post lint of B; exit status 3 when they\n"
+      "differ");
+  add_simulate(*dif, diff);
+  dif->add_option("PROGRAM_B", diff.program_b, "the program to compare with PROGRAM")
+      ->required()
+      ->check(kNotEmpty);
+  dif->add_option("--tolerance", diff.tolerance,
+                  "a span of material longer than this along a dexel ray is a difference, mm\n"
+                  "(default: half the dexel spacing)")
+      ->check(kFinitePositive);
+  dif->add_option("--report", diff.report, "write the JSON report of the comparison")
+      ->check(kNotEmpty);
+  CLI::App* lnt = app.add_subcommand(
+      "lint",
+      "post-processor mistakes at file:line: units changed mid-program, G43 H missing or not\n"
+      "the tool's, integer coordinates, arc centres of the other G90.1/G91.1 mode; exit status 3\n"
+      "when any is found");
+  add_common(*lnt, lint);
+  lnt->add_option("--report", lint.report, "write the findings as JSON")->check(kNotEmpty);
+  return {dif, lnt};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -236,6 +271,10 @@ int main(int argc, char** argv) {
          "--clearance", check.clearance,
          "report moves whose shank or holder comes closer than this to the stock, mm (0: none)")
       ->check(kFiniteNonNegative);
+  chk->add_option("--allowance", check.allowance,
+                  "stock to leave on the design, mm: the surface must stand this far outside it,\n"
+                  "within the tolerances (a roughing program; default 0)")
+      ->check(kFiniteNonNegative);
   chk->add_option("-o,--output", check.output, "write the machined result as binary STL")
       ->check(kNotEmpty);
   chk->add_option("--report", check.report, "write the JSON report of the check")->check(kNotEmpty);
@@ -259,6 +298,10 @@ int main(int argc, char** argv) {
   grp->add_option("-o,--output", groups.output, "write to a file instead of stdout")
       ->check(kNotEmpty);
 
+  DiffOptions diff;
+  LintOptions lint;
+  const auto [dif, lnt] = add_diff_and_lint(app, diff, lint, *mov, moves);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -273,6 +316,8 @@ int main(int argc, char** argv) {
     if (chk->parsed()) return run_check(check);
     if (mov->parsed()) return run_moves(moves);
     if (grp->parsed()) return run_groups(groups);
+    if (dif->parsed()) return run_diff(diff);
+    if (lnt->parsed()) return run_lint(lint);
   } catch (const tridex::gcode::GcodeError& e) {
     std::cerr << terminal_safe(e.what()) << '\n';
     return kBadInput;

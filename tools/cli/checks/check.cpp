@@ -242,6 +242,17 @@ std::string file_name(const SimulationResult& r, int file) {
 }
 
 // The deviation of the machined surface from the design, its colours and its regions.
+// --allowance at `p`: what must be left there at least. Near a box stock's faces, where the design
+// meets the stock's side unmachined, no more than the distance to the face can be left.
+double allowance_at(const CheckOptions& options, const SimulationResult& r, const Vec3& p) {
+  if (options.allowance <= 0 || r.stock.mesh) return options.allowance;
+  double least = options.allowance;
+  for (int a = 0; a < 3; ++a)
+    least =
+        std::min({least, std::abs(p[a] - r.stock.box.min[a]), std::abs(p[a] - r.stock.box.max[a])});
+  return least;
+}
+
 void measure_deviation(const CheckOptions& options, const SimulationResult& r, const Mesh& design,
                        Progress& progress, CheckFindings& f) {
   const Mesh& mesh = r.mesh;
@@ -259,8 +270,11 @@ void measure_deviation(const CheckOptions& options, const SimulationResult& r, c
   std::vector<char> gouge(deviation.size()), excess(deviation.size());
   f.colours.assign(deviation.size(), kOkColour);
   for (std::size_t v = 0; v < deviation.size(); ++v) {
-    gouge[v] = deviation[v] < -f.gouge_tol;
-    excess[v] = deviation[v] > f.excess_tol;
+    // --allowance: a machined surface should stand that far outside the design (issue 39); the
+    // stock's own faces, where the design meets them, are not machined.
+    const double allowance = allowance_at(options, r, Vec3(mesh.positions[v]));
+    gouge[v] = deviation[v] < allowance - f.gouge_tol;
+    excess[v] = deviation[v] > options.allowance + f.excess_tol;
     if (gouge[v]) f.colours[v] = kGougeColour;
     if (excess[v]) f.colours[v] = kExcessColour;
   }
@@ -292,10 +306,11 @@ void measure_design_side(const CheckOptions& options, const SimulationResult& r,
   long long missing = 0, left = 0;
   double missing_depth = 0, left_depth = 0;
   for (std::size_t k = 0; k < design_deviation.size(); ++k) {
-    if (design_deviation[k] < -f.gouge_tol)
+    const double allowance = allowance_at(options, r, samples[k]);
+    if (design_deviation[k] < allowance - f.gouge_tol)
       ++missing, missing_box.extend(samples[k]),
           missing_depth = std::max(missing_depth, -design_deviation[k]);
-    if (design_deviation[k] > f.excess_tol)
+    if (design_deviation[k] > options.allowance + f.excess_tol)
       ++left, left_box.extend(samples[k]), left_depth = std::max(left_depth, design_deviation[k]);
   }
   if (mesh.triangles.empty())
@@ -443,6 +458,7 @@ Json check_report(const CheckOptions& options, const SimulationResult& r,
   report["verdict"] = failed ? "fail" : "pass";
   report["tolerances_mm"] = {{"gouge", f.gouge_tol}, {"excess", f.excess_tol}};
   report["tolerance_source"] = f.tolerance_source;
+  if (options.allowance > 0) report["allowance_mm"] = options.allowance;
   report["stock"] = r.stock.description;
   report["segments"] = r.segments;
   report["dexel"] = {{"cell_mm", r.lattice.spacing},

@@ -58,6 +58,7 @@ void print_warnings(const std::vector<std::string>& warnings, bool quiet) {
 }  // namespace
 
 int run_moves(const ListOptions& options) {
+  if (!options.diff.empty()) return run_moves_diff(options);
   ProgramInput input = resolve_program(options);
   check_output(options, input);
   InterpretResult result;

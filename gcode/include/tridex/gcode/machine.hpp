@@ -6,9 +6,9 @@
 //
 // The machine file is a JSON object; every key is optional: "name", "description", "base" (a
 // bundled machine to start from), "dialect", "units", "linear_units", "start", "tool_change",
-// "tool_loads_on_t", "initial_tool", "arc_radius_tolerance_mm", "d_offsets", "g53", "home",
-// "reference2", "work_offsets", "m_codes", "forbidden_m_codes", "variables", "far_distance",
-// "subprograms" (folders relative to the file), "kinematics" and the speeds
+// "tool_loads_on_t", "decimal_point_input", "initial_tool", "arc_radius_tolerance_mm", "d_offsets",
+// "g53", "home", "reference2", "work_offsets", "m_codes", "forbidden_m_codes", "variables",
+// "far_distance", "subprograms" (folders relative to the file), "kinematics" and the speeds
 // "rapid_rate_mm_per_min", "rapid_rate_deg_per_min", "max_feed_mm_per_min".
 //
 // Key "kinematics" (issue 11's machine file; see gcode/README.md, "Machine kinematics"): either
@@ -105,6 +105,10 @@ struct MachineConfig {
   ToolChange tool_change = ToolChange::retract_far;
   Vec3 tool_change_position{0.0};  // machine coordinates, for ToolChange::to_position
   bool tool_loads_on_t = false;    // the control loads a tool on T alone (no M6 needed)
+  // Fanuc's decimal-point input (parameter 3401 bit 0): true, X102 is 102 mm (calculator input);
+  // false, X102 is 102 least increments (0.102 mm). Unset: not known. The interpreter reads an
+  // integer as whole units either way; `tridex lint` and `diff` flag integers (issue 39).
+  std::optional<bool> decimal_point_input;
   // How far an I/J/K arc's end may lie off its circle (mm) before the control alarms; within it
   // the arc is cut as a spiral. Unset: the dialect's rule (docs/gcode.md, "Arcs"): Fanuc and
   // Haas 0.020 mm under G21 and 0.0020 in under G20 (Fanuc's parameter 3410, in the input unit,

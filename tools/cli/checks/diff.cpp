@@ -1,0 +1,551 @@
+// tridex diff — did my post change the part? (issue 39). Two programs simulated on the same
+// stock, dexel lattice and tools (pipeline.hpp); their triple dexels compared ray by ray: where
+// one solid has material and the other not for longer than the tolerance along a ray, the span is
+// a difference sample. Samples whose lattice nodes touch (26-neighbours) form a region; its volume
+// is the larger of the three ray directions' sums (each direction alone misses walls parallel to
+// it), its deepest point the middle of its longest span.
+//
+// Each region is attributed to lines: the moves of the program that removed the material there
+// (those whose swept cutter reaches the region's deepest samples, as `check` finds a gouge's
+// moves), their counterparts in the other program by the two texts' line alignment
+// (line_alignment.hpp), and the changed lines that govern them: the nearest change at or before
+// each such line (a G68.2, a tool change, a G20 that moves everything after it) and a change right
+// after the last (a tool change moved later). Post mistakes that change no volume come from the
+// lint (lint.hpp), counted when program B has them and A does not.
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <queue>
+#include <set>
+#include <unordered_map>
+
+#include "checks/line_alignment.hpp"
+#include "checks/lint.hpp"
+#include "commands.hpp"
+#include "errors.hpp"
+#include "inputs/json_input.hpp"
+#include "outputs/output.hpp"
+#include "pipeline/pipeline.hpp"
+#include "tridex/detail/move_geometry.hpp"
+
+namespace tridex::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr std::size_t kDiffRegionsListed = 100;
+constexpr std::size_t kDiffRegionsWithLines = 20;
+constexpr std::size_t kDiffProbes = 16;
+constexpr std::size_t kDiffLinesListed = 200;
+
+// A span along one ray where the two solids differ.
+struct DiffSpan {
+  int axis = 0, iu = 0, iv = 0;
+  float from = 0, to = 0;
+  bool removed = false;  // material in A that B removed (else material B left that A removed)
+  Vec3 point(const TripleDexel& d, double t) const {
+    Vec3 p = d.node(0, 0, 0);
+    p[TripleDexel::u_axis(axis)] += d.spacing * iu;
+    p[TripleDexel::v_axis(axis)] += d.spacing * iv;
+    p[axis] = t;
+    return p;
+  }
+};
+
+struct DiffRegion {
+  bool removed = false;
+  std::vector<std::size_t> spans;  // into the span list
+  double volume = 0, depth = 0;
+  Vec3 deepest{0};
+  Aabb box;
+  std::vector<Vec3> probes;
+  std::set<int> lines_a, lines_b, changed_a, changed_b, tools_a, tools_b;
+};
+
+// The spans of one ray where exactly one of `a` and `b` holds material, longer than `tolerance`.
+void ray_differences(std::span<const DexelInterval> a, std::span<const DexelInterval> b,
+                     DiffSpan base, double tolerance, std::vector<DiffSpan>& out) {
+  if (a.size() == b.size() &&
+      std::equal(a.begin(), a.end(), b.begin(), [](const DexelInterval& p, const DexelInterval& q) {
+        return p.enter == q.enter && p.exit == q.exit;
+      }))
+    return;
+  std::vector<float> cuts;
+  for (const DexelInterval& i : a) cuts.push_back(i.enter), cuts.push_back(i.exit);
+  for (const DexelInterval& i : b) cuts.push_back(i.enter), cuts.push_back(i.exit);
+  std::sort(cuts.begin(), cuts.end());
+  cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
+  auto inside = [](std::span<const DexelInterval> s, float t) {
+    for (const DexelInterval& i : s)
+      if (i.enter <= t && t <= i.exit) return true;
+    return false;
+  };
+  int state = 0, state_from = 0;  // 0 same, 1 removed, 2 left
+  float from = 0;
+  auto close = [&](float at) {
+    if (state != 0 && at - from > tolerance) {
+      DiffSpan s = base;
+      s.from = from, s.to = at, s.removed = state == 1;
+      out.push_back(s);
+    }
+  };
+  for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
+    const float mid = 0.5f * (cuts[k] + cuts[k + 1]);
+    const bool in_a = inside(a, mid), in_b = inside(b, mid);
+    state_from = in_a == in_b ? 0 : in_a ? 1 : 2;
+    if (state_from != state) {
+      close(cuts[k]);
+      state = state_from, from = cuts[k];
+    }
+  }
+  if (!cuts.empty()) close(cuts.back());
+}
+
+std::vector<DiffSpan> solid_differences(const TripleDexel& a, const TripleDexel& b,
+                                        double tolerance) {
+  std::vector<DiffSpan> spans;
+  for (int axis = 0; axis < 3; ++axis) {
+    const DexelGrid& ga = a.grids[axis];
+    const DexelGrid& gb = b.grids[axis];
+    for (int iv = 0; iv < ga.nv; ++iv)
+      for (int iu = 0; iu < ga.nu; ++iu)
+        ray_differences(ga.ray(iu, iv), gb.ray(iu, iv), DiffSpan{axis, iu, iv}, tolerance, spans);
+  }
+  return spans;
+}
+
+// Spans joined into regions through the lattice nodes they cover (26-neighbours, one kind).
+std::vector<DiffRegion> connect_spans(const std::vector<DiffSpan>& spans, const TripleDexel& d) {
+  const glm::ivec3 n = d.n;
+  auto key = [&](glm::ivec3 c, bool removed) {
+    return ((static_cast<std::uint64_t>(c.z) * static_cast<std::uint64_t>(n.y) +
+             static_cast<std::uint64_t>(c.y)) *
+                static_cast<std::uint64_t>(n.x) +
+            static_cast<std::uint64_t>(c.x)) *
+               2 +
+           (removed ? 1u : 0u);
+  };
+  std::unordered_map<std::uint64_t, int> node_region;  // -1: not yet visited
+  std::vector<std::pair<glm::ivec3, bool>> first_node(spans.size());
+  for (std::size_t s = 0; s < spans.size(); ++s) {
+    const DiffSpan& span = spans[s];
+    const int a = span.axis;
+    auto index = [&](double t) {
+      return std::clamp(static_cast<int>(std::floor((t - d.origin[a]) / d.spacing + 0.5)), 0,
+                        n[a] - 1);
+    };
+    int k0 = index(span.from), k1 = index(span.to);
+    if (k1 < k0) k0 = k1 = index(0.5 * (span.from + span.to));
+    glm::ivec3 c(0);
+    c[TripleDexel::u_axis(a)] = span.iu;
+    c[TripleDexel::v_axis(a)] = span.iv;
+    for (int k = k0; k <= k1; ++k) {
+      c[a] = k;
+      node_region.emplace(key(c, span.removed), -1);
+      if (k == k0) first_node[s] = {c, span.removed};
+    }
+  }
+  // Breadth-first over the marked nodes.
+  std::vector<DiffRegion> regions;
+  for (std::size_t s = 0; s < spans.size(); ++s) {
+    const auto [start, removed] = first_node[s];
+    if (node_region.at(key(start, removed)) >= 0) continue;
+    const int id = static_cast<int>(regions.size());
+    DiffRegion region;
+    region.removed = removed;
+    regions.push_back(std::move(region));
+    std::queue<glm::ivec3> queue;
+    queue.push(start);
+    node_region[key(start, removed)] = id;
+    while (!queue.empty()) {
+      const glm::ivec3 c = queue.front();
+      queue.pop();
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const glm::ivec3 m = c + glm::ivec3(dx, dy, dz);
+            if (glm::any(glm::lessThan(m, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(m, n)))
+              continue;
+            auto it = node_region.find(key(m, removed));
+            if (it == node_region.end() || it->second >= 0) continue;
+            it->second = id;
+            queue.push(m);
+          }
+    }
+  }
+  for (std::size_t s = 0; s < spans.size(); ++s) {
+    const auto [start, removed] = first_node[s];
+    regions[static_cast<std::size_t>(node_region.at(key(start, removed)))].spans.push_back(s);
+  }
+  return regions;
+}
+
+// Volume, deepest point, box and probes of each region; the regions largest first.
+void measure_regions(std::vector<DiffRegion>& regions, const std::vector<DiffSpan>& spans,
+                     const TripleDexel& d) {
+  const double area = d.spacing * d.spacing;
+  for (DiffRegion& region : regions) {
+    double by_axis[3] = {0, 0, 0};
+    std::vector<std::size_t> order = region.spans;
+    for (std::size_t s : order) {
+      const DiffSpan& span = spans[s];
+      by_axis[span.axis] += (span.to - span.from) * area;
+      region.box.extend(span.point(d, span.from));
+      region.box.extend(span.point(d, span.to));
+    }
+    region.volume = std::max({by_axis[0], by_axis[1], by_axis[2]});
+    std::sort(order.begin(), order.end(), [&](std::size_t p, std::size_t q) {
+      return spans[p].to - spans[p].from > spans[q].to - spans[q].from;
+    });
+    const DiffSpan& deepest = spans[order.front()];
+    region.depth = deepest.to - deepest.from;
+    region.deepest = deepest.point(d, 0.5 * (deepest.from + deepest.to));
+    for (std::size_t k = 0; k < order.size() && k < kDiffProbes; ++k) {
+      const DiffSpan& span = spans[order[k]];
+      region.probes.push_back(span.point(d, 0.5 * (span.from + span.to)));
+    }
+  }
+  std::stable_sort(regions.begin(), regions.end(),
+                   [](const DiffRegion& p, const DiffRegion& q) { return p.volume > q.volume; });
+}
+
+// Main-file lines (and their tools) of the moves whose swept cutter reaches one of `probes`, as
+// check finds a gouge's moves: p is reached when it lies above the move's swept lower surface in
+// the group's frame, within `slack`.
+std::map<int, int> reaching_lines(const std::vector<Vec3>& probes, const SimulationResult& r,
+                                  double slack) {
+  std::map<int, int> lines;  // line -> tool
+  for (const gcode::MoveGroup& group : r.groups) {
+    std::vector<Vec3> local;
+    for (const Vec3& p : probes) local.push_back(group.frame.to_local(p));
+    const gcode::Move* previous = nullptr;
+    for (const gcode::Move& m : group.moves) {
+      const bool continues = previous && glm::length(previous->end - m.start) < 1e-9;
+      previous = &m;
+      if (m.file != 0) continue;
+      const Cutter& cutter = r.cutters[r.cutter_of_tool.at(m.tool)];
+      Segment tip{group.frame.to_local(m.start), group.frame.to_local(m.end)};
+      const double radius = cutter.radius();
+      for (const Vec3& p : local) {
+        if (p.x < std::min(tip.a.x, tip.b.x) - radius ||
+            p.x > std::max(tip.a.x, tip.b.x) + radius ||
+            p.y < std::min(tip.a.y, tip.b.y) - radius ||
+            p.y > std::max(tip.a.y, tip.b.y) + radius || p.z + slack < std::min(tip.a.z, tip.b.z))
+          continue;
+        detail::MoveGeometry::Lowest lowest = detail::MoveGeometry(cutter, tip).lowest(p.x, p.y);
+        if (p.z + slack >= lowest.z && !(continues && lowest.t <= 1e-9)) {
+          lines.emplace(m.line, m.tool);
+          break;
+        }
+      }
+    }
+  }
+  return lines;
+}
+
+// The tool of the moves of each main-file line.
+std::map<int, int> line_tools(const SimulationResult& r) {
+  std::map<int, int> tools;
+  for (const gcode::MoveGroup& group : r.groups)
+    for (const gcode::Move& m : group.moves)
+      if (m.file == 0) tools.emplace(m.line, m.tool);
+  return tools;
+}
+
+// The changed lines that govern `lines` (header comment): the nearest change at or before each,
+// and the first change after the last when no move line lies between.
+std::set<int> governing_changes(const std::set<int>& lines, const std::vector<char>& changed,
+                                const std::map<int, int>& move_lines) {
+  std::set<int> out;
+  for (int line : lines)
+    if (int c = changed_at_or_before(changed, line); c > 0) out.insert(c);
+  if (!lines.empty())
+    if (int c = changed_after(changed, *lines.rbegin()); c > 0) {
+      auto next_move = move_lines.upper_bound(*lines.rbegin());
+      if (next_move == move_lines.end() || next_move->first >= c) out.insert(c);
+    }
+  return out;
+}
+
+struct DiffRun {
+  SimulationResult a, b;
+  std::string text_a, text_b;
+  std::string file_a, file_b;  // the main files, as the findings name them
+  LineAlignment alignment;
+  std::vector<LintFinding> lint_a, lint_b;  // lint_b: the findings A does not share
+  std::optional<LintFinding> error_b;       // B does not run
+  double tolerance = 0;
+  std::string tolerance_source;
+  std::vector<DiffSpan> spans;
+  std::vector<DiffRegion> regions;
+};
+
+void attribute_region(DiffRegion& region, DiffRun& run, const std::map<int, int>& tools_a,
+                      const std::map<int, int>& tools_b) {
+  // The probes lie inside the region, so the moves that cut it reach them; the slack absorbs
+  // the Z-map's grid only.
+  const double slack = 0.25 * run.a.lattice.spacing;
+  const SimulationResult& cutter = region.removed ? run.b : run.a;
+  const std::map<int, int> cut = reaching_lines(region.probes, cutter, slack);
+  std::set<int>& own = region.removed ? region.lines_b : region.lines_a;
+  std::set<int>& other = region.removed ? region.lines_a : region.lines_b;
+  const std::vector<int>& map = region.removed ? run.alignment.b_to_a : run.alignment.a_to_b;
+  for (const auto& [line, tool] : cut) {
+    own.insert(line);
+    if (line < static_cast<int>(map.size()) && map[static_cast<std::size_t>(line)] > 0)
+      other.insert(map[static_cast<std::size_t>(line)]);
+  }
+  region.changed_a = governing_changes(region.lines_a, run.alignment.changed_a, tools_a);
+  region.changed_b = governing_changes(region.lines_b, run.alignment.changed_b, tools_b);
+  for (int line : region.lines_a)
+    if (auto t = tools_a.find(line); t != tools_a.end()) region.tools_a.insert(t->second);
+  for (int line : region.lines_b)
+    if (auto t = tools_b.find(line); t != tools_b.end()) region.tools_b.insert(t->second);
+  region.lines_a.insert(region.changed_a.begin(), region.changed_a.end());
+  region.lines_b.insert(region.changed_b.begin(), region.changed_b.end());
+}
+
+// Each line's normalized text (line_alignment.hpp), line k at k - 1.
+std::vector<std::string> text_lines(std::string_view text) {
+  std::vector<std::string> lines;
+  std::size_t at = 0;
+  while (at <= text.size()) {
+    std::size_t end = text.find('\n', at);
+    if (end == std::string_view::npos) end = text.size();
+    lines.push_back(normalized_block(text.substr(at, end - at)));
+    at = end + 1;
+  }
+  return lines;
+}
+
+// The lint of both programs; B's findings that A shares (same kind, aligned line) are dropped.
+void lint_both(DiffRun& run, const gcode::MachineConfig& machine) {
+  LintSettings settings;
+  settings.decimal_point_input = machine.decimal_point_input;
+  settings.linuxcnc = machine.dialect == gcode::Dialect::linuxcnc;
+  settings.expect_g43 = program_uses_g43(run.text_a);
+  settings.strict = true;
+  run.lint_a = lint_text(run.text_a, run.file_a, settings);
+  std::vector<LintFinding> all_b = lint_text(run.text_b, run.file_b, settings);
+  // Shared: the same kind at the aligned line, or on a block of the same text (a moved block).
+  const std::vector<std::string> lines_a = text_lines(run.text_a), lines_b = text_lines(run.text_b);
+  std::set<std::pair<std::string, int>> at_line;
+  std::set<std::pair<std::string, std::string>> on_text;
+  for (const LintFinding& f : run.lint_a) {
+    if (f.line < static_cast<int>(run.alignment.a_to_b.size()))
+      at_line.insert({f.code, run.alignment.a_to_b[static_cast<std::size_t>(f.line)]});
+    if (f.line >= 1 && f.line <= static_cast<int>(lines_a.size()))
+      on_text.insert({f.code, lines_a[static_cast<std::size_t>(f.line - 1)]});
+  }
+  for (LintFinding& f : all_b) {
+    const bool shared = at_line.count({f.code, f.line}) ||
+                        (f.line >= 1 && f.line <= static_cast<int>(lines_b.size()) &&
+                         on_text.count({f.code, lines_b[static_cast<std::size_t>(f.line - 1)]}));
+    if (!shared) run.lint_b.push_back(std::move(f));
+  }
+}
+
+Json diff_lines_json(const std::set<int>& lines) {
+  Json out = Json::array();
+  for (int line : lines)
+    if (out.size() < kDiffLinesListed) out.push_back(line);
+  return out;
+}
+
+Json diff_region_json(const DiffRegion& region) {
+  return {{"kind", region.removed ? "removed_by_b" : "left_by_b"},
+          {"volume_mm3", region.volume},
+          {"depth_mm", region.depth},
+          {"deepest_point", to_json(region.deepest)},
+          {"bbox", {{"min", to_json(region.box.min)}, {"max", to_json(region.box.max)}}},
+          {"lines_a", diff_lines_json(region.lines_a)},
+          {"lines_b", diff_lines_json(region.lines_b)},
+          {"changed_lines_a", diff_lines_json(region.changed_a)},
+          {"changed_lines_b", diff_lines_json(region.changed_b)},
+          {"tools_a", region.tools_a},
+          {"tools_b", region.tools_b}};
+}
+
+Json diff_report(const DiffOptions& options, const DiffRun& run, bool different) {
+  Json report;
+  report["program_a"] = options.program;
+  report["program_b"] = options.program_b;
+  report["verdict"] = different ? "different" : "same";
+  report["tolerance_mm"] = run.tolerance;
+  report["tolerance_source"] = run.tolerance_source;
+  report["stock"] = run.a.stock.description;
+  report["dexel"] = {{"cell_mm", run.a.lattice.spacing},
+                     {"res", {run.a.lattice.n.x, run.a.lattice.n.y, run.a.lattice.n.z}}};
+  report["volume_a_mm3"] = run.a.volume;
+  if (!run.error_b) report["volume_b_mm3"] = run.b.volume;
+  Json regions = Json::array();
+  for (std::size_t k = 0; k < run.regions.size() && k < kDiffRegionsListed; ++k)
+    regions.push_back(diff_region_json(run.regions[k]));
+  report["regions"] = regions;
+  report["regions_count"] = run.regions.size();
+  Json lint = Json::array();
+  for (const LintFinding& f : run.lint_b) lint.push_back(lint_json(f));
+  if (run.error_b) {
+    Json e = lint_json(*run.error_b);
+    if (int c = changed_at_or_before(run.alignment.changed_b, run.error_b->line); c > 0)
+      e["changed_line"] = c;
+    lint.push_back(e);
+  }
+  report["lint"] = lint;
+  Json lint_a = Json::array();
+  for (const LintFinding& f : run.lint_a) lint_a.push_back(lint_json(f));
+  report["lint_a"] = lint_a;
+  int changed_a = 0, changed_b = 0;
+  for (char c : run.alignment.changed_a) changed_a += c;
+  for (char c : run.alignment.changed_b) changed_b += c;
+  report["changed_lines"] = {{"a", changed_a}, {"b", changed_b}};
+  report["warnings_a"] = run.a.warnings;
+  report["warnings_b"] = run.b.warnings;
+  return report;
+}
+
+std::string diff_lines_text(const std::string& file, const std::set<int>& lines) {
+  std::string out;
+  std::size_t count = 0;
+  for (int line : lines)
+    if (count++ < 12) out += (out.empty() ? "" : ", ") + file + ":" + std::to_string(line);
+  if (count > 12) out += ", … (" + std::to_string(count) + " in all)";
+  return out.empty() ? "none" : out;
+}
+
+void print_diff(const DiffRun& run, bool different) {
+  std::printf("%s vs %s: %zu region(s) differ beyond %g mm (%s), %zu lint finding(s)%s: %s\n",
+              run.file_a.c_str(), run.file_b.c_str(), run.regions.size(), run.tolerance,
+              run.tolerance_source.c_str(), run.lint_b.size(),
+              run.error_b ? ", B does not run" : "", different ? "DIFFERENT" : "same");
+  for (std::size_t k = 0; k < run.regions.size() && k < kDiffRegionsWithLines; ++k) {
+    const DiffRegion& g = run.regions[k];
+    std::printf("  %s %.4g mm3, %.3f mm deep at (%.3f, %.3f, %.3f)\n",
+                g.removed ? "removed by B" : "left by B", g.volume, g.depth, g.deepest.x,
+                g.deepest.y, g.deepest.z);
+    std::printf("    changed: %s; %s\n", diff_lines_text(run.file_b, g.changed_b).c_str(),
+                diff_lines_text(run.file_a, g.changed_a).c_str());
+    std::printf("    B lines %s\n    A lines %s\n", diff_lines_text(run.file_b, g.lines_b).c_str(),
+                diff_lines_text(run.file_a, g.lines_a).c_str());
+  }
+  for (const LintFinding& f : run.lint_b)
+    std::printf("  %s\n", terminal_safe(lint_text_line(f)).c_str());
+  if (run.error_b) std::printf("  %s\n", terminal_safe(lint_text_line(*run.error_b)).c_str());
+}
+
+// B on A's stock: the same box (an automatic stock is A's), the same file, so the same lattice.
+DiffOptions options_for_b(const DiffOptions& options, const SimulationResult& a) {
+  DiffOptions b = options;
+  b.program = options.program_b;
+  if (a.stock.mesh) {
+    b.stock = a.stock.description["file"].get<std::string>();
+  } else {
+    char box[256];
+    std::snprintf(box, sizeof box, "box:%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", a.stock.box.min.x,
+                  a.stock.box.min.y, a.stock.box.min.z, a.stock.box.max.x, a.stock.box.max.y,
+                  a.stock.box.max.z);
+    b.stock = box;
+  }
+  return b;
+}
+
+}  // namespace
+
+int run_diff(const DiffOptions& options) {
+  Progress progress(!options.quiet && (options.progress || stderr_is_terminal()));
+  PipelineRequest request;
+  if (!options.report.empty()) request.outputs.push_back({"--report", options.report});
+  request.extra_inputs = {options.program, options.program_b};
+  DiffRun run;
+  run.a = simulate_program(options, progress, request);
+  const DiffOptions for_b = options_for_b(options, run.a);
+  run.file_a = run.a.input.files.at(0).string();
+  run.text_a = read_text_file(run.a.input.files.at(0), "a G-code file");
+  const ProgramInput input_b = resolve_program(for_b);
+  run.file_b = input_b.files.at(0).string();
+  run.text_b = read_text_file(input_b.files.at(0), "a G-code file");
+  run.alignment = align_lines(run.text_a, run.text_b);
+  lint_both(run, run.a.input.machine);
+  try {
+    run.b = simulate_program(for_b, progress, request);
+  } catch (const gcode::GcodeError& e) {
+    run.error_b = lint_error_finding(e.where.file, e.where.line, e.where.message);
+  } catch (const InputError& e) {  // B names a tool the table lacks, runs past --max-moves, …
+    const std::string message = e.what();
+    const std::size_t at = message.find(run.file_b + ":");  // "bug.nc:63: tool 7 is …"
+    const int line =
+        at == std::string::npos ? 0 : std::atoi(message.c_str() + at + run.file_b.size() + 1);
+    run.error_b = LintFinding{run.file_b, line, "program_error", message};
+  }
+  run.tolerance = options.tolerance > 0 ? options.tolerance : 0.5 * run.a.lattice.spacing;
+  run.tolerance_source = options.tolerance > 0 ? "given" : "half the dexel spacing; --tolerance";
+  if (!run.error_b) {
+    if (!(run.a.result.lattice() == run.b.result.lattice()))
+      throw std::runtime_error("diff: the two programs ran on different lattices");
+    progress.stage("comparing the solids");
+    run.spans = solid_differences(run.a.result, run.b.result, run.tolerance);
+    run.regions = connect_spans(run.spans, run.a.result);
+    measure_regions(run.regions, run.spans, run.a.result);
+    const std::map<int, int> tools_a = line_tools(run.a), tools_b = line_tools(run.b);
+    for (std::size_t k = 0; k < run.regions.size() && k < kDiffRegionsWithLines; ++k)
+      attribute_region(run.regions[k], run, tools_a, tools_b);
+  }
+  const bool different = !run.regions.empty() || !run.lint_b.empty() || run.error_b;
+  const Json report = diff_report(options, run, different);
+  if (!options.report.empty()) {
+    progress.stage("writing " + options.report);
+    write_file_atomically(options.report, dump_json(report, 2) + "\n");
+  }
+  progress.finish();
+  if (!options.quiet) print_diff(run, different);
+  return different ? kFindings : kSuccess;
+}
+
+}  // namespace tridex::cli
+
+namespace tridex::cli {
+
+// tridex lint: the post lint of the program's files, and the interpreter's verdict on it.
+int run_lint(const LintOptions& options) {
+  const ProgramInput input = resolve_program(options);
+  if (!options.report.empty())
+    check_output_path("--report", options.report, files_read(options, input));
+  LintSettings settings;
+  settings.decimal_point_input = input.machine.decimal_point_input;
+  settings.linuxcnc = input.machine.dialect == gcode::Dialect::linuxcnc;
+  std::vector<LintFinding> findings;
+  for (const fs::path& file : input.files) {
+    std::vector<LintFinding> own =
+        lint_text(read_text_file(file, "a G-code file"), file.string(), settings);
+    findings.insert(findings.end(), own.begin(), own.end());
+  }
+  try {
+    interpret(
+        input, interpreter_options(options), [](const gcode::Move&, std::size_t) {}, {},
+        options.max_moves);
+  } catch (const gcode::GcodeError& e) {
+    findings.push_back(lint_error_finding(e.where.file, e.where.line, e.where.message));
+  }
+  if (!options.report.empty()) {
+    Json list = Json::array();
+    for (const LintFinding& f : findings) list.push_back(lint_json(f));
+    write_file_atomically(options.report,
+                          dump_json(Json{{"program", options.program},
+                                         {"verdict", findings.empty() ? "clean" : "findings"},
+                                         {"findings", list}},
+                                    2) +
+                              "\n");
+  }
+  if (!options.quiet) {
+    for (const LintFinding& f : findings)
+      std::printf("%s\n", terminal_safe(lint_text_line(f)).c_str());
+    std::printf("%s: %zu lint finding(s)\n", options.program.c_str(), findings.size());
+  }
+  return findings.empty() ? kSuccess : kFindings;
+}
+
+}  // namespace tridex::cli
