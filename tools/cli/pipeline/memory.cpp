@@ -69,7 +69,7 @@ double resident_bytes() {
 }
 
 double MemoryEstimate::total() const {
-  const double stages = std::max({milling, zmaps + walls, zmaps + fine + dexels,
+  const double stages = std::max({milling, zmaps + dump, zmaps + walls, zmaps + fine + dexels,
                                   result + mesh + after + (keep_maps ? zmaps : 0.0)});
   return std::max(peak_before, held + stages);
 }
@@ -80,15 +80,19 @@ MemoryEstimate estimate_memory(double held_bytes, double peak_bytes, const Memor
   e.held = held_bytes;
   e.keep_maps = shape.keep_maps;
   // Float heights and tile maxima (4.1 bytes a point); raise_uncut marks a byte a point of the
-  // largest map; a kept copy adds to all. A dumped map's polyhedron (a vertex and two triangles
-  // a point) and its STL bytes (two 50-byte records a point, and more at the walls) add to the
-  // largest: measured 340 bytes a point on the example.
+  // largest map; a kept copy adds to all. A dumped map's polyhedron and its STL stream add to the
+  // maps while it is written (measured under 60 bytes a point of the largest).
   e.zmaps = 4.2 * shape.zmap_points + 1.0 * shape.largest_map;
   if (shape.keep_maps) e.zmaps += 4.2 * shape.zmap_points;
-  if (shape.dump_maps) e.zmaps += 400.0 * shape.largest_map;
+  if (shape.dump_maps) e.dump = 60.0 * shape.largest_map;
   // The largest direction's moves as CutMoves (feeds and rapids, a pointer to each rapid), each
-  // filed in one or two bins of the miller, and the threads' scratch.
-  e.milling = e.zmaps + (sizeof(CutMove) + 8 + 4 * 4) * shape.largest_group + (32 << 20);
+  // filed in one or two of the miller's blocks; and each thread's scratch for the moves of its
+  // block (geometry and vector lanes, measured about 2.5 KiB a move: 39 MiB a thread for 222,000
+  // arc chords over about 16 blocks). A block's share is not known before binning: up to 16,384
+  // moves a block are counted, which covers the bench programs (bench/README.md, issue 37).
+  const double block_moves = std::min(shape.largest_group, 16384.0);
+  e.milling = e.zmaps + (sizeof(CutMove) + 8 + 4 * 4) * shape.largest_group +
+              shape.threads * (2560.0 * block_moves + (1 << 20));
   // A ray costs a 4-byte offset and, typically, one or two 8-byte intervals, in the stock and
   // in the result (measured 66-91 bytes a ray with the grid trees and the threads' buffers).
   e.dexels = 120.0 * shape.rays + 1.0 * shape.zmap_points;

@@ -27,7 +27,8 @@ std::uint64_t max_memory_bytes(const std::string& option);
 struct MemoryEstimate {
   double peak_before = 0;  // the peak resident size before milling (a floor of the total)
   double held = 0;     // resident before milling: the libraries, the moves kept, the meshes read
-  double zmaps = 0;    // every direction's heights (and their kept copies, a dump's polyhedron)
+  double zmaps = 0;    // every direction's heights (and their kept copies)
+  double dump = 0;     // --dump-zmaps: the largest map's polyhedron while it is written
   double milling = 0;  // the largest direction's moves as cutter sweeps, binned, while milled
   double dexels = 0;   // the stock triple dexel, the result, the scan's buffers over the Z-maps
   double result = 0;   // the result's triple dexel alone, which outlives the maps
@@ -45,6 +46,7 @@ struct MemoryShape {
   double zmap_points = 0;    // the sum over directions of nx·ny
   double largest_map = 0;    // nx·ny of the largest direction's map
   double largest_group = 0;  // the moves of the direction with most
+  double threads = 1;        // the threads milling, each with its block's scratch
   double rays = 0;           // nx·ny + ny·nz + nz·nx of the triple dexel's lattice
   bool keep_maps = false;    // the milled maps are copied and kept to the end
   bool dump_maps = false;    // --dump-zmaps: each map's polyhedron is built and written

@@ -495,7 +495,9 @@ void size_the_run(const SimulateOptions& options, const PipelineRequest& request
                                : std::min(diagonal * kDefaultZmapCellFraction,
                                           kDefaultZmapCellOfSpacing * lattice.spacing);
   r.zmap_cell = zmap_cell;
-  MemoryShape shape{.keep_maps = request.keep_maps, .dump_maps = !options.dump_zmaps.empty()};
+  MemoryShape shape{.threads = static_cast<double>(detail::resolve_threads(options.threads)),
+                    .keep_maps = request.keep_maps,
+                    .dump_maps = !options.dump_zmaps.empty()};
   for (const gcode::MoveGroup& group : r.groups) {
     try {
       r.grids.push_back(
