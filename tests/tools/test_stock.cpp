@@ -68,7 +68,7 @@ TEST_CASE("--max-memory units and the memory estimate") {
   // Keeping or dumping the maps costs more.
   CHECK(estimate_memory(0, 0, {.zmap_points = 1e6, .largest_map = 5e5, .keep_maps = true}).zmaps >
         small.zmaps);
-  CHECK(estimate_memory(0, 0, {.zmap_points = 1e6, .largest_map = 5e5, .dump_maps = true}).zmaps >
-        small.zmaps);
+  CHECK(estimate_memory(0, 0, {.zmap_points = 1e6, .largest_map = 5e5, .dump_maps = true}).total() >
+        estimate_memory(0, 0, {.zmap_points = 1e6, .largest_map = 5e5}).total());
   CHECK(physical_memory_bytes() > (64ull << 20));
 }

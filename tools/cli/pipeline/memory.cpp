@@ -87,12 +87,15 @@ MemoryEstimate estimate_memory(double held_bytes, double peak_bytes, const Memor
   if (shape.dump_maps) e.dump = 60.0 * shape.largest_map;
   // The largest direction's moves as CutMoves (feeds and rapids, a pointer to each rapid), each
   // filed in one or two of the miller's blocks; and each thread's scratch for the moves of its
-  // block (geometry and vector lanes, measured about 2.5 KiB a move: 39 MiB a thread for 222,000
-  // arc chords over about 16 blocks). A block's share is not known before binning: up to 16,384
-  // moves a block are counted, which covers the bench programs (bench/README.md, issue 37).
-  const double block_moves = std::min(shape.largest_group, 16384.0);
+  // block (geometry and vector lanes, measured about 2.5 KiB a move, 2.75 counted: 39 MiB a thread
+  // for 222,000 arc chords on one circle, about 14,000 in each block it crosses). A block's share
+  // is not known before binning: four times the mean, at least 2,048 and at most 16,384 moves, is
+  // counted, which covers the bench programs and the tests (bench/README.md, issue 37).
+  const double block_moves =
+      std::min({shape.largest_group, 16384.0,
+                std::max(2048.0, 4 * shape.largest_group / std::max(1.0, shape.group_blocks))});
   e.milling = e.zmaps + (sizeof(CutMove) + 8 + 4 * 4) * shape.largest_group +
-              shape.threads * (2560.0 * block_moves + (1 << 20));
+              shape.threads * (2816.0 * block_moves + (1 << 20));
   // A ray costs a 4-byte offset and, typically, one or two 8-byte intervals, in the stock and
   // in the result (measured 66-91 bytes a ray with the grid trees and the threads' buffers).
   e.dexels = 120.0 * shape.rays + 1.0 * shape.zmap_points;

@@ -46,6 +46,7 @@ struct MemoryShape {
   double zmap_points = 0;    // the sum over directions of nx·ny
   double largest_map = 0;    // nx·ny of the largest direction's map
   double largest_group = 0;  // the moves of the direction with most
+  double group_blocks = 1;   // its map's blocks of 128 × 128 points (the miller's work blocks)
   double threads = 1;        // the threads milling, each with its block's scratch
   double rays = 0;           // nx·ny + ny·nz + nz·nx of the triple dexel's lattice
   bool keep_maps = false;    // the milled maps are copied and kept to the end

@@ -508,7 +508,11 @@ void size_the_run(const SimulateOptions& options, const PipelineRequest& request
     const double points = static_cast<double>(r.grids.back().nx) * r.grids.back().ny;
     shape.zmap_points += points;
     shape.largest_map = std::max(shape.largest_map, points);
-    shape.largest_group = std::max(shape.largest_group, static_cast<double>(group.moves.size()));
+    if (static_cast<double>(group.moves.size()) > shape.largest_group) {
+      shape.largest_group = static_cast<double>(group.moves.size());
+      shape.group_blocks =
+          std::ceil(r.grids.back().nx / 128.0) * std::ceil(r.grids.back().ny / 128.0);
+    }
   }
   const glm::dvec3 n(lattice.n);
   shape.rays = n.x * n.y + n.y * n.z + n.z * n.x;
