@@ -72,13 +72,16 @@ namespace detail {
 
 // The moves whose swept box reaches each band of kWallBandRows cell rows, in program order: a
 // counting sort (one pass to count, one to place), so that a band never scans the whole program.
+// Only the bands `wanted` marks get their moves (the others stay empty): those that hold a fine
+// cell, so that the lists cost in proportion to the walls, not to every move's every band.
 struct MovesByBand {
   // Band b's moves are band_moves[band_begin[b]] up to band_moves[band_begin[b + 1]].
   std::vector<std::size_t> band_begin;
   std::vector<std::uint32_t> band_moves;
 };
 inline MovesByBand moves_by_band(const ZMapGrid& g, std::span<const Cutter> cutters,
-                                 std::span<const CutMove> moves, int bands) {
+                                 std::span<const CutMove> moves, int bands,
+                                 std::span<const std::uint8_t> wanted) {
   constexpr int kBandRows = kWallBandRows;
   auto band_range = [&](const CutMove& m) {
     const double r = cutters[m.cutter].radius();
@@ -95,7 +98,7 @@ inline MovesByBand moves_by_band(const ZMapGrid& g, std::span<const Cutter> cutt
   band_begin.assign(static_cast<std::size_t>(bands) + 1, 0);
   for (const CutMove& m : moves)
     for (auto [b0, b1] = band_range(m); b0 <= b1; ++b0)
-      ++band_begin[static_cast<std::size_t>(b0) + 1];
+      band_begin[static_cast<std::size_t>(b0) + 1] += wanted[static_cast<std::size_t>(b0)];
   for (std::size_t b = 0; b < static_cast<std::size_t>(bands); ++b)
     band_begin[b + 1] += band_begin[b];
   std::vector<std::uint32_t>& band_moves = by_band.band_moves;
@@ -104,7 +107,8 @@ inline MovesByBand moves_by_band(const ZMapGrid& g, std::span<const Cutter> cutt
     std::vector<std::size_t> at(band_begin.begin(), band_begin.end() - 1);
     for (std::size_t m = 0; m < moves.size(); ++m)
       for (auto [b0, b1] = band_range(moves[m]); b0 <= b1; ++b0)
-        band_moves[at[static_cast<std::size_t>(b0)]++] = static_cast<std::uint32_t>(m);
+        if (wanted[static_cast<std::size_t>(b0)])
+          band_moves[at[static_cast<std::size_t>(b0)]++] = static_cast<std::uint32_t>(m);
   }
   return by_band;
 }
@@ -126,7 +130,12 @@ inline void lower_fine_cells(const ZMapGrid& g, std::span<const Cutter> cutters,
   // band never scans the whole program: a 5000-row map has 313 bands.
   constexpr int kBandRows = kWallBandRows;
   const int bands = (g.ny - 1 + kBandRows - 1) / kBandRows;
-  const MovesByBand by_band = moves_by_band(g, cutters, moves, bands);
+  std::vector<std::uint8_t> wanted(static_cast<std::size_t>(bands));
+  for (int band = 0; band < bands; ++band)
+    wanted[static_cast<std::size_t>(band)] =
+        row_begin[static_cast<std::size_t>(band * kBandRows)] !=
+        row_begin[static_cast<std::size_t>(std::min(g.ny - 1, (band + 1) * kBandRows))];
+  const MovesByBand by_band = moves_by_band(g, cutters, moves, bands, wanted);
   const std::vector<std::size_t>& band_begin = by_band.band_begin;
   const std::vector<std::uint32_t>& band_moves = by_band.band_moves;
   // The highest sub-point of each fine cell so far: a move whose swept cutter cannot reach below

@@ -90,8 +90,14 @@ void check_bound(std::vector<std::string> args, const fs::path& dir, int success
                   << at_limit.peak_bytes / (1 << 20) << " MiB");
   CHECK(at_limit.status == success_status);
   CHECK(at_limit.peak_bytes <= static_cast<double>(limit_mib) * (1 << 20));
-  bounded.back() = std::to_string(static_cast<long long>(std::floor(estimate_mib)) - 1) + "M";
-  CHECK(run_measured(bounded).status == 2);
+  // Within 1.5x of the peak (issue 37): a bound far above it refuses runs that fit.
+  CHECK(estimate_mib * (1 << 20) <= 1.5 * unbounded.peak_bytes);
+  // Just below the estimate: refused before the process reaches that limit (issue 36).
+  const long long below_mib = static_cast<long long>(std::floor(estimate_mib)) - 1;
+  bounded.back() = std::to_string(below_mib) + "M";
+  Measured refused = run_measured(bounded);
+  CHECK(refused.status == 2);
+  CHECK(refused.peak_bytes <= static_cast<double>(below_mib) * (1 << 20));
 }
 
 const std::string kTools =
@@ -244,7 +250,8 @@ TEST_CASE(
                                       "--zmap-cell", "0.05",
                                       "-o",          (dir / "out.stl").string()};
   check_bound(args, dir);
-  // A limit that holds everything but the walls' sub-grids: refused once they are counted.
+  // Just below the estimate, which the walls' sub-grids and move lists make: the milling fits,
+  // and the refusal comes once the steep cells are counted, before any sub-grid is allocated.
   std::vector<std::string> first = args;
   first.insert(first.end(), {"--report", (dir / "report.json").string()});
   REQUIRE(run_tridex(first, dir).status == 0);
@@ -255,7 +262,7 @@ TEST_CASE(
   REQUIRE(walls > 4);
   std::vector<std::string> below = args;
   below.insert(below.end(),
-               {"--max-memory", std::to_string(static_cast<long long>(total - walls) + 2) + "M"});
+               {"--max-memory", std::to_string(static_cast<long long>(total) - 1) + "M"});
   fs::remove(dir / "out.stl");
   CommandResult refused = run_tridex(below, dir);
   CHECK(refused.status == 2);
@@ -279,6 +286,20 @@ TEST_CASE("memory: the estimate bounds the peak of simulate with --html and with
   std::vector<std::string> dump = args;
   dump.insert(dump.end(), {"--dump-zmaps", (dir / "maps").string()});
   check_bound(dump, dir);
+  fs::remove_all(dir);
+}
+
+// Full circles in fine chords over a small stock: the moves, not the maps, make the peak.
+TEST_CASE("memory: the estimate bounds the peak of simulate with many arc chords") {
+  fs::path dir = scratch("memory-chords");
+  std::string p = "G21 G90\nT1 M6\nS1000 M3\nG0 X-20 Y0 Z5\nG1 Z-1 F300\n";
+  for (int k = 0; k < 100; ++k) p += "G2 X-20 Y0 I20 J0\n";
+  write_text(dir / "p.nc", p + "G0 Z5\nM30\n");
+  write_text(dir / "tools.json", kTools);
+  check_bound({"simulate", (dir / "p.nc").string(), "--tools", (dir / "tools.json").string(),
+               "--stock", "box:-30,-30,-10,30,30,0", "--dexel-res", "60", "--arc-tolerance",
+               "0.00002", "-o", (dir / "out.stl").string()},
+              dir);
   fs::remove_all(dir);
 }
 

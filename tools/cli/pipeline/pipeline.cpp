@@ -495,7 +495,9 @@ void size_the_run(const SimulateOptions& options, const PipelineRequest& request
                                : std::min(diagonal * kDefaultZmapCellFraction,
                                           kDefaultZmapCellOfSpacing * lattice.spacing);
   r.zmap_cell = zmap_cell;
-  MemoryShape shape{.keep_maps = request.keep_maps, .dump_maps = !options.dump_zmaps.empty()};
+  MemoryShape shape{.threads = static_cast<double>(detail::resolve_threads(options.threads)),
+                    .keep_maps = request.keep_maps,
+                    .dump_maps = !options.dump_zmaps.empty()};
   for (const gcode::MoveGroup& group : r.groups) {
     try {
       r.grids.push_back(
@@ -506,11 +508,17 @@ void size_the_run(const SimulateOptions& options, const PipelineRequest& request
     const double points = static_cast<double>(r.grids.back().nx) * r.grids.back().ny;
     shape.zmap_points += points;
     shape.largest_map = std::max(shape.largest_map, points);
+    if (static_cast<double>(group.moves.size()) > shape.largest_group) {
+      shape.largest_group = static_cast<double>(group.moves.size());
+      shape.group_blocks =
+          std::ceil(r.grids.back().nx / 128.0) * std::ceil(r.grids.back().ny / 128.0);
+    }
   }
   const glm::dvec3 n(lattice.n);
   shape.rays = n.x * n.y + n.y * n.z + n.z * n.x;
-  // The peak so far holds the libraries, every move kept and the meshes read: all alive to the end.
-  r.memory = estimate_memory(peak_rss_bytes(), shape);
+  // What the process holds now (the libraries, every move kept, the meshes read) is alive to the
+  // end; the parser's buffers it freed are not, but the peak so far is a floor.
+  r.memory = estimate_memory(resident_bytes(), peak_rss_bytes(), shape);
   if (request.memory_after)
     r.memory.after = request.memory_after(lattice.spacing, kTrianglesPerRay * shape.rays);
   const MemoryEstimate& need = r.memory;
@@ -622,12 +630,15 @@ void refine_walls(const SimulateOptions& options, std::uint64_t max_memory, Simu
   double widest = 0;
   for (const Cutter& c : r.cutters) widest = std::max(widest, 2 * c.radius());
   const double bands_per_move = 2 + widest / (kWallBandRows * r.zmap_cell);
+  const double before = r.memory.total();
   r.memory.walls =
       fine_cell_bytes(static_cast<double>(steep_cells), rows, most_moves, bands_per_move);
+  r.memory.fine = fine_cell_bytes(static_cast<double>(steep_cells), rows, 0, 0);
   if (r.memory.total() > static_cast<double>(max_memory))
     input_error("the walls need finer heights in ", steep_cells,
-                " steep Z-map cells: an estimated ", format_mib(r.memory.walls), " on top of ",
-                format_mib(r.memory.total() - r.memory.walls), ", more than --max-memory ",
+                " steep Z-map cells: an estimated ", format_mib(r.memory.walls), " next to ",
+                format_mib(r.memory.zmaps), " of Z-maps (", format_mib(before),
+                " in all without them), more than --max-memory ",
                 format_mib(static_cast<double>(max_memory)),
                 "; use a larger --zmap-cell or --dexel-cell, or a smaller --dexel-res");
   std::vector<CutMove> moves;  // one buffer for every direction: its pages are touched once

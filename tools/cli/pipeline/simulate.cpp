@@ -92,6 +92,10 @@ int run_simulate(const SimulateOptions& options) {
                      {"--png", options.png},
                      {"--report", options.report},
                      {"--html", options.html}};
+  // The page's copy of the surface, encoded, next to the surface itself (measured about 35 bytes
+  // a triangle counted).
+  if (!options.html.empty())
+    request.memory_after = [](double, double triangles) { return 60.0 * triangles; };
   SimulationResult r = simulate_program(options, progress, request);
   const ProgramInput& input = r.input;
   const std::vector<gcode::MoveGroup>& groups = r.groups;
