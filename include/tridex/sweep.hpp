@@ -80,46 +80,51 @@ struct SweepPlan {
   double band = 0;  // the largest e of its sub-steps, mm
 };
 
-inline constexpr int kPoseSamples = 16;       // K above
-inline constexpr int kMaxSubSteps = 1 << 14;  // per move
+inline constexpr int kMaxSubSteps = 1 << 14;       // per move
+inline constexpr long kMaxPoseSamples = 1L << 22;  // per move
 
 // The sub-steps of one move whose pose `pose_at(s)` (a ToolPose) turns, with e ≤ `tolerance` or,
-// at kMaxSubSteps, the band achieved.
+// at max_steps, the band achieved. The move is sampled at S + 1 equally spaced poses, S a power
+// of two chosen so that the Lipschitz margins (V/S and reach·Ω/(2S)) take at most a quarter of
+// the tolerance; then sub-steps double (K = S/N samples each) until the sampled deviations fit.
 template <class PoseAt>
 SweepPlan plan_sweep(PoseAt&& pose_at, const PoseBounds& bounds, double reach, double tolerance,
                      std::uint32_t cutter = 0, int max_steps = kMaxSubSteps) {
   detail::require_positive(tolerance, "sweep tolerance");
-  const int k = kPoseSamples;
-  // A first guess from the first-order terms alone, then doubling.
-  double guess =
-      (bounds.tip_straight ? 0.0 : bounds.tip_speed) / k + reach * bounds.turn_rate / (2.0 * k);
-  int n = std::clamp(static_cast<int>(std::ceil(guess / tolerance)), 1, max_steps);
-  std::vector<ToolPose> samples(static_cast<std::size_t>(n) * k + 1);
-  for (;;) {
-    samples.resize(static_cast<std::size_t>(n) * k + 1);
-    for (std::size_t j = 0; j < samples.size(); ++j)
-      samples[j] = pose_at(static_cast<double>(j) / static_cast<double>(samples.size() - 1));
-    SweepPlan plan;
-    const double delta = 1.0 / n;
-    for (int i = 0; i < n; ++i) {
-      const ToolPose& p0 = samples[static_cast<std::size_t>(i) * k];
-      const ToolPose& p1 = samples[static_cast<std::size_t>(i + 1) * k];
-      const Vec3 mid = samples[static_cast<std::size_t>(i) * k + k / 2].axis;
-      double tip = 0, angle = 0;
-      for (int j = 0; j <= k; ++j) {
-        const ToolPose& p = samples[static_cast<std::size_t>(i) * k + j];
-        const double t = static_cast<double>(j) / k;
-        if (!bounds.tip_straight)
-          tip = std::max(tip, glm::length(p.tip - (p0.tip + t * (p1.tip - p0.tip))));
-        angle = std::max(angle, std::acos(std::clamp(glm::dot(p.axis, mid), -1.0, 1.0)));
-      }
-      if (!bounds.tip_straight) tip += bounds.tip_speed * delta / k;
-      angle += bounds.turn_rate * delta / (2.0 * k);
-      plan.band = std::max(plan.band, tip + reach * angle);
-      plan.steps.push_back({p0.tip, p1.tip, mid, cutter});
+  const double margin_rate =
+      (bounds.tip_straight ? 0.0 : bounds.tip_speed) + reach * bounds.turn_rate / 2;
+  long samples = 64;
+  while (samples < kMaxPoseSamples && margin_rate / static_cast<double>(samples) > tolerance / 4)
+    samples *= 2;
+  std::vector<ToolPose> poses;
+  auto sample = [&] {
+    poses.resize(static_cast<std::size_t>(samples) + 1);
+    for (std::size_t j = 0; j < poses.size(); ++j)
+      poses[j] = pose_at(static_cast<double>(j) / static_cast<double>(samples));
+  };
+  sample();
+  for (long n = 1;; n *= 2) {
+    if (2 * n > samples && samples < kMaxPoseSamples) {
+      samples *= 2;
+      sample();
     }
-    if (plan.band <= tolerance || n >= max_steps) return plan;
-    n = std::min(max_steps, 2 * n);
+    const long k = samples / n;
+    SweepPlan plan;
+    const double margin = margin_rate / static_cast<double>(samples);
+    for (long i = 0; i < n; ++i) {
+      const ToolPose* p = poses.data() + i * k;  // p[0] … p[k]
+      const Vec3 mid = p[k / 2].axis;
+      double tip = 0, angle = 0;
+      for (long j = 0; j <= k; ++j) {
+        const double t = static_cast<double>(j) / static_cast<double>(k);
+        if (!bounds.tip_straight)
+          tip = std::max(tip, glm::length(p[j].tip - (p[0].tip + t * (p[k].tip - p[0].tip))));
+        angle = std::max(angle, std::acos(std::clamp(glm::dot(p[j].axis, mid), -1.0, 1.0)));
+      }
+      plan.band = std::max(plan.band, tip + reach * angle + margin);
+      plan.steps.push_back({p[0].tip, p[k].tip, mid, cutter});
+    }
+    if (plan.band <= tolerance || n >= max_steps || k < 2) return plan;
   }
 }
 
