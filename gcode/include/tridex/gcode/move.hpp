@@ -29,7 +29,7 @@ inline const char* to_string(MoveKind kind) {
 // stays `axis` and the tip runs straight from `start` to `end` (every move of a 3+2 program).
 // joints: rotary words on a cut without TCP: every joint (the linear axes' machine coordinates
 // and the rotary positions) runs linearly in time from its start to its end value, so the tip
-// curves on the part. tcp: under G43.4/G43.5 (Haas G234) the tip runs straight on the part while
+// curves on the part. tcp: under G43.4/G43.5 the tip runs straight on the part while
 // the rotaries run linearly in angle. Only joints and tcp moves turn the tool.
 enum class PoseLaw : unsigned char { fixed, joints, tcp };
 

@@ -4,7 +4,7 @@
 //
 // joints (raw rotary words): the linear axes' machine coordinates X(s) and the rotary positions
 // R(s) run linearly in s ∈ [0, 1]; the tip on the part is tip_in_part(X(s), R(s)).
-// tcp (G43.4, G43.5, Haas G234): the tip runs straight on the part, R(s) linearly.
+// tcp (G43.4, G43.5): the tip runs straight on the part, R(s) linearly.
 // Either way the tool axis is tool_direction(R(s)).
 #pragma once
 
