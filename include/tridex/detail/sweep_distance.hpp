@@ -20,13 +20,17 @@
 
 namespace tridex::detail {
 
+// √(x² + y²) without std::hypot's care for overflow, which costs several times more and which
+// lengths of millimetres never need.
+inline double length_2d(double x, double y) { return std::sqrt(x * x + y * y); }
+
 // Distance from (px, py) to the segment (ax, ay)–(bx, by).
 inline double segment_distance_2d(double px, double py, double ax, double ay, double bx,
                                   double by) {
   const double dx = bx - ax, dy = by - ay, len2 = dx * dx + dy * dy;
   double t = len2 > 0 ? ((px - ax) * dx + (py - ay) * dy) / len2 : 0.0;
   t = std::clamp(t, 0.0, 1.0);
-  return std::hypot(px - ax - t * dx, py - ay - t * dy);
+  return length_2d(px - ax - t * dx, py - ay - t * dy);
 }
 
 // Distance from the meridian point (d, h) to one piece of a cutter's lower surface.
@@ -35,12 +39,12 @@ inline double piece_distance(const ProfilePiece& p, double d, double h) {
   if (!p.is_arc) return segment_distance_2d(d, h, p.d0, h0, p.d1, h1);
   // A lower arc: the circle's nearest point is on the arc when it lies below the centre and
   // within [d0, d1]; otherwise an end point is nearest.
-  const double vx = d - p.centre_d, vy = h - p.centre_h, len = std::hypot(vx, vy);
+  const double vx = d - p.centre_d, vy = h - p.centre_h, len = length_2d(vx, vy);
   if (len > 0 && vy <= 0) {
     const double x = p.centre_d + p.radius * vx / len;
     if (x >= p.d0 && x <= p.d1) return std::abs(len - p.radius);
   }
-  return std::min(std::hypot(d - p.d0, h - h0), std::hypot(d - p.d1, h - h1));
+  return std::min(length_2d(d - p.d0, h - h0), length_2d(d - p.d1, h - h1));
 }
 
 // Signed distance (negative inside) from the meridian point (d ≥ 0 from the axis, h above the
