@@ -72,6 +72,18 @@ TEST_CASE("simulate: 3+2 passes with raw and TCP simultaneous cuts, watertight")
   long long grouped = 0;
   for (const json& g : report["groups"]) grouped += g["moves"].get<long long>();
   CHECK(grouped == report["segments"].get<long long>());
+  // `groups` counts them apart, by tool; `moves` gives each its start's joints and pose law.
+  CommandResult g =
+      run_tridex({"groups", kData + "tilt_turn.ngc", "--machine", "ac-trunnion"}, dir);
+  REQUIRE(g.status == 0);
+  const json groups = json::parse(g.out);
+  CHECK(groups["simultaneous"]["moves"] == 4);
+  CHECK(groups["simultaneous"]["by_tool"]["2"] == 4);
+  CommandResult m = run_tridex({"moves", kData + "tilt_turn.ngc", "--machine", "ac-trunnion"}, dir);
+  REQUIRE(m.status == 0);
+  CHECK(m.out.find("\"pose\":\"tcp\"") != std::string::npos);
+  CHECK(m.out.find("\"pose\":\"joints\",\"rotary_start\":{\"A\":0.0,\"C\":0.0}") !=
+        std::string::npos);
   fs::remove_all(dir);
 }
 
