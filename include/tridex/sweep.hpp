@@ -180,44 +180,42 @@ inline std::optional<std::pair<double, double>> ray_sweep_interval(const SweepCu
 namespace detail {
 
 // Ray r of grid `axis` (lattice coordinates iu, iv) less the sweeps of `steps` listed for its row.
+// Each sweep is subtracted as soon as it is found, and the next is searched only over the
+// material left within its box: the sub-steps of a move overlap, so most rays find nothing left
+// to cut after the first (subtraction in any order gives the same set).
 inline void sweep_ray(std::span<const DexelInterval> ray, const TripleDexel& d, int axis, int iu,
                       int iv, std::span<const SweepCutter> cutters,
                       std::span<const SweepStep> steps, std::span<const Aabb> boxes,
                       std::span<const std::uint32_t> row, double precision,
-                      std::vector<DexelInterval>& removed, std::vector<DexelInterval>& out) {
+                      std::vector<DexelInterval>& current, std::vector<DexelInterval>& out) {
   const int u = TripleDexel::u_axis(axis), v = TripleDexel::v_axis(axis);
   Vec3 point = d.origin;
   point[u] += d.spacing * iu;
   point[v] += d.spacing * iv;
-  removed.clear();
+  current.assign(ray.begin(), ray.end());
+  std::vector<DexelInterval> next;
   for (std::uint32_t s : row) {
     const Aabb& box = boxes[s];
+    if (current.empty()) break;
     if (point[u] < box.min[u] || point[u] > box.max[u] || point[v] < box.min[v] ||
         point[v] > box.max[v])
       continue;
-    const double lo = box.min[axis], hi = box.max[axis];
-    bool material = false;  // only rays with material there can lose any
-    for (const DexelInterval& span : ray) material |= span.exit >= lo && span.enter <= hi;
-    if (!material) continue;
-    if (auto cut =
-            ray_sweep_interval(cutters[steps[s].cutter], steps[s], point, axis, lo, hi, precision))
-      removed.push_back({static_cast<float>(cut->first), static_cast<float>(cut->second)});
+    double lo = box.max[axis], hi = box.min[axis];  // the material left within the box
+    for (const DexelInterval& span : current)
+      if (span.exit >= box.min[axis] && span.enter <= box.max[axis]) {
+        lo = std::min(lo, std::max<double>(span.enter, box.min[axis]));
+        hi = std::max(hi, std::min<double>(span.exit, box.max[axis]));
+      }
+    if (!(lo <= hi)) continue;
+    auto cut =
+        ray_sweep_interval(cutters[steps[s].cutter], steps[s], point, axis, lo, hi, precision);
+    if (!cut) continue;
+    const DexelInterval removed{static_cast<float>(cut->first), static_cast<float>(cut->second)};
+    next.clear();
+    subtract_ray(current, {&removed, 1}, next);
+    current.swap(next);
   }
-  if (removed.empty()) {
-    out.insert(out.end(), ray.begin(), ray.end());
-    return;
-  }
-  std::sort(removed.begin(), removed.end(),
-            [](const DexelInterval& a, const DexelInterval& b) { return a.enter < b.enter; });
-  std::size_t merged = 0;
-  for (std::size_t i = 1; i < removed.size(); ++i) {
-    if (removed[i].enter <= removed[merged].exit)
-      removed[merged].exit = std::max(removed[merged].exit, removed[i].exit);
-    else
-      removed[++merged] = removed[i];
-  }
-  removed.resize(merged + 1);
-  subtract_ray(ray, removed, out);
+  out.insert(out.end(), current.begin(), current.end());
 }
 
 }  // namespace detail
