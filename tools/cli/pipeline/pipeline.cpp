@@ -737,7 +737,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   mill_directions(options, request, progress, r);
   if (!options.dump_zmaps.empty()) dump_zmaps(options.dump_zmaps, r, progress);
   intersect_directions(options, request, run.max_memory, progress, r);
-  if (!r.simultaneous.empty()) cut_simultaneous(options, r);
+  if (!r.simultaneous.empty()) cut_simultaneous(options, r, request.body_clearance.has_value());
   extract_result_surface(options, progress, r);
   return r;
 }

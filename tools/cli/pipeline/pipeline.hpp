@@ -154,8 +154,9 @@ struct SimulationResult {
 
 // Cuts r.simultaneous from r.result (simultaneous.cpp): each move sub-stepped so that its band
 // stays within a tenth of the dexel spacing (or the sub-step cap, with a warning), its sweeps
-// subtracted ray by ray; fills r.sweeps and the result's dexel volume.
-void cut_simultaneous(const SimulateOptions& options, SimulationResult& r);
+// subtracted ray by ray; fills r.sweeps and the result's dexel volume. `bodies_checked` (check's
+// collision check): warn that these moves' shanks, holders and rapids are not checked yet.
+void cut_simultaneous(const SimulateOptions& options, SimulationResult& r, bool bodies_checked);
 // The JSON of r.sweeps for the report and `--certify`.
 Json sweeps_json(const SimulationResult& r);
 

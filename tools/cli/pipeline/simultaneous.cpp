@@ -29,7 +29,7 @@ SweepCutter sweep_cutter_of(const Cutter& cutter, const ToolBody& body) {
 
 }  // namespace
 
-void cut_simultaneous(const SimulateOptions& options, SimulationResult& r) {
+void cut_simultaneous(const SimulateOptions& options, SimulationResult& r, bool bodies_checked) {
   const auto start = std::chrono::steady_clock::now();
   const std::optional<gcode::Kinematics>& kinematics = r.input.machine.kinematics;
   if (!kinematics) detail::fail("cut_simultaneous: simultaneous moves without kinematics");
@@ -57,6 +57,11 @@ void cut_simultaneous(const SimulateOptions& options, SimulationResult& r) {
                          " needed more than " + std::to_string(kMaxSubSteps) +
                          " sub-steps: their band exceeds " + std::to_string(r.sweep_tolerance) +
                          " mm (see the report's \"simultaneous\")");
+  if (bodies_checked)  // never a silent pass: the material is cut, the bodies not yet checked
+    r.warnings.push_back(std::to_string(r.simultaneous.size()) +
+                         " simultaneous 5-axis move(s) were cut, but their shanks, holders and "
+                         "rapids are not checked for collisions yet (docs/design.md, "
+                         "\"Simultaneous moves\")");
   sweep_remove(r.result, cutters, steps, options.threads, r.sweep_tolerance / 100);
   r.result_dexel_volume = tridex::volume(r.result);
   r.sweep_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
