@@ -553,11 +553,13 @@ void Interpreter::State::machine_coordinate_move() {
 void Interpreter::State::motion_mode_move(bool new_code) {
   bool axes = has_axis_words();
   if (modal.motion == kG0 || modal.motion == kG1) {
-    if (axes) {
+    // A G1 that only turns the rotaries is a move too: the table turns under the tool.
+    if (axes || simultaneous.active) {
       if (modal.motion == kG1) require_feed();
       linear(modal.motion == kG0 ? MoveKind::rapid : MoveKind::feed,
              modal.motion == kG0 ? 0.0 : modal.feed);
     }
+    simultaneous.active = false;
   } else if (modal.motion == kG2 || modal.motion == kG3) {
     char cu = kCenterLetter[plane_axes(modal.plane)[0]],
          cv = kCenterLetter[plane_axes(modal.plane)[1]];

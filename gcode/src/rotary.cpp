@@ -47,7 +47,7 @@ void Interpreter::State::tool_center_codes() {
 // its limits; the tool direction becomes the kinematics'. An indexing move (G0) leaves the tool
 // far along its axis, except in raw form where the machine coordinates keep the tip known (the
 // sweep of the rotation itself is not simulated). Rotary motion during G1 is simultaneous
-// 5-axis: an error, or with lenient a warning and the move indexed at its end orientation.
+// 5-axis (simultaneous_start).
 // LinuxCNC's U/V/W: linear axes of their own (a quill, a second carriage) that a LinuxCNC
 // machine may have and reads as plain axes (rs274 run standalone, with no INI, has none and
 // refuses them). They do not move the tool tridex simulates: read under the LinuxCNC dialect
@@ -123,18 +123,34 @@ void Interpreter::State::rotary_words() {
                           "] (machine file)");
   }
   if (next == frame.rotary_position) return;
-  const bool cut = modal.motion == kG1;
-  const std::string message =
-      "rotary motion during a cut (G1 turning A/B/C: simultaneous 5-axis) is "
-      "outside 3+2";
-  if (cut && !options.lenient) error(first, message + "; index with G0 first");
+  if (modal.motion == kG1) {
+    simultaneous_start(first);
+  } else if (frame.tilted || frame.tcp || frame.dwo) {
+    go_far();
+  }
   set_rotary(next);
-  if (cut)  // lenient: said on the line and counted per direction for the run's summary
-    lenient_read(first,
-                 message + "; read as indexed at its end orientation, direction " +
-                     direction_text(tool.axis) + " (lenient mode)",
-                 "rotary motion during a cut read as indexed along " + direction_text(tool.axis));
-  if (!cut && (frame.tilted || frame.tcp || frame.dwo)) go_far();
+}
+
+// G1 turning A/B/C: simultaneous 5-axis (docs/gcode.md, "Simultaneous 5-axis"). The block's move
+// carries its start (the tip on the part, the rotary positions now) and its pose law: every joint
+// linear in time (raw rotary words), or under TCP the tip straight on the part with the rotaries
+// linear in angle. G43.5 is read as G43.4 (the rotaries, not the tool vector, are interpolated).
+// DWO (G254) and tilted planes are 3+2 frames: a turn within one is refused, even lenient (no
+// reading of it would be the machine's).
+void Interpreter::State::simultaneous_start(int column) {
+  if (frame.tilted || frame.dwo)
+    error(column, std::string("rotary motion during a cut under ") +
+                      (frame.dwo ? "DWO (G254)" : "a tilted plane") +
+                      " is not simultaneous 5-axis on any control: cancel it and use TCP "
+                      "(G43.4), or raw rotary words");
+  if (tool.far)
+    error(column,
+          "rotary motion during a cut while the tool is retracted far along its axis: the "
+          "cut's start is unknown; position the tool (X Y Z) before turning it");
+  simultaneous.active = true;
+  simultaneous.pose = frame.tcp ? PoseLaw::tcp : PoseLaw::joints;
+  simultaneous.tip = tool.pos;
+  simultaneous.rotary = frame.rotary_position;
 }
 
 // New rotary positions: the tool direction and the raw frame follow; the tip keeps its machine

@@ -553,6 +553,12 @@ struct Interpreter::State : ParameterReader {
     move.feed = move_feed;
     move.from_far = from_far;
     move.spindle = modal.speed * modal.spindle_direction;
+    if (simultaneous.active) {  // a cut that turns the rotaries: its true start (rotary.cpp)
+      simultaneous.active = false;
+      move.start = simultaneous.tip - frame.world_origin;
+      move.pose = simultaneous.pose;
+      move.rotary_start = simultaneous.rotary;
+    }
     if (machine.kinematics) {
       for (const RotaryAxis& rotary_axis : machine.kinematics->axes)
         move.rotary_axes |= static_cast<unsigned char>(1u << rotary_index(rotary_axis.letter));
@@ -701,8 +707,18 @@ struct Interpreter::State : ParameterReader {
   // ---- rotary axes, DWO and TCP (rotary.cpp) ----
   void tool_center_codes();
   void rotary_words();
+  void simultaneous_start(int column);
   void extra_linear_words(bool track);  // LinuxCNC's U/V/W
   void set_rotary(const RotaryPositions& next);
+  // A cut that turns the rotaries (rotary.cpp): where its tool started (the tip on the part and
+  // the rotary positions before the block's words), for the move the block emits next.
+  struct SimultaneousStart {
+    bool active = false;
+    PoseLaw pose = PoseLaw::joints;
+    Vec3 tip{0.0};
+    RotaryPositions rotary{};
+  };
+  SimultaneousStart simultaneous;
 
   // ---- tilted planes (tilted_plane_codes.cpp) ----
   std::optional<Frame> plane_words(int code);  // nullopt: a several-block form awaits more blocks

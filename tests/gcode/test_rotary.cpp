@@ -183,22 +183,14 @@ TEST_CASE("rotary 3+2: bad input is an error at its line and column") {
   CHECK(d.line == 2);
   CHECK(d.column == 2);
   CHECK(d.message.find("G53.1") != std::string::npos);
-  d = error_of("G0 X0 Y0 Z0\nG1 X1 A10 F100\n", {}, ac);
-  CHECK(d.line == 2);
-  CHECK(d.column == 7);
-  CHECK(d.message.find("during a cut") != std::string::npos);
   d = error_of("G2 X1 Y0 I0.5 A10 F100\n", {}, ac);
   CHECK(d.column == 15);
-  // Lenient: a warning, the move indexed at its end orientation.
-  InterpreterOptions lenient;
-  lenient.lenient = true;
-  Result r = run_program("G0 X0 Y0 Z0\nG1 X1 A10 F100\nM30\n", lenient, ac);
-  REQUIRE(r.moves.size() == 2);
-  REQUIRE(r.warnings.size() == 2);  // the line's, then the run's summary of the cause
-  CHECK(r.warnings[0].line == 2);
-  CHECK(r.warnings[0].message.find("end orientation") != std::string::npos);
-  CHECK(r.warnings[1].message.find("lenient mode read 1 × rotary motion during a cut") == 0);
-  CHECK(near(r.moves[1].axis, tool_direction(*ac.kinematics, {10, 0, 0}), 1e-12));
+  CHECK(d.message.find("need G0 or G1") != std::string::npos);
+  // A turn under DWO or from far along the axis has no simultaneous reading: refused, even
+  // lenient.
+  d = error_of("G0 X0 Y0 Z0\nG254\nG1 X1 A10 F100\n", {}, ac);
+  CHECK(d.line == 3);
+  CHECK(d.message.find("DWO") != std::string::npos);
   // Without kinematics a rotary word is an error naming the machine file, even lenient.
   for (bool is_lenient : {false, true}) {
     InterpreterOptions options;
@@ -211,9 +203,9 @@ TEST_CASE("rotary 3+2: bad input is an error at its line and column") {
 }
 
 TEST_CASE("rotary 3+2, lenient: every line read otherwise is counted, past the 1000-warning cap") {
-  // 1500 cuts that turn A (each read as indexed at its end orientation), then 1200 moves under a
-  // plane not normal to the tool: the warnings stop at 1000, the summaries count every line and
-  // say along which direction they were read.
+  // 1500 cuts that turn A (simultaneous moves: read as such, no warning), then 1200 moves under a
+  // plane not normal to the tool: the warnings stop at 1000, the summary counts every line and
+  // says along which direction they were read.
   MachineConfig ac = with_kinematics("ac-trunnion");
   std::string text = "G0 X0 Y0 Z0\n";
   for (int k = 1; k <= 1500; ++k) text += cat("G1 X", k % 7, " A", k % 2 == 0 ? 10 : 20, " F100\n");
@@ -224,27 +216,43 @@ TEST_CASE("rotary 3+2, lenient: every line read otherwise is counted, past the 1
   lenient.lenient = true;
   Result r = run_program(text, lenient, ac);
   REQUIRE(r.moves.size() == 1 + 1500 + 1200);
-  CHECK(near(r.moves[1500].axis, tool_direction(*ac.kinematics, {10, 0, 0}),
-             1e-12));  // k = 1500: A10
+  CHECK(near(r.moves[1500].axis, tool_direction(*ac.kinematics, {10, 0, 0}), 1e-12));  // A10
+  CHECK(r.moves[1500].pose == PoseLaw::joints);
+  CHECK(r.moves[1500].rotary_start[0] == 20);
   auto summary = [&](const std::string& start) {
     for (const Diagnostic& d : r.warnings)
       if (d.message.rfind(start, 0) == 0) return d.message;
     return std::string();
   };
-  auto direction = [&](double a) {
-    Vec3 d = tool_direction(*ac.kinematics, {a, 0, 0});
-    char words[128];
-    std::snprintf(words, sizeof words, "(%.10g, %.10g, %.10g)", d.x, d.y, d.z);
-    return std::string(words);
-  };
-  const std::string cut =
-      "lenient mode read 750 × rotary motion during a cut read as indexed along ";
-  CHECK(summary(cut + direction(20) + " (lines 2, 4, 6, 8, 10, …)") != "");
-  CHECK(summary(cut + direction(10) + " (lines 3, 5, 7, 9, 11, …)") != "");
   CHECK(summary("lenient mode read 1200 × move under an ambiguous tilted plane along the current "
                 "direction (0, 0, 1) "
                 "(lines 1504, 1505, 1506, 1507, 1508, …)") != "");
-  CHECK(r.warnings.size() == 1000 + 3);  // capped per line; three summaries (A10, A20, the plane)
+  CHECK(r.warnings.size() == 1000 + 1);  // capped per line; one summary (the plane)
+}
+
+// G1 turning A/B/C: a simultaneous move carrying its start's rotary positions and its pose law
+// (docs/gcode.md, "Simultaneous 5-axis"): raw rotary words keep the machine coordinates and curve
+// the tip on the part; under TCP the tip runs straight; a G1 with rotary words alone is a move.
+TEST_CASE("rotary: simultaneous moves carry their start and their pose law") {
+  MachineConfig ac = with_kinematics("ac-trunnion");
+  Result r = run_program("G0 X20 Y0 Z-2 A0 C0\nG1 C90 F500\nG1 X10 A10 C100\nM30\n", {}, ac);
+  REQUIRE(r.moves.size() == 3);
+  const Move& turn = r.moves[1];
+  CHECK(turn.pose == PoseLaw::joints);
+  CHECK(near(turn.start, Vec3(20, 0, -2), 1e-9));
+  CHECK(near(turn.end, tip_in_part(*ac.kinematics, Vec3(20, 0, -2), {0, 0, 90}), 1e-9));
+  CHECK(turn.rotary_start[2] == 0);
+  CHECK(turn.rotary[2] == 90);
+  CHECK(near(turn.machine, Vec3(20, 0, -2), 1e-9));
+  CHECK(r.moves[2].rotary_start[2] == 90);
+  CHECK(r.moves[2].rotary[0] == 10);
+  CHECK(r.moves[0].pose == PoseLaw::fixed);
+  // Under TCP (G43.4) the tip's part coordinates are programmed: the law is tcp.
+  r = run_program("G43.4\nG0 X0 Y0 Z5 A0 C0\nG1 Z-1 F300\nG1 X10 A10 C45\nM30\n", {}, ac);
+  REQUIRE(r.moves.size() >= 2);
+  CHECK(r.moves.back().pose == PoseLaw::tcp);
+  CHECK(near(r.moves.back().start, Vec3(0, 0, -1), 1e-9));
+  CHECK(near(r.moves.back().end, Vec3(10, 0, -1), 1e-9));
 }
 
 TEST_CASE(

@@ -314,7 +314,7 @@ TEST_CASE("rotary bad input through the command: file:line:col, exit 2; lenient 
        ":2:4: ", "outside the A axis's limits [-120, 120]"},  // ac-trunnion
       {"G0 X0 Y0 Z50\nG0 C10 B5\n", ":2:8: ", "the machine has no B axis"},
       {"G68.2 X0 Y0 Z0 I0 J150 K0\n G53.1\n", ":2:2: ", "G53.1"},  // beyond A's limits
-      {"G0 X0 Y0 Z0\nG1 X1 A10 F100\n", ":2:7: ", "during a cut"},
+      {"G0 X0 Y0 Z0\nG2 X1 Y0 I0.5 A10 F100\n", ":2:15: ", "need G0 or G1"},
   };
   for (const Case& c : cases) {
     write_text(program, std::string(c.text) + "M30\n");
@@ -326,21 +326,20 @@ TEST_CASE("rotary bad input through the command: file:line:col, exit 2; lenient 
     CHECK(r.err.find(c.expected) != std::string::npos);
     CHECK(!fs::exists(dir / "m.jsonl"));
   }
-  // Lenient: the cut that turns A is read as indexed at its end orientation, said on its line and
-  // in the run's summary, in the report of simulate too.
+  // A cut that turns A is a simultaneous move, strict or lenient: no warning, its start's rotary
+  // positions and its pose law in the record.
   write_text(program, "G0 X0 Y0 Z0\nG1 X1 A10 F100\nG1 X2 A20\nM30\n");
-  CommandResult r = run_tridex({"moves", program, "--machine", "ac-trunnion", "--lenient"}, dir);
+  CommandResult r = run_tridex({"moves", program, "--machine", "ac-trunnion"}, dir);
   REQUIRE(r.status == 0);
-  CHECK(r.err.find(program + ":2:7: rotary motion during a cut") != std::string::npos);
-  CHECK(r.err.find(program + ":3:7: rotary motion during a cut") != std::string::npos);
-  CHECK(r.err.find("lenient mode read 1 × rotary motion during a cut read as indexed along") !=
-        std::string::npos);
-  CHECK(r.err.find("(lines 2)") != std::string::npos);
-  CHECK(r.err.find("(lines 3)") != std::string::npos);
+  CHECK(r.err.find("rotary motion during a cut") == std::string::npos);
   std::vector<nlohmann::json> moves = moves_of(r);
   REQUIRE(moves.size() == 3);
   CHECK(moves[1]["rotary"]["A"] == 10.0);
+  CHECK(moves[1]["rotary_start"]["A"] == 0.0);
+  CHECK(moves[1]["pose"] == "joints");
   CHECK(moves[2]["rotary"]["A"] == 20.0);
+  CHECK(moves[2]["rotary_start"]["A"] == 10.0);
+  CHECK(!moves[0].contains("pose"));
   fs::remove_all(dir);
 }
 

@@ -49,6 +49,7 @@ struct SimulateOptions : CommonOptions {
   unsigned threads = 0;                // 0: every hardware thread
   std::string zmap_backend = "cpu";    // --zmap-backend: cpu | gl (tools/backends)
   std::string dexel_backend = "scan";  // --dexel-backend: scan | tree | embree
+  bool certify = false;  // --certify: print the sweeps' worst band e per tool (simultaneous moves)
 };
 
 // A small safety distance (mm): shanks and holders closer than this to the stock are near misses.

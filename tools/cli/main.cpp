@@ -158,6 +158,9 @@ void add_simulate(CLI::App& command, SimulateOptions& options) {
   command
       .add_option("--threads", options.threads, "worker threads (default: every hardware thread)")
       ->check(CLI::Range(0u, 4096u));
+  command.add_flag("--certify", options.certify,
+                   "print, per tool, the simultaneous 5-axis moves and the worst band e (mm) "
+                   "their sweeps\nstay within");
   command
       .add_option("--zmap-backend", options.zmap_backend,
                   "Step 1: cpu (the kernel's exact milling, default) or gl (the swept cutters "

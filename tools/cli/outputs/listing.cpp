@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <array>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -13,17 +14,31 @@
 #include "outputs/output.hpp"
 #include "pipeline/memory.hpp"
 #include "tridex/gcode/grouping.hpp"
+#include "tridex/gcode/simultaneous.hpp"
 
 namespace tridex::cli {
 
 namespace {
 
 // {"A": .., "C": ..}: the positions, in degrees, of the machine's rotary axes.
-Json rotary_json(const gcode::Move& m) {
+Json rotary_json(const gcode::Move& m, const std::array<double, 3>& rotary) {
   Json j = Json::object();
   for (std::size_t i = 0; i < 3; ++i)
-    if ((m.rotary_axes >> i) & 1u) j[std::string(1, static_cast<char>('A' + i))] = m.rotary[i];
+    if ((m.rotary_axes >> i) & 1u) j[std::string(1, static_cast<char>('A' + i))] = rotary[i];
   return j;
+}
+Json rotary_json(const gcode::Move& m) { return rotary_json(m, m.rotary); }
+
+// A simultaneous move's own fields (docs/command-line.md, `moves`): its pose law and its start's
+// joints (the end's are "rotary" and "machine").
+void append_simultaneous(std::string& record, const gcode::Move& m,
+                         const gcode::Kinematics& kinematics) {
+  record += ",\"pose\":\"";
+  record += m.pose == gcode::PoseLaw::tcp ? "tcp" : "joints";
+  record += "\",\"rotary_start\":";
+  record += rotary_json(m, m.rotary_start).dump();
+  record += ",\"machine_start\":";
+  append_vec3(record, gcode::MovePath(kinematics, m).machine_start());
 }
 
 // Writes through an atomic file, or to stdout for "-".
@@ -95,6 +110,8 @@ int run_moves(const ListOptions& options) {
             record += rotary_json(m).dump();
             record += ",\"machine\":";
             append_vec3(record, m.machine);
+            if (m.pose != gcode::PoseLaw::fixed)
+              append_simultaneous(record, m, *input.machine.kinematics);
           }
           record += "}\n";
           out << record;
@@ -120,11 +137,19 @@ int run_groups(const ListOptions& options) {
   };
   std::vector<Extra> extras;
   MachiningTimer timer(input.machine);
+  // Moves whose tool turns belong to no direction: counted apart, by tool.
+  long long simultaneous = 0;
+  std::map<std::string, long long> simultaneous_by_tool;
   InterpretResult result = interpret(
       input, interpreter_options(options),
       [&](const gcode::Move& m, std::size_t file) {
         budget.keep(m, input.files[file].string());
         timer.add(m);
+        if (m.pose != gcode::PoseLaw::fixed) {
+          ++simultaneous;
+          ++simultaneous_by_tool[std::to_string(m.tool)];
+          return;
+        }
         std::size_t g = grouper.add(m);
         if (g >= extras.size()) extras.resize(g + 1);
         Extra& e = extras[g];
@@ -175,6 +200,8 @@ int run_groups(const ListOptions& options) {
   document["program"] = input.program.string();
   document["segments"] = result.moves;
   document["groups"] = std::move(groups);
+  if (simultaneous)  // absent for 3+2 programs, whose output stays as it was
+    document["simultaneous"] = {{"moves", simultaneous}, {"by_tool", simultaneous_by_tool}};
   document["machining_time"] = machining_time_json(timer);
   document["warnings"] = result.warnings;
   write_output(options.output, [&](std::ostream& out) { out << dump_json(document, 2) << '\n'; });

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <set>
 
 #include "checks/rapid_check.hpp"
 #include "errors.hpp"
@@ -313,6 +314,12 @@ ParsedProgram parse_grouped(const SimulateOptions& options, std::uint64_t max_me
   // dwells the timer also reads.
   BatchPipe<gcode::Move> grouping(
       [&](const gcode::Move& m) {
+        if (m.pose != gcode::PoseLaw::fixed) {  // the tool turns: cut_simultaneous's
+          r.simultaneous.push_back(m);
+          cutting_bounds.extend(m.start);
+          cutting_bounds.extend(m.end);
+          return;
+        }
         const auto group = static_cast<std::uint32_t>(grouper.add(m));
         if (r.order.empty() || r.order.back().group != group) r.order.push_back({group, 0});
         ++r.order.back().moves;
@@ -352,8 +359,12 @@ void load_cutters(const SimulateOptions& options, const std::optional<ToolTable>
   const ProgramInput& input = r.input;
   std::vector<Cutter>& cutters = r.cutters;
   std::map<int, std::uint32_t>& cutter_of_tool = r.cutter_of_tool;
-  for (const gcode::MoveGroup& group : r.groups)
-    for (int tool : group.tools) {
+  std::vector<std::set<int>> tool_sets;  // the groups', then the simultaneous moves'
+  for (const gcode::MoveGroup& group : r.groups) tool_sets.push_back(group.tools);
+  tool_sets.emplace_back();
+  for (const gcode::Move& m : r.simultaneous) tool_sets.back().insert(m.tool);
+  for (const std::set<int>& group_tools : tool_sets)
+    for (int tool : group_tools) {
       if (cutter_of_tool.count(tool)) continue;
       const ToolSpec* spec = table ? table->find(tool) : nullptr;
       if (spec) {
@@ -737,6 +748,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   mill_directions(options, request, progress, r);
   if (!options.dump_zmaps.empty()) dump_zmaps(options.dump_zmaps, r, progress);
   intersect_directions(options, request, run.max_memory, progress, r);
+  if (!r.simultaneous.empty()) cut_simultaneous(options, r, request.body_clearance.has_value());
   extract_result_surface(options, progress, r);
   return r;
 }

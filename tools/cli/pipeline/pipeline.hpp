@@ -107,6 +107,13 @@ struct GroupRun {
   std::uint64_t moves = 0;
 };
 
+// The simultaneous 5-axis moves of one tool (simultaneous.cpp): how many, their sub-steps, and
+// the largest band e of the sweep's certificate (sweep.hpp), mm.
+struct SweepSummary {
+  long long moves = 0, sub_steps = 0;
+  double band = 0;
+};
+
 struct SimulationResult {
   ProgramInput input;
   std::vector<gcode::MoveGroup> groups;  // moves in program order within each group
@@ -137,7 +144,21 @@ struct SimulationResult {
   MachiningTimer machining;  // the program's machining time
   std::vector<std::string> warnings;
   PipelineTimings timings;
+  // Moves whose tool turns (Move::pose ≠ fixed), in program order: in no group, cut on the triple
+  // dexel after the groups' Z-maps (cut_simultaneous), summarised by tool.
+  std::vector<gcode::Move> simultaneous;
+  std::map<int, SweepSummary> sweeps;
+  double sweep_tolerance = 0;  // mm: the band asked of each sub-step
+  double sweep_seconds = 0;
 };
+
+// Cuts r.simultaneous from r.result (simultaneous.cpp): each move sub-stepped so that its band
+// stays within a tenth of the dexel spacing (or the sub-step cap, with a warning), its sweeps
+// subtracted ray by ray; fills r.sweeps and the result's dexel volume. `bodies_checked` (check's
+// collision check): warn that these moves' shanks, holders and rapids are not checked yet.
+void cut_simultaneous(const SimulateOptions& options, SimulationResult& r, bool bodies_checked);
+// The JSON of r.sweeps for the report and `--certify`.
+Json sweeps_json(const SimulationResult& r);
 
 // A rapid deeper than this below the material is reported (mm): well above the rounding of float
 // heights, well below any real collision.

@@ -36,6 +36,20 @@ double removed_mm3(const SimulationResult& r) {
   return removed >= 0 ? removed : std::max(0.0, r.stock_dexel_volume - r.result_dexel_volume);
 }
 
+// "simultaneous 5-axis: N moves (T3: n moves, s sub-steps, band ≤ e mm)", and with --certify
+// every tool's worst band against the tolerance.
+std::string simultaneous_text(const SimulationResult& r) {
+  char text[200];
+  std::string out = "simultaneous 5-axis:";
+  for (const auto& [tool, s] : r.sweeps) {
+    std::snprintf(text, sizeof text, " T%d %lld move%s, %lld sub-steps, band <= %.3g mm;", tool,
+                  s.moves, s.moves == 1 ? "" : "s", s.sub_steps, s.band);
+    out += text;
+  }
+  std::snprintf(text, sizeof text, " tolerance %.3g mm", r.sweep_tolerance);
+  return out + text;
+}
+
 // The JSON report (docs/reports.md), with the run's total time and the rapids that cut.
 Json simulate_report(const SimulateOptions& options, const SimulationResult& r,
                      const Json& rapid_findings, double total_s) {
@@ -78,6 +92,7 @@ Json simulate_report(const SimulateOptions& options, const SimulationResult& r,
                       {"watertight", check.closed()}};
   report["rapid_cuts"] = rapid_findings;
   report["machining_time"] = machining_time_json(r.machining);
+  if (!r.simultaneous.empty()) report["simultaneous"] = sweeps_json(r);  // absent for 3+2
   report["warnings"] = r.warnings;
   return report;
 }
@@ -169,6 +184,17 @@ int run_simulate(const SimulateOptions& options) {
                        .cutter_of_tool = &r.cutter_of_tool});
   }
   progress.finish();
+  if (options.certify) {  // on stdout even with --quiet: it is what was asked for
+    std::printf("certify: sweep tolerance %.6g mm (a tenth of the dexel spacing)\n",
+                r.sweep_tolerance);
+    for (const auto& [tool, s] : r.sweeps)
+      std::printf(
+          "certify: tool %d: %lld simultaneous move%s, %lld sub-steps, worst band e = "
+          "%.6g mm%s\n",
+          tool, s.moves, s.moves == 1 ? "" : "s", s.sub_steps, s.band,
+          s.band <= r.sweep_tolerance ? "" : " (OVER the tolerance)");
+    if (r.sweeps.empty()) std::printf("certify: no simultaneous moves\n");
+  }
 
   if (!options.quiet) {
     for (const std::string& w : warnings) std::cerr << "warning: " << terminal_safe(w) << '\n';
@@ -186,6 +212,7 @@ int run_simulate(const SimulateOptions& options) {
         written.c_str(), total_s);
     std::printf("  %s\n", machining_time_text(r.machining).c_str());
     std::printf("  %s\n  %s\n", tools_text(r).c_str(), directions_text(r).c_str());
+    if (!r.simultaneous.empty()) std::printf("  %s\n", simultaneous_text(r).c_str());
   }
   return kSuccess;
 }

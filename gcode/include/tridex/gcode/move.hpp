@@ -25,6 +25,14 @@ inline const char* to_string(MoveKind kind) {
   return "?";
 }
 
+// How the tool moves along a move (docs/gcode.md, "Simultaneous 5-axis"). fixed: the tool axis
+// stays `axis` and the tip runs straight from `start` to `end` (every move of a 3+2 program).
+// joints: rotary words on a cut without TCP: every joint (the linear axes' machine coordinates
+// and the rotary positions) runs linearly in time from its start to its end value, so the tip
+// curves on the part. tcp: under G43.4/G43.5 the tip runs straight on the part while
+// the rotaries run linearly in angle. Only joints and tcp moves turn the tool.
+enum class PoseLaw : unsigned char { fixed, joints, tcp };
+
 struct Move {
   int line = 0;  // 1-based source line of the block that made the move
   MoveKind kind = MoveKind::rapid;
@@ -43,8 +51,13 @@ struct Move {
   // A, 1 B, 2 C), their positions in degrees (A, B, C) and the machine coordinates of the linear
   // axes at `end` (work offset included: where the machine's axes stand).
   unsigned char rotary_axes = 0;
+  PoseLaw pose = PoseLaw::fixed;
   std::array<double, 3> rotary{};
   Vec3 machine{0.0};
+  // A simultaneous move (pose ≠ fixed) only: the rotary positions at `start`; `axis`, `rotary`
+  // and `machine` are the end's. The start's machine coordinates follow from `start` and these
+  // (gcode/simultaneous.hpp).
+  std::array<double, 3> rotary_start{};
 };
 
 // A pause with the tool standing still: G4, and the pause at a hole's bottom in G82, G86 and

@@ -1,0 +1,163 @@
+// Simultaneous 5-axis sweeps on the triple dexel (sweep.hpp): the exact oracle on random turning
+// moves of every cutter shape, the analytic C-turning groove, and thread-count identity.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <vector>
+
+#include "tridex/sweep.hpp"
+
+namespace test_sweep {
+
+using namespace tridex;
+
+// A turning move: tip from a to b along a bowed path, axis turning from one direction to another
+// (a rotation about a fixed unit vector), with certified speed bounds.
+struct TurningMove {
+  Vec3 a{0.0}, b{0.0}, bow{0.0};
+  Vec3 axis0{0, 0, 1}, turn_about{1, 0, 0};
+  double turn = 0;  // radians over the move
+  bool straight = false;
+  ToolPose at(double s) const {
+    const Vec3 tip = a + s * (b - a) + (straight ? 0.0 : 4 * s * (1 - s)) * bow;
+    const double t = turn * s, c = std::cos(t), sn = std::sin(t);
+    const Vec3& k = turn_about;
+    const Vec3 axis = axis0 * c + glm::cross(k, axis0) * sn + k * glm::dot(k, axis0) * (1 - c);
+    return {tip, glm::normalize(axis)};
+  }
+  PoseBounds bounds() const {
+    // |tip'| ≤ |b − a| + 4|bow| (|d/ds 4s(1−s)| ≤ 4); |axis'| = turn·|k × axis| ≤ turn.
+    return {glm::length(b - a) + (straight ? 0.0 : 4 * glm::length(bow)), std::abs(turn), straight};
+  }
+};
+
+std::vector<SweepCutter> shapes() {
+  return {{Cutter::ball(1.5), 5},
+          {Cutter::flat(1.5), 5},
+          {Cutter::bull_nose(1.5, 0.5), 5},
+          {Cutter::cone(1.5, 30), 5},
+          {Cutter::chamfer(1.5, 0.5, 45), 5}};
+}
+
+TEST_CASE("sweep: the meridian distance is exact on a flat end and a ball") {
+  SweepCutter flat{Cutter::flat(2), 6};
+  CHECK(flat.distance(Vec3(0), Vec3(0, 0, 1), Vec3(0, 0, -1)) == doctest::Approx(1));
+  CHECK(flat.distance(Vec3(0), Vec3(0, 0, 1), Vec3(3, 0, 3)) == doctest::Approx(1));
+  CHECK(flat.distance(Vec3(0), Vec3(0, 0, 1), Vec3(0, 0, 1)) == doctest::Approx(-1));
+  CHECK(flat.distance(Vec3(0), Vec3(0, 0, 1), Vec3(0, 0, 7)) == doctest::Approx(1));
+  SweepCutter ball{Cutter::ball(2), 6};
+  CHECK(ball.distance(Vec3(0), Vec3(1, 0, 0), Vec3(2, 3, 0)) == doctest::Approx(1));
+  CHECK(ball.distance(Vec3(0), Vec3(1, 0, 0), Vec3(-1, 0, 0)) == doctest::Approx(1));
+  CHECK(ball.distance(Vec3(0), Vec3(0, 0, 1), Vec3(0, 0, 1)) == doctest::Approx(-1));
+}
+
+// Material is removed by the true moving cutter iff min over t of the signed distance is ≤ 0.
+// The oracle samples t finely; with body points moving at most vmax per unit t, the sampled
+// minimum exceeds the true one by at most vmax·dt/2. A dexel sample may differ from the oracle
+// only where the true minimum lies within the band (plus the precision and float rounding).
+TEST_CASE("sweep: zero dexel samples wrong by more than the band, random turning moves") {
+  std::mt19937 rng(34);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  const Aabb stock{Vec3(-4, -4, -4), Vec3(4, 4, 4)};
+  const DexelLattice lattice = DexelLattice::covering(stock, 0.4);
+  const std::vector<SweepCutter> cutters = shapes();
+  long long checked = 0, wrong = 0;
+  for (std::uint32_t c = 0; c < cutters.size(); ++c)
+    for (int trial = static_cast<int>(c % 2); trial < static_cast<int>(c % 2) + 1; ++trial) {
+      TurningMove m;
+      m.a = Vec3(unit(rng), unit(rng), unit(rng)) * 2.0 - Vec3(0, 0, 1);
+      m.b = Vec3(unit(rng), unit(rng), unit(rng)) * 2.0 - Vec3(0, 0, 1);
+      m.bow = Vec3(unit(rng), unit(rng), unit(rng)) * 0.6;
+      m.straight = trial == 1;
+      m.axis0 = glm::normalize(Vec3(unit(rng), unit(rng), 2.0));
+      m.turn_about = glm::normalize(Vec3(unit(rng), unit(rng), unit(rng)));
+      m.turn = 0.8 * unit(rng);
+      const double tolerance = lattice.spacing / 10;
+      const SweepPlan plan = plan_sweep([&](double s) { return m.at(s); }, m.bounds(),
+                                        cutters[c].reach(), tolerance, c);
+      REQUIRE(plan.band <= tolerance);
+      TripleDexel d = TripleDexel::box(lattice, stock);
+      sweep_remove(d, cutters, plan.steps, 2);
+      const int oracle_steps = 200;
+      const double vmax = m.bounds().tip_speed + cutters[c].reach() * m.bounds().turn_rate;
+      const double slack = vmax / oracle_steps / 2 + 1e-3;
+      for (int a = 0; a < 3; ++a) {
+        const DexelGrid& g = d.grids[a];
+        const int u = TripleDexel::u_axis(a), v = TripleDexel::v_axis(a);
+        for (int iv = trial; iv < g.nv; iv += 3)
+          for (int iu = c % 3; iu < g.nu; iu += 3) {
+            auto ray = g.ray(iu, iv);
+            for (double x = stock.min[a] + 0.013; x < stock.max[a]; x += 0.23) {
+              Vec3 p = d.origin;
+              p[u] += d.spacing * iu, p[v] += d.spacing * iv, p[a] = x;
+              if (!stock.contains(p)) continue;
+              bool material = false;
+              for (const DexelInterval& s : ray) material |= s.enter <= x && x <= s.exit;
+              double oracle = 1e300;
+              for (int k = 0; k <= oracle_steps; ++k) {
+                const ToolPose pose = m.at(double(k) / oracle_steps);
+                oracle = std::min(oracle, cutters[c].distance(pose.tip, pose.axis, p));
+              }
+              ++checked;
+              if (material && oracle < -(plan.band + slack)) ++wrong;
+              if (!material && oracle - slack > plan.band + 1e-3) ++wrong;
+            }
+          }
+      }
+    }
+  CHECK(checked > 2500);
+  CHECK(wrong == 0);
+}
+
+// A flat end of radius R standing parallel to C at radius r, plunged d into the stock, while C
+// turns by φ: the part sees the tool run an arc, removing d(2φrR + πR²).
+TEST_CASE("sweep: the C-turning groove's volume, and the same dexels on 1, 2 and 8 threads") {
+  const double radius = 3, arc = 12, depth = 2, phi = std::numbers::pi / 2;
+  auto pose = [&](double s) {
+    return ToolPose{Vec3(arc * std::cos(phi * s), arc * std::sin(phi * s), -depth), Vec3(0, 0, 1)};
+  };
+  const std::vector<SweepCutter> cutters{{Cutter::flat(radius), 8}};
+  const double spacing = 0.3;
+  const SweepPlan plan =
+      plan_sweep(pose, PoseBounds{arc * phi, 0, false}, cutters[0].reach(), spacing / 10);
+  CHECK(plan.band <= spacing / 10);
+  CHECK(plan.steps.size() <= 128);
+  const Aabb stock{Vec3(-18, -18, -6), Vec3(18, 18, 0)};
+  const DexelLattice lattice = DexelLattice::covering(stock, spacing);
+  std::vector<TripleDexel> results;
+  for (unsigned threads : {1u, 2u, 8u}) {
+    TripleDexel d = TripleDexel::box(lattice, stock);
+    // The Z rays run along the tool: each measures the depth exactly, so their sum is the
+    // groove's area by the midpoint rule, within about its outline's length times the spacing
+    // (the X and Y rays also round the depth to their rows: O(h) too, larger here).
+    auto z_length = [](const TripleDexel& t) {
+      double sum = 0;
+      for (const DexelInterval& s : t.grids[2].intervals) sum += double(s.exit) - double(s.enter);
+      return sum * t.spacing * t.spacing;
+    };
+    const double before = z_length(d);
+    sweep_remove(d, cutters, plan.steps, threads);
+    if (threads == 1) {
+      const double expected = depth * (2 * phi * arc * radius + std::numbers::pi * radius * radius);
+      const double removed = before - z_length(d);
+      const double outline = 2 * phi * arc + 2 * std::numbers::pi * radius;
+      INFO("removed " << removed << " expected " << expected);
+      CHECK(std::abs(removed - expected) < 0.5 * outline * spacing * depth);
+      CHECK(std::abs(removed - expected) < 0.01 * expected);
+    }
+    results.push_back(std::move(d));
+  }
+  for (const TripleDexel& d : results)
+    for (int a = 0; a < 3; ++a) {
+      CHECK(d.grids[a].offsets == results[0].grids[a].offsets);
+      CHECK(std::equal(d.grids[a].intervals.begin(), d.grids[a].intervals.end(),
+                       results[0].grids[a].intervals.begin(), results[0].grids[a].intervals.end(),
+                       [](const DexelInterval& x, const DexelInterval& y) {
+                         return x.enter == y.enter && x.exit == y.exit;
+                       }));
+    }
+}
+
+}  // namespace test_sweep

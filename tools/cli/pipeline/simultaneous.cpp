@@ -1,0 +1,87 @@
+// tridex command — simultaneous 5-axis moves (Move::pose ≠ fixed): each move's pose from the
+// machine's kinematics (gcode/simultaneous.hpp), sub-stepped with a certified band and cut from
+// the triple dexel after the Z-maps' intersection (tridex/sweep.hpp; docs/design.md,
+// "Simultaneous moves"). Removal commutes with the intersection, so the order does not matter.
+#include <algorithm>
+#include <chrono>
+#include <string>
+
+#include "errors.hpp"
+#include "pipeline/pipeline.hpp"
+#include "tridex/dexel_ops.hpp"
+#include "tridex/gcode/simultaneous.hpp"
+#include "tridex/sweep.hpp"
+
+namespace tridex::cli {
+
+namespace {
+
+// A sweep needs a finite cutter: up to the flutes' top where the tool table gives a shank (its
+// bottom), else the cutting part and two diameters above it (docs/design.md says why a cutter
+// taller than the material it can reach changes nothing).
+SweepCutter sweep_cutter_of(const Cutter& cutter, const ToolBody& body) {
+  const double profile = cutter.profile_height();
+  double height = profile + 4 * cutter.radius();
+  if (!body.parts.empty() && body.parts.front().bottom > profile)
+    height = body.parts.front().bottom;
+  return {cutter, height};
+}
+
+}  // namespace
+
+void cut_simultaneous(const SimulateOptions& options, SimulationResult& r, bool bodies_checked) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::optional<gcode::Kinematics>& kinematics = r.input.machine.kinematics;
+  if (!kinematics) detail::fail("cut_simultaneous: simultaneous moves without kinematics");
+  std::vector<SweepCutter> cutters;
+  for (std::size_t c = 0; c < r.cutters.size(); ++c)
+    cutters.push_back(sweep_cutter_of(r.cutters[c], r.bodies[c]));
+  r.sweep_tolerance = r.lattice.spacing / 10;
+  std::vector<SweepStep> steps;
+  long long capped = 0;
+  for (const gcode::Move& m : r.simultaneous) {
+    auto it = r.cutter_of_tool.find(m.tool);
+    if (it == r.cutter_of_tool.end()) continue;  // before any tool (dropped as the groups' are)
+    const gcode::MovePath path(*kinematics, m);
+    const SweepPlan plan = plan_sweep([&](double s) { return path.at(s); }, path.bounds(),
+                                      cutters[it->second].reach(), r.sweep_tolerance, it->second);
+    SweepSummary& summary = r.sweeps[m.tool];
+    ++summary.moves;
+    summary.sub_steps += static_cast<long long>(plan.steps.size());
+    summary.band = std::max(summary.band, plan.band);
+    if (plan.band > r.sweep_tolerance) ++capped;
+    steps.insert(steps.end(), plan.steps.begin(), plan.steps.end());
+  }
+  if (capped)
+    r.warnings.push_back(std::to_string(capped) + " simultaneous move" + (capped == 1 ? "" : "s") +
+                         " needed more than " + std::to_string(kMaxSubSteps) +
+                         " sub-steps: their band exceeds " + std::to_string(r.sweep_tolerance) +
+                         " mm (see the report's \"simultaneous\")");
+  if (bodies_checked)  // never a silent pass: the material is cut, the bodies not yet checked
+    r.warnings.push_back(std::to_string(r.simultaneous.size()) +
+                         " simultaneous 5-axis move(s) were cut, but their shanks, holders and "
+                         "rapids are not checked for collisions yet (docs/design.md, "
+                         "\"Simultaneous moves\")");
+  sweep_remove(r.result, cutters, steps, options.threads, r.sweep_tolerance / 100);
+  r.result_dexel_volume = tridex::volume(r.result);
+  r.sweep_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+Json sweeps_json(const SimulationResult& r) {
+  Json by_tool = Json::object();
+  long long moves = 0, sub_steps = 0;
+  double band = 0;
+  for (const auto& [tool, s] : r.sweeps) {
+    by_tool[std::to_string(tool)] = {
+        {"moves", s.moves}, {"sub_steps", s.sub_steps}, {"band_mm", s.band}};
+    moves += s.moves, sub_steps += s.sub_steps, band = std::max(band, s.band);
+  }
+  return {{"moves", moves},
+          {"sub_steps", sub_steps},
+          {"band_mm", band},
+          {"tolerance_mm", r.sweep_tolerance},
+          {"seconds", r.sweep_seconds},
+          {"by_tool", by_tool}};
+}
+
+}  // namespace tridex::cli
