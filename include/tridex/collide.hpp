@@ -254,13 +254,16 @@ inline TreeDistance tree_distance(const TriangleTree& a, const Frame& fa, const 
     // Split the larger node (a leaf cannot be split).
     const bool split_a =
         y.count > 0 || (x.count == 0 && glm::length(x.box.size()) >= glm::length(y.box.size()));
-    if (split_a) {
-      stack.push_back({x.right, ib});
-      stack.push_back({x.left, ib});
-    } else {
-      stack.push_back({ia, y.right});
-      stack.push_back({ia, y.left});
-    }
+    // The nearer child last, so it is searched first and the bound tightens early.
+    std::pair<std::uint32_t, std::uint32_t> first{x.left, ib}, second{x.right, ib};
+    if (!split_a) first = {ia, y.left}, second = {ia, y.right};
+    auto lower = [&](const std::pair<std::uint32_t, std::uint32_t>& p) {
+      return TriangleTree::box_box_distance2(na[p.first].box, turned_box(rel, nb[p.second].box));
+    };
+    const double l1 = lower(first), l2 = lower(second);
+    if (l1 > l2) std::swap(first, second);
+    if (std::max(l1, l2) < best2) stack.push_back(second);
+    if (std::min(l1, l2) < best2) stack.push_back(first);
   }
   if (best2 < cap * cap) result.distance = std::sqrt(best2);
   return result;

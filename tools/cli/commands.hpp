@@ -63,6 +63,7 @@ struct CheckOptions : SimulateOptions {
   std::string ply;                       // --ply OUT.ply: the machined mesh coloured by deviation
   std::string envelope;                  // --envelope box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX
   double clearance = kDefaultClearance;  // --clearance: near misses of shanks and holders, mm
+  std::vector<std::string> fixtures;     // --fixture FILE.stl (repeatable; machine_run.hpp)
 };
 
 // check's default verdict tolerance, mm: a shop's usual ±0.02 mm on a milled surface (ISO 2768-f

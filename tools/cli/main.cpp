@@ -236,6 +236,10 @@ int main(int argc, char** argv) {
          "--clearance", check.clearance,
          "report moves whose shank or holder comes closer than this to the stock, mm (0: none)")
       ->check(kFiniteNonNegative);
+  chk->add_option("--fixture", check.fixtures,
+                  "a fixture (vise, clamp) as STL in the work frame, never cut: the tool and the "
+                  "machine's parts are\nchecked against it along every move (repeatable)")
+      ->check(kNotEmpty);
   chk->add_option("-o,--output", check.output, "write the machined result as binary STL")
       ->check(kNotEmpty);
   chk->add_option("--report", check.report, "write the JSON report of the check")->check(kNotEmpty);

@@ -25,6 +25,7 @@ struct ProgramInput {
   std::optional<StockSpec> stock;            // from a project
   gcode::MachineConfig machine;              // --machine, --subprograms
   bool project = false;                      // a CAMotics project
+  std::vector<std::filesystem::path> fixtures;  // a project's "fixtures" (STL, work frame)
 };
 
 // --machine NAME|FILE and --subprograms: a bundled machine (tridex/gcode/machine.hpp's registry)
