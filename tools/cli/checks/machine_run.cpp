@@ -131,6 +131,25 @@ MachineRun run_machine_check(const std::vector<std::string>& fixtures, const Sim
   for (const MachineBody& b : check.bodies()) run.bodies.push_back(b.name);
 
   const Vec3 g54 = machine.work_offsets.count(1) ? machine.work_offsets.at(1) : Vec3(0);
+  // Pairs in contact on the last move checked: a retract straight up the tool from such a
+  // contact is where the machine backs off the crash already reported, not a new one.
+  std::set<std::pair<std::string, std::string>> touching;
+  auto checked = [&](const MachineMove& move, const gcode::Move& m) {
+    const std::size_t first = run.found.collisions.size();
+    check.check(move, run.found);
+    const Vec3 path = m.end - m.start;
+    const bool retract = glm::length(path) > 0 && glm::dot(path, m.axis) >= 0.999 * glm::length(path);
+    std::set<std::pair<std::string, std::string>> now;
+    auto& list = run.found.collisions;
+    for (std::size_t k = first; k < list.size();) {
+      now.insert({list[k].a, list[k].b});
+      if (retract && list[k].t == 0 && touching.count({list[k].a, list[k].b}))
+        list.erase(list.begin() + static_cast<std::ptrdiff_t>(k));
+      else
+        ++k;
+    }
+    touching = std::move(now);
+  };
   std::vector<std::size_t> next(r.groups.size(), 0);
   const gcode::Move* previous = nullptr;
   for (const GroupRun& span : r.order)
@@ -144,7 +163,7 @@ MachineRun run_machine_check(const std::vector<std::string>& fixtures, const Sim
       if (!machine.kinematics) {
         move.offset = g54;
         move.from.x = m.start + g54, move.to.x = m.end + g54;
-        check.check(move, run.found);
+        checked(move, m);
         continue;
       }
       const gcode::Kinematics& kin = *machine.kinematics;
@@ -156,9 +175,9 @@ MachineRun run_machine_check(const std::vector<std::string>& fixtures, const Sim
         MachineMove turn = move;
         turn.from = {before->machine, before->rotary};
         turn.to = {before->machine, m.rotary};
-        check.check(turn, run.found);
+        checked(turn, m);
       }
-      check.check(move, run.found);
+      checked(move, m);
     }
   return run;
 }
