@@ -222,8 +222,8 @@ void read_components(const json& value, const std::string& where, const std::str
       else if (key == "on")
         part.on = string_value(v, key_at).get<std::string>();
       else if (key == "mesh")
-        part.mesh = (fs::path(file).parent_path() / string_value(v, key_at).get<std::string>())
-                        .string();
+        part.mesh =
+            (fs::path(file).parent_path() / string_value(v, key_at).get<std::string>()).string();
       else
         machine_error(key_at, ": unknown key (known: name, on, mesh)");
     }
@@ -414,8 +414,8 @@ MachineConfig parse(const json& doc, const std::string& file) {
           where,
           ": unknown key (known: name, description, base, dialect, units, start, "
           "tool_change, tool_loads_on_t, initial_tool, arc_radius_tolerance_mm, d_offsets, home, "
-          "reference2, work_offsets, m_codes, "
-          "forbidden_m_codes, variables, far_distance, subprograms, kinematics, "
+          "reference2, work_offsets, m_codes, forbidden_m_codes, variables, far_distance, "
+          "subprograms, kinematics, "
           "rapid_rate_mm_per_min, rapid_rate_deg_per_min, max_feed_mm_per_min, components, "
           "collision, linear_axes)");
     }

@@ -16,8 +16,10 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <utility>
 #include <vector>
 
@@ -61,6 +63,26 @@ class TriangleTree {
       r = std::max(
           {r, glm::length(t.a - centre), glm::length(t.b - centre), glm::length(t.c - centre)});
     return r;
+  }
+
+  // A vertex of each connected piece of the surface (triangles sharing a corner point join).
+  std::vector<Vec3> piece_vertices() const {
+    std::vector<std::uint32_t> parent(triangles_.size());
+    for (std::uint32_t k = 0; k < parent.size(); ++k) parent[k] = k;
+    auto root = [&](std::uint32_t k) {
+      while (parent[k] != k) k = parent[k] = parent[parent[k]];
+      return k;
+    };
+    std::map<std::array<double, 3>, std::uint32_t> owner;
+    for (std::uint32_t k = 0; k < triangles_.size(); ++k)
+      for (const Vec3& p : {triangles_[k].a, triangles_[k].b, triangles_[k].c}) {
+        auto [it, fresh] = owner.try_emplace({p.x, p.y, p.z}, k);
+        if (!fresh) parent[root(k)] = root(it->second);
+      }
+    std::vector<Vec3> out;
+    for (std::uint32_t k = 0; k < triangles_.size(); ++k)
+      if (root(k) == k) out.push_back(triangles_[k].a);
+    return out;
   }
 
   // Distance from point p (this tree's frame) to the surface.
@@ -176,7 +198,7 @@ class TriangleTree {
       }
       nodes_[node].box = box;
       const Vec3 size = centre_box.size();
-      if (count <= 4 || (size.x <= 0 && size.y <= 0 && size.z <= 0)) {
+      if (count <= 4) {  // (equal centres still split in half: leaves hold at most 4)
         nodes_[node].first = first, nodes_[node].count = count;
         continue;
       }
@@ -237,18 +259,30 @@ inline TreeDistance tree_distance(const TriangleTree& a, const Frame& fa, const 
     const TriangleTree::Node &x = na[ia], &y = nb[ib];
     if (!(TriangleTree::box_box_distance2(x.box, turned_box(rel, y.box)) < best2)) continue;
     if (x.count > 0 && y.count > 0) {
-      for (std::uint32_t i = x.first; i < x.first + x.count; ++i)
-        for (std::uint32_t j = y.first; j < y.first + y.count; ++j) {
-          const detail::Triangle3& s = b.triangles()[j];
-          const detail::Triangle3 t{rel.to_world(s.a), rel.to_world(s.b), rel.to_world(s.c)};
-          const double d2 = detail::triangle_distance2(a.triangles()[i], t);
+      detail::Triangle3 moved[4];
+      Aabb moved_box[4];
+      for (std::uint32_t j = 0; j < y.count; ++j) {
+        const detail::Triangle3& s = b.triangles()[y.first + j];
+        moved[j] = {rel.to_world(s.a), rel.to_world(s.b), rel.to_world(s.c)};
+        moved_box[j] = Aabb::of(glm::min(moved[j].a, moved[j].b), glm::max(moved[j].a, moved[j].b));
+        moved_box[j].extend(moved[j].c);
+      }
+      for (std::uint32_t i = x.first; i < x.first + x.count; ++i) {
+        const detail::Triangle3& u = a.triangles()[i];
+        Aabb box = Aabb::of(glm::min(u.a, u.b), glm::max(u.a, u.b));
+        box.extend(u.c);
+        for (std::uint32_t j = 0; j < y.count; ++j) {
+          if (!(TriangleTree::box_box_distance2(box, moved_box[j]) < best2)) continue;
+          const detail::Triangle3& t = moved[j];
+          const double d2 = detail::triangle_distance2(u, t);
           if (d2 < best2) {
             best2 = d2;
             const Vec3 centre = (t.a + t.b + t.c) / 3.0;
-            result.on_a = fa.to_world(detail::closest_on_triangle(centre, a.triangles()[i]));
+            result.on_a = fa.to_world(detail::closest_on_triangle(centre, u));
             result.on_b = fa.to_world(centre);
           }
         }
+      }
       continue;
     }
     // Split the larger node (a leaf cannot be split).
@@ -267,6 +301,74 @@ inline TreeDistance tree_distance(const TriangleTree& a, const Frame& fa, const 
   }
   if (best2 < cap * cap) result.distance = std::sqrt(best2);
   return result;
+}
+
+// The surface swept by a tree's triangles translated by d: each triangle at its start and its
+// end, and each edge's parallelogram. A triangle translated along a segment sweeps the convex
+// prism these bound, so the least distance from another mesh to this surface, when neither lies
+// inside the other's prism, is the least distance over the whole translation (used by the machine
+// check to settle a straight move in two queries, tools/cli/checks/machine_check.hpp).
+inline std::vector<detail::Triangle3> swept_triangles(const TriangleTree& tree, const Vec3& d) {
+  std::vector<detail::Triangle3> out;
+  out.reserve(8 * tree.size());
+  for (const detail::Triangle3& t : tree.triangles()) {
+    out.push_back(t);
+    out.push_back({t.a + d, t.b + d, t.c + d});
+    const Vec3 v[3] = {t.a, t.b, t.c};
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 &p = v[k], &q = v[(k + 1) % 3];
+      out.push_back({p, q, q + d});
+      out.push_back({p, q + d, p + d});
+    }
+  }
+  return out;
+}
+
+// ---- simple closed meshes (the tools' parts and the bundled machines' parts) -------------------
+
+// A box from `lo` to `hi`; a frustum about +Z (radii r0 at z0, r1 at z1) whose polygon of `sides`
+// facets lies around the circle (never inside it); several meshes as one.
+
+inline Mesh make_box_mesh(const Vec3& lo, const Vec3& hi) {
+  Mesh m;
+  for (int i = 0; i < 8; ++i)
+    m.positions.emplace_back((i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z);
+  const unsigned f[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                             {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  for (const auto& t : f) m.triangles.emplace_back(t[0], t[1], t[2]);
+  return m;
+}
+
+inline Mesh make_frustum_mesh(double r0, double r1, double z0, double z1, int sides = 24) {
+  Mesh m;
+  // The polygon's edges touch the circle at their middles: every point of the round body is in.
+  const double grow = 1 / std::cos(3.14159265358979323846 / sides);
+  for (int ring = 0; ring < 2; ++ring)
+    for (int k = 0; k < sides; ++k) {
+      const double a = 2 * 3.14159265358979323846 * k / sides, r = (ring ? r1 : r0) * grow;
+      m.positions.emplace_back(r * std::cos(a), r * std::sin(a), ring ? z1 : z0);
+    }
+  const auto n = static_cast<unsigned>(sides);
+  m.positions.emplace_back(0, 0, z0);
+  m.positions.emplace_back(0, 0, z1);
+  for (unsigned k = 0; k < n; ++k) {
+    const unsigned k1 = (k + 1) % n;
+    m.triangles.emplace_back(k, k1, n + k1);
+    m.triangles.emplace_back(k, n + k1, n + k);
+    m.triangles.emplace_back(2 * n, k1, k);
+    m.triangles.emplace_back(2 * n + 1, n + k, n + k1);
+  }
+  return m;
+}
+
+inline Mesh merge_meshes(const std::vector<Mesh>& parts) {
+  Mesh m;
+  for (const Mesh& p : parts) {
+    const auto base = static_cast<unsigned>(m.positions.size());
+    m.positions.insert(m.positions.end(), p.positions.begin(), p.positions.end());
+    for (const glm::uvec3& t : p.triangles) m.triangles.push_back(t + glm::uvec3(base));
+  }
+  return m;
 }
 
 }  // namespace tridex

@@ -35,7 +35,7 @@ TEST_CASE("machine check: thin plates and spikes between a fixed sampler's poses
   gcode::CollisionSettings settings;  // contact only
   MachineCheck check(std::nullopt, {true, true, true}, settings);
   // The tool: a cylinder of radius 3 from the tip up 50 mm, on a rapid from X-500 to X500 at Z5.
-  check.add(body("tool", {LinkKind::tool, 0}, frustum_mesh(3, 3, 0, 50)));
+  check.add(body("tool", {LinkKind::tool, 0}, make_frustum_mesh(3, 3, 0, 50)));
   MachineMove move;
   move.from.x = Vec3(-500, 0, 5), move.to.x = Vec3(500, 0, 5);
   // A sampler testing 100 poses 10 mm apart covers X within 3 mm of each; obstacles go in the gaps.
@@ -43,11 +43,12 @@ TEST_CASE("machine check: thin plates and spikes between a fixed sampler's poses
   for (int k = 0; k < planted; ++k) {
     const double x = -500 + 10 * std::floor(u(rng) * 100) + 3.5 + 2.7 * u(rng);
     const double y = 2.8 * (2 * u(rng) - 1);
-    const Mesh m = k % 2 == 0
-                       // a plate 0.3 mm thick across the path, its top anywhere above Z2
-                       ? box_mesh(Vec3(x, -20, -10), Vec3(x + 0.3, 20, 2 + 50 * u(rng)))
-                       // a spike 0.2 mm square rising into the tool's path within its radius
-                       : box_mesh(Vec3(x, y - 0.1, -10), Vec3(x + 0.2, y + 0.1, 5.01 + 40 * u(rng)));
+    const Mesh m =
+        k % 2 == 0
+            // a plate 0.3 mm thick across the path, its top anywhere above Z2
+            ? make_box_mesh(Vec3(x, -20, -10), Vec3(x + 0.3, 20, 2 + 50 * u(rng)))
+            // a spike 0.2 mm square rising into the tool's path within its radius
+            : make_box_mesh(Vec3(x, y - 0.1, -10), Vec3(x + 0.2, y + 0.1, 5.01 + 40 * u(rng)));
     check.add(body("obstacle " + std::to_string(k), {LinkKind::work, 0}, m));
   }
   // The fixed-step sampler misses every one of them ...
@@ -75,8 +76,8 @@ TEST_CASE("machine check: a box on a turning C table meets a fixed box at the cl
   kin.axes = {c};
   MachineCheck check(kin, {true, true, true}, gcode::CollisionSettings{});
   // On C: x 10..50, y -5..5. Fixed (on the spindle, X at 0): the face y = 20.
-  check.add(body("arm", {LinkKind::table, 1}, box_mesh(Vec3(10, -5, 0), Vec3(50, 5, 10))));
-  check.add(body("wall", {LinkKind::spindle, 0}, box_mesh(Vec3(0, 20, 0), Vec3(100, 30, 10))));
+  check.add(body("arm", {LinkKind::table, 1}, make_box_mesh(Vec3(10, -5, 0), Vec3(50, 5, 10))));
+  check.add(body("wall", {LinkKind::spindle, 0}, make_box_mesh(Vec3(0, 20, 0), Vec3(100, 30, 10))));
   MachineMove move;
   move.to.rotary[2] = 90;
   MachineFindings found;
@@ -119,7 +120,7 @@ TEST_CASE("machine check: travel passed inside a TCP move whose ends are within"
 // ---- end to end: a vise, a clamp, a 0.3 mm plate and a spindle nose ---------------------------
 
 void write_ascii_stl(const fs::path& path, const std::vector<Mesh>& parts) {
-  const Mesh m = merged(parts);
+  const Mesh m = merge_meshes(parts);
   std::string text = "solid part\n";
   for (const glm::uvec3& t : m.triangles) {
     text += " facet normal 0 0 0\n  outer loop\n";
@@ -140,14 +141,15 @@ struct Setup {
 
 Setup make_setup(const std::string& name) {
   Setup s{scratch(name), {}};
-  write_ascii_stl(s.dir / "vise.stl", {box_mesh(Vec3(0, -20, -30), Vec3(100, 0, 0)),
-                                       box_mesh(Vec3(0, 60, -30), Vec3(100, 80, 0))});
-  write_ascii_stl(s.dir / "clamp.stl", {box_mesh(Vec3(110, 20, -30), Vec3(130, 40, 35))});
-  write_ascii_stl(s.dir / "plate.stl", {box_mesh(Vec3(150, -10, -30), Vec3(150.3, 70, 20))});
+  write_ascii_stl(s.dir / "vise.stl", {make_box_mesh(Vec3(0, -20, -30), Vec3(100, 0, 0)),
+                                       make_box_mesh(Vec3(0, 60, -30), Vec3(100, 80, 0))});
+  write_ascii_stl(s.dir / "clamp.stl", {make_box_mesh(Vec3(110, 20, -30), Vec3(130, 40, 35))});
+  write_ascii_stl(s.dir / "plate.stl", {make_box_mesh(Vec3(150, -10, -30), Vec3(150.3, 70, 20))});
   fs::create_directories(s.dir / "parts");
-  write_ascii_stl(s.dir / "parts" / "nose.stl", {frustum_mesh(40, 40, 0, 80)});
-  write_text(s.dir / "machine.json",
-             R"({"components": [{"name": "spindle nose", "on": "spindle", "mesh": "parts/nose.stl"}],
+  write_ascii_stl(s.dir / "parts" / "nose.stl", {make_frustum_mesh(40, 40, 0, 80)});
+  write_text(
+      s.dir / "machine.json",
+      R"({"components": [{"name": "spindle nose", "on": "spindle", "mesh": "parts/nose.stl"}],
                  "collision": {"clearance": 0.5, "near_miss": 2}})");
   write_text(s.dir / "tools.json",
              R"({"1": {"shape": "cylindrical", "diameter": 6, "length": 20, "tool-length": 50}})");
@@ -160,19 +162,19 @@ json run_check(const Setup& s, const std::string& program, CommandResult& result
   write_text(s.dir / "p.nc", "G21 G90 G17\nT1 M6\nG43 H1\n" + program + "M30\n");
   fs::remove(s.dir / "report.json");
   const std::string stock = "box:0,0,-30,100,60,0";
-  CommandResult made = run_tridex({"simulate", (s.dir / "p.nc").string(), "--tools",
-                                   (s.dir / "tools.json").string(), "--stock", stock,
-                                   "--dexel-cell", "1", "-o", (s.dir / "design.stl").string(), "-q"},
-                                  s.dir);
+  CommandResult made = run_tridex(
+      {"simulate", (s.dir / "p.nc").string(), "--tools", (s.dir / "tools.json").string(), "--stock",
+       stock, "--dexel-cell", "1", "-o", (s.dir / "design.stl").string(), "-q"},
+      s.dir);
   REQUIRE(made.status == 0);
-  std::vector<std::string> args{"check",       (s.dir / "p.nc").string(),
-                                "--design",    (s.dir / "design.stl").string(),
-                                "--tools",     (s.dir / "tools.json").string(),
-                                "--machine",   (s.dir / "machine.json").string(),
-                                "--stock",     stock,
+  std::vector<std::string> args{"check",        (s.dir / "p.nc").string(),
+                                "--design",     (s.dir / "design.stl").string(),
+                                "--tools",      (s.dir / "tools.json").string(),
+                                "--machine",    (s.dir / "machine.json").string(),
+                                "--stock",      stock,
                                 "--dexel-cell", "1",
-                                "--tolerance", "1",
-                                "--report",    (s.dir / "report.json").string()};
+                                "--tolerance",  "1",
+                                "--report",     (s.dir / "report.json").string()};
   args.insert(args.end(), s.fixture_args.begin(), s.fixture_args.end());
   result = run_tridex(args, s.dir);
   return fs::exists(s.dir / "report.json") ? json::parse(slurp(s.dir / "report.json")) : json();
@@ -217,22 +219,23 @@ TEST_CASE("check --fixture and a spindle nose: each planted crash at its line, n
 TEST_CASE("machine file: the collision keys' faults name the key, exit status 2") {
   const Setup s = make_setup("machine-file-faults");
   write_text(s.dir / "p.nc", "G0 X0 Y0 Z10\nM30\n");
-  for (const auto& [text, expected] : std::vector<std::pair<std::string, std::string>>{
-           {R"({"components": [{"name": "x", "on": "B", "mesh": "parts/nose.stl"}]})",
-            "\"components\"[0].on"},
-           {R"({"components": [{"name": "x", "on": "bed", "mesh": "parts/nose.stl", "colour": 1}]})",
-            "colour: unknown key"},
-           {R"({"collision": {"clearance": -1}})", "clearance: must be a distance"},
-           {R"({"collision": {"ignore": [["a", "b"]]}})", "ignore: no component"},
-           {R"({"linear_axes": {"X": "ram"}})", "\"head\" or \"table\""},
-           {R"({"components": [{"name": "x", "on": "bed", "mesh": "missing.stl"}]})",
-            "missing.stl: no such file"}}) {
+  for (
+      const auto& [text, expected] : std::vector<std::pair<std::string, std::string>>{
+          {R"({"components": [{"name": "x", "on": "B", "mesh": "parts/nose.stl"}]})",
+           "\"components\"[0].on"},
+          {R"({"components": [{"name": "x", "on": "bed", "mesh": "parts/nose.stl", "colour": 1}]})",
+           "colour: unknown key"},
+          {R"({"collision": {"clearance": -1}})", "clearance: must be a distance"},
+          {R"({"collision": {"ignore": [["a", "b"]]}})", "ignore: no component"},
+          {R"({"linear_axes": {"X": "ram"}})", "\"head\" or \"table\""},
+          {R"({"components": [{"name": "x", "on": "bed", "mesh": "missing.stl"}]})",
+           "missing.stl: no such file"}}) {
     write_text(s.dir / "bad.json", text);
-    CommandResult r = run_tridex({"check", (s.dir / "p.nc").string(), "--design",
-                                  (s.dir / "clamp.stl").string(), "--machine",
-                                  (s.dir / "bad.json").string(), "--stock", "box:0,0,-30,100,60,0",
-                                  "--dexel-cell", "2"},
-                                 s.dir);
+    CommandResult r =
+        run_tridex({"check", (s.dir / "p.nc").string(), "--design", (s.dir / "clamp.stl").string(),
+                    "--machine", (s.dir / "bad.json").string(), "--stock", "box:0,0,-30,100,60,0",
+                    "--dexel-cell", "2"},
+                   s.dir);
     INFO(text, r.err);
     CHECK(r.status == 2);
     CHECK(r.err.find(expected) != std::string::npos);

@@ -623,11 +623,12 @@ int run_check(const CheckOptions& options) {
   if (!options.quiet) {
     print_summary(options, r, report, f, failed, total_s);
     if (machine.active)
-      std::printf("  machine: %zu collision(s), %zu near miss(es) within %g mm, %zu limit(s) passed "
-                  "inside moves; %lld moves, %lld distance queries, %.2f s\n",
-                  machine.found.collisions.size(), machine.found.near_misses.size(),
-                  r.input.machine.collision.near_miss, machine.found.travel.size(),
-                  machine.found.moves, machine.found.queries, machine.found.seconds);
+      std::printf(
+          "  machine: %zu collision(s), %zu near miss(es) within %g mm, %zu limit(s) passed "
+          "inside moves; %lld moves, %lld distance queries, %.2f s\n",
+          machine.found.collisions.size(), machine.found.near_misses.size(),
+          r.input.machine.collision.near_miss, machine.found.travel.size(), machine.found.moves,
+          machine.found.queries, machine.found.seconds);
     print_machine_findings(machine, r, kFindingsPrinted);
   }
   return failed ? kFindings : kSuccess;

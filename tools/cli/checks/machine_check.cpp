@@ -15,7 +15,7 @@ constexpr double kMachineContactSlack = 1e-4;
 // At most this many poses a pair and move (a pair that stays within the near-miss distance along
 // a long move steps by the gap to the clearance; the cap keeps a pathological move finite, and a
 // pair stopped by it is reported at its closest pose as a near miss).
-constexpr int kMachineMaxSteps = 100000;
+constexpr int kMachineMaxSteps = 20000;
 // Travel along a move: samples where machine coordinates are not straight (TCP with turning
 // rotaries), then a golden-section refinement of the worst.
 constexpr int kTravelSamples = 64;
@@ -62,6 +62,7 @@ void MachineCheck::add(MachineBody body) {
   const Aabb box = body.tree->bounds();
   body.centre = box.center();
   body.radius = body.tree->radius_about(body.centre);
+  body.pieces = body.tree->piece_vertices();
   bodies_.push_back(std::move(body));
 }
 
@@ -70,9 +71,8 @@ MachineState MachineCheck::state_at(const MachineMove& move, double t) const {
   for (std::size_t k = 0; k < 3; ++k)
     s.rotary[k] = move.from.rotary[k] + t * (move.to.rotary[k] - move.from.rotary[k]);
   if (move.tip_linear && kin_)
-    s.x = gcode::machine_from_part(*kin_, move.tip_from + t * (move.tip_to - move.tip_from) +
-                                              move.offset,
-                                   s.rotary);
+    s.x = gcode::machine_from_part(
+        *kin_, move.tip_from + t * (move.tip_to - move.tip_from) + move.offset, s.rotary);
   else
     s.x = move.from.x + t * (move.to.x - move.from.x);
   return s;
@@ -140,8 +140,8 @@ double MachineCheck::speed_bound(const MachineBody& body, const MachineMove& mov
   for (std::size_t j = depth; j-- > 0;) {
     reach = j + 1 == depth ? glm::length(body.centre + shift - axes[j]->pivot) + body.radius
                            : reach + glm::length(axes[j + 1]->pivot - axes[j]->pivot);
-    v += glm::radians(std::abs(mc_angle(move.to.rotary, *axes[j]) -
-                               mc_angle(move.from.rotary, *axes[j]))) *
+    v += glm::radians(
+             std::abs(mc_angle(move.to.rotary, *axes[j]) - mc_angle(move.from.rotary, *axes[j]))) *
          reach;
   }
   return v;
@@ -179,8 +179,10 @@ bool MachineCheck::pair_tested(const MachineBody& a, const MachineBody& b, int t
     if ((x == a.name && y == b.name) || (x == b.name && y == a.name)) return false;
   const Link &p = a.link, &q = b.link;
   if (p == q) return false;
-  const bool head_a = mc_is_head_side(p.kind) || (p.kind == LinkKind::carriage && on_head_[p.index]);
-  const bool head_b = mc_is_head_side(q.kind) || (q.kind == LinkKind::carriage && on_head_[q.index]);
+  const bool head_a =
+      mc_is_head_side(p.kind) || (p.kind == LinkKind::carriage && on_head_[p.index]);
+  const bool head_b =
+      mc_is_head_side(q.kind) || (q.kind == LinkKind::carriage && on_head_[q.index]);
   // Within one side only the chain's parts that are not neighbours: a tool's parts, the spindle,
   // the head axes and their carriages move together or next to each other; fixtures sit on the
   // table; the table's links on each other.
@@ -213,8 +215,40 @@ void MachineCheck::check(const MachineMove& move, MachineFindings& found) const 
       if (pair_tested(bodies_[i], bodies_[j], move.tool))
         check_pair(bodies_[i], bodies_[j], move, found);
   if (kin_) check_travel(move, found);
-  found.seconds +=
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  found.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// A straight move (no rotary turns): every body keeps its orientation, so in one body's
+// coordinates the other moves along one segment. The prism the smaller body sweeps (collide.hpp,
+// swept_triangles) settles the move: the bodies meet where the other body's surface crosses that
+// swept surface, or where a connected piece of it lies wholly inside a swept prism, when its
+// every point, a representative vertex included, passes through the moving triangle (tested as
+// that vertex's path against the moving body). When they do not meet, the least distance from
+// the swept surface is the least distance over the move, exactly. Returns it (≤ the clearance
+// and the slack where they meet; at most `cap`).
+double MachineCheck::swept_distance(const MachineBody& a, const MachineBody& b,
+                                    const MachineMove& move, double cap) const {
+  const bool swap = a.tree->size() > b.tree->size();
+  const MachineBody& moving = swap ? b : a;  // the one swept
+  const MachineBody& other = swap ? a : b;
+  const MachineState s0 = state_at(move, 0), s1 = state_at(move, 1);
+  const Frame fm0 = frame_of(moving, s0, move), fo0 = frame_of(other, s0, move);
+  const Frame fm1 = frame_of(moving, s1, move), fo1 = frame_of(other, s1, move);
+  // How far `moving` moves in `other`'s coordinates (its orientation there stays).
+  const Vec3 in_other = fo1.to_local(fm1.origin) - fo0.to_local(fm0.origin);
+  const Vec3 in_moving = glm::transpose(fm0.rotation) * (fo0.rotation * in_other);
+  const double slack = settings_.clearance + kMachineContactSlack;
+  cap = std::max(cap, 2 * slack);  // a cap at or below the contact distance would say "contact"
+  const TriangleTree swept(swept_triangles(*moving.tree, in_moving));
+  const double least = tree_distance(swept, fm0, *other.tree, fo0, slack, cap).distance;
+  if (least <= slack) return least;
+  // Each piece of `other` that could lie inside a prism: its representative's path, in moving's
+  // coordinates at t = 0, runs from r to r − in_moving.
+  for (const Vec3& r : other.pieces) {
+    const Vec3 p = fm0.to_local(fo0.to_world(r));
+    if (moving.tree->distance(p, p - in_moving) <= slack) return 0;
+  }
+  return least;
 }
 
 void MachineCheck::check_pair(const MachineBody& a, const MachineBody& b, const MachineMove& move,
@@ -223,34 +257,61 @@ void MachineCheck::check_pair(const MachineBody& a, const MachineBody& b, const 
   const double v = speed_bound(a, move, linear) + speed_bound(b, move, linear);
   const double clearance = settings_.clearance;
   const double near = std::max(settings_.near_miss, clearance);
-  // While outside the near-miss distance, step to where it may be reached; inside, to where the
-  // clearance may be (so the closest pose inside is sampled, and contact never skipped).
-  double t = 0, closest = std::numeric_limits<double>::infinity(), closest_t = 0;
-  TreeDistance closest_d;
+  const bool straight = move.from.rotary == move.to.rotary;
   auto finding = [&](double distance, double at, const TreeDistance& where) {
     const MachineState here = state_at(move, at);
     MachineBody work_body;
     work_body.link = {LinkKind::work, 0};
     const Frame work = frame_of(work_body, here, move);
-    return MachineFinding{move.file, move.line, move.tool, a.name,
-                          b.name,    distance,  at,        here,
-                          work.to_local(0.5 * (where.on_a + where.on_b))};
+    return MachineFinding{move.file, move.line, move.tool,
+                          a.name,    b.name,    distance,
+                          at,        here,      work.to_local(0.5 * (where.on_a + where.on_b))};
   };
-  for (int step = 0; step < kMachineMaxSteps; ++step) {
+  auto at = [&](double t) {
     const MachineState s = state_at(move, t);
-    const TreeDistance d = tree_distance(*a.tree, frame_of(a, s, move), *b.tree,
-                                         frame_of(b, s, move), clearance + kMachineContactSlack);
     ++found.queries;
+    return tree_distance(*a.tree, frame_of(a, s, move), *b.tree, frame_of(b, s, move),
+                         clearance + kMachineContactSlack);
+  };
+  // Conservative advancement (machine_check.hpp) from t = 0: while outside the near-miss distance
+  // step to where it may be reached; inside, to where the clearance may be. A straight move that
+  // comes near is settled by its swept surfaces instead of by small steps.
+  double t = 0, closest = std::numeric_limits<double>::infinity(), closest_t = 0;
+  TreeDistance closest_d;
+  bool settled_contact = false;
+  for (int step = 0; step < kMachineMaxSteps; ++step) {
+    const TreeDistance d = at(t);
     if (d.distance < closest) closest = d.distance, closest_t = t, closest_d = d;
     if (d.distance <= clearance + kMachineContactSlack) {
       found.collisions.push_back(finding(std::max(0.0, d.distance), t, d));
       return;
     }
     if (t >= 1 || !(v > 0)) break;
-    const double gap = d.distance > near ? d.distance - near : d.distance - clearance;
+    if (straight && !settled_contact && d.distance <= near + v * (1 - t)) {
+      found.queries += 2;
+      const double least = swept_distance(a, b, move, near);
+      if (least > clearance + kMachineContactSlack) {
+        if (least < settings_.near_miss) {
+          // The pose of the closest approach: the nearest of a few samples.
+          for (int k = 1; k <= 16; ++k)
+            if (const TreeDistance e = at(k / 16.0); e.distance < closest)
+              closest = e.distance, closest_t = k / 16.0, closest_d = e;
+          closest = least;
+        }
+        break;
+      }
+      settled_contact = true;  // they meet: find where first, stepping to the clearance
+    }
+    const double gap =
+        d.distance > near && !settled_contact ? d.distance - near : d.distance - clearance;
     t = std::min(1.0, t + std::max(gap, 0.5 * kMachineContactSlack) / v);
   }
-  if (closest < settings_.near_miss) found.near_misses.push_back(finding(closest, closest_t, closest_d));
+  if (settled_contact) {  // the step cap reached while grazing: the closest pose found
+    found.collisions.push_back(finding(std::max(0.0, closest), closest_t, closest_d));
+    return;
+  }
+  if (closest < settings_.near_miss)
+    found.near_misses.push_back(finding(closest, closest_t, closest_d));
 }
 
 // Travel along a move: with straight machine axes the ends bound every axis (the pipeline checks
@@ -285,50 +346,6 @@ void MachineCheck::check_travel(const MachineMove& move, MachineFindings& found)
                                 state_at(move, t).x[k], (*range)[side], t});
     }
   }
-}
-
-// ---- simple closed meshes (tool parts and the bundled machines' parts) -------------------------
-
-Mesh box_mesh(const Vec3& lo, const Vec3& hi) {
-  Mesh m;
-  for (int i = 0; i < 8; ++i)
-    m.positions.emplace_back((i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z);
-  const unsigned f[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                             {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  for (const auto& t : f) m.triangles.emplace_back(t[0], t[1], t[2]);
-  return m;
-}
-
-Mesh frustum_mesh(double r0, double r1, double z0, double z1, int sides) {
-  Mesh m;
-  // The polygon's edges touch the circle at their middles: every point of the round body is in.
-  const double grow = 1 / std::cos(std::numbers::pi / sides);
-  for (int ring = 0; ring < 2; ++ring)
-    for (int k = 0; k < sides; ++k) {
-      const double a = 2 * std::numbers::pi * k / sides, r = (ring ? r1 : r0) * grow;
-      m.positions.emplace_back(r * std::cos(a), r * std::sin(a), ring ? z1 : z0);
-    }
-  const auto n = static_cast<unsigned>(sides);
-  m.positions.emplace_back(0, 0, z0);
-  m.positions.emplace_back(0, 0, z1);
-  for (unsigned k = 0; k < n; ++k) {
-    const unsigned k1 = (k + 1) % n;
-    m.triangles.emplace_back(k, k1, n + k1);
-    m.triangles.emplace_back(k, n + k1, n + k);
-    m.triangles.emplace_back(2 * n, k1, k);
-    m.triangles.emplace_back(2 * n + 1, n + k, n + k1);
-  }
-  return m;
-}
-
-Mesh merged(const std::vector<Mesh>& parts) {
-  Mesh m;
-  for (const Mesh& p : parts) {
-    const auto base = static_cast<unsigned>(m.positions.size());
-    m.positions.insert(m.positions.end(), p.positions.begin(), p.positions.end());
-    for (const glm::uvec3& t : p.triangles) m.triangles.push_back(t + glm::uvec3(base));
-  }
-  return m;
 }
 
 }  // namespace tridex::cli

@@ -54,6 +54,7 @@ struct MachineBody {
   std::shared_ptr<const TriangleTree> tree;
   Vec3 centre{0};  // a bounding sphere of the tree (its own coordinates)
   double radius = 0;
+  std::vector<Vec3> pieces;  // a vertex of each connected piece (TriangleTree::piece_vertices)
 };
 
 // The machine's state: the linear axes' machine coordinates and the rotary positions (degrees).
@@ -76,7 +77,7 @@ struct MachineMove {
 
 struct MachineFinding {
   int file = 0, line = 0, tool = 0;
-  std::string a, b;   // the pair's names
+  std::string a, b;     // the pair's names
   double distance = 0;  // the closest the pair came (collision: ≤ the clearance)
   double t = 0;         // where along the move (0..1), collisions: the first contact
   MachineState state;   // the axes' positions there
@@ -117,6 +118,8 @@ class MachineCheck {
   bool pair_tested(const MachineBody& a, const MachineBody& b, int tool) const;
   double speed_bound(const MachineBody& body, const MachineMove& move, double linear) const;
   double linear_speed_bound(const MachineMove& move) const;
+  double swept_distance(const MachineBody& a, const MachineBody& b, const MachineMove& move,
+                        double cap) const;
   void check_pair(const MachineBody& a, const MachineBody& b, const MachineMove& move,
                   MachineFindings& found) const;
   void check_travel(const MachineMove& move, MachineFindings& found) const;
@@ -127,11 +130,5 @@ class MachineCheck {
   std::vector<MachineBody> bodies_;
   std::vector<const gcode::RotaryAxis*> table_axes_, head_axes_;  // chain order
 };
-
-// A closed mesh: a box from `lo` to `hi`; a frustum about +Z (radii at z0 and z1), `sides`
-// facets, its polygon around the circle (never inside it).
-Mesh box_mesh(const Vec3& lo, const Vec3& hi);
-Mesh frustum_mesh(double r0, double r1, double z0, double z1, int sides = 24);
-Mesh merged(const std::vector<Mesh>& parts);
 
 }  // namespace tridex::cli

@@ -67,8 +67,7 @@ double mr_gauge(const SimulationResult& r, int tool) {
   auto c = r.cutter_of_tool.find(tool);
   if (c == r.cutter_of_tool.end()) return 0;
   const ToolBody& body = r.bodies[c->second];
-  if (!body.parts.empty())
-    return body.parts.back().bottom + body.parts.back().shape.length;
+  if (!body.parts.empty()) return body.parts.back().bottom + body.parts.back().shape.length;
   const Cutter& cutter = r.cutters[c->second];
   return std::max(cutter.profile_height(), 6 * cutter.radius());
 }
@@ -81,7 +80,7 @@ void mr_add_tool(MachineCheck& check, const SimulationResult& r, int tool, std::
   std::vector<Mesh> flutes;
   // The profile by rings; each piece of the cone between two rings lowered by how far the
   // profile sags below its chord (a ball's lower surface is convex), so that the mesh holds it.
-  constexpr int kRings = 16;
+  constexpr int kRings = 6;
   double last_d = 0, last_h = std::min(cutter.lower_height(0), top);
   for (int k = 1; k <= kRings; ++k) {
     const double d = cutter.radius() * k / kRings, h = std::min(cutter.lower_height(d), top);
@@ -90,23 +89,26 @@ void mr_add_tool(MachineCheck& check, const SimulationResult& r, int tool, std::
       const double dd = last_d + (d - last_d) * i / 8;
       sag = std::max(sag, last_h + (h - last_h) * i / 8 - std::min(cutter.lower_height(dd), top));
     }
-    flutes.push_back(frustum_mesh(last_d, d, last_h - sag, h - sag));
+    flutes.push_back(make_frustum_mesh(last_d, d, last_h - sag, h - sag));
     last_d = d, last_h = h;
   }
-  if (top > last_h) flutes.push_back(frustum_mesh(cutter.radius(), cutter.radius(), last_h, top));
+  if (top > last_h)
+    flutes.push_back(make_frustum_mesh(cutter.radius(), cutter.radius(), last_h, top));
   const std::string name = "tool " + std::to_string(tool);
-  check.add(mr_body(name + " flutes", "tool", {LinkKind::tool, 0}, tool, mr_tree(merged(flutes))));
+  check.add(
+      mr_body(name + " flutes", "tool", {LinkKind::tool, 0}, tool, mr_tree(merge_meshes(flutes))));
   std::vector<Mesh> holder;
   for (const BodyPart& part : body.parts) {
     const BodySection& s = part.shape;
-    Mesh m = frustum_mesh(s.bottom_radius, s.top_radius, part.bottom, part.bottom + s.length);
+    Mesh m = make_frustum_mesh(s.bottom_radius, s.top_radius, part.bottom, part.bottom + s.length);
     if (part.name == "shank")
       check.add(mr_body(name + " shank", "tool", {LinkKind::tool, 0}, tool, mr_tree(m)));
     else
       holder.push_back(std::move(m));
   }
   if (!holder.empty())
-    check.add(mr_body(name + " holder", "tool", {LinkKind::tool, 0}, tool, mr_tree(merged(holder))));
+    check.add(mr_body(name + " holder", "tool", {LinkKind::tool, 0}, tool,
+                      mr_tree(merge_meshes(holder))));
 }
 
 }  // namespace
@@ -120,13 +122,13 @@ MachineRun run_machine_check(const std::vector<std::string>& fixtures, const Sim
   run.active = true;
   MachineCheck check(machine.kinematics, machine.linear_on_head, machine.collision);
   for (const std::string& path : all_fixtures)
-    check.add(mr_body(std::filesystem::path(path).filename().string(), "fixture", {LinkKind::work, 0}, -1,
-               mr_tree(mr_read(path, "--fixture " + path))));
+    check.add(mr_body(std::filesystem::path(path).filename().string(), "fixture",
+                      {LinkKind::work, 0}, -1, mr_tree(mr_read(path, "--fixture " + path))));
   for (const gcode::MachineComponent& c : machine.components)
     check.add(mr_body(c.name, "component", mr_link(c.on, machine.kinematics), -1,
-               c.built ? mr_tree(*c.built)
-                       : mr_tree(mr_read(c.mesh, "--machine: component \"" + c.name + "\" mesh " +
-                                                     c.mesh))));
+                      c.built ? mr_tree(*c.built)
+                              : mr_tree(mr_read(c.mesh, "--machine: component \"" + c.name +
+                                                            "\" mesh " + c.mesh))));
   for (const auto& [tool, c] : r.cutter_of_tool) mr_add_tool(check, r, tool, c);
   for (const MachineBody& b : check.bodies()) run.bodies.push_back(b.name);
 
@@ -138,7 +140,8 @@ MachineRun run_machine_check(const std::vector<std::string>& fixtures, const Sim
     const std::size_t first = run.found.collisions.size();
     check.check(move, run.found);
     const Vec3 path = m.end - m.start;
-    const bool retract = glm::length(path) > 0 && glm::dot(path, m.axis) >= 0.999 * glm::length(path);
+    const bool retract =
+        glm::length(path) > 0 && glm::dot(path, m.axis) >= 0.999 * glm::length(path);
     std::set<std::pair<std::string, std::string>> now;
     auto& list = run.found.collisions;
     for (std::size_t k = first; k < list.size();) {
@@ -244,10 +247,11 @@ void print_machine_findings(const MachineRun& run, const SimulationResult& r, st
   const auto& found = run.found;
   for (std::size_t k = 0; k < found.collisions.size() && k < limit; ++k) {
     const MachineFinding& f = found.collisions[k];
-    std::printf("  %s:%d: collision: %s and %s meet (distance %.3f mm, %.0f%% along the move, "
-                "at %s)\n",
-                r.files.at(static_cast<std::size_t>(f.file)).c_str(), f.line, f.a.c_str(),
-                f.b.c_str(), f.distance, 100 * f.t, axes_text(f.state).c_str());
+    std::printf(
+        "  %s:%d: collision: %s and %s meet (distance %.3f mm, %.0f%% along the move, "
+        "at %s)\n",
+        r.files.at(static_cast<std::size_t>(f.file)).c_str(), f.line, f.a.c_str(), f.b.c_str(),
+        f.distance, 100 * f.t, axes_text(f.state).c_str());
   }
   for (std::size_t k = 0; k < found.travel.size() && k < limit; ++k) {
     const TravelAlong& t = found.travel[k];
