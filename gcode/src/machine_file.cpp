@@ -307,6 +307,12 @@ void check_component_links(const std::string& file, const MachineConfig& m) {
         machine_error(file, ": \"collision\".ignore: no component \"", name, "\"");
 }
 
+constexpr const char* kMachineFileKeys =
+    "name, description, base, dialect, units, start, tool_change, tool_loads_on_t, initial_tool, "
+    "arc_radius_tolerance_mm, d_offsets, home, reference2, work_offsets, m_codes, "
+    "forbidden_m_codes, variables, far_distance, subprograms, kinematics, rapid_rate_mm_per_min, "
+    "rapid_rate_deg_per_min, max_feed_mm_per_min, components, collision, linear_axes";
+
 MachineConfig parse(const json& doc, const std::string& file) {
   if (!doc.is_object()) machine_error(file, ": a machine file is a JSON object");
   MachineConfig m;
@@ -410,14 +416,7 @@ MachineConfig parse(const json& doc, const std::string& file) {
       for (const json& dir : value)
         m.subprogram_dirs.push_back((base / string_value(dir, where).get<std::string>()).string());
     } else if (!read_parts_key(key, value, file, m)) {
-      machine_error(
-          where,
-          ": unknown key (known: name, description, base, dialect, units, start, "
-          "tool_change, tool_loads_on_t, initial_tool, arc_radius_tolerance_mm, d_offsets, home, "
-          "reference2, work_offsets, m_codes, forbidden_m_codes, variables, far_distance, "
-          "subprograms, kinematics, "
-          "rapid_rate_mm_per_min, rapid_rate_deg_per_min, max_feed_mm_per_min, components, "
-          "collision, linear_axes)");
+      machine_error(where, ": unknown key (known: ", kMachineFileKeys, ")");
     }
   }
   for (int code : m.m_codes)

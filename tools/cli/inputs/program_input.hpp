@@ -27,7 +27,6 @@ struct ProgramInput {
   bool project = false;                      // a CAMotics project
   // A project's "fixtures" (STL files in the work frame; check's machine check).
   std::vector<std::filesystem::path> fixtures;
-  std::vector<std::filesystem::path> fixtures;  // a project's "fixtures" (STL, work frame)
 };
 
 // --machine NAME|FILE and --subprograms: a bundled machine (tridex/gcode/machine.hpp's registry)
