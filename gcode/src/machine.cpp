@@ -9,7 +9,12 @@
 #include <cctype>
 #include <cmath>
 #include <initializer_list>
+#include <memory>
 #include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "tridex/collide.hpp"
 #include <utility>
 
 namespace tridex::gcode {
@@ -82,42 +87,77 @@ MachineConfig linuxcnc_machine() {
 // the pivots put the table-face centre (or the tip, for head axes) at the origin, as a machine
 // file written against a machine's own zero would after subtracting it.
 
+// ---- the profiles' parts (issue 33) -------------------------------------------------------------
+// Boxes and cylinders of a plausible size (a 200-400 mm table, a 90 mm spindle nose), placed as
+// the machine stands with every axis at zero, so that a profile checks its table and head without
+// the builder's CAD; a machine file's "components" (docs/machine-files.md) replaces them. The
+// table face is z = 0, the bed well below what the table's turns sweep.
+
+MachineComponent built_part(std::string name, std::string on, Mesh mesh) {
+  MachineComponent c;
+  c.name = std::move(name), c.on = std::move(on);
+  c.built = std::make_shared<const Mesh>(std::move(mesh));
+  return c;
+}
+
+MachineConfig with_parts(MachineConfig m, std::vector<MachineComponent> parts) {
+  parts.push_back(built_part("spindle nose", "spindle", make_frustum_mesh(45, 45, 0, 150)));
+  m.components = std::move(parts);
+  return m;
+}
+
 // Table-table: A tilts the trunnion about X through (0, 0, −75) (the C face 75 mm above the tilt
 // axis), −120°…120°; C turns the platter on it about Z through the origin, endless. LinuxCNC's
 // xyzac-trt kinematics with its default directions (part_to_machine = Rx(A)·Rz(C) about the
 // pivots).
 MachineConfig ac_trunnion() {
-  return rotary_machine(
-      MachineType::table_table,
-      {make_axis('A', false, {1, 0, 0}, {0, 0, -75}, std::array<double, 2>{-120, 120}),
-       make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{})});
+  return with_parts(
+      rotary_machine(
+          MachineType::table_table,
+          {make_axis('A', false, {1, 0, 0}, {0, 0, -75}, std::array<double, 2>{-120, 120}),
+           make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{})}),
+      {built_part("platter", "C", make_frustum_mesh(100, 100, -30, 0)),
+       built_part("trunnion", "A", make_box_mesh({-160, -110, -110}, {160, 110, -35})),
+       built_part("bed", "bed", make_box_mesh({-600, -400, -500}, {600, 400, -420}))});
 }
 
 // Table-table, Haas UMC-style: B tilts about Y through (0, 0, −50), −35°…110° (a UMC-750's
 // published tilt range); C turns about Z through the origin, endless.
 MachineConfig bc_trunnion() {
-  return rotary_machine(
-      MachineType::table_table,
-      {make_axis('B', false, {0, 1, 0}, {0, 0, -50}, std::array<double, 2>{-35, 110}),
-       make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{})});
+  return with_parts(
+      rotary_machine(
+          MachineType::table_table,
+          {make_axis('B', false, {0, 1, 0}, {0, 0, -50}, std::array<double, 2>{-35, 110}),
+           make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{})}),
+      {built_part("platter", "C", make_frustum_mesh(100, 100, -30, 0)),
+       built_part("trunnion", "B", make_box_mesh({-120, -150, -110}, {120, 150, -35})),
+       built_part("bed", "bed", make_box_mesh({-600, -400, -500}, {600, 400, -420}))});
 }
 
 // Head-table: B turns the head about Y through (0, 0, 150) (pivot 150 mm above the tip),
 // −110°…110°; C turns the table about Z through the origin, endless.
 MachineConfig b_head_c_table() {
-  return rotary_machine(
-      MachineType::head_table,
-      {make_axis('B', true, {0, 1, 0}, {0, 0, 150}, std::array<double, 2>{-110, 110}),
-       make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{})});
+  return with_parts(
+      rotary_machine(
+          MachineType::head_table,
+          {make_axis('B', true, {0, 1, 0}, {0, 0, 150}, std::array<double, 2>{-110, 110}),
+           make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{})}),
+      {built_part("head", "B", make_box_mesh({-80, -80, 200}, {80, 80, 450})),
+       built_part("table", "C", make_frustum_mesh(200, 200, -40, 0)),
+       built_part("bed", "bed", make_box_mesh({-600, -400, -500}, {600, 400, -420}))});
 }
 
 // Head-head: C turns the head about Z through the spindle line, −360°…360°; A, carried by C,
 // tilts the spindle about X through (0, 0, 150), −100°…100°.
 MachineConfig head_head() {
-  return rotary_machine(
-      MachineType::head_head,
-      {make_axis('C', true, {0, 0, 1}, {0, 0, 0}, std::array<double, 2>{-360, 360}),
-       make_axis('A', true, {1, 0, 0}, {0, 0, 150}, std::array<double, 2>{-100, 100})});
+  return with_parts(
+      rotary_machine(
+          MachineType::head_head,
+          {make_axis('C', true, {0, 0, 1}, {0, 0, 0}, std::array<double, 2>{-360, 360}),
+           make_axis('A', true, {1, 0, 0}, {0, 0, 150}, std::array<double, 2>{-100, 100})}),
+      {built_part("fork", "C", make_box_mesh({-150, -60, 330}, {150, 60, 450})),
+       built_part("head", "A", make_box_mesh({-70, -70, 200}, {70, 70, 250})),
+       built_part("table", "bed", make_box_mesh({-500, -300, -60}, {500, 300, 0}))});
 }
 
 // Horizontal machining centre: the spindle along machine Z (horizontal, Y vertical, as on any

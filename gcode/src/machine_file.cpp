@@ -1,6 +1,7 @@
 // tridex::gcode — the machine file: a machine described in JSON (machine.hpp lists the keys,
 // README "Machine files" documents them), read into a MachineConfig, its kinematics and its
 // speeds. Every fault is a MachineError naming the file, the key and the value.
+#include <algorithm>
 #include <array>
 #include <cctype>
 #include <cmath>
@@ -196,6 +197,123 @@ int tool_number(const json& value, const std::string& where) {
   return static_cast<int>(value.get<long long>());
 }
 
+// ---- the collision check's keys (issue 33): "components", "collision", "linear_axes" --------
+
+double parts_distance(const json& value, const std::string& where) {
+  if (!in_range(value) || value.get<double>() < 0)
+    machine_error(where, ": must be a distance >= 0 in mm, got ", value.dump());
+  return value.get<double>();
+}
+
+void read_components(const json& value, const std::string& where, const std::string& file,
+                     MachineConfig& m) {
+  if (!value.is_array())
+    machine_error(where, ": must be a list of {\"name\", \"on\", \"mesh\"} objects");
+  m.components.clear();
+  for (std::size_t k = 0; k < value.size(); ++k) {
+    const json& c = value[k];
+    const std::string at = cat(where, "[", k, "]");
+    if (!c.is_object()) machine_error(at, ": must be an object {\"name\", \"on\", \"mesh\"}");
+    MachineComponent part;
+    for (const auto& [key, v] : c.items()) {
+      const std::string key_at = cat(at, ".", key);
+      if (key == "name")
+        part.name = string_value(v, key_at).get<std::string>();
+      else if (key == "on")
+        part.on = string_value(v, key_at).get<std::string>();
+      else if (key == "mesh")
+        part.mesh =
+            (fs::path(file).parent_path() / string_value(v, key_at).get<std::string>()).string();
+      else
+        machine_error(key_at, ": unknown key (known: name, on, mesh)");
+    }
+    if (part.name.empty() || part.on.empty() || part.mesh.empty())
+      machine_error(at, ": needs \"name\", \"on\" and \"mesh\", got ", c.dump());
+    for (const MachineComponent& other : m.components)
+      if (other.name == part.name) machine_error(at, ": a second component \"", part.name, "\"");
+    m.components.push_back(std::move(part));
+  }
+}
+
+void read_collision(const json& value, const std::string& where, MachineConfig& m) {
+  if (!value.is_object())
+    machine_error(where, ": must be an object {\"clearance\", \"near_miss\", \"ignore\"}");
+  for (const auto& [key, v] : value.items()) {
+    const std::string at = cat(where, ".", key);
+    if (key == "clearance") {
+      m.collision.clearance = parts_distance(v, at);
+    } else if (key == "near_miss") {
+      m.collision.near_miss = parts_distance(v, at);
+    } else if (key == "ignore") {
+      if (!v.is_array()) machine_error(at, ": must be a list of [name, name] pairs");
+      m.collision.ignore.clear();
+      for (const json& pair : v) {
+        if (!pair.is_array() || pair.size() != 2 || !pair[0].is_string() || !pair[1].is_string())
+          machine_error(at, ": each entry is a pair of component names, got ", pair.dump());
+        m.collision.ignore.emplace_back(pair[0].get<std::string>(), pair[1].get<std::string>());
+      }
+    } else {
+      machine_error(at, ": unknown key (known: clearance, near_miss, ignore)");
+    }
+  }
+}
+
+void read_linear_axes(const json& value, const std::string& where, MachineConfig& m) {
+  if (!value.is_object())
+    machine_error(where, ": must be an object such as {\"X\": \"head\", \"Y\": \"table\"}");
+  for (const auto& [key, v] : value.items()) {
+    const std::string at = cat(where, ".", key);
+    if (key != "X" && key != "Y" && key != "Z") machine_error(at, ": the linear axes are X, Y, Z");
+    const std::string side = string_value(v, at).get<std::string>();
+    if (side != "head" && side != "table")
+      machine_error(at, ": \"head\" or \"table\", got \"", side, "\"");
+    m.linear_on_head[static_cast<std::size_t>(key[0] - 'X')] = side == "head";
+  }
+}
+
+// Reads one of the collision check's keys; false for another key.
+bool read_parts_key(const std::string& key, const json& value, const std::string& file,
+                    MachineConfig& m) {
+  const std::string where = cat(file, ": \"", key, "\"");
+  if (key == "components")
+    read_components(value, where, file, m);
+  else if (key == "collision")
+    read_collision(value, where, m);
+  else if (key == "linear_axes")
+    read_linear_axes(value, where, m);
+  else
+    return false;
+  return true;
+}
+
+// After every key is read (the kinematics may come later in the file): each component's link
+// exists, and each ignored pair names components.
+void check_component_links(const std::string& file, const MachineConfig& m) {
+  for (std::size_t k = 0; k < m.components.size(); ++k) {
+    const MachineComponent& c = m.components[k];
+    const std::string& on = c.on;
+    const bool rotary =
+        (on == "A" || on == "B" || on == "C") && m.kinematics && m.kinematics->find(on[0]);
+    const bool linear = on == "X" || on == "Y" || on == "Z";
+    if (on != "bed" && on != "spindle" && !rotary && !linear)
+      machine_error(file, ": \"components\"[", k, "].on: \"", on,
+                    "\" is no link of this machine (bed, spindle, X, Y, Z",
+                    m.kinematics ? " or one of its rotary axes" : "", ")");
+  }
+  for (const auto& [a, b] : m.collision.ignore)
+    for (const std::string& name : {a, b})
+      if (std::none_of(m.components.begin(), m.components.end(),
+                       [&](const MachineComponent& c) { return c.name == name; }))
+        machine_error(file, ": \"collision\".ignore: no component \"", name, "\"");
+}
+
+constexpr const char* kMachineFileKeys =
+    "name, description, base, dialect, units, start, tool_change, tool_loads_on_t, "
+    "decimal_point_input, initial_tool, "
+    "arc_radius_tolerance_mm, d_offsets, home, reference2, work_offsets, m_codes, "
+    "forbidden_m_codes, variables, far_distance, subprograms, kinematics, rapid_rate_mm_per_min, "
+    "rapid_rate_deg_per_min, max_feed_mm_per_min, components, collision, linear_axes";
+
 MachineConfig parse(const json& doc, const std::string& file) {
   if (!doc.is_object()) machine_error(file, ": a machine file is a JSON object");
   MachineConfig m;
@@ -299,19 +417,14 @@ MachineConfig parse(const json& doc, const std::string& file) {
       fs::path base = fs::path(file).parent_path();
       for (const json& dir : value)
         m.subprogram_dirs.push_back((base / string_value(dir, where).get<std::string>()).string());
-    } else {
-      machine_error(where,
-                    ": unknown key (known: name, description, base, dialect, units, start, "
-                    "tool_change, tool_loads_on_t, decimal_point_input, initial_tool, "
-                    "arc_radius_tolerance_mm, "
-                    "d_offsets, home, reference2, work_offsets, m_codes, "
-                    "forbidden_m_codes, variables, far_distance, subprograms, kinematics, "
-                    "rapid_rate_mm_per_min, rapid_rate_deg_per_min, max_feed_mm_per_min)");
+    } else if (!read_parts_key(key, value, file, m)) {
+      machine_error(where, ": unknown key (known: ", kMachineFileKeys, ")");
     }
   }
   for (int code : m.m_codes)
     if (m.forbidden_m_codes.count(code))
       machine_error(file, ": M", code, " is both in \"m_codes\" and in \"forbidden_m_codes\"");
+  check_component_links(file, m);
   return m;
 }
 

@@ -66,6 +66,7 @@ struct CheckOptions : SimulateOptions {
   std::string envelope;                  // --envelope box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX
   double clearance = kDefaultClearance;  // --clearance: near misses of shanks and holders, mm
   double allowance = 0;                  // --allowance: stock to leave on the design, mm (issue 39)
+  std::vector<std::string> fixtures;     // --fixture FILE.stl (repeatable; machine_run.hpp)
 };
 
 // `diff` (issue 39): simulate's options for both programs (PROGRAM is A), B's solid compared

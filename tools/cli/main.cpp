@@ -278,6 +278,10 @@ int main(int argc, char** argv) {
                   "stock to leave on the design, mm: the surface must stand this far outside it,\n"
                   "within the tolerances (a roughing program; default 0)")
       ->check(kFiniteNonNegative);
+  chk->add_option("--fixture", check.fixtures,
+                  "a fixture (vise, clamp) as STL in the work frame, never cut: the tool and the "
+                  "machine's parts are\nchecked against it along every move (repeatable)")
+      ->check(kNotEmpty);
   chk->add_option("-o,--output", check.output, "write the machined result as binary STL")
       ->check(kNotEmpty);
   chk->add_option("--report", check.report, "write the JSON report of the check")->check(kNotEmpty);

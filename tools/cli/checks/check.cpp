@@ -25,6 +25,7 @@
 #include <set>
 
 #include "checks/deviation.hpp"
+#include "checks/machine_run.hpp"
 #include "commands.hpp"
 #include "errors.hpp"
 #include "inputs/numbers.hpp"
@@ -408,7 +409,8 @@ void list_program_findings(const SimulationResult& r, const std::optional<Aabb>&
                              {"limit", finding.limit}});
 }
 
-bool check_failed(const SimulationResult& r, const CheckFindings& f) {
+bool check_failed(const SimulationResult& r, const CheckFindings& f, const MachineRun& machine) {
+  if (!machine.found.collisions.empty() || !machine.found.travel.empty()) return true;
   const bool design_side_finding = f.design_side["missing"]["samples"].get<long long>() > 0 ||
                                    f.design_side["left"]["samples"].get<long long>() > 0;
   return !f.gouges.empty() || !f.excesses.empty() || design_side_finding || !f.rapid_list.empty() ||
@@ -627,12 +629,24 @@ int run_check(const CheckOptions& options) {
     r.warnings.push_back("the result mesh is not watertight (" +
                          std::to_string(r.mesh_check.boundary_edges) + " boundary, " +
                          std::to_string(r.mesh_check.non_manifold_edges) + " non-manifold edges)");
-  const bool failed = check_failed(r, f);
+  const MachineRun machine = run_machine_check(options.fixtures, r);
+  const bool failed = check_failed(r, f, machine);
   const double total_s = seconds_since(start);
-  const Json report = check_report(options, r, in.envelope, f, failed, deviation_s, total_s);
+  Json report = check_report(options, r, in.envelope, f, failed, deviation_s, total_s);
+  if (machine.active || !machine.found.travel.empty()) report["machine"] = machine_json(machine, r);
   write_reports(options, r, in.design, report, f, progress);
   progress.finish();
-  if (!options.quiet) print_summary(options, r, report, f, failed, total_s);
+  if (!options.quiet) {
+    print_summary(options, r, report, f, failed, total_s);
+    if (machine.active)
+      std::printf(
+          "  machine: %zu collision(s), %zu near miss(es) within %g mm, %zu limit(s) passed "
+          "inside moves; %lld moves, %lld distance queries, %.2f s\n",
+          machine.found.collisions.size(), machine.found.near_misses.size(),
+          r.input.machine.collision.near_miss, machine.found.travel.size(), machine.found.moves,
+          machine.found.queries, machine.found.seconds);
+    print_machine_findings(machine, r, kFindingsPrinted);
+  }
   return failed ? kFindings : kSuccess;
 }
 

@@ -77,6 +77,7 @@ ProgramInput resolve_program(const CommonOptions& options) {
     input.files = std::move(project.files);
     input.tools = std::move(project.tools);
     input.stock = project.stock;
+    input.fixtures = std::move(project.fixtures);
     input.project = true;
   } else {
     input.files.push_back(input.program);

@@ -25,6 +25,8 @@ struct ProgramInput {
   std::optional<StockSpec> stock;            // from a project
   gcode::MachineConfig machine;              // --machine, --subprograms
   bool project = false;                      // a CAMotics project
+  // A project's "fixtures" (STL files in the work frame; check's machine check).
+  std::vector<std::filesystem::path> fixtures;
 };
 
 // --machine NAME|FILE and --subprograms: a bundled machine (tridex/gcode/machine.hpp's registry)

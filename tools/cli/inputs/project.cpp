@@ -67,6 +67,20 @@ Project project_from_json(const nlohmann::json& json, const fs::path& path) {
   }
   if (auto tools = json.find("tools"); tools != json.end())
     project.tools = ToolTable::from_json(*tools, source + ": \"tools\"");
+  if (auto fixtures = json.find("fixtures"); fixtures != json.end()) {
+    if (!fixtures->is_array())
+      input_error(source, ": \"fixtures\" must list STL files, got ", json_type_name(*fixtures));
+    for (const auto& f : *fixtures) {
+      if (!f.is_string() || f.get<std::string>().empty())
+        input_error(source, ": \"fixtures\" entries must be file names, got ", json_type_name(f));
+      fs::path file = f.get<std::string>();
+      if (file.is_relative()) file = folder / file;
+      std::error_code error;
+      if (!fs::is_regular_file(file, error))
+        input_error(source, ": fixture ", file.string(), " does not exist");
+      project.fixtures.push_back(file);
+    }
+  }
   if (auto work = json.find("workpiece"); work != json.end()) {
     if (!work->is_object()) input_error(source, ": \"workpiece\" must be an object");
     StockSpec stock;

@@ -3,7 +3,9 @@
 // From a project tridex takes the program file(s) ("files", relative to the project's folder),
 // the tool table ("tools", the same schema as --tools) and the workpiece ("workpiece":
 // {"automatic": bool, "margin": percent, "bounds": {"min": [x,y,z], "max": [x,y,z]}}, in mm as
-// CAMotics stores it). Options given on the command line take precedence.
+// CAMotics stores it). Options given on the command line take precedence. tridex's own key
+// "fixtures" lists STL files (relative to the project's folder) that hold the part, in the work
+// frame, for check's machine check (--fixture adds to them).
 #pragma once
 
 #include <filesystem>
@@ -22,6 +24,7 @@ struct Project {
   std::vector<std::filesystem::path> files;
   std::optional<ToolTable> tools;
   std::optional<StockSpec> stock;
+  std::vector<std::filesystem::path> fixtures;  // "fixtures": STL files, for check (issue 33)
 };
 
 // True if `path` looks like a CAMotics project (its extension, or a leading '{').

@@ -8,8 +8,9 @@
 // bundled machine to start from), "dialect", "units", "linear_units", "start", "tool_change",
 // "tool_loads_on_t", "decimal_point_input", "initial_tool", "arc_radius_tolerance_mm", "d_offsets",
 // "g53", "home", "reference2", "work_offsets", "m_codes", "forbidden_m_codes", "variables",
-// "far_distance", "subprograms" (folders relative to the file), "kinematics" and the speeds
-// "rapid_rate_mm_per_min", "rapid_rate_deg_per_min", "max_feed_mm_per_min".
+// "far_distance", "subprograms" (folders relative to the file), "kinematics", the speeds
+// "rapid_rate_mm_per_min", "rapid_rate_deg_per_min", "max_feed_mm_per_min", and the collision
+// check's "components", "collision" and "linear_axes" (machine_parts below).
 //
 // Key "kinematics" (issue 11's machine file; see gcode/README.md, "Machine kinematics"): either
 // the name of a bundled machine that has rotary axes (a profile), or an object:
@@ -32,16 +33,19 @@
 
 #include <array>
 #include <map>
+#include <memory>
 #include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <set>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "tridex/error.hpp"
 #include "tridex/gcode/kinematics.hpp"
 #include "tridex/geometry.hpp"
+#include "tridex/mesh.hpp"
 
 namespace tridex::gcode {
 
@@ -56,6 +60,26 @@ struct MachineRates {
   std::array<double, 3> rapid_deg_per_min{};  // A, B, C; 0: not given (such turns are not timed)
   std::optional<double> max_feed_mm_per_min;
   std::string source = "default";  // where the rapid rate came from: "default" or the file
+};
+
+// The machine's parts for the collision check (issue 33; docs/machine-files.md, "Components"):
+// each a mesh attached to a link of the chain, placed as it is with every axis at zero. `on` is
+// "bed", "spindle" (the mesh relative to the spindle's gauge point, +Z up the tool), a rotary
+// axis letter ("A", "B", "C") or a linear axis letter ("X", "Y", "Z": that axis's carriage).
+struct MachineComponent {
+  std::string name;
+  std::string on;
+  std::string mesh;  // the STL's path, resolved against the machine file's folder
+  // A bundled machine's part, made in code (machine.cpp): used when `mesh` is empty.
+  std::shared_ptr<const Mesh> built;
+};
+
+// The machine file's "collision": bodies closer than `clearance` (mm) collide, closer than
+// `near_miss` come near; `ignore` lists pairs of component names never tested.
+struct CollisionSettings {
+  double clearance = 0;
+  double near_miss = 0;
+  std::vector<std::pair<std::string, std::string>> ignore;
 };
 
 // The controller dialect: where Fanuc (and Haas, Mazak, most Fanuc-like controls) and LinuxCNC
@@ -178,6 +202,13 @@ struct MachineConfig {
 
   // The speeds, for the machining time (the interpreter does not read them).
   MachineRates rates;
+
+  // The collision check's machine (issue 33): its parts, which side each linear axis moves
+  // ("linear_axes": true = the head, false = the table; default the head, as kinematics.hpp's
+  // model has it) and the distances.
+  std::vector<MachineComponent> components;
+  std::array<bool, 3> linear_on_head{true, true, true};
+  CollisionSettings collision;
 
   // A bundled machine by name (the registry in machine.cpp); nullopt for another name.
   static std::optional<MachineConfig> bundled(std::string_view name);

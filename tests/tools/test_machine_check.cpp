@@ -1,0 +1,245 @@
+// The machine and the fixture (issue 33): the continuous check against plates and spikes planted
+// between the poses a fixed-step sampler tests, a closed-form first contact of a turning table,
+// travel passed inside a TCP move, and planted crashes end to end through `tridex check`.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <random>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "checks/machine_check.hpp"
+#include "command_harness.hpp"
+
+namespace test_machine_check {
+
+using namespace tridex;
+using namespace tridex::cli;
+using namespace tridex::test;
+using nlohmann::json;
+
+std::shared_ptr<const TriangleTree> tree_of(const Mesh& m) {
+  return std::make_shared<const TriangleTree>(m);
+}
+
+MachineBody body(const std::string& name, Link link, const Mesh& mesh) {
+  MachineBody b;
+  b.name = name, b.group = "test", b.link = link, b.tree = tree_of(mesh);
+  return b;
+}
+
+TEST_CASE("machine check: thin plates and spikes between a fixed sampler's poses, zero misses") {
+  std::mt19937 rng(33);
+  std::uniform_real_distribution<double> u(0, 1);
+  gcode::CollisionSettings settings;  // contact only
+  MachineCheck check(std::nullopt, {true, true, true}, settings);
+  // The tool: a cylinder of radius 3 from the tip up 50 mm, on a rapid from X-500 to X500 at Z5.
+  check.add(body("tool", {LinkKind::tool, 0}, make_frustum_mesh(3, 3, 0, 50)));
+  MachineMove move;
+  move.from.x = Vec3(-500, 0, 5), move.to.x = Vec3(500, 0, 5);
+  // A sampler testing 100 poses 10 mm apart covers X within 3 mm of each; obstacles go in the gaps.
+  const int planted = 60;
+  for (int k = 0; k < planted; ++k) {
+    const double x = -500 + 10 * std::floor(u(rng) * 100) + 3.5 + 2.7 * u(rng);
+    const double y = 2.8 * (2 * u(rng) - 1);
+    const Mesh m =
+        k % 2 == 0
+            // a plate 0.3 mm thick across the path, its top anywhere above Z2
+            ? make_box_mesh(Vec3(x, -20, -10), Vec3(x + 0.3, 20, 2 + 50 * u(rng)))
+            // a spike 0.2 mm square rising into the tool's path within its radius
+            : make_box_mesh(Vec3(x, y - 0.1, -10), Vec3(x + 0.2, y + 0.1, 5.01 + 40 * u(rng)));
+    check.add(body("obstacle " + std::to_string(k), {LinkKind::work, 0}, m));
+  }
+  // The fixed-step sampler misses every one of them ...
+  for (std::size_t b = 1; b < check.bodies().size(); ++b)
+    for (int i = 0; i <= 100; ++i) {
+      const MachineState s = check.state_at(move, i / 100.0);
+      const MachineBody& tool = check.bodies()[0];
+      const MachineBody& obstacle = check.bodies()[b];
+      REQUIRE(tree_distance(*tool.tree, check.frame_of(tool, s, move), *obstacle.tree,
+                            check.frame_of(obstacle, s, move))
+                  .distance > 0);
+    }
+  // ... and the check finds each.
+  MachineFindings found;
+  check.check(move, found);
+  CHECK(found.collisions.size() == std::size_t(planted));
+  CHECK(found.queries < 100000);
+}
+
+TEST_CASE("machine check: a box on a turning C table meets a fixed box at the closed-form angle") {
+  gcode::Kinematics kin;
+  kin.type = gcode::MachineType::table_table;
+  gcode::RotaryAxis c;
+  c.letter = 'C', c.direction = Vec3(0, 0, 1), c.pivot = Vec3(0);
+  kin.axes = {c};
+  MachineCheck check(kin, {true, true, true}, gcode::CollisionSettings{});
+  // On C: x 10..50, y -5..5. Fixed (on the spindle, X at 0): the face y = 20.
+  check.add(body("arm", {LinkKind::table, 1}, make_box_mesh(Vec3(10, -5, 0), Vec3(50, 5, 10))));
+  check.add(body("wall", {LinkKind::spindle, 0}, make_box_mesh(Vec3(0, 20, 0), Vec3(100, 30, 10))));
+  MachineMove move;
+  move.to.rotary[2] = 90;
+  MachineFindings found;
+  check.check(move, found);
+  REQUIRE(found.collisions.size() == 1);
+  // The corner (50, 5) reaches y = 20: 50 sin θ + 5 cos θ = 20.
+  const double phi = std::atan2(5.0, 50.0), radius = std::hypot(50.0, 5.0);
+  const double expected = glm::degrees(std::asin(20 / radius) - phi);
+  CHECK(std::abs(found.collisions[0].state.rotary[2] - expected) < 0.01);
+  // Turning the other way it never meets the wall.
+  MachineFindings away;
+  move.to.rotary[2] = -60;
+  check.check(move, away);
+  CHECK(away.collisions.empty());
+}
+
+TEST_CASE("machine check: travel passed inside a TCP move whose ends are within") {
+  gcode::Kinematics kin;
+  gcode::RotaryAxis c;
+  c.letter = 'C', c.direction = Vec3(0, 0, 1), c.pivot = Vec3(0);
+  kin.axes = {c};
+  kin.travel[1] = std::array<double, 2>{-50, 50};
+  MachineCheck check(kin, {true, true, true}, gcode::CollisionSettings{});
+  MachineMove move;
+  move.tip_linear = true;
+  move.tip_from = move.tip_to = Vec3(80, 0, 0);
+  move.to.rotary[2] = 180;
+  move.from.x = check.state_at(move, 0).x;
+  move.to.x = check.state_at(move, 1).x;
+  REQUIRE(std::abs(move.from.x.y) < 1e-9);
+  REQUIRE(std::abs(move.to.x.y) < 1e-9);
+  MachineFindings found;
+  check.check(move, found);
+  REQUIRE(found.travel.size() == 1);
+  CHECK(found.travel[0].axis == 'Y');
+  CHECK(found.travel[0].value == doctest::Approx(80).epsilon(1e-6));
+  CHECK(found.travel[0].t == doctest::Approx(0.5).epsilon(1e-4));
+}
+
+// ---- end to end: a vise, a clamp, a 0.3 mm plate and a spindle nose ---------------------------
+
+void write_ascii_stl(const fs::path& path, const std::vector<Mesh>& parts) {
+  const Mesh m = merge_meshes(parts);
+  std::string text = "solid part\n";
+  for (const glm::uvec3& t : m.triangles) {
+    text += " facet normal 0 0 0\n  outer loop\n";
+    for (unsigned i : {t.x, t.y, t.z}) {
+      const glm::vec3 p = m.positions[i];
+      text += "   vertex " + std::to_string(p.x) + " " + std::to_string(p.y) + " " +
+              std::to_string(p.z) + "\n";
+    }
+    text += "  endloop\n endfacet\n";
+  }
+  write_text(path, text + "endsolid part\n");
+}
+
+struct Setup {
+  fs::path dir;
+  std::vector<std::string> fixture_args;
+};
+
+Setup make_setup(const std::string& name) {
+  Setup s{scratch(name), {}};
+  write_ascii_stl(s.dir / "vise.stl", {make_box_mesh(Vec3(0, -20, -30), Vec3(100, 0, 0)),
+                                       make_box_mesh(Vec3(0, 60, -30), Vec3(100, 80, 0))});
+  write_ascii_stl(s.dir / "clamp.stl", {make_box_mesh(Vec3(110, 20, -30), Vec3(130, 40, 35))});
+  write_ascii_stl(s.dir / "plate.stl", {make_box_mesh(Vec3(150, -10, -30), Vec3(150.3, 70, 20))});
+  fs::create_directories(s.dir / "parts");
+  write_ascii_stl(s.dir / "parts" / "nose.stl", {make_frustum_mesh(40, 40, 0, 80)});
+  write_text(
+      s.dir / "machine.json",
+      R"({"components": [{"name": "spindle nose", "on": "spindle", "mesh": "parts/nose.stl"}],
+                 "collision": {"clearance": 0.5, "near_miss": 2}})");
+  write_text(s.dir / "tools.json",
+             R"({"1": {"shape": "cylindrical", "diameter": 6, "length": 20, "tool-length": 50}})");
+  for (const char* f : {"vise.stl", "clamp.stl", "plate.stl"})
+    s.fixture_args.insert(s.fixture_args.end(), {"--fixture", (s.dir / f).string()});
+  return s;
+}
+
+json run_check(const Setup& s, const std::string& program, CommandResult& result) {
+  write_text(s.dir / "p.nc", "G21 G90 G17\nT1 M6\nG43 H1\n" + program + "M30\n");
+  fs::remove(s.dir / "report.json");
+  const std::string stock = "box:0,0,-30,100,60,0";
+  CommandResult made = run_tridex(
+      {"simulate", (s.dir / "p.nc").string(), "--tools", (s.dir / "tools.json").string(), "--stock",
+       stock, "--dexel-cell", "1", "-o", (s.dir / "design.stl").string(), "-q"},
+      s.dir);
+  REQUIRE(made.status == 0);
+  std::vector<std::string> args{"check",        (s.dir / "p.nc").string(),
+                                "--design",     (s.dir / "design.stl").string(),
+                                "--tools",      (s.dir / "tools.json").string(),
+                                "--machine",    (s.dir / "machine.json").string(),
+                                "--stock",      stock,
+                                "--dexel-cell", "1",
+                                "--tolerance",  "1",
+                                "--report",     (s.dir / "report.json").string()};
+  args.insert(args.end(), s.fixture_args.begin(), s.fixture_args.end());
+  result = run_tridex(args, s.dir);
+  return fs::exists(s.dir / "report.json") ? json::parse(slurp(s.dir / "report.json")) : json();
+}
+
+std::set<int> collision_lines(const json& report) {
+  std::set<int> lines;
+  for (const json& c : report["machine"]["collisions"]) lines.insert(c["line"].get<int>());
+  return lines;
+}
+
+TEST_CASE("check --fixture and a spindle nose: each planted crash at its line, none when clean") {
+  const Setup s = make_setup("machine-crashes");
+  CommandResult r;
+  // Line 4 onward are the program's; line 6 crosses the clamp at Z5.
+  json report = run_check(s, "G0 X100 Y30 Z40\nG0 Z5\nG0 X140\nG0 Z40\n", r);
+  INFO(r.out, r.err);
+  CHECK(r.status == 3);
+  CHECK(collision_lines(report) == std::set<int>{6});
+  CHECK(report["machine"]["collisions"][0]["b"] == "tool 1 flutes");
+  CHECK(r.out.find("p.nc:6: collision: clamp.stl and tool 1 flutes") != std::string::npos);
+  // The spindle nose (radius 40, 50 mm above the tip) comes down onto the clamp's top (Z35)
+  // while the tool goes 20 deep into a pocket at X95 (line 6); the retract is not a new crash.
+  report = run_check(s, "G0 X95 Y30 Z40\nG1 Z-10 F300\nG1 Z-20\nG0 Z40\n", r);
+  CHECK(collision_lines(report) == std::set<int>{6});
+  CHECK(report["machine"]["collisions"][0]["a"] == "clamp.stl");
+  CHECK(report["machine"]["collisions"][0]["b"] == "spindle nose");
+  // A 1000 mm rapid at Z5 across the plate, 0.3 mm thick (and the clamp): line 6 both times.
+  report = run_check(s, "G0 X-400 Y50 Z40\nG0 Z5\nG0 X600\nG0 Z40\n", r);
+  CHECK(collision_lines(report) == std::set<int>{6});
+  bool plate = false;
+  for (const json& c : report["machine"]["collisions"]) plate |= c["a"] == "plate.stl";
+  CHECK(plate);
+  // Clean: pockets inside the vise at safe heights, the rapids above everything.
+  report = run_check(s, "G0 X50 Y30 Z40\nG1 Z-10 F300\nG1 X60\nG1 Y35\nG0 Z40\nG0 X200\n", r);
+  CHECK(r.status == 0);
+  CHECK(report["machine"]["collisions"].empty());
+  CHECK(report["machine"]["near_misses"].empty());
+  CHECK(r.out.find("collision:") == std::string::npos);
+}
+
+TEST_CASE("machine file: the collision keys' faults name the key, exit status 2") {
+  const Setup s = make_setup("machine-file-faults");
+  write_text(s.dir / "p.nc", "G0 X0 Y0 Z10\nM30\n");
+  for (
+      const auto& [text, expected] : std::vector<std::pair<std::string, std::string>>{
+          {R"({"components": [{"name": "x", "on": "B", "mesh": "parts/nose.stl"}]})",
+           "\"components\"[0].on"},
+          {R"({"components": [{"name": "x", "on": "bed", "mesh": "parts/nose.stl", "colour": 1}]})",
+           "colour: unknown key"},
+          {R"({"collision": {"clearance": -1}})", "clearance: must be a distance"},
+          {R"({"collision": {"ignore": [["a", "b"]]}})", "ignore: no component"},
+          {R"({"linear_axes": {"X": "ram"}})", "\"head\" or \"table\""},
+          {R"({"components": [{"name": "x", "on": "bed", "mesh": "missing.stl"}]})",
+           "missing.stl: no such file"}}) {
+    write_text(s.dir / "bad.json", text);
+    CommandResult r =
+        run_tridex({"check", (s.dir / "p.nc").string(), "--design", (s.dir / "clamp.stl").string(),
+                    "--machine", (s.dir / "bad.json").string(), "--stock", "box:0,0,-30,100,60,0",
+                    "--dexel-cell", "2"},
+                   s.dir);
+    INFO(text, r.err);
+    CHECK(r.status == 2);
+    CHECK(r.err.find(expected) != std::string::npos);
+  }
+}
+
+}  // namespace test_machine_check

@@ -1,0 +1,264 @@
+#include "checks/machine_run.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <set>
+
+#include "errors.hpp"
+#include "tridex/stl.hpp"
+
+namespace tridex::cli {
+
+namespace {
+
+constexpr std::size_t kMachineFindingsListed = 1000;  // of each kind, in the report
+
+MachineBody mr_body(std::string name, std::string group, Link link, int tool,
+                    std::shared_ptr<const TriangleTree> tree) {
+  MachineBody b;
+  b.name = std::move(name), b.group = std::move(group), b.link = link, b.tool = tool;
+  b.tree = std::move(tree);
+  return b;
+}
+
+std::shared_ptr<const TriangleTree> mr_tree(const Mesh& mesh) {
+  return std::make_shared<const TriangleTree>(mesh);
+}
+
+Mesh mr_read(const std::string& path, const std::string& what) {
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) input_error(what, ": no such file");
+  try {
+    Mesh mesh = read_stl(path);
+    if (mesh.triangles.empty()) input_error(what, ": the mesh has no triangles");
+    return mesh;
+  } catch (const tridex::Error& e) {
+    input_error(what, ": ", e.what());
+  }
+}
+
+// Where a machine file's component rides (machine_file.cpp has checked the names).
+Link mr_link(const std::string& on, const std::optional<gcode::Kinematics>& kin) {
+  if (on == "bed") return {LinkKind::bed, 0};
+  if (on == "spindle") return {LinkKind::spindle, 0};
+  if (on == "X" || on == "Y" || on == "Z") return {LinkKind::carriage, on[0] - 'X'};
+  int depth = 0;
+  for (const gcode::RotaryAxis& axis : kin->axes) {
+    const bool head = axis.on_head;
+    if (axis.letter == on[0]) {
+      int d = 0;
+      for (const gcode::RotaryAxis& other : kin->axes) {
+        if (other.on_head == head) ++d;
+        if (&other == &axis) break;
+      }
+      depth = d;
+      return {head ? LinkKind::head : LinkKind::table, depth};
+    }
+  }
+  return {LinkKind::bed, 0};
+}
+
+// The tool's length from the tip to the spindle's gauge point (machine_run.hpp).
+double mr_gauge(const SimulationResult& r, int tool) {
+  if (auto length = r.input.machine.tool_lengths.find(tool);
+      length != r.input.machine.tool_lengths.end() && length->second > 0)
+    return length->second;
+  auto c = r.cutter_of_tool.find(tool);
+  if (c == r.cutter_of_tool.end()) return 0;
+  const ToolBody& body = r.bodies[c->second];
+  if (!body.parts.empty()) return body.parts.back().bottom + body.parts.back().shape.length;
+  const Cutter& cutter = r.cutters[c->second];
+  return std::max(cutter.profile_height(), 6 * cutter.radius());
+}
+
+// The tool's flutes, shank and holder as meshes in tool coordinates.
+void mr_add_tool(MachineCheck& check, const SimulationResult& r, int tool, std::uint32_t c) {
+  const Cutter& cutter = r.cutters[c];
+  const ToolBody& body = r.bodies[c];
+  const double top = body.parts.empty() ? mr_gauge(r, tool) : body.parts.front().bottom;
+  std::vector<Mesh> flutes;
+  // The profile by rings; each piece of the cone between two rings lowered by how far the
+  // profile sags below its chord (a ball's lower surface is convex), so that the mesh holds it.
+  constexpr int kRings = 6;
+  double last_d = 0, last_h = std::min(cutter.lower_height(0), top);
+  for (int k = 1; k <= kRings; ++k) {
+    const double d = cutter.radius() * k / kRings, h = std::min(cutter.lower_height(d), top);
+    double sag = 0;
+    for (int i = 1; i < 8; ++i) {
+      const double dd = last_d + (d - last_d) * i / 8;
+      sag = std::max(sag, last_h + (h - last_h) * i / 8 - std::min(cutter.lower_height(dd), top));
+    }
+    flutes.push_back(make_frustum_mesh(last_d, d, last_h - sag, h - sag));
+    last_d = d, last_h = h;
+  }
+  if (top > last_h)
+    flutes.push_back(make_frustum_mesh(cutter.radius(), cutter.radius(), last_h, top));
+  const std::string name = "tool " + std::to_string(tool);
+  check.add(
+      mr_body(name + " flutes", "tool", {LinkKind::tool, 0}, tool, mr_tree(merge_meshes(flutes))));
+  std::vector<Mesh> holder;
+  for (const BodyPart& part : body.parts) {
+    const BodySection& s = part.shape;
+    Mesh m = make_frustum_mesh(s.bottom_radius, s.top_radius, part.bottom, part.bottom + s.length);
+    if (part.name == "shank")
+      check.add(mr_body(name + " shank", "tool", {LinkKind::tool, 0}, tool, mr_tree(m)));
+    else
+      holder.push_back(std::move(m));
+  }
+  if (!holder.empty())
+    check.add(mr_body(name + " holder", "tool", {LinkKind::tool, 0}, tool,
+                      mr_tree(merge_meshes(holder))));
+}
+
+}  // namespace
+
+MachineRun run_machine_check(const std::vector<std::string>& fixtures, const SimulationResult& r) {
+  MachineRun run;
+  const gcode::MachineConfig& machine = r.input.machine;
+  std::vector<std::string> all_fixtures = fixtures;
+  for (const auto& f : r.input.fixtures) all_fixtures.push_back(f.string());
+  if (all_fixtures.empty() && machine.components.empty()) return run;
+  run.active = true;
+  MachineCheck check(machine.kinematics, machine.linear_on_head, machine.collision);
+  for (const std::string& path : all_fixtures)
+    check.add(mr_body(std::filesystem::path(path).filename().string(), "fixture",
+                      {LinkKind::work, 0}, -1, mr_tree(mr_read(path, "--fixture " + path))));
+  for (const gcode::MachineComponent& c : machine.components)
+    check.add(mr_body(c.name, "component", mr_link(c.on, machine.kinematics), -1,
+                      c.built ? mr_tree(*c.built)
+                              : mr_tree(mr_read(c.mesh, "--machine: component \"" + c.name +
+                                                            "\" mesh " + c.mesh))));
+  for (const auto& [tool, c] : r.cutter_of_tool) mr_add_tool(check, r, tool, c);
+  for (const MachineBody& b : check.bodies()) run.bodies.push_back(b.name);
+
+  const Vec3 g54 = machine.work_offsets.count(1) ? machine.work_offsets.at(1) : Vec3(0);
+  // Pairs in contact on the last move checked: a retract straight up the tool from such a
+  // contact is where the machine backs off the crash already reported, not a new one.
+  std::set<std::pair<std::string, std::string>> touching;
+  auto checked = [&](const MachineMove& move, const gcode::Move& m) {
+    const std::size_t first = run.found.collisions.size();
+    check.check(move, run.found);
+    const Vec3 path = m.end - m.start;
+    const bool retract =
+        glm::length(path) > 0 && glm::dot(path, m.axis) >= 0.999 * glm::length(path);
+    std::set<std::pair<std::string, std::string>> now;
+    auto& list = run.found.collisions;
+    for (std::size_t k = first; k < list.size();) {
+      now.insert({list[k].a, list[k].b});
+      if (retract && list[k].t == 0 && touching.count({list[k].a, list[k].b}))
+        list.erase(list.begin() + static_cast<std::ptrdiff_t>(k));
+      else
+        ++k;
+    }
+    touching = std::move(now);
+  };
+  std::vector<std::size_t> next(r.groups.size(), 0);
+  const gcode::Move* previous = nullptr;
+  for (const GroupRun& span : r.order)
+    for (std::uint64_t k = 0; k < span.moves; ++k) {
+      const gcode::Move& m = r.groups[span.group].moves[next[span.group]++];
+      const gcode::Move* before = previous;
+      previous = &m;
+      if (m.from_far) continue;
+      MachineMove move;
+      move.file = m.file, move.line = m.line, move.tool = m.tool, move.gauge = mr_gauge(r, m.tool);
+      if (!machine.kinematics) {
+        move.offset = g54;
+        move.from.x = m.start + g54, move.to.x = m.end + g54;
+        checked(move, m);
+        continue;
+      }
+      const gcode::Kinematics& kin = *machine.kinematics;
+      move.offset = gcode::tip_in_part(kin, m.machine, m.rotary) - m.end;
+      move.to = {m.machine, m.rotary};
+      move.from = {gcode::machine_from_part(kin, m.start + move.offset, m.rotary), m.rotary};
+      if (before && before->rotary != m.rotary) {
+        // The turn before the move, the machine's linear axes standing where the last move ended.
+        MachineMove turn = move;
+        turn.from = {before->machine, before->rotary};
+        turn.to = {before->machine, m.rotary};
+        checked(turn, m);
+      }
+      checked(move, m);
+    }
+  return run;
+}
+
+Json machine_json(const MachineRun& run, const SimulationResult& r) {
+  auto state_json = [&](const MachineState& s) {
+    Json axes{{"X", s.x.x}, {"Y", s.x.y}, {"Z", s.x.z}};
+    if (r.input.machine.kinematics)
+      for (const gcode::RotaryAxis& a : r.input.machine.kinematics->axes)
+        axes[std::string(1, a.letter)] = s.rotary[std::size_t(gcode::rotary_index(a.letter))];
+    return axes;
+  };
+  auto list = [&](const std::vector<MachineFinding>& findings) {
+    Json out = Json::array();
+    for (std::size_t k = 0; k < findings.size() && k < kMachineFindingsListed; ++k) {
+      const MachineFinding& f = findings[k];
+      out.push_back({{"file", r.files.at(static_cast<std::size_t>(f.file))},
+                     {"line", f.line},
+                     {"tool", f.tool},
+                     {"a", f.a},
+                     {"b", f.b},
+                     {"distance_mm", f.distance},
+                     {"along", f.t},
+                     {"point", to_json(f.where)},
+                     {"axes", state_json(f.state)}});
+    }
+    return out;
+  };
+  Json travel = Json::array();
+  for (const TravelAlong& t : run.found.travel)
+    travel.push_back({{"file", r.files.at(static_cast<std::size_t>(t.file))},
+                      {"line", t.line},
+                      {"axis", std::string(1, t.axis)},
+                      {"value", t.value},
+                      {"limit", t.limit},
+                      {"along", t.t}});
+  const gcode::CollisionSettings& s = r.input.machine.collision;
+  return {{"bodies", run.bodies},
+          {"clearance_mm", s.clearance},
+          {"near_miss_mm", s.near_miss},
+          {"collisions", list(run.found.collisions)},
+          {"collisions_count", run.found.collisions.size()},
+          {"near_misses", list(run.found.near_misses)},
+          {"near_misses_count", run.found.near_misses.size()},
+          {"travel_along_moves", travel},
+          {"moves", run.found.moves},
+          {"queries", run.found.queries},
+          {"seconds", run.found.seconds}};
+}
+
+void print_machine_findings(const MachineRun& run, const SimulationResult& r, std::size_t limit) {
+  auto axes_text = [&](const MachineState& s) {
+    char text[160];
+    std::snprintf(text, sizeof text, "X%.3f Y%.3f Z%.3f", s.x.x, s.x.y, s.x.z);
+    std::string out = text;
+    if (r.input.machine.kinematics)
+      for (const gcode::RotaryAxis& a : r.input.machine.kinematics->axes) {
+        std::snprintf(text, sizeof text, " %c%.3f", a.letter,
+                      s.rotary[std::size_t(gcode::rotary_index(a.letter))]);
+        out += text;
+      }
+    return out;
+  };
+  const auto& found = run.found;
+  for (std::size_t k = 0; k < found.collisions.size() && k < limit; ++k) {
+    const MachineFinding& f = found.collisions[k];
+    std::printf(
+        "  %s:%d: collision: %s and %s meet (distance %.3f mm, %.0f%% along the move, "
+        "at %s)\n",
+        r.files.at(static_cast<std::size_t>(f.file)).c_str(), f.line, f.a.c_str(), f.b.c_str(),
+        f.distance, 100 * f.t, axes_text(f.state).c_str());
+  }
+  for (std::size_t k = 0; k < found.travel.size() && k < limit; ++k) {
+    const TravelAlong& t = found.travel[k];
+    std::printf("  %s:%d: %c %.6g mm inside the move, past the travel's end %.6g\n",
+                r.files.at(static_cast<std::size_t>(t.file)).c_str(), t.line, t.axis, t.value,
+                t.limit);
+  }
+}
+
+}  // namespace tridex::cli
