@@ -217,6 +217,27 @@ std::pair<CLI::App*, CLI::App*> add_diff_and_lint(CLI::App& app, DiffOptions& di
   return {dif, lnt};
 }
 
+// check's options for what it looks for beyond the design: the envelope, the shank's and the
+// holder's clearance, the roughing allowance, the fixtures.
+void add_check_findings(CLI::App& chk, CheckOptions& check) {
+  chk.add_option(
+         "--envelope", check.envelope,
+         "box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX: every move whose tool tip ends outside is a finding")
+      ->check(kNotEmpty);
+  chk.add_option(
+         "--clearance", check.clearance,
+         "report moves whose shank or holder comes closer than this to the stock, mm (0: none)")
+      ->check(kFiniteNonNegative);
+  chk.add_option("--allowance", check.allowance,
+                 "stock to leave on the design, mm: the surface must stand this far outside it,\n"
+                 "within the tolerances (a roughing program; default 0)")
+      ->check(kFiniteNonNegative);
+  chk.add_option("--fixture", check.fixtures,
+                 "a fixture (vise, clamp) as STL in the work frame, never cut: the tool and the "
+                 "machine's parts are\nchecked against it along every move (repeatable)")
+      ->check(kNotEmpty);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -266,22 +287,7 @@ int main(int argc, char** argv) {
                   "material left outside the design beyond this is excess, mm")
       ->check(kFinitePositive)
       ->excludes(tolerance);
-  chk->add_option(
-         "--envelope", check.envelope,
-         "box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX: every move whose tool tip ends outside is a finding")
-      ->check(kNotEmpty);
-  chk->add_option(
-         "--clearance", check.clearance,
-         "report moves whose shank or holder comes closer than this to the stock, mm (0: none)")
-      ->check(kFiniteNonNegative);
-  chk->add_option("--allowance", check.allowance,
-                  "stock to leave on the design, mm: the surface must stand this far outside it,\n"
-                  "within the tolerances (a roughing program; default 0)")
-      ->check(kFiniteNonNegative);
-  chk->add_option("--fixture", check.fixtures,
-                  "a fixture (vise, clamp) as STL in the work frame, never cut: the tool and the "
-                  "machine's parts are\nchecked against it along every move (repeatable)")
-      ->check(kNotEmpty);
+  add_check_findings(*chk, check);
   chk->add_option("-o,--output", check.output, "write the machined result as binary STL")
       ->check(kNotEmpty);
   chk->add_option("--report", check.report, "write the JSON report of the check")->check(kNotEmpty);
