@@ -19,18 +19,6 @@ constexpr double kSameDirection = 1e-9;  // 1 − cos of the angle below which d
 constexpr double kFreeAxis = 1e-9;       // |component normal to an axis| below which it is along it
 constexpr double kParallelAxes = 1e-6;   // |a × b| below which two rotary axes are parallel
 
-// Rotation by `degrees` about the unit axis `k`, right-handed (Rodrigues).
-Mat3 rotation_about(const Vec3& k, double degrees) {
-  double t = glm::radians(degrees), c = std::cos(t), s = std::sin(t);
-  Mat3 m;
-  for (int col = 0; col < 3; ++col) {
-    Vec3 e(0.0);
-    e[col] = 1;
-    m[col] = e * c + glm::cross(k, e) * s + k * glm::dot(k, e) * (1 - c);
-  }
-  return m;
-}
-
 // The rigid turn of an axis's carriage: p ↦ pivot + R·(p − pivot).
 Frame axis_turn(const RotaryAxis& axis, double degrees) {
   Mat3 r = rotation_about(axis.direction, degrees);

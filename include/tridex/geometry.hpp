@@ -21,6 +21,18 @@ using Vec2 = glm::dvec2;
 using Vec3 = glm::dvec3;
 using Mat3 = glm::dmat3;
 
+// Rotation by `degrees` about the unit axis `k`, right-handed (Rodrigues' formula).
+inline Mat3 rotation_about(const Vec3& k, double degrees) {
+  const double t = glm::radians(degrees), c = std::cos(t), s = std::sin(t);
+  Mat3 m;
+  for (int col = 0; col < 3; ++col) {
+    Vec3 e(0.0);
+    e[col] = 1;
+    m[col] = e * c + glm::cross(k, e) * s + k * glm::dot(k, e) * (1 - c);
+  }
+  return m;
+}
+
 inline bool is_finite(const Vec3& p) {
   return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
 }

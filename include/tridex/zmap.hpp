@@ -175,7 +175,10 @@ inline ZMapGrid ZMapGrid::covering(const Frame& frame, const Aabb& local_box, do
 
 inline ZMap ZMap::from_box(const Frame& frame, const Aabb& stock, double cell, ZMapLimits limits,
                            unsigned threads) {
-  const auto [g, empty] = detail::box_map_grid(frame, stock, cell);
+  // Named copies, not a structured binding: clang 14 cannot capture bindings in the lambda.
+  const std::pair<ZMapGrid, float> grid_and_empty = detail::box_map_grid(frame, stock, cell);
+  const ZMapGrid& g = grid_and_empty.first;
+  const float empty = grid_and_empty.second;
   ZMap map(g, empty, empty, limits);
   const auto bands =
       static_cast<std::size_t>((g.ny + detail::kMapBandRows - 1) / detail::kMapBandRows);
@@ -258,7 +261,10 @@ inline void raise_uncut(ZMap& milled, const ZMap& initial, unsigned threads) {
 
 inline void raise_uncut(ZMap& milled, const Aabb& box_stock, unsigned threads) {
   const ZMapGrid& a = milled.grid;
-  const auto [b, empty] = detail::box_map_grid(a.frame, box_stock, a.cell);
+  const std::pair<ZMapGrid, float> grid_and_empty =
+      detail::box_map_grid(a.frame, box_stock, a.cell);
+  const ZMapGrid& b = grid_and_empty.first;  // a structured binding: clang 14 cannot capture it
+  const float empty = grid_and_empty.second;
   if (!detail::same_points(a, b) || milled.heights.size() != b.size())
     detail::fail("raise_uncut: the milled Z-map's grid is not the box stock's");
   detail::raise_uncut_rows(

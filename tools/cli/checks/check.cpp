@@ -26,6 +26,7 @@
 
 #include "checks/deviation.hpp"
 #include "checks/machine_run.hpp"
+#include "checks/reaching_moves.hpp"
 #include "commands.hpp"
 #include "errors.hpp"
 #include "inputs/numbers.hpp"
@@ -117,33 +118,12 @@ std::vector<std::pair<int, int>> gouging_lines(const DeviationRegion& region, co
                     probes.end(),
                     [&](std::uint32_t a, std::uint32_t b) { return deviation[a] < deviation[b]; });
   probes.resize(keep);
+  std::vector<Vec3> points;
+  for (std::uint32_t v : probes) points.emplace_back(mesh.positions[v]);
   std::set<std::pair<int, int>> lines;
-  for (const gcode::MoveGroup& group : r.groups) {
-    std::vector<Vec3> local;
-    for (std::uint32_t v : probes) local.push_back(group.frame.to_local(Vec3(mesh.positions[v])));
-    const gcode::Move* previous = nullptr;
-    for (const gcode::Move& m : group.moves) {
-      // A move that reaches p only at its start, where the move before it left the cutter, cut
-      // nothing there (a retract from the bottom of a plunge).
-      const bool continues = previous && glm::length(previous->end - m.start) < 1e-9;
-      previous = &m;
-      const Cutter& cutter = r.cutters[r.cutter_of_tool.at(m.tool)];
-      Segment tip{group.frame.to_local(m.start), group.frame.to_local(m.end)};
-      const double radius = cutter.radius();
-      for (const Vec3& p : local) {
-        if (p.x < std::min(tip.a.x, tip.b.x) - radius ||
-            p.x > std::max(tip.a.x, tip.b.x) + radius ||
-            p.y < std::min(tip.a.y, tip.b.y) - radius ||
-            p.y > std::max(tip.a.y, tip.b.y) + radius || p.z + slack < std::min(tip.a.z, tip.b.z))
-          continue;
-        detail::MoveGeometry::Lowest lowest = detail::MoveGeometry(cutter, tip).lowest(p.x, p.y);
-        if (p.z + slack >= lowest.z && !(continues && lowest.t <= 1e-9)) {
-          lines.insert({m.file, m.line});
-          break;
-        }
-      }
-    }
-  }
+  for_each_reaching_move(r, points, slack, [&](const gcode::Move& m) {
+    lines.insert({m.file, m.line});
+  });
   return {lines.begin(), lines.end()};
 }
 

@@ -24,6 +24,7 @@
 
 #include "checks/line_alignment.hpp"
 #include "checks/lint.hpp"
+#include "checks/reaching_moves.hpp"
 #include "commands.hpp"
 #include "errors.hpp"
 #include "inputs/json_input.hpp"
@@ -219,31 +220,9 @@ void measure_regions(std::vector<DiffRegion>& regions, const std::vector<DiffSpa
 std::map<int, int> reaching_lines(const std::vector<Vec3>& probes, const SimulationResult& r,
                                   double slack) {
   std::map<int, int> lines;  // line -> tool
-  for (const gcode::MoveGroup& group : r.groups) {
-    std::vector<Vec3> local;
-    for (const Vec3& p : probes) local.push_back(group.frame.to_local(p));
-    const gcode::Move* previous = nullptr;
-    for (const gcode::Move& m : group.moves) {
-      const bool continues = previous && glm::length(previous->end - m.start) < 1e-9;
-      previous = &m;
-      if (m.file != 0) continue;
-      const Cutter& cutter = r.cutters[r.cutter_of_tool.at(m.tool)];
-      Segment tip{group.frame.to_local(m.start), group.frame.to_local(m.end)};
-      const double radius = cutter.radius();
-      for (const Vec3& p : local) {
-        if (p.x < std::min(tip.a.x, tip.b.x) - radius ||
-            p.x > std::max(tip.a.x, tip.b.x) + radius ||
-            p.y < std::min(tip.a.y, tip.b.y) - radius ||
-            p.y > std::max(tip.a.y, tip.b.y) + radius || p.z + slack < std::min(tip.a.z, tip.b.z))
-          continue;
-        detail::MoveGeometry::Lowest lowest = detail::MoveGeometry(cutter, tip).lowest(p.x, p.y);
-        if (p.z + slack >= lowest.z && !(continues && lowest.t <= 1e-9)) {
-          lines.emplace(m.line, m.tool);
-          break;
-        }
-      }
-    }
-  }
+  for_each_reaching_move(r, probes, slack, [&](const gcode::Move& m) {
+    if (m.file == 0) lines.emplace(m.line, m.tool);
+  });
   return lines;
 }
 

@@ -24,19 +24,8 @@ Frame mc_compose(const Frame& a, const Frame& b) {
   return Frame{a.rotation * b.rotation, a.rotation * b.origin + a.origin};
 }
 
-Mat3 mc_rotation_about(const Vec3& k, double degrees) {
-  const double t = glm::radians(degrees), c = std::cos(t), s = std::sin(t);
-  Mat3 m;
-  for (int col = 0; col < 3; ++col) {
-    Vec3 e(0.0);
-    e[col] = 1;
-    m[col] = e * c + glm::cross(k, e) * s + k * glm::dot(k, e) * (1 - c);
-  }
-  return m;
-}
-
 Frame mc_turn(const gcode::RotaryAxis& axis, double degrees) {
-  const Mat3 r = mc_rotation_about(axis.direction, degrees);
+  const Mat3 r = rotation_about(axis.direction, degrees);
   return Frame{r, axis.pivot - r * axis.pivot};
 }
 
