@@ -69,6 +69,14 @@ run(['simulate', write('face_good.nc', faceProgram(-2, 'G0 X-5 Y-3\nG1 Z-1.5\nG0
 const facePage = path.join(out, 'face.html');
 run(['check', write('face.nc', faceProgram(-2.3, '')), ...stock, '--design', path.join(out, 'face_design.stl'), '--tolerance', '0.1',
      '--report', path.join(out, 'face.json'), '--html', facePage], [3]);
+// A program over the page's 4 MiB of plain text (160,000 short moves): its text goes compressed in
+// chunks of lines, and the slider still shows the text of any line.
+const largeLines = ['%', 'G21 G17 G90', 'T1 M6', 'S8000 M3', 'G0 X0 Y0 Z5', 'G1 Z-0.5 F900'];
+for (let k = 0; k < 160000; ++k) largeLines.push('G1 X' + (k % 2 ? 39.5 : 0.5).toFixed(3) + ' Y' + (0.00025 * k).toFixed(5) + ' Z-0.5');
+largeLines.push('G0 Z5', 'M30', '%');
+const largeProgram = write('large.nc', largeLines.join('\n') + '\n');
+const largePage = path.join(out, 'large.html');
+run(['simulate', largeProgram, '--tools', tools, '--stock', 'box:0,0,-5,40,40,0', '--dexel-cell', '1', '-q', '--html', largePage]);
 // Nothing left: a cutter wider than the stock plunges through it. No moves: a program of words only.
 const emptyPage = path.join(out, 'empty.html');
 run(['simulate', write('through.nc', '%\nG21 G90\nT1 M6\nM3 S1000\nG0 X5 Y5 Z20\nG1 Z-20 F100\nG0 Z20\nM30\n%\n'),
@@ -459,6 +467,23 @@ try {
     await page.emulateMediaType('print');
     await page.screenshot({ path: path.join(out, 'face_print.png'), fullPage: true });
     await page.emulateMediaType(null);
+    clean();
+    await page.close();
+  }
+  // The large program: the slider's label shows the line's text, inflated from its chunk.
+  {
+    const { page, clean } = await open(largePage);
+    const data = await pageData(page);
+    check(data.files[0].chunks && data.files[0].chunks.length === Math.ceil(largeLines.length / data.files[0].chunk_lines),
+          'large: the text in compressed chunks: ' + (data.files[0].chunks || []).length + ', ' + data.files[0].note);
+    const stops = await page.$eval('#path-slider', (e) => Number(e.max) + 1);
+    for (const stop of [Math.floor(stops / 3), stops - 2, 1]) {
+      await setSlider(page, stop);
+      await page.waitForFunction(() => !document.getElementById('path-label').textContent.endsWith('…'), { timeout: 30000, polling: 100 });
+      const label = await page.$eval('#path-label', (e) => e.textContent);
+      const line = Number(/up to line (\d+) /.exec(label)[1]);
+      check(label.endsWith(': ' + largeLines[line - 1]), 'large: the slider at line ' + line + ' shows its text: ' + label);
+    }
     clean();
     await page.close();
   }

@@ -14,6 +14,7 @@
 
 #include "checks/deviation.hpp"
 #include "command_harness.hpp"
+#include "outputs/compressed_text.hpp"
 #include "outputs/html_report.hpp"
 #include "tridex/gcode/interpreter.hpp"
 
@@ -32,6 +33,28 @@ json page_data(const std::string& html) {
   const std::size_t end = html.find("</script>", start);
   REQUIRE(end != std::string::npos);
   return json::parse(html.substr(start + open.size(), end - start - open.size()));
+}
+
+// Base64 decoded (RFC 4648, written here rather than taken from the writer under test).
+std::string html_unbase64(const std::string& text) {
+  const std::string digits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  std::uint32_t bits = 0;
+  int count = 0;
+  for (char c : text) {
+    if (c == '=') break;
+    bits = bits << 6 | static_cast<std::uint32_t>(digits.find(c));
+    if ((count += 6) >= 8) out += static_cast<char>((bits >> (count -= 8)) & 0xff);
+  }
+  return out;
+}
+
+// A page file's compressed chunks of lines, inflated and joined: its text as the slider sees it.
+std::string html_chunked_text(const json& file) {
+  std::string text;
+  for (const json& chunk : file["chunks"])
+    text += inflate_raw(html_unbase64(chunk.get<std::string>()));
+  return text;
 }
 
 // A heightfield of n × n cells (2 n² triangles), gently curved so that simplifying costs error.
@@ -294,9 +317,10 @@ TEST_CASE(
   CHECK(data["files"][0]["source"] == source_lines({{7, 13}}));
   CHECK(data["files"][1]["name"] == subprogram.string());
   CHECK(data["files"][1]["source"] == source_lines({{1, 5}, {15, 20}}));
-  // Each large file's whole text as one block too: the slider shows any line's text (issue 32).
-  CHECK(data["files"][0]["text"] == text);
-  CHECK(data["files"][1]["text"] == text);
+  // Each large file's whole text compressed too: the slider shows any line's text (issue 32).
+  CHECK(html_chunked_text(data["files"][0]) == text);
+  CHECK(html_chunked_text(data["files"][1]) == text);
+  CHECK(data["files"][0]["note"] == "the program is large: its text is kept compressed");
   CHECK(data["mesh"]["triangles_shown"] == 0);
   CHECK(data["toolpath"]["segments"] == 0);
   REQUIRE(data["messages"].size() == 2);
@@ -495,4 +519,35 @@ TEST_CASE("playback: each stock cell is removed at the first stop whose cutter p
   CHECK(by_stop[2] > 0);
   CHECK(by_stop[1] + by_stop[2] + by_stop[3] == static_cast<int>(removed));
   CHECK(by_stop.count(0) == 0);  // the rapid above the stock removes nothing
+}
+
+TEST_CASE("a large program's text: deflated in chunks of lines, kept in order within the budget") {
+  std::string text;
+  for (int k = 1; k <= 1000; ++k) text += "G1 X" + std::to_string(k % 97) + ".125 Y-3.5 Z0.25\n";
+  for (const std::string& tail : {std::string(), std::string("M30")}) {  // with a last line unended
+    const std::string whole = text + tail;
+    for (unsigned threads : {1u, 3u}) {
+      const CompressedText packed = compress_lines(whole, 64, std::size_t{1} << 30, threads);
+      CHECK(packed.lines == (tail.empty() ? 1000u : 1001u));
+      CHECK(packed.lines_kept == packed.lines);
+      CHECK(packed.chunks.size() == (packed.lines + 63) / 64);
+      std::string joined;
+      for (const std::string& chunk : packed.chunks) {
+        const std::string lines = inflate_raw(html_unbase64(chunk));
+        CHECK(lines.size() < 64 * 40);
+        joined += lines;
+      }
+      CHECK(joined == whole);
+      CHECK(packed.chunks.front().size() * 3 < 64 * 24);  // near-identical lines deflate well
+    }
+  }
+  // A budget for three chunks keeps the first three, and says how many lines they hold.
+  const CompressedText full = compress_lines(text, 64, std::size_t{1} << 30);
+  const std::size_t three = full.chunks[0].size() + full.chunks[1].size() + full.chunks[2].size();
+  const CompressedText cut = compress_lines(text, 64, three);
+  CHECK(cut.chunks.size() == 3);
+  CHECK(cut.lines_kept == 192);
+  CHECK(cut.lines == 1000);
+  CHECK(compress_lines("", 64, 1000).chunks.empty());
+  CHECK_THROWS(inflate_raw("not deflate data"));
 }

@@ -258,7 +258,7 @@ struct BullLanes : RisingMove {
                   root2 = max_n(corner2 - reach * reach, splat(0));
     const DoubleN root = sqrt_n(root2);
     const DoubleN factor =
-        p.has_plane & (reach > 0) ? reach / (max_n(root, splat(corner * 1e-7)) * dist) : splat(0);
+        (p.has_plane & (reach > 0)) ? reach / (max_n(root, splat(corner * 1e-7)) * dist) : splat(0);
     p.z = d[0] < kInf ? low + t[0] * w + (corner - root) : splat(kInf);
     p.gx = factor * px, p.gy = factor * py;
     return p;
@@ -448,7 +448,7 @@ struct ProfileLanes : RisingMove {
     Plane p;
     p.z = covered ? low + t * w + height(d) : splat(kInf);
     p.has_plane = covered & (d2 < r2 * (1 - 1e-7)) & ~kink;
-    const DoubleN factor = p.has_plane & (d > 0) ? slope(d) / d : splat(0);
+    const DoubleN factor = (p.has_plane & (d > 0)) ? slope(d) / d : splat(0);
     p.gx = factor * px, p.gy = factor * py;
     return p;
   }

@@ -15,6 +15,8 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "json_text.hpp"
+#include "outputs/compressed_text.hpp"
 #include "outputs/output.hpp"
 #include "pipeline/pipeline.hpp"
 #include "tridex/detail/move_geometry.hpp"
@@ -94,10 +96,13 @@ std::map<std::string, std::set<int>> listed_lines(const Json& report, int contex
 }
 
 // Each G-code file of the program (Move::file's table) with its text, line -> text: whole files
-// while their total stays within max_source_bytes, of the others only the lines around findings.
+// while their total stays within max_source_bytes; of the others the lines around findings, and
+// their whole text deflated in chunks of lines (compressed_text.hpp) while the chunks stay within
+// max_compressed_source_bytes, so the slider shows the text of any line of any program that fits.
 Json source_files(const HtmlPage& page, const HtmlLimits& limits) {
   Json files = Json::array();
   std::uintmax_t budget = limits.max_source_bytes;
+  std::size_t compressed_budget = limits.max_compressed_source_bytes;
   std::optional<std::map<std::string, std::set<int>>> wanted;
   for (const std::string& name : page.files) {
     Json file = {{"name", name}, {"source", Json::object()}, {"note", ""}};
@@ -115,7 +120,6 @@ Json source_files(const HtmlPage& page, const HtmlLimits& limits) {
     } else {
       if (!wanted) wanted = listed_lines(page.report, limits.context);
       lines = &(*wanted)[name];
-      file["note"] = "the program is large: its text is kept as one block";
     }
     Json& source = file["source"];
     std::string text, whole;
@@ -125,9 +129,20 @@ Json source_files(const HtmlPage& page, const HtmlLimits& limits) {
       if (lines && !lines->count(line)) continue;
       source[std::to_string(line)] = text;
     }
-    // A large file's text as one block too (far smaller than a line -> text object): the slider
-    // shows the text of any line, whatever the program's size.
-    if (lines) file["text"] = std::move(whole);
+    if (lines) {
+      // The chunks bypass the JSON writer's transcoding: make the text UTF-8 here.
+      if (!json_detail::valid_utf8(whole)) whole = latin1_to_utf8(whole);
+      CompressedText packed =
+          compress_lines(whole, limits.compressed_chunk_lines, compressed_budget);
+      for (const std::string& chunk : packed.chunks) compressed_budget -= chunk.size();
+      file["chunk_lines"] = packed.lines_per_chunk;
+      file["chunks"] = std::move(packed.chunks);
+      file["note"] = packed.lines_kept == packed.lines
+                         ? "the program is large: its text is kept compressed"
+                         : "the page's text budget ends at line " +
+                               std::to_string(packed.lines_kept) + " of " +
+                               std::to_string(packed.lines);
+    }
     files.push_back(std::move(file));
   }
   return files;

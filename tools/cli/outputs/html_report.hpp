@@ -40,7 +40,11 @@ struct HtmlLimits {
   std::size_t max_segments = 1'000'000;        // of the toolpath after thinning
   double path_tolerance = 1.0 / 4000;  // thinning, as a fraction of the toolpath's box diagonal
   std::uintmax_t max_source_bytes = 4 << 20;  // the whole program text is inlined up to this size
-  int context = 3;                            // neighbouring lines shown around a finding's line
+  // Beyond it, each file's text deflated in chunks of lines, up to this many bytes (base64) in all:
+  // the paper-scale program's 144 MB of G-code take 34 MB.
+  std::size_t max_compressed_source_bytes = std::size_t{48} << 20;
+  std::size_t compressed_chunk_lines = 32768;
+  int context = 3;  // neighbouring lines shown around a finding's line
   // Playback (the stock as it stands at the slider): cells of the stock's box, at most this many,
   // and of them at most max_playback_removed removed ones (coarser cells until both hold). Each
   // removed cell costs 2 bytes, each cell 1 or 2 bits: at most 0.6 MB of page (docs/reports.md).
