@@ -14,10 +14,10 @@ namespace tridex::gcode {
 namespace {
 
 constexpr double kTurn = 360.0;
-constexpr double kLimitSlack = 1e-9;     // degrees: a solution this close to a limit is inside
-constexpr double kSameDirection = 1e-9;  // 1 − cos of the angle below which directions agree
-constexpr double kFreeAxis = 1e-9;       // |component normal to an axis| below which it is along it
-constexpr double kParallelAxes = 1e-6;   // |a × b| below which two rotary axes are parallel
+constexpr double kLimitSlack = 1e-9;      // degrees: a solution this close to a limit is inside
+constexpr double kSolutionsAgree = 1e-9;  // 1 − cos of the angle below which directions agree
+constexpr double kFreeAxis = 1e-9;      // |component normal to an axis| below which it is along it
+constexpr double kParallelAxes = 1e-6;  // |a × b| below which two rotary axes are parallel
 
 // The rigid turn of an axis's carriage: p ↦ pivot + R·(p − pivot).
 Frame axis_turn(const RotaryAxis& axis, double degrees) {
@@ -284,7 +284,7 @@ RotaryPositions orient_tool(const Kinematics& kin, const Vec3& part_direction,
     }
     if (!inside) continue;
     // Numerical guard: the pose must give the direction asked for.
-    if (glm::dot(tool_direction(kin, p), v) < 1 - kSameDirection) continue;
+    if (glm::dot(tool_direction(kin, p), v) < 1 - kSolutionsAgree) continue;
     double distance = 0;
     for (int i = 0; i < 3; ++i) distance += std::abs(p[std::size_t(i)] - current[std::size_t(i)]);
     if (distance < best_distance) best = p, best_distance = distance;
