@@ -69,14 +69,17 @@ run(['simulate', write('face_good.nc', faceProgram(-2, 'G0 X-5 Y-3\nG1 Z-1.5\nG0
 const facePage = path.join(out, 'face.html');
 run(['check', write('face.nc', faceProgram(-2.3, '')), ...stock, '--design', path.join(out, 'face_design.stl'), '--tolerance', '0.1',
      '--report', path.join(out, 'face.json'), '--html', facePage], [3]);
-// A program over the page's 4 MiB of plain text (160,000 short moves): its text goes compressed in
-// chunks of lines, and the slider still shows the text of any line.
-const largeLines = ['%', 'G21 G17 G90', 'T1 M6', 'S8000 M3', 'G0 X0 Y0 Z5', 'G1 Z-0.5 F900'];
-for (let k = 0; k < 160000; ++k) largeLines.push('G1 X' + (k % 2 ? 39.5 : 0.5).toFixed(3) + ' Y' + (0.00025 * k).toFixed(5) + ' Z-0.5');
+// A program over the page's 4 MiB of plain text (40,000 short moves, each line with a long comment,
+// as some posts write): its text goes compressed in chunks of lines, and the slider still shows the
+// text of any line. (Few, short moves: the page's playback cells cost moves × cells they cross.)
+const largeLines = ['%', 'G21 G17 G90', 'T1 M6', 'S8000 M3', 'G0 X10 Y10 Z5', 'G1 Z-0.5 F900'];
+for (let k = 0; k < 40000; ++k)
+  largeLines.push('G1 X' + (k % 2 ? 11 : 10).toFixed(3) + ' Y' + (10 + 0.002 * k).toFixed(4) + ' Z-0.5 (pass ' + k +
+                  ' of 40000: ' + 'a comment a post writes on every line, '.repeat(2) + ')');
 largeLines.push('G0 Z5', 'M30', '%');
 const largeProgram = write('large.nc', largeLines.join('\n') + '\n');
 const largePage = path.join(out, 'large.html');
-run(['simulate', largeProgram, '--tools', tools, '--stock', 'box:0,0,-5,40,40,0', '--dexel-cell', '1', '-q', '--html', largePage]);
+run(['simulate', largeProgram, '--tools', tools, '--stock', 'box:0,0,-5,100,100,0', '--dexel-cell', '1', '-q', '--html', largePage]);
 // Nothing left: a cutter wider than the stock plunges through it. No moves: a program of words only.
 const emptyPage = path.join(out, 'empty.html');
 run(['simulate', write('through.nc', '%\nG21 G90\nT1 M6\nM3 S1000\nG0 X5 Y5 Z20\nG1 Z-20 F100\nG0 Z20\nM30\n%\n'),
