@@ -14,7 +14,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-using Json = nlohmann::json;
+using InputJson = nlohmann::json;
 
 constexpr int kMaxJsonDepth = 64;
 
@@ -23,23 +23,23 @@ constexpr int kMaxJsonDepth = 64;
 // error is recorded with its byte position instead of thrown as library text.
 class CheckedSax {
  public:
-  explicit CheckedSax(Json& result) : dom_(result, false) {}
+  explicit CheckedSax(InputJson& result) : dom_(result, false) {}
 
   bool null() { return dom_.null(); }
   bool boolean(bool value) { return dom_.boolean(value); }
-  bool number_integer(Json::number_integer_t value) { return dom_.number_integer(value); }
-  bool number_unsigned(Json::number_unsigned_t value) { return dom_.number_unsigned(value); }
-  bool number_float(Json::number_float_t value, const Json::string_t& text) {
+  bool number_integer(InputJson::number_integer_t value) { return dom_.number_integer(value); }
+  bool number_unsigned(InputJson::number_unsigned_t value) { return dom_.number_unsigned(value); }
+  bool number_float(InputJson::number_float_t value, const InputJson::string_t& text) {
     return dom_.number_float(value, text);
   }
-  bool string(Json::string_t& value) { return dom_.string(value); }
-  bool binary(Json::binary_t& value) { return dom_.binary(value); }
+  bool string(InputJson::string_t& value) { return dom_.string(value); }
+  bool binary(InputJson::binary_t& value) { return dom_.binary(value); }
   bool start_object(std::size_t size) {
     if (!deeper()) return false;
     keys_.emplace_back();
     return dom_.start_object(size);
   }
-  bool key(Json::string_t& key) {
+  bool key(InputJson::string_t& key) {
     if (!keys_.back().insert(key).second) {
       duplicate = key;
       return false;
@@ -84,7 +84,7 @@ class CheckedSax {
   }
   int depth_ = 0;
 
-  nlohmann::detail::json_sax_dom_parser<Json> dom_;
+  nlohmann::detail::json_sax_dom_parser<InputJson> dom_;
   std::vector<std::set<std::string>> keys_;
 };
 
@@ -107,10 +107,10 @@ std::string shown(const std::string& text) {
 
 }  // namespace
 
-Json parse_json_text(const std::string& text, const std::string& source) {
-  Json result;
+InputJson parse_json_text(const std::string& text, const std::string& source) {
+  InputJson result;
   CheckedSax sax(result);
-  bool ok = Json::sax_parse(text, &sax);
+  bool ok = InputJson::sax_parse(text, &sax);
   if (!sax.duplicate.empty())
     input_error(source, ": key \"", shown(sax.duplicate), "\" appears twice in one object");
   if (sax.too_deep)
@@ -158,25 +158,25 @@ std::string read_text_file(const fs::path& path, const std::string& kind) {
   return text;
 }
 
-Json read_json_file(const fs::path& path) {
+InputJson read_json_file(const fs::path& path) {
   return parse_json_text(read_text_file(path, "a JSON file"), path.string());
 }
 
-std::string json_type_name(const Json& value) {
+std::string json_type_name(const InputJson& value) {
   switch (value.type()) {
-    case Json::value_t::null:
+    case InputJson::value_t::null:
       return "null";
-    case Json::value_t::object:
+    case InputJson::value_t::object:
       return "an object";
-    case Json::value_t::array:
+    case InputJson::value_t::array:
       return "an array";
-    case Json::value_t::string:
+    case InputJson::value_t::string:
       return "a string";
-    case Json::value_t::boolean:
+    case InputJson::value_t::boolean:
       return "a boolean";
-    case Json::value_t::binary:
+    case InputJson::value_t::binary:
       return "binary data";
-    case Json::value_t::discarded:
+    case InputJson::value_t::discarded:
       return "nothing";
     default:
       return "a number";

@@ -15,13 +15,13 @@
 
 namespace tridex::cli {
 
-namespace {
-
-std::string lower(std::string text) {
+std::string ascii_lower(std::string text) {
   std::transform(text.begin(), text.end(), text.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return text;
 }
+
+namespace {
 
 double number_field(const nlohmann::json& tool, const std::string& where,
                     std::initializer_list<const char*> keys, bool required) {
@@ -343,7 +343,7 @@ ToolTable ToolTable::from_json(const nlohmann::json& table, const std::string& s
     if (auto units = tool.find("units"); units != tool.end()) {
       if (!units->is_string())
         input_error(where, ": \"units\" must be a string, got ", json_type_name(*units));
-      std::string u = lower(units->get<std::string>());
+      std::string u = ascii_lower(units->get<std::string>());
       if (u == "mm" || u == "metric")
         scale = 1;
       else if (u == "inch" || u == "in" || u == "imperial")
@@ -357,7 +357,7 @@ ToolTable ToolTable::from_json(const nlohmann::json& table, const std::string& s
     auto shape = tool.find("shape");
     if (shape == tool.end() || !shape->is_string())
       input_error(where, ": missing \"shape\" (a string)");
-    spec.shape = lower(shape->get<std::string>());
+    spec.shape = ascii_lower(shape->get<std::string>());
     spec.diameter_mm = scale * number_field(tool, where, {"diameter"}, true);
     spec.length_mm = scale * number_field(tool, where, {"length"}, false);
     spec.corner_radius_mm =
@@ -480,7 +480,7 @@ ToolTable ToolTable::from_fusion_json(const nlohmann::json& library, const std::
     auto type = tool.find("type");
     if (type == tool.end() || !type->is_string())
       input_error(where, ": missing \"type\" (a string)");
-    const std::string type_name = lower(type->get<std::string>());
+    const std::string type_name = ascii_lower(type->get<std::string>());
     std::string description;
     if (auto d = tool.find("description"); d != tool.end() && d->is_string())
       description = d->get<std::string>();
@@ -517,7 +517,7 @@ ToolTable ToolTable::from_fusion_json(const nlohmann::json& library, const std::
       if (unit == object.end()) return fallback;
       if (!unit->is_string())
         input_error(at, ": \"unit\" must be a string, got ", json_type_name(*unit));
-      std::string u = lower(unit->get<std::string>());
+      std::string u = ascii_lower(unit->get<std::string>());
       if (u == "millimeters" || u == "mm") return 1.0;
       if (u == "inches" || u == "inch" || u == "in") return 25.4;
       input_error(at, ": unknown \"unit\" \"", u, "\" (expected millimeters or inches)");
@@ -574,7 +574,7 @@ ToolTable ToolTable::from_fusion_json(const nlohmann::json& library, const std::
 }
 
 ToolTable ToolTable::read(const std::filesystem::path& path, double tbl_unit_mm) {
-  if (lower(path.extension().string()) == ".tbl")
+  if (ascii_lower(path.extension().string()) == ".tbl")
     return from_tbl(read_text_file(path, "a tool table"), path.string(), tbl_unit_mm);
   nlohmann::json json = read_json_file(path);
   if (json.is_object() && json.contains("data") && json["data"].is_array())

@@ -115,4 +115,7 @@ Cutter make_cutter(const ToolSpec& spec, const std::string& where);
 // holder above a positive stick-out); throws InputError naming `where` and the key.
 ToolBody make_body(const ToolSpec& spec, const std::string& where);
 
+// `text` with its ASCII letters lowered: units, shapes, types and extensions match in any case.
+std::string ascii_lower(std::string text);
+
 }  // namespace tridex::cli

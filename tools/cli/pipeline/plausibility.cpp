@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <fstream>
 
+#include "inputs/tool_table.hpp"
+
 namespace tridex::cli {
 
 namespace fs = std::filesystem;
@@ -21,12 +23,6 @@ std::string box_text(const Aabb& box) {
   char text[160];
   std::snprintf(text, sizeof text, "%g,%g,%g,%g,%g,%g", box.min.x, box.min.y, box.min.z, box.max.x,
                 box.max.y, box.max.z);
-  return text;
-}
-
-std::string lower(std::string text) {
-  std::transform(text.begin(), text.end(), text.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return text;
 }
 
@@ -67,7 +63,7 @@ void warn_automatic_stock(SimulationResult& r) {
 // A .tbl's units: LinuxCNC reads it in the machine's units ([TRAJ]LINEAR_UNITS), which tridex
 // cannot know unless told.
 void warn_tbl_units(const SimulateOptions& options, SimulationResult& r) {
-  if (options.tools.empty() || lower(fs::path(options.tools).extension().string()) != ".tbl")
+  if (options.tools.empty() || ascii_lower(fs::path(options.tools).extension().string()) != ".tbl")
     return;
   const gcode::MachineConfig& machine = r.input.machine;
   const double unit = machine.tool_table_in_inches ? 25.4 : 1.0;
