@@ -74,6 +74,7 @@ Session::Session(const SessionOptions& options) : options_(options) {
   }
   zmap_cell_ = std::min(glm::length(size) * cli::kDefaultZmapCellFraction,
                         cli::kDefaultZmapCellOfSpacing * lattice_.spacing);
+  cache_ = SolidCache(stock_, lattice_, options.threads);
 }
 
 std::vector<gcode::Move> Session::run_piece(gcode::Interpreter& interpreter,
@@ -181,6 +182,7 @@ void Session::mill(const std::vector<gcode::Move>& moves) {
     if (batch.empty()) continue;
     backends::mill_with(backends::ZMapBackend::cpu, maps_[g], cutters_, batch,
                         batch.size() < 64 ? 1u : options_.threads);
+    cache_.milled(g, maps_[g], cutters_, batch);
   }
   moves_ += static_cast<long long>(moves.size());
   if (!moves.empty()) {
@@ -189,22 +191,18 @@ void Session::mill(const std::vector<gcode::Move>& moves) {
   }
 }
 
-// Steps 2-3 and the surface on copies of the live maps (pipeline.cpp: intersect_directions,
-// refine_walls, extract_result_surface).
+// Steps 2-3 where the pieces since changed a map (SolidCache), and the surface (pipeline.cpp:
+// intersect_directions, refine_walls, extract_result_surface).
 void Session::ensure_solid() {
   if (solid_valid_) return;
   const unsigned threads = options_.threads;
-  std::vector<ZMap> maps = maps_;
-  for (ZMap& map : maps) raise_uncut(map, stock_, threads);
-  for (std::size_t g = 0; g < maps.size(); ++g)
-    refine_steep_cells(maps[g], cutters_, cuts_[g], {.threads = threads});
-  const TripleDexel stock_dexel = TripleDexel::box(lattice_, stock_);
-  solid_ = backends::machine_with(backends::DexelBackend::scan, stock_dexel, maps, threads);
-  mesh_ = extract_surface(solid_, {.threads = threads});
+  const TripleDexel& solid = cache_.update(maps_, cutters_, cuts_);
+  const TripleDexel& stock_dexel = cache_.stock_dexel();
+  mesh_ = extract_surface(solid, {.threads = threads});
   volume_ = mesh_.signed_volume();
   removed_ = stock_volume_ - volume_;
   // As simulate's removed_mm3: the surface's rounding never makes a negative removal.
-  if (removed_ < 0) removed_ = std::max(0.0, tridex::volume(stock_dexel) - tridex::volume(solid_));
+  if (removed_ < 0) removed_ = std::max(0.0, tridex::volume(stock_dexel) - tridex::volume(solid));
   solid_valid_ = true;
 }
 

@@ -3,10 +3,11 @@
 //
 // Moves are milled into one live Z-map per spindle direction as they are read (Step 1 of Inui,
 // Chen and Umezu, CAD&A 19(4) 2022, §3, incrementally: a Z-map's milling is a minimum over the
-// moves, so pieces give the same heights as the whole program). The solid (Steps 2-3 and the
-// surface) is made from copies of the live maps when a question needs it and kept until the next
-// piece: the same stages as `tridex simulate` (tools/cli/pipeline/pipeline.cpp), so the session's
-// solid equals simulate's on the same program, stock, tools and --dexel-cell.
+// moves, so pieces give the same heights as the whole program). The solid (Steps 2-3) is brought
+// up to date when a question needs it, only where the pieces since changed a map (SolidCache),
+// and its surface made again: the same stages as `tridex simulate`
+// (tools/cli/pipeline/pipeline.cpp), so the session's solid equals simulate's on the same
+// program, stock, tools and --dexel-cell.
 #pragma once
 
 #include <cstddef>
@@ -18,6 +19,7 @@
 #include <vector>
 
 #include "inputs/program_input.hpp"
+#include "solid_cache.hpp"
 #include "tridex/cutter.hpp"
 #include "tridex/dexel.hpp"
 #include "tridex/gcode/grouping.hpp"
@@ -66,6 +68,8 @@ class Session {
   long long moves() const { return moves_; }
   double dexel_spacing() const { return lattice_.spacing; }
   double zmap_cell() const { return zmap_cell_; }
+  // The share of the result's rays the last question intersected again (1: all), for the tests.
+  double last_rays_redone() const { return cache_.last_rays_redone(); }
 
   static constexpr double kCutTolerance = 0.005;  // mm: simulate's rapid tolerance
 
@@ -95,8 +99,8 @@ class Session {
   std::vector<std::string> warnings_;
 
   // The solid as it stands, kept until the next piece.
+  SolidCache cache_;
   bool solid_valid_ = false;
-  TripleDexel solid_;
   Mesh mesh_;
   double volume_ = 0;
   double removed_ = 0;
