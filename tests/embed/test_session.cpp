@@ -191,6 +191,84 @@ TEST_CASE("session: would_cut and inside see every direction's cuts") {
   CHECK(checked > 300);
 }
 
+TEST_CASE("session: the stock's extent along a line, against the solid and against inside") {
+  const fs::path dir = scratch("extent");
+  embed::Session s(session_options(Aabb{Vec3(0), Vec3(40, 40, 20)}, flat_table(dir), 0.5));
+  s.feed(kStart);
+  s.feed(facing(15));
+  s.feed(side_facing(12));  // left: 12..40 x 0..40 x 0..15
+  using Spans = std::vector<std::pair<double, double>>;
+  auto near = [](const Spans& got, const Spans& want) {
+    if (got.size() != want.size()) return false;
+    for (std::size_t k = 0; k < got.size(); ++k)
+      if (std::abs(got[k].first - want[k].first) > 0.05 ||
+          std::abs(got[k].second - want[k].second) > 0.05)
+        return false;
+    return true;
+  };
+  CHECK(near(s.extent(Vec3(20, 20, 0), Vec3(0, 0, 1)), {{0, 15}}));    // the height at 20, 20
+  CHECK(near(s.extent(Vec3(20, 20, 0), Vec3(0, 0, -2)), {{-15, 0}}));  // any length, sign
+  CHECK(near(s.extent(Vec3(0, 20, 5), Vec3(1, 0, 0)), {{12, 40}}));
+  CHECK(near(s.extent(Vec3(30, -10, 5), Vec3(0, 1, 0)), {{10, 50}}));
+  CHECK(s.extent(Vec3(6, 20, 0), Vec3(0, 0, 1)).empty());  // the -x facing took it all
+  // Skew lines against inside() at points along them, away from the surface.
+  std::mt19937 random(383);
+  std::uniform_real_distribution<double> u(-1, 1), w(0, 40);
+  int checked = 0;
+  for (int line = 0; line < 12; ++line) {
+    const Vec3 p(w(random), w(random), w(random) * 0.5);
+    const Vec3 d = glm::normalize(Vec3(u(random), u(random), u(random)));
+    const Spans spans = s.extent(p, d);
+    CAPTURE(p);
+    CAPTURE(d);
+    for (double t = -60; t <= 60; t += 1.7) {
+      bool in = false;
+      double margin = 1e9;
+      for (const auto& [a, b] : spans) {
+        in = in || (t > a && t < b);
+        margin = std::min({margin, std::abs(t - a), std::abs(t - b)});
+      }
+      if (margin < 0.5) continue;  // within a dexel spacing of the surface
+      CHECK(s.inside(p + t * d) == in);
+      ++checked;
+    }
+  }
+  CHECK(checked > 500);
+  CHECK_THROWS_AS(s.extent(Vec3(0), Vec3(0)), cli::InputError);
+}
+
+TEST_CASE("session: moves given directly cut as the same moves in G-code; removal per piece") {
+  const fs::path dir = scratch("direct");
+  const std::string table = flat_table(dir);
+  const Aabb stock{Vec3(0), Vec3(40, 40, 20)};
+  const std::string program = std::string(kStart) + facing(15) + side_facing(12) +
+                              "G0 X26 Y-10\nG1 Z12 F300\nG1 Y50\nG0 Z30\n";
+  embed::Session by_gcode(session_options(stock, table, 1));
+  const double removed = by_gcode.feed_measured(program);
+  CHECK(removed == doctest::Approx(15200 + 10 * 40 * 3).epsilon(2e-3));
+  CHECK(removed == by_gcode.removed_volume());
+  const long long cut = by_gcode.moves();
+  CHECK(by_gcode.feed_measured("G0 X20 Y20 Z30\n") == 0);  // in the air
+  // The same moves, as the interpreter makes them, given one by one.
+  gcode::Interpreter interpreter;
+  std::vector<gcode::Move> moves;
+  std::istringstream in(program);
+  interpreter.feed(in, "direct", [&](const gcode::Move& m) { moves.push_back(m); });
+  embed::Session direct(session_options(stock, table, 1));
+  int tilted = 0;
+  for (const gcode::Move& m : moves) {
+    if (m.tool == 0) continue;  // before T1 M6: simulate does not cut them either
+    direct.add_move(m.start, m.end, m.tool, m.axis * 3.0, m.kind == gcode::MoveKind::rapid);
+    tilted += m.axis.z < 0.5;
+  }
+  CHECK(tilted > 10);
+  CHECK(direct.moves() == cut);
+  CHECK(same_mesh(direct.mesh(), by_gcode.mesh()));
+  CHECK_THROWS_AS(direct.add_move(Vec3(0), Vec3(1), 7, Vec3(0, 0, 1)), cli::InputError);
+  CHECK_THROWS_AS(direct.add_move(Vec3(0), Vec3(1), 1, Vec3(0)), cli::InputError);
+  CHECK(direct.moves() == cut);
+}
+
 TEST_CASE("session: a piece that fails changes nothing; state carries over") {
   const fs::path dir = scratch("errors");
   embed::Session s(session_options(Aabb{Vec3(0), Vec3(40, 40, 20)}, flat_table(dir), 1));

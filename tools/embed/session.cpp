@@ -26,7 +26,10 @@ namespace {
 // The name a fed program's diagnostics and moves carry.
 const std::string kFedProgram = "<fed>";
 
-std::string where_text(const gcode::Move& m) { return kFedProgram + ":" + std::to_string(m.line); }
+// Where a move came from: its line of the fed program, or "a move given directly" (line 0).
+std::string where_text(const gcode::Move& m) {
+  return m.line > 0 ? kFedProgram + ":" + std::to_string(m.line) : "a move given directly";
+}
 
 // Whether the ray p + t·d (t > 0) crosses triangle (a, b, c) (Möller and Trumbore, "Fast, minimum
 // storage ray-triangle intersection", JGT 2(1) 1997).
@@ -107,9 +110,8 @@ std::uint32_t Session::cutter_for(int tool, const gcode::Move& m, bool add) {
                    options_.tools);
 }
 
-void Session::feed(std::string_view text) {
-  gcode::Interpreter trial = interpreter_.clone();
-  std::vector<gcode::Move> moves = run_piece(trial, text);
+template <class Commit>
+void Session::cut_moves(std::vector<gcode::Move> moves, Commit&& commit) {
   // Tools first, so that a piece that fails changes nothing (simulate's load_initial_tool,
   // load_cutters and drop_toolless_moves, move by move).
   const int initial = input_.machine.initial_tool;
@@ -148,7 +150,7 @@ void Session::feed(std::string_view text) {
   for (const auto& [tool, m] : first_use) cutter_for(tool, *m, false);
   // Committed from here on.
   for (const auto& [tool, m] : first_use) cutter_for(tool, *m, true);
-  interpreter_ = std::move(trial);
+  commit();
   toolless_rapids_ = std::move(toolless);
   initial_tool_cuts_ = initial_cuts;
   if (dropped > 0)
@@ -158,6 +160,34 @@ void Session::feed(std::string_view text) {
   warnings_ = own_warnings_;
   for (const gcode::Diagnostic& d : interpreter_.warnings()) warnings_.push_back(d.to_string());
   mill(cut);
+}
+
+void Session::feed(std::string_view text) {
+  gcode::Interpreter trial = interpreter_.clone();
+  std::vector<gcode::Move> moves = run_piece(trial, text);
+  cut_moves(std::move(moves), [&] { interpreter_ = std::move(trial); });
+}
+
+double Session::feed_measured(std::string_view text) {
+  const double before = removed_volume();
+  feed(text);
+  return removed_volume() - before;
+}
+
+void Session::add_move(const Vec3& start, const Vec3& end, int tool, const Vec3& axis, bool rapid) {
+  if (!is_finite(start) || !is_finite(end))
+    cli::input_error("add_move: the start and end points must be finite");
+  const double length = glm::length(axis);
+  if (!is_finite(axis) || !(length > 1e-12))
+    cli::input_error("add_move: the tool axis must be a finite, non-zero direction");
+  if (tool < 0) cli::input_error("add_move: tool ", tool, " is not a tool number");
+  gcode::Move m;
+  m.kind = rapid ? gcode::MoveKind::rapid : gcode::MoveKind::feed;
+  m.tool = tool;
+  m.start = start;
+  m.end = end;
+  m.axis = axis / length;
+  cut_moves({m}, [] {});
 }
 
 // Step 1, incrementally: each direction's new moves milled into its live map.
@@ -281,6 +311,60 @@ bool Session::inside(const Vec3& point) {
     votes += crossings % 2;
   }
   return votes >= 2;
+}
+
+std::vector<std::pair<double, double>> Session::extent(const Vec3& point, const Vec3& direction) {
+  ensure_solid();
+  const double length = glm::length(direction);
+  if (!is_finite(point) || !is_finite(direction) || !(length > 1e-12))
+    cli::input_error("extent: give a finite point and a finite, non-zero direction");
+  const Vec3 d = direction / length;
+  // The crossings of the line with the surface, entering (the triangle faces against d) or
+  // leaving, counted in order: the solid is where more were entered than left. A line that meets
+  // an edge or a vertex may count a crossing once too often or too few: then the count does not
+  // come back to zero, and the line is moved aside by a hair (1e-6 of a spacing, skew) and asked
+  // again, as inside() outvotes such a ray.
+  static const std::array<Vec3, 4> aside = {Vec3(0), Vec3(0.5377, 0.3141, 0.7826),
+                                            Vec3(-0.2718, 0.8413, -0.4669),
+                                            Vec3(0.6931, -0.5772, -0.4142)};
+  std::vector<std::pair<double, int>> hits;
+  for (const Vec3& nudge : aside) {
+    const Vec3 p = point + nudge * (1e-6 * lattice_.spacing);
+    hits.clear();
+    for (const glm::uvec3& t : mesh_.triangles) {
+      const Vec3 a(mesh_.positions[t.x]), b(mesh_.positions[t.y]), c(mesh_.positions[t.z]);
+      const Vec3 e1 = b - a, e2 = c - a;
+      const Vec3 q = glm::cross(d, e2);
+      const double det = glm::dot(e1, q);
+      if (std::abs(det) < 1e-300) continue;  // along the line: no crossing
+      const Vec3 s = p - a;
+      const double u = glm::dot(s, q) / det;
+      if (u < 0 || u > 1) continue;
+      const Vec3 r = glm::cross(s, e1);
+      const double v = glm::dot(d, r) / det;
+      if (v < 0 || u + v > 1) continue;
+      // det = −(e1 × e2)·d: positive when the outward normal faces against d, the line entering.
+      hits.emplace_back(glm::dot(e2, r) / det, det > 0 ? 1 : -1);
+    }
+    std::sort(hits.begin(), hits.end());
+    std::vector<std::pair<double, double>> spans;
+    int depth = 0;
+    bool sound = true;
+    for (const auto& [t, step] : hits) {
+      if (depth == 0 && step > 0) spans.emplace_back(t, t);
+      depth += step;
+      if (depth < 0) sound = false;
+      if (depth == 0 && step < 0 && !spans.empty()) spans.back().second = t;
+    }
+    if (sound && depth == 0) {
+      // The hair's offset along d is not undone: it is far below the surface's own rounding.
+      spans.erase(std::remove_if(spans.begin(), spans.end(),
+                                 [](const auto& span) { return !(span.second > span.first); }),
+                  spans.end());
+      return spans;
+    }
+  }
+  throw tridex::Error("extent: the surface's crossings along the line do not pair up");
 }
 
 }  // namespace tridex::embed

@@ -51,6 +51,15 @@ class Session {
   // InputError: a tool missing from the table, a feed move with no tool) leaves the session as
   // it was, interpreter state included.
   void feed(std::string_view text);
+  // feed(), and the mm³ that piece removed (the removed volume after it less before it: the
+  // solid is brought up to date before and after, at the cost of two questions).
+  double feed_measured(std::string_view text);
+  // One straight move given directly, not as G-code (issue 38): from `start` to `end` (tool tip,
+  // mm, the work frame: the part's coordinates, as the stock and a program's moves), cut by tool
+  // `tool` of the table with its spindle along `axis` (tip towards holder; normalized here). A
+  // rapid cuts as a feed does (simulate cuts rapids too). The interpreter's state is untouched.
+  // Throws cli::InputError (a tool missing from the table, a zero or non-finite axis or point).
+  void add_move(const Vec3& start, const Vec3& end, int tool, const Vec3& axis, bool rapid = false);
 
   // mm³ removed so far: the stock's volume less the solid's (its surface's volume, as simulate's
   // "removed_mm3"). A piece's removal is the difference across its feed().
@@ -61,6 +70,10 @@ class Session {
   double would_cut(std::string_view block);
   // Whether a point (work frame) lies inside the stock as it stands (the solid's surface).
   bool inside(const Vec3& point);
+  // The stock's extent along the line point + t·direction (t in mm along the unit direction):
+  // the intervals [t_in, t_out] of the line inside the solid's surface, ascending. The height at
+  // (x, y) is the last t_out from (x, y, 0) along +z; any axis and any line work alike.
+  std::vector<std::pair<double, double>> extent(const Vec3& point, const Vec3& direction);
   const Mesh& mesh();
   void write_stl(const std::filesystem::path& path);
 
@@ -75,6 +88,10 @@ class Session {
 
  private:
   std::vector<gcode::Move> run_piece(gcode::Interpreter& interpreter, std::string_view text);
+  // Resolves the moves' tools (simulate's rules for moves before any tool change) and mills them;
+  // changes nothing when that throws. `commit` then runs first (the interpreter's new state).
+  template <class Commit>
+  void cut_moves(std::vector<gcode::Move> moves, Commit&& commit);
   std::uint32_t cutter_for(int tool, const gcode::Move& m, bool add);
   void mill(const std::vector<gcode::Move>& moves);
   void ensure_solid();
