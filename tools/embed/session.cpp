@@ -49,7 +49,9 @@ bool ray_crosses(const Vec3& p, const Vec3& d, const Vec3& a, const Vec3& b, con
 
 }  // namespace
 
-Session::Session(const SessionOptions& options) : options_(options) {
+Session::Session(const SessionOptions& options)
+    : options_(options), pool_(std::make_unique<detail::ThreadPool>(options.threads)) {
+  const detail::UsePool use(*pool_);
   stock_ = options.stock;
   const Vec3 size = stock_.size();
   if (!is_finite(stock_.min) || !is_finite(stock_.max) || !(size.x > 0) || !(size.y > 0) ||
@@ -163,18 +165,21 @@ void Session::cut_moves(std::vector<gcode::Move> moves, Commit&& commit) {
 }
 
 void Session::feed(std::string_view text) {
+  const detail::UsePool use(*pool_);
   gcode::Interpreter trial = interpreter_.clone();
   std::vector<gcode::Move> moves = run_piece(trial, text);
   cut_moves(std::move(moves), [&] { interpreter_ = std::move(trial); });
 }
 
 double Session::feed_measured(std::string_view text) {
+  const detail::UsePool use(*pool_);
   const double before = removed_volume();
   feed(text);
   return removed_volume() - before;
 }
 
 void Session::add_move(const Vec3& start, const Vec3& end, int tool, const Vec3& axis, bool rapid) {
+  const detail::UsePool use(*pool_);
   if (!is_finite(start) || !is_finite(end))
     cli::input_error("add_move: the start and end points must be finite");
   const double length = glm::length(axis);
@@ -237,16 +242,19 @@ void Session::ensure_solid() {
 }
 
 double Session::removed_volume() {
+  const detail::UsePool use(*pool_);
   ensure_solid();
   return removed_;
 }
 
 const Mesh& Session::mesh() {
+  const detail::UsePool use(*pool_);
   ensure_solid();
   return mesh_;
 }
 
 void Session::write_stl(const std::filesystem::path& path) {
+  const detail::UsePool use(*pool_);
   ensure_solid();
   cli::write_stl_file(path, mesh_);
 }
@@ -265,6 +273,7 @@ const ZMap& Session::probe_map(const Vec3& axis) {
 }
 
 double Session::would_cut(std::string_view block) {
+  const detail::UsePool use(*pool_);
   gcode::Interpreter trial = interpreter_.clone();
   trial.resume();  // a block asked about after the program's end still runs
   const std::vector<gcode::Move> moves = run_piece(trial, block);
@@ -292,6 +301,7 @@ double Session::would_cut(std::string_view block) {
 }
 
 bool Session::inside(const Vec3& point) {
+  const detail::UsePool use(*pool_);
   ensure_solid();
   if (!is_finite(point)) cli::input_error("inside: the point must be finite");
   const Aabb box = mesh_.bounds();
@@ -314,6 +324,7 @@ bool Session::inside(const Vec3& point) {
 }
 
 std::vector<std::pair<double, double>> Session::extent(const Vec3& point, const Vec3& direction) {
+  const detail::UsePool use(*pool_);
   ensure_solid();
   const double length = glm::length(direction);
   if (!is_finite(point) || !is_finite(direction) || !(length > 1e-12))

@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -26,18 +27,19 @@
 #include "tridex/gcode/interpreter.hpp"
 #include "tridex/mill.hpp"
 #include "tridex/mesh.hpp"
+#include "tridex/parallel.hpp"
 #include "tridex/zmap.hpp"
 
 namespace tridex::embed {
 
 struct SessionOptions {
-  Aabb stock;                    // the stock box, work frame (mm)
-  std::string tools;             // tool table file, as --tools (CAMotics JSON, Fusion, .tbl)
-  std::string machine;           // as --machine: a bundled name or a machine file; empty: default
-  double cell = 0;               // dexel spacing (mm), as --dexel-cell; 0: --dexel-res's default
-  unsigned threads = 0;          // 0: every hardware thread (parallel.hpp's pool)
-  std::string tool_units;        // as --tool-units: a .tbl's units (empty: the machine's)
-  int initial_tool = -1;         // as --initial-tool (-1: the machine's)
+  Aabb stock;              // the stock box, work frame (mm)
+  std::string tools;       // tool table file, as --tools (CAMotics JSON, Fusion, .tbl)
+  std::string machine;     // as --machine: a bundled name or a machine file; empty: default
+  double cell = 0;         // dexel spacing (mm), as --dexel-cell; 0: --dexel-res's default
+  unsigned threads = 0;    // every call's threads, kept by the session (0: every hardware thread)
+  std::string tool_units;  // as --tool-units: a .tbl's units (empty: the machine's)
+  int initial_tool = -1;   // as --initial-tool (-1: the machine's)
   double arc_tolerance = 0.001;  // mm
   bool lenient = false;
 };
@@ -98,6 +100,8 @@ class Session {
   const ZMap& probe_map(const Vec3& axis);
 
   SessionOptions options_;
+  // The session's threads, started once: every call's parallel work runs on them (UsePool).
+  std::unique_ptr<detail::ThreadPool> pool_;
   cli::ProgramInput input_;
   gcode::Interpreter interpreter_;
   Aabb stock_;
