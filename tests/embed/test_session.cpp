@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "errors.hpp"
+#include "outputs/result_files.hpp"
 #include "pipeline/pipeline.hpp"
 #include "session.hpp"
 #include "tridex/gcode/diagnostic.hpp"
@@ -267,6 +268,58 @@ TEST_CASE("session: moves given directly cut as the same moves in G-code; remova
   CHECK_THROWS_AS(direct.add_move(Vec3(0), Vec3(1), 7, Vec3(0, 0, 1)), cli::InputError);
   CHECK_THROWS_AS(direct.add_move(Vec3(0), Vec3(1), 1, Vec3(0)), cli::InputError);
   CHECK(direct.moves() == cut);
+}
+
+// A ramp 40 x 40, 20 high at x = 0 down to 4 at x = 40, as a closed, outward STL.
+fs::path ramp_stl(const fs::path& dir) {
+  Mesh m;
+  for (const Vec3& p : {Vec3(0, 0, 0), Vec3(40, 0, 0), Vec3(40, 40, 0), Vec3(0, 40, 0),
+                        Vec3(0, 0, 20), Vec3(40, 0, 4), Vec3(40, 40, 4), Vec3(0, 40, 20)})
+    m.positions.emplace_back(p);
+  const Vec3 centre(20, 20, 6);
+  auto quad = [&](unsigned a, unsigned b, unsigned c, unsigned d) {
+    for (glm::uvec3 t : {glm::uvec3(a, b, c), glm::uvec3(a, c, d)}) {
+      const Vec3 p0(m.positions[t.x]), p1(m.positions[t.y]), p2(m.positions[t.z]);
+      if (glm::dot(glm::cross(p1 - p0, p2 - p0), p0 - centre) < 0) std::swap(t.y, t.z);
+      m.triangles.push_back(t);
+    }
+  };
+  quad(0, 1, 2, 3), quad(4, 5, 6, 7), quad(0, 1, 5, 4), quad(1, 2, 6, 5), quad(2, 3, 7, 6),
+      quad(3, 0, 4, 7);
+  const fs::path path = dir / "ramp.stl";
+  cli::write_stl_file(path, m);
+  return path;
+}
+
+TEST_CASE("session: a mesh stock, fed in pieces, is simulate's solid on that STL") {
+  const fs::path dir = scratch("mesh_stock");
+  const std::string table = flat_table(dir);
+  const fs::path stock = ramp_stl(dir);
+  const std::string program = std::string(kStart) + facing(14) + side_facing(10) +
+                              "G0 X26 Y-10\nG1 Z6 F300\nG1 Y50\nG0 Z30\n";
+  const fs::path file = dir / "ramp.nc";
+  std::ofstream(file) << program;
+  cli::SimulateOptions options;
+  options.program = file.string();
+  options.tools = table;
+  options.stock = stock.string();
+  options.dexel_cell = 1;
+  options.quiet = true;
+  cli::Progress progress(false);
+  const cli::SimulationResult whole = cli::simulate_program(options, progress);
+  embed::SessionOptions o = session_options(Aabb{}, table, 1);
+  o.stock_file = stock.string();
+  embed::Session s(o);
+  const std::vector<std::string> lines = lines_of(file);
+  s.feed(join(lines, 0, 12));
+  CHECK(s.removed_volume() > 0);  // the top of the ramp above z 14
+  s.feed(join(lines, 12, 30));
+  s.removed_volume();  // brought up to date in between
+  s.feed(join(lines, 30, lines.size()));
+  CHECK(same_mesh(s.mesh(), whole.mesh));
+  CHECK(s.removed_volume() == doctest::Approx(whole.stock.volume - whole.volume).epsilon(1e-12));
+  o.stock_file = (dir / "none.stl").string();
+  CHECK_THROWS_AS(embed::Session{o}, cli::InputError);
 }
 
 TEST_CASE("session: a piece that fails changes nothing; state carries over") {

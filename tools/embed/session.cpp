@@ -17,6 +17,7 @@
 #include "tridex/dexel_ops.hpp"
 #include "tridex/fine_cells.hpp"
 #include "tridex/mill.hpp"
+#include "tridex/stl.hpp"
 #include "tridex/surface.hpp"
 
 namespace tridex::embed {
@@ -52,12 +53,28 @@ bool ray_crosses(const Vec3& p, const Vec3& d, const Vec3& a, const Vec3& b, con
 Session::Session(const SessionOptions& options)
     : options_(options), pool_(std::make_unique<detail::ThreadPool>(options.threads)) {
   const detail::UsePool use(*pool_);
-  stock_ = options.stock;
+  if (!options.stock_file.empty()) {
+    try {  // as simulate reads --stock FILE.stl (pipeline.cpp, load_stock)
+      stock_mesh_ = std::make_shared<const Mesh>(
+          read_stl(options.stock_file, StlOptions{.require_closed = true}));
+    } catch (const tridex::Error& e) {
+      cli::input_error("stock ", options.stock_file, ": ", e.what());
+    }
+    stock_ = stock_mesh_->bounds();
+    stock_volume_ = stock_mesh_->signed_volume();
+    if (!(stock_volume_ > 0))
+      cli::input_error("stock ", options.stock_file, ": the mesh encloses no volume (",
+                       stock_volume_, " mm^3); are its triangles inside out?");
+  } else {
+    stock_ = options.stock;
+    const Vec3 box = stock_.size();
+    if (!is_finite(stock_.min) || !is_finite(stock_.max) || !(box.x > 0) || !(box.y > 0) ||
+        !(box.z > 0))
+      cli::input_error(
+          "stock: give xmin, ymin, zmin, xmax, ymax, zmax with each max above its min");
+    stock_volume_ = box.x * box.y * box.z;
+  }
   const Vec3 size = stock_.size();
-  if (!is_finite(stock_.min) || !is_finite(stock_.max) || !(size.x > 0) || !(size.y > 0) ||
-      !(size.z > 0))
-    cli::input_error("stock: give xmin, ymin, zmin, xmax, ymax, zmax with each max above its min");
-  stock_volume_ = size.x * size.y * size.z;
   if (!(options.cell >= 0) || !std::isfinite(options.cell))
     cli::input_error("cell: the dexel spacing must be a positive number of mm (", options.cell,
                      ")");
@@ -79,7 +96,7 @@ Session::Session(const SessionOptions& options)
   }
   zmap_cell_ = std::min(glm::length(size) * cli::kDefaultZmapCellFraction,
                         cli::kDefaultZmapCellOfSpacing * lattice_.spacing);
-  cache_ = SolidCache(stock_, lattice_, options.threads);
+  cache_ = SolidCache(stock_, stock_mesh_, lattice_, options.threads);
 }
 
 std::vector<gcode::Move> Session::run_piece(gcode::Interpreter& interpreter,
@@ -205,7 +222,9 @@ void Session::mill(const std::vector<gcode::Move>& moves) {
     if (g == maps_.size()) {
       ZMapLimits limits;
       limits.max_points = std::numeric_limits<std::size_t>::max();
-      maps_.push_back(ZMap::from_box(group.frame, stock_, zmap_cell_, limits, options_.threads));
+      maps_.push_back(
+          stock_mesh_ ? ZMap::from_mesh(group.frame, *stock_mesh_, zmap_cell_, limits)
+                      : ZMap::from_box(group.frame, stock_, zmap_cell_, limits, options_.threads));
       cuts_.emplace_back();
       fed.push_back(0);
     }

@@ -34,6 +34,7 @@ namespace tridex::embed {
 
 struct SessionOptions {
   Aabb stock;              // the stock box, work frame (mm)
+  std::string stock_file;  // or a closed STL as the stock (as --stock FILE.stl), bounds and all
   std::string tools;       // tool table file, as --tools (CAMotics JSON, Fusion, .tbl)
   std::string machine;     // as --machine: a bundled name or a machine file; empty: default
   double cell = 0;         // dexel spacing (mm), as --dexel-cell; 0: --dexel-res's default
@@ -105,6 +106,7 @@ class Session {
   cli::ProgramInput input_;
   gcode::Interpreter interpreter_;
   Aabb stock_;
+  std::shared_ptr<const Mesh> stock_mesh_;  // a mesh stock, or null for the box
   double stock_volume_ = 0;
   DexelLattice lattice_;
   double zmap_cell_ = 0;

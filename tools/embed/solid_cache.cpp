@@ -7,8 +7,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <utility>
 
+#include "tridex/dexelize.hpp"
 #include "tridex/fine_cells.hpp"
 #include "tridex/parallel.hpp"
 #include "tridex/polyhedron.hpp"
@@ -20,11 +22,39 @@ namespace {
 
 constexpr int kRaiseReach = 2;  // raise_uncut reads points this many rows away
 
+// A direction's stock map before milling, row by row, as raise_uncut computes it again: a box's
+// tops (ZMap::from_box) or a mesh's triangles rasterised (ZMap::from_mesh).
+class StockRows {
+ public:
+  StockRows(const ZMap& live, const Aabb& box, const Mesh* mesh) : box_(box) {
+    if (mesh) {
+      top_.emplace(live.grid.frame, *mesh, live.grid.cell);
+      top_->index_bands();
+      grid_ = top_->grid(), empty_ = top_->empty();
+    } else {
+      const std::pair<ZMapGrid, float> grid_and_empty =
+          detail::box_map_grid(live.grid.frame, box, live.grid.cell);
+      grid_ = grid_and_empty.first, empty_ = grid_and_empty.second;
+    }
+  }
+  float empty() const { return empty_; }
+  void row(int j, float* out) const {
+    if (top_)
+      top_->row(j, out);
+    else
+      detail::box_top_row(grid_, box_, empty_, j, out);
+  }
+
+ private:
+  Aabb box_;
+  std::optional<detail::MeshTop> top_;
+  ZMapGrid grid_;
+  float empty_ = 0;
+};
+
 // The highest point of the stock's Z-map before milling (raise_uncut_rows' `top`).
-float stock_top(const ZMap& live, const Aabb& stock, unsigned threads) {
-  const std::pair<ZMapGrid, float> grid_and_empty =
-      detail::box_map_grid(live.grid.frame, stock, live.grid.cell);
-  const ZMapGrid& b = grid_and_empty.first;
+float stock_top(const ZMap& live, const StockRows& stock, unsigned threads) {
+  const ZMapGrid& b = live.grid;
   const auto bands =
       static_cast<std::size_t>((b.ny + detail::kMapBandRows - 1) / detail::kMapBandRows);
   std::vector<float> band_top(bands, live.empty_height);
@@ -33,7 +63,7 @@ float stock_top(const ZMap& live, const Aabb& stock, unsigned threads) {
     const int j0 = static_cast<int>(band) * detail::kMapBandRows,
               j1 = std::min(b.ny, j0 + detail::kMapBandRows);
     for (int j = j0; j < j1; ++j) {
-      detail::box_top_row(b, stock, grid_and_empty.second, j, row.data());
+      stock.row(j, row.data());
       for (float h : row) band_top[band] = std::max(band_top[band], h);
     }
   });
@@ -52,8 +82,13 @@ std::vector<std::size_t> rows_of(const std::vector<std::uint32_t>& cells, const 
 
 }  // namespace
 
-SolidCache::SolidCache(const Aabb& stock, const DexelLattice& lattice, unsigned threads)
-    : stock_(stock), threads_(threads), stock_dexel_(TripleDexel::box(lattice, stock)) {}
+SolidCache::SolidCache(const Aabb& stock, std::shared_ptr<const Mesh> stock_mesh,
+                       const DexelLattice& lattice, unsigned threads)
+    : stock_(stock),
+      stock_mesh_(std::move(stock_mesh)),
+      threads_(threads),
+      stock_dexel_(stock_mesh_ ? dexelize(*stock_mesh_, lattice, DexelizeOptions{threads})
+                               : TripleDexel::box(lattice, stock)) {}
 
 void SolidCache::milled(std::size_t g, const ZMap& live, std::span<const Cutter> cutters,
                         std::span<const CutMove> batch) {
@@ -77,10 +112,8 @@ void SolidCache::milled(std::size_t g, const ZMap& live, std::span<const Cutter>
 void SolidCache::raise_rows(std::size_t g, const ZMap& live, int r0, int r1) {
   const float above = directions_[g].above;
   ZMap& out = prepared_[g];
-  const std::pair<ZMapGrid, float> grid_and_empty =
-      detail::box_map_grid(live.grid.frame, stock_, live.grid.cell);
-  const ZMapGrid& b = grid_and_empty.first;
-  const float initial_empty = grid_and_empty.second;
+  const StockRows stock(live, stock_, stock_mesh_.get());
+  const float initial_empty = stock.empty();
   const ZMapGrid& a = live.grid;
   const auto nx = static_cast<std::size_t>(a.nx);
   const int rows = r1 - r0 + 1;
@@ -92,8 +125,7 @@ void SolidCache::raise_rows(std::size_t g, const ZMap& live, int r0, int r1) {
     const int w0 = std::max(0, j0 - kRaiseReach), w1 = std::min(a.ny, j1 + kRaiseReach);
     std::vector<float> window(static_cast<std::size_t>(w1 - w0) * nx);
     for (int j = w0; j < w1; ++j)
-      detail::box_top_row(b, stock_, initial_empty, j,
-                          window.data() + static_cast<std::size_t>(j - w0) * nx);
+      stock.row(j, window.data() + static_cast<std::size_t>(j - w0) * nx);
     auto initial = [&](int i, int j) {
       return window[static_cast<std::size_t>(j - w0) * nx + static_cast<std::size_t>(i)];
     };
@@ -200,7 +232,8 @@ bool SolidCache::prepare(std::size_t g, const ZMap& live, std::span<const Cutter
     map.empty_height = live.empty_height;
     map.heights.resize(live.heights.size());
     d.above =
-        static_cast<float>(stock_top(live, stock_, threads_) + detail::empty_margin(grid.cell));
+        static_cast<float>(stock_top(live, StockRows(live, stock_, stock_mesh_.get()), threads_) +
+                           detail::empty_margin(grid.cell));
     d.raw_cells.clear();
     d.raw_sub.clear();
     d.moves_done = 0;

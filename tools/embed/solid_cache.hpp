@@ -22,11 +22,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <span>
 #include <vector>
 
 #include "tridex/cutter.hpp"
 #include "tridex/dexel.hpp"
+#include "tridex/mesh.hpp"
 #include "tridex/mill.hpp"
 #include "tridex/zmap.hpp"
 
@@ -35,7 +37,9 @@ namespace tridex::embed {
 class SolidCache {
  public:
   SolidCache() = default;
-  SolidCache(const Aabb& stock, const DexelLattice& lattice, unsigned threads);
+  // A box stock, or the closed mesh `stock_mesh` (its bounds `stock`) when not null.
+  SolidCache(const Aabb& stock, std::shared_ptr<const Mesh> stock_mesh, const DexelLattice& lattice,
+             unsigned threads);
 
   // `batch` was milled into direction g's live map `live` (a new direction when g is the count
   // so far): the rows its swept cutters reach are marked to be prepared again.
@@ -77,6 +81,7 @@ class SolidCache {
   void redo_marked_rays();
 
   Aabb stock_;
+  std::shared_ptr<const Mesh> stock_mesh_;
   unsigned threads_ = 0;
   TripleDexel stock_dexel_;
   TripleDexel result_;

@@ -78,6 +78,7 @@ tridex_status tridex_session_new(const tridex_session_options* options, tridex_s
     o.machine = options->machine ? options->machine : "";
     o.cell = options->cell;
     o.threads = options->threads;
+    o.stock_file = options->stock_file ? options->stock_file : "";
     auto handle = std::make_unique<tridex_session>();
     handle->session = std::make_unique<tridex::embed::Session>(o);
     *out = handle.release();

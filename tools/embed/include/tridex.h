@@ -26,7 +26,9 @@ typedef struct tridex_session_options {
       tools; /* tool table file (CAMotics JSON, Fusion library, LinuxCNC .tbl); NULL: none */
   const char* machine; /* as --machine: a bundled machine's name or a machine file; NULL: default */
   double cell;         /* dexel spacing (mm), as --dexel-cell; 0: the default resolution */
-  unsigned threads;    /* 0: every hardware thread */
+  unsigned threads; /* every call's threads, started once per session; 0: every hardware thread */
+  const char*
+      stock_file; /* a closed STL as the stock (its bounds replace `stock`); NULL: the box */
 } tridex_session_options;
 
 /* The message of the calling thread's last failed call ("" when none); valid until its next call.

@@ -45,6 +45,7 @@ class _Options(ctypes.Structure):
         ("machine", ctypes.c_char_p),
         ("cell", ctypes.c_double),
         ("threads", ctypes.c_uint),
+        ("stock_file", ctypes.c_char_p),
     ]
 
 
@@ -116,11 +117,14 @@ class Session:
     """A stock being milled: feed() program text, then ask about the stock."""
 
     def __init__(self, stock, tools=None, machine=None, cell=0.0, threads=0):
-        box = [float(v) for v in stock]
-        if len(box) != 6:
-            raise ValueError("stock must be (xmin, ymin, zmin, xmax, ymax, zmax)")
         options = _Options()
-        options.stock = (ctypes.c_double * 6)(*box)
+        if isinstance(stock, (str, bytes, os.PathLike)):  # a closed STL
+            options.stock_file = _path(stock)
+        else:
+            box = [float(v) for v in stock]
+            if len(box) != 6:
+                raise ValueError("stock must be (xmin, ymin, zmin, xmax, ymax, zmax) or an STL file")
+            options.stock = (ctypes.c_double * 6)(*box)
         options.tools = _path(tools) if tools is not None else None
         options.machine = _path(machine) if machine is not None else None
         options.cell = float(cell)
