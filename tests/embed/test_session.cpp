@@ -333,6 +333,21 @@ TEST_CASE("session: a piece that fails changes nothing; state carries over") {
   CHECK(s.removed_volume() == 0);
   s.feed("G1 Z18\n");  // F400 from an earlier piece
   CHECK(s.removed_volume() == doctest::Approx(25 * 3.14159265 * 2).epsilon(0.05));  // cell 1
+  // A simultaneous 5-axis move is refused (the session cuts fixed-axis moves only), naming its
+  // line.
+  embed::SessionOptions five = session_options(Aabb{Vec3(-20), Vec3(20, 20, 0)}, "", 2);
+  five.machine = "ac-trunnion";
+  five.tools = flat_table(dir);
+  embed::Session turning(five);
+  turning.feed("G21 G90 G17\nT1 M6\nS9000 M3\nG0 X-12 Y8 Z5 A0 C0\nG1 Z-0.5 F400\n");
+  const long long before = turning.moves();
+  try {
+    turning.feed("G1 X12 A8 C20 F600\n");
+    FAIL("a simultaneous move was cut");
+  } catch (const cli::InputError& e) {
+    CHECK(std::string(e.what()).find("<fed>:6: a simultaneous 5-axis move") != std::string::npos);
+  }
+  CHECK(turning.moves() == before);
   CHECK_THROWS_AS(embed::Session(session_options(Aabb{Vec3(0), Vec3(0, 40, 20)}, "", 0)),
                   cli::InputError);
   CHECK_THROWS_AS(embed::Session(session_options(Aabb{Vec3(0), Vec3(40, 40, 20)},

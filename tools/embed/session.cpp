@@ -140,6 +140,11 @@ void Session::cut_moves(std::vector<gcode::Move> moves, Commit&& commit) {
   bool initial_cuts = initial_tool_cuts_;
   long long dropped = 0;
   for (gcode::Move m : moves) {
+    // simulate cuts these on their own (cut_simultaneous); the session's maps would take them as
+    // fixed-axis moves, a wrong solid: refused, not passed over.
+    if (m.pose != gcode::PoseLaw::fixed)
+      cli::input_error(where_text(m), ": a simultaneous 5-axis move (the tool turns during it) ",
+                       "is not cut by a session yet; simulate the program with `tridex simulate`");
     if (m.tool == 0 && !tool_zero_cuts) {
       const bool rapid = m.kind == gcode::MoveKind::rapid;
       if (initial > 0 && !initial_cuts && !rapid) {
