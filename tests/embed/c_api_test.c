@@ -58,13 +58,30 @@ int main(int argc, char** argv) {
   FILE* written = fopen(stl, "rb");
   EXPECT(written != NULL);
   if (written) fclose(written);
+  /* The height at (20, 20) and at (5, 5): the hole's bottom and the stock's top. */
+  double spans[4] = {0, 0, 0, 0};
+  int count = -1;
+  const double hole[3] = {20, 20, 0}, corner[3] = {5, 5, 0}, up[3] = {0, 0, 1};
+  EXPECT(tridex_session_extent(s, hole, up, spans, 2, &count) == TRIDEX_OK && count == 1 &&
+         fabs(spans[0]) < 0.05 && fabs(spans[1] - 15) < 0.05);
+  EXPECT(tridex_session_extent(s, corner, up, NULL, 0, &count) == TRIDEX_OK && count == 1);
+  /* A move given directly: a slot 2 mm deep from x 20 to 30 at y 20 (tool 1, spindle +z), and
+   * the removal of a piece. */
+  const double from[3] = {20, 20, 18}, to[3] = {30, 20, 18};
+  EXPECT(tridex_session_add_move(s, from, to, 1, up, 0) == TRIDEX_OK);
+  double before = -1, piece = -1;
+  EXPECT(tridex_session_removed_volume(s, &before) == TRIDEX_OK && before > removed + 150);
+  EXPECT(tridex_session_feed_measured(s, "G0 X30 Y30\nG1 Z17\nG0 Z30\n", &piece) == TRIDEX_OK);
+  EXPECT(tridex_session_removed_volume(s, &removed) == TRIDEX_OK && piece > 0 &&
+         fabs(removed - before - piece) < 1e-6);
+  EXPECT(tridex_session_add_move(s, from, to, 9, up, 0) == TRIDEX_BAD_INPUT);
   long long moves = 0;
   EXPECT(tridex_session_moves(s, &moves) == TRIDEX_OK && moves > 0);
 
   /* Bad input: status 2 and a message naming the line; the session is unchanged. */
   EXPECT(tridex_session_feed(s, "G1 X10\nG1 Q\n") == TRIDEX_BAD_INPUT);
-  /* Line numbers run on across pieces: 5 + 2 lines before, the second line of this one. */
-  EXPECT(strstr(tridex_last_error(), "<fed>:9:") != NULL);
+  /* Line numbers run on across pieces: 5 + 2 + 3 lines before, the second line of this one. */
+  EXPECT(strstr(tridex_last_error(), "<fed>:12:") != NULL);
   long long after = 0;
   EXPECT(tridex_session_moves(s, &after) == TRIDEX_OK && after == moves);
   EXPECT(tridex_session_feed(s, "T9 M6\nG1 X5 Z10\n") == TRIDEX_BAD_INPUT);

@@ -74,8 +74,47 @@ for a, b in zip(cuts, cuts[1:]):
         check(s.removed_volume() == removed, "would_cut cut nothing")
 
 s.write_stl(piece_stl)
-with open(whole, "rb") as f1, open(piece_stl, "rb") as f2:
-    check(f1.read() == f2.read(), "the pieces' STL is simulate's, byte for byte")
+final_stl = open(piece_stl, "rb").read()
+
+# The stock's extent along lines against inside() at points on them; the height at x, y.
+random.seed(383)
+checked = 0
+for _ in range(8):
+    p = [random.uniform(0, 100), random.uniform(0, 80), random.uniform(0, 50)]
+    d = [random.uniform(-1, 1) for _ in range(3)]
+    spans = s.extent(p, d)
+    norm = sum(v * v for v in d) ** 0.5
+    for k in range(-25, 26):
+        t = 4.3 * k
+        inside_spans = any(a < t < b for a, b in spans)
+        if any(min(abs(t - a), abs(t - b)) < CELL for a, b in spans):
+            continue  # within a dexel spacing of the surface
+        q = [p[i] + t * d[i] / norm for i in range(3)]
+        check(s.inside(q) == inside_spans, "extent and inside agree at %s" % q)
+        checked += 1
+check(checked > 100, "extent checked at %d points" % checked)
+top = s.height(50, 40)
+check(top is not None and s.inside((50, 40, top - CELL)) and not s.inside((50, 40, top + CELL)),
+      "the height at 50, 40 is the stock's top (%s)" % top)
+
+# Moves given directly: the session's first G-code piece as moves gives the same solid.
+with tridex.Session(stock=(0, 0, 0, 40, 40, 20), tools=TOOLS, cell=1) as by_gcode, \
+        tridex.Session(stock=(0, 0, 0, 40, 40, 20), tools=TOOLS, cell=1) as direct:
+    removed = by_gcode.feed_measured("G21 G90 T1 M6 S9000 M3\nG0 X-10 Y10 Z25\nG1 Z18 F900\n"
+                                     "G1 X50\nG1 Y30\nG1 X-10\nG0 Z25\n")
+    check(abs(removed - by_gcode.removed_volume()) < 1e-9 and removed > 0, "feed_measured")
+    for a, b in [((-10, 10, 25), (-10, 10, 18)), ((-10, 10, 18), (50, 10, 18)),
+                 ((50, 10, 18), (50, 30, 18)), ((50, 30, 18), (-10, 30, 18))]:
+        direct.add_move(a, b, tool=1, axis=(0, 0, 1))
+    direct.add_move((-10, 30, 18), (-10, 30, 25), tool=1, axis=(0, 0, 1), rapid=True)
+    a_stl, b_stl = (os.path.join(SCRATCH, n) for n in ("python_gcode.stl", "python_direct.stl"))
+    by_gcode.write_stl(a_stl)
+    direct.write_stl(b_stl)
+    with open(a_stl, "rb") as f1, open(b_stl, "rb") as f2:
+        check(f1.read() == f2.read(), "moves given directly cut as their G-code")
+
+with open(whole, "rb") as f1:
+    check(f1.read() == final_stl, "the pieces' STL is simulate's, byte for byte")
 
 # Bad input raises BadInput (status 2) with the line, and changes nothing.
 moves = s.moves()

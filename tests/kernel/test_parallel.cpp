@@ -3,8 +3,11 @@
 // the caller instead of ending the process.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
 #include "tridex/parallel.hpp"
@@ -111,3 +114,54 @@ TEST_CASE(
     dropped.start([] { throw std::runtime_error("dropped"); });
   }
 }
+
+namespace test_parallel {
+
+// Threads that ran a chunk for the first time: each thread's own marker, made on its first chunk
+// (thread ids can be reused by the system; a thread-local is made anew in every new thread).
+std::atomic<int> threads_seen{0};
+struct ThreadMark {
+  ThreadMark() { threads_seen.fetch_add(1); }
+};
+
+int new_threads_in_call(unsigned threads) {
+  const int before = threads_seen.load();
+  for_each_chunk(64, threads, [&](std::size_t) {
+    thread_local ThreadMark mark;
+    std::this_thread::sleep_for(std::chrono::microseconds(200));  // room for every worker
+  });
+  return threads_seen.load() - before;
+}
+
+TEST_CASE("parallel: a pool put in place runs every call on the same kept threads") {
+  ThreadPool pool(3);
+  CHECK(pool.size() == 3);
+  const UsePool use(pool);
+  new_threads_in_call(3);
+  for (int call = 0; call < 4; ++call) CHECK(new_threads_in_call(3) == 0);  // none started
+  // Every chunk once, and exceptions back to the caller, as without a pool.
+  for (std::size_t chunks : {std::size_t{1}, std::size_t{7}, std::size_t{1000}}) {
+    std::vector<std::atomic<int>> runs(chunks);
+    for_each_chunk(chunks, 3, [&](std::size_t c) { runs[c].fetch_add(1); });
+    for (std::size_t c = 0; c < chunks; ++c) CHECK(runs[c].load() == 1);
+  }
+  CHECK_THROWS_AS(for_each_chunk(100, 3,
+                                 [](std::size_t c) {
+                                   if (c == 42) throw std::runtime_error("chunk 42");
+                                 }),
+                  std::runtime_error);
+  // A parallel call inside a chunk (the pool busy) starts threads of its own.
+  std::atomic<int> inner{0};
+  for_each_chunk(
+      4, 3, [&](std::size_t) { for_each_chunk(10, 2, [&](std::size_t) { inner.fetch_add(1); }); });
+  CHECK(inner.load() == 40);
+  CHECK(new_threads_in_call(3) == 0);  // still the kept threads after a failure and a nesting
+}
+
+TEST_CASE("parallel: without a pool the calls start threads of their own") {
+  int started = 0;
+  for (int call = 0; call < 4; ++call) started += new_threads_in_call(3);
+  CHECK(started > 0);
+}
+
+}  // namespace test_parallel

@@ -4,10 +4,13 @@
 // anything else a failure.
 #include "tridex.h"
 
+#include <algorithm>
 #include <exception>
 #include <memory>
 #include <new>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "errors.hpp"
 #include "session.hpp"
@@ -49,6 +52,8 @@ tridex_status guarded(Body&& body) {
   }
 }
 
+tridex::Vec3 vec3(const double p[3]) { return tridex::Vec3(p[0], p[1], p[2]); }
+
 tridex_status bad_call(const char* what) {
   last_error = std::string(what) + " is null";
   return TRIDEX_BAD_CALL;
@@ -73,6 +78,7 @@ tridex_status tridex_session_new(const tridex_session_options* options, tridex_s
     o.machine = options->machine ? options->machine : "";
     o.cell = options->cell;
     o.threads = options->threads;
+    o.stock_file = options->stock_file ? options->stock_file : "";
     auto handle = std::make_unique<tridex_session>();
     handle->session = std::make_unique<tridex::embed::Session>(o);
     *out = handle.release();
@@ -85,6 +91,43 @@ tridex_status tridex_session_feed(tridex_session* session, const char* text) {
   if (!session) return bad_call("session");
   if (!text) return bad_call("text");
   return guarded([&] { session->session->feed(text); });
+}
+
+tridex_status tridex_session_feed_measured(tridex_session* session, const char* text,
+                                           double* removed) {
+  if (!session) return bad_call("session");
+  if (!text) return bad_call("text");
+  if (!removed) return bad_call("removed");
+  return guarded([&] { *removed = session->session->feed_measured(text); });
+}
+
+tridex_status tridex_session_add_move(tridex_session* session, const double start[3],
+                                      const double end[3], int tool, const double axis[3],
+                                      int rapid) {
+  if (!session) return bad_call("session");
+  if (!start) return bad_call("start");
+  if (!end) return bad_call("end");
+  if (!axis) return bad_call("axis");
+  return guarded(
+      [&] { session->session->add_move(vec3(start), vec3(end), tool, vec3(axis), rapid != 0); });
+}
+
+tridex_status tridex_session_extent(tridex_session* session, const double point[3],
+                                    const double direction[3], double* spans, int capacity,
+                                    int* count) {
+  if (!session) return bad_call("session");
+  if (!point) return bad_call("point");
+  if (!direction) return bad_call("direction");
+  if (!count) return bad_call("count");
+  if (capacity > 0 && !spans) return bad_call("spans");
+  return guarded([&] {
+    const std::vector<std::pair<double, double>> found =
+        session->session->extent(vec3(point), vec3(direction));
+    for (std::size_t k = 0; k < found.size() && k < static_cast<std::size_t>(std::max(0, capacity));
+         ++k)
+      spans[2 * k] = found[k].first, spans[2 * k + 1] = found[k].second;
+    *count = static_cast<int>(found.size());
+  });
 }
 
 tridex_status tridex_session_removed_volume(tridex_session* session, double* out) {

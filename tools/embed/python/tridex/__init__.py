@@ -45,6 +45,7 @@ class _Options(ctypes.Structure):
         ("machine", ctypes.c_char_p),
         ("cell", ctypes.c_double),
         ("threads", ctypes.c_uint),
+        ("stock_file", ctypes.c_char_p),
     ]
 
 
@@ -55,6 +56,12 @@ _lib.tridex_session_new.argtypes = [ctypes.POINTER(_Options), ctypes.POINTER(_P)
 _lib.tridex_session_free.argtypes = [_P]
 _lib.tridex_session_free.restype = None
 _lib.tridex_session_feed.argtypes = [_P, ctypes.c_char_p]
+_lib.tridex_session_feed_measured.argtypes = [_P, ctypes.c_char_p, ctypes.POINTER(ctypes.c_double)]
+_lib.tridex_session_add_move.argtypes = [_P, ctypes.c_double * 3, ctypes.c_double * 3, ctypes.c_int,
+                                         ctypes.c_double * 3, ctypes.c_int]
+_lib.tridex_session_extent.argtypes = [_P, ctypes.c_double * 3, ctypes.c_double * 3,
+                                       ctypes.POINTER(ctypes.c_double), ctypes.c_int,
+                                       ctypes.POINTER(ctypes.c_int)]
 _lib.tridex_session_removed_volume.argtypes = [_P, ctypes.POINTER(ctypes.c_double)]
 _lib.tridex_session_would_cut.argtypes = [_P, ctypes.c_char_p, ctypes.POINTER(ctypes.c_double)]
 _lib.tridex_session_inside.argtypes = [_P, ctypes.c_double * 3, ctypes.POINTER(ctypes.c_int)]
@@ -95,6 +102,13 @@ def _path(value):
     return os.fsencode(value)
 
 
+def _point(value, what):
+    values = [float(v) for v in value]
+    if len(values) != 3:
+        raise ValueError(what + " must be (x, y, z)")
+    return (ctypes.c_double * 3)(*values)
+
+
 def version():
     return _lib.tridex_version().decode()
 
@@ -103,11 +117,14 @@ class Session:
     """A stock being milled: feed() program text, then ask about the stock."""
 
     def __init__(self, stock, tools=None, machine=None, cell=0.0, threads=0):
-        box = [float(v) for v in stock]
-        if len(box) != 6:
-            raise ValueError("stock must be (xmin, ymin, zmin, xmax, ymax, zmax)")
         options = _Options()
-        options.stock = (ctypes.c_double * 6)(*box)
+        if isinstance(stock, (str, bytes, os.PathLike)):  # a closed STL
+            options.stock_file = _path(stock)
+        else:
+            box = [float(v) for v in stock]
+            if len(box) != 6:
+                raise ValueError("stock must be (xmin, ymin, zmin, xmax, ymax, zmax) or an STL file")
+            options.stock = (ctypes.c_double * 6)(*box)
         options.tools = _path(tools) if tools is not None else None
         options.machine = _path(machine) if machine is not None else None
         options.cell = float(cell)
@@ -139,6 +156,38 @@ class Session:
     def feed(self, text):
         """Runs more program text (state kept from the last piece); its moves are cut."""
         _check(_lib.tridex_session_feed(self._h(), _text(text, "text")))
+
+    def feed_measured(self, text):
+        """feed(), returning the mm^3 that piece removed (costs a question before and after)."""
+        out = ctypes.c_double()
+        _check(_lib.tridex_session_feed_measured(self._h(), _text(text, "text"),
+                                                 ctypes.byref(out)))
+        return out.value
+
+    def add_move(self, start, end, tool, axis=(0, 0, 1), rapid=False):
+        """One straight move given directly: tool tip from start to end (mm, the part's
+        coordinates, as the stock), cut by `tool` of the table, spindle along `axis`."""
+        _check(_lib.tridex_session_add_move(self._h(), _point(start, "start"), _point(end, "end"),
+                                            int(tool), _point(axis, "axis"), 1 if rapid else 0))
+
+    def extent(self, point, direction=(0, 0, 1)):
+        """The intervals (t_in, t_out) of the line point + t*direction (t in mm along the unit
+        direction) inside the stock as it stands, ascending."""
+        count = ctypes.c_int()
+        capacity = 16
+        while True:
+            spans = (ctypes.c_double * (2 * capacity))()
+            _check(_lib.tridex_session_extent(self._h(), _point(point, "point"),
+                                              _point(direction, "direction"), spans, capacity,
+                                              ctypes.byref(count)))
+            if count.value <= capacity:
+                return [(spans[2 * k], spans[2 * k + 1]) for k in range(count.value)]
+            capacity = count.value
+
+    def height(self, x, y):
+        """The stock's top at (x, y) along +z, or None where no stock is left."""
+        spans = self.extent((x, y, 0), (0, 0, 1))
+        return spans[-1][1] if spans else None
 
     def removed_volume(self):
         """mm^3 removed so far."""
