@@ -217,6 +217,27 @@ std::pair<CLI::App*, CLI::App*> add_diff_and_lint(CLI::App& app, DiffOptions& di
   return {dif, lnt};
 }
 
+// issue 39: `regress` (a regression folder).
+CLI::App* add_regress(CLI::App& app, RegressOptions& regress) {
+  CLI::App* reg = app.add_subcommand(
+      "regress",
+      "run every program of a folder (or one program) and compare each solid with its stored\n"
+      "baseline; --bless stores new baselines; exit status 3 when any changed or is new");
+  add_simulate(*reg, regress);
+  reg->add_option("--baseline", regress.baseline,
+                  "the folder of baselines (NAME.dexel and NAME.json per program)")
+      ->required()
+      ->check(kNotEmpty);
+  reg->add_flag("--bless", regress.bless, "store the results as the new baselines");
+  reg->add_option("--tolerance", regress.tolerance,
+                  "a span of material longer than this along a dexel ray is a difference, mm\n"
+                  "(default: half the dexel spacing)")
+      ->check(kFinitePositive);
+  reg->add_option("--report", regress.report, "write the JSON report of every program")
+      ->check(kNotEmpty);
+  return reg;
+}
+
 // check's options for what it looks for beyond the design: the envelope, the shank's and the
 // holder's clearance, the roughing allowance, the fixtures.
 void add_check_findings(CLI::App& chk, CheckOptions& check) {
@@ -314,6 +335,8 @@ int main(int argc, char** argv) {
   DiffOptions diff;
   LintOptions lint;
   const auto [dif, lnt] = add_diff_and_lint(app, diff, lint, *mov, moves);
+  RegressOptions regress;
+  CLI::App* reg = add_regress(app, regress);
 
   try {
     app.parse(argc, argv);
@@ -331,6 +354,7 @@ int main(int argc, char** argv) {
     if (grp->parsed()) return run_groups(groups);
     if (dif->parsed()) return run_diff(diff);
     if (lnt->parsed()) return run_lint(lint);
+    if (reg->parsed()) return run_regress(regress);
   } catch (const tridex::gcode::GcodeError& e) {
     std::cerr << terminal_safe(e.what()) << '\n';
     return kBadInput;
