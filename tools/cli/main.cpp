@@ -207,6 +207,9 @@ std::pair<CLI::App*, CLI::App*> add_diff_and_lint(CLI::App& app, DiffOptions& di
       ->check(kFinitePositive);
   dif->add_option("--report", diff.report, "write the JSON report of the comparison")
       ->check(kNotEmpty);
+  dif->add_option("--png", diff.png,
+                  "write a picture of B's result coloured where it differs from A's")
+      ->check(kNotEmpty);
   CLI::App* lnt = app.add_subcommand(
       "lint",
       "post-processor mistakes at file:line: units changed mid-program, G43 H missing or not\n"

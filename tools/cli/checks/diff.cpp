@@ -22,6 +22,7 @@
 #include <set>
 #include <unordered_map>
 
+#include "checks/deviation.hpp"
 #include "checks/line_alignment.hpp"
 #include "checks/lint.hpp"
 #include "checks/reaching_moves.hpp"
@@ -29,9 +30,13 @@
 #include "commands.hpp"
 #include "errors.hpp"
 #include "inputs/json_input.hpp"
+#include "outputs/html_report.hpp"
 #include "outputs/output.hpp"
+#include "outputs/result_files.hpp"
 #include "pipeline/pipeline.hpp"
+#include "render.hpp"
 #include "tridex/detail/move_geometry.hpp"
+#include "tridex/dexel_ops.hpp"
 
 namespace tridex::cli {
 
@@ -261,6 +266,69 @@ DiffOptions options_for_b(const DiffOptions& options, const SimulationResult& a)
   return b;
 }
 
+// --png and --html: B's surface coloured by its signed distance to A's (deviation.hpp, A's solid
+// deciding the sign where the faces cannot), as check colours the result by the design: red where
+// B removed A's material beyond the tolerance, blue where it left material A removed; the page
+// lists the regions as findings with their lines in B and shows A's surface as the ghost.
+void write_diff_pictures(const DiffOptions& options, DiffRun& run, const Json& report,
+                         Progress& progress) {
+  if (run.error_b) {
+    std::fprintf(stderr, "warning: B does not run: no --png or --html written\n");
+    return;
+  }
+  const Mesh& mesh = run.b.mesh;
+  std::vector<double> deviation(mesh.positions.size(), 0.0);
+  std::vector<glm::vec3> colours(mesh.positions.size(), glm::vec3(0.70f, 0.76f, 0.70f));
+  if (!mesh.triangles.empty() && !run.a.mesh.triangles.empty()) {
+    progress.stage("measuring B's surface against A's");
+    const DistanceTree a_tree(run.a.mesh);
+    for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+      deviation[v] = a_tree.signed_distance(
+          Vec3(mesh.positions[v]), [&](const Vec3& p) { return contains(run.a.result, p); });
+      if (deviation[v] < -run.tolerance) colours[v] = glm::vec3(0.86f, 0.16f, 0.14f);
+      if (deviation[v] > run.tolerance) colours[v] = glm::vec3(0.18f, 0.40f, 0.90f);
+    }
+  }
+  if (!options.png.empty()) {
+    progress.stage("rendering " + options.png);
+    if (mesh.triangles.empty()) {
+      std::fprintf(stderr, "warning: B leaves no material: %s was not written\n",
+                   options.png.c_str());
+    } else {
+      render::MeshRenderOptions view;
+      view.vertex_colours = colours;
+      render::Image image = render::render_mesh(mesh, view);
+      char removed[64], left[64];
+      std::snprintf(removed, sizeof removed, "removed by B > %.3g mm", run.tolerance);
+      std::snprintf(left, sizeof left, "left by B > %.3g mm", run.tolerance);
+      render::draw_legend(image, {{glm::vec3(0.86f, 0.16f, 0.14f), removed},
+                                  {glm::vec3(0.70f, 0.76f, 0.70f), "the same"},
+                                  {glm::vec3(0.18f, 0.40f, 0.90f), left}});
+      write_file_atomically(options.png, render::encode_png(image));
+    }
+  }
+  if (!options.html.empty()) {
+    progress.stage("writing " + options.html);
+    Json page_report = report;
+    page_report["program"] = run.file_b;
+    page_report["tolerances_mm"] = {{"gouge", run.tolerance}, {"excess", run.tolerance}};
+    write_html_report(options.html,
+                      {.title = "tridex diff: " + fs::path(run.file_b).filename().string() +
+                                " against " + fs::path(run.file_a).filename().string(),
+                       .report = page_report,
+                       .mesh = &mesh,
+                       .deviation = deviation,
+                       .design = &run.a.mesh,
+                       .groups = &run.b.groups,
+                       .order = run.b.order,
+                       .files = run.b.files,
+                       .stock = &run.b.stock,
+                       .cutters = run.b.cutters,
+                       .bodies = run.b.bodies,
+                       .cutter_of_tool = &run.b.cutter_of_tool});
+  }
+}
+
 }  // namespace
 
 int run_diff(const DiffOptions& options) {
@@ -269,8 +337,12 @@ int run_diff(const DiffOptions& options) {
   if (!options.report.empty()) request.outputs.push_back({"--report", options.report});
   request.extra_inputs = {options.program, options.program_b};
   DiffRun run;
+  for (const auto& [option, path] :
+       {std::pair<std::string, std::string>{"--png", options.png}, {"--html", options.html}})
+    if (!path.empty()) request.outputs.push_back({option, path});
   run.a = simulate_program(options, progress, request);
   const DiffOptions for_b = options_for_b(options, run.a);
+  if (options.tools.empty()) request.tools = run.a.input.tools;  // a project A's table for B
   run.file_a = run.a.input.files.at(0).string();
   run.text_a = read_text_file(run.a.input.files.at(0), "a G-code file");
   const ProgramInput input_b = resolve_program(for_b);
@@ -303,11 +375,14 @@ int run_diff(const DiffOptions& options) {
       attribute_region(run.regions[k], run, tools_a, tools_b);
   }
   const bool different = !run.regions.empty() || !run.lint_b.empty() || run.error_b;
-  const Json report = diff_report(options, run, different);
+  Json report = diff_report(options, run, different);
+  if (!run.error_b && !run.b.files.empty()) report["file_b"] = run.b.files.front();
   if (!options.report.empty()) {
     progress.stage("writing " + options.report);
     write_file_atomically(options.report, dump_json(report, 2) + "\n");
   }
+  if (!options.png.empty() || !options.html.empty())
+    write_diff_pictures(options, run, report, progress);
   progress.finish();
   if (!options.quiet) print_diff(run, different);
   return different ? kFindings : kSuccess;
