@@ -51,11 +51,16 @@ constexpr std::size_t kDiffLinesListed = 200;
 // Main-file lines (and their tools) of the moves whose swept cutter reaches one of `probes`, as
 // check finds a gouge's moves: p is reached when it lies above the move's swept lower surface in
 // the group's frame, within `slack`.
+// Moves in subprogram files go to `elsewhere` as "file:line" (the texts aligned are the main
+// files'; a called file is the same in both programs, so its lines need no counterpart).
 std::map<int, int> reaching_lines(const std::vector<Vec3>& probes, const SimulationResult& r,
-                                  double slack) {
+                                  double slack, std::set<std::string>& elsewhere) {
   std::map<int, int> lines;  // line -> tool
   for_each_reaching_move(r, probes, slack, [&](const gcode::Move& m) {
-    if (m.file == 0) lines.emplace(m.line, m.tool);
+    if (m.file == 0)
+      lines.emplace(m.line, m.tool);
+    else if (elsewhere.size() < kDiffLinesListed)
+      elsewhere.insert(r.files.at(static_cast<std::size_t>(m.file)) + ":" + std::to_string(m.line));
   });
   return lines;
 }
@@ -103,7 +108,8 @@ void attribute_region(DiffRegion& region, DiffRun& run, const std::map<int, int>
   // the Z-map's grid only.
   const double slack = 0.25 * run.a.lattice.spacing;
   const SimulationResult& cutter = region.removed ? run.b : run.a;
-  const std::map<int, int> cut = reaching_lines(region.probes, cutter, slack);
+  const std::map<int, int> cut =
+      reaching_lines(region.probes, cutter, slack, region.removed ? region.sub_b : region.sub_a);
   std::set<int>& own = region.removed ? region.lines_b : region.lines_a;
   std::set<int>& other = region.removed ? region.lines_a : region.lines_b;
   const std::vector<int>& map = region.removed ? run.alignment.b_to_a : run.alignment.a_to_b;
@@ -180,7 +186,9 @@ Json diff_region_json(const DiffRegion& region) {
           {"changed_lines_a", diff_lines_json(region.changed_a)},
           {"changed_lines_b", diff_lines_json(region.changed_b)},
           {"tools_a", region.tools_a},
-          {"tools_b", region.tools_b}};
+          {"tools_b", region.tools_b},
+          {"subprogram_lines_a", region.sub_a},
+          {"subprogram_lines_b", region.sub_b}};
 }
 
 Json diff_report(const DiffOptions& options, const DiffRun& run, bool different) {

@@ -51,12 +51,14 @@ std::vector<NearMove> nearest_moves(const SimulationResult& r, const std::vector
       const glm::dvec2 a(tip.a.x, tip.a.y), ab = glm::dvec2(tip.b.x, tip.b.y) - a;
       const double length2 = glm::dot(ab, ab);
       double best = std::numeric_limits<double>::infinity();
+      bool over = false;  // the move passes over a point (at any height)
       for (const Vec3& p : local) {
         const glm::dvec2 q(p.x, p.y);
         const double t = length2 > 0 ? std::clamp(glm::dot(q - a, ab) / length2, 0.0, 1.0) : 0.0;
         const double beside = glm::length(q - (a + t * ab)) - radius;
         double gap = 0;
         if (beside <= 0) {
+          over = true;
           gap = std::max(0.0, detail::MoveGeometry(cutter, tip).lowest(p.x, p.y).z - p.z);
         } else {
           const double above = std::max(0.0, tip.a.z + t * (tip.b.z - tip.a.z) - p.z);
@@ -64,7 +66,7 @@ std::vector<NearMove> nearest_moves(const SimulationResult& r, const std::vector
         }
         best = std::min(best, gap);
       }
-      if (best < std::numeric_limits<double>::infinity()) all.push_back({&m, best});
+      if (best < std::numeric_limits<double>::infinity()) all.push_back({&m, best, over});
     }
   }
   std::stable_sort(all.begin(), all.end(),
@@ -74,8 +76,9 @@ std::vector<NearMove> nearest_moves(const SimulationResult& r, const std::vector
   std::vector<NearMove> kept;  // the nearest move of each line
   std::set<std::pair<int, int>> lines;
   for (const NearMove& near : all) {
-    if (near.gap > limit || kept.size() >= count) break;
-    if (lines.insert({near.move->file, near.move->line}).second) kept.push_back(near);
+    if (kept.size() >= count) break;
+    if ((near.gap <= limit || near.over) && lines.insert({near.move->file, near.move->line}).second)
+      kept.push_back(near);
   }
   return kept;
 }

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <set>
+#include <string>
 #include <vector>
 
 #include "tridex/dexel.hpp"
@@ -36,6 +37,7 @@ struct DiffRegion {
   Aabb box;
   std::vector<Vec3> probes;
   std::set<int> lines_a, lines_b, changed_a, changed_b, tools_a, tools_b;
+  std::set<std::string> sub_a, sub_b;  // diff: "file:line" of moves in subprogram files
 };
 
 // The spans where exactly one of `a` and `b` (one lattice) holds material, longer than `tolerance`.
