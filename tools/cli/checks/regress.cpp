@@ -400,7 +400,6 @@ void print_table(const std::vector<Outcome>& outcomes, bool bless) {
 }  // namespace regress
 
 int run_regress(const RegressOptions& options) {
-  using namespace regress;
   Progress progress(!options.quiet && (options.progress || stderr_is_terminal()));
   std::error_code error;
   if (options.bless) fs::create_directories(options.baseline, error);
@@ -408,21 +407,21 @@ int run_regress(const RegressOptions& options) {
     input_error(
         "--baseline ", options.baseline,
         options.bless ? ": cannot create the folder" : ": no such folder (--bless creates it)");
-  const std::vector<fs::path> programs = programs_of(options.program);
+  const std::vector<fs::path> programs = regress::programs_of(options.program);
   std::set<std::string> names;
   for (const fs::path& p : programs)
     if (!names.insert(p.filename().string()).second)
       input_error(p.string(), ": two programs of one name share a baseline");
   if (!options.report.empty()) check_output_path("--report", options.report, programs);
-  std::vector<Outcome> outcomes;
+  std::vector<regress::Outcome> outcomes;
   for (const fs::path& program : programs) {
     progress.stage("running " + program.string());
-    outcomes.push_back(run_one(options, program, progress));
+    outcomes.push_back(regress::run_one(options, program, progress));
   }
   progress.finish();
   int same = 0, changed = 0, fresh = 0, errors = 0;
   Json list = Json::array();
-  for (Outcome& o : outcomes) {
+  for (regress::Outcome& o : outcomes) {
     same += o.status == "same", changed += o.status == "changed", fresh += o.status == "new",
         errors += o.status == "error";
     o.entry["status"] = o.status;
@@ -454,11 +453,11 @@ int run_regress(const RegressOptions& options) {
                                                     2) +
                                               "\n");
   if (!options.quiet) {
-    print_table(outcomes, options.bless);
+    regress::print_table(outcomes, options.bless);
     std::printf("%zu program(s): %d same, %d changed, %d new, %d error(s)%s\n", outcomes.size(),
                 same, changed, fresh, errors, options.bless ? "; baselines stored" : "");
   }
-  for (const Outcome& o : outcomes)
+  for (const regress::Outcome& o : outcomes)
     if (o.status == "error") std::cerr << "tridex: " << terminal_safe(o.reason) << '\n';
   return status;
 }
