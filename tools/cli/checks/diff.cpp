@@ -14,6 +14,7 @@
 // lint (lint.hpp), counted when program B has them and A does not.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <cstdio>
 #include <iostream>
@@ -320,6 +321,18 @@ void write_diff_pictures(const DiffOptions& options, DiffRun& run, const Json& r
     Json page_report = report;
     page_report["program"] = run.file_b;
     page_report["tolerances_mm"] = {{"gouge", run.tolerance}, {"excess", run.tolerance}};
+    // The page's legend and summary read check's deviation figures: B's surface against A's.
+    if (!deviation.empty()) {
+      const auto [lo, hi] = std::minmax_element(deviation.begin(), deviation.end());
+      double sum = 0, sum2 = 0;
+      for (double d : deviation) sum += d, sum2 += d * d;
+      const double n = static_cast<double>(deviation.size());
+      page_report["deviation"] = {{"samples", deviation.size()},
+                                  {"min_mm", *lo},
+                                  {"max_mm", *hi},
+                                  {"mean_mm", sum / n},
+                                  {"rms_mm", std::sqrt(sum2 / n)}};
+    }
     write_html_report(options.html,
                       {.title = "tridex diff: " + fs::path(run.file_b).filename().string() +
                                 " against " + fs::path(run.file_a).filename().string(),
