@@ -74,6 +74,11 @@ const emptyPage = path.join(out, 'empty.html');
 run(['simulate', write('through.nc', '%\nG21 G90\nT1 M6\nM3 S1000\nG0 X5 Y5 Z20\nG1 Z-20 F100\nG0 Z20\nM30\n%\n'),
      '--tools', write('big.json', '{"1": {"units": "mm", "shape": "cylindrical", "diameter": 60, "length": 50}}'),
      '--stock', 'box:0,0,0,10,10,10', '-q', '--html', emptyPage]);
+// diff (issue 39): the plunge 0.3 mm too deep against the correct program: one region B removed,
+// listed with its line in B (13), B's surface as the part and A's as the ghost.
+const diffPage = path.join(out, 'diff.html');
+run(['diff', path.join(out, 'good.nc'), write('deep.nc', program(-2.3)), ...stock, '--tolerance', '0.1',
+     '--report', path.join(out, 'diff.json'), '--html', diffPage], [3]);
 const noMovesPage = path.join(out, 'no_moves.html');
 run(['simulate', write('nothing.nc', '%\nG21 G90\nM30\n%\n'), '--stock', 'box:0,0,0,10,10,10', '-q', '--html', noMovesPage]);
 
@@ -459,6 +464,16 @@ try {
     await page.emulateMediaType('print');
     await page.screenshot({ path: path.join(out, 'face_print.png'), fullPage: true });
     await page.emulateMediaType(null);
+    clean();
+    await page.close();
+  }
+  {
+    const { page, clean } = await open(diffPage);
+    const items = await page.$$eval('#findings li[data-finding]', (l) => l.map((e) => e.textContent));
+    check(items.length >= 1 && items[0].startsWith('removed by B') && items[0].includes('B line 13'),
+          'diff: the region B removed, at its line: ' + items.join(' | '));
+    check((await page.$eval('#verdict-line', (e) => e.textContent)).includes('DIFFERENT'), 'diff: the verdict DIFFERENT');
+    await page.screenshot({ path: diffPage.replace(/\.html$/, '.png') });
     clean();
     await page.close();
   }
