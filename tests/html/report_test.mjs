@@ -45,6 +45,11 @@ run(['simulate', write('good.nc', program(-2)), ...stock, '-o', path.join(out, '
 const checkPage = path.join(out, 'check.html');
 run(['check', write('gouge.nc', program(-2.3)), ...stock, '--design', path.join(out, 'design.stl'), '--tolerance', '0.1',
      '--envelope', 'box:-1,-1,-1,21,21,14', '--report', path.join(out, 'check.json'), '--html', checkPage], [3]);
+// diff (issue 39): the plunge 0.3 mm too deep against the correct program: one region B removed,
+// listed with its line in B (13), B's surface as the part and A's as the ghost.
+const diffPage = path.join(out, 'diff.html');
+run(['diff', path.join(out, 'good.nc'), write('deep.nc', program(-2.3)), ...stock, '--tolerance', '0.1',
+     '--report', path.join(out, 'diff.json'), '--html', diffPage], [3]);
 // A holder that hits, in a subprogram file (M98 P1002 finds O1002.nc beside the program): a hole
 // 25 mm deep 4 mm from the front face buries the Ø30 holder 20 mm out (tests/tools/test_collisions.cpp)
 // at the subprogram's line 3; the main program's line 3 moves too (its listing must not be marked).
@@ -74,11 +79,6 @@ const emptyPage = path.join(out, 'empty.html');
 run(['simulate', write('through.nc', '%\nG21 G90\nT1 M6\nM3 S1000\nG0 X5 Y5 Z20\nG1 Z-20 F100\nG0 Z20\nM30\n%\n'),
      '--tools', write('big.json', '{"1": {"units": "mm", "shape": "cylindrical", "diameter": 60, "length": 50}}'),
      '--stock', 'box:0,0,0,10,10,10', '-q', '--html', emptyPage]);
-// diff (issue 39): the plunge 0.3 mm too deep against the correct program: one region B removed,
-// listed with its line in B (13), B's surface as the part and A's as the ghost.
-const diffPage = path.join(out, 'diff.html');
-run(['diff', path.join(out, 'good.nc'), write('deep.nc', program(-2.3)), ...stock, '--tolerance', '0.1',
-     '--report', path.join(out, 'diff.json'), '--html', diffPage], [3]);
 const noMovesPage = path.join(out, 'no_moves.html');
 run(['simulate', write('nothing.nc', '%\nG21 G90\nM30\n%\n'), '--stock', 'box:0,0,0,10,10,10', '-q', '--html', noMovesPage]);
 
@@ -371,6 +371,16 @@ try {
     clean();
     await page.close();
   }
+  {
+    const { page, clean } = await open(diffPage);
+    const items = await page.$$eval('#findings li[data-finding]', (l) => l.map((e) => e.textContent));
+    check(items.length >= 1 && items[0].startsWith('removed by B') && items[0].includes('B line 13'),
+          'diff: the region B removed, at its line: ' + items.join(' | '));
+    check((await page.$eval('#verdict-line', (e) => e.textContent)).includes('DIFFERENT'), 'diff: the verdict DIFFERENT');
+    await page.screenshot({ path: diffPage.replace(/\.html$/, '.png') });
+    clean();
+    await page.close();
+  }
   // A holder collision in a subprogram file: listed, flown to, its line shown from that file; the
   // slider goes through the program in execution order, into the subprogram and back.
   {
@@ -464,16 +474,6 @@ try {
     await page.emulateMediaType('print');
     await page.screenshot({ path: path.join(out, 'face_print.png'), fullPage: true });
     await page.emulateMediaType(null);
-    clean();
-    await page.close();
-  }
-  {
-    const { page, clean } = await open(diffPage);
-    const items = await page.$$eval('#findings li[data-finding]', (l) => l.map((e) => e.textContent));
-    check(items.length >= 1 && items[0].startsWith('removed by B') && items[0].includes('B line 13'),
-          'diff: the region B removed, at its line: ' + items.join(' | '));
-    check((await page.$eval('#verdict-line', (e) => e.textContent)).includes('DIFFERENT'), 'diff: the verdict DIFFERENT');
-    await page.screenshot({ path: diffPage.replace(/\.html$/, '.png') });
     clean();
     await page.close();
   }
