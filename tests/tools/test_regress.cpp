@@ -72,8 +72,8 @@ const json& entry(const json& report, const std::string& name) {
   return none;
 }
 
-TEST_CASE("regress: bless, a clean rerun, one program changed, a new one, one alone") {
-  const fs::path dir = scratch("regress");
+// A folder of three programs (one with a sidecar, one file not a program) in `dir`/progs.
+fs::path three_programs(const fs::path& dir) {
   const fs::path progs = dir / "progs";
   fs::create_directories(progs);
   write_text(dir / "tools.json", kTools);
@@ -83,7 +83,12 @@ TEST_CASE("regress: bless, a clean rerun, one program changed, a new one, one al
   // A sidecar: c_slot runs on a finer lattice than the command line's.
   write_text(progs / "c_slot.tridex.json", R"({"dexel_res": 50})");
   write_text(progs / "notes.txt", "not a program");
+  return progs;
+}
 
+TEST_CASE("regress: bless, a clean rerun, one program changed, left shallower alone") {
+  const fs::path dir = scratch("regress");
+  const fs::path progs = three_programs(dir);
   // Without a baseline folder: bad input.
   CHECK(regress(dir, progs.string(), false).run.status == 2);
   Run blessed = regress(dir, progs.string(), true);
@@ -134,6 +139,13 @@ TEST_CASE("regress: bless, a clean rerun, one program changed, a new one, one al
   CHECK(l["regions"][0]["lines"].dump().find(line5) != std::string::npos);
   CHECK(l["regions"][0]["tools"] == json::array({1}));
 
+  fs::remove_all(dir);
+}
+
+TEST_CASE("regress: a new program fails until blessed; a program that does not run") {
+  const fs::path dir = scratch("regress-new");
+  const fs::path progs = three_programs(dir);
+  REQUIRE(regress(dir, progs.string(), true).run.status == 0);
   // A program without a baseline: "new", which fails until blessed.
   write_text(progs / "b_slot.nc", slot(10, 2));
   write_text(progs / "d_new.nc", slot(20, 1));
