@@ -45,6 +45,11 @@ run(['simulate', write('good.nc', program(-2)), ...stock, '-o', path.join(out, '
 const checkPage = path.join(out, 'check.html');
 run(['check', write('gouge.nc', program(-2.3)), ...stock, '--design', path.join(out, 'design.stl'), '--tolerance', '0.1',
      '--envelope', 'box:-1,-1,-1,21,21,14', '--report', path.join(out, 'check.json'), '--html', checkPage], [3]);
+// diff (issue 39): the plunge 0.3 mm too deep against the correct program: one region B removed,
+// listed with its line in B (13), B's surface as the part and A's as the ghost.
+const diffPage = path.join(out, 'diff.html');
+run(['diff', path.join(out, 'good.nc'), write('deep.nc', program(-2.3)), ...stock, '--tolerance', '0.1',
+     '--report', path.join(out, 'diff.json'), '--html', diffPage], [3]);
 // A holder that hits, in a subprogram file (M98 P1002 finds O1002.nc beside the program): a hole
 // 25 mm deep 4 mm from the front face buries the Ø30 holder 20 mm out (tests/tools/test_collisions.cpp)
 // at the subprogram's line 3; the main program's line 3 moves too (its listing must not be marked).
@@ -374,6 +379,16 @@ try {
     await settle(page);
     const tip = report.envelope.violations[0].tip, seen = await page.evaluate((p) => window.tridexView.project(p), tip);
     check(Math.abs(seen[0]) < 0.02 && Math.abs(seen[1]) < 0.02, 'check: the camera flew to the envelope finding: ' + seen);
+    clean();
+    await page.close();
+  }
+  {
+    const { page, clean } = await open(diffPage);
+    const items = await page.$$eval('#findings li[data-finding]', (l) => l.map((e) => e.textContent));
+    check(items.length >= 1 && items[0].startsWith('removed by B') && items[0].includes('B line 13'),
+          'diff: the region B removed, at its line: ' + items.join(' | '));
+    check((await page.$eval('#verdict-line', (e) => e.textContent)).includes('DIFFERENT'), 'diff: the verdict DIFFERENT');
+    await page.screenshot({ path: diffPage.replace(/\.html$/, '.png') });
     clean();
     await page.close();
   }

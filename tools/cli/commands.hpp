@@ -76,6 +76,14 @@ struct DiffOptions : SimulateOptions {
   double tolerance = 0;  // --tolerance, mm; 0: half the dexel spacing
 };
 
+// `regress` (issue 39): PROGRAM is a folder of programs or one program; simulate's options are
+// every program's defaults (a NAME.tridex.json sidecar overrides them for NAME.nc).
+struct RegressOptions : SimulateOptions {
+  std::string baseline;  // --baseline BASE: NAME.dexel and NAME.json per program
+  bool bless = false;    // --bless: store the results as the new baselines
+  double tolerance = 0;  // --tolerance, mm; 0: half the dexel spacing
+};
+
 // `lint`: the post lint of a program (checks/lint.hpp).
 struct LintOptions : CommonOptions {
   std::string report;  // --report FILE: the findings as JSON
@@ -96,5 +104,6 @@ int run_check(const CheckOptions& options);
 int run_diff(const DiffOptions& options);
 int run_moves_diff(const ListOptions& options);
 int run_lint(const LintOptions& options);
+int run_regress(const RegressOptions& options);
 
 }  // namespace tridex::cli

@@ -207,6 +207,9 @@ std::pair<CLI::App*, CLI::App*> add_diff_and_lint(CLI::App& app, DiffOptions& di
       ->check(kFinitePositive);
   dif->add_option("--report", diff.report, "write the JSON report of the comparison")
       ->check(kNotEmpty);
+  dif->add_option("--png", diff.png,
+                  "write a picture of B's result coloured where it differs from A's")
+      ->check(kNotEmpty);
   CLI::App* lnt = app.add_subcommand(
       "lint",
       "post-processor mistakes at file:line: units changed mid-program, G43 H missing or not\n"
@@ -215,6 +218,27 @@ std::pair<CLI::App*, CLI::App*> add_diff_and_lint(CLI::App& app, DiffOptions& di
   add_common(*lnt, lint);
   lnt->add_option("--report", lint.report, "write the findings as JSON")->check(kNotEmpty);
   return {dif, lnt};
+}
+
+// issue 39: `regress` (a regression folder).
+CLI::App* add_regress(CLI::App& app, RegressOptions& regress) {
+  CLI::App* reg = app.add_subcommand(
+      "regress",
+      "run every program of a folder (or one program) and compare each solid with its stored\n"
+      "baseline; --bless stores new baselines; exit status 3 when any changed or is new");
+  add_simulate(*reg, regress);
+  reg->add_option("--baseline", regress.baseline,
+                  "the folder of baselines (NAME.dexel and NAME.json per program)")
+      ->required()
+      ->check(kNotEmpty);
+  reg->add_flag("--bless", regress.bless, "store the results as the new baselines");
+  reg->add_option("--tolerance", regress.tolerance,
+                  "a span of material longer than this along a dexel ray is a difference, mm\n"
+                  "(default: half the dexel spacing)")
+      ->check(kFinitePositive);
+  reg->add_option("--report", regress.report, "write the JSON report of every program")
+      ->check(kNotEmpty);
+  return reg;
 }
 
 // check's options for what it looks for beyond the design: the envelope, the shank's and the
@@ -314,6 +338,8 @@ int main(int argc, char** argv) {
   DiffOptions diff;
   LintOptions lint;
   const auto [dif, lnt] = add_diff_and_lint(app, diff, lint, *mov, moves);
+  RegressOptions regress;
+  CLI::App* reg = add_regress(app, regress);
 
   try {
     app.parse(argc, argv);
@@ -331,6 +357,7 @@ int main(int argc, char** argv) {
     if (grp->parsed()) return run_groups(groups);
     if (dif->parsed()) return run_diff(diff);
     if (lnt->parsed()) return run_lint(lint);
+    if (reg->parsed()) return run_regress(regress);
   } catch (const tridex::gcode::GcodeError& e) {
     std::cerr << terminal_safe(e.what()) << '\n';
     return kBadInput;

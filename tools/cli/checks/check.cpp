@@ -57,9 +57,10 @@ constexpr glm::vec3 kOkColour{0.70f, 0.76f, 0.70f};
 constexpr glm::vec3 kExcessColour{0.18f, 0.40f, 0.90f};
 constexpr std::size_t kRegionsListed = 100;  // per kind, deepest first
 constexpr std::size_t kRegionsWithLines = 20;
-constexpr std::size_t kFindingsListed = 1000;  // envelope violations in the report, in line order
-constexpr std::size_t kFindingsPrinted = 20;   // of each kind on stdout
-constexpr std::size_t kProbesPerRegion = 16;   // deepest vertices tested against the moves
+constexpr std::size_t kFindingsListed = 1000;   // envelope violations in the report, in line order
+constexpr std::size_t kFindingsPrinted = 20;    // of each kind on stdout
+constexpr std::size_t kProbesPerRegion = 16;    // deepest vertices tested against the moves
+constexpr std::size_t kExcessLinesListed = 20;  // the nearest lines of an excess region
 constexpr int kHistogramBins = 20;
 constexpr std::size_t kMaxDesignSamples = 4'000'000;
 
@@ -125,6 +126,38 @@ std::vector<std::pair<int, int>> gouging_lines(const DeviationRegion& region, co
     lines.insert({m.file, m.line});
   });
   return {lines.begin(), lines.end()};
+}
+
+// The moves nearest an excess region (reaching_moves.hpp: nearest_moves), from its highest
+// vertices: those whose swept cutter passes within the region's depth and one dexel spacing of
+// them (a move that should have removed the material reaches the design there, at most the depth
+// below), else the nearest. "lines", "files" (as a gouge's), "tools" and "nearest_mm".
+void add_excess_lines(Json& g, const DeviationRegion& region, const Mesh& mesh,
+                      const std::vector<double>& deviation, const SimulationResult& r) {
+  std::vector<std::uint32_t> probes = region.vertices;
+  const std::size_t keep = std::min(kProbesPerRegion, probes.size());
+  std::partial_sort(probes.begin(), probes.begin() + static_cast<std::ptrdiff_t>(keep),
+                    probes.end(),
+                    [&](std::uint32_t a, std::uint32_t b) { return deviation[a] > deviation[b]; });
+  probes.resize(keep);
+  std::vector<Vec3> points;
+  for (std::uint32_t v : probes) points.emplace_back(mesh.positions[v]);
+  const double spacing = r.lattice.spacing;
+  const std::vector<NearMove> near =
+      nearest_moves(r, points, region.depth + spacing, spacing, kExcessLinesListed);
+  std::set<std::pair<int, int>> lines;
+  std::set<int> tools;
+  for (const NearMove& m : near)
+    lines.insert({m.move->file, m.move->line}), tools.insert(m.move->tool);
+  Json line_list = Json::array(), files = Json::array();
+  for (const auto& [file, line] : lines) {
+    line_list.push_back(line);
+    files.push_back(r.files.at(static_cast<std::size_t>(file)));
+  }
+  g["lines"] = line_list;
+  g["files"] = files;
+  g["tools"] = tools;
+  if (!near.empty()) g["nearest_mm"] = near.front().gap;
 }
 
 Json region_json(const DeviationRegion& region, const Mesh& mesh,
@@ -326,8 +359,11 @@ void list_regions(const SimulationResult& r, Progress& progress, CheckFindings& 
     }
     f.gouge_list.push_back(g);
   }
-  for (std::size_t k = 0; k < f.excesses.size() && k < kRegionsListed; ++k)
-    f.excess_list.push_back(region_json(f.excesses[k], mesh, f.deviation));
+  for (std::size_t k = 0; k < f.excesses.size() && k < kRegionsListed; ++k) {
+    Json g = region_json(f.excesses[k], mesh, f.deviation);
+    if (k < kRegionsWithLines) add_excess_lines(g, f.excesses[k], mesh, f.deviation, r);
+    f.excess_list.push_back(g);
+  }
 }
 
 // The program's own findings: rapids that cut, shanks and holders in the material or near it, the
@@ -505,6 +541,28 @@ void write_reports(const CheckOptions& options, const SimulationResult& r, const
   }
 }
 
+// The excess regions with the lines nearest them, as the gouges: "excess 0.300 mm around (x, y,
+// z), nearest lines p.nc:12, p.nc:14 (T1, 0.05 mm away)".
+void print_excess_lines(const Json& excess_list) {
+  std::size_t printed = 0;
+  for (const Json& g : excess_list)
+    if (g.contains("lines") && printed++ < kFindingsPrinted) {
+      std::string lines, tools;
+      for (std::size_t i = 0; i < g["lines"].size() && i < 10; ++i)
+        lines += (lines.empty() ? "" : ", ") + g["files"][i].get<std::string>() + ":" +
+                 std::to_string(g["lines"][i].get<int>());
+      if (g["lines"].size() > 10) lines += ", … (" + std::to_string(g["lines"].size()) + " in all)";
+      for (const Json& t : g["tools"]) tools += (tools.empty() ? "T" : ", T") + t.dump();
+      const Json& c = g["centroid"];
+      std::printf(
+          "  excess %.3f mm around (%.3f, %.3f, %.3f), nearest lines %s (%s, %.3f mm "
+          "away)\n",
+          g["depth_mm"].get<double>(), c[0].get<double>(), c[1].get<double>(), c[2].get<double>(),
+          lines.empty() ? "?" : terminal_safe(lines).c_str(), tools.c_str(),
+          g.value("nearest_mm", 0.0));
+    }
+}
+
 // The warnings on stderr, then the verdict line and the first findings of each kind on stdout.
 void print_summary(const CheckOptions& options, const SimulationResult& r, const Json& report,
                    const CheckFindings& f, bool failed, double total_s) {
@@ -549,6 +607,7 @@ void print_summary(const CheckOptions& options, const SimulationResult& r, const
                   g["depth_mm"].get<double>(), c[0].get<double>(), c[1].get<double>(),
                   c[2].get<double>(), lines.empty() ? "?" : lines.c_str());
     }
+  print_excess_lines(f.excess_list);
   const Json& rapid_list = f.rapid_list;
   for (std::size_t k = 0; k < rapid_list.size() && k < kFindingsPrinted; ++k)
     std::printf("  %s:%d: rapid cuts %.3f mm of material\n",

@@ -14,6 +14,7 @@
 // lint (lint.hpp), counted when program B has them and A does not.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <cstdio>
 #include <iostream>
@@ -22,15 +23,21 @@
 #include <set>
 #include <unordered_map>
 
+#include "checks/deviation.hpp"
 #include "checks/line_alignment.hpp"
 #include "checks/lint.hpp"
 #include "checks/reaching_moves.hpp"
+#include "checks/solid_diff.hpp"
 #include "commands.hpp"
 #include "errors.hpp"
 #include "inputs/json_input.hpp"
+#include "outputs/html_report.hpp"
 #include "outputs/output.hpp"
+#include "outputs/result_files.hpp"
 #include "pipeline/pipeline.hpp"
+#include "render.hpp"
 #include "tridex/detail/move_geometry.hpp"
+#include "tridex/dexel_ops.hpp"
 
 namespace tridex::cli {
 
@@ -40,188 +47,21 @@ namespace {
 
 constexpr std::size_t kDiffRegionsListed = 100;
 constexpr std::size_t kDiffRegionsWithLines = 20;
-constexpr std::size_t kDiffProbes = 16;
 constexpr std::size_t kDiffLinesListed = 200;
-
-// A span along one ray where the two solids differ.
-struct DiffSpan {
-  int axis = 0, iu = 0, iv = 0;
-  float from = 0, to = 0;
-  bool removed = false;  // material in A that B removed (else material B left that A removed)
-  Vec3 point(const TripleDexel& d, double t) const {
-    Vec3 p = d.node(0, 0, 0);
-    p[TripleDexel::u_axis(axis)] += d.spacing * iu;
-    p[TripleDexel::v_axis(axis)] += d.spacing * iv;
-    p[axis] = t;
-    return p;
-  }
-};
-
-struct DiffRegion {
-  bool removed = false;
-  std::vector<std::size_t> spans;  // into the span list
-  double volume = 0, depth = 0;
-  Vec3 deepest{0};
-  Aabb box;
-  std::vector<Vec3> probes;
-  std::set<int> lines_a, lines_b, changed_a, changed_b, tools_a, tools_b;
-};
-
-// The spans of one ray where exactly one of `a` and `b` holds material, longer than `tolerance`.
-void ray_differences(std::span<const DexelInterval> a, std::span<const DexelInterval> b,
-                     DiffSpan base, double tolerance, std::vector<DiffSpan>& out) {
-  if (a.size() == b.size() &&
-      std::equal(a.begin(), a.end(), b.begin(), [](const DexelInterval& p, const DexelInterval& q) {
-        return p.enter == q.enter && p.exit == q.exit;
-      }))
-    return;
-  std::vector<float> cuts;
-  for (const DexelInterval& i : a) cuts.push_back(i.enter), cuts.push_back(i.exit);
-  for (const DexelInterval& i : b) cuts.push_back(i.enter), cuts.push_back(i.exit);
-  std::sort(cuts.begin(), cuts.end());
-  cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
-  auto inside = [](std::span<const DexelInterval> s, float t) {
-    for (const DexelInterval& i : s)
-      if (i.enter <= t && t <= i.exit) return true;
-    return false;
-  };
-  int state = 0, state_from = 0;  // 0 same, 1 removed, 2 left
-  float from = 0;
-  auto close = [&](float at) {
-    if (state != 0 && at - from > tolerance) {
-      DiffSpan s = base;
-      s.from = from, s.to = at, s.removed = state == 1;
-      out.push_back(s);
-    }
-  };
-  for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
-    const float mid = 0.5f * (cuts[k] + cuts[k + 1]);
-    const bool in_a = inside(a, mid), in_b = inside(b, mid);
-    state_from = in_a == in_b ? 0 : in_a ? 1 : 2;
-    if (state_from != state) {
-      close(cuts[k]);
-      state = state_from, from = cuts[k];
-    }
-  }
-  if (!cuts.empty()) close(cuts.back());
-}
-
-std::vector<DiffSpan> solid_differences(const TripleDexel& a, const TripleDexel& b,
-                                        double tolerance) {
-  std::vector<DiffSpan> spans;
-  for (int axis = 0; axis < 3; ++axis) {
-    const DexelGrid& ga = a.grids[axis];
-    const DexelGrid& gb = b.grids[axis];
-    for (int iv = 0; iv < ga.nv; ++iv)
-      for (int iu = 0; iu < ga.nu; ++iu)
-        ray_differences(ga.ray(iu, iv), gb.ray(iu, iv), DiffSpan{axis, iu, iv}, tolerance, spans);
-  }
-  return spans;
-}
-
-// Spans joined into regions through the lattice nodes they cover (26-neighbours, one kind).
-std::vector<DiffRegion> connect_spans(const std::vector<DiffSpan>& spans, const TripleDexel& d) {
-  const glm::ivec3 n = d.n;
-  auto key = [&](glm::ivec3 c, bool removed) {
-    return ((static_cast<std::uint64_t>(c.z) * static_cast<std::uint64_t>(n.y) +
-             static_cast<std::uint64_t>(c.y)) *
-                static_cast<std::uint64_t>(n.x) +
-            static_cast<std::uint64_t>(c.x)) *
-               2 +
-           (removed ? 1u : 0u);
-  };
-  std::unordered_map<std::uint64_t, int> node_region;  // -1: not yet visited
-  std::vector<std::pair<glm::ivec3, bool>> first_node(spans.size());
-  for (std::size_t s = 0; s < spans.size(); ++s) {
-    const DiffSpan& span = spans[s];
-    const int a = span.axis;
-    auto index = [&](double t) {
-      return std::clamp(static_cast<int>(std::floor((t - d.origin[a]) / d.spacing + 0.5)), 0,
-                        n[a] - 1);
-    };
-    int k0 = index(span.from), k1 = index(span.to);
-    if (k1 < k0) k0 = k1 = index(0.5 * (span.from + span.to));
-    glm::ivec3 c(0);
-    c[TripleDexel::u_axis(a)] = span.iu;
-    c[TripleDexel::v_axis(a)] = span.iv;
-    for (int k = k0; k <= k1; ++k) {
-      c[a] = k;
-      node_region.emplace(key(c, span.removed), -1);
-      if (k == k0) first_node[s] = {c, span.removed};
-    }
-  }
-  // Breadth-first over the marked nodes.
-  std::vector<DiffRegion> regions;
-  for (std::size_t s = 0; s < spans.size(); ++s) {
-    const auto [start, removed] = first_node[s];
-    if (node_region.at(key(start, removed)) >= 0) continue;
-    const int id = static_cast<int>(regions.size());
-    DiffRegion region;
-    region.removed = removed;
-    regions.push_back(std::move(region));
-    std::queue<glm::ivec3> queue;
-    queue.push(start);
-    node_region[key(start, removed)] = id;
-    while (!queue.empty()) {
-      const glm::ivec3 c = queue.front();
-      queue.pop();
-      for (int dz = -1; dz <= 1; ++dz)
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            const glm::ivec3 m = c + glm::ivec3(dx, dy, dz);
-            if (glm::any(glm::lessThan(m, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(m, n)))
-              continue;
-            auto it = node_region.find(key(m, removed));
-            if (it == node_region.end() || it->second >= 0) continue;
-            it->second = id;
-            queue.push(m);
-          }
-    }
-  }
-  for (std::size_t s = 0; s < spans.size(); ++s) {
-    const auto [start, removed] = first_node[s];
-    regions[static_cast<std::size_t>(node_region.at(key(start, removed)))].spans.push_back(s);
-  }
-  return regions;
-}
-
-// Volume, deepest point, box and probes of each region; the regions largest first.
-void measure_regions(std::vector<DiffRegion>& regions, const std::vector<DiffSpan>& spans,
-                     const TripleDexel& d) {
-  const double area = d.spacing * d.spacing;
-  for (DiffRegion& region : regions) {
-    double by_axis[3] = {0, 0, 0};
-    std::vector<std::size_t> order = region.spans;
-    for (std::size_t s : order) {
-      const DiffSpan& span = spans[s];
-      by_axis[span.axis] += (span.to - span.from) * area;
-      region.box.extend(span.point(d, span.from));
-      region.box.extend(span.point(d, span.to));
-    }
-    region.volume = std::max({by_axis[0], by_axis[1], by_axis[2]});
-    std::sort(order.begin(), order.end(), [&](std::size_t p, std::size_t q) {
-      return spans[p].to - spans[p].from > spans[q].to - spans[q].from;
-    });
-    const DiffSpan& deepest = spans[order.front()];
-    region.depth = deepest.to - deepest.from;
-    region.deepest = deepest.point(d, 0.5 * (deepest.from + deepest.to));
-    for (std::size_t k = 0; k < order.size() && k < kDiffProbes; ++k) {
-      const DiffSpan& span = spans[order[k]];
-      region.probes.push_back(span.point(d, 0.5 * (span.from + span.to)));
-    }
-  }
-  std::stable_sort(regions.begin(), regions.end(),
-                   [](const DiffRegion& p, const DiffRegion& q) { return p.volume > q.volume; });
-}
 
 // Main-file lines (and their tools) of the moves whose swept cutter reaches one of `probes`, as
 // check finds a gouge's moves: p is reached when it lies above the move's swept lower surface in
 // the group's frame, within `slack`.
+// Moves in subprogram files go to `elsewhere` as "file:line" (the texts aligned are the main
+// files'; a called file is the same in both programs, so its lines need no counterpart).
 std::map<int, int> reaching_lines(const std::vector<Vec3>& probes, const SimulationResult& r,
-                                  double slack) {
+                                  double slack, std::set<std::string>& elsewhere) {
   std::map<int, int> lines;  // line -> tool
   for_each_reaching_move(r, probes, slack, [&](const gcode::Move& m) {
-    if (m.file == 0) lines.emplace(m.line, m.tool);
+    if (m.file == 0)
+      lines.emplace(m.line, m.tool);
+    else if (elsewhere.size() < kDiffLinesListed)
+      elsewhere.insert(r.files.at(static_cast<std::size_t>(m.file)) + ":" + std::to_string(m.line));
   });
   return lines;
 }
@@ -269,7 +109,8 @@ void attribute_region(DiffRegion& region, DiffRun& run, const std::map<int, int>
   // the Z-map's grid only.
   const double slack = 0.25 * run.a.lattice.spacing;
   const SimulationResult& cutter = region.removed ? run.b : run.a;
-  const std::map<int, int> cut = reaching_lines(region.probes, cutter, slack);
+  const std::map<int, int> cut =
+      reaching_lines(region.probes, cutter, slack, region.removed ? region.sub_b : region.sub_a);
   std::set<int>& own = region.removed ? region.lines_b : region.lines_a;
   std::set<int>& other = region.removed ? region.lines_a : region.lines_b;
   const std::vector<int>& map = region.removed ? run.alignment.b_to_a : run.alignment.a_to_b;
@@ -346,7 +187,9 @@ Json diff_region_json(const DiffRegion& region) {
           {"changed_lines_a", diff_lines_json(region.changed_a)},
           {"changed_lines_b", diff_lines_json(region.changed_b)},
           {"tools_a", region.tools_a},
-          {"tools_b", region.tools_b}};
+          {"tools_b", region.tools_b},
+          {"subprogram_lines_a", region.sub_a},
+          {"subprogram_lines_b", region.sub_b}};
 }
 
 Json diff_report(const DiffOptions& options, const DiffRun& run, bool different) {
@@ -432,6 +275,81 @@ DiffOptions options_for_b(const DiffOptions& options, const SimulationResult& a)
   return b;
 }
 
+// --png and --html: B's surface coloured by its signed distance to A's (deviation.hpp, A's solid
+// deciding the sign where the faces cannot), as check colours the result by the design: red where
+// B removed A's material beyond the tolerance, blue where it left material A removed; the page
+// lists the regions as findings with their lines in B and shows A's surface as the ghost.
+void write_diff_pictures(const DiffOptions& options, DiffRun& run, const Json& report,
+                         Progress& progress) {
+  if (run.error_b) {
+    std::fprintf(stderr, "warning: B does not run: no --png or --html written\n");
+    return;
+  }
+  const Mesh& mesh = run.b.mesh;
+  std::vector<double> deviation(mesh.positions.size(), 0.0);
+  std::vector<glm::vec3> colours(mesh.positions.size(), glm::vec3(0.70f, 0.76f, 0.70f));
+  if (!mesh.triangles.empty() && !run.a.mesh.triangles.empty()) {
+    progress.stage("measuring B's surface against A's");
+    const DistanceTree a_tree(run.a.mesh);
+    for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+      deviation[v] = a_tree.signed_distance(
+          Vec3(mesh.positions[v]), [&](const Vec3& p) { return contains(run.a.result, p); });
+      if (deviation[v] < -run.tolerance) colours[v] = glm::vec3(0.86f, 0.16f, 0.14f);
+      if (deviation[v] > run.tolerance) colours[v] = glm::vec3(0.18f, 0.40f, 0.90f);
+    }
+  }
+  if (!options.png.empty()) {
+    progress.stage("rendering " + options.png);
+    if (mesh.triangles.empty()) {
+      std::fprintf(stderr, "warning: B leaves no material: %s was not written\n",
+                   options.png.c_str());
+    } else {
+      render::MeshRenderOptions view;
+      view.vertex_colours = colours;
+      render::Image image = render::render_mesh(mesh, view);
+      char removed[64], left[64];
+      std::snprintf(removed, sizeof removed, "removed by B > %.3g mm", run.tolerance);
+      std::snprintf(left, sizeof left, "left by B > %.3g mm", run.tolerance);
+      render::draw_legend(image, {{glm::vec3(0.86f, 0.16f, 0.14f), removed},
+                                  {glm::vec3(0.70f, 0.76f, 0.70f), "the same"},
+                                  {glm::vec3(0.18f, 0.40f, 0.90f), left}});
+      write_file_atomically(options.png, render::encode_png(image));
+    }
+  }
+  if (!options.html.empty()) {
+    progress.stage("writing " + options.html);
+    Json page_report = report;
+    page_report["program"] = run.file_b;
+    page_report["tolerances_mm"] = {{"gouge", run.tolerance}, {"excess", run.tolerance}};
+    // The page's legend and summary read check's deviation figures: B's surface against A's.
+    if (!deviation.empty()) {
+      const auto [lo, hi] = std::minmax_element(deviation.begin(), deviation.end());
+      double sum = 0, sum2 = 0;
+      for (double d : deviation) sum += d, sum2 += d * d;
+      const double n = static_cast<double>(deviation.size());
+      page_report["deviation"] = {{"samples", deviation.size()},
+                                  {"min_mm", *lo},
+                                  {"max_mm", *hi},
+                                  {"mean_mm", sum / n},
+                                  {"rms_mm", std::sqrt(sum2 / n)}};
+    }
+    write_html_report(options.html,
+                      {.title = "tridex diff: " + fs::path(run.file_b).filename().string() +
+                                " against " + fs::path(run.file_a).filename().string(),
+                       .report = page_report,
+                       .mesh = &mesh,
+                       .deviation = deviation,
+                       .design = &run.a.mesh,
+                       .groups = &run.b.groups,
+                       .order = run.b.order,
+                       .files = run.b.files,
+                       .stock = &run.b.stock,
+                       .cutters = run.b.cutters,
+                       .bodies = run.b.bodies,
+                       .cutter_of_tool = &run.b.cutter_of_tool});
+  }
+}
+
 }  // namespace
 
 int run_diff(const DiffOptions& options) {
@@ -440,8 +358,12 @@ int run_diff(const DiffOptions& options) {
   if (!options.report.empty()) request.outputs.push_back({"--report", options.report});
   request.extra_inputs = {options.program, options.program_b};
   DiffRun run;
+  for (const auto& [option, path] :
+       {std::pair<std::string, std::string>{"--png", options.png}, {"--html", options.html}})
+    if (!path.empty()) request.outputs.push_back({option, path});
   run.a = simulate_program(options, progress, request);
   const DiffOptions for_b = options_for_b(options, run.a);
+  if (options.tools.empty()) request.tools = run.a.input.tools;  // a project A's table for B
   run.file_a = run.a.input.files.at(0).string();
   run.text_a = read_text_file(run.a.input.files.at(0), "a G-code file");
   const ProgramInput input_b = resolve_program(for_b);
@@ -474,11 +396,14 @@ int run_diff(const DiffOptions& options) {
       attribute_region(run.regions[k], run, tools_a, tools_b);
   }
   const bool different = !run.regions.empty() || !run.lint_b.empty() || run.error_b;
-  const Json report = diff_report(options, run, different);
+  Json report = diff_report(options, run, different);
+  if (!run.error_b && !run.b.files.empty()) report["file_b"] = run.b.files.front();
   if (!options.report.empty()) {
     progress.stage("writing " + options.report);
     write_file_atomically(options.report, dump_json(report, 2) + "\n");
   }
+  if (!options.png.empty() || !options.html.empty())
+    write_diff_pictures(options, run, report, progress);
   progress.finish();
   if (!options.quiet) print_diff(run, different);
   return different ? kFindings : kSuccess;

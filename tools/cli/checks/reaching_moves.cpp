@@ -1,6 +1,9 @@
 #include "checks/reaching_moves.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
 
 #include "tridex/detail/move_geometry.hpp"
 
@@ -32,6 +35,52 @@ void for_each_reaching_move(const SimulationResult& r, const std::vector<Vec3>& 
       }
     }
   }
+}
+
+std::vector<NearMove> nearest_moves(const SimulationResult& r, const std::vector<Vec3>& points,
+                                    double within, double slack, std::size_t count) {
+  std::vector<NearMove> all;
+  for (const gcode::MoveGroup& group : r.groups) {
+    std::vector<Vec3> local;
+    for (const Vec3& p : points) local.push_back(group.frame.to_local(p));
+    for (const gcode::Move& m : group.moves) {
+      if (m.kind == gcode::MoveKind::rapid) continue;
+      const Cutter& cutter = r.cutters[r.cutter_of_tool.at(m.tool)];
+      const Segment tip{group.frame.to_local(m.start), group.frame.to_local(m.end)};
+      const double radius = cutter.radius();
+      const glm::dvec2 a(tip.a.x, tip.a.y), ab = glm::dvec2(tip.b.x, tip.b.y) - a;
+      const double length2 = glm::dot(ab, ab);
+      double best = std::numeric_limits<double>::infinity();
+      bool over = false;  // the move passes over a point (at any height)
+      for (const Vec3& p : local) {
+        const glm::dvec2 q(p.x, p.y);
+        const double t = length2 > 0 ? std::clamp(glm::dot(q - a, ab) / length2, 0.0, 1.0) : 0.0;
+        const double beside = glm::length(q - (a + t * ab)) - radius;
+        double gap = 0;
+        if (beside <= 0) {
+          over = true;
+          gap = std::max(0.0, detail::MoveGeometry(cutter, tip).lowest(p.x, p.y).z - p.z);
+        } else {
+          const double above = std::max(0.0, tip.a.z + t * (tip.b.z - tip.a.z) - p.z);
+          gap = std::hypot(beside, above);
+        }
+        best = std::min(best, gap);
+      }
+      if (best < std::numeric_limits<double>::infinity()) all.push_back({&m, best, over});
+    }
+  }
+  std::stable_sort(all.begin(), all.end(),
+                   [](const NearMove& p, const NearMove& q) { return p.gap < q.gap; });
+  if (all.empty()) return all;
+  const double limit = all.front().gap <= within ? within : all.front().gap + slack;
+  std::vector<NearMove> kept;  // the nearest move of each line
+  std::set<std::pair<int, int>> lines;
+  for (const NearMove& near : all) {
+    if (kept.size() >= count) break;
+    if ((near.gap <= limit || near.over) && lines.insert({near.move->file, near.move->line}).second)
+      kept.push_back(near);
+  }
+  return kept;
 }
 
 }  // namespace tridex::cli

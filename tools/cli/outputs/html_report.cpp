@@ -80,13 +80,18 @@ std::map<std::string, std::set<int>> listed_lines(const Json& report, int contex
     std::set<int>& lines = wanted[file.get<std::string>()];
     for (int k = line.get<int>() - context; k <= line.get<int>() + context; ++k) lines.insert(k);
   };
-  for (const char* kind : {"gouges", "rapid_cuts", "collisions"})
+  for (const char* kind : {"gouges", "excess", "rapid_cuts", "collisions"})
     if (report.contains(kind))
       for (const Json& f : report[kind]) {
-        if (f.contains("lines"))  // a gouge's: "files"[i] is the file of "lines"[i]
+        if (f.contains("lines") && f.contains("files"))  // "files"[i]: the file of "lines"[i]
           for (std::size_t i = 0; i < f["lines"].size(); ++i) add(f["files"][i], f["lines"][i]);
         if (f.contains("line")) add(f["file"], f["line"]);
       }
+  if (report.contains("regions") && report.contains("file_b"))  // diff's (issue 39)
+    for (const Json& g : report["regions"])
+      for (const Json& line : g["lines_b"]) add(report["file_b"], line);
+  if (report.contains("lint"))
+    for (const Json& f : report["lint"]) add(f["file"], f["line"]);
   for (const char* kind : {"envelope", "travel"})
     if (report.contains(kind))
       for (const Json& v : report[kind]["violations"]) add(v["file"], v["line"]);

@@ -258,6 +258,10 @@ RunInputs check_inputs_and_outputs(const SimulateOptions& options, const Pipelin
                                    SimulationResult& r) {
   RunInputs run;
   r.input = resolve_program(options);
+  if (!r.input.tools && request.tools) {
+    r.input.tools = request.tools;
+    apply_tool_options(options, r.input);  // G41/G42 D and G43 H from the table
+  }
   const ProgramInput& input = r.input;
   // --tools, else the project's; the input keeps its copy for the summary and the warnings.
   if (r.input.tools) run.table = r.input.tools;

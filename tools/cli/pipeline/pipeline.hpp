@@ -57,6 +57,9 @@ struct PipelineRequest {
   std::vector<std::pair<std::string, std::filesystem::path>>
       outputs;                                      // (option, path), checked first
   std::vector<std::filesystem::path> extra_inputs;  // never overwritten either
+  // The tool table of a program that has none of its own (no --tools, not a project with tools):
+  // diff's B runs with a project A's table (issue 39).
+  std::optional<ToolTable> tools;
   // Other geometry that must lie within the exact range on the lattice (check's design), with
   // its name for the message.
   std::vector<std::pair<std::string, Aabb>> extra_bounds;
