@@ -125,30 +125,65 @@ inline std::optional<std::pair<double, double>> sweep_conic_range(const SweepCon
   return std::pair{lo, hi};
 }
 
+// The interval of the ray x(u) = point + u·e_axis (point's axis coordinate ignored) in the
+// capsule of radius r around the segment c0–c1: the hull of the ray's crossings with the two end
+// balls and with the side cylinder where it lies between them (the capsule is convex and its
+// boundary is made of these; the ray–cylinder quadratic as in Quílez's capsule intersection).
+inline std::optional<std::pair<double, double>> capsule_interval(const Vec3& c0, const Vec3& c1,
+                                                                 double r, const Vec3& point,
+                                                                 int axis) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  Vec3 m = point - c0;
+  m[axis] = -c0[axis];
+  const Vec3 d = c1 - c0;
+  const double me = m[axis], mm = glm::dot(m, m), r2 = r * r;
+  auto ball = [&](double b, double c) {  // u² + 2bu + c = 0
+    const double disc = b * b - c;
+    if (disc < 0) return;
+    const double root = std::sqrt(disc);
+    lo = std::min(lo, -b - root), hi = std::max(hi, -b + root);
+  };
+  ball(me, mm - r2);
+  const double dd = glm::dot(d, d);
+  if (dd > 0) {
+    const Vec3 m1 = m - d;
+    ball(m1[axis], glm::dot(m1, m1) - r2);
+    const double md = glm::dot(m, d), nd = d[axis];
+    const double a = dd - nd * nd, b = dd * me - nd * md, c = dd * (mm - r2) - md * md;
+    const double disc = b * b - a * c;
+    if (a > 1e-12 * dd && disc >= 0) {
+      const double root = std::sqrt(disc);
+      for (const double u : {(-b - root) / a, (-b + root) / a}) {
+        const double t = md + u * nd;  // dd × the parameter of the nearest segment point
+        if (t >= 0 && t <= dd) lo = std::min(lo, u), hi = std::max(hi, u);
+      }
+    }
+  }
+  if (!(lo <= hi)) return std::nullopt;
+  return std::pair{lo, hi};
+}
+
 // The interval of the ray x(u) = point + u·e_ray_axis (point's ray-axis coordinate ignored) in
 // the sweep of `piece` with unit axis `axis`, tip from `from` moved by `travel`.
 inline std::optional<std::pair<double, double>> sweep_piece_interval(
     const SweepPiece& piece, const Vec3& from, const Vec3& travel, const Vec3& axis,
     const Vec3& point, int ray_axis) {
+  if (piece.ball) {
+    const Vec3 c0 = from + piece.centre * axis;
+    return capsule_interval(c0, c0 + travel, piece.radius, point, ray_axis);
+  }
   Vec3 w = point - from;
   w[ray_axis] = -from[ray_axis];
   const double hw = glm::dot(w, axis), hu = axis[ray_axis], hs = -glm::dot(travel, axis);
+  // |y|² − h² − (ρ0 + m(h − lo))²: the squared distance from the axis less the squared radius.
   SweepConic f;
-  double size = piece.hi + glm::length(travel);
-  if (piece.ball) {
-    for (int i = 0; i < 3; ++i)
-      f.add_square(w[i] - piece.centre * axis[i], i == ray_axis ? 1.0 : 0.0, -travel[i], 1);
-    f.g -= piece.radius * piece.radius;
-    size += piece.radius;
-  } else {
-    // |y|² − h² − (ρ0 + m(h − lo))²: the squared distance from the axis less the squared radius.
-    for (int i = 0; i < 3; ++i) f.add_square(w[i], i == ray_axis ? 1.0 : 0.0, -travel[i], 1);
-    f.add_square(hw, hu, hs, -1);
-    const double m = piece.slope;
-    f.add_square(piece.rho0 + m * (hw - piece.lo), m * hu, m * hs, -1);
-    size += piece.rho0 + m * (piece.hi - piece.lo);
-  }
-  const SweepSide sides[4] = {{0, 1, 0}, {0, -1, 1}, {hu, hs, hw - piece.lo}, {-hu, -hs, piece.hi - hw}};
+  for (int i = 0; i < 3; ++i) f.add_square(w[i], i == ray_axis ? 1.0 : 0.0, -travel[i], 1);
+  f.add_square(hw, hu, hs, -1);
+  const double m = piece.slope;
+  f.add_square(piece.rho0 + m * (hw - piece.lo), m * hu, m * hs, -1);
+  const double size = piece.hi + glm::length(travel) + piece.rho0 + m * (piece.hi - piece.lo);
+  const SweepSide sides[4] = {
+      {0, 1, 0}, {0, -1, 1}, {hu, hs, hw - piece.lo}, {-hu, -hs, piece.hi - hw}};
   const double tol = 1e-9 * (1 + size);
   return sweep_conic_range(f, sides, 2 * tol * (1 + size), tol);
 }
