@@ -6,13 +6,13 @@
 // (removal commutes with intersection: the order does not change the result).
 //
 // The exact primitive is a cutter with a FIXED axis translated along a segment: the swept solid
-// is convex (a Minkowski sum of convex sets), so each dexel ray meets it in one interval. With the
-// signed distance D to the cutter (convex, detail/sweep_distance.hpp), a ray point x(u) lies in
-// the sweep iff F(u) = min over s in [0, 1] of D(x(u) − s·(to − from)) ≤ 0, and F is convex in u:
+// is convex (a Minkowski sum of convex sets), so each dexel ray meets it in one interval. For the
+// quadric pieces of a profile (a ball on the axis, frusta: flat, cone, chamfer, the shank) it is
+// closed form (detail/sweep_interval.hpp). Otherwise (the bull nose's torus), with the signed
+// distance D to the cutter (convex, detail/sweep_distance.hpp), a ray point x(u) lies in the
+// sweep iff F(u) = min over s in [0, 1] of D(x(u) − s·(to − from)) ≤ 0, and F is convex in u:
 // golden-section search finds a point where it is ≤ 0 (or its minimum) and bisection its zeros, to
-// `precision`, with no sampling that could miss a contact. Ball, flat, bull nose, cone, chamfer and
-// every convex profile go through this one path (the distance to lines and arcs of the profile is
-// closed form).
+// `precision`, with no sampling that could miss a contact.
 //
 // A turning tool is split into sub-steps, each swept with the tool axis held at its middle pose
 // and the tip moved straight between the sub-step's end poses. plan_sweep() bounds how far any
@@ -24,7 +24,9 @@
 //     + reach · (max_j ∠(axis(s_j), axis_mid) + Ω·Δ/(2K)),
 // the sampled deviations being Lipschitz with constants 2V and Ω, and a point at distance ≤ reach
 // from the tip moving by at most reach·angle when the axis turns by that angle. Sub-steps double
-// until e ≤ the tolerance (or a cap, and the band achieved is reported).
+// until e ≤ the tolerance (or a cap, and the band achieved is reported). plan_sweep_parts() does
+// the same for the cutter's tip and shank apart, closed form under TCP, and drops the sub-steps
+// that cannot reach material (docs/design.md, "Simultaneous moves").
 #pragma once
 
 #include <algorithm>
@@ -78,6 +80,8 @@ struct SweepStep {
 };
 
 // Bounds on a move's pose as a function of its parameter s ∈ [0, 1] (per unit s).
+// turn_rate must also bound |d² axis / ds²| by its square, as rotations about fixed axes at
+// constant rates do (the sum of their rates: plan_sweep_parts's ball bound relies on it).
 struct PoseBounds {
   double tip_speed = 0;       // |d tip / ds|
   double turn_rate = 0;       // |d axis / ds| (radians)
@@ -203,7 +207,8 @@ inline Aabb sweep_step_bounds(const SweepCutter& c, const SweepStep& step) {
 // cutter's and of the two slabs', still convex and 1-Lipschitz, ≤ 0 exactly on the part).
 inline std::optional<std::pair<double, double>> ray_sweep_interval(
     const SweepCutter& c, const SweepStep& step, const Vec3& point, int axis, double lo, double hi,
-    double precision, double part_lo = 0, double part_hi = std::numeric_limits<double>::infinity()) {
+    double precision, double part_lo = 0,
+    double part_hi = std::numeric_limits<double>::infinity()) {
   auto distance = [&](const Vec3& tip, const Vec3& x) {
     const double h = glm::dot(x - tip, step.axis);
     return std::max({c.distance(tip, step.axis, x), part_lo - h, h - part_hi});
@@ -249,8 +254,9 @@ class SweepMaterial {
       Tiles& t = tiles_[static_cast<std::size_t>(a)];
       t.nu = g.nu, t.nv = g.nv, t.tu = (g.nu + kTile - 1) / kTile;
       const int tv = (g.nv + kTile - 1) / kTile;
-      t.extent.assign(static_cast<std::size_t>(t.tu) * static_cast<std::size_t>(tv),
-                      {std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()});
+      t.extent.assign(
+          static_cast<std::size_t>(t.tu) * static_cast<std::size_t>(tv),
+          {std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()});
       for (int iv = 0; iv < g.nv; ++iv)
         for (int iu = 0; iu < g.nu; ++iu) {
           const auto ray = g.ray(iu, iv);
@@ -472,9 +478,9 @@ inline void sweep_ray(std::span<const DexelInterval> ray, const TripleDexel& d, 
       }
     if (!(lo <= hi)) continue;
     const SweepStep& step = steps[s];
-    const auto cut = sweep_step_interval(cutters[step.cutter],
-                                         shapes[step.cutter].parts[static_cast<std::size_t>(step.part)],
-                                         step, point, axis, lo, hi, precision);
+    const auto cut = sweep_step_interval(
+        cutters[step.cutter], shapes[step.cutter].parts[static_cast<std::size_t>(step.part)], step,
+        point, axis, lo, hi, precision);
     if (!cut) continue;
     const DexelInterval removed{static_cast<float>(cut->first), static_cast<float>(cut->second)};
     next.clear();

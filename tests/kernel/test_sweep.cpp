@@ -114,8 +114,8 @@ TEST_CASE("sweep: zero dexel samples wrong by more than the band, random turning
     const int trial = static_cast<int>(c % 2);
     const TurningMove m = random_move(rng, trial == 1, 1);
     const double tolerance = lattice.spacing / 10;
-    const SweepPlan plan = plan_sweep([&](double s) { return m.at(s); }, m.bounds(),
-                                      cutters[c].reach(), tolerance, c);
+    const SweepPlan plan =
+        plan_sweep([&](double s) { return m.at(s); }, m.bounds(), cutters[c].reach(), tolerance, c);
     REQUIRE(plan.band <= tolerance);
     TripleDexel d = TripleDexel::box(lattice, stock);
     sweep_remove(d, cutters, plan.steps, 2);
@@ -143,17 +143,17 @@ TEST_CASE("sweep: plan_sweep_parts, zero samples wrong beyond the band") {
       TripleDexel d = TripleDexel::box(lattice, stock);
       const SweepMaterial material(d);
       const SweepShape shape = sweep_shape(cutters[c]);
-      const SweepPlan plan = plan_sweep_parts(
-          [&](double s) { return m.at(s); }, m.bounds(), cutters[c], shape, tolerance, c,
-          [&](const Aabb& box) { return material.may_touch(box); });
+      const SweepPlan plan =
+          plan_sweep_parts([&](double s) { return m.at(s); }, m.bounds(), cutters[c], shape,
+                           tolerance, c, [&](const Aabb& box) { return material.may_touch(box); });
       REQUIRE(plan.band <= tolerance);
-      const SweepPlan kept_all = plan_sweep_parts([&](double s) { return m.at(s); }, m.bounds(),
-                                                  cutters[c], shape, tolerance, c,
-                                                  [](const Aabb&) { return true; });
+      const SweepPlan kept_all =
+          plan_sweep_parts([&](double s) { return m.at(s); }, m.bounds(), cutters[c], shape,
+                           tolerance, c, [](const Aabb&) { return true; });
       dropped += static_cast<long long>(kept_all.steps.size() - plan.steps.size());
       sweep_remove(d, cutters, plan.steps, 2);
-      wrong += oracle_wrong(m, cutters[c], plan, d, stock, trial + 2 * static_cast<int>(c),
-                            checked);
+      wrong +=
+          oracle_wrong(m, cutters[c], plan, d, stock, trial + 2 * static_cast<int>(c), checked);
     }
   CHECK(checked > 5000);
   CHECK(dropped > 0);

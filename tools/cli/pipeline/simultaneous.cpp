@@ -51,8 +51,8 @@ void cut_simultaneous(const SimulateOptions& options, SimulationResult& r, bool 
     const gcode::MovePath path(*kinematics, m);
     const std::size_t c = it->second;
     const SweepPlan plan =
-        plan_sweep_parts([&](double s) { return path.at(s); }, path.bounds(), cutters[c],
-                         shapes[c], r.sweep_tolerance, static_cast<std::uint32_t>(c), may_touch);
+        plan_sweep_parts([&](double s) { return path.at(s); }, path.bounds(), cutters[c], shapes[c],
+                         r.sweep_tolerance, static_cast<std::uint32_t>(c), may_touch);
     SweepSummary& summary = r.sweeps[m.tool];
     ++summary.moves;
     summary.sub_steps += static_cast<long long>(plan.steps.size());
