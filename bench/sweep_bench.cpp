@@ -26,14 +26,14 @@ using namespace tridex;
 const Aabb kStock{Vec3(0), Vec3(100, 100, 40)};
 constexpr int kSegments = 200;
 
-SweepCutter bench_cutter(int shape) {
+SweepCutter bench_cutter(int shape, double chord) {
   switch (shape) {
     case 0:
       return {Cutter::ball(3), 30};
     case 1:
       return {Cutter::flat(3), 30};
     default:
-      return {Cutter::bull_nose(3, 1), 30};
+      return {Cutter::bull_nose(3, 1), 30, chord};
   }
 }
 
@@ -44,7 +44,10 @@ Vec3 tilted(double degrees) {
 
 void BM_sweep_segments(benchmark::State& state) {
   const double spacing = static_cast<double>(state.range(0)) / 100;
-  const std::vector<SweepCutter> cutters{bench_cutter(static_cast<int>(state.range(1)))};
+  // plan_sweep_parts cuts the bull nose's torus as chords of sagitta ≤ a quarter of the tolerance.
+  const double tolerance = spacing / 10;
+  const std::vector<SweepCutter> cutters{
+      bench_cutter(static_cast<int>(state.range(1)), state.range(2) == 1 ? tolerance / 4 : 0)};
   const DexelLattice lattice = DexelLattice::covering(kStock, spacing);
   std::vector<SweepStep> steps;
   double band = 0;
@@ -58,9 +61,9 @@ void BM_sweep_segments(benchmark::State& state) {
     auto pose = [&](double s) { return ToolPose{a + s * (b - a), tilted(from + s * (to - from))}; };
     const PoseBounds bounds{2, 2 * 3.141592653589793 / 180, true};
     const SweepPlan plan =
-        parts ? plan_sweep_parts(pose, bounds, cutters[0], shape, spacing / 10, 0,
+        parts ? plan_sweep_parts(pose, bounds, cutters[0], shape, tolerance, 0,
                                  [&](const Aabb& box) { return material.may_touch(box); })
-              : plan_sweep(pose, bounds, cutters[0].reach(), spacing / 10);
+              : plan_sweep(pose, bounds, cutters[0].reach(), tolerance);
     band = std::max(band, plan.band);
     steps.insert(steps.end(), plan.steps.begin(), plan.steps.end());
   }

@@ -52,6 +52,10 @@ namespace tridex {
 struct SweepCutter {
   Cutter cutter;
   double height = 0;  // > cutter.profile_height()
+  // 0: a profile arc off the axis (the bull nose's torus) is searched (exact, slow). > 0: it is
+  // replaced by inscribed chords of at most this sagitta, cut in closed form, and the sagitta
+  // joins the band (plan_sweep_parts).
+  double chord = 0;
   // The farthest cutter point from the tip.
   double reach() const { return std::hypot(cutter.radius(), height); }
   double distance(const Vec3& tip, const Vec3& axis, const Vec3& x) const {
@@ -148,6 +152,7 @@ struct SweepPartShape {
   double lo = 0, hi = 0;  // the part: the cutter between these heights
   double top = 0;         // the highest point of its pieces (a ball end's whole ball reaches 2R)
   bool closed = true;
+  double chord_error = 0;  // how far the cutter may stand outside the pieces (SweepCutter::chord)
   std::vector<detail::SweepPiece> pieces;
   bool empty() const { return !(hi > lo); }
 };
@@ -170,7 +175,8 @@ inline SweepShape sweep_shape(const SweepCutter& c) {
     SweepPartShape& part = shape.parts[p];
     part.lo = heights[p][0], part.hi = heights[p][1], part.top = part.hi;
     if (part.empty()) continue;
-    part.closed = detail::sweep_pieces(c.cutter, c.height, part.lo, part.hi, part.pieces);
+    part.closed = detail::sweep_pieces(c.cutter, c.height, part.lo, part.hi, c.chord, part.pieces,
+                                       part.chord_error);
     if (!part.closed) part.pieces.clear();
     for (const detail::SweepPiece& piece : part.pieces) part.top = std::max(part.top, piece.hi);
   }
@@ -310,7 +316,8 @@ void plan_straight_part(PoseAt& pose_at, double omega, const SweepCutter& c,
   const bool ball = which == SweepPart::tip && shape.ball_tip;
   const double reach = std::hypot(c.cutter.radius(), part.top), centre = shape.ball_centre;
   auto band = [&](double delta) {
-    return ball ? centre * omega * omega * delta * delta / 8 : reach * omega * delta / 2;
+    return part.chord_error +
+           (ball ? centre * omega * omega * delta * delta / 8 : reach * omega * delta / 2);
   };
   long n = 1;
   while (n < kMaxSubSteps && band(1.0 / static_cast<double>(n)) > tolerance) n *= 2;
@@ -344,6 +351,7 @@ void plan_straight_part(PoseAt& pose_at, double omega, const SweepCutter& c,
 // centre, c above the tip, from its chord by c·Ω²·Δ²/8, since |axis''| ≤ Ω² for rotations about
 // fixed axes at constant rates (a ball's sweep is the same whatever its axis: it needs no more
 // sub-steps than its centre's path). Otherwise each part is planned as plan_sweep plans a move.
+// A part cut as inscribed chords (SweepCutter::chord) adds their sagitta to its band.
 template <class PoseAt, class MayTouch>
 SweepPlan plan_sweep_parts(PoseAt&& pose_at, const PoseBounds& bounds, const SweepCutter& c,
                            const SweepShape& shape, double tolerance, std::uint32_t cutter,
@@ -367,7 +375,9 @@ SweepPlan plan_sweep_parts(PoseAt&& pose_at, const PoseBounds& bounds, const Swe
     };
     const PoseBounds b{bounds.tip_speed + centre * bounds.turn_rate, bounds.turn_rate, false};
     const double reach = ball ? 0.0 : std::hypot(c.cutter.radius(), part.top);
-    const SweepPlan p = plan_sweep(centre_at, b, reach, tolerance, cutter);
+    const double geometric = std::max(tolerance - part.chord_error, tolerance / 16);
+    SweepPlan p = plan_sweep(centre_at, b, reach, geometric, cutter);
+    p.band += part.chord_error;
     for (SweepStep step : p.steps) {
       step.from -= centre * step.axis, step.to -= centre * step.axis, step.part = which;
       if (!may_touch(sweep_part_bounds(c, part, step.from, step.to, step.axis).inflated(p.band)))

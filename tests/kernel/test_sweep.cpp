@@ -128,13 +128,15 @@ TEST_CASE("sweep: zero dexel samples wrong by more than the band, random turning
 // The pipeline's planner: tip and shank apart, a ball along its centre's path, closed-form bands
 // under a straight tip, sub-steps whose grown box holds no material dropped. The stock's top is
 // near the tips, so the shanks' sub-steps are often dropped; the oracle still finds no sample
-// wrong beyond the band, for every cutter shape, straight and bowed tips.
+// wrong beyond the band, for every cutter shape (the bull nose searched and as chords), straight
+// and bowed tips.
 TEST_CASE("sweep: plan_sweep_parts, zero samples wrong beyond the band") {
   std::mt19937 rng(3434);
   const Aabb stock{Vec3(-4, -4, -4), Vec3(4, 4, 0.5)};
   const DexelLattice lattice = DexelLattice::covering(stock, 0.4);
   std::vector<SweepCutter> cutters = shapes();
   cutters.push_back({Cutter::tapered_ball(1.5, 0.5, 10), 5});
+  cutters.push_back({Cutter::bull_nose(1.5, 0.5), 5, 0.01});  // the torus as chords
   long long checked = 0, wrong = 0, dropped = 0;
   for (std::uint32_t c = 0; c < cutters.size(); ++c)
     for (int trial = 0; trial < 2; ++trial) {

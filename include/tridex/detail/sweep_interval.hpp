@@ -188,23 +188,47 @@ inline std::optional<std::pair<double, double>> sweep_piece_interval(
   return sweep_conic_range(f, sides, 2 * tol * (1 + size), tol);
 }
 
-// The convex pieces of cutter `c` cut at `height` between heights lo and hi, or false if one of
-// them is not a quadric (an arc off the axis: the bull nose's torus). An arc centred on the axis
-// is the whole ball (it lies inside the cutter: the profile above it is tangent or wider), so a
-// piece list with a ball may reach above `hi` by up to the ball's radius, never outside the cutter.
-inline bool sweep_pieces(const Cutter& c, double height, double lo, double hi,
-                         std::vector<SweepPiece>& out) {
+// Appends the frustum between meridian points (d0, h0) and (d1, h1), h1 > h0, clipped to [lo, hi].
+inline void sweep_frustum(double d0, double h0, double d1, double h1, double lo, double hi,
+                          std::vector<SweepPiece>& out) {
+  if (h1 <= lo || h0 >= hi || h1 <= h0) return;  // a flat bottom: the face of the piece above it
+  const double slope = (d1 - d0) / (h1 - h0), a = std::max(lo, h0), b = std::min(hi, h1);
+  out.push_back({a, b, false, d0 + slope * (a - h0), slope, 0, 0});
+}
+
+// The convex pieces of cutter `c` cut at `height` between heights lo and hi; false if an arc off
+// the axis (the bull nose's torus, no quadric) is met and `chord` is 0. With `chord` > 0 such an
+// arc is replaced by inscribed chords (frusta) whose sagitta is at most `chord`: the pieces then
+// lie inside the cutter and the cutter within `error` (the largest sagitta) of them. An arc
+// centred on the axis is the whole ball (it lies inside the cutter: the profile above it is
+// tangent or wider), so a piece list with a ball may reach above `hi` by up to the ball's radius,
+// never outside the cutter.
+inline bool sweep_pieces(const Cutter& c, double height, double lo, double hi, double chord,
+                         std::vector<SweepPiece>& out, double& error) {
   for (const ProfilePiece& p : c.pieces()) {
     const double h0 = p.height(p.d0), h1 = p.height(p.d1);
     if (h1 <= lo || h0 >= hi) continue;
-    if (p.is_arc) {
-      if (p.centre_d != 0 || p.d0 != 0 || p.centre_h + p.radius > height) return false;
+    if (!p.is_arc) {
+      sweep_frustum(p.d0, h0, p.d1, h1, lo, hi, out);
+      continue;
+    }
+    if (p.centre_d == 0 && p.d0 == 0 && p.centre_h + p.radius <= height) {
       out.push_back({0, p.centre_h + p.radius, true, 0, 0, p.centre_h, p.radius});
       continue;
     }
-    if (h1 <= h0) continue;  // a flat bottom: the face of the piece above it
-    const double slope = (p.d1 - p.d0) / (h1 - h0), a = std::max(lo, h0), b = std::min(hi, h1);
-    out.push_back({a, b, false, p.d0 + slope * (a - h0), slope, 0, 0});
+    if (!(chord > 0)) return false;
+    // The lower arc at angles from the downward vertical: d = centre_d + radius·sin(angle).
+    const double a0 = std::asin(std::clamp((p.d0 - p.centre_d) / p.radius, -1.0, 1.0));
+    const double a1 = std::asin(std::clamp((p.d1 - p.centre_d) / p.radius, -1.0, 1.0));
+    const double step = 2 * std::acos(std::max(0.0, 1 - chord / p.radius));
+    const int k = std::max(1, static_cast<int>(std::ceil((a1 - a0) / step)));
+    error = std::max(error, p.radius * (1 - std::cos((a1 - a0) / (2 * k))));
+    for (int i = 0; i < k; ++i) {
+      const double b0 = a0 + (a1 - a0) * i / k, b1 = a0 + (a1 - a0) * (i + 1) / k;
+      sweep_frustum(p.centre_d + p.radius * std::sin(b0), p.centre_h - p.radius * std::cos(b0),
+                    p.centre_d + p.radius * std::sin(b1), p.centre_h - p.radius * std::cos(b1), lo,
+                    hi, out);
+    }
   }
   const double top = std::max(lo, c.profile_height()), end = std::min(hi, height);
   if (end > top) out.push_back({top, end, false, c.radius(), 0, 0, 0});
