@@ -319,8 +319,11 @@ void plan_straight_part(PoseAt& pose_at, double omega, const SweepCutter& c,
     return part.chord_error +
            (ball ? centre * omega * omega * delta * delta / 8 : reach * omega * delta / 2);
   };
+  // As plan_sweep_parts's sampled branch: chords too coarse for the tolerance cannot be made up
+  // by sub-steps, so those stop at a sixteenth of it (the band then says what was achieved).
+  const double enough = part.chord_error + std::max(tolerance - part.chord_error, tolerance / 16);
   long n = 1;
-  while (n < kMaxSubSteps && band(1.0 / static_cast<double>(n)) > tolerance) n *= 2;
+  while (n < kMaxSubSteps && band(1.0 / static_cast<double>(n)) > enough) n *= 2;
   auto visit = [&](auto& self, double s0, double s1) -> void {
     const ToolPose p0 = pose_at(s0), p1 = pose_at(s1), mid = pose_at(0.5 * (s0 + s1));
     Vec3 from = p0.tip, to = p1.tip;
