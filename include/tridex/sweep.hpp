@@ -322,9 +322,23 @@ void plan_straight_part(PoseAt& pose_at, double omega, const SweepCutter& c,
   // As plan_sweep_parts's sampled branch: chords too coarse for the tolerance cannot be made up
   // by sub-steps, so those stop at a sixteenth of it (the band then says what was achieved).
   const double enough = part.chord_error + std::max(tolerance - part.chord_error, tolerance / 16);
+  // The fewest equal sub-steps n that fit (the band falls with their length): a power of two
+  // found by doubling, then the least n below it by bisection.
   long n = 1;
   while (n < kMaxSubSteps && band(1.0 / static_cast<double>(n)) > enough) n *= 2;
-  auto visit = [&](auto& self, double s0, double s1) -> void {
+  long lo = n / 2 + 1, hi = n;
+  while (lo < hi) {
+    const long m = lo + (hi - lo) / 2;
+    if (band(1.0 / static_cast<double>(m)) > enough)
+      lo = m + 1;
+    else
+      hi = m;
+  }
+  n = hi;
+  // Halves of the n sub-steps, [i0, i1] of them, dropped whole where they cannot reach material.
+  auto visit = [&](auto& self, long i0, long i1) -> void {
+    const double s0 = static_cast<double>(i0) / static_cast<double>(n);
+    const double s1 = static_cast<double>(i1) / static_cast<double>(n);
     const ToolPose p0 = pose_at(s0), p1 = pose_at(s1), mid = pose_at(0.5 * (s0 + s1));
     Vec3 from = p0.tip, to = p1.tip;
     if (ball) {  // the ball's centre on its chord, the step's tip below it on the middle axis
@@ -333,15 +347,15 @@ void plan_straight_part(PoseAt& pose_at, double omega, const SweepCutter& c,
     }
     const double e = band(s1 - s0);
     if (!may_touch(sweep_part_bounds(c, part, from, to, mid.axis).inflated(e))) return;
-    if ((s1 - s0) * static_cast<double>(n) > 1.5) {
-      self(self, s0, 0.5 * (s0 + s1));
-      self(self, 0.5 * (s0 + s1), s1);
+    if (i1 - i0 > 1) {
+      self(self, i0, i0 + (i1 - i0) / 2);
+      self(self, i0 + (i1 - i0) / 2, i1);
       return;
     }
     plan.band = std::max(plan.band, e);
     plan.steps.push_back({from, to, mid.axis, cutter, which});
   };
-  visit(visit, 0.0, 1.0);
+  visit(visit, 0L, n);
 }
 
 }  // namespace detail
