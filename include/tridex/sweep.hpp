@@ -6,13 +6,13 @@
 // (removal commutes with intersection: the order does not change the result).
 //
 // The exact primitive is a cutter with a FIXED axis translated along a segment: the swept solid
-// is convex (a Minkowski sum of convex sets), so each dexel ray meets it in one interval. With the
-// signed distance D to the cutter (convex, detail/sweep_distance.hpp), a ray point x(u) lies in
-// the sweep iff F(u) = min over s in [0, 1] of D(x(u) − s·(to − from)) ≤ 0, and F is convex in u:
+// is convex (a Minkowski sum of convex sets), so each dexel ray meets it in one interval. For the
+// quadric pieces of a profile (a ball on the axis, frusta: flat, cone, chamfer, the shank) it is
+// closed form (detail/sweep_interval.hpp). Otherwise (the bull nose's torus), with the signed
+// distance D to the cutter (convex, detail/sweep_distance.hpp), a ray point x(u) lies in the
+// sweep iff F(u) = min over s in [0, 1] of D(x(u) − s·(to − from)) ≤ 0, and F is convex in u:
 // golden-section search finds a point where it is ≤ 0 (or its minimum) and bisection its zeros, to
-// `precision`, with no sampling that could miss a contact. Ball, flat, bull nose, cone, chamfer and
-// every convex profile go through this one path (the distance to lines and arcs of the profile is
-// closed form).
+// `precision`, with no sampling that could miss a contact.
 //
 // A turning tool is split into sub-steps, each swept with the tool axis held at its middle pose
 // and the tip moved straight between the sub-step's end poses. plan_sweep() bounds how far any
@@ -24,10 +24,13 @@
 //     + reach · (max_j ∠(axis(s_j), axis_mid) + Ω·Δ/(2K)),
 // the sampled deviations being Lipschitz with constants 2V and Ω, and a point at distance ≤ reach
 // from the tip moving by at most reach·angle when the axis turns by that angle. Sub-steps double
-// until e ≤ the tolerance (or a cap, and the band achieved is reported).
+// until e ≤ the tolerance (or a cap, and the band achieved is reported). plan_sweep_parts() does
+// the same for the cutter's tip and shank apart, closed form under TCP, and drops the sub-steps
+// that cannot reach material (docs/design.md, "Simultaneous moves").
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <optional>
@@ -37,6 +40,7 @@
 
 #include "tridex/cutter.hpp"
 #include "tridex/detail/sweep_distance.hpp"
+#include "tridex/detail/sweep_interval.hpp"
 #include "tridex/dexel.hpp"
 #include "tridex/dexel_ops.hpp"
 #include "tridex/geometry.hpp"
@@ -48,6 +52,10 @@ namespace tridex {
 struct SweepCutter {
   Cutter cutter;
   double height = 0;  // > cutter.profile_height()
+  // 0: a profile arc off the axis (the bull nose's torus) is searched (exact, slow). > 0: it is
+  // replaced by inscribed chords of at most this sagitta, cut in closed form, and the sagitta
+  // joins the band (plan_sweep_parts).
+  double chord = 0;
   // The farthest cutter point from the tip.
   double reach() const { return std::hypot(cutter.radius(), height); }
   double distance(const Vec3& tip, const Vec3& axis, const Vec3& x) const {
@@ -60,15 +68,24 @@ struct ToolPose {
   Vec3 axis{0.0, 0.0, 1.0};  // unit
 };
 
-// One swept piece: cutter `cutter` (an index into the caller's cutters) with unit axis `axis`
-// translated from tip `from` to tip `to`.
+// The part of a cutter a sweep step moves. A turning cutter's points move the more the farther
+// they are from the tip, so plan_sweep_parts() sub-steps the tip (the profile and a radius of
+// the side above it; a ball end's ball alone, which turning does not change) apart from the
+// shank above it, and drops the shank's sub-steps that cannot reach material.
+enum class SweepPart : std::uint8_t { whole, tip, shank };
+
+// One swept piece: part `part` of cutter `cutter` (an index into the caller's cutters) with
+// unit axis `axis` translated from tip `from` to tip `to`.
 struct SweepStep {
   Vec3 from{0.0}, to{0.0};
   Vec3 axis{0.0, 0.0, 1.0};
   std::uint32_t cutter = 0;
+  SweepPart part = SweepPart::whole;
 };
 
 // Bounds on a move's pose as a function of its parameter s ∈ [0, 1] (per unit s).
+// turn_rate must also bound |d² axis / ds²| by its square, as rotations about fixed axes at
+// constant rates do (the sum of their rates: plan_sweep_parts's ball bound relies on it).
 struct PoseBounds {
   double tip_speed = 0;       // |d tip / ds|
   double turn_rate = 0;       // |d axis / ds| (radians)
@@ -128,27 +145,80 @@ SweepPlan plan_sweep(PoseAt&& pose_at, const PoseBounds& bounds, double reach, d
   }
 }
 
-// The box around cutter `c` in one sub-step (both end poses; the sweep is their convex hull).
-inline Aabb sweep_step_bounds(const SweepCutter& c, const SweepStep& step) {
+// A cutter's parts as sweep_remove cuts them (SweepPart): each part's heights above the tip and
+// its convex pieces, when all are quadrics (detail/sweep_interval.hpp: closed-form intervals);
+// otherwise `closed` is false and the distance search below is used.
+struct SweepPartShape {
+  double lo = 0, hi = 0;  // the part: the cutter between these heights
+  double top = 0;         // the highest point of its pieces (a ball end's whole ball reaches 2R)
+  bool closed = true;
+  double chord_error = 0;  // how far the cutter may stand outside the pieces (SweepCutter::chord)
+  std::vector<detail::SweepPiece> pieces;
+  bool empty() const { return !(hi > lo); }
+};
+
+struct SweepShape {
+  std::array<SweepPartShape, 3> parts;  // by SweepPart
+  bool ball_tip = false;                // the tip is one ball on the axis: turning moves it not
+  double ball_centre = 0;               // its centre's height above the tip
+};
+
+// The tip part is the profile and one radius of side above it (a ball end: the ball alone), the
+// shank the rest: the material a cut reaches is mostly within the tip, whose points move least.
+inline SweepShape sweep_shape(const SweepCutter& c) {
+  SweepShape shape;
+  const double r = c.cutter.radius();
+  const bool ball = c.cutter.shape() == CutterShape::ball && c.height >= 2 * r;
+  const double split = std::min(c.height, ball ? r : c.cutter.profile_height() + r);
+  const double heights[3][2] = {{0, c.height}, {0, split}, {split, c.height}};
+  for (std::size_t p = 0; p < 3; ++p) {
+    SweepPartShape& part = shape.parts[p];
+    part.lo = heights[p][0], part.hi = heights[p][1], part.top = part.hi;
+    if (part.empty()) continue;
+    part.closed = detail::sweep_pieces(c.cutter, c.height, part.lo, part.hi, c.chord, part.pieces,
+                                       part.chord_error);
+    if (!part.closed) part.pieces.clear();
+    for (const detail::SweepPiece& piece : part.pieces) part.top = std::max(part.top, piece.hi);
+  }
+  const auto& tip = shape.parts[1].pieces;
+  shape.ball_tip = ball && tip.size() == 1 && tip[0].ball;
+  if (shape.ball_tip) shape.ball_centre = tip[0].centre;
+  return shape;
+}
+
+// The box around part `part` of cutter `c` swept with axis `axis` from tip `from` to tip `to`.
+inline Aabb sweep_part_bounds(const SweepCutter& c, const SweepPartShape& part, const Vec3& from,
+                              const Vec3& to, const Vec3& axis) {
   Aabb box;
   Vec3 lateral;
   for (int i = 0; i < 3; ++i)
-    lateral[i] = c.cutter.radius() * std::sqrt(std::max(0.0, 1.0 - step.axis[i] * step.axis[i]));
-  for (const Vec3& tip : {step.from, step.to})
-    for (const Vec3& end : {tip, tip + c.height * step.axis}) {
+    lateral[i] = c.cutter.radius() * std::sqrt(std::max(0.0, 1.0 - axis[i] * axis[i]));
+  for (const Vec3& tip : {from, to})
+    for (const Vec3& end : {tip + part.lo * axis, tip + part.top * axis}) {
       box.extend(end - lateral);
       box.extend(end + lateral);
     }
   return box;
 }
 
+// The box around cutter `c` in one sub-step (both end poses; the sweep is their convex hull).
+inline Aabb sweep_step_bounds(const SweepCutter& c, const SweepStep& step) {
+  const SweepPartShape& part = sweep_shape(c).parts[static_cast<std::size_t>(step.part)];
+  return sweep_part_bounds(c, part, step.from, step.to, step.axis);
+}
+
 // The interval [enter, exit] of the ray x(u) = point + u·e_axis, u ∈ [lo, hi], inside the
-// sweep of `step`, to within `precision` (mm, on the side of more removal); nullopt if none.
-inline std::optional<std::pair<double, double>> ray_sweep_interval(const SweepCutter& c,
-                                                                   const SweepStep& step,
-                                                                   const Vec3& point, int axis,
-                                                                   double lo, double hi,
-                                                                   double precision) {
+// sweep of `step`, to within `precision` (mm, on the side of more removal); nullopt if none. The
+// cutter is taken between heights part_lo and part_hi (the part's distance: the largest of the
+// cutter's and of the two slabs', still convex and 1-Lipschitz, ≤ 0 exactly on the part).
+inline std::optional<std::pair<double, double>> ray_sweep_interval(
+    const SweepCutter& c, const SweepStep& step, const Vec3& point, int axis, double lo, double hi,
+    double precision, double part_lo = 0,
+    double part_hi = std::numeric_limits<double>::infinity()) {
+  auto distance = [&](const Vec3& tip, const Vec3& x) {
+    const double h = glm::dot(x - tip, step.axis);
+    return std::max({c.distance(tip, step.axis, x), part_lo - h, h - part_hi});
+  };
   const Vec3 travel = step.to - step.from;
   const double length = glm::length(travel);
   auto at = [&](double u) {
@@ -160,14 +230,14 @@ inline std::optional<std::pair<double, double>> ray_sweep_interval(const SweepCu
   // the distance is 1-Lipschitz in u and `length`-Lipschitz in s.
   auto f = [&](double u) {
     const Vec3 x = at(u);
-    if (length <= precision) return c.distance(step.from, step.axis, x);
-    auto along = [&](double s) { return c.distance(step.from + s * travel, step.axis, x); };
+    if (length <= precision) return distance(step.from, x);
+    auto along = [&](double s) { return distance(step.from + s * travel, x); };
     return detail::convex_minimum(along, 0.0, 1.0, precision / length).second;
   };
   auto inside = [&](double u) {
     const Vec3 x = at(u);
-    if (length <= precision) return c.distance(step.from, step.axis, x) <= 0;
-    auto along = [&](double s) { return c.distance(step.from + s * travel, step.axis, x); };
+    if (length <= precision) return distance(step.from, x) <= 0;
+    auto along = [&](double s) { return distance(step.from + s * travel, x); };
     return detail::convex_minimum(along, 0.0, 1.0, precision / length, length).second <= 0;
   };
   const auto [u_in, f_in] = detail::convex_minimum(f, lo, hi, precision, 1.0);
@@ -177,29 +247,256 @@ inline std::optional<std::pair<double, double>> ray_sweep_interval(const SweepCu
   return std::pair{enter, exit};
 }
 
+// Where material may lie, for dropping sub-steps that cannot reach any: per grid, tiles of
+// kTile × kTile rays with the least entry and the greatest exit of their intervals. Removal only
+// shrinks rays, so a box whose rays' tiles hold nothing within it stays empty through sweep_remove;
+// and a sweep inside such a box would remove nothing from any ray.
+class SweepMaterial {
+ public:
+  static constexpr int kTile = 16;
+  explicit SweepMaterial(const TripleDexel& d) : origin_(d.origin), spacing_(d.spacing) {
+    for (int a = 0; a < 3; ++a) {
+      const DexelGrid& g = d.grids[static_cast<std::size_t>(a)];
+      Tiles& t = tiles_[static_cast<std::size_t>(a)];
+      t.nu = g.nu, t.nv = g.nv, t.tu = (g.nu + kTile - 1) / kTile;
+      const int tv = (g.nv + kTile - 1) / kTile;
+      t.extent.assign(
+          static_cast<std::size_t>(t.tu) * static_cast<std::size_t>(tv),
+          {std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()});
+      for (int iv = 0; iv < g.nv; ++iv)
+        for (int iu = 0; iu < g.nu; ++iu) {
+          const auto ray = g.ray(iu, iv);
+          if (ray.empty()) continue;
+          auto& e = t.extent[static_cast<std::size_t>((iv / kTile) * t.tu + iu / kTile)];
+          e.first = std::min(e.first, ray.front().enter);
+          e.second = std::max(e.second, ray.back().exit);
+        }
+    }
+  }
+  bool may_touch(const Aabb& box) const {
+    for (int a = 0; a < 3; ++a) {
+      const Tiles& t = tiles_[static_cast<std::size_t>(a)];
+      const int u = TripleDexel::u_axis(a), v = TripleDexel::v_axis(a);
+      const int u0 = first(box.min[u], u), u1 = last(box.max[u], u, t.nu);
+      const int v0 = first(box.min[v], v), v1 = last(box.max[v], v, t.nv);
+      for (int tv = v0 / kTile; u0 <= u1 && v0 <= v1 && tv <= v1 / kTile; ++tv)
+        for (int tu = u0 / kTile; tu <= u1 / kTile; ++tu) {
+          const auto& e = t.extent[static_cast<std::size_t>(tv * t.tu + tu)];
+          if (e.first <= box.max[a] && e.second >= box.min[a]) return true;
+        }
+    }
+    return false;
+  }
+
+ private:
+  struct Tiles {
+    int nu = 0, nv = 0, tu = 0;
+    std::vector<std::pair<float, float>> extent;
+  };
+  int first(double x, int axis) const {
+    return static_cast<int>(std::max(0.0, std::ceil((x - origin_[axis]) / spacing_)));
+  }
+  int last(double x, int axis, int n) const {
+    return static_cast<int>(std::min(n - 1.0, std::floor((x - origin_[axis]) / spacing_)));
+  }
+  Vec3 origin_;
+  double spacing_;
+  std::array<Tiles, 3> tiles_;
+};
+
 namespace detail {
 
-// Ray r of grid `axis` (lattice coordinates iu, iv) less the sweeps of `steps` listed for its row.
-// Each sweep is subtracted as soon as it is found, and the next is searched only over the
-// material left within its box: the sub-steps of a move overlap, so most rays find nothing left
-// to cut after the first (subtraction in any order gives the same set).
+// plan_sweep_parts for a straight tip (TCP): the band of a sub-step of length Δ in s is closed
+// form, so sub-steps halve from the whole move, dropping those whose grown box holds no material.
+template <class PoseAt, class MayTouch>
+void plan_straight_part(PoseAt& pose_at, double omega, const SweepCutter& c,
+                        const SweepShape& shape, SweepPart which, double tolerance,
+                        std::uint32_t cutter, MayTouch& may_touch, SweepPlan& plan) {
+  const SweepPartShape& part = shape.parts[static_cast<std::size_t>(which)];
+  const bool ball = which == SweepPart::tip && shape.ball_tip;
+  const double reach = std::hypot(c.cutter.radius(), part.top), centre = shape.ball_centre;
+  auto band = [&](double delta) {
+    return part.chord_error +
+           (ball ? centre * omega * omega * delta * delta / 8 : reach * omega * delta / 2);
+  };
+  // As plan_sweep_parts's sampled branch: chords too coarse for the tolerance cannot be made up
+  // by sub-steps, so those stop at a sixteenth of it (the band then says what was achieved).
+  const double enough = part.chord_error + std::max(tolerance - part.chord_error, tolerance / 16);
+  // The fewest equal sub-steps n that fit (the band falls with their length): a power of two
+  // found by doubling, then the least n below it by bisection.
+  long n = 1;
+  while (n < kMaxSubSteps && band(1.0 / static_cast<double>(n)) > enough) n *= 2;
+  long lo = n / 2 + 1, hi = n;
+  while (lo < hi) {
+    const long m = lo + (hi - lo) / 2;
+    if (band(1.0 / static_cast<double>(m)) > enough)
+      lo = m + 1;
+    else
+      hi = m;
+  }
+  n = hi;
+  // Halves of the n sub-steps, [i0, i1] of them, dropped whole where they cannot reach material.
+  auto visit = [&](auto& self, long i0, long i1) -> void {
+    const double s0 = static_cast<double>(i0) / static_cast<double>(n);
+    const double s1 = static_cast<double>(i1) / static_cast<double>(n);
+    const ToolPose p0 = pose_at(s0), p1 = pose_at(s1), mid = pose_at(0.5 * (s0 + s1));
+    Vec3 from = p0.tip, to = p1.tip;
+    if (ball) {  // the ball's centre on its chord, the step's tip below it on the middle axis
+      from += centre * (p0.axis - mid.axis);
+      to += centre * (p1.axis - mid.axis);
+    }
+    const double e = band(s1 - s0);
+    if (!may_touch(sweep_part_bounds(c, part, from, to, mid.axis).inflated(e))) return;
+    if (i1 - i0 > 1) {
+      self(self, i0, i0 + (i1 - i0) / 2);
+      self(self, i0 + (i1 - i0) / 2, i1);
+      return;
+    }
+    plan.band = std::max(plan.band, e);
+    plan.steps.push_back({from, to, mid.axis, cutter, which});
+  };
+  visit(visit, 0L, n);
+}
+
+}  // namespace detail
+
+// The sub-steps of one move for the tip and the shank of cutter `c` apart (SweepPart), each
+// with e ≤ `tolerance` (or the band achieved at the cap), dropping those whose box grown by e
+// `may_touch(Aabb)` says holds no material (SweepMaterial). Under a straight tip (TCP) the band
+// is closed form: a point at distance ≤ ρ from the tip strays from the sub-step's middle-axis
+// copy by at most ρ·Ω·Δ/2 (Ω = bounds.turn_rate, Δ the sub-step's length in s), and a ball's
+// centre, c above the tip, from its chord by c·Ω²·Δ²/8, since |axis''| ≤ Ω² for rotations about
+// fixed axes at constant rates (a ball's sweep is the same whatever its axis: it needs no more
+// sub-steps than its centre's path). Otherwise each part is planned as plan_sweep plans a move.
+// A part cut as inscribed chords (SweepCutter::chord) adds their sagitta to its band.
+template <class PoseAt, class MayTouch>
+SweepPlan plan_sweep_parts(PoseAt&& pose_at, const PoseBounds& bounds, const SweepCutter& c,
+                           const SweepShape& shape, double tolerance, std::uint32_t cutter,
+                           MayTouch&& may_touch) {
+  detail::require_positive(tolerance, "sweep tolerance");
+  SweepPlan plan;
+  for (SweepPart which : {SweepPart::tip, SweepPart::shank}) {
+    const SweepPartShape& part = shape.parts[static_cast<std::size_t>(which)];
+    if (part.empty()) continue;
+    if (bounds.tip_straight) {
+      detail::plan_straight_part(pose_at, bounds.turn_rate, c, shape, which, tolerance, cutter,
+                                 may_touch, plan);
+      continue;
+    }
+    const bool ball = which == SweepPart::tip && shape.ball_tip;
+    const double centre = ball ? shape.ball_centre : 0.0;
+    auto centre_at = [&](double s) {  // a ball is swept along its centre's path
+      ToolPose p = pose_at(s);
+      p.tip += centre * p.axis;
+      return p;
+    };
+    const PoseBounds b{bounds.tip_speed + centre * bounds.turn_rate, bounds.turn_rate, false};
+    const double reach = ball ? 0.0 : std::hypot(c.cutter.radius(), part.top);
+    const double geometric = std::max(tolerance - part.chord_error, tolerance / 16);
+    SweepPlan p = plan_sweep(centre_at, b, reach, geometric, cutter);
+    p.band += part.chord_error;
+    for (SweepStep step : p.steps) {
+      step.from -= centre * step.axis, step.to -= centre * step.axis, step.part = which;
+      if (!may_touch(sweep_part_bounds(c, part, step.from, step.to, step.axis).inflated(p.band)))
+        continue;
+      plan.band = std::max(plan.band, p.band);
+      plan.steps.push_back(step);
+    }
+  }
+  return plan;
+}
+
+namespace detail {
+
+// The interval of the ray through `point` along `axis` in the sweep of `step` (part `part` of
+// cutter `c`): closed form for quadric pieces, else the search (within [lo, hi], `precision`).
+inline std::optional<std::pair<double, double>> sweep_step_interval(
+    const SweepCutter& c, const SweepPartShape& part, const SweepStep& step, const Vec3& point,
+    int axis, double lo, double hi, double precision) {
+  if (!part.closed)
+    return ray_sweep_interval(c, step, point, axis, lo, hi, precision, part.lo, part.hi);
+  std::optional<std::pair<double, double>> hull;
+  const Vec3 travel = step.to - step.from;
+  for (const SweepPiece& piece : part.pieces) {
+    const auto cut = sweep_piece_interval(piece, step.from, travel, step.axis, point, axis);
+    if (!cut) continue;
+    // The part is convex, so its pieces' intervals on one ray overlap: their hull is the union.
+    hull = hull ? std::pair{std::min(hull->first, cut->first), std::max(hull->second, cut->second)}
+                : *cut;
+  }
+  return hull;
+}
+
+// The steps of one grid listed by row (v index) and block of kBlock rays along the row.
+struct SweepRows {
+  static constexpr int kBlock = 32;
+  int blocks = 0;
+  std::vector<std::uint32_t> offsets, steps;
+  std::span<const std::uint32_t> at(int iu, int iv) const {
+    const std::size_t k = static_cast<std::size_t>(iv) * static_cast<std::size_t>(blocks) +
+                          static_cast<std::size_t>(iu / kBlock);
+    return {steps.data() + offsets[k], steps.data() + offsets[k + 1]};
+  }
+};
+
+inline SweepRows sweep_rows(const TripleDexel& d, int axis, std::span<const Aabb> boxes) {
+  const int u = TripleDexel::u_axis(axis), v = TripleDexel::v_axis(axis);
+  const DexelGrid& g = d.grids[static_cast<std::size_t>(axis)];
+  SweepRows rows;
+  rows.blocks = (g.nu + SweepRows::kBlock - 1) / SweepRows::kBlock;
+  rows.offsets.assign(static_cast<std::size_t>(g.nv) * static_cast<std::size_t>(rows.blocks) + 1,
+                      0);
+  auto range = [&](const Aabb& box, int a, int n) {
+    const double first = std::ceil((box.min[a] - d.origin[a]) / d.spacing);
+    const double last = std::floor((box.max[a] - d.origin[a]) / d.spacing);
+    return std::pair{static_cast<int>(std::max(first, 0.0)),
+                     static_cast<int>(std::min(last, n - 1.0))};
+  };
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<std::uint32_t> fill(rows.offsets.begin(), rows.offsets.end() - 1);
+    for (std::size_t s = 0; s < boxes.size(); ++s) {
+      const auto [u0, u1] = range(boxes[s], u, g.nu);
+      const auto [v0, v1] = range(boxes[s], v, g.nv);
+      if (u0 > u1) continue;
+      for (int iv = v0; iv <= v1; ++iv)
+        for (int b = u0 / SweepRows::kBlock; b <= u1 / SweepRows::kBlock; ++b) {
+          const std::size_t k =
+              static_cast<std::size_t>(iv) * static_cast<std::size_t>(rows.blocks) +
+              static_cast<std::size_t>(b);
+          if (pass == 0)
+            ++rows.offsets[k + 1];
+          else
+            rows.steps[fill[k]++] = static_cast<std::uint32_t>(s);
+        }
+    }
+    if (pass == 0) {
+      for (std::size_t k = 1; k < rows.offsets.size(); ++k) rows.offsets[k] += rows.offsets[k - 1];
+      rows.steps.resize(rows.offsets.back());
+    }
+  }
+  return rows;
+}
+
+// Ray (iu, iv) of grid `axis` less the sweeps of the steps listed for it. Each sweep is
+// subtracted as soon as it is found; one whose box holds no material left is not computed.
+// Intervals are closed form (or found to `precision` within the material left), and subtraction
+// in any order gives the same set.
 inline void sweep_ray(std::span<const DexelInterval> ray, const TripleDexel& d, int axis, int iu,
                       int iv, std::span<const SweepCutter> cutters,
-                      std::span<const SweepStep> steps, std::span<const Aabb> boxes,
-                      std::span<const std::uint32_t> row, double precision,
-                      std::vector<DexelInterval>& current, std::vector<DexelInterval>& out) {
+                      std::span<const SweepShape> shapes, std::span<const SweepStep> steps,
+                      std::span<const Aabb> boxes, std::span<const std::uint32_t> listed,
+                      double precision, std::vector<DexelInterval>& current,
+                      std::vector<DexelInterval>& out) {
   const int u = TripleDexel::u_axis(axis), v = TripleDexel::v_axis(axis);
   Vec3 point = d.origin;
   point[u] += d.spacing * iu;
   point[v] += d.spacing * iv;
   current.assign(ray.begin(), ray.end());
-  std::vector<DexelInterval> next;
-  for (std::uint32_t s : row) {
+  thread_local std::vector<DexelInterval> next;
+  for (std::uint32_t s : listed) {
     const Aabb& box = boxes[s];
     if (current.empty()) break;
-    if (point[u] < box.min[u] || point[u] > box.max[u] || point[v] < box.min[v] ||
-        point[v] > box.max[v])
-      continue;
+    if (point[u] < box.min[u] || point[u] > box.max[u]) continue;
     double lo = box.max[axis], hi = box.min[axis];  // the material left within the box
     for (const DexelInterval& span : current)
       if (span.exit >= box.min[axis] && span.enter <= box.max[axis]) {
@@ -207,8 +504,10 @@ inline void sweep_ray(std::span<const DexelInterval> ray, const TripleDexel& d, 
         hi = std::max(hi, std::min<double>(span.exit, box.max[axis]));
       }
     if (!(lo <= hi)) continue;
-    auto cut =
-        ray_sweep_interval(cutters[steps[s].cutter], steps[s], point, axis, lo, hi, precision);
+    const SweepStep& step = steps[s];
+    const auto cut = sweep_step_interval(
+        cutters[step.cutter], shapes[step.cutter].parts[static_cast<std::size_t>(step.part)], step,
+        point, axis, lo, hi, precision);
     if (!cut) continue;
     const DexelInterval removed{static_cast<float>(cut->first), static_cast<float>(cut->second)};
     next.clear();
@@ -221,44 +520,40 @@ inline void sweep_ray(std::span<const DexelInterval> ray, const TripleDexel& d, 
 }  // namespace detail
 
 // Removes the sweeps of `steps` (each with its cutter) from every ray of `d`, to within
-// `precision` mm. Rays are independent and the grids are rebuilt in ray order, so the result does
-// not depend on `threads`.
+// `precision` mm where a part's interval is searched (closed-form ones are exact). Rays are
+// independent, each takes its steps in order, and the grids are rebuilt in ray order, so the
+// result does not depend on `threads`.
 inline void sweep_remove(TripleDexel& d, std::span<const SweepCutter> cutters,
                          std::span<const SweepStep> steps, unsigned threads,
                          double precision = 1e-4) {
   detail::require_positive(precision, "sweep precision");
+  std::vector<SweepShape> shapes;
+  for (const SweepCutter& c : cutters) shapes.push_back(sweep_shape(c));
   std::vector<Aabb> boxes;
   boxes.reserve(steps.size());
   for (const SweepStep& s : steps) {
     if (s.cutter >= cutters.size()) detail::fail("sweep_remove: step names cutter ", s.cutter);
-    boxes.push_back(sweep_step_bounds(cutters[s.cutter], s));
+    const SweepPartShape& part = shapes[s.cutter].parts[static_cast<std::size_t>(s.part)];
+    boxes.push_back(sweep_part_bounds(cutters[s.cutter], part, s.from, s.to, s.axis));
   }
   for (int axis = 0; axis < 3; ++axis) {
-    const int v = TripleDexel::v_axis(axis);
-    const DexelGrid& old = d.grids[axis];
-    // Each step listed for the rows (v index) its box spans.
-    std::vector<std::vector<std::uint32_t>> rows(static_cast<std::size_t>(old.nv));
-    for (std::size_t s = 0; s < steps.size(); ++s) {
-      const double first = std::ceil((boxes[s].min[v] - d.origin[v]) / d.spacing);
-      const double last = std::floor((boxes[s].max[v] - d.origin[v]) / d.spacing);
-      for (double iv = std::max(first, 0.0); iv <= std::min(last, old.nv - 1.0); ++iv)
-        rows[static_cast<std::size_t>(iv)].push_back(static_cast<std::uint32_t>(s));
-    }
+    const DexelGrid& old = d.grids[static_cast<std::size_t>(axis)];
+    const detail::SweepRows rows = detail::sweep_rows(d, axis, boxes);
     DexelGrid next = detail::build_grid(
         d.lattice(), axis, threads, [&](std::size_t r, std::vector<DexelInterval>& out) {
           const int iu = static_cast<int>(r % static_cast<std::size_t>(old.nu));
           const int iv = static_cast<int>(r / static_cast<std::size_t>(old.nu));
-          const auto& row = rows[static_cast<std::size_t>(iv)];
-          if (row.empty()) {
+          const auto listed = rows.at(iu, iv);
+          if (listed.empty()) {
             const auto ray = old.ray(r);
             out.insert(out.end(), ray.begin(), ray.end());
             return;
           }
           thread_local std::vector<DexelInterval> scratch;
-          detail::sweep_ray(old.ray(r), d, axis, iu, iv, cutters, steps, boxes, row, precision,
-                            scratch, out);
+          detail::sweep_ray(old.ray(r), d, axis, iu, iv, cutters, shapes, steps, boxes, listed,
+                            precision, scratch, out);
         });
-    d.grids[axis] = std::move(next);
+    d.grids[static_cast<std::size_t>(axis)] = std::move(next);
   }
 }
 

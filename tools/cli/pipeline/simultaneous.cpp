@@ -33,18 +33,28 @@ void cut_simultaneous(const SimulateOptions& options, SimulationResult& r, bool 
   const auto start = std::chrono::steady_clock::now();
   const std::optional<gcode::Kinematics>& kinematics = r.input.machine.kinematics;
   if (!kinematics) detail::fail("cut_simultaneous: simultaneous moves without kinematics");
-  std::vector<SweepCutter> cutters;
-  for (std::size_t c = 0; c < r.cutters.size(); ++c)
-    cutters.push_back(sweep_cutter_of(r.cutters[c], r.bodies[c]));
   r.sweep_tolerance = r.lattice.spacing / 10;
+  std::vector<SweepCutter> cutters;
+  std::vector<SweepShape> shapes;
+  for (std::size_t c = 0; c < r.cutters.size(); ++c) {
+    cutters.push_back(sweep_cutter_of(r.cutters[c], r.bodies[c]));
+    // A bull nose's torus as inscribed chords, their sagitta a quarter of the band (sweep.hpp).
+    cutters.back().chord = r.sweep_tolerance / 4;
+    shapes.push_back(sweep_shape(cutters.back()));
+  }
+  // Sub-steps that cannot reach the material left after the 3+2 cuts are dropped (sweep.hpp).
+  const SweepMaterial material(r.result);
+  auto may_touch = [&](const Aabb& box) { return material.may_touch(box); };
   std::vector<SweepStep> steps;
   long long capped = 0;
   for (const gcode::Move& m : r.simultaneous) {
     auto it = r.cutter_of_tool.find(m.tool);
     if (it == r.cutter_of_tool.end()) continue;  // before any tool (dropped as the groups' are)
     const gcode::MovePath path(*kinematics, m);
-    const SweepPlan plan = plan_sweep([&](double s) { return path.at(s); }, path.bounds(),
-                                      cutters[it->second].reach(), r.sweep_tolerance, it->second);
+    const std::size_t c = it->second;
+    const SweepPlan plan =
+        plan_sweep_parts([&](double s) { return path.at(s); }, path.bounds(), cutters[c], shapes[c],
+                         r.sweep_tolerance, static_cast<std::uint32_t>(c), may_touch);
     SweepSummary& summary = r.sweeps[m.tool];
     ++summary.moves;
     summary.sub_steps += static_cast<long long>(plan.steps.size());

@@ -1,0 +1,238 @@
+// tridex — machinery of sweep.hpp: the interval a dexel ray meets in a convex cutter translated
+// with a fixed axis, in closed form.
+//
+// A ray point x(u) = p + u·e lies in the sweep of a cutter piece K (tip moving from `from` by s·T,
+// s ∈ [0, 1]) iff some s puts y = x(u) − from − s·T in K. The pieces here are a frustum (distance
+// from the axis ≤ ρ0 + m·(h − lo) for heights h ∈ [lo, hi]: flat, cone, chamfer and shank
+// cylinders) and a ball centred on the axis (ball and tapered-ball tips). Each is a quadratic
+// inequality F(u, s) ≤ 0 with linear side conditions (0 ≤ s ≤ 1, lo ≤ h ≤ hi), a compact convex set
+// in the (u, s) plane; the ray's interval is that set's extent in u. The extremes of a linear
+// function over such a set lie at a vertex of the side conditions, where a side line meets the
+// conic, or where the conic's tangent is parallel to the s axis (∂F/∂s = 0): a handful of
+// quadratics, no search. The bull nose's torus is no quadric; sweep.hpp searches it instead.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "tridex/cutter.hpp"
+#include "tridex/geometry.hpp"
+
+namespace tridex::detail {
+
+// One convex piece of a cutter over heights [lo, hi] above the tip: a frustum (radius
+// rho0 + slope·(h − lo)) or a ball of `radius` centred `centre` above the tip on the axis.
+struct SweepPiece {
+  double lo = 0, hi = 0;
+  bool ball = false;
+  double rho0 = 0, slope = 0;
+  double centre = 0, radius = 0;
+};
+
+// F(u, s) = A u² + 2B us + C s² + 2D u + 2E s + G.
+struct SweepConic {
+  double a = 0, b = 0, c = 0, d = 0, e = 0, g = 0;
+  double at(double u, double s) const {
+    return a * u * u + 2 * b * u * s + c * s * s + 2 * d * u + 2 * e * s + g;
+  }
+  // Adds sign·(g0 + u·g1 + s·g2)².
+  void add_square(double g0, double g1, double g2, double sign) {
+    a += sign * g1 * g1, b += sign * g1 * g2, c += sign * g2 * g2;
+    d += sign * g0 * g1, e += sign * g0 * g2, g += sign * g0 * g0;
+  }
+};
+
+// A side condition lu·u + ls·s + l0 ≥ 0.
+struct SweepSide {
+  double lu = 0, ls = 0, l0 = 0;
+  double at(double u, double s) const { return lu * u + ls * s + l0; }
+};
+
+// The real roots of q2 x² + q1 x + q0 (none when all vanish: the caller's vertices cover a line
+// lying in the set). A discriminant a rounding below zero counts as a double root (tangency).
+template <class Out>
+void sweep_roots(double q2, double q1, double q0, Out&& out) {
+  const double scale = std::abs(q2) + std::abs(q1) + std::abs(q0);
+  if (!(scale > 0)) return;
+  if (std::abs(q2) <= 1e-13 * scale) {
+    if (std::abs(q1) > 1e-13 * scale) out(-q0 / q1);
+    return;
+  }
+  double disc = q1 * q1 - 4 * q2 * q0;
+  if (disc < 0) {
+    if (disc < -1e-12 * (q1 * q1 + std::abs(4 * q2 * q0))) return;
+    disc = 0;
+  }
+  const double q = -0.5 * (q1 + std::copysign(std::sqrt(disc), q1));
+  out(q / q2);
+  if (q != 0) out(q0 / q);
+}
+
+// F restricted to the line s = s0 + s1·u, as a quadratic in u.
+inline void sweep_along_s(const SweepConic& f, double s0, double s1, double& q2, double& q1,
+                          double& q0) {
+  q2 = f.a + 2 * f.b * s1 + f.c * s1 * s1;
+  q1 = 2 * (f.b * s0 + f.c * s0 * s1 + f.d + f.e * s1);
+  q0 = f.c * s0 * s0 + 2 * f.e * s0 + f.g;
+}
+
+// The extent in u of {F ≤ 0} ∩ sides, or nullopt if empty. `tol`: slack in mm for the tests of
+// candidate points (F is about 2·radius·distance near the surface).
+inline std::optional<std::pair<double, double>> sweep_conic_range(const SweepConic& f,
+                                                                  std::span<const SweepSide> sides,
+                                                                  double f_tol, double tol) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  auto consider = [&](double u, double s) {
+    if (!std::isfinite(u) || !std::isfinite(s)) return;
+    for (const SweepSide& side : sides)
+      if (side.at(u, s) < -tol) return;
+    if (f.at(u, s) > f_tol) return;
+    lo = std::min(lo, u), hi = std::max(hi, u);
+  };
+  double q2, q1, q0;
+  if (std::abs(f.c) > 1e-14 * (std::abs(f.a) + std::abs(f.b) + std::abs(f.c))) {
+    const double s1 = -f.b / f.c, s0 = -f.e / f.c;  // ∂F/∂s = 0
+    sweep_along_s(f, s0, s1, q2, q1, q0);
+    sweep_roots(q2, q1, q0, [&](double u) { consider(u, s0 + s1 * u); });
+  }
+  for (const SweepSide& side : sides) {
+    if (std::abs(side.ls) >= std::abs(side.lu)) {
+      if (side.ls == 0) continue;
+      const double s1 = -side.lu / side.ls, s0 = -side.l0 / side.ls;
+      sweep_along_s(f, s0, s1, q2, q1, q0);
+      sweep_roots(q2, q1, q0, [&](double u) { consider(u, s0 + s1 * u); });
+    } else {
+      const double u1 = -side.ls / side.lu, u0 = -side.l0 / side.lu;  // u = u0 + u1·s
+      q2 = f.a * u1 * u1 + 2 * f.b * u1 + f.c;
+      q1 = 2 * (f.a * u0 * u1 + f.b * u0 + f.d * u1 + f.e);
+      q0 = f.a * u0 * u0 + 2 * f.d * u0 + f.g;
+      sweep_roots(q2, q1, q0, [&](double s) { consider(u0 + u1 * s, s); });
+    }
+  }
+  for (std::size_t i = 0; i < sides.size(); ++i)
+    for (std::size_t j = i + 1; j < sides.size(); ++j) {
+      const SweepSide &p = sides[i], &q = sides[j];
+      const double det = p.lu * q.ls - q.lu * p.ls;
+      if (std::abs(det) <= 1e-14 * (std::abs(p.lu * q.ls) + std::abs(q.lu * p.ls))) continue;
+      consider((-p.l0 * q.ls + q.l0 * p.ls) / det, (-p.lu * q.l0 + q.lu * p.l0) / det);
+    }
+  if (!(lo <= hi)) return std::nullopt;
+  return std::pair{lo, hi};
+}
+
+// The interval of the ray x(u) = point + u·e_axis (point's axis coordinate ignored) in the
+// capsule of radius r around the segment c0–c1: the hull of the ray's crossings with the two end
+// balls and with the side cylinder where it lies between them (the capsule is convex and its
+// boundary is made of these; the ray–cylinder quadratic as in Quílez's capsule intersection).
+inline std::optional<std::pair<double, double>> capsule_interval(const Vec3& c0, const Vec3& c1,
+                                                                 double r, const Vec3& point,
+                                                                 int axis) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  Vec3 m = point - c0;
+  m[axis] = -c0[axis];
+  const Vec3 d = c1 - c0;
+  const double me = m[axis], mm = glm::dot(m, m), r2 = r * r;
+  auto ball = [&](double b, double c) {  // u² + 2bu + c = 0
+    const double disc = b * b - c;
+    if (disc < 0) return;
+    const double root = std::sqrt(disc);
+    lo = std::min(lo, -b - root), hi = std::max(hi, -b + root);
+  };
+  ball(me, mm - r2);
+  const double dd = glm::dot(d, d);
+  if (dd > 0) {
+    const Vec3 m1 = m - d;
+    ball(m1[axis], glm::dot(m1, m1) - r2);
+    const double md = glm::dot(m, d), nd = d[axis];
+    const double a = dd - nd * nd, b = dd * me - nd * md, c = dd * (mm - r2) - md * md;
+    const double disc = b * b - a * c;
+    if (a > 1e-12 * dd && disc >= 0) {
+      const double root = std::sqrt(disc);
+      for (const double u : {(-b - root) / a, (-b + root) / a}) {
+        const double t = md + u * nd;  // dd × the parameter of the nearest segment point
+        if (t >= 0 && t <= dd) lo = std::min(lo, u), hi = std::max(hi, u);
+      }
+    }
+  }
+  if (!(lo <= hi)) return std::nullopt;
+  return std::pair{lo, hi};
+}
+
+// The interval of the ray x(u) = point + u·e_ray_axis (point's ray-axis coordinate ignored) in
+// the sweep of `piece` with unit axis `axis`, tip from `from` moved by `travel`.
+inline std::optional<std::pair<double, double>> sweep_piece_interval(
+    const SweepPiece& piece, const Vec3& from, const Vec3& travel, const Vec3& axis,
+    const Vec3& point, int ray_axis) {
+  if (piece.ball) {
+    const Vec3 c0 = from + piece.centre * axis;
+    return capsule_interval(c0, c0 + travel, piece.radius, point, ray_axis);
+  }
+  Vec3 w = point - from;
+  w[ray_axis] = -from[ray_axis];
+  const double hw = glm::dot(w, axis), hu = axis[ray_axis], hs = -glm::dot(travel, axis);
+  // |y|² − h² − (ρ0 + m(h − lo))²: the squared distance from the axis less the squared radius.
+  SweepConic f;
+  for (int i = 0; i < 3; ++i) f.add_square(w[i], i == ray_axis ? 1.0 : 0.0, -travel[i], 1);
+  f.add_square(hw, hu, hs, -1);
+  const double m = piece.slope;
+  f.add_square(piece.rho0 + m * (hw - piece.lo), m * hu, m * hs, -1);
+  const double size = piece.hi + glm::length(travel) + piece.rho0 + m * (piece.hi - piece.lo);
+  const SweepSide sides[4] = {
+      {0, 1, 0}, {0, -1, 1}, {hu, hs, hw - piece.lo}, {-hu, -hs, piece.hi - hw}};
+  const double tol = 1e-9 * (1 + size);
+  return sweep_conic_range(f, sides, 2 * tol * (1 + size), tol);
+}
+
+// Appends the frustum between meridian points (d0, h0) and (d1, h1), h1 > h0, clipped to [lo, hi].
+inline void sweep_frustum(double d0, double h0, double d1, double h1, double lo, double hi,
+                          std::vector<SweepPiece>& out) {
+  if (h1 <= lo || h0 >= hi || h1 <= h0) return;  // a flat bottom: the face of the piece above it
+  const double slope = (d1 - d0) / (h1 - h0), a = std::max(lo, h0), b = std::min(hi, h1);
+  out.push_back({a, b, false, d0 + slope * (a - h0), slope, 0, 0});
+}
+
+// The convex pieces of cutter `c` cut at `height` between heights lo and hi; false if an arc off
+// the axis (the bull nose's torus, no quadric) is met and `chord` is 0. With `chord` > 0 such an
+// arc is replaced by inscribed chords (frusta) whose sagitta is at most `chord`: the pieces then
+// lie inside the cutter and the cutter within `error` (the largest sagitta) of them. An arc
+// centred on the axis is the whole ball (it lies inside the cutter: the profile above it is
+// tangent or wider), so a piece list with a ball may reach above `hi` by up to the ball's radius,
+// never outside the cutter.
+inline bool sweep_pieces(const Cutter& c, double height, double lo, double hi, double chord,
+                         std::vector<SweepPiece>& out, double& error) {
+  for (const ProfilePiece& p : c.pieces()) {
+    const double h0 = p.height(p.d0), h1 = p.height(p.d1);
+    if (h1 <= lo || h0 >= hi) continue;
+    if (!p.is_arc) {
+      sweep_frustum(p.d0, h0, p.d1, h1, lo, hi, out);
+      continue;
+    }
+    if (p.centre_d == 0 && p.d0 == 0 && p.centre_h + p.radius <= height) {
+      out.push_back({0, p.centre_h + p.radius, true, 0, 0, p.centre_h, p.radius});
+      continue;
+    }
+    if (!(chord > 0)) return false;
+    // The lower arc at angles from the downward vertical: d = centre_d + radius·sin(angle).
+    const double a0 = std::asin(std::clamp((p.d0 - p.centre_d) / p.radius, -1.0, 1.0));
+    const double a1 = std::asin(std::clamp((p.d1 - p.centre_d) / p.radius, -1.0, 1.0));
+    const double step = 2 * std::acos(std::max(0.0, 1 - chord / p.radius));
+    const int k = std::max(1, static_cast<int>(std::ceil((a1 - a0) / step)));
+    error = std::max(error, p.radius * (1 - std::cos((a1 - a0) / (2 * k))));
+    for (int i = 0; i < k; ++i) {
+      const double b0 = a0 + (a1 - a0) * i / k, b1 = a0 + (a1 - a0) * (i + 1) / k;
+      sweep_frustum(p.centre_d + p.radius * std::sin(b0), p.centre_h - p.radius * std::cos(b0),
+                    p.centre_d + p.radius * std::sin(b1), p.centre_h - p.radius * std::cos(b1), lo,
+                    hi, out);
+    }
+  }
+  const double top = std::max(lo, c.profile_height()), end = std::min(hi, height);
+  if (end > top) out.push_back({top, end, false, c.radius(), 0, 0, 0});
+  return true;
+}
+
+}  // namespace tridex::detail
