@@ -216,6 +216,59 @@ TEST_CASE("check --fixture and a spindle nose: each planted crash at its line, n
   CHECK(r.out.find("collision:") == std::string::npos);
 }
 
+// ---- the bundled example on the bundled trunnion ---------------------------------------------
+
+// The example's tool table with gauge lengths (tool tip to spindle nose) of real holders; without
+// them the spindle's parts are not placed (machine_run.hpp).
+json example_tools(double t3_t4_length) {
+  const std::string examples = std::string(TRIDEX_SOURCE_DIR) + "/gcode/examples/";
+  json tools = json::parse(slurp(examples + "mold_3plus2.tools.json"));
+  tools["1"]["tool-length"] = 110, tools["2"]["tool-length"] = 110;
+  tools["3"]["tool-length"] = t3_t4_length, tools["4"]["tool-length"] = t3_t4_length;
+  return tools;
+}
+
+json run_example(const fs::path& dir, const json& tools, CommandResult& result) {
+  const std::string examples = std::string(TRIDEX_SOURCE_DIR) + "/gcode/examples/";
+  write_text(dir / "tools.json", tools.dump());
+  fs::remove(dir / "report.json");
+  result = run_tridex({"check", examples + "mold_3plus2_bc.nc", "--machine", "bc-trunnion",
+                       "--tools", (dir / "tools.json").string(), "--stock", "box:0,0,0,100,80,50",
+                       "--design", examples + "mold_3plus2.design.stl", "--dexel-res", "24",
+                       "--tolerance", "5", "--report", (dir / "report.json").string()},
+                      dir);
+  return fs::exists(dir / "report.json") ? json::parse(slurp(dir / "report.json")) : json();
+}
+
+TEST_CASE("check --machine bc-trunnion: the bundled example with real tool lengths is clean") {
+  const fs::path dir = scratch("machine-example");
+  CommandResult r;
+  // Gauge lengths of 110 and 120 mm: the 90 mm spindle nose clears the 200 mm platter when the
+  // part's -X face (on the platter's centre line) is cut at B90, and the cradle everywhere.
+  json report = run_example(dir, example_tools(120), r);
+  INFO(r.out, r.err);
+  REQUIRE(report.contains("machine"));
+  const json& m = report["machine"];
+  CHECK(m["moves"].get<long long>() > 20000);
+  CHECK(m["spindle_parts_unplaced_tools"].empty());
+  CHECK(m["collisions_count"] == 0);
+  CHECK(m["near_misses_count"] == 0);
+  CHECK(r.out.find("collision:") == std::string::npos);
+  // The nose is checked: 100 mm tools for T3/T4 put it inside the platter's rim where they cut
+  // the faces that lie on the platter's centre lines (the stock's corner is on the C axis): -X
+  // (B90 C0, the tip at X1.5) and -Y (B90 C-90); nowhere else.
+  report = run_example(dir, example_tools(100), r);
+  REQUIRE(report.contains("machine"));
+  CHECK(report["machine"]["collisions_count"].get<int>() > 0);
+  for (const json& c : report["machine"]["collisions"]) {
+    CHECK(c["b"] == "spindle nose");
+    CHECK(c["axes"]["B"].get<double>() == doctest::Approx(90));
+    const double c_axis = c["axes"]["C"].get<double>();
+    CHECK((std::abs(c_axis) < 1e-6 || std::abs(c_axis + 90) < 1e-6));
+    CHECK((c["tool"] == 3 || c["tool"] == 4));
+  }
+}
+
 TEST_CASE("machine file: the collision keys' faults name the key, exit status 2") {
   const Setup s = make_setup("machine-file-faults");
   write_text(s.dir / "p.nc", "G0 X0 Y0 Z10\nM30\n");
