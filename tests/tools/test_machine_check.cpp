@@ -216,6 +216,75 @@ TEST_CASE("check --fixture and a spindle nose: each planted crash at its line, n
   CHECK(r.out.find("collision:") == std::string::npos);
 }
 
+// The issue's bar: a vise, a clamp and a 0.3 mm plate as fixtures, a spindle nose on the spindle,
+// a long tool (60 mm from tip to gauge point) for a 25 mm deep pocket. Each planted crash is
+// found at its line only; the clean program cuts the deep pocket with the nose passing 4.6 mm
+// from the clamp, below its top, and gives nothing (not even a near miss at 2 mm).
+Setup make_bar_setup(const std::string& name) {
+  Setup s{scratch(name), {}};
+  write_ascii_stl(s.dir / "vise.stl", {make_box_mesh(Vec3(0, -20, -30), Vec3(100, 0, 0)),
+                                       make_box_mesh(Vec3(0, 60, -30), Vec3(100, 80, 0))});
+  write_ascii_stl(s.dir / "clamp.stl", {make_box_mesh(Vec3(110, 20, -30), Vec3(130, 40, 45))});
+  write_ascii_stl(s.dir / "plate.stl", {make_box_mesh(Vec3(150, -10, -30), Vec3(150.3, 70, 20))});
+  fs::create_directories(s.dir / "parts");
+  write_ascii_stl(s.dir / "parts" / "nose.stl", {make_frustum_mesh(40, 40, 0, 80)});
+  write_text(
+      s.dir / "machine.json",
+      R"({"components": [{"name": "spindle nose", "on": "spindle", "mesh": "parts/nose.stl"}],
+                 "collision": {"clearance": 0.5, "near_miss": 2}})");
+  write_text(s.dir / "tools.json",
+             R"({"1": {"shape": "cylindrical", "diameter": 6, "length": 35, "tool-length": 60}})");
+  for (const char* f : {"vise.stl", "clamp.stl", "plate.stl"})
+    s.fixture_args.insert(s.fixture_args.end(), {"--fixture", (s.dir / f).string()});
+  return s;
+}
+
+std::set<std::pair<std::string, std::string>> collision_pairs(const json& report) {
+  std::set<std::pair<std::string, std::string>> pairs;
+  for (const json& c : report["machine"]["collisions"])
+    pairs.insert({c["a"].get<std::string>(), c["b"].get<std::string>()});
+  return pairs;
+}
+
+TEST_CASE("the issue's bar: vise, clamp, plate and spindle nose; planted crashes at their lines") {
+  const Setup s = make_bar_setup("machine-bar");
+  CommandResult r;
+  using Pairs = std::set<std::pair<std::string, std::string>>;
+  // A rapid through the clamp at Z10 (line 6); the nose passes 25 mm above the clamp's top.
+  json report = run_check(s, "G0 X50 Y30 Z50\nG0 Z10\nG0 X140\nG0 Z50\n", r);
+  INFO(r.out, r.err);
+  CHECK(r.status == 3);
+  CHECK(collision_lines(report) == std::set<int>{6});
+  CHECK(collision_pairs(report) == Pairs{{"clamp.stl", "tool 1 flutes"}});
+  // The nose (radius 40, 60 mm above the tip) onto the clamp's top (Z45) as the tool plunges
+  // 25 mm deep at X85 beside it (line 5); the retract (line 6) backs off the same contact.
+  report = run_check(s, "G0 X85 Y30 Z50\nG1 Z-25 F300\nG0 Z50\n", r);
+  CHECK(r.status == 3);
+  CHECK(collision_lines(report) == std::set<int>{5});
+  CHECK(collision_pairs(report) == Pairs{{"clamp.stl", "spindle nose"}});
+  // The tip reaches Z-14.5 when the nose's bottom (Z45.5) comes within the clearance.
+  CHECK(report["machine"]["collisions"][0]["axes"]["Z"].get<double>() ==
+        doctest::Approx(-14.5).epsilon(1e-3));
+  // A 260 mm rapid at Z5 across the 0.3 mm plate (line 6), clear of the clamp beside it.
+  report = run_check(s, "G0 X140 Y50 Z50\nG0 Z5\nG0 X400\nG0 Z50\n", r);
+  CHECK(r.status == 3);
+  CHECK(collision_lines(report) == std::set<int>{6});
+  CHECK(collision_pairs(report) == Pairs{{"plate.stl", "tool 1 flutes"}});
+  // Clean: the deep pocket at X55..65, the nose 4.6 mm from the clamp and 15 mm below its top;
+  // the rapids above everything.
+  report = run_check(s,
+                     "G0 X65 Y30 Z50\nG1 Z-25 F300\nG1 X55\nG1 Y35\nG1 X65\nG1 Y30\nG0 Z50\n"
+                     "G0 X200\n",
+                     r);
+  CHECK(r.status == 0);
+  CHECK(report["machine"]["collisions"].empty());
+  CHECK(report["machine"]["near_misses"].empty());
+  CHECK(r.out.find("collision:") == std::string::npos);
+  // The same pocket 6 mm nearer the clamp (X71) puts the nose in it: the bar is not vacuous.
+  report = run_check(s, "G0 X71 Y30 Z50\nG1 Z-25 F300\nG0 Z50\n", r);
+  CHECK(collision_lines(report) == std::set<int>{5});
+}
+
 // ---- the bundled example on the bundled trunnion ---------------------------------------------
 
 // The example's tool table with gauge lengths (tool tip to spindle nose) of real holders; without
