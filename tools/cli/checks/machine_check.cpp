@@ -258,7 +258,7 @@ void MachineCheck::check_pair(const MachineBody& a, const MachineBody& b, const 
   const bool straight = move.from.rotary == move.to.rotary;
   // The bound the last move left (PairBound), carried to this move's start.
   double lower = -1;
-  if (bound.valid && bound.tool == move.tool && bound.gauge == move.gauge &&
+  if (bounded_ && bound.valid && bound.tool == move.tool && bound.gauge == move.gauge &&
       bound.at.rotary == move.from.rotary)
     lower = bound.lower - glm::length(move.from.x - bound.at.x) -
             glm::length(move.offset - bound.offset);
@@ -290,7 +290,8 @@ void MachineCheck::check_pair(const MachineBody& a, const MachineBody& b, const 
   bool settled_contact = false;
   for (int step = 0; step < kMachineMaxSteps; ++step) {
     // Searched up to what this move needs and the margin (a result at the cap means "at least").
-    const TreeDistance d = at(t, near + v * (1 - t) + kMachineReuseMargin);
+    const TreeDistance d = at(t, bounded_ ? near + v * (1 - t) + kMachineReuseMargin
+                                          : std::numeric_limits<double>::infinity());
     bound.lower = d.distance - v * (1 - t);
     if (d.distance < closest) closest = d.distance, closest_t = t, closest_d = d;
     if (d.distance <= clearance + kMachineContactSlack) {

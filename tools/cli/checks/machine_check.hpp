@@ -104,6 +104,10 @@ class MachineCheck {
   MachineCheck(std::optional<gcode::Kinematics> kinematics, std::array<bool, 3> linear_on_head,
                gcode::CollisionSettings settings);
 
+  // Off: every query searches for the exact distance and no pair reuses the last move's bound
+  // (the first version's behaviour; bench/tools/machine_bench.cpp compares the two).
+  void set_bounded_search(bool on) { bounded_ = on; }
+
   // Adds a body (its tree in its link's coordinates, work-frame bodies in the work frame).
   void add(MachineBody body);
   const std::vector<MachineBody>& bodies() const { return bodies_; }
@@ -146,6 +150,7 @@ class MachineCheck {
   std::vector<MachineBody> bodies_;
   std::vector<const gcode::RotaryAxis*> table_axes_, head_axes_;  // chain order
   std::vector<PairBound> bounds_;                                 // bodies² (i < j used)
+  bool bounded_ = true;
 };
 
 }  // namespace tridex::cli
