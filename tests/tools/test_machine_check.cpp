@@ -280,6 +280,9 @@ TEST_CASE("the issue's bar: vise, clamp, plate and spindle nose; planted crashes
   CHECK(report["machine"]["collisions"].empty());
   CHECK(report["machine"]["near_misses"].empty());
   CHECK(r.out.find("collision:") == std::string::npos);
+  // The program's first move comes from "far along the tool axis": where it lands is checked.
+  report = run_check(s, "G0 X120 Y30 Z10\nG0 Z50\n", r);
+  CHECK(collision_lines(report) == std::set<int>{4});
   // The same pocket 6 mm nearer the clamp (X71) puts the nose in it: the bar is not vacuous.
   report = run_check(s, "G0 X71 Y30 Z50\nG1 Z-25 F300\nG0 Z50\n", r);
   CHECK(collision_lines(report) == std::set<int>{5});

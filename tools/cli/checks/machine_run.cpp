@@ -170,7 +170,6 @@ MachineRun run_machine_check(const std::vector<std::string>& fixtures, const Sim
       const gcode::Move& m = r.groups[span.group].moves[next[span.group]++];
       const gcode::Move* before = previous;
       previous = &m;
-      if (m.from_far) continue;
       MachineMove move;
       move.file = m.file, move.line = m.line, move.tool = m.tool;
       const std::optional<double> gauge = mr_gauge(r, m.tool);
@@ -178,7 +177,7 @@ MachineRun run_machine_check(const std::vector<std::string>& fixtures, const Sim
       if (!gauge && spindle_parts) run.spindle_unplaced.insert(m.tool);
       if (!machine.kinematics) {
         move.offset = g54;
-        move.from.x = m.start + g54, move.to.x = m.end + g54;
+        move.from.x = (m.from_far ? m.end : m.start) + g54, move.to.x = m.end + g54;
         checked(move, m);
         continue;
       }
@@ -186,6 +185,11 @@ MachineRun run_machine_check(const std::vector<std::string>& fixtures, const Sim
       move.offset = gcode::tip_in_part(kin, m.machine, m.rotary) - m.end;
       move.to = {m.machine, m.rotary};
       move.from = {gcode::machine_from_part(kin, m.start + move.offset, m.rotary), m.rotary};
+      if (m.from_far) {  // the start is a stand-in: the pose it ends at only
+        move.from = move.to;
+        checked(move, m);
+        continue;
+      }
       if (before && before->rotary != m.rotary) {
         // The turn before the move, the machine's linear axes standing where the last move ended.
         MachineMove turn = move;

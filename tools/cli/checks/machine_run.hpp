@@ -12,10 +12,11 @@
 // 90 mm spindle nose a few millimetres above a small ball end's tip: false crashes), and the
 // report and stdout name such tools.
 //
-// Moves that come from "far along the tool axis" (from_far: the start is a stand-in) are not
-// checked. Under raw rotary programs a turn of the rotaries happens at the machine position where
-// the last move ended, before the move that follows (rotary.cpp): it is checked as a rotary-only
-// move at that move's line.
+// Of a move that comes from "far along the tool axis" (from_far: the start is a stand-in, where
+// the machine stood is unknown) only the pose it ends at is checked: a first rapid that lands
+// in a clamp is found; the way there is not known. Under raw rotary programs a turn of the rotaries
+// happens at the machine position where the last move ended, before the move that follows
+// (rotary.cpp): it is checked as a rotary-only move at that move's line.
 #pragma once
 
 #include <set>
