@@ -106,6 +106,23 @@ MachineConfig with_parts(MachineConfig m, std::vector<MachineComponent> parts) {
   return m;
 }
 
+// A trunnion's cradle as a UMC-style table stands (tilt axis along X, axis 0, or Y, axis 1, at
+// height `pivot`): the C drive's housing under the platter, no wider than it (so that a head that
+// clears the platter at a high tilt clears the housing); a floor plate under it; the side plates
+// at the tilt axis's ends, 180-210 mm out, well clear of the 200 mm platter and of what stands on
+// it, rising to the bearings 30 mm above the tilt axis (still below the table face).
+Mesh trunnion_cradle(int along, double pivot) {
+  auto box = [&](Vec3 lo, Vec3 hi) {  // given with the tilt axis along X
+    if (along == 1) std::swap(lo.x, lo.y), std::swap(hi.x, hi.y);
+    return make_box_mesh(lo, hi);
+  };
+  const double bottom = pivot - 60;
+  return merge_meshes({make_frustum_mesh(100, 100, bottom, -30),
+                       box({-210, -90, bottom}, {210, 90, bottom + 25}),
+                       box({-210, -110, bottom}, {-180, 110, pivot + 30}),
+                       box({180, -110, bottom}, {210, 110, pivot + 30})});
+}
+
 // Table-table: A tilts the trunnion about X through (0, 0, −75) (the C face 75 mm above the tilt
 // axis), −120°…120°; C turns the platter on it about Z through the origin, endless. LinuxCNC's
 // xyzac-trt kinematics with its default directions (part_to_machine = Rx(A)·Rz(C) about the
@@ -117,7 +134,7 @@ MachineConfig ac_trunnion() {
           {make_axis('A', false, {1, 0, 0}, {0, 0, -75}, std::array<double, 2>{-120, 120}),
            make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{})}),
       {built_part("platter", "C", make_frustum_mesh(100, 100, -30, 0)),
-       built_part("trunnion", "A", make_box_mesh({-160, -110, -110}, {160, 110, -35})),
+       built_part("trunnion", "A", trunnion_cradle(0, -75)),
        built_part("bed", "bed", make_box_mesh({-600, -400, -500}, {600, 400, -420}))});
 }
 
@@ -130,7 +147,7 @@ MachineConfig bc_trunnion() {
           {make_axis('B', false, {0, 1, 0}, {0, 0, -50}, std::array<double, 2>{-35, 110}),
            make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{})}),
       {built_part("platter", "C", make_frustum_mesh(100, 100, -30, 0)),
-       built_part("trunnion", "B", make_box_mesh({-120, -150, -110}, {120, 150, -35})),
+       built_part("trunnion", "B", trunnion_cradle(1, -50)),
        built_part("bed", "bed", make_box_mesh({-600, -400, -500}, {600, 400, -420}))});
 }
 

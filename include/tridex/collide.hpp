@@ -232,6 +232,17 @@ inline Aabb turned_box(const Frame& f, const Aabb& b) {
   return Aabb{c - e, c + e};
 }
 
+// A lower bound of the squared distance between triangles u and t: how far t lies wholly on one
+// side of u's plane (0 when it touches or crosses it, or u is degenerate).
+inline double plane_gap2(const detail::Triangle3& u, const detail::Triangle3& t) {
+  const Vec3 n = glm::cross(u.b - u.a, u.c - u.a);
+  const double n2 = glm::dot(n, n);
+  if (!(n2 > 0)) return 0;
+  const double a = glm::dot(n, t.a - u.a), b = glm::dot(n, t.b - u.a), c = glm::dot(n, t.c - u.a);
+  const double gap = std::max({std::min({a, b, c}), -std::max({a, b, c}), 0.0});
+  return gap * gap / n2;
+}
+
 // The distance between tree a placed by frame fa and tree b placed by frb (each frame maps its
 // tree's coordinates to a common one), and the closest points in the common frame. The search
 // stops early at the first pair closer than `stop_below` (the result is then that pair's
@@ -274,6 +285,9 @@ inline TreeDistance tree_distance(const TriangleTree& a, const Frame& fa, const 
         for (std::uint32_t j = 0; j < y.count; ++j) {
           if (!(TriangleTree::box_box_distance2(box, moved_box[j]) < best2)) continue;
           const detail::Triangle3& t = moved[j];
+          // Each triangle's plane separates: no point of the other lies nearer to it than the
+          // nearest vertex on the far side (prunes parallel faces, whose boxes overlap).
+          if (!(plane_gap2(u, t) < best2) || !(plane_gap2(t, u) < best2)) continue;
           const double d2 = detail::triangle_distance2(u, t);
           if (d2 < best2) {
             best2 = d2;

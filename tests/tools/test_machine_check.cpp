@@ -216,6 +216,131 @@ TEST_CASE("check --fixture and a spindle nose: each planted crash at its line, n
   CHECK(r.out.find("collision:") == std::string::npos);
 }
 
+// The issue's bar: a vise, a clamp and a 0.3 mm plate as fixtures, a spindle nose on the spindle,
+// a long tool (60 mm from tip to gauge point) for a 25 mm deep pocket. Each planted crash is
+// found at its line only; the clean program cuts the deep pocket with the nose passing 4.6 mm
+// from the clamp, below its top, and gives nothing (not even a near miss at 2 mm).
+Setup make_bar_setup(const std::string& name) {
+  Setup s{scratch(name), {}};
+  write_ascii_stl(s.dir / "vise.stl", {make_box_mesh(Vec3(0, -20, -30), Vec3(100, 0, 0)),
+                                       make_box_mesh(Vec3(0, 60, -30), Vec3(100, 80, 0))});
+  write_ascii_stl(s.dir / "clamp.stl", {make_box_mesh(Vec3(110, 20, -30), Vec3(130, 40, 45))});
+  write_ascii_stl(s.dir / "plate.stl", {make_box_mesh(Vec3(150, -10, -30), Vec3(150.3, 70, 20))});
+  fs::create_directories(s.dir / "parts");
+  write_ascii_stl(s.dir / "parts" / "nose.stl", {make_frustum_mesh(40, 40, 0, 80)});
+  write_text(
+      s.dir / "machine.json",
+      R"({"components": [{"name": "spindle nose", "on": "spindle", "mesh": "parts/nose.stl"}],
+                 "collision": {"clearance": 0.5, "near_miss": 2}})");
+  write_text(s.dir / "tools.json",
+             R"({"1": {"shape": "cylindrical", "diameter": 6, "length": 35, "tool-length": 60}})");
+  for (const char* f : {"vise.stl", "clamp.stl", "plate.stl"})
+    s.fixture_args.insert(s.fixture_args.end(), {"--fixture", (s.dir / f).string()});
+  return s;
+}
+
+std::set<std::pair<std::string, std::string>> collision_pairs(const json& report) {
+  std::set<std::pair<std::string, std::string>> pairs;
+  for (const json& c : report["machine"]["collisions"])
+    pairs.insert({c["a"].get<std::string>(), c["b"].get<std::string>()});
+  return pairs;
+}
+
+TEST_CASE("the issue's bar: vise, clamp, plate and spindle nose; planted crashes at their lines") {
+  const Setup s = make_bar_setup("machine-bar");
+  CommandResult r;
+  using Pairs = std::set<std::pair<std::string, std::string>>;
+  // A rapid through the clamp at Z10 (line 6); the nose passes 25 mm above the clamp's top.
+  json report = run_check(s, "G0 X50 Y30 Z50\nG0 Z10\nG0 X140\nG0 Z50\n", r);
+  INFO(r.out, r.err);
+  CHECK(r.status == 3);
+  CHECK(collision_lines(report) == std::set<int>{6});
+  CHECK(collision_pairs(report) == Pairs{{"clamp.stl", "tool 1 flutes"}});
+  // The nose (radius 40, 60 mm above the tip) onto the clamp's top (Z45) as the tool plunges
+  // 25 mm deep at X85 beside it (line 5); the retract (line 6) backs off the same contact.
+  report = run_check(s, "G0 X85 Y30 Z50\nG1 Z-25 F300\nG0 Z50\n", r);
+  CHECK(r.status == 3);
+  CHECK(collision_lines(report) == std::set<int>{5});
+  CHECK(collision_pairs(report) == Pairs{{"clamp.stl", "spindle nose"}});
+  // The tip reaches Z-14.5 when the nose's bottom (Z45.5) comes within the clearance.
+  CHECK(report["machine"]["collisions"][0]["axes"]["Z"].get<double>() ==
+        doctest::Approx(-14.5).epsilon(1e-3));
+  // A 260 mm rapid at Z5 across the 0.3 mm plate (line 6), clear of the clamp beside it.
+  report = run_check(s, "G0 X140 Y50 Z50\nG0 Z5\nG0 X400\nG0 Z50\n", r);
+  CHECK(r.status == 3);
+  CHECK(collision_lines(report) == std::set<int>{6});
+  CHECK(collision_pairs(report) == Pairs{{"plate.stl", "tool 1 flutes"}});
+  // Clean: the deep pocket at X55..65, the nose 4.6 mm from the clamp and 15 mm below its top;
+  // the rapids above everything.
+  report = run_check(s,
+                     "G0 X65 Y30 Z50\nG1 Z-25 F300\nG1 X55\nG1 Y35\nG1 X65\nG1 Y30\nG0 Z50\n"
+                     "G0 X200\n",
+                     r);
+  CHECK(r.status == 0);
+  CHECK(report["machine"]["collisions"].empty());
+  CHECK(report["machine"]["near_misses"].empty());
+  CHECK(r.out.find("collision:") == std::string::npos);
+  // The program's first move comes from "far along the tool axis": where it lands is checked.
+  report = run_check(s, "G0 X120 Y30 Z10\nG0 Z50\n", r);
+  CHECK(collision_lines(report) == std::set<int>{4});
+  // The same pocket 6 mm nearer the clamp (X71) puts the nose in it: the bar is not vacuous.
+  report = run_check(s, "G0 X71 Y30 Z50\nG1 Z-25 F300\nG0 Z50\n", r);
+  CHECK(collision_lines(report) == std::set<int>{5});
+}
+
+// ---- the bundled example on the bundled trunnion ---------------------------------------------
+
+// The example's tool table with gauge lengths (tool tip to spindle nose) of real holders; without
+// them the spindle's parts are not placed (machine_run.hpp).
+json example_tools(double t3_t4_length) {
+  const std::string examples = std::string(TRIDEX_SOURCE_DIR) + "/gcode/examples/";
+  json tools = json::parse(slurp(examples + "mold_3plus2.tools.json"));
+  tools["1"]["tool-length"] = 110, tools["2"]["tool-length"] = 110;
+  tools["3"]["tool-length"] = t3_t4_length, tools["4"]["tool-length"] = t3_t4_length;
+  return tools;
+}
+
+json run_example(const fs::path& dir, const json& tools, CommandResult& result) {
+  const std::string examples = std::string(TRIDEX_SOURCE_DIR) + "/gcode/examples/";
+  write_text(dir / "tools.json", tools.dump());
+  fs::remove(dir / "report.json");
+  result = run_tridex({"check", examples + "mold_3plus2_bc.nc", "--machine", "bc-trunnion",
+                       "--tools", (dir / "tools.json").string(), "--stock", "box:0,0,0,100,80,50",
+                       "--design", examples + "mold_3plus2.design.stl", "--dexel-res", "24",
+                       "--tolerance", "5", "--report", (dir / "report.json").string()},
+                      dir);
+  return fs::exists(dir / "report.json") ? json::parse(slurp(dir / "report.json")) : json();
+}
+
+TEST_CASE("check --machine bc-trunnion: the bundled example with real tool lengths is clean") {
+  const fs::path dir = scratch("machine-example");
+  CommandResult r;
+  // Gauge lengths of 110 and 120 mm: the 90 mm spindle nose clears the 200 mm platter when the
+  // part's -X face (on the platter's centre line) is cut at B90, and the cradle everywhere.
+  json report = run_example(dir, example_tools(120), r);
+  INFO(r.out, r.err);
+  REQUIRE(report.contains("machine"));
+  const json& m = report["machine"];
+  CHECK(m["moves"].get<long long>() > 20000);
+  CHECK(m["spindle_parts_unplaced_tools"].empty());
+  CHECK(m["collisions_count"] == 0);
+  CHECK(m["near_misses_count"] == 0);
+  CHECK(r.out.find("collision:") == std::string::npos);
+  // The nose is checked: 100 mm tools for T3/T4 put it inside the platter's rim where they cut
+  // the faces that lie on the platter's centre lines (the stock's corner is on the C axis): -X
+  // (B90 C0, the tip at X1.5) and -Y (B90 C-90); nowhere else.
+  report = run_example(dir, example_tools(100), r);
+  REQUIRE(report.contains("machine"));
+  CHECK(report["machine"]["collisions_count"].get<int>() > 0);
+  for (const json& c : report["machine"]["collisions"]) {
+    CHECK(c["b"] == "spindle nose");
+    CHECK(c["axes"]["B"].get<double>() == doctest::Approx(90));
+    const double c_axis = c["axes"]["C"].get<double>();
+    CHECK((std::abs(c_axis) < 1e-6 || std::abs(c_axis + 90) < 1e-6));
+    CHECK((c["tool"] == 3 || c["tool"] == 4));
+  }
+}
+
 TEST_CASE("machine file: the collision keys' faults name the key, exit status 2") {
   const Setup s = make_setup("machine-file-faults");
   write_text(s.dir / "p.nc", "G0 X0 Y0 Z10\nM30\n");

@@ -19,6 +19,11 @@ constexpr int kMachineMaxSteps = 20000;
 // Travel along a move: samples where machine coordinates are not straight (TCP with turning
 // rotaries), then a golden-section refinement of the worst.
 constexpr int kTravelSamples = 64;
+// A pair's distance is searched only up to what the move needs (the near-miss distance plus how
+// far the bodies can close in over the rest of the move) plus this margin, kept for the moves
+// that follow (MachineCheck::PairBound): a larger margin skips more moves after a query, a
+// smaller one prunes more of the trees in it (mm; bench/machine_bench.cpp).
+constexpr double kMachineReuseMargin = 10;
 
 Frame mc_compose(const Frame& a, const Frame& b) {
   return Frame{a.rotation * b.rotation, a.rotation * b.origin + a.origin};
@@ -196,13 +201,17 @@ bool MachineCheck::pair_tested(const MachineBody& a, const MachineBody& b, int t
   return true;
 }
 
-void MachineCheck::check(const MachineMove& move, MachineFindings& found) const {
+void MachineCheck::check(const MachineMove& move, MachineFindings& found) {
   const auto start = std::chrono::steady_clock::now();
   ++found.moves;
-  for (std::size_t i = 0; i < bodies_.size(); ++i)
-    for (std::size_t j = i + 1; j < bodies_.size(); ++j)
-      if (pair_tested(bodies_[i], bodies_[j], move.tool))
-        check_pair(bodies_[i], bodies_[j], move, found);
+  const std::size_t n = bodies_.size();
+  bounds_.resize(n * n);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j)
+      if (pair_tested(bodies_[i], bodies_[j], move.tool) &&
+          (move.gauge_known || (bodies_[i].link.kind != LinkKind::spindle &&
+                                bodies_[j].link.kind != LinkKind::spindle)))
+        check_pair(bodies_[i], bodies_[j], move, found, bounds_[i * n + j]);
   if (kin_) check_travel(move, found);
   found.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -241,12 +250,23 @@ double MachineCheck::swept_distance(const MachineBody& a, const MachineBody& b,
 }
 
 void MachineCheck::check_pair(const MachineBody& a, const MachineBody& b, const MachineMove& move,
-                              MachineFindings& found) const {
+                              MachineFindings& found, PairBound& bound) const {
   const double linear = linear_speed_bound(move);
   const double v = speed_bound(a, move, linear) + speed_bound(b, move, linear);
   const double clearance = settings_.clearance;
   const double near = std::max(settings_.near_miss, clearance);
   const bool straight = move.from.rotary == move.to.rotary;
+  // The bound the last move left (PairBound), carried to this move's start.
+  double lower = -1;
+  if (bounded_ && bound.valid && bound.tool == move.tool && bound.gauge == move.gauge &&
+      bound.at.rotary == move.from.rotary)
+    lower = bound.lower - glm::length(move.from.x - bound.at.x) -
+            glm::length(move.offset - bound.offset);
+  bound = PairBound{true, state_at(move, 1), move.offset, move.gauge, move.tool, 0};
+  if (lower > near + v) {  // cannot come within the near-miss distance anywhere on the move
+    bound.lower = lower - v;
+    return;
+  }
   auto finding = [&](double distance, double at, const TreeDistance& where) {
     const MachineState here = state_at(move, at);
     MachineBody work_body;
@@ -256,11 +276,11 @@ void MachineCheck::check_pair(const MachineBody& a, const MachineBody& b, const 
                           a.name,    b.name,    distance,
                           at,        here,      work.to_local(0.5 * (where.on_a + where.on_b))};
   };
-  auto at = [&](double t) {
+  auto at = [&](double t, double cap) {
     const MachineState s = state_at(move, t);
     ++found.queries;
     return tree_distance(*a.tree, frame_of(a, s, move), *b.tree, frame_of(b, s, move),
-                         clearance + kMachineContactSlack);
+                         clearance + kMachineContactSlack, cap);
   };
   // Conservative advancement (machine_check.hpp) from t = 0: while outside the near-miss distance
   // step to where it may be reached; inside, to where the clearance may be. A straight move that
@@ -269,10 +289,14 @@ void MachineCheck::check_pair(const MachineBody& a, const MachineBody& b, const 
   TreeDistance closest_d;
   bool settled_contact = false;
   for (int step = 0; step < kMachineMaxSteps; ++step) {
-    const TreeDistance d = at(t);
+    // Searched up to what this move needs and the margin (a result at the cap means "at least").
+    const TreeDistance d = at(t, bounded_ ? near + v * (1 - t) + kMachineReuseMargin
+                                          : std::numeric_limits<double>::infinity());
+    bound.lower = d.distance - v * (1 - t);
     if (d.distance < closest) closest = d.distance, closest_t = t, closest_d = d;
     if (d.distance <= clearance + kMachineContactSlack) {
       found.collisions.push_back(finding(std::max(0.0, d.distance), t, d));
+      bound.valid = false;
       return;
     }
     if (t >= 1 || !(v > 0)) break;
@@ -283,10 +307,11 @@ void MachineCheck::check_pair(const MachineBody& a, const MachineBody& b, const 
         if (least < settings_.near_miss) {
           // The pose of the closest approach: the nearest of a few samples.
           for (int k = 1; k <= 16; ++k)
-            if (const TreeDistance e = at(k / 16.0); e.distance < closest)
+            if (const TreeDistance e = at(k / 16.0, near); e.distance < closest)
               closest = e.distance, closest_t = k / 16.0, closest_d = e;
           closest = least;
         }
+        bound.lower = least;  // the least over the whole move
         break;
       }
       settled_contact = true;  // they meet: find where first, stepping to the clearance
@@ -297,6 +322,7 @@ void MachineCheck::check_pair(const MachineBody& a, const MachineBody& b, const 
   }
   if (settled_contact) {  // the step cap reached while grazing: the closest pose found
     found.collisions.push_back(finding(std::max(0.0, closest), closest_t, closest_d));
+    bound.valid = false;
     return;
   }
   if (closest < settings_.near_miss)

@@ -73,6 +73,7 @@ struct MachineMove {
   Vec3 tip_from{0}, tip_to{0};  // work frame (tip_linear only)
   Vec3 offset{0};               // part frame − work frame
   double gauge = 0;             // tool length: the tip to the spindle's gauge point
+  bool gauge_known = true;      // else the spindle's parts are not tested on this move
 };
 
 struct MachineFinding {
@@ -103,6 +104,10 @@ class MachineCheck {
   MachineCheck(std::optional<gcode::Kinematics> kinematics, std::array<bool, 3> linear_on_head,
                gcode::CollisionSettings settings);
 
+  // Off: every query searches for the exact distance and no pair reuses the last move's bound
+  // (the first version's behaviour; bench/tools/machine_bench.cpp compares the two).
+  void set_bounded_search(bool on) { bounded_ = on; }
+
   // Adds a body (its tree in its link's coordinates, work-frame bodies in the work frame).
   void add(MachineBody body);
   const std::vector<MachineBody>& bodies() const { return bodies_; }
@@ -111,8 +116,10 @@ class MachineCheck {
   Frame frame_of(const MachineBody& body, const MachineState& state, const MachineMove& move) const;
   MachineState state_at(const MachineMove& move, double t) const;
 
-  // Checks one move: every pair that may meet, continuously, and the travel along it.
-  void check(const MachineMove& move, MachineFindings& found) const;
+  // Checks one move: every pair that may meet, continuously, and the travel along it. Moves in
+  // program order let a pair reuse the bound it ended the last move with (PairBound); any order
+  // is sound.
+  void check(const MachineMove& move, MachineFindings& found);
 
  private:
   bool pair_tested(const MachineBody& a, const MachineBody& b, int tool) const;
@@ -120,8 +127,21 @@ class MachineCheck {
   double linear_speed_bound(const MachineMove& move) const;
   double swept_distance(const MachineBody& a, const MachineBody& b, const MachineMove& move,
                         double cap) const;
+  // What a pair knew at the end of the last move it was checked on: the distance there is at
+  // least `lower` (the last distance found, less the farthest the bodies could close in since).
+  // A move that starts within |ΔX| + |Δoffset| of that pose (rotaries, tool and gauge the same)
+  // starts at least that much less, and is skipped when even its fastest point cannot close the
+  // rest of the gap to the near-miss distance.
+  struct PairBound {
+    bool valid = false;
+    MachineState at;
+    Vec3 offset{0};
+    double gauge = 0;
+    int tool = 0;
+    double lower = 0;
+  };
   void check_pair(const MachineBody& a, const MachineBody& b, const MachineMove& move,
-                  MachineFindings& found) const;
+                  MachineFindings& found, PairBound& bound) const;
   void check_travel(const MachineMove& move, MachineFindings& found) const;
 
   std::optional<gcode::Kinematics> kin_;
@@ -129,6 +149,8 @@ class MachineCheck {
   gcode::CollisionSettings settings_;
   std::vector<MachineBody> bodies_;
   std::vector<const gcode::RotaryAxis*> table_axes_, head_axes_;  // chain order
+  std::vector<PairBound> bounds_;                                 // bodies² (i < j used)
+  bool bounded_ = true;
 };
 
 }  // namespace tridex::cli

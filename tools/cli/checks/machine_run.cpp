@@ -59,24 +59,32 @@ Link mr_link(const std::string& on, const std::optional<gcode::Kinematics>& kin)
   return {LinkKind::bed, 0};
 }
 
-// The tool's length from the tip to the spindle's gauge point (machine_run.hpp).
-double mr_gauge(const SimulationResult& r, int tool) {
+// The tool's length from the tip to the spindle's gauge point (machine_run.hpp): the tool
+// table's tool length, else the top of the holder; none when neither is given (the flutes' top
+// is not the gauge point: a tool sticks out of a holder tridex is not told of).
+std::optional<double> mr_gauge(const SimulationResult& r, int tool) {
   if (auto length = r.input.machine.tool_lengths.find(tool);
       length != r.input.machine.tool_lengths.end() && length->second > 0)
     return length->second;
   auto c = r.cutter_of_tool.find(tool);
-  if (c == r.cutter_of_tool.end()) return 0;
+  if (c == r.cutter_of_tool.end()) return std::nullopt;
   const ToolBody& body = r.bodies[c->second];
   if (!body.parts.empty()) return body.parts.back().bottom + body.parts.back().shape.length;
-  const Cutter& cutter = r.cutters[c->second];
-  return std::max(cutter.profile_height(), 6 * cutter.radius());
+  return std::nullopt;
+}
+
+// Where the flutes end with neither a shank nor a holder: the gauge point, else the profile's
+// top or 6 radii, whichever is higher.
+double mr_flutes_top(const SimulationResult& r, int tool, const Cutter& cutter) {
+  return mr_gauge(r, tool).value_or(std::max(cutter.profile_height(), 6 * cutter.radius()));
 }
 
 // The tool's flutes, shank and holder as meshes in tool coordinates.
 void mr_add_tool(MachineCheck& check, const SimulationResult& r, int tool, std::uint32_t c) {
   const Cutter& cutter = r.cutters[c];
   const ToolBody& body = r.bodies[c];
-  const double top = body.parts.empty() ? mr_gauge(r, tool) : body.parts.front().bottom;
+  const double top =
+      body.parts.empty() ? mr_flutes_top(r, tool, cutter) : body.parts.front().bottom;
   std::vector<Mesh> flutes;
   // The profile by rings; each piece of the cone between two rings lowered by how far the
   // profile sags below its chord (a ball's lower surface is convex), so that the mesh holds it.
@@ -130,6 +138,8 @@ MachineRun run_machine_check(const std::vector<std::string>& fixtures, const Sim
                               : mr_tree(mr_read(c.mesh, "--machine: component \"" + c.name +
                                                             "\" mesh " + c.mesh))));
   for (const auto& [tool, c] : r.cutter_of_tool) mr_add_tool(check, r, tool, c);
+  bool spindle_parts = false;
+  for (const MachineBody& b : check.bodies()) spindle_parts |= b.link.kind == LinkKind::spindle;
   for (const MachineBody& b : check.bodies()) run.bodies.push_back(b.name);
 
   const Vec3 g54 = machine.work_offsets.count(1) ? machine.work_offsets.at(1) : Vec3(0);
@@ -160,12 +170,14 @@ MachineRun run_machine_check(const std::vector<std::string>& fixtures, const Sim
       const gcode::Move& m = r.groups[span.group].moves[next[span.group]++];
       const gcode::Move* before = previous;
       previous = &m;
-      if (m.from_far) continue;
       MachineMove move;
-      move.file = m.file, move.line = m.line, move.tool = m.tool, move.gauge = mr_gauge(r, m.tool);
+      move.file = m.file, move.line = m.line, move.tool = m.tool;
+      const std::optional<double> gauge = mr_gauge(r, m.tool);
+      move.gauge = gauge.value_or(0), move.gauge_known = gauge.has_value();
+      if (!gauge && spindle_parts) run.spindle_unplaced.insert(m.tool);
       if (!machine.kinematics) {
         move.offset = g54;
-        move.from.x = m.start + g54, move.to.x = m.end + g54;
+        move.from.x = (m.from_far ? m.end : m.start) + g54, move.to.x = m.end + g54;
         checked(move, m);
         continue;
       }
@@ -173,6 +185,11 @@ MachineRun run_machine_check(const std::vector<std::string>& fixtures, const Sim
       move.offset = gcode::tip_in_part(kin, m.machine, m.rotary) - m.end;
       move.to = {m.machine, m.rotary};
       move.from = {gcode::machine_from_part(kin, m.start + move.offset, m.rotary), m.rotary};
+      if (m.from_far) {  // the start is a stand-in: the pose it ends at only
+        move.from = move.to;
+        checked(move, m);
+        continue;
+      }
       if (before && before->rotary != m.rotary) {
         // The turn before the move, the machine's linear axes standing where the last move ended.
         MachineMove turn = move;
@@ -226,6 +243,7 @@ Json machine_json(const MachineRun& run, const SimulationResult& r) {
           {"near_misses", list(run.found.near_misses)},
           {"near_misses_count", run.found.near_misses.size()},
           {"travel_along_moves", travel},
+          {"spindle_parts_unplaced_tools", run.spindle_unplaced},
           {"moves", run.found.moves},
           {"queries", run.found.queries},
           {"seconds", run.found.seconds}};
@@ -245,6 +263,14 @@ void print_machine_findings(const MachineRun& run, const SimulationResult& r, st
     return out;
   };
   const auto& found = run.found;
+  if (!run.spindle_unplaced.empty()) {
+    std::string tools;
+    for (int t : run.spindle_unplaced) tools += (tools.empty() ? "T" : ", T") + std::to_string(t);
+    std::printf(
+        "  machine: the spindle's parts not tested with %s: no tool length (the tool table's "
+        "\"tool-length\" or a holder places the gauge point)\n",
+        tools.c_str());
+  }
   for (std::size_t k = 0; k < found.collisions.size() && k < limit; ++k) {
     const MachineFinding& f = found.collisions[k];
     std::printf(

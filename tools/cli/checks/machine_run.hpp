@@ -4,17 +4,22 @@
 // findings as the report, stdout and the HTML page give them.
 //
 // A tool's parts: its flutes (the cutter's profile turned about the axis, up to the shank's
-// bottom; with no shank, to the gauge point), its shank and each holder section (frusta), all as
-// polygons around the round bodies. The gauge point (where the spindle's parts hang from) lies the
-// tool's length above the tip: the tool table's tool length; else the top of the holder; else the
-// flutes' top, max(the profile's height, 6 radii).
+// bottom; with no shank, to the gauge point, else max(the profile's height, 6 radii)), its shank
+// and each holder section (frusta), all as polygons around the round bodies. The gauge point
+// (where the spindle's parts hang from) lies the tool's length above the tip: the tool table's
+// tool length, else the top of the holder. A tool with neither has no gauge point: the spindle's
+// parts are not tested while it is in the spindle (placing them at the flutes' top would put a
+// 90 mm spindle nose a few millimetres above a small ball end's tip: false crashes), and the
+// report and stdout name such tools.
 //
-// Moves that come from "far along the tool axis" (from_far: the start is a stand-in) are not
-// checked. Under raw rotary programs a turn of the rotaries happens at the machine position where
-// the last move ended, before the move that follows (rotary.cpp): it is checked as a rotary-only
-// move at that move's line.
+// Of a move that comes from "far along the tool axis" (from_far: the start is a stand-in, where
+// the machine stood is unknown) only the pose it ends at is checked: a first rapid that lands
+// in a clamp is found; the way there is not known. Under raw rotary programs a turn of the rotaries
+// happens at the machine position where the last move ended, before the move that follows
+// (rotary.cpp): it is checked as a rotary-only move at that move's line.
 #pragma once
 
+#include <set>
 #include <string>
 #include <vector>
 
@@ -27,6 +32,7 @@ namespace tridex::cli {
 struct MachineRun {
   bool active = false;  // fixtures or components were given
   std::vector<std::string> bodies;
+  std::set<int> spindle_unplaced;  // tools without a gauge point: spindle parts not tested
   MachineFindings found;
 };
 
