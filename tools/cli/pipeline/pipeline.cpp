@@ -472,6 +472,66 @@ void drop_toolless_moves(SimulationResult& r) {
         " rapid move(s) before the first tool change were not simulated (no tool)");
 }
 
+std::string clean_number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
+// check (PipelineRequest::resolve_gouges, resolution.hpp): the bound of what the lattice can miss
+// (r.resolution), the lattice refined when the options left the spacing to tridex and it does not
+// resolve the tolerance, and a spacing given that does not refused (exit status 2).
+void resolve_tolerance(const SimulateOptions& options, const PipelineRequest& request,
+                       const std::function<double(double)>& zmap_cell_for, SimulationResult& r) {
+  const double tolerance = request.resolve_gouges;
+  const auto bound_at = [&](double spacing) {
+    return resolution_bound(r.groups, r.simultaneous, r.cutters, r.cutter_of_tool, spacing,
+                            zmap_cell_for(spacing));
+  };
+  r.resolution = bound_at(r.lattice.spacing);
+  if (r.resolution.missable <= tolerance || request.lattice_only) return;
+  const double needed = spacing_for_tolerance(
+      [&](double spacing) { return bound_at(spacing).missable; }, r.lattice.spacing, tolerance);
+  const std::string missed = missable_text(r.resolution, r.cutters, r.cutter_of_tool);
+  char spacing_text[96] = "none (the Z-map cell alone is too coarse: a smaller --zmap-cell)";
+  if (needed > 0) std::snprintf(spacing_text, sizeof spacing_text, "%.4g mm", needed);
+  const bool given = options.dexel_cell > 0 || options.dexel_res > 0;
+  std::string option;
+  if (options.dexel_cell > 0) option = "--dexel-cell " + clean_number(options.dexel_cell) + ": ";
+  if (options.dexel_res > 0) option = "--dexel-res " + std::to_string(options.dexel_res) + ": ";
+  if (given || needed == 0)
+    input_error(option, "a dexel spacing of ", r.lattice.spacing, " mm can miss a gouge of ",
+                missed, " between its samples, more than the gouge tolerance ", tolerance,
+                " mm; the spacing that resolves it: ", spacing_text,
+                ". Give a finer --dexel-cell, leave --dexel-res/--dexel-cell out to let check "
+                "choose, give a looser --tolerance, or --lattice-only to compare on the samples "
+                "alone (a design made by tridex on this lattice)");
+  r.unrefined_spacing = r.lattice.spacing;
+  r.unrefined = r.resolution;
+  try {
+    r.lattice = DexelLattice::covering(r.stock.box, needed);
+  } catch (const tridex::Error& e) {
+    input_error("check at a gouge tolerance of ", tolerance, " mm needs a dexel spacing of ",
+                spacing_text, ": ", e.what(), "; give a looser --tolerance");
+  }
+  r.resolution = bound_at(r.lattice.spacing);
+}
+
+std::string refined_memory_message(const PipelineRequest& request, const SimulationResult& r,
+                                   std::uint64_t max_memory) {
+  char text[256];
+  std::snprintf(text, sizeof text, "check at a gouge tolerance of %g mm needs a dexel spacing of %.4g mm",
+                request.resolve_gouges, r.lattice.spacing);
+  char unrefined[64];
+  std::snprintf(unrefined, sizeof unrefined, "%.4g mm", r.unrefined_spacing);
+  return std::string(text) + " (at " + unrefined + " the lattice can miss a gouge of " +
+         missable_text(r.unrefined, r.cutters, r.cutter_of_tool) +
+         " between its samples), which needs an estimated " + format_mib(r.memory.total()) +
+         ", more than --max-memory " + format_mib(static_cast<double>(max_memory)) +
+         "; give a larger --max-memory, a looser --tolerance, or --dexel-res/--dexel-cell with a "
+         "--tolerance it resolves";
+}
+
 // The stock, the resolutions (the dexel lattice, the Z-map cell and grids), and the memory they
 // need, checked against --max-memory before anything big is allocated.
 void size_the_run(const SimulateOptions& options, const PipelineRequest& request,
@@ -489,6 +549,15 @@ void size_the_run(const SimulateOptions& options, const PipelineRequest& request
   } catch (const tridex::Error& e) {
     input_error("dexel resolution: ", e.what());
   }
+  // A Z-map's polyhedron ramps across the cell where a wall parallel to its spindle drops, and
+  // is off by up to a cell at the wall's rims, where it meets the other directions' cuts
+  // (docs/design.md, "Known errors"); at most half a dexel spacing keeps those edges within h/2.
+  const auto zmap_cell_for = [&](double spacing) {
+    return options.zmap_cell > 0
+               ? options.zmap_cell
+               : std::min(diagonal * kDefaultZmapCellFraction, kDefaultZmapCellOfSpacing * spacing);
+  };
+  if (request.resolve_gouges > 0) resolve_tolerance(options, request, zmap_cell_for, r);
   const DexelLattice& lattice = r.lattice;
   // Where no move cuts, the stock's faces are all there is to represent (a wider range).
   check_reach(
@@ -498,13 +567,7 @@ void size_the_run(const SimulateOptions& options, const PipelineRequest& request
       no_move_reaches(r.groups, r.cutters, stock.box) ? kMaxUncutReachSpacings : kMaxReachSpacings);
   for (const auto& [what, bounds] : request.extra_bounds)
     check_reach(what, bounds, lattice.spacing);
-  // A Z-map's polyhedron ramps across the cell where a wall parallel to its spindle drops, and
-  // is off by up to a cell at the wall's rims, where it meets the other directions' cuts
-  // (docs/design.md, "Known errors"); at most half a dexel spacing keeps those edges within h/2.
-  const double zmap_cell = options.zmap_cell > 0
-                               ? options.zmap_cell
-                               : std::min(diagonal * kDefaultZmapCellFraction,
-                                          kDefaultZmapCellOfSpacing * lattice.spacing);
+  const double zmap_cell = zmap_cell_for(lattice.spacing);
   r.zmap_cell = zmap_cell;
   MemoryShape shape{.threads = static_cast<double>(detail::resolve_threads(options.threads)),
                     .keep_maps = request.keep_maps,
@@ -533,6 +596,8 @@ void size_the_run(const SimulateOptions& options, const PipelineRequest& request
   if (request.memory_after)
     r.memory.after = request.memory_after(lattice.spacing, kTrianglesPerRay * shape.rays);
   const MemoryEstimate& need = r.memory;
+  if (need.total() > static_cast<double>(max_memory) && r.unrefined_spacing > 0)
+    input_error(refined_memory_message(request, r, max_memory));
   if (need.total() > static_cast<double>(max_memory))
     input_error("the resolution needs an estimated ", format_mib(need.total()),
                 " (in use before milling ", format_mib(need.held), " with ", parsed.moves_kept,
