@@ -55,9 +55,8 @@ std::string program(double ball_z, bool wide = false) {
     text += "G0 X-8 Y1 Z5\nG1 Z-1 F500\nG1 X48\n";
   }
   char ball[160];
-  std::snprintf(ball, sizeof ball,
-                "G0 Z5\nT2 M6\nG0 X-2 Y%d\nG1 Z%.3f F300\nG1 X42\nG0 Z5\nM30\n", wide ? 20 : 1,
-                ball_z);
+  std::snprintf(ball, sizeof ball, "G0 Z5\nT2 M6\nG0 X-2 Y%d\nG1 Z%.3f F300\nG1 X42\nG0 Z5\nM30\n",
+                wide ? 20 : 1, ball_z);
   return text + ball;
 }
 

@@ -172,7 +172,7 @@ CheckInputs read_check_inputs(const CheckOptions& options, Progress& progress) {
 }
 
 double gouge_tolerance(const CheckOptions& options) {
-  return options.gouge_tol > 0 ? options.gouge_tol
+  return options.gouge_tol > 0   ? options.gouge_tol
          : options.tolerance > 0 ? options.tolerance
                                  : kShopTolerance;
 }
@@ -208,6 +208,8 @@ PipelineRequest check_request(const CheckOptions& options, const Mesh& design) {
   // coarser one given is reported, not refused.
   request.resolve_gouges = gouge_tolerance(options);
   request.lattice_only = options.lattice_only;
+  // The design and its samples are measured on the lattice: it covers the whole stock.
+  request.clip_to_reach = false;
   return request;
 }
 
@@ -542,8 +544,10 @@ std::string resolution_text(const CheckOptions& options, const SimulationResult&
                   r.unrefined_spacing);
     line += text;
   }
-  std::snprintf(text, sizeof text, ", Z-map cell %.4g mm: a gouge can go deeper than the samples "
-                "show by %s", r.zmap_cell, std::isfinite(r.resolution.missable) ? "at most " : "");
+  std::snprintf(text, sizeof text,
+                ", Z-map cell %.4g mm: a gouge can go deeper than the samples "
+                "show by %s",
+                r.zmap_cell, std::isfinite(r.resolution.missable) ? "at most " : "");
   line += text;
   line += missable_text(r.resolution, r.cutters, r.cutter_of_tool);
   if (options.lattice_only && r.resolution.missable > gouge_tolerance(options))

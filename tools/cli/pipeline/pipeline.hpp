@@ -78,6 +78,9 @@ struct PipelineRequest {
   // --max-memory; a spacing given that cannot resolve it is refused unless `lattice_only`.
   double resolve_gouges = 0;
   bool lattice_only = false;  // --lattice-only: the bound is reported, not enforced
+  // A box stock much larger than the toolpath: the lattice over the part the moves reach
+  // (reach.hpp). check keeps the whole stock: it measures the design on the lattice.
+  bool clip_to_reach = true;
 };
 
 // A rapid that cuts: `depth_mm` below the material along the spindle at `where` (work frame).
@@ -133,6 +136,10 @@ struct SimulationResult {
   std::vector<ZMapGrid> grids;  // one per group
   std::vector<ZMap> maps;       // milled, one per group (empty unless keep_maps)
   DexelLattice lattice;
+  // The box the lattice, the Z-maps and r.result cover: the stock's, or the part of a box stock
+  // the moves reach (`reach_only`, reach.hpp); r.mesh is the whole stock's surface either way.
+  Aabb lattice_box;
+  bool reach_only = false;
   // With PipelineRequest::resolve_gouges: the deepest gouge the lattice can miss, and the spacing
   // the options gave before it was refined for the tolerance (0: not refined).
   ResolutionBound resolution, unrefined;

@@ -17,8 +17,8 @@ double missable_depth(const Cutter& cutter, double s) {
 ResolutionBound resolution_bound(const std::vector<gcode::MoveGroup>& groups,
                                  const std::vector<gcode::Move>& simultaneous,
                                  std::span<const Cutter> cutters,
-                                 const std::map<int, std::uint32_t>& cutter_of_tool,
-                                 double spacing, double zmap_cell) {
+                                 const std::map<int, std::uint32_t>& cutter_of_tool, double spacing,
+                                 double zmap_cell) {
   ResolutionBound bound;
   auto consider = [&](int tool, double s) {
     const auto found = cutter_of_tool.find(tool);
@@ -37,8 +37,8 @@ ResolutionBound resolution_bound(const std::vector<gcode::MoveGroup>& groups,
   return bound;
 }
 
-double spacing_for_tolerance(const std::function<double(double spacing)>& bound_at,
-                             double coarsest, double tolerance) {
+double spacing_for_tolerance(const std::function<double(double spacing)>& bound_at, double coarsest,
+                             double tolerance) {
   if (bound_at(coarsest) <= tolerance) return coarsest;
   // The bound grows with the spacing: bisect on [0, coarsest] for the largest one within it.
   double fine = 0, coarse = coarsest;

@@ -39,9 +39,9 @@ namespace tridex::cli {
 double missable_depth(const Cutter& cutter, double s);
 
 struct ResolutionBound {
-  double missable = 0;   // mm, infinite when a cutter fits between the samples
-  int tool = 0;          // the tool that sets it (0: no tool cuts)
-  double distance = 0;   // s for that tool's direction, mm
+  double missable = 0;  // mm, infinite when a cutter fits between the samples
+  int tool = 0;         // the tool that sets it (0: no tool cuts)
+  double distance = 0;  // s for that tool's direction, mm
 };
 
 // The bound for every tool of every group (and the simultaneous moves') on a lattice of
@@ -49,13 +49,13 @@ struct ResolutionBound {
 ResolutionBound resolution_bound(const std::vector<gcode::MoveGroup>& groups,
                                  const std::vector<gcode::Move>& simultaneous,
                                  std::span<const Cutter> cutters,
-                                 const std::map<int, std::uint32_t>& cutter_of_tool,
-                                 double spacing, double zmap_cell);
+                                 const std::map<int, std::uint32_t>& cutter_of_tool, double spacing,
+                                 double zmap_cell);
 
 // The largest spacing ≤ `coarsest` whose bound (with the Z-map cell that zmap_cell_for gives
 // it) is within `tolerance`; 0 when none is (a Z-map cell given that is too coarse by itself).
-double spacing_for_tolerance(const std::function<double(double spacing)>& bound_at,
-                             double coarsest, double tolerance);
+double spacing_for_tolerance(const std::function<double(double spacing)>& bound_at, double coarsest,
+                             double tolerance);
 
 // "0.0123 mm (tool 4, 2 mm ball end)" or "any depth (tool 4, 2 mm ball end: a sample can lie
 // 1.3 mm from its tip, beyond its radius)"; `cutters`/`cutter_of_tool` as resolution_bound's.
