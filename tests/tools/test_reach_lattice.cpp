@@ -22,10 +22,10 @@ constexpr const char* kPocket =
 constexpr double kPocketVolume = (10.0 * 10.0 + std::numbers::pi * 25.0) * 2.0;
 
 json simulate(const fs::path& dir, const std::string& stock, const fs::path& stl) {
-  CommandResult r = run_tridex({"simulate", (dir / "pocket.nc").string(), "--tools",
-                                (dir / "tools.json").string(), "--stock", stock, "-o",
-                                stl.string(), "--report", (dir / "report.json").string()},
-                               dir);
+  CommandResult r = run_tridex(
+      {"simulate", (dir / "pocket.nc").string(), "--tools", (dir / "tools.json").string(),
+       "--stock", stock, "-o", stl.string(), "--report", (dir / "report.json").string()},
+      dir);
   REQUIRE(r.status == 0);
   return json::parse(slurp(dir / "report.json"));
 }
@@ -41,8 +41,9 @@ TEST_CASE("simulate: a 10 mm pocket in a 10 m plate is measured on a lattice ove
   CHECK(report["dexel"]["cell_mm"].get<double>() < 0.1);
   bool said = false;
   for (const json& w : report["warnings"])
-    said = said || w.get<std::string>().find("covers only the part of the stock the moves "
-                                             "reach") != std::string::npos;
+    said = said || w.get<std::string>().find(
+                       "covers only the part of the stock the moves "
+                       "reach") != std::string::npos;
   CHECK(said);
   CHECK(report["result"]["watertight"].get<bool>());
   // The STL: the whole plate, closed, its volume the plate's less the analytic pocket's.
