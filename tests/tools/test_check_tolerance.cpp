@@ -103,27 +103,36 @@ TEST_CASE("check: the default tolerance is the shop's ±0.02 mm, and finds 0.05 
   fs::remove_all(dir);
 }
 
-// The README's first check: the bundled example against the design STL it ships passes at the
-// default tolerance, and a tool table whose 4 mm ball end is 4.1 mm gouges it.
+// The README's first check: the bundled example against the design STL it ships (its own result
+// at 64 dexels, so compared on that lattice's samples: --lattice-only) passes at the default
+// tolerance, and a tool table whose 4 mm ball end is 4.1 mm gouges it. Without --lattice-only
+// the 64-dexel lattice is refused: the 2 mm ball end fits between its samples.
 TEST_CASE("check: the bundled example passes against its design; a 4.1 mm T3 gouges") {
   fs::path dir = scratch("check-example-design");
   const fs::path examples = fs::path(TRIDEX_SOURCE_DIR) / "gcode" / "examples";
   const std::string design = (examples / "mold_3plus2.design.stl").string();
   CHECK(fs::file_size(design) < 2'000'000);
   CommandResult pass = run_tridex({"check", (examples / "mold_3plus2.camotics").string(),
-                                   "--design", design, "--dexel-res", "64"},
+                                   "--design", design, "--dexel-res", "64", "--lattice-only"},
                                   dir);
   CHECK(pass.status == 0);
   CHECK(pass.out.find("verdict: pass at ±0.02 mm") != std::string::npos);
+  CHECK(pass.out.find("--lattice-only: the verdict holds on the lattice's samples") !=
+        std::string::npos);
+  CommandResult refused = run_tridex({"check", (examples / "mold_3plus2.camotics").string(),
+                                      "--design", design, "--dexel-res", "64"},
+                                     dir);
+  CHECK(refused.status == 2);
+  CHECK(refused.err.find("any depth (tool 4, 2 mm ball end") != std::string::npos);
   std::string tools = slurp(examples / "mold_3plus2.tools.json");
   const std::size_t at = tools.find("\"diameter\": 4.0");
   REQUIRE(at != std::string::npos);
   tools.replace(at, 15, "\"diameter\": 4.1");
   write_text(dir / "wrong_t3.json", tools);
-  CommandResult gouge =
-      run_tridex({"check", (examples / "mold_3plus2.camotics").string(), "--tools",
-                  (dir / "wrong_t3.json").string(), "--design", design, "--dexel-res", "64"},
-                 dir);
+  CommandResult gouge = run_tridex(
+      {"check", (examples / "mold_3plus2.camotics").string(), "--tools",
+       (dir / "wrong_t3.json").string(), "--design", design, "--dexel-res", "64", "--lattice-only"},
+      dir);
   CHECK(gouge.status == 3);
   CHECK(gouge.out.find("verdict: FAIL at ±0.02 mm") != std::string::npos);
   CHECK(gouge.out.find("  gouge 0.0") != std::string::npos);

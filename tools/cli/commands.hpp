@@ -67,6 +67,9 @@ struct CheckOptions : SimulateOptions {
   double clearance = kDefaultClearance;  // --clearance: near misses of shanks and holders, mm
   double allowance = 0;                  // --allowance: stock to leave on the design, mm (issue 39)
   std::vector<std::string> fixtures;     // --fixture FILE.stl (repeatable; machine_run.hpp)
+  // --lattice-only: a --dexel-res/--dexel-cell that cannot resolve the gouge tolerance is used
+  // anyway, the verdict holding on the lattice's samples (pipeline/resolution.hpp)
+  bool lattice_only = false;
 };
 
 // `diff` (issue 39): simulate's options for both programs (PROGRAM is A), B's solid compared

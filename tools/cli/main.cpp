@@ -311,6 +311,10 @@ int main(int argc, char** argv) {
                   "material left outside the design beyond this is excess, mm")
       ->check(kFinitePositive)
       ->excludes(tolerance);
+  chk->add_flag(
+      "--lattice-only", check.lattice_only,
+      "with --dexel-res/--dexel-cell: compare on the lattice's samples even where it "
+      "cannot resolve\nthe gouge tolerance (a design made by tridex on the same lattice)");
   add_check_findings(*chk, check);
   chk->add_option("-o,--output", check.output, "write the machined result as binary STL")
       ->check(kNotEmpty);

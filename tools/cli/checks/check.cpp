@@ -204,6 +204,12 @@ CheckInputs read_check_inputs(const CheckOptions& options, Progress& progress) {
   return in;
 }
 
+double gouge_tolerance(const CheckOptions& options) {
+  return options.gouge_tol > 0   ? options.gouge_tol
+         : options.tolerance > 0 ? options.tolerance
+                                 : kShopTolerance;
+}
+
 // The pipeline as check runs it: rapids and shanks and holders in program order, the design's
 // bounds on the lattice, and the comparison's memory counted up front.
 PipelineRequest check_request(const CheckOptions& options, const Mesh& design) {
@@ -231,6 +237,12 @@ PipelineRequest check_request(const CheckOptions& options, const Mesh& design) {
            (sizeof(Vec3) + sizeof(double)) * samples;
   };
   request.body_clearance = options.clearance;
+  // The lattice resolves the gouge tolerance (pipeline/resolution.hpp); with --lattice-only a
+  // coarser one given is reported, not refused.
+  request.resolve_gouges = gouge_tolerance(options);
+  request.lattice_only = options.lattice_only;
+  // The design and its samples are measured on the lattice: it covers the whole stock.
+  request.clip_to_reach = false;
   return request;
 }
 
@@ -465,6 +477,21 @@ void write_result_files(const CheckOptions& options, SimulationResult& r, const 
   }
 }
 
+// What the lattice resolves (pipeline/resolution.hpp): the deepest gouge it can miss between its
+// samples (null: a whole cut), the spacing, and the spacing before it was refined for the
+// tolerance.
+Json resolution_json(const CheckOptions& options, const SimulationResult& r) {
+  Json j;
+  j["missable_gouge_mm"] =
+      std::isfinite(r.resolution.missable) ? Json(r.resolution.missable) : Json(nullptr);
+  j["tool"] = r.resolution.tool;
+  j["dexel_cell_mm"] = r.lattice.spacing;
+  j["zmap_cell_mm"] = r.zmap_cell;
+  if (r.unrefined_spacing > 0) j["refined_from_mm"] = r.unrefined_spacing;
+  j["lattice_only"] = options.lattice_only;
+  return j;
+}
+
 // --report's JSON (and the --html page's figures).
 Json check_report(const CheckOptions& options, const SimulationResult& r,
                   const std::optional<Aabb>& envelope, const CheckFindings& f, bool failed,
@@ -482,6 +509,7 @@ Json check_report(const CheckOptions& options, const SimulationResult& r,
   report["dexel"] = {{"cell_mm", r.lattice.spacing},
                      {"res", {r.lattice.n.x, r.lattice.n.y, r.lattice.n.z}}};
   report["backends"] = {{"zmap", options.zmap_backend}, {"dexel", options.dexel_backend}};
+  report["resolution"] = resolution_json(options, r);
   report["deviation"] = statistics(f.deviation);
   report["gouges"] = f.gouge_list;
   report["excess"] = f.excess_list;
@@ -563,6 +591,28 @@ void print_excess_lines(const Json& excess_list) {
     }
 }
 
+// "resolution: dexel spacing 0.1385 mm (refined from 0.3125 mm for the tolerance), Z-map cell
+// 0.06925 mm: a gouge can go deeper than the samples show by at most 0.02 mm (tool 4, …)".
+std::string resolution_text(const CheckOptions& options, const SimulationResult& r) {
+  char text[160];
+  std::snprintf(text, sizeof text, "resolution: dexel spacing %.4g mm", r.lattice.spacing);
+  std::string line = text;
+  if (r.unrefined_spacing > 0) {
+    std::snprintf(text, sizeof text, " (refined from %.4g mm for the tolerance)",
+                  r.unrefined_spacing);
+    line += text;
+  }
+  std::snprintf(text, sizeof text,
+                ", Z-map cell %.4g mm: a gouge can go deeper than the samples "
+                "show by %s",
+                r.zmap_cell, std::isfinite(r.resolution.missable) ? "at most " : "");
+  line += text;
+  line += missable_text(r.resolution, r.cutters, r.cutter_of_tool);
+  if (options.lattice_only && r.resolution.missable > gouge_tolerance(options))
+    line += " (--lattice-only: the verdict holds on the lattice's samples)";
+  return line;
+}
+
 // The warnings on stderr, then the verdict line and the first findings of each kind on stdout.
 void print_summary(const CheckOptions& options, const SimulationResult& r, const Json& report,
                    const CheckFindings& f, bool failed, double total_s) {
@@ -591,6 +641,7 @@ void print_summary(const CheckOptions& options, const SimulationResult& r, const
   else
     std::printf("  verdict: %s at -%g/+%g mm (%s)\n", failed ? "FAIL" : "pass", f.gouge_tol,
                 f.excess_tol, f.tolerance_source.c_str());
+  std::printf("  %s\n", resolution_text(options, r).c_str());
   std::printf("  %s\n  %s\n", tools_text(r).c_str(), directions_text(r).c_str());
   std::size_t printed = 0;
   for (const Json& g : f.gouge_list)
@@ -646,9 +697,7 @@ int run_check(const CheckOptions& options) {
   const CheckInputs in = read_check_inputs(options, progress);
   SimulationResult r = simulate_program(options, progress, check_request(options, in.design));
   CheckFindings f;
-  f.gouge_tol = options.gouge_tol > 0   ? options.gouge_tol
-                : options.tolerance > 0 ? options.tolerance
-                                        : kShopTolerance;
+  f.gouge_tol = gouge_tolerance(options);
   f.excess_tol = options.excess_tol > 0  ? options.excess_tol
                  : options.tolerance > 0 ? options.tolerance
                                          : kShopTolerance;

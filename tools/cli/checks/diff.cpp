@@ -357,6 +357,7 @@ int run_diff(const DiffOptions& options) {
   PipelineRequest request;
   if (!options.report.empty()) request.outputs.push_back({"--report", options.report});
   request.extra_inputs = {options.program, options.program_b};
+  request.clip_to_reach = false;  // A's and B's moves reach apart: one lattice over the stock
   DiffRun run;
   for (const auto& [option, path] :
        {std::pair<std::string, std::string>{"--png", options.png}, {"--html", options.html}})

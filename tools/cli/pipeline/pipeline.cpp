@@ -13,6 +13,7 @@
 #include "outputs/result_files.hpp"
 #include "pipeline/batch_pipe.hpp"
 #include "pipeline/plausibility.hpp"
+#include "pipeline/reach.hpp"
 #include "render.hpp"
 #include "tridex/backends/backends.hpp"
 #include "tridex/dexel_ops.hpp"
@@ -476,6 +477,88 @@ void drop_toolless_moves(SimulationResult& r) {
         " rapid move(s) before the first tool change were not simulated (no tool)");
 }
 
+std::string clean_number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
+// A box stock much larger than what the moves reach (reach.hpp): the lattice over that part,
+// grown by a margin of kReachMarginCells cells, at --dexel-cell or --dexel-res cells along its
+// longest side; said in a warning.
+void clip_lattice_to_reach(const SimulateOptions& options, int res, SimulationResult& r) {
+  const std::optional<Aabb> reach =
+      reach_of_moves(r.groups, r.simultaneous, r.cutters, r.cutter_of_tool, r.stock.box);
+  if (!reach) return;
+  const Vec3 size = reach->size();
+  const double spacing =
+      options.dexel_cell > 0 ? options.dexel_cell : std::max({size.x, size.y, size.z}) / res;
+  if (!(spacing > 0)) return;
+  const std::optional<Aabb> clipped = clipped_reach(*reach, r.stock.box, spacing);
+  if (!clipped) return;
+  r.lattice_box = *clipped;
+  r.reach_only = true;
+  r.lattice = DexelLattice::covering(*clipped, spacing);
+  r.warnings.push_back("the lattice covers only the part of the stock the moves reach (" +
+                       describe_box(*clipped) + ", " + clean_number(spacing) +
+                       " mm dexels); the rest of the stock is uncut and meshed as its faces");
+}
+
+// check (PipelineRequest::resolve_gouges, resolution.hpp): the bound of what the lattice can miss
+// (r.resolution), the lattice refined when the options left the spacing to tridex and it does not
+// resolve the tolerance, and a spacing given that does not refused (exit status 2).
+void resolve_tolerance(const SimulateOptions& options, const PipelineRequest& request,
+                       const std::function<double(double)>& zmap_cell_for, SimulationResult& r) {
+  const double tolerance = request.resolve_gouges;
+  const auto bound_at = [&](double spacing) {
+    return resolution_bound(r.groups, r.simultaneous, r.cutters, r.cutter_of_tool, spacing,
+                            zmap_cell_for(spacing));
+  };
+  r.resolution = bound_at(r.lattice.spacing);
+  if (r.resolution.missable <= tolerance || request.lattice_only) return;
+  const double needed = spacing_for_tolerance(
+      [&](double spacing) { return bound_at(spacing).missable; }, r.lattice.spacing, tolerance);
+  const std::string missed = missable_text(r.resolution, r.cutters, r.cutter_of_tool);
+  char spacing_text[96] = "none (the Z-map cell alone is too coarse: a smaller --zmap-cell)";
+  if (needed > 0) std::snprintf(spacing_text, sizeof spacing_text, "%.4g mm", needed);
+  const bool given = options.dexel_cell > 0 || options.dexel_res > 0;
+  std::string option;
+  if (options.dexel_cell > 0) option = "--dexel-cell " + clean_number(options.dexel_cell) + ": ";
+  if (options.dexel_res > 0) option = "--dexel-res " + std::to_string(options.dexel_res) + ": ";
+  if (given || needed == 0)
+    input_error(option, "a dexel spacing of ", r.lattice.spacing, " mm can miss a gouge of ",
+                missed, " between its samples, more than the gouge tolerance ", tolerance,
+                " mm; the spacing that resolves it: ", spacing_text,
+                ". Give a finer --dexel-cell, leave --dexel-res/--dexel-cell out to let check "
+                "choose, give a looser --tolerance, or --lattice-only to compare on the samples "
+                "alone (a design made by tridex on this lattice)");
+  r.unrefined_spacing = r.lattice.spacing;
+  r.unrefined = r.resolution;
+  try {
+    r.lattice = DexelLattice::covering(r.lattice_box, needed);
+  } catch (const tridex::Error& e) {
+    input_error("check at a gouge tolerance of ", tolerance, " mm needs a dexel spacing of ",
+                spacing_text, ": ", e.what(), "; give a looser --tolerance");
+  }
+  r.resolution = bound_at(r.lattice.spacing);
+}
+
+std::string refined_memory_message(const PipelineRequest& request, const SimulationResult& r,
+                                   std::uint64_t max_memory) {
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "check at a gouge tolerance of %g mm needs a dexel spacing of %.4g mm",
+                request.resolve_gouges, r.lattice.spacing);
+  char unrefined[64];
+  std::snprintf(unrefined, sizeof unrefined, "%.4g mm", r.unrefined_spacing);
+  return std::string(text) + " (at " + unrefined + " the lattice can miss a gouge of " +
+         missable_text(r.unrefined, r.cutters, r.cutter_of_tool) +
+         " between its samples), which needs an estimated " + format_mib(r.memory.total()) +
+         ", more than --max-memory " + format_mib(static_cast<double>(max_memory)) +
+         "; give a larger --max-memory, a looser --tolerance, or --dexel-res/--dexel-cell with a "
+         "--tolerance it resolves";
+}
+
 // The stock, the resolutions (the dexel lattice, the Z-map cell and grids), and the memory they
 // need, checked against --max-memory before anything big is allocated.
 void size_the_run(const SimulateOptions& options, const PipelineRequest& request,
@@ -484,39 +567,50 @@ void size_the_run(const SimulateOptions& options, const PipelineRequest& request
   const std::uint64_t max_memory = run.max_memory;
   r.stock = load_stock(stock_spec, parsed.cutting_bounds, max_memory);
   const Stock& stock = r.stock;
-  const double diagonal = glm::length(stock.box.size());
+  r.lattice_box = stock.box;
+  const int res = options.dexel_res > 0 ? options.dexel_res : kDefaultDexelRes;
   try {
-    r.lattice = options.dexel_cell > 0
-                    ? DexelLattice::covering(stock.box, options.dexel_cell)
-                    : DexelLattice::covering_resolution(
-                          stock.box, options.dexel_res > 0 ? options.dexel_res : kDefaultDexelRes);
+    r.lattice = options.dexel_cell > 0 ? DexelLattice::covering(stock.box, options.dexel_cell)
+                                       : DexelLattice::covering_resolution(stock.box, res);
+    if (!stock.mesh && request.clip_to_reach) clip_lattice_to_reach(options, res, r);
   } catch (const tridex::Error& e) {
     input_error("dexel resolution: ", e.what());
   }
-  const DexelLattice& lattice = r.lattice;
-  // Where no move cuts, the stock's faces are all there is to represent (a wider range).
-  check_reach(
-      stock_spec.kind == StockSpec::Kind::mesh ? "--stock " + stock_spec.mesh_path.string()
-                                               : "the stock",
-      stock.box, lattice.spacing,
-      no_move_reaches(r.groups, r.cutters, stock.box) ? kMaxUncutReachSpacings : kMaxReachSpacings);
-  for (const auto& [what, bounds] : request.extra_bounds)
-    check_reach(what, bounds, lattice.spacing);
+  const Aabb& box = r.lattice_box;
+  const double diagonal = glm::length(box.size());
   // A Z-map's polyhedron ramps across the cell where a wall parallel to its spindle drops, and
   // is off by up to a cell at the wall's rims, where it meets the other directions' cuts
   // (docs/design.md, "Known errors"); at most half a dexel spacing keeps those edges within h/2.
-  const double zmap_cell = options.zmap_cell > 0
-                               ? options.zmap_cell
-                               : std::min(diagonal * kDefaultZmapCellFraction,
-                                          kDefaultZmapCellOfSpacing * lattice.spacing);
+  const auto zmap_cell_for = [&](double spacing) {
+    return options.zmap_cell > 0
+               ? options.zmap_cell
+               : std::min(diagonal * kDefaultZmapCellFraction, kDefaultZmapCellOfSpacing * spacing);
+  };
+  const DexelLattice& lattice = r.lattice;
+  const auto check_reaches = [&] {
+    // Where no move cuts, the stock's faces are all there is to represent (a wider range).
+    check_reach(stock_spec.kind == StockSpec::Kind::mesh
+                    ? "--stock " + stock_spec.mesh_path.string()
+                    : (r.reach_only ? "the part of the stock the moves reach" : "the stock"),
+                box, lattice.spacing,
+                no_move_reaches(r.groups, r.cutters, stock.box) ? kMaxUncutReachSpacings
+                                                                : kMaxReachSpacings);
+    for (const auto& [what, bounds] : request.extra_bounds)
+      check_reach(what, bounds, lattice.spacing);
+  };
+  check_reaches();
+  if (request.resolve_gouges > 0) {
+    resolve_tolerance(options, request, zmap_cell_for, r);
+    if (r.unrefined_spacing > 0) check_reaches();  // a finer lattice reaches less far
+  }
+  const double zmap_cell = zmap_cell_for(lattice.spacing);
   r.zmap_cell = zmap_cell;
   MemoryShape shape{.threads = static_cast<double>(detail::resolve_threads(options.threads)),
                     .keep_maps = request.keep_maps,
                     .dump_maps = !options.dump_zmaps.empty()};
   for (const gcode::MoveGroup& group : r.groups) {
     try {
-      r.grids.push_back(
-          ZMapGrid::covering(group.frame, local_bounds(group.frame, stock.box), zmap_cell));
+      r.grids.push_back(ZMapGrid::covering(group.frame, local_bounds(group.frame, box), zmap_cell));
     } catch (const tridex::Error& e) {
       input_error("--zmap-cell ", zmap_cell, ": ", e.what());
     }
@@ -537,6 +631,8 @@ void size_the_run(const SimulateOptions& options, const PipelineRequest& request
   if (request.memory_after)
     r.memory.after = request.memory_after(lattice.spacing, kTrianglesPerRay * shape.rays);
   const MemoryEstimate& need = r.memory;
+  if (need.total() > static_cast<double>(max_memory) && r.unrefined_spacing > 0)
+    input_error(refined_memory_message(request, r, max_memory));
   if (need.total() > static_cast<double>(max_memory))
     input_error("the resolution needs an estimated ", format_mib(need.total()),
                 " (in use before milling ", format_mib(need.held), " with ", parsed.moves_kept,
@@ -599,9 +695,9 @@ void mill_directions(const SimulateOptions& options, const PipelineRequest& requ
     progress.stage("milling direction " + std::to_string(g + 1) + "/" +
                    std::to_string(groups.size()) + " (" + axis_label(group.axis) + ", " +
                    std::to_string(group.moves.size()) + " moves)");
-    maps.push_back(
-        stock.mesh ? ZMap::from_mesh(group.frame, *stock.mesh, r.zmap_cell, limits)
-                   : ZMap::from_box(group.frame, stock.box, r.zmap_cell, limits, options.threads));
+    maps.push_back(stock.mesh ? ZMap::from_mesh(group.frame, *stock.mesh, r.zmap_cell, limits)
+                              : ZMap::from_box(group.frame, r.lattice_box, r.zmap_cell, limits,
+                                               options.threads));
     r.segments += static_cast<long long>(group.moves.size());
     if (request.rapid_check == RapidCheck::in_program_order) {
       std::optional<BodyCheck> bodies;
@@ -684,13 +780,13 @@ void intersect_directions(const SimulateOptions& options, const PipelineRequest&
     if (stock.mesh)
       raise_uncut(maps[g], *stock.mesh, options.threads);
     else
-      raise_uncut(maps[g], stock.box, options.threads);
+      raise_uncut(maps[g], r.lattice_box, options.threads);
   }
   if (request.fine_cells) refine_walls(options, max_memory, r);
   progress.stage("dexelizing the stock");
   TripleDexel stock_dexel = stock.mesh
                                 ? dexelize(*stock.mesh, r.lattice, DexelizeOptions{options.threads})
-                                : TripleDexel::box(r.lattice, stock.box);
+                                : TripleDexel::box(r.lattice, r.lattice_box);
   r.timings.dexelize = seconds_since(t);
   progress.stage("dexelizing and intersecting " + std::to_string(maps.size()) + " Z-maps");
   t = Clock::now();
@@ -728,6 +824,8 @@ void extract_result_surface(const SimulateOptions& options, Progress& progress,
   progress.stage("extracting the surface");
   const Clock::time_point t = Clock::now();
   r.mesh = extract_surface(r.result, {.threads = options.threads});
+  if (r.reach_only)
+    r.mesh = stitch_into_stock(r.mesh, r.lattice_box, r.stock.box, r.lattice.spacing);
   r.mesh_check = check_mesh(r.mesh);
   r.timings.mesh = seconds_since(t);
   r.volume = r.mesh.signed_volume();

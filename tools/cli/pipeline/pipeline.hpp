@@ -22,6 +22,7 @@
 #include "checks/machining_time.hpp"
 #include "pipeline/memory.hpp"
 #include "pipeline/progress.hpp"
+#include "pipeline/resolution.hpp"
 #include "tridex/cutter.hpp"
 #include "tridex/dexel.hpp"
 #include "tridex/gcode/grouping.hpp"
@@ -75,6 +76,14 @@ struct PipelineRequest {
   // estimated triangle count of the surface (check: the design's and the result's distance
   // trees, the deviations, the design samples); counted in the up-front memory check.
   std::function<double(double spacing, double triangles)> memory_after;
+  // check (issue 31): the gouge tolerance the lattice must resolve, mm (resolution.hpp); 0: none.
+  // Without --dexel-res/--dexel-cell the spacing is made fine enough for it, within
+  // --max-memory; a spacing given that cannot resolve it is refused unless `lattice_only`.
+  double resolve_gouges = 0;
+  bool lattice_only = false;  // --lattice-only: the bound is reported, not enforced
+  // A box stock much larger than the toolpath: the lattice over the part the moves reach
+  // (reach.hpp). check keeps the whole stock: it measures the design on the lattice.
+  bool clip_to_reach = true;
 };
 
 // A rapid that cuts: `depth_mm` below the material along the spindle at `where` (work frame).
@@ -130,6 +139,14 @@ struct SimulationResult {
   std::vector<ZMapGrid> grids;  // one per group
   std::vector<ZMap> maps;       // milled, one per group (empty unless keep_maps)
   DexelLattice lattice;
+  // The box the lattice, the Z-maps and r.result cover: the stock's, or the part of a box stock
+  // the moves reach (`reach_only`, reach.hpp); r.mesh is the whole stock's surface either way.
+  Aabb lattice_box;
+  bool reach_only = false;
+  // With PipelineRequest::resolve_gouges: the deepest gouge the lattice can miss, and the spacing
+  // the options gave before it was refined for the tolerance (0: not refined).
+  ResolutionBound resolution, unrefined;
+  double unrefined_spacing = 0;
   MemoryEstimate memory;
   TripleDexel result;
   Mesh mesh;
