@@ -42,8 +42,8 @@ def main():
         stage = next((name for name, pattern in STAGES if re.search(pattern, symbol)), "other")
         samples[stage] += n
     for name in [s for s, _ in STAGES] + ["other"]:
-        print(f"{name:30} {samples[name] / hz:7.1f} s CPU {100 * samples[name] / max(total, 1):5.1f} %")
-    print(f"{'all samples':30} {total / hz:7.1f} s CPU")
+        print(f"{name:30} {samples[name] / hz:7.2f} s CPU {100 * samples[name] / max(total, 1):5.1f} %")
+    print(f"{'all samples':30} {total / hz:7.2f} s CPU")
 
 
 if __name__ == "__main__":
