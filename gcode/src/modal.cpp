@@ -190,21 +190,26 @@ Flow Interpreter::State::execute(const Block& block) {
     error(block.words.front().column, incomplete_plane());
   if (int column = w.find_g(kG65)) return macro_call(column);
   BlockCodes codes = block_codes();
-  units_codes();
+  // Most blocks of a CAM program hold no G code but G0/G1 (`X.. Y.. Z..`): the stages marked
+  // below look only for their own G codes, so such a block skips them (the hot path of plain
+  // programs stays free of compensation's, kinematics' and the modal groups' look-ups).
+  if (codes.modal_g) units_codes();
   feed_mode_codes();
   tool_change_codes();
   spindle_codes();
   if (codes.nonmodal == kG4) dwell_code(codes);
-  plane_codes();
-  // Cutter radius compensation (comp.cpp): after the plane, before motion (NIST IR 6556 §3.8).
-  for (int code : {kG40, kG41, kG42, kG41_1, kG42_1})
-    if (int column = w.find_g(code)) cutter_comp_codes(code, column);
-  distance_mode_codes();
-  tool_length_codes();
-  tool_center_codes();  // G43.4/G43.5 TCP, G254/G255 DWO (rotary.cpp)
-  smoothing_codes(codes);
-  return_mode_codes();
-  work_system_codes();
+  if (codes.modal_g) {
+    plane_codes();
+    // Cutter radius compensation (comp.cpp): after the plane, before motion (NIST IR 6556 §3.8).
+    for (int code : {kG40, kG41, kG42, kG41_1, kG42_1})
+      if (int column = w.find_g(code)) cutter_comp_codes(code, column);
+    distance_mode_codes();
+    tool_length_codes();
+    tool_center_codes();  // G43.4/G43.5 TCP, G254/G255 DWO (rotary.cpp)
+    smoothing_codes(codes);
+    return_mode_codes();
+    work_system_codes();
+  }
   offset_codes(codes);
   tilted_plane_group(codes);  // tilted_plane_codes.cpp
   motion_mode_codes(codes);
@@ -222,6 +227,7 @@ Interpreter::State::BlockCodes Interpreter::State::block_codes() {
   context.motion_column = 0;
   for (int i = 0; i < w.g_count; ++i) {
     const Code& g = w.g[static_cast<std::size_t>(i)];
+    if (g.code != kG0 && g.code != kG1) codes.modal_g = true;
     int group = block_g_group(g.code);
     if (group == kMotion) {
       codes.motion = g.code;

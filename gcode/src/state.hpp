@@ -737,6 +737,7 @@ struct Interpreter::State : ParameterReader {
     int tilt = -1;
     int orient = -1;
     bool axis_consumer = false;
+    bool modal_g = false;  // a G code other than G0 and G1 (execute's modal stages look for one)
   };
   BlockCodes block_codes();
   void units_codes();

@@ -113,6 +113,68 @@ inline MovesByBand moves_by_band(const ZMapGrid& g, std::span<const Cutter> cutt
   return by_band;
 }
 
+// A move near a band's fine cells (lower_fine_cells): its lowest tip, and the cell rows and
+// columns of the band its swept box reaches.
+struct FineCellMove {
+  double tip;
+  std::uint32_t move, i0, i1;
+  int row0, row1;
+};
+
+// Lowers the sub-points of the fine cells in rows n.row0..n.row1, columns n.i0..n.i1, to the
+// lowest point of the swept cutter of one move above them; cell_top[k] is the highest sub-point
+// of cells[k], kept so.
+inline void lower_cells_under_move(const ZMapGrid& g, const Cutter& cutter, const Segment& s,
+                                   const FineCellMove& n, const std::vector<std::uint32_t>& cells,
+                                   const std::vector<std::size_t>& row_begin,
+                                   std::vector<float>& cell_top, std::vector<float>& sub) {
+  constexpr int kSteps = ZMapFineCells::kSteps, kSide = ZMapFineCells::kSide;
+  constexpr auto kPoints = static_cast<std::size_t>(ZMapFineCells::kPoints);
+  const double step = g.cell / kSteps;  // exact: kSteps is a power of two
+  const double half_diagonal = g.cell * std::sqrt(0.5) * (1 + 1e-9);
+  const double tile_half_diagonal = kWallBandRows * half_diagonal;
+  const double r = cutter.radius();
+  // Built here, for the few (band, move) pairs that come this far: kept for every move up
+  // front, the program's geometry took longer to write than the bands take to read.
+  const detail::MoveGeometry move(cutter, s);
+  const double tip = move.lowest_tip();
+  for (int j = n.row0; j <= n.row1; ++j) {
+    const auto row = static_cast<std::size_t>(j), base = row * static_cast<std::size_t>(g.nx);
+    const auto first = cells.begin() + static_cast<std::ptrdiff_t>(row_begin[row]);
+    const auto last = cells.begin() + static_cast<std::ptrdiff_t>(row_begin[row + 1]);
+    for (auto c = std::lower_bound(first, last, static_cast<std::uint32_t>(base + n.i0));
+         c != last && *c <= base + n.i1; ++c) {
+      const auto index = static_cast<std::size_t>(c - cells.begin());
+      if (tip >= double(cell_top[index])) continue;
+      const int i = static_cast<int>(*c - base);
+      // The cell's sub-points lie at least `reach` from the tip path in XY. Beyond the radius
+      // the cutter never passes over them; within it, the swept cutter stands at least the
+      // profile's height at `reach` above its lowest tip there (profiles rise outward), less a
+      // rounding margin far below float heights.
+      const double cx = g.x0 + (i + 0.5) * g.cell, cy = g.y0 + (j + 0.5) * g.cell;
+      const double reach =
+          std::sqrt(distance2_point_segment(Vec2(cx, cy), Vec2(s.a.x, s.a.y), Vec2(s.b.x, s.b.y))) -
+          half_diagonal;
+      if (reach > r + tile_half_diagonal) continue;
+      const double bound = tip + cutter.lower_height(std::max(0.0, reach)) - 1e-6;
+      if (bound >= double(cell_top[index])) continue;
+      // The same bound, sub-point by sub-point: a wall cell next to uncut stock keeps its top at
+      // the ceiling, so the cell's test passes for every move near it, while its sub-points
+      // already cut at or below the bound cannot be lowered by this move.
+      float* h = sub.data() + index * kPoints;
+      for (int b = 0; b < kSide; ++b)
+        for (int a = 0; a < kSide; ++a) {
+          float& to = h[a + kSide * b];
+          if (bound >= double(to)) continue;
+          const double x = g.x0 + (kSteps * i + a) * step, y = g.y0 + (kSteps * j + b) * step;
+          const double z = move.lowest(x, y).z;
+          if (z < double(to)) to = static_cast<float>(z);
+        }
+      cell_top[index] = *std::max_element(h, h + kPoints);
+    }
+  }
+}
+
 // The heart of refine_steep_cells: lowers `sub` (the fine cells' sub-point heights, kPoints per
 // cell of `cells`, all starting at `ceiling`) to the lowest point of every move's swept cutter
 // above them, band by band on `threads` threads (0: every hardware thread). row_begin[j] is the
@@ -122,9 +184,6 @@ inline void lower_fine_cells(const ZMapGrid& g, std::span<const Cutter> cutters,
                              const std::vector<std::uint32_t>& cells,
                              const std::vector<std::size_t>& row_begin, float ceiling,
                              unsigned threads, std::vector<float>& sub) {
-  constexpr int kSteps = ZMapFineCells::kSteps, kSide = ZMapFineCells::kSide;
-  constexpr auto kPoints = static_cast<std::size_t>(ZMapFineCells::kPoints);
-  const double step = g.cell / kSteps;  // exact: kSteps is a power of two
   // Bands of cell rows, one thread each at a time. Each band gets the moves whose swept box
   // reaches it, in program order (a counting sort: one pass to count, one to place), so that a
   // band never scans the whole program: a 5000-row map has 313 bands.
@@ -151,81 +210,54 @@ inline void lower_fine_cells(const ZMapGrid& g, std::span<const Cutter> cutters,
     tile_walls[c / static_cast<std::uint32_t>(g.nx) / kBandRows * tiles_x +
                c % static_cast<std::uint32_t>(g.nx) / kBandTile] = 1;
   detail::for_each_chunk(static_cast<std::size_t>(bands), threads, [&](std::size_t band_index) {
-    {
-      const int band = static_cast<int>(band_index);
-      const int j0 = band * kBandRows, j1 = std::min(g.ny - 1, j0 + kBandRows);
-      if (row_begin[static_cast<std::size_t>(j0)] == row_begin[static_cast<std::size_t>(j1)])
-        return;
-      for (std::size_t at = band_begin[static_cast<std::size_t>(band)];
-           at < band_begin[static_cast<std::size_t>(band) + 1]; ++at) {
-        const std::size_t m = band_moves[at];
-        const Segment& s = moves[m].tip;
-        const double r = cutters[moves[m].cutter].radius();
-        const double lo_y = std::min(s.a.y, s.b.y) - r, hi_y = std::max(s.a.y, s.b.y) + r;
-        const int row0 = std::max(j0, static_cast<int>(std::floor((lo_y - g.y0) / g.cell)));
-        const int row1 = std::min(j1 - 1, static_cast<int>(std::floor((hi_y - g.y0) / g.cell)));
-        if (row0 > row1) continue;
-        const double lo_x = std::min(s.a.x, s.b.x) - r, hi_x = std::max(s.a.x, s.b.x) + r;
-        auto i0 = static_cast<std::uint32_t>(
-            std::clamp(std::floor((lo_x - g.x0) / g.cell), 0.0, double(g.nx)));
-        auto i1 = static_cast<std::uint32_t>(
-            std::clamp(std::floor((hi_x - g.x0) / g.cell), 0.0, double(g.nx)));
-        // Only the band's tiles that hold a fine cell and come within the radius of the tip
-        // path: most of a map has no wall, and a move's box spans many cell rows.
-        const std::size_t tx0 = i0 / kBandTile,
-                          tx1 = std::min<std::size_t>(i1, static_cast<std::size_t>(g.nx - 2)) /
-                                kBandTile;
-        std::size_t first_tile = tiles_x, last_tile = 0;
-        for (std::size_t tx = tx0; tx <= tx1; ++tx) {
-          if (!tile_walls[static_cast<std::size_t>(band) * tiles_x + tx]) continue;
-          const double cx = g.x0 + (double(tx) + 0.5) * kBandTile * g.cell,
-                       cy = g.y0 + 0.5 * (j0 + j1) * g.cell;
-          if (distance2_point_segment(Vec2(cx, cy), Vec2(s.a.x, s.a.y), Vec2(s.b.x, s.b.y)) >
-              (r + tile_half_diagonal) * (r + tile_half_diagonal))
-            continue;
-          first_tile = std::min(first_tile, tx), last_tile = tx;
-        }
-        if (first_tile > last_tile) continue;
-        i0 = std::max(i0, static_cast<std::uint32_t>(first_tile * kBandTile));
-        i1 = std::min(i1, static_cast<std::uint32_t>(last_tile * kBandTile + kBandTile - 1));
-        // Built here, for the few (band, move) pairs that come this far: kept for every move up
-        // front, the program's geometry took longer to write than the bands take to read.
-        const detail::MoveGeometry move(cutters[moves[m].cutter], s);
-        const double tip = move.lowest_tip();
-        for (int j = row0; j <= row1; ++j) {
-          const auto row = static_cast<std::size_t>(j), base = row * static_cast<std::size_t>(g.nx);
-          const auto first = cells.begin() + static_cast<std::ptrdiff_t>(row_begin[row]);
-          const auto last = cells.begin() + static_cast<std::ptrdiff_t>(row_begin[row + 1]);
-          for (auto c = std::lower_bound(first, last, static_cast<std::uint32_t>(base + i0));
-               c != last && *c <= base + i1; ++c) {
-            const auto index = static_cast<std::size_t>(c - cells.begin());
-            if (tip >= double(cell_top[index])) continue;
-            const int i = static_cast<int>(*c - base);
-            // The cell's sub-points lie at least `reach` from the tip path in XY. Beyond the
-            // radius the cutter never passes over them; within it, the swept cutter stands at
-            // least the profile's height at `reach` above its lowest tip there (profiles rise
-            // outward), less a rounding margin far below float heights.
-            const double cx = g.x0 + (i + 0.5) * g.cell, cy = g.y0 + (j + 0.5) * g.cell;
-            const double reach = std::sqrt(distance2_point_segment(Vec2(cx, cy), Vec2(s.a.x, s.a.y),
-                                                                   Vec2(s.b.x, s.b.y))) -
-                                 half_diagonal;
-            if (reach > r + tile_half_diagonal) continue;
-            if (tip + move.cutter->lower_height(std::max(0.0, reach)) - 1e-6 >=
-                double(cell_top[index]))
-              continue;
-            float* h = sub.data() + index * kPoints;
-            for (int b = 0; b < kSide; ++b)
-              for (int a = 0; a < kSide; ++a) {
-                const double x = g.x0 + (kSteps * i + a) * step, y = g.y0 + (kSteps * j + b) * step;
-                const double z = move.lowest(x, y).z;
-                float& to = h[a + kSide * b];
-                if (z < double(to)) to = static_cast<float>(z);
-              }
-            cell_top[index] = *std::max_element(h, h + kPoints);
-          }
-        }
+    const int band = static_cast<int>(band_index);
+    const int j0 = band * kBandRows, j1 = std::min(g.ny - 1, j0 + kBandRows);
+    if (row_begin[static_cast<std::size_t>(j0)] == row_begin[static_cast<std::size_t>(j1)]) return;
+    // The band's moves that come near one of its fine cells, lowest first: a sub-point's height
+    // is the minimum over the moves, whatever their order, and taken deepest first it is near
+    // its end at once, so that the moves above (a roughing program's earlier layers) fail the
+    // bound below instead of lowering it again, layer by layer.
+    std::vector<FineCellMove> near;
+    for (std::size_t at = band_begin[static_cast<std::size_t>(band)];
+         at < band_begin[static_cast<std::size_t>(band) + 1]; ++at) {
+      const std::uint32_t m = band_moves[at];
+      const Segment& s = moves[m].tip;
+      const double r = cutters[moves[m].cutter].radius();
+      const double lo_y = std::min(s.a.y, s.b.y) - r, hi_y = std::max(s.a.y, s.b.y) + r;
+      const int row0 = std::max(j0, static_cast<int>(std::floor((lo_y - g.y0) / g.cell)));
+      const int row1 = std::min(j1 - 1, static_cast<int>(std::floor((hi_y - g.y0) / g.cell)));
+      if (row0 > row1) continue;
+      const double lo_x = std::min(s.a.x, s.b.x) - r, hi_x = std::max(s.a.x, s.b.x) + r;
+      auto i0 = static_cast<std::uint32_t>(
+          std::clamp(std::floor((lo_x - g.x0) / g.cell), 0.0, double(g.nx)));
+      auto i1 = static_cast<std::uint32_t>(
+          std::clamp(std::floor((hi_x - g.x0) / g.cell), 0.0, double(g.nx)));
+      // Only the band's tiles that hold a fine cell and come within the radius of the tip
+      // path: most of a map has no wall, and a move's box spans many cell rows.
+      const std::size_t tx0 = i0 / kBandTile,
+                        tx1 = std::min<std::size_t>(i1, static_cast<std::size_t>(g.nx - 2)) /
+                              kBandTile;
+      std::size_t first_tile = tiles_x, last_tile = 0;
+      for (std::size_t tx = tx0; tx <= tx1; ++tx) {
+        if (!tile_walls[static_cast<std::size_t>(band) * tiles_x + tx]) continue;
+        const double cx = g.x0 + (double(tx) + 0.5) * kBandTile * g.cell,
+                     cy = g.y0 + 0.5 * (j0 + j1) * g.cell;
+        if (distance2_point_segment(Vec2(cx, cy), Vec2(s.a.x, s.a.y), Vec2(s.b.x, s.b.y)) >
+            (r + tile_half_diagonal) * (r + tile_half_diagonal))
+          continue;
+        first_tile = std::min(first_tile, tx), last_tile = tx;
       }
+      if (first_tile > last_tile) continue;
+      i0 = std::max(i0, static_cast<std::uint32_t>(first_tile * kBandTile));
+      i1 = std::min(i1, static_cast<std::uint32_t>(last_tile * kBandTile + kBandTile - 1));
+      near.push_back({std::min(s.a.z, s.b.z), m, i0, i1, row0, row1});
     }
+    std::sort(near.begin(), near.end(), [](const FineCellMove& a, const FineCellMove& b) {
+      return a.tip < b.tip || (a.tip == b.tip && a.move < b.move);
+    });
+    for (const FineCellMove& n : near)
+      lower_cells_under_move(g, cutters[moves[n.move].cutter], moves[n.move].tip, n, cells,
+                             row_begin, cell_top, sub);
   });
 }
 
