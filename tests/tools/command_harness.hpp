@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -89,6 +90,25 @@ inline Mesh read_binary_stl(const fs::path& path) {
     mesh.triangles.emplace_back(base, base + 1, base + 2);
   }
   return mesh;
+}
+
+// A closed box as an ASCII STL, outward normals.
+inline std::string box_stl_text(double x0, double y0, double z0, double x1, double y1, double z1) {
+  const double p[8][3] = {{x0, y0, z0}, {x1, y0, z0}, {x1, y1, z0}, {x0, y1, z0},
+                          {x0, y0, z1}, {x1, y0, z1}, {x1, y1, z1}, {x0, y1, z1}};
+  const int faces[12][3] = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                            {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+  std::string text = "solid box\n";
+  for (const auto& f : faces) {
+    text += "facet normal 0 0 0\nouter loop\n";
+    for (int k : f) {
+      char line[128];
+      std::snprintf(line, sizeof line, "vertex %.6f %.6f %.6f\n", p[k][0], p[k][1], p[k][2]);
+      text += line;
+    }
+    text += "endloop\nendfacet\n";
+  }
+  return text + "endsolid box\n";
 }
 
 }  // namespace tridex::test

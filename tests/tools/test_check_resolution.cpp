@@ -21,25 +21,6 @@ using nlohmann::json;
 
 namespace test_check_resolution {
 
-// A closed box as an ASCII STL, outward normals.
-std::string box_stl(double x0, double y0, double z0, double x1, double y1, double z1) {
-  const double p[8][3] = {{x0, y0, z0}, {x1, y0, z0}, {x1, y1, z0}, {x0, y1, z0},
-                          {x0, y0, z1}, {x1, y0, z1}, {x1, y1, z1}, {x0, y1, z1}};
-  const int faces[12][3] = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
-                            {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
-  std::string text = "solid box\n";
-  for (const auto& f : faces) {
-    text += "facet normal 0 0 0\nouter loop\n";
-    for (int k : f) {
-      char line[128];
-      std::snprintf(line, sizeof line, "vertex %.6f %.6f %.6f\n", p[k][0], p[k][1], p[k][2]);
-      text += line;
-    }
-    text += "endloop\nendfacet\n";
-  }
-  return text + "endsolid box\n";
-}
-
 // Faces the bar's top 1 mm down with T1, then runs T2 along it with its tip at `ball_z`; a
 // 40 x 40 block (`wide`) is faced in ten passes instead.
 std::string program(double ball_z, bool wide = false) {
@@ -68,7 +49,7 @@ struct Setup {
                                        "2": {"shape": "ballnose", "diameter": 0.8}})");
     write_text(dir / "part.nc", program(ball_z, wide));
     if (wide) stock = "box:0,0,-3,40,40,0";
-    write_text(dir / "design.stl", box_stl(0, 0, -3, 40, wide ? 40 : 2, -1));
+    write_text(dir / "design.stl", box_stl_text(0, 0, -3, 40, wide ? 40 : 2, -1));
   }
   ~Setup() { fs::remove_all(dir); }
   CommandResult check(std::vector<std::string> extra) const {

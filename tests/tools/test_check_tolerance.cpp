@@ -14,25 +14,6 @@ using nlohmann::json;
 
 namespace test_check_tolerance {
 
-// A closed box as an ASCII STL, outward normals.
-std::string box_stl(double x0, double y0, double z0, double x1, double y1, double z1) {
-  const double p[8][3] = {{x0, y0, z0}, {x1, y0, z0}, {x1, y1, z0}, {x0, y1, z0},
-                          {x0, y0, z1}, {x1, y0, z1}, {x1, y1, z1}, {x0, y1, z1}};
-  const int faces[12][3] = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
-                            {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
-  std::string text = "solid box\n";
-  for (const auto& f : faces) {
-    text += "facet normal 0 0 0\nouter loop\n";
-    for (int k : f) {
-      char line[128];
-      std::snprintf(line, sizeof line, "vertex %.6f %.6f %.6f\n", p[k][0], p[k][1], p[k][2]);
-      text += line;
-    }
-    text += "endloop\nendfacet\n";
-  }
-  return text + "endsolid box\n";
-}
-
 // Faces the top of a 40 x 40 x 10 block 1 mm down with a 10 mm flat end.
 std::string facing_program() {
   std::string text = "G21 G90 G17\nT1 M6\nS8000 M3\nG0 X-8 Y-2 Z5\nG1 Z-1 F500\n";
@@ -50,7 +31,7 @@ struct Outcome {
 };
 
 Outcome check_against(const fs::path& dir, double design_top) {
-  write_text(dir / "design.stl", box_stl(0, 0, -10, 40, 40, design_top));
+  write_text(dir / "design.stl", box_stl_text(0, 0, -10, 40, 40, design_top));
   Outcome o;
   o.run = run_tridex({"check", (dir / "face.nc").string(), "--tools", (dir / "tools.json").string(),
                       "--stock", "box:0,0,-10,40,40,0", "--design", (dir / "design.stl").string(),
@@ -93,7 +74,7 @@ TEST_CASE("check: the default tolerance is the shop's ±0.02 mm, and finds 0.05 
   CHECK(gouge.run.out.find("verdict: FAIL at ±0.02 mm") != std::string::npos);
 
   // A tolerance given is stated as given, and 0.05 mm then passes.
-  write_text(dir / "design.stl", box_stl(0, 0, -10, 40, 40, -1.05));
+  write_text(dir / "design.stl", box_stl_text(0, 0, -10, 40, 40, -1.05));
   CommandResult loose = run_tridex(
       {"check", (dir / "face.nc").string(), "--tools", (dir / "tools.json").string(), "--stock",
        "box:0,0,-10,40,40,0", "--design", (dir / "design.stl").string(), "--tolerance", "0.1"},
@@ -145,7 +126,7 @@ TEST_CASE("check --allowance: a faced plane left 0.3 mm high") {
   fs::path dir = scratch("check-allowance");
   write_text(dir / "tools.json", R"({"1": {"shape": "cylindrical", "diameter": 10}})");
   write_text(dir / "face.nc", facing_program());
-  write_text(dir / "design.stl", box_stl(0, 0, -10, 40, 40, -1.3));
+  write_text(dir / "design.stl", box_stl_text(0, 0, -10, 40, 40, -1.3));
   auto run = [&](const std::vector<std::string>& extra) {
     std::vector<std::string> args = {"check",       (dir / "face.nc").string(),
                                      "--tools",     (dir / "tools.json").string(),

@@ -139,11 +139,16 @@ struct Setup {
   std::vector<std::string> fixture_args;
 };
 
-Setup make_setup(const std::string& name) {
+// The fixtures (a vise, a clamp up to clamp_top, a 0.3 mm plate), a spindle nose and one tool.
+Setup make_setup(
+    const std::string& name, double clamp_top = 35,
+    const std::string& tool =
+        R"({"shape": "cylindrical", "diameter": 6, "length": 20, "tool-length": 50})") {
   Setup s{scratch(name), {}};
   write_ascii_stl(s.dir / "vise.stl", {make_box_mesh(Vec3(0, -20, -30), Vec3(100, 0, 0)),
                                        make_box_mesh(Vec3(0, 60, -30), Vec3(100, 80, 0))});
-  write_ascii_stl(s.dir / "clamp.stl", {make_box_mesh(Vec3(110, 20, -30), Vec3(130, 40, 35))});
+  write_ascii_stl(s.dir / "clamp.stl",
+                  {make_box_mesh(Vec3(110, 20, -30), Vec3(130, 40, clamp_top))});
   write_ascii_stl(s.dir / "plate.stl", {make_box_mesh(Vec3(150, -10, -30), Vec3(150.3, 70, 20))});
   fs::create_directories(s.dir / "parts");
   write_ascii_stl(s.dir / "parts" / "nose.stl", {make_frustum_mesh(40, 40, 0, 80)});
@@ -151,8 +156,7 @@ Setup make_setup(const std::string& name) {
       s.dir / "machine.json",
       R"({"components": [{"name": "spindle nose", "on": "spindle", "mesh": "parts/nose.stl"}],
                  "collision": {"clearance": 0.5, "near_miss": 2}})");
-  write_text(s.dir / "tools.json",
-             R"({"1": {"shape": "cylindrical", "diameter": 6, "length": 20, "tool-length": 50}})");
+  write_text(s.dir / "tools.json", R"({"1": )" + tool + "}");
   for (const char* f : {"vise.stl", "clamp.stl", "plate.stl"})
     s.fixture_args.insert(s.fixture_args.end(), {"--fixture", (s.dir / f).string()});
   return s;
@@ -221,22 +225,8 @@ TEST_CASE("check --fixture and a spindle nose: each planted crash at its line, n
 // found at its line only; the clean program cuts the deep pocket with the nose passing 4.6 mm
 // from the clamp, below its top, and gives nothing (not even a near miss at 2 mm).
 Setup make_bar_setup(const std::string& name) {
-  Setup s{scratch(name), {}};
-  write_ascii_stl(s.dir / "vise.stl", {make_box_mesh(Vec3(0, -20, -30), Vec3(100, 0, 0)),
-                                       make_box_mesh(Vec3(0, 60, -30), Vec3(100, 80, 0))});
-  write_ascii_stl(s.dir / "clamp.stl", {make_box_mesh(Vec3(110, 20, -30), Vec3(130, 40, 45))});
-  write_ascii_stl(s.dir / "plate.stl", {make_box_mesh(Vec3(150, -10, -30), Vec3(150.3, 70, 20))});
-  fs::create_directories(s.dir / "parts");
-  write_ascii_stl(s.dir / "parts" / "nose.stl", {make_frustum_mesh(40, 40, 0, 80)});
-  write_text(
-      s.dir / "machine.json",
-      R"({"components": [{"name": "spindle nose", "on": "spindle", "mesh": "parts/nose.stl"}],
-                 "collision": {"clearance": 0.5, "near_miss": 2}})");
-  write_text(s.dir / "tools.json",
-             R"({"1": {"shape": "cylindrical", "diameter": 6, "length": 35, "tool-length": 60}})");
-  for (const char* f : {"vise.stl", "clamp.stl", "plate.stl"})
-    s.fixture_args.insert(s.fixture_args.end(), {"--fixture", (s.dir / f).string()});
-  return s;
+  return make_setup(name, 45,
+                    R"({"shape": "cylindrical", "diameter": 6, "length": 35, "tool-length": 60})");
 }
 
 std::set<std::pair<std::string, std::string>> collision_pairs(const json& report) {
