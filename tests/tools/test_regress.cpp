@@ -172,25 +172,14 @@ TEST_CASE("check: a planted excess names the pass that left it") {
   int raised = 0;
   write_text(dir / "face.nc", facing(20, &raised));
   REQUIRE(raised > 0);
-  // The design: the faced block, its top at Z -1 (an ASCII STL of a box).
-  std::string stl = "solid d\n";
-  const double p[8][3] = {{0, 0, -10}, {40, 0, -10}, {40, 40, -10}, {0, 40, -10},
-                          {0, 0, -1},  {40, 0, -1},  {40, 40, -1},  {0, 40, -1}};
-  const int faces[12][3] = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
-                            {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
-  for (const auto& f : faces) {
-    stl += "facet normal 0 0 0\nouter loop\n";
-    for (int k : f)
-      stl += "vertex " + std::to_string(p[k][0]) + " " + std::to_string(p[k][1]) + " " +
-             std::to_string(p[k][2]) + "\n";
-    stl += "endloop\nendfacet\n";
-  }
-  write_text(dir / "design.stl", stl + "endsolid d\n");
-  CommandResult r = run_tridex(
-      {"check", (dir / "face.nc").string(), "--tools", (dir / "tools.json").string(), "--stock",
-       "box:0,0,-10,40,40,0", "--design", (dir / "design.stl").string(), "--dexel-res", "80",
-       "--report", (dir / "report.json").string(), "--html", (dir / "page.html").string()},
-      dir);
+  // The design: the faced block, its top at Z -1.
+  write_text(dir / "design.stl", box_stl_text(0, 0, -10, 40, 40, -1));
+  CommandResult r =
+      run_tridex({"check", (dir / "face.nc").string(), "--tools", (dir / "tools.json").string(),
+                  "--stock", "box:0,0,-10,40,40,0", "--design", (dir / "design.stl").string(),
+                  "--dexel-res", "80", "--tolerance", "0.05", "--report",
+                  (dir / "report.json").string(), "--html", (dir / "page.html").string()},
+                 dir);
   CHECK(r.status == 3);
   const json report = json::parse(slurp(dir / "report.json"));
   REQUIRE(!report["excess"].empty());
