@@ -64,10 +64,6 @@ constexpr std::size_t kExcessLinesListed = 20;  // the nearest lines of an exces
 constexpr int kHistogramBins = 20;
 constexpr std::size_t kMaxDesignSamples = 4'000'000;
 
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
 // Runs body(k) for k in [0, n) on `threads` threads (0: every hardware thread), in blocks of 4096.
 template <class Body>
 void parallel_for(std::size_t n, unsigned threads, const Body& body) {

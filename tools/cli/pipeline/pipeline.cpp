@@ -33,10 +33,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
 Stock load_stock(const StockSpec& spec, const Aabb& cutting_bounds, std::uint64_t max_memory) {
   Stock stock;
   switch (spec.kind) {

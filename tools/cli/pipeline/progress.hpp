@@ -9,6 +9,11 @@
 
 namespace tridex::cli {
 
+// Seconds since `start` on the steady clock: each stage's time in the report.
+inline double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 bool stderr_is_terminal();
 
 class Progress {
