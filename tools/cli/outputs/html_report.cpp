@@ -350,11 +350,13 @@ std::vector<DirectionColumns> milled_columns(const HtmlPage& page, const Aabb& b
                                              std::size_t& stop_count) {
   const std::vector<gcode::MoveGroup>& groups = *page.groups;
   std::vector<DirectionColumns> columns(groups.size());
+  std::vector<double> top(groups.size());  // the stock box's highest point in each direction
   for (std::size_t g = 0; g < groups.size(); ++g) {
     DirectionColumns& dc = columns[g];
     dc.frame = &groups[g].frame;
     Aabb local;
     for (const Vec3& corner : box.corners()) local.extend(dc.frame->to_local(corner));
+    top[g] = local.max.z;
     dc.x0 = local.min.x, dc.y0 = local.min.y, dc.cell = cell;
     dc.nx = std::max(1, static_cast<int>(std::ceil(local.size().x / cell)));
     dc.ny = std::max(1, static_cast<int>(std::ceil(local.size().y / cell)));
@@ -378,6 +380,10 @@ std::vector<DirectionColumns> milled_columns(const HtmlPage& page, const Aabb& b
         continue;
       DirectionColumns& dc = columns[run.group];
       const Segment tip{dc.frame->to_local(m.start), dc.frame->to_local(m.end)};
+      // No column falls below the move's lowest tip; a fall above the stock's box is below no
+      // cell of it (removal_stop): such moves and columns are skipped, the result is the same.
+      const double lowest_tip = std::min(tip.a.z, tip.b.z);
+      if (lowest_tip >= top[run.group]) continue;
       const Cutter& c = page.cutters[cutter->second];
       const detail::MoveGeometry geometry(c, tip);
       const double r = c.radius();
@@ -391,8 +397,9 @@ std::vector<DirectionColumns> milled_columns(const HtmlPage& page, const Aabb& b
           dc.ny - 1, static_cast<int>(std::floor((std::max(tip.a.y, tip.b.y) + r - dc.y0) / cell)));
       for (int j = j0; j <= j1; ++j)
         for (int i = i0; i <= i1; ++i) {
-          const double z = geometry.lowest(dc.x0 + (i + 0.5) * cell, dc.y0 + (j + 0.5) * cell).z;
           auto& falls = dc.falls[static_cast<std::size_t>(j) * dc.nx + i];
+          if (!falls.empty() && double(falls.back().second) <= lowest_tip) continue;
+          const double z = geometry.lowest(dc.x0 + (i + 0.5) * cell, dc.y0 + (j + 0.5) * cell).z;
           if (z < (falls.empty() ? kFar : double(falls.back().second)))
             falls.push_back({stop, static_cast<float>(z)});
         }
