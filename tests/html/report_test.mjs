@@ -577,6 +577,9 @@ try {
     const nose = data.machine.collisions[0][1].matrix;
     check(Math.abs(nose[3] - 85) < 1e-6 && Math.abs(nose[11] - 45.5) < 0.05, 'machine: the nose placed at the finding\'s pose: ' + nose);
     await page.screenshot({ path: path.join(out, 'machine_collision.png') });
+    // Printing draws each finding in turn, then puts the chosen one's pair back.
+    await page.evaluate(() => window.dispatchEvent(new Event('beforeprint')));
+    check(JSON.stringify((await view(page, 'machineShown')).pair) === JSON.stringify(chosen.pair), 'machine: the pair again after printing');
     await view(page, 'layer', 'machine', false);
     const hidden = await view(page, 'sample');
     check(hidden.machine < 0.001 * hidden.all && (await view(page, 'machineShown')).pair.length === 0,
