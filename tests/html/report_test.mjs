@@ -93,6 +93,50 @@ run(['simulate', write('through.nc', '%\nG21 G90\nT1 M6\nM3 S1000\nG0 X5 Y5 Z20\
 const noMovesPage = path.join(out, 'no_moves.html');
 run(['simulate', write('nothing.nc', '%\nG21 G90\nM30\n%\n'), '--stock', 'box:0,0,0,10,10,10', '-q', '--html', noMovesPage]);
 
+// The machine check (issue 33): a clamp beside the stock and a spindle nose (Ø80, on the spindle,
+// 60 mm above the tip with the tool's length) that comes down onto the clamp's top while the tool
+// plunges beside it (line 5, as tests/tools/test_machine_check.cpp's bar). Without a tool length
+// the nose cannot be placed: the page says so by the verdict.
+const boxFacets = (lo, hi) => {
+  const v = (i) => [i & 1 ? hi[0] : lo[0], i & 2 ? hi[1] : lo[1], i & 4 ? hi[2] : lo[2]];
+  return [[0, 2, 3], [0, 3, 1], [4, 5, 7], [4, 7, 6], [0, 1, 5], [0, 5, 4], [2, 6, 7], [2, 7, 3], [0, 4, 6], [0, 6, 2], [1, 3, 7], [1, 7, 5]]
+    .map((t) => t.map(v));
+};
+const prismFacets = (r, h, sides) => {
+  const at = (k, z) => [r * Math.cos(2 * Math.PI * k / sides), r * Math.sin(2 * Math.PI * k / sides), z], out = [];
+  for (let k = 0; k < sides; ++k) {
+    out.push([at(k, 0), at(k + 1, 0), at(k + 1, h)], [at(k, 0), at(k + 1, h), at(k, h)]);
+    out.push([[0, 0, 0], at(k + 1, 0), at(k, 0)], [[0, 0, h], at(k, h), at(k + 1, h)]);
+  }
+  return out;
+};
+const stl = (name, facets) => write(name, 'solid s\n' + facets.map((t) => ' facet normal 0 0 0\n  outer loop\n' +
+  t.map((p) => '   vertex ' + p.join(' ') + '\n').join('') + '  endloop\n endfacet\n').join('') + 'endsolid s\n');
+const clamp = stl('clamp.stl', boxFacets([110, 20, -30], [130, 40, 45]));
+stl('nose.stl', prismFacets(40, 80, 24));
+const machineFile = write('machine_file.json', '{"components": [{"name": "spindle nose", "on": "spindle", "mesh": "nose.stl"}], ' +
+                          '"collision": {"clearance": 0.5, "near_miss": 2}}');
+const machineProgram = write('machine.nc', 'G21 G90 G17\nT1 M6\nG43 H1\nG0 X85 Y30 Z50\nG1 Z-25 F300\nG0 Z50\nM30\n');
+const machineArgs = (tool) => ['--tools', write('machine_tools.json', '{"1": {"shape": "cylindrical", "diameter": 6, "length": 35' + tool + '}}'),
+                               '--stock', 'box:0,0,-30,100,60,0', '--dexel-cell', '1', '-q'];
+run(['simulate', machineProgram, ...machineArgs(', "tool-length": 60'), '-o', path.join(out, 'machine_design.stl')]);
+const machinePage = path.join(out, 'machine.html');
+run(['check', machineProgram, ...machineArgs(', "tool-length": 60'), '--design', path.join(out, 'machine_design.stl'), '--tolerance', '1',
+     '--machine', machineFile, '--fixture', clamp, '--report', path.join(out, 'machine_report.json'), '--html', machinePage], [3]);
+const unplacedPage = path.join(out, 'unplaced.html');
+run(['check', machineProgram, ...machineArgs(''), '--design', path.join(out, 'machine_design.stl'), '--tolerance', '1',
+     '--machine', machineFile, '--fixture', clamp, '--report', path.join(out, 'unplaced.json'), '--html', unplacedPage], [0, 3]);
+// Five spindle directions (as the bundled example has): the toolbar wraps to a second row at
+// 1280 × 800, where the deviation legend once covered the clipping plane's "flip".
+const planes = [[0, 20], [90, 20], [180, 20], [-90, 20], [45, 30]];
+const manyProgram = '%\nG21 G17 G90\nT1 M6\nS8000 M3\n' + planes.map(([i, j], k) => 'G68.2 X10 Y10 Z10 I' + i + ' J' + j + ' K0\nG53.1\n' +
+  'G0 X' + (k - 2) * 3 + ' Y0\nG0 Z5\nG1 Z-0.5 F500\nG0 Z5\nG69\n').join('') + 'M30\n%\n';
+write('many.nc', manyProgram);
+const coarse = ['--tools', tools, '--stock', 'box:0,0,0,20,20,10', '--dexel-cell', '0.25', '-q'];  // the layout is the subject
+run(['simulate', path.join(out, 'many.nc'), ...coarse, '-o', path.join(out, 'many_design.stl')]);
+const manyPage = path.join(out, 'many.html');
+run(['check', path.join(out, 'many.nc'), ...coarse, '--design', path.join(out, 'many_design.stl'), '--tolerance', '0.5', '--html', manyPage], [0, 3]);
+
 // ---- the browser ---------------------------------------------------------------------------------
 const profile = fs.mkdtempSync(path.join(out, 'profile-'));
 const browser = await puppeteer.launch({
@@ -507,6 +551,73 @@ try {
       const line = Number(/up to line (\d+) /.exec(label)[1]);
       check(label.endsWith(': ' + largeLines[line - 1]), 'large: the slider at line ' + line + ' shows its text: ' + label);
     }
+    clean();
+    await page.close();
+  }
+  // The machine check (issue 33): the fixture drawn from the start; choosing the machine finding
+  // draws its pair (the clamp and the spindle nose) at the finding's pose in teal; the machine
+  // layer hides them.
+  {
+    const { page, clean } = await open(machinePage);
+    const report = JSON.parse(fs.readFileSync(path.join(out, 'machine_report.json'))), data = await pageData(page);
+    check(report.machine.collisions.length === 1 && report.machine.collisions[0].line === 5 &&
+          report.machine.collisions[0].b === 'spindle nose', 'machine: the nose onto the clamp at line 5: ' + JSON.stringify(report.machine.collisions));
+    check(await page.$eval('#machine-toggle', (e) => !e.hidden), 'machine: the machine layer is offered');
+    await toggle(page, 'show-path'); await toggle(page, 'show-rapids');
+    const first = await view(page, 'machineShown');
+    check(JSON.stringify(first) === JSON.stringify({ fixtures: ['clamp.stl'], pair: [] }), 'machine: the fixture drawn at first: ' + JSON.stringify(first));
+    const before = await view(page, 'sample');
+    check(before.machine < 0.001 * before.all, 'machine: no teal before a finding is chosen: ' + JSON.stringify(before));
+    await chooseFinding(page, 'machine.collisions:0');
+    await settle(page);
+    const chosen = await view(page, 'machineShown');
+    check(JSON.stringify(chosen.pair) === JSON.stringify(['clamp.stl', 'spindle nose']), 'machine: the pair drawn once chosen: ' + JSON.stringify(chosen));
+    const drawn = await view(page, 'sample');
+    check(drawn.machine > 0.01 * drawn.all, 'machine: teal pixels of the pair: ' + JSON.stringify(drawn));
+    // Where the nose stands: its gauge point 60 mm above the tip at the contact (the clamp's top, Z45).
+    const nose = data.machine.collisions[0][1].matrix;
+    check(Math.abs(nose[3] - 85) < 1e-6 && Math.abs(nose[11] - 45.5) < 0.05, 'machine: the nose placed at the finding\'s pose: ' + nose);
+    await page.screenshot({ path: path.join(out, 'machine_collision.png') });
+    // Printing draws each finding in turn, then puts the chosen one's pair back.
+    await page.evaluate(() => window.dispatchEvent(new Event('beforeprint')));
+    check(JSON.stringify((await view(page, 'machineShown')).pair) === JSON.stringify(chosen.pair), 'machine: the pair again after printing');
+    await view(page, 'layer', 'machine', false);
+    const hidden = await view(page, 'sample');
+    check(hidden.machine < 0.001 * hidden.all && (await view(page, 'machineShown')).pair.length === 0,
+          'machine: the machine layer hides the pair: ' + JSON.stringify(hidden));
+    clean();
+    await page.close();
+  }
+  {
+    const { page, clean } = await open(unplacedPage);
+    const said = await page.$$eval('#not-checked .message', (l) => l.map((e) => e.textContent));
+    check(said.length === 1 && said[0].startsWith('Not checked: the spindle\'s parts not tested with T1'),
+          'unplaced: "not checked" by the verdict: ' + said);
+    const verdict = await page.$eval('#verdict-line', (e) => e.getBoundingClientRect().bottom);
+    const message = await page.$eval('#not-checked .message', (e) => e.getBoundingClientRect().top);
+    check(message >= verdict && message < verdict + 40, 'unplaced: right under the verdict: ' + [verdict, message]);
+    const warnings = await page.$$eval('#summary tr', (l) => l.filter((r) => r.cells[0].textContent === 'warning').map((r) => r.cells[1].textContent));
+    check(warnings.some((w) => w.startsWith('the spindle\'s parts not tested with T1')), 'unplaced: among the warnings: ' + warnings);
+    await page.screenshot({ path: path.join(out, 'unplaced.png') });
+    clean();
+    await page.close();
+  }
+  // The legend overlaps no control of the toolbar (nor the slider's box) at 1280 × 800, with one
+  // direction and with five.
+  for (const file of [checkPage, manyPage]) {
+    const { page, clean } = await open(file);
+    const rects = await page.evaluate(() => {
+      const r = (e) => { const b = e.getBoundingClientRect(); return { name: e.id || e.textContent.trim() || e.tagName, l: b.left, t: b.top, r: b.right, b: b.bottom }; };
+      const controls = [...document.querySelectorAll('#toolbar button, #toolbar label, #toolbar select, #toolbar input')]
+        .filter((e) => e.offsetParent !== null).map(r);
+      return { legend: r(document.getElementById('legend')), controls, bottom: r(document.getElementById('bottom')),
+               rows: new Set(controls.map((c) => Math.round(c.t))).size };
+    });
+    const overlaps = (a, b) => a.l < b.r && b.l < a.r && a.t < b.b && b.t < a.b;
+    const hit = rects.controls.filter((c) => overlaps(c, rects.legend)).map((c) => c.name);
+    check(hit.length === 0 && !overlaps(rects.legend, rects.bottom), path.basename(file) + ': the legend covers ' + hit + ' ' + JSON.stringify(rects.legend));
+    if (file === manyPage) check(rects.rows >= 2, 'many: the toolbar wraps at 1280 × 800: ' + rects.rows + ' rows');
+    await page.screenshot({ path: file.replace(/\.html$/, '_legend.png') });
     clean();
     await page.close();
   }

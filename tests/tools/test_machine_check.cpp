@@ -4,12 +4,14 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <map>
 #include <random>
 #include <set>
 
 #include <nlohmann/json.hpp>
 
 #include "checks/machine_check.hpp"
+#include "outputs/html_report.hpp"
 #include "command_harness.hpp"
 
 namespace test_machine_check {
@@ -276,6 +278,175 @@ TEST_CASE("the issue's bar: vise, clamp, plate and spindle nose; planted crashes
   // The same pocket 6 mm nearer the clamp (X71) puts the nose in it: the bar is not vacuous.
   report = run_check(s, "G0 X71 Y30 Z50\nG1 Z-25 F300\nG0 Z50\n", r);
   CHECK(collision_lines(report) == std::set<int>{5});
+}
+
+// ---- the spindle's parts and the in-process stock; what could not be checked; the page ----------
+
+// A bore plunged 38 mm deep, then again to 45 mm, by a tool whose gauge point is 40 mm above its
+// tip: the nose (radius 40) clears the stock's top by 2 mm on the first plunge and goes 5 mm below
+// it on the second (line 7), into the bore the first cut. No fixtures: the stock alone. (Parts
+// are tested against the stock as it stands before their move is milled, as holders are:
+// collision_check.hpp.)
+json run_bore(const Setup& s, double diameter, CommandResult& result,
+              const std::string& html = "") {
+  write_text(s.dir / "tools.json", R"({"1": {"shape": "cylindrical", "diameter": )" +
+                                       std::to_string(diameter) +
+                                       R"(, "length": 35, "tool-length": 40}})");
+  write_text(
+      s.dir / "p.nc",
+      "G21 G90 G17\nT1 M6\nG43 H1\nG0 X50 Y50 Z20\nG1 Z-38 F300\nG0 Z20\nG1 Z-45\nG0 Z20\nM30\n");
+  fs::remove(s.dir / "report.json");
+  const std::string stock = "box:0,0,-60,100,100,0";
+  const std::vector<std::string> common{
+      "--tools", (s.dir / "tools.json").string(), "--stock", stock, "--dexel-cell", "1", "-q"};
+  std::vector<std::string> make{"simulate", (s.dir / "p.nc").string(), "-o",
+                                (s.dir / "design.stl").string()};
+  make.insert(make.end(), common.begin(), common.end());
+  REQUIRE(run_tridex(make, s.dir).status == 0);
+  std::vector<std::string> args{"check",       (s.dir / "p.nc").string(),
+                                "--design",    (s.dir / "design.stl").string(),
+                                "--machine",   (s.dir / "machine.json").string(),
+                                "--tolerance", "1",
+                                "--report",    (s.dir / "report.json").string()};
+  args.insert(args.end(), common.begin(), common.end() - 1);
+  if (!html.empty()) args.insert(args.end(), {"--html", (s.dir / html).string()});
+  result = run_tridex(args, s.dir);
+  return fs::exists(s.dir / "report.json") ? json::parse(slurp(s.dir / "report.json")) : json();
+}
+
+TEST_CASE("check: the spindle nose against the in-process stock, not the raw stock") {
+  const Setup s = make_setup("machine-nose-stock");
+  CommandResult r;
+  // A Ø60 bore: its walls stand within the nose's 40 mm radius, 5 mm above its bottom.
+  json report = run_bore(s, 60, r);
+  INFO(r.out, r.err);
+  CHECK(r.status == 3);
+  // The second plunge (line 7) and the retract from there (line 8), as a holder's are reported.
+  REQUIRE(report["collisions"].size() == 2);
+  for (const json& c : report["collisions"]) {
+    CHECK(c["part"] == "spindle nose");
+    CHECK(c["depth_mm"].get<double>() == doctest::Approx(5).epsilon(0.05));
+  }
+  CHECK(report["collisions"][0]["line"] == 7);
+  CHECK(report["collisions"][1]["line"] == 8);
+  CHECK(r.out.find("p.nc:7: tool 1's spindle nose is 5.000 mm into the stock") !=
+        std::string::npos);
+  CHECK(report["machine"]["collisions"].empty());  // no fixture: the stock is the only obstacle
+  // A Ø100 bore: the first plunge cut away all the material the nose reaches on the second (the
+  // raw stock would hold it): nothing.
+  report = run_bore(s, 100, r);
+  CHECK(r.status == 0);
+  CHECK(report["collisions"].empty());
+  CHECK(report["near_misses"]["moves"].empty());
+}
+
+TEST_CASE("check: spindle parts a tool cannot place are said where the verdict is read") {
+  const Setup s = make_setup("machine-unplaced", 35,
+                             R"({"shape": "cylindrical", "diameter": 6, "length": 20})");
+  CommandResult r;
+  const json report = run_check(s, "G0 X50 Y30 Z40\nG1 Z-10 F300\nG0 Z40\n", r);
+  INFO(r.out, r.err);
+  CHECK(r.status == 0);  // nothing found: the verdict passes, and says what it does not cover
+  CHECK(report["machine"]["spindle_parts_unplaced_tools"] == json::array({1}));
+  REQUIRE(report["not_checked"].size() == 1);
+  const std::string text = report["not_checked"][0];
+  CHECK(text.find("spindle's parts not tested with T1") != std::string::npos);
+  bool warned = false;
+  for (const json& w : report["warnings"]) warned |= w == text;
+  CHECK(warned);
+  const std::size_t verdict = r.out.find("  verdict: pass");
+  REQUIRE(verdict != std::string::npos);
+  const std::string line = r.out.substr(verdict, r.out.find('\n', verdict) - verdict);
+  CHECK(line.find("NOT CHECKED: " + text) != std::string::npos);
+  CHECK(r.err.find("warning: " + text) != std::string::npos);
+  // With a tool length the nose is placed: nothing said.
+  const Setup placed = make_setup("machine-placed");
+  const json clean = run_check(placed, "G0 X50 Y30 Z40\nG1 Z-10 F300\nG0 Z40\n", r);
+  CHECK(!clean.contains("not_checked"));
+  CHECK(r.out.find("NOT CHECKED") == std::string::npos);
+}
+
+// The JSON inside a page's tridex-data block.
+json machine_page_data(const fs::path& html) {
+  const std::string text = slurp(html);
+  const std::string open = "<script type=\"application/json\" id=\"tridex-data\">";
+  const std::size_t start = text.find(open);
+  REQUIRE(start != std::string::npos);
+  return json::parse(
+      text.substr(start + open.size(), text.find("</script>", start) - start - open.size()));
+}
+
+TEST_CASE("check --html: the machine finding's pair drawn at its pose, the fixtures always") {
+  const Setup s = make_bar_setup("machine-page");
+  CommandResult r;
+  // The nose onto the clamp's top (the bar's second crash): the tip at Z-14.5 then.
+  const std::vector<std::string> html{"--html", (s.dir / "page.html").string()};
+  Setup with_page = s;
+  with_page.fixture_args.insert(with_page.fixture_args.end(), html.begin(), html.end());
+  const json report = run_check(with_page, "G0 X85 Y30 Z50\nG1 Z-25 F300\nG0 Z50\n", r);
+  INFO(r.out, r.err);
+  REQUIRE(report["machine"]["collisions"].size() == 1);
+  const json data = machine_page_data(s.dir / "page.html");
+  REQUIRE(data.contains("machine"));
+  const json& m = data["machine"];
+  std::map<std::string, json> bodies;
+  for (const json& b : m["bodies"]) bodies[b["name"].get<std::string>()] = b;
+  // The fixtures and the pair drawn; the tool's parts (in no finding) left out.
+  for (const char* name : {"vise.stl", "clamp.stl", "plate.stl", "spindle nose"})
+    CHECK(bodies[name]["triangles_shown"].get<int>() > 0);
+  CHECK(bodies["tool 1 flutes"]["triangles_shown"] == 0);
+  CHECK(bodies["clamp.stl"]["group"] == "fixture");
+  REQUIRE(m["collisions"].size() == 1);
+  const json& pose = m["collisions"][0];
+  REQUIRE(pose.size() == 2);
+  const auto& names = m["bodies"];
+  CHECK(names[pose[0]["body"].get<int>()]["name"] == "clamp.stl");
+  CHECK(names[pose[1]["body"].get<int>()]["name"] == "spindle nose");
+  // The clamp is in the work frame (the identity); the nose's gauge point 60 mm above the tip.
+  const std::vector<double> identity{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+  for (std::size_t k = 0; k < 12; ++k)
+    CHECK(pose[0]["matrix"][k].get<double>() == doctest::Approx(identity[k]));
+  const json& nose = pose[1]["matrix"];
+  CHECK(nose[3].get<double>() == doctest::Approx(85));
+  CHECK(nose[7].get<double>() == doctest::Approx(30));
+  CHECK(nose[11].get<double>() == doctest::Approx(-14.5 + 60).epsilon(1e-3));
+  CHECK(nose[10].get<double>() == doctest::Approx(1));
+}
+
+TEST_CASE("the page's machine bodies: a 100 k triangle part within the budget") {
+  // A wavy sheet of 2 × 224² triangles on the spindle, and a small fixture.
+  Mesh big;
+  const int n = 224;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i)
+      big.positions.emplace_back(i, j, 3 * std::sin(0.3 * i) * std::cos(0.2 * j));
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const unsigned a = static_cast<unsigned>(j * (n + 1) + i), b = a + 1, c = a + n + 1,
+                     d = c + 1;
+      big.triangles.push_back({a, b, d});
+      big.triangles.push_back({a, d, c});
+    }
+  REQUIRE(big.triangles.size() > 100000);
+  const Mesh vise = make_box_mesh(Vec3(0), Vec3(10));
+  HtmlMachine machine;
+  machine.names = {"head", "vise.stl", "bed"};
+  machine.groups = {"component", "fixture", "component"};
+  machine.meshes = {&big, &vise, &big};
+  machine.collisions.push_back({HtmlMachinePose{0, Frame{}}, HtmlMachinePose{1, Frame{}}});
+  HtmlPage page;
+  page.report = json::object();
+  page.machine = &machine;
+  HtmlLimits limits;
+  const json data = html_page_data(page, limits);
+  const json& bodies = data["machine"]["bodies"];
+  const std::size_t shown = bodies[0]["triangles_shown"].get<std::size_t>();
+  CHECK(shown > 0);
+  CHECK(shown <= limits.max_machine_triangles);
+  CHECK(bodies[0]["triangles"] == big.triangles.size());
+  CHECK(bodies[1]["triangles_shown"] == 12);  // under its floor: whole
+  CHECK(bodies[2]["triangles_shown"] == 0);   // in no finding and no fixture: not drawn
+  CHECK(data["machine"].dump().size() < std::size_t{2} << 20);
 }
 
 // ---- the bundled example on the bundled trunnion ---------------------------------------------

@@ -256,6 +256,9 @@ struct CheckFindings {
   Json envelope_list = Json::array();
   std::size_t envelope_outside = 0;
   Json travel_list = Json::array();
+  // What could not be checked (the verdict does not cover it): said on the verdict line, in the
+  // report's "not_checked" and next to the page's verdict.
+  std::vector<std::string> not_checked;
 };
 
 // A finding's file: the name of Move::file's entry, as --report's "files" and messages give it.
@@ -541,13 +544,15 @@ Json check_report(const CheckOptions& options, const SimulationResult& r,
 
 // --report and --html.
 void write_reports(const CheckOptions& options, const SimulationResult& r, const Mesh& design,
-                   const Json& report, const CheckFindings& f, Progress& progress) {
+                   const Json& report, const CheckFindings& f, const MachineRun& machine,
+                   Progress& progress) {
   if (!options.report.empty()) {
     progress.stage("writing " + options.report);
     write_file_atomically(options.report, dump_json(report, 2) + "\n");
   }
   if (!options.html.empty()) {
     progress.stage("writing " + options.html);
+    const HtmlMachine machine_parts = machine_page(machine);
     write_html_report(options.html,
                       {.title = "tridex check: " + r.input.program.filename().string() +
                                 " against " + fs::path(options.design).filename().string(),
@@ -561,7 +566,8 @@ void write_reports(const CheckOptions& options, const SimulationResult& r, const
                        .stock = &r.stock,
                        .cutters = r.cutters,
                        .bodies = r.bodies,
-                       .cutter_of_tool = &r.cutter_of_tool});
+                       .cutter_of_tool = &r.cutter_of_tool,
+                       .machine = machine.active ? &machine_parts : nullptr});
   }
 }
 
@@ -631,12 +637,14 @@ void print_summary(const CheckOptions& options, const SimulationResult& r, const
       r.travel_count, r.body.collisions.size(), r.body.near_misses.size(), options.clearance,
       failed ? "FAIL" : "pass", total_s);
   std::printf("  %s\n", machining_time_text(r.machining).c_str());
+  std::string unchecked;
+  for (const std::string& text : f.not_checked) unchecked += "; NOT CHECKED: " + text;
   if (f.gouge_tol == f.excess_tol)
-    std::printf("  verdict: %s at ±%g mm (%s)\n", failed ? "FAIL" : "pass", f.gouge_tol,
-                f.tolerance_source.c_str());
+    std::printf("  verdict: %s at ±%g mm (%s)%s\n", failed ? "FAIL" : "pass", f.gouge_tol,
+                f.tolerance_source.c_str(), unchecked.c_str());
   else
-    std::printf("  verdict: %s at -%g/+%g mm (%s)\n", failed ? "FAIL" : "pass", f.gouge_tol,
-                f.excess_tol, f.tolerance_source.c_str());
+    std::printf("  verdict: %s at -%g/+%g mm (%s)%s\n", failed ? "FAIL" : "pass", f.gouge_tol,
+                f.excess_tol, f.tolerance_source.c_str(), unchecked.c_str());
   std::printf("  %s\n", resolution_text(options, r).c_str());
   std::printf("  %s\n  %s\n", tools_text(r).c_str(), directions_text(r).c_str());
   std::size_t printed = 0;
@@ -714,11 +722,16 @@ int run_check(const CheckOptions& options) {
                          std::to_string(r.mesh_check.boundary_edges) + " boundary, " +
                          std::to_string(r.mesh_check.non_manifold_edges) + " non-manifold edges)");
   const MachineRun machine = run_machine_check(options.fixtures, r);
+  if (const std::string text = machine_unchecked_text(machine); !text.empty()) {
+    r.warnings.push_back(text);
+    f.not_checked.push_back(text);
+  }
   const bool failed = check_failed(r, f, machine);
   const double total_s = seconds_since(start);
   Json report = check_report(options, r, in.envelope, f, failed, deviation_s, total_s);
+  if (!f.not_checked.empty()) report["not_checked"] = f.not_checked;
   if (machine.active || !machine.found.travel.empty()) report["machine"] = machine_json(machine, r);
-  write_reports(options, r, in.design, report, f, progress);
+  write_reports(options, r, in.design, report, f, machine, progress);
   progress.finish();
   if (!options.quiet) {
     print_summary(options, r, report, f, failed, total_s);

@@ -45,6 +45,8 @@ BodyCheck::BodyCheck(const ZMap& map, std::span<const ToolBody> bodies, double c
                    -std::numeric_limits<float>::infinity());
   tile_pending_.assign(tile_top_.size(), 0);
   refresh_tiles(map, 0, map.grid.nx - 1, 0, map.grid.ny - 1);
+  // Heights only fall: the stock's top now bounds the material for good.
+  for (float top : tile_top_) map_top_ = std::max(map_top_, double(top));
 }
 
 void BodyCheck::will_mill(const ZMap& map, const Cutter& cutter, const CutMove& move) {
@@ -129,6 +131,8 @@ void BodyCheck::check(const ZMap& map, const gcode::Move& move, const CutMove& c
   for (std::size_t k = 0; k < body.parts.size(); ++k) {
     const BodyPart& part = body.parts[k];
     const Cutter& grown = grown_[cut.cutter][k];
+    // Above all the material (a spindle's parts mostly are): nothing to search.
+    if (std::min(cut.tip.a.z, cut.tip.b.z) + part.bottom - clearance_ >= map_top_) continue;
     bool stale = false;
     if (contact_depth(map, grown, raised(cut.tip, part.bottom - clearance_),
                       up_to_date ? nullptr : &stale)
@@ -154,7 +158,9 @@ void BodyCheck::check(const ZMap& map, const gcode::Move& move, const CutMove& c
              BodyFinding{move.file, move.line, move.tool, part.name, plain.depth, located(plain),
                          axis, group},
              true);
-      if (body.has_holder() && part.bottom >= body.stick_out) {
+      // The holder's own sections only (the spindle's parts follow them: machine_run.hpp).
+      if (body.has_holder() && part.bottom >= body.stick_out &&
+          part.name.starts_with("holder section")) {
         double& deepest = found.holder_depth[{move.tool, group}];
         deepest = std::max(deepest, plain.depth);
       }

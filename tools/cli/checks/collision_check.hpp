@@ -21,6 +21,7 @@
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <map>
 #include <span>
 #include <string>
@@ -91,6 +92,7 @@ class BodyCheck {
   std::vector<std::vector<Cutter>> plain_, grown_;  // per cutter, per part
   int tiles_x_ = 0, tiles_y_ = 0;
   std::vector<float> tile_top_;
+  double map_top_ = -std::numeric_limits<double>::infinity();  // the stock's highest point
   std::vector<unsigned char> tile_pending_;  // 1: a move of the batch not yet milled reaches it
 };
 

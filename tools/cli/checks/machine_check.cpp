@@ -271,10 +271,16 @@ void MachineCheck::check_pair(const MachineBody& a, const MachineBody& b, const 
     const MachineState here = state_at(move, at);
     MachineBody work_body;
     work_body.link = {LinkKind::work, 0};
-    const Frame work = frame_of(work_body, here, move);
-    return MachineFinding{move.file, move.line, move.tool,
-                          a.name,    b.name,    distance,
-                          at,        here,      work.to_local(0.5 * (where.on_a + where.on_b))};
+    const Frame work = frame_of(work_body, here, move), to_work = work.inverse();
+    MachineFinding f;
+    f.file = move.file, f.line = move.line, f.tool = move.tool;
+    f.a = a.name, f.b = b.name, f.distance = distance, f.t = at, f.state = here;
+    f.where = work.to_local(0.5 * (where.on_a + where.on_b));
+    f.body_a = static_cast<int>(&a - bodies_.data());
+    f.body_b = static_cast<int>(&b - bodies_.data());
+    f.pose_a = mc_compose(to_work, frame_of(a, here, move));
+    f.pose_b = mc_compose(to_work, frame_of(b, here, move));
+    return f;
   };
   auto at = [&](double t, double cap) {
     const MachineState s = state_at(move, t);

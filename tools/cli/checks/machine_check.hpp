@@ -52,7 +52,8 @@ struct MachineBody {
   Link link;
   int tool = -1;  // tool parts: the tool they belong to
   std::shared_ptr<const TriangleTree> tree;
-  Vec3 centre{0};  // a bounding sphere of the tree (its own coordinates)
+  std::shared_ptr<const Mesh> mesh;  // what the tree was built from (the HTML page draws it)
+  Vec3 centre{0};                    // a bounding sphere of the tree (its own coordinates)
   double radius = 0;
   std::vector<Vec3> pieces;  // a vertex of each connected piece (TriangleTree::piece_vertices)
 };
@@ -83,6 +84,10 @@ struct MachineFinding {
   double t = 0;         // where along the move (0..1), collisions: the first contact
   MachineState state;   // the axes' positions there
   Vec3 where{0};        // a point near the contact, work frame
+  // The pair as bodies() lists them, and each one's frame there (its coordinates to the work
+  // frame): the HTML page draws the two at this pose.
+  int body_a = -1, body_b = -1;
+  Frame pose_a, pose_b;
 };
 
 struct TravelAlong {

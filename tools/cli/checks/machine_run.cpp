@@ -1,6 +1,9 @@
 #include "checks/machine_run.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <limits>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -15,15 +18,16 @@ namespace {
 constexpr std::size_t kMachineFindingsListed = 1000;  // of each kind, in the report
 
 MachineBody mr_body(std::string name, std::string group, Link link, int tool,
-                    std::shared_ptr<const TriangleTree> tree) {
+                    std::shared_ptr<const Mesh> mesh) {
   MachineBody b;
   b.name = std::move(name), b.group = std::move(group), b.link = link, b.tool = tool;
-  b.tree = std::move(tree);
+  b.tree = std::make_shared<const TriangleTree>(*mesh);
+  b.mesh = std::move(mesh);
   return b;
 }
 
-std::shared_ptr<const TriangleTree> mr_tree(const Mesh& mesh) {
-  return std::make_shared<const TriangleTree>(mesh);
+std::shared_ptr<const Mesh> mr_mesh(Mesh mesh) {
+  return std::make_shared<const Mesh>(std::move(mesh));
 }
 
 Mesh mr_read(const std::string& path, const std::string& what) {
@@ -104,22 +108,86 @@ void mr_add_tool(MachineCheck& check, const SimulationResult& r, int tool, std::
     flutes.push_back(make_frustum_mesh(cutter.radius(), cutter.radius(), last_h, top));
   const std::string name = "tool " + std::to_string(tool);
   check.add(
-      mr_body(name + " flutes", "tool", {LinkKind::tool, 0}, tool, mr_tree(merge_meshes(flutes))));
+      mr_body(name + " flutes", "tool", {LinkKind::tool, 0}, tool, mr_mesh(merge_meshes(flutes))));
   std::vector<Mesh> holder;
   for (const BodyPart& part : body.parts) {
     const BodySection& s = part.shape;
     Mesh m = make_frustum_mesh(s.bottom_radius, s.top_radius, part.bottom, part.bottom + s.length);
     if (part.name == "shank")
-      check.add(mr_body(name + " shank", "tool", {LinkKind::tool, 0}, tool, mr_tree(m)));
+      check.add(mr_body(name + " shank", "tool", {LinkKind::tool, 0}, tool, mr_mesh(std::move(m))));
     else
       holder.push_back(std::move(m));
   }
   if (!holder.empty())
     check.add(mr_body(name + " holder", "tool", {LinkKind::tool, 0}, tool,
-                      mr_tree(merge_meshes(holder))));
+                      mr_mesh(merge_meshes(holder))));
+}
+
+// At most this many stacked cylinders stand for one spindle part (bodies_against_stock).
+constexpr std::size_t kSpindleSlabs = 8;
+
+// A spindle part's envelope of revolution about the spindle axis (its coordinates: the gauge
+// point at the origin, +Z up the tool) as stacked cylinders, `gauge` above the tip: between each
+// two of its vertices' distinct heights (or kSpindleSlabs equal slabs), a cylinder as wide as
+// the farthest vertex of any triangle that reaches into the slab (the distance from an axis is
+// convex: a triangle's farthest point is a vertex). A BodyCheck tests each as the material below
+// its bottom disc (tool_body.hpp), so the stack holds the part.
+std::vector<BodyPart> mr_spindle_envelope(const std::string& name, const Mesh& mesh, double gauge) {
+  std::vector<double> heights;
+  for (const glm::vec3& p : mesh.positions) heights.push_back(p.z);
+  std::sort(heights.begin(), heights.end());
+  if (heights.empty()) return {};
+  const double lo = heights.front(), hi = heights.back(), merge = 1e-6 * (1 + hi - lo);
+  std::vector<double> levels;
+  for (double z : heights)
+    if (levels.empty() || z > levels.back() + merge) levels.push_back(z);
+  if (levels.size() > kSpindleSlabs + 1) {
+    levels.clear();
+    for (std::size_t k = 0; k <= kSpindleSlabs; ++k)
+      levels.push_back(lo + (hi - lo) * static_cast<double>(k) / kSpindleSlabs);
+  }
+  if (levels.size() == 1) levels.push_back(lo + 1e-3);  // a flat part: one thin slab
+  std::vector<double> radius(levels.size() - 1, 0.0);
+  for (const glm::uvec3& t : mesh.triangles) {
+    double z0 = std::numeric_limits<double>::infinity(), z1 = -z0, r = 0;
+    for (int v = 0; v < 3; ++v) {
+      const glm::vec3& p = mesh.positions[t[v]];
+      z0 = std::min(z0, double(p.z)), z1 = std::max(z1, double(p.z));
+      r = std::max(r, std::hypot(double(p.x), double(p.y)));
+    }
+    for (std::size_t k = 0; k + 1 < levels.size(); ++k)
+      if (z1 >= levels[k] - merge && z0 <= levels[k + 1] + merge)
+        radius[k] = std::max(radius[k], r);
+  }
+  std::vector<BodyPart> parts;
+  for (std::size_t k = 0; k + 1 < levels.size(); ++k)
+    if (radius[k] > 0)
+      parts.push_back(BodyPart{name, gauge + levels[k],
+                               BodySection{radius[k], radius[k], levels[k + 1] - levels[k]}});
+  return parts;
 }
 
 }  // namespace
+
+std::vector<ToolBody> bodies_against_stock(const SimulationResult& r) {
+  std::vector<ToolBody> bodies = r.bodies;
+  std::vector<std::pair<std::string, std::shared_ptr<const Mesh>>> spindle;
+  for (const gcode::MachineComponent& c : r.input.machine.components)
+    if (c.on == "spindle")
+      spindle.emplace_back(
+          c.name, c.built ? c.built
+                          : mr_mesh(mr_read(
+                                c.mesh, "--machine: component \"" + c.name + "\" mesh " + c.mesh)));
+  if (spindle.empty()) return bodies;
+  for (const auto& [tool, c] : r.cutter_of_tool) {
+    const std::optional<double> gauge = mr_gauge(r, tool);
+    if (!gauge || c >= bodies.size()) continue;  // not placed: machine_unchecked_text says so
+    for (const auto& [name, mesh] : spindle)
+      for (BodyPart& part : mr_spindle_envelope(name, *mesh, *gauge))
+        bodies[c].parts.push_back(std::move(part));
+  }
+  return bodies;
+}
 
 MachineRun run_machine_check(const std::vector<std::string>& fixtures, const SimulationResult& r) {
   MachineRun run;
@@ -131,16 +199,20 @@ MachineRun run_machine_check(const std::vector<std::string>& fixtures, const Sim
   MachineCheck check(machine.kinematics, machine.linear_on_head, machine.collision);
   for (const std::string& path : all_fixtures)
     check.add(mr_body(std::filesystem::path(path).filename().string(), "fixture",
-                      {LinkKind::work, 0}, -1, mr_tree(mr_read(path, "--fixture " + path))));
+                      {LinkKind::work, 0}, -1, mr_mesh(mr_read(path, "--fixture " + path))));
   for (const gcode::MachineComponent& c : machine.components)
     check.add(mr_body(c.name, "component", mr_link(c.on, machine.kinematics), -1,
-                      c.built ? mr_tree(*c.built)
-                              : mr_tree(mr_read(c.mesh, "--machine: component \"" + c.name +
+                      c.built ? c.built
+                              : mr_mesh(mr_read(c.mesh, "--machine: component \"" + c.name +
                                                             "\" mesh " + c.mesh))));
   for (const auto& [tool, c] : r.cutter_of_tool) mr_add_tool(check, r, tool, c);
   bool spindle_parts = false;
   for (const MachineBody& b : check.bodies()) spindle_parts |= b.link.kind == LinkKind::spindle;
-  for (const MachineBody& b : check.bodies()) run.bodies.push_back(b.name);
+  for (const MachineBody& b : check.bodies()) {
+    run.bodies.push_back(b.name);
+    run.groups.push_back(b.group);
+    run.meshes.push_back(b.mesh);
+  }
 
   const Vec3 g54 = machine.work_offsets.count(1) ? machine.work_offsets.at(1) : Vec3(0);
   // Pairs in contact on the last move checked: a retract straight up the tool from such a
@@ -249,6 +321,30 @@ Json machine_json(const MachineRun& run, const SimulationResult& r) {
           {"seconds", run.found.seconds}};
 }
 
+std::string machine_unchecked_text(const MachineRun& run) {
+  if (run.spindle_unplaced.empty()) return {};
+  std::string tools;
+  for (int t : run.spindle_unplaced) tools += (tools.empty() ? "T" : ", T") + std::to_string(t);
+  return "the spindle's parts not tested with " + tools +
+         ": no tool length (the tool table's \"tool-length\" or a holder places the gauge point)";
+}
+
+HtmlMachine machine_page(const MachineRun& run) {
+  HtmlMachine page;
+  page.names = run.bodies, page.groups = run.groups;
+  for (const auto& mesh : run.meshes) page.meshes.push_back(mesh.get());
+  auto poses = [](const std::vector<MachineFinding>& findings) {
+    std::vector<std::array<HtmlMachinePose, 2>> out;
+    for (std::size_t k = 0; k < findings.size() && k < kMachineFindingsListed; ++k)
+      out.push_back({HtmlMachinePose{findings[k].body_a, findings[k].pose_a},
+                     HtmlMachinePose{findings[k].body_b, findings[k].pose_b}});
+    return out;
+  };
+  page.collisions = poses(run.found.collisions);
+  page.near_misses = poses(run.found.near_misses);
+  return page;
+}
+
 void print_machine_findings(const MachineRun& run, const SimulationResult& r, std::size_t limit) {
   auto axes_text = [&](const MachineState& s) {
     char text[160];
@@ -263,14 +359,8 @@ void print_machine_findings(const MachineRun& run, const SimulationResult& r, st
     return out;
   };
   const auto& found = run.found;
-  if (!run.spindle_unplaced.empty()) {
-    std::string tools;
-    for (int t : run.spindle_unplaced) tools += (tools.empty() ? "T" : ", T") + std::to_string(t);
-    std::printf(
-        "  machine: the spindle's parts not tested with %s: no tool length (the tool table's "
-        "\"tool-length\" or a holder places the gauge point)\n",
-        tools.c_str());
-  }
+  if (const std::string text = machine_unchecked_text(run); !text.empty())
+    std::printf("  machine: %s\n", text.c_str());
   for (std::size_t k = 0; k < found.collisions.size() && k < limit; ++k) {
     const MachineFinding& f = found.collisions[k];
     std::printf(

@@ -19,19 +19,23 @@
 // (rotary.cpp): it is checked as a rotary-only move at that move's line.
 #pragma once
 
+#include <memory>
 #include <set>
 #include <string>
 #include <vector>
 
 #include "checks/machine_check.hpp"
 #include "json_text.hpp"
+#include "outputs/html_report.hpp"
 #include "pipeline/pipeline.hpp"
 
 namespace tridex::cli {
 
 struct MachineRun {
-  bool active = false;  // fixtures or components were given
-  std::vector<std::string> bodies;
+  bool active = false;              // fixtures or components were given
+  std::vector<std::string> bodies;  // names, as MachineCheck::bodies() lists them
+  std::vector<std::string> groups;
+  std::vector<std::shared_ptr<const Mesh>> meshes;
   std::set<int> spindle_unplaced;  // tools without a gauge point: spindle parts not tested
   MachineFindings found;
 };
@@ -40,8 +44,26 @@ struct MachineRun {
 // every move. Inactive (nothing done) when there are neither fixtures nor components.
 MachineRun run_machine_check(const std::vector<std::string>& fixtures, const SimulationResult& r);
 
+// The tools' bodies as check tests them against the in-process stock (collision_check.hpp, in the
+// pipeline): each tool's shank and holder sections, then, when the tool has a gauge point, the
+// spindle's parts (the machine's components on "spindle") there, each as its envelope of
+// revolution about the spindle axis in stacked cylinders. Exact for a nose turned about the
+// spindle; a part off to one side is tested as if it turned with the spindle (conservative: it may
+// be reported near material it passes beside). Against fixtures and the table's parts the machine
+// check tests the meshes themselves. Reads the spindle parts' meshes (InputError, exit status 2).
+std::vector<ToolBody> bodies_against_stock(const SimulationResult& r);
+
 // The report's "machine" object.
 Json machine_json(const MachineRun& run, const SimulationResult& r);
+
+// What the machine check could not do, in words (empty: all done): the spindle's parts with the
+// tools that have no gauge point. check puts it on the verdict line, in the report's
+// "not_checked" and "warnings", and next to the page's verdict: never a silent pass.
+std::string machine_unchecked_text(const MachineRun& run);
+
+// The bodies and the listed findings' poses as the HTML page draws them (html_report.hpp); it
+// points into `run`.
+HtmlMachine machine_page(const MachineRun& run);
 
 // "file:line: collision: A and B ..." lines on stdout, the first `limit` of each kind.
 void print_machine_findings(const MachineRun& run, const SimulationResult& r, std::size_t limit);

@@ -268,6 +268,56 @@ Json tools_json(const HtmlPage& page) {
   return tools;
 }
 
+// The machine check's bodies and its findings' poses (HtmlMachine); a body is drawn (its mesh
+// simplified to its share of the budget, HtmlLimits) when it is a fixture or in a listed finding.
+Json machine_page_json(const HtmlMachine& machine, const HtmlLimits& limits) {
+  const std::size_t n = machine.meshes.size();
+  std::vector<bool> drawn(n, false);
+  auto poses = [&](const std::vector<std::array<HtmlMachinePose, 2>>& list) {
+    Json out = Json::array();
+    for (const auto& pair : list) {
+      Json entry = Json::array();
+      for (const HtmlMachinePose& p : pair) {
+        if (p.body < 0 || static_cast<std::size_t>(p.body) >= n) continue;
+        drawn[static_cast<std::size_t>(p.body)] = true;
+        // Row by row, [R | o]: THREE.Matrix4.set's order.
+        Json m = Json::array();
+        for (int r = 0; r < 3; ++r) {
+          for (int c = 0; c < 3; ++c) m.push_back(p.frame.rotation[c][r]);
+          m.push_back(p.frame.origin[r]);
+        }
+        entry.push_back({{"body", p.body}, {"matrix", m}});
+      }
+      out.push_back(std::move(entry));
+    }
+    return out;
+  };
+  Json out;
+  out["collisions"] = poses(machine.collisions);
+  out["near_misses"] = poses(machine.near_misses);
+  std::size_t total = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (k < machine.groups.size() && machine.groups[k] == "fixture") drawn[k] = true;
+    if (drawn[k] && machine.meshes[k]) total += machine.meshes[k]->triangles.size();
+  }
+  Json bodies = Json::array();
+  for (std::size_t k = 0; k < n; ++k) {
+    const Mesh* mesh = drawn[k] ? machine.meshes[k] : nullptr;
+    const std::size_t size = mesh ? mesh->triangles.size() : 0;
+    const std::size_t share =
+        std::max(limits.min_machine_body_triangles,
+                 static_cast<std::size_t>(static_cast<double>(limits.max_machine_triangles) *
+                                          static_cast<double>(size) /
+                                          static_cast<double>(std::max<std::size_t>(total, 1))));
+    Json body = display_mesh_json(mesh, {}, 0, 0, share);
+    body["name"] = k < machine.names.size() ? machine.names[k] : "";
+    body["group"] = k < machine.groups.size() ? machine.groups[k] : "";
+    bodies.push_back(std::move(body));
+  }
+  out["bodies"] = std::move(bodies);
+  return out;
+}
+
 std::string html_escaped(std::string_view text) {
   std::string out;
   for (char c : text) {
@@ -650,6 +700,7 @@ Json html_page_data(const HtmlPage& page, const HtmlLimits& limits) {
   data["directions"] = directions;
   data["playback"] = playback_json(page, limits);
   data["tools"] = tools_json(page);
+  if (page.machine) data["machine"] = machine_page_json(*page.machine, limits);
   data["files"] = source_files(page, limits);
   data["context"] = limits.context;
   data["listing_lines"] = 20;  // of a finding's lines, the first this many are listed

@@ -17,6 +17,7 @@
 // to 16 bits over their box and stored base64.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -50,6 +51,25 @@ struct HtmlLimits {
   // removed cell costs 2 bytes, each cell 1 or 2 bits: at most 0.6 MB of page (docs/reports.md).
   std::size_t max_playback_cells = 1 << 20;
   std::size_t max_playback_removed = 150'000;
+  // The machine check's bodies drawn (the fixtures, and those of a listed finding): at most this
+  // many triangles in all, each body's share by its size and at least min_machine_body_triangles
+  // (simplify_for_display). A machine of 100 k triangles costs the page about 1 MB at most.
+  std::size_t max_machine_triangles = 60'000;
+  std::size_t min_machine_body_triangles = 500;
+};
+
+// check's machine check (issue 33): its bodies (fixtures, the machine's components, the tools'
+// parts, each in its own coordinates) and, per finding of the report's machine.collisions and
+// machine.near_misses (in their order), the pair's two bodies and their frames at the finding's
+// pose (body coordinates to the work frame, where the page draws everything).
+struct HtmlMachinePose {
+  int body = -1;
+  Frame frame;
+};
+struct HtmlMachine {
+  std::vector<std::string> names, groups;  // groups: "fixture", "component", "tool"
+  std::vector<const Mesh*> meshes;
+  std::vector<std::array<HtmlMachinePose, 2>> collisions, near_misses;
 };
 
 struct HtmlPage {
@@ -67,6 +87,7 @@ struct HtmlPage {
   std::span<const Cutter> cutters;
   std::span<const ToolBody> bodies;
   const std::map<int, std::uint32_t>* cutter_of_tool = nullptr;
+  const HtmlMachine* machine = nullptr;  // check with fixtures or machine components
 };
 
 // Writes the page atomically (output.hpp).

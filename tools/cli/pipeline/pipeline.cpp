@@ -7,6 +7,7 @@
 #include <limits>
 #include <set>
 
+#include "checks/machine_run.hpp"
 #include "checks/rapid_check.hpp"
 #include "errors.hpp"
 #include "outputs/output.hpp"
@@ -686,6 +687,9 @@ void mill_directions(const SimulateOptions& options, const PipelineRequest& requ
         "rapid moves were not checked for cutting stock: that check needs --zmap-backend cpu");
   ZMapLimits limits;
   limits.max_points = std::numeric_limits<std::size_t>::max();  // the memory check above rules
+  // The shanks, holders and spindle parts that check tests against the stock (machine_run.hpp).
+  const std::vector<ToolBody> stock_bodies =
+      request.body_clearance ? bodies_against_stock(r) : std::vector<ToolBody>{};
   for (std::size_t g = 0; g < groups.size(); ++g) {
     const gcode::MoveGroup& group = groups[g];
     progress.stage("milling direction " + std::to_string(g + 1) + "/" +
@@ -697,7 +701,8 @@ void mill_directions(const SimulateOptions& options, const PipelineRequest& requ
     r.segments += static_cast<long long>(group.moves.size());
     if (request.rapid_check == RapidCheck::in_program_order) {
       std::optional<BodyCheck> bodies;
-      if (request.body_clearance) bodies.emplace(maps.back(), r.bodies, *request.body_clearance);
+      if (request.body_clearance)
+        bodies.emplace(maps.back(), stock_bodies, *request.body_clearance);
       mill_in_program_order(maps.back(), group, g, r.cutters, r.cutter_of_tool, zmap_backend,
                             options.threads, r.rapid_cuts, bodies ? &*bodies : nullptr, r.body);
       continue;
