@@ -11,6 +11,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -151,7 +152,11 @@ struct SimulationResult {
   TripleDexel result;
   Mesh mesh;
   MeshCheck mesh_check;
+  // The result's volume: the stock's less what was removed, measured as the uncut stock's surface
+  // volume less the result's (the surfaces' offset from the lattice nodes cancels: pipeline.cpp,
+  // surface_volume). The mesh's own enclosed volume differs by that offset times the uncut faces.
   double volume = 0;
+  double stock_surface_volume = 0;  // the uncut stock's surface on the lattice, mm³
   // The stock's and the result's volume on the dexel lattice: what the lattice resolves as
   // removed, never negative (the surface's volume may exceed the stock's by its rounding when
   // the cuts are finer than the lattice).
@@ -177,6 +182,17 @@ struct SimulationResult {
 // subtracted ray by ray; fills r.sweeps and the result's dexel volume. `bodies_checked` (check's
 // collision check): warn that these moves' shanks, holders and rapids are not checked yet.
 void cut_simultaneous(const SimulateOptions& options, SimulationResult& r, bool bodies_checked);
+// How near a simultaneous move of r.simultaneous passes to `points` (simultaneous.cpp), for
+// check's gouge and excess attribution: `gap` bounds from below the least signed distance of a
+// point to the cutter over the move's poses (≤ 0: the cutter reached it), within `precision`
+// (the poses are sampled densely enough that the distance between samples cannot drop by more).
+// `valid` is false for a move with no cutter (before any tool).
+struct SimultaneousReach {
+  bool valid = false;
+  double gap = 0;
+};
+SimultaneousReach simultaneous_reach(const SimulationResult& r, const gcode::Move& m,
+                                     std::span<const Vec3> points, double precision);
 // The JSON of r.sweeps for the report and `--certify`.
 Json sweeps_json(const SimulationResult& r);
 

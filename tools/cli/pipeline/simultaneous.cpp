@@ -4,6 +4,7 @@
 // "Simultaneous moves"). Removal commutes with the intersection, so the order does not matter.
 #include <algorithm>
 #include <chrono>
+#include <limits>
 #include <string>
 
 #include "errors.hpp"
@@ -75,6 +76,47 @@ void cut_simultaneous(const SimulateOptions& options, SimulationResult& r, bool 
   sweep_remove(r.result, cutters, steps, options.threads, r.sweep_tolerance / 100);
   r.result_dexel_volume = tridex::volume(r.result);
   r.sweep_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+SimultaneousReach simultaneous_reach(const SimulationResult& r, const gcode::Move& m,
+                                     std::span<const Vec3> points, double precision) {
+  SimultaneousReach out;
+  auto it = r.cutter_of_tool.find(m.tool);
+  if (it == r.cutter_of_tool.end() || !r.input.machine.kinematics || points.empty()) return out;
+  const SweepCutter cutter = sweep_cutter_of(r.cutters[it->second], r.bodies[it->second]);
+  const gcode::MovePath path(*r.input.machine.kinematics, m);
+  const PoseBounds bounds = path.bounds();
+  // The signed distance to the cutter at pose s changes by at most this per unit s (a cutter
+  // point at most `reach` from the tip moves by at most tip speed + reach · turn rate).
+  const double rate = bounds.tip_speed + cutter.reach() * bounds.turn_rate;
+  long samples = 16;
+  while (samples < kMaxSubSteps && rate / (2.0 * static_cast<double>(samples)) > precision)
+    samples *= 2;
+  const double margin = rate / (2.0 * static_cast<double>(samples));
+  // A cheap rejection first: each point's distance to the box of the tip's whole path, less the
+  // cutter's reach, bounds its distance to the sweep from below.
+  Aabb tips;
+  for (long j = 0; j <= samples; ++j)
+    tips.extend(path.at(static_cast<double>(j) / static_cast<double>(samples)).tip);
+  const double slack = margin + bounds.tip_speed / static_cast<double>(samples);
+  double best = std::numeric_limits<double>::infinity();
+  std::vector<std::size_t> near;
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const Vec3 q = glm::clamp(points[k], tips.min, tips.max);
+    const double floor = glm::length(points[k] - q) - cutter.reach() - slack;
+    if (floor > 0)
+      best = std::min(best, floor);
+    else
+      near.push_back(k);
+  }
+  for (long j = 0; j <= samples && !near.empty(); ++j) {
+    const ToolPose pose = path.at(static_cast<double>(j) / static_cast<double>(samples));
+    for (std::size_t k : near)
+      best = std::min(best, cutter.distance(pose.tip, pose.axis, points[k]) - margin);
+  }
+  out.gap = best;
+  out.valid = true;
+  return out;
 }
 
 Json sweeps_json(const SimulationResult& r) {
