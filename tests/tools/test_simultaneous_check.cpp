@@ -1,6 +1,7 @@
 // `tridex check` on simultaneous 5-axis programs (tests/data/gcode/five_axis): the moves whose
 // tool turns are milled by the dexel sweep before the comparison (the right program passes
-// against its own result), and a gouge they make is located at their line as other gouges are.
+// against its own result), a gouge they make is located at their line as other gouges are, and
+// a rapid turn of the table through the material is a rapid cut.
 #include <doctest/doctest.h>
 
 #include <string>
@@ -38,8 +39,8 @@ std::vector<std::string> machine_args(const fs::path& dir) {
           "--report",     (dir / "report.json").string()};
 }
 
-CommandResult check(const fs::path& dir, const std::string& z) {
-  write_text(dir / "p.ngc", groove(z));
+CommandResult check_text(const fs::path& dir, const std::string& text) {
+  write_text(dir / "p.ngc", text);
   std::vector<std::string> args{"check",
                                 (dir / "p.ngc").string(),
                                 "--design",
@@ -51,7 +52,13 @@ CommandResult check(const fs::path& dir, const std::string& z) {
   return run_tridex(args, dir);
 }
 
-TEST_CASE("check: simultaneous moves are milled before the comparison, gouges at their line") {
+CommandResult check(const fs::path& dir, const std::string& z) {
+  return check_text(dir, groove(z));
+}
+
+TEST_CASE(
+    "check: simultaneous moves are milled before the comparison, gouges at their line, turning "
+    "rapids checked") {
   fs::path dir = scratch("simultaneous-check");
   // The design: the right groove's simulated result.
   write_text(dir / "good.ngc", groove("-2"));
@@ -93,6 +100,25 @@ TEST_CASE("check: simultaneous moves are milled before the comparison, gouges at
   report = json::parse(slurp(dir / "report.json"));
   REQUIRE(!report["excess"].empty());
   CHECK(report["excess"][0]["lines"].dump().find("8") != std::string::npos);
+
+  // A rapid turn of the table (G0 C180, raw: no move of its own) with the tool still 2 mm deep
+  // sweeps it through the stock: a rapid cut, at the line of the move after it (10).
+  std::string text = groove("-2");
+  const std::string turn = "G1 C90 F500\n";
+  text.insert(text.find(turn) + turn.size(), "G0 C180\n");
+  CommandResult rapid = check_text(dir, text);
+  INFO(rapid.out);
+  CHECK(rapid.status == 3);
+  report = json::parse(slurp(dir / "report.json"));
+  REQUIRE(report["rapid_cuts"].size() == 1);
+  CHECK(report["rapid_cuts"][0]["line"] == 10);
+  CHECK(report["rapid_cuts"][0]["depth_mm"].get<double>() == doctest::Approx(2).epsilon(0.1));
+  // Turned above the stock, it cuts nothing.
+  text = groove("-2");
+  text.insert(text.find(turn) + turn.size(), "G1 Z10\nG0 C180\n");
+  rapid = check_text(dir, text);
+  report = json::parse(slurp(dir / "report.json"));
+  CHECK(report["rapid_cuts"].empty());
   fs::remove_all(dir);
 }
 

@@ -313,8 +313,13 @@ ParsedProgram parse_grouped(const SimulateOptions& options, std::uint64_t max_me
   // Grouping (and the checks that read each move once) runs on a second thread when there is one,
   // overlapping the interpreter; the budget and the machining time stay on this thread, with the
   // dwells the timer also reads.
+  std::optional<gcode::Move> previous;  // the move before, for turning rapids
   BatchPipe<gcode::Move> grouping(
       [&](const gcode::Move& m) {
+        if (kinematics) {
+          if (previous) note_turning_rapid(*previous, m, r);
+          previous = m;
+        }
         if (m.pose != gcode::PoseLaw::fixed) {  // the tool turns: cut_simultaneous's
           r.simultaneous.push_back(m);
           cutting_bounds.extend(m.start);
@@ -861,6 +866,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   if (!options.dump_zmaps.empty()) dump_zmaps(options.dump_zmaps, r, progress);
   intersect_directions(options, request, run.max_memory, progress, r);
   if (!r.simultaneous.empty()) cut_simultaneous(options, r, request.body_clearance.has_value());
+  if (request.rapid_check == RapidCheck::in_program_order) check_turning_rapids(r);
   extract_result_surface(options, progress, r);
   return r;
 }

@@ -119,6 +119,89 @@ SimultaneousReach simultaneous_reach(const SimulationResult& r, const gcode::Mov
   return out;
 }
 
+void note_turning_rapid(const gcode::Move& before, const gcode::Move& after, SimulationResult& r) {
+  const std::array<double, 3> start_rotary =
+      after.pose == gcode::PoseLaw::fixed ? after.rotary : after.rotary_start;
+  if (after.from_far || before.rotary == start_rotary || after.tool != before.tool) return;
+  gcode::Move turn = after;
+  turn.kind = gcode::MoveKind::rapid;
+  turn.pose = gcode::PoseLaw::joints;
+  turn.feed = 0;
+  turn.start = before.end;
+  turn.end = after.start;
+  turn.rotary_start = before.rotary;
+  turn.rotary = start_rotary;
+  turn.machine = before.machine;
+  r.turning_rapids.push_back(turn);
+}
+
+namespace {
+
+// The box of the cutter at `pose`: a cylinder of its radius from the tip up its axis to its height.
+Aabb cutter_box(const SweepCutter& cutter, const ToolPose& pose) {
+  const Vec3 top = pose.tip + cutter.height * pose.axis;
+  const double radius = cutter.cutter.radius();
+  Vec3 grow(0.0);
+  for (int i = 0; i < 3; ++i)
+    grow[i] = radius * std::sqrt(std::max(0.0, 1 - pose.axis[i] * pose.axis[i]));
+  return Aabb{glm::min(pose.tip, top) - grow, glm::max(pose.tip, top) + grow};
+}
+
+// The deepest the cutter reaches into the material of the Z rays of `d` at `pose` (0: none),
+// each ray's material searched for the cutter's least signed distance (convex along the ray).
+double pose_depth(const TripleDexel& d, const SweepCutter& cutter, const ToolPose& pose,
+                  const Aabb& box, double precision, Vec3& where) {
+  const double h = d.spacing;
+  const DexelGrid& g = d.grids[2];
+  const int i0 = std::max(0, static_cast<int>(std::ceil((box.min.x - d.origin.x) / h)));
+  const int i1 = std::min(g.nu - 1, static_cast<int>(std::floor((box.max.x - d.origin.x) / h)));
+  const int j0 = std::max(0, static_cast<int>(std::ceil((box.min.y - d.origin.y) / h)));
+  const int j1 = std::min(g.nv - 1, static_cast<int>(std::floor((box.max.y - d.origin.y) / h)));
+  double depth = 0;
+  for (int i = i0; i <= i1; ++i)
+    for (int j = j0; j <= j1; ++j) {
+      const double x = d.origin.x + i * h, y = d.origin.y + j * h;
+      for (const DexelInterval& s : g.ray(i, j)) {
+        const double lo = std::max(double(s.enter), box.min.z),
+                     hi = std::min(double(s.exit), box.max.z);
+        if (!(lo < hi)) continue;
+        auto f = [&](double z) { return cutter.distance(pose.tip, pose.axis, Vec3(x, y, z)); };
+        const std::pair<double, double> best = detail::convex_minimum(f, lo, hi, precision);
+        if (-best.second > depth) depth = -best.second, where = Vec3(x, y, best.first);
+      }
+    }
+  return depth;
+}
+
+}  // namespace
+
+void check_turning_rapids(SimulationResult& r) {
+  if (r.turning_rapids.empty() || !r.input.machine.kinematics) return;
+  const SweepMaterial material(r.result);
+  const double h = r.lattice.spacing;
+  for (const gcode::Move& m : r.turning_rapids) {
+    auto it = r.cutter_of_tool.find(m.tool);
+    if (it == r.cutter_of_tool.end()) continue;
+    const SweepCutter cutter = sweep_cutter_of(r.cutters[it->second], r.bodies[it->second]);
+    const gcode::MovePath path(*r.input.machine.kinematics, m);
+    const PoseBounds bounds = path.bounds();
+    // Poses close enough that no cutter point moves more than a quarter spacing between them.
+    const double rate = bounds.tip_speed + cutter.reach() * bounds.turn_rate;
+    long samples = 16;
+    while (samples < kMaxSubSteps && rate / static_cast<double>(samples) > h / 2) samples *= 2;
+    double depth = 0;
+    Vec3 where(0.0);
+    for (long k = 0; k <= samples; ++k) {
+      const ToolPose pose = path.at(static_cast<double>(k) / static_cast<double>(samples));
+      const Aabb box = cutter_box(cutter, pose);
+      if (!material.may_touch(box)) continue;
+      depth = std::max(depth, pose_depth(r.result, cutter, pose, box, h / 8, where));
+    }
+    if (depth > kRapidTolerance)
+      r.rapid_cuts.push_back(RapidFinding{m.file, m.line, m.tool, m.axis, depth, where, 0});
+  }
+}
+
 Json sweeps_json(const SimulationResult& r) {
   Json by_tool = Json::object();
   long long moves = 0, sub_steps = 0;
