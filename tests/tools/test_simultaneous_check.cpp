@@ -35,7 +35,7 @@ std::vector<std::string> machine_args(const fs::path& dir) {
           "--tools",      kData + "tools.tbl",
           "--tool-units", "mm",
           "--stock",      kStock,
-          "--dexel-cell", "0.4",
+          "--dexel-cell", "0.6",
           "--report",     (dir / "report.json").string()};
 }
 
@@ -56,11 +56,9 @@ CommandResult check(const fs::path& dir, const std::string& z) {
   return check_text(dir, groove(z));
 }
 
-TEST_CASE(
-    "check: simultaneous moves are milled before the comparison, gouges at their line, turning "
-    "rapids checked") {
-  fs::path dir = scratch("simultaneous-check");
-  // The design: the right groove's simulated result.
+// A scratch folder holding the design: the right groove's simulated result.
+fs::path with_design(const std::string& name) {
+  fs::path dir = scratch(name);
   write_text(dir / "good.ngc", groove("-2"));
   std::vector<std::string> made{"simulate", (dir / "good.ngc").string(), "-o",
                                 (dir / "design.stl").string(), "-q"};
@@ -68,6 +66,11 @@ TEST_CASE(
   CommandResult design = run_tridex(made, dir);
   INFO(design.err);
   REQUIRE(design.status == 0);
+  return dir;
+}
+
+TEST_CASE("check: simultaneous moves are milled before the comparison, gouges at their line") {
+  fs::path dir = with_design("simultaneous-check");
 
   // The same program passes: the turning cut is milled (without it the groove would be excess).
   CommandResult same = check(dir, "-2");
@@ -101,6 +104,12 @@ TEST_CASE(
   REQUIRE(!report["excess"].empty());
   CHECK(report["excess"][0]["lines"].dump().find("8") != std::string::npos);
 
+  fs::remove_all(dir);
+}
+
+TEST_CASE("check: a rapid turn of the table through the stock is a rapid cut") {
+  fs::path dir = with_design("simultaneous-check-rapid");
+  json report;
   // A rapid turn of the table (G0 C180, raw: no move of its own) with the tool still 2 mm deep
   // sweeps it through the stock: a rapid cut, at the line of the move after it (10).
   std::string text = groove("-2");
