@@ -41,7 +41,8 @@ inline constexpr int kG92 = 920, kG92_1 = 921, kG92_2 = 922, kG92_3 = 923;
 inline constexpr int kG93 = 930, kG94 = 940, kG95 = 950, kG96 = 960, kG97 = 970, kG98 = 980,
                      kG99 = 990;
 inline constexpr int kG103 = 1030, kG154 = 1540, kG187 = 1870;  // Haas look-ahead, offsets; G187
-inline constexpr int kG253 = 2530, kG254 = 2540, kG255 = 2550, kG268 = 2680, kG269 = 2690;  // Haas
+inline constexpr int kG234 = 2340, kG253 = 2530, kG254 = 2540, kG255 = 2550, kG268 = 2680,
+                     kG269 = 2690;  // Haas
 
 // The M codes by name, as Code::code holds them for M (not times ten: M98 is 98).
 inline constexpr int kM0 = 0, kM1 = 1, kM2 = 2, kM3 = 3, kM4 = 4, kM5 = 5, kM6 = 6;

@@ -18,11 +18,12 @@ void Interpreter::State::load_tool(int number) {
 
 // Tool length offsets (RS274/NGC, NIST IR 6556 §3.6.3; LinuxCNC's G43, G43.1, G49): G43 H n
 // takes tool n's length (no H: the loaded tool's, as LinuxCNC does; H0: none), Fanuc's G44 H n
-// its negative, LinuxCNC's G43.1 Z the length written, G49 none. G43.4/G43.5 H n (TCP) take it as
-// G43 does. With no tool lengths in the machine, they all leave the path alone.
+// its negative, LinuxCNC's G43.1 Z the length written, G49 none. G43.4/G43.5 H n (TCP), and
+// Haas's G234 H n (its TCPC), take it as G43 does. With no tool lengths in the machine, they all
+// leave the path alone.
 void Interpreter::State::tool_length_codes() {
   int code = 0, column = 0;
-  for (int c : {kG43, kG43_1, kG43_4, kG43_5, kG44, kG49})
+  for (int c : {kG43, kG43_1, kG43_4, kG43_5, kG234, kG44, kG49})
     if (int at = w.find_g(c)) {
       code = c;
       column = at;
@@ -205,7 +206,7 @@ Flow Interpreter::State::execute(const Block& block) {
       if (int column = w.find_g(code)) cutter_comp_codes(code, column);
     distance_mode_codes();
     tool_length_codes();
-    tool_center_codes();  // G43.4/G43.5 TCP, G254/G255 DWO (rotary.cpp)
+    tool_center_codes();  // G43.4/G43.5/G234 TCP, G254/G255 DWO (rotary.cpp)
     smoothing_codes(codes);
     return_mode_codes();
     work_system_codes();

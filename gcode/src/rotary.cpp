@@ -11,12 +11,13 @@
 
 namespace tridex::gcode {
 
-// G43.4 / G43.5 switch TCP on (G43, G44 and G49 off: the same modal group); G254 / G255 switch
-// DWO on and off. G43.5 I J K gives the tool direction on the part directly.
+// G43.4 / G43.5 switch TCP on (G43, G44 and G49 off: the same modal group), as Haas's G234
+// (TCPC, read on the Haas dialect only: block_g_group) does; G254 / G255 switch DWO on and off.
+// G43.5 I J K gives the tool direction on the part directly.
 void Interpreter::State::tool_center_codes() {
   bool was_tcp = frame.tcp, was_dwo = frame.dwo;
   if (w.find_g(kG43) || w.find_g(kG44) || w.find_g(kG49)) frame.tcp = false;
-  if (w.find_g(kG43_4)) frame.tcp = true;
+  if (w.find_g(kG43_4) || w.find_g(kG234)) frame.tcp = true;
   if (int column = w.find_g(kG43_5)) {
     frame.tcp = true;
     if (w.has('I') || w.has('J') || w.has('K')) {

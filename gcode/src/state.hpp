@@ -332,14 +332,17 @@ struct Interpreter::State : ParameterReader {
       g5_1_spline |= ij;
     }
   }
-  // The modal group of a G code in this block: g_group, and the motions of the LinuxCNC dialect
-  // (G5 and G5.1 splines, G5.2 NURBS and its G5.3 end, G38.2–G38.5 straight probes).
+  // The modal group of a G code in this block: g_group, the motions of the LinuxCNC dialect
+  // (G5 and G5.1 splines, G5.2 NURBS and its G5.3 end, G38.2–G38.5 straight probes) and Haas's
+  // G234.
   int block_g_group(int code) const {
     if ((code == kG5 && g5_spline) || (code == kG5_1 && g5_1_spline)) return kMotion;
     if (machine.dialect == Dialect::linuxcnc && (code == kG5_2 || code == kG5_3))
       return code == kG5_2 ? kMotion : kNonModal;
     if (code >= kG38_2 && code <= kG38_5 && machine.dialect == Dialect::linuxcnc) return kMotion;
     if (code == kG68 && machine.dialect == Dialect::linuxcnc) return -1;  // no G68 in LinuxCNC
+    // Haas's G234 (TCPC, group 08, cancelled by G49: Haas mill operator's manual) is Fanuc's G43.4.
+    if (code == kG234 && machine.dialect == Dialect::haas) return kToolLength;
     return g_group(code);
   }
 

@@ -255,6 +255,29 @@ TEST_CASE("rotary: simultaneous moves carry their start and their pose law") {
   CHECK(near(r.moves.back().end, Vec3(10, 0, -1), 1e-9));
 }
 
+TEST_CASE("rotary: Haas's G234 (TCPC) is read as G43.4 on the Haas dialect, cancelled by G49") {
+  MachineConfig haas = with_kinematics("ac-trunnion");
+  haas.dialect = Dialect::haas;
+  const std::string body = " H1\nG0 X0 Y0 Z5 A0 C0\nG1 Z-1 F300\nG1 X10 A10 C45\n";
+  Result tcpc = run_program(cat("G234", body, "G49\nG1 C60\nM30\n"), {}, haas);
+  Result fanuc = run_program(cat("G43.4", body, "G49\nG1 C60\nM30\n"), {}, haas);
+  REQUIRE(tcpc.moves.size() == 4);
+  check_same(tcpc.moves, fanuc.moves, "G234 against G43.4");
+  CHECK(tcpc.moves[2].pose == PoseLaw::tcp);
+  CHECK(near(tcpc.moves[2].end, Vec3(10, 0, -1), 1e-9));
+  // G49 ends TCPC: the next turn is in raw joints.
+  CHECK(tcpc.moves[3].pose == PoseLaw::joints);
+  // Without TCPC the same words are raw: the tip curves on the part.
+  Result raw = run_program(cat("G43", body, "M30\n"), {}, haas);
+  REQUIRE(raw.moves.size() == 3);
+  CHECK(raw.moves[2].pose == PoseLaw::joints);
+  // Another control has no G234: an unknown code, refused where it would change the path.
+  MachineConfig fanuc_machine = with_kinematics("ac-trunnion");
+  Diagnostic d = error_of(cat("G234", body, "M30\n"), {}, fanuc_machine);
+  CHECK(d.line == 1);
+  CHECK(d.message.find("G234") != std::string::npos);
+}
+
 TEST_CASE(
     "A/B/C on a LinuxCNC machine without kinematics are plain axes, as in rs274; elsewhere "
     "errors") {

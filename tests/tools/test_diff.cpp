@@ -234,6 +234,15 @@ TEST_CASE("lint: a stray G20 in a millimetre program, H of another tool, decimal
   cli::LintSettings calculator;
   calculator.decimal_point_input = true;  // X12 is 12 mm: nothing to say
   CHECK(cli::lint_text(join(lines), "p.nc", calculator).size() == 2);
+  // Haas's TCPC G234 H n applies the length as G43 does: after it, Z moves are not g43_missing.
+  const std::vector<std::string> haas = {
+      "G90 G21", "T1 M6", "G43 H1 Z10.", "T2 M6", "G234 H2 X0. Y0. Z10.", "G1 Z-1.5"};
+  CHECK(cli::lint_text(join(haas), "p.nc", {}).empty());
+  std::vector<std::string> missing = haas;
+  missing[4] = "G0 X0. Y0. Z10.";  // no length applied after T2
+  const auto found = cli::lint_text(join(missing), "p.nc", {});
+  REQUIRE(found.size() == 1);
+  CHECK((found[0].line == 5 && found[0].code == "g43_missing"));
 }
 
 // `moves A --diff B`'s JSON lines.

@@ -48,7 +48,9 @@ TEST_CASE("simulate: a C-turning groove removes d(2φrR + πR²), the same on 1 
   const double expected = depth * (2 * phi * r * radius + std::numbers::pi * radius * radius);
   const double removed = a["result"]["removed_mm3"].get<double>();
   INFO("removed " << removed << " expected " << expected);
-  CHECK(std::abs(removed - expected) < 0.015 * expected);
+  // Issue 34's bar: within 0.5 % (measured -0.07 % at this 0.3 mm spacing; -0.26 % before the
+  // removal was measured surface against surface, -0.85 % at 0.25 mm).
+  CHECK(std::abs(removed - expected) < 0.005 * expected);
   const json& sweeps = a["simultaneous"];
   CHECK(sweeps["moves"] == 1);
   CHECK(sweeps["by_tool"]["1"]["moves"] == 1);

@@ -258,9 +258,13 @@ void Session::ensure_solid() {
   const TripleDexel& solid = cache_.update(maps_, cutters_, cuts_);
   const TripleDexel& stock_dexel = cache_.stock_dexel();
   mesh_ = extract_surface(solid, {.threads = threads});
-  volume_ = mesh_.signed_volume();
-  removed_ = stock_volume_ - volume_;
-  // As simulate's removed_mm3: the surface's rounding never makes a negative removal.
+  // As simulate's removed_mm3: the uncut stock's surface volume less the solid's, the surfaces'
+  // offset from the lattice nodes cancelling (pipeline.cpp, surface_volume). The stock's is
+  // measured once: the lattice and the stock stay.
+  if (!stock_surface_volume_)
+    stock_surface_volume_ = extract_surface(stock_dexel, {.threads = threads}).signed_volume();
+  removed_ = *stock_surface_volume_ - mesh_.signed_volume();
+  // The surface's rounding never makes a negative removal.
   if (removed_ < 0) removed_ = std::max(0.0, tridex::volume(stock_dexel) - tridex::volume(solid));
   solid_valid_ = true;
 }

@@ -64,8 +64,8 @@ class Session {
   // Throws cli::InputError (a tool missing from the table, a zero or non-finite axis or point).
   void add_move(const Vec3& start, const Vec3& end, int tool, const Vec3& axis, bool rapid = false);
 
-  // mm³ removed so far: the stock's volume less the solid's (its surface's volume, as simulate's
-  // "removed_mm3"). A piece's removal is the difference across its feed().
+  // mm³ removed so far: the uncut stock's surface volume less the solid's, as simulate's
+  // "removed_mm3" (docs/reports.md). A piece's removal is the difference across its feed().
   double removed_volume();
   // The depth (mm, along each move's spindle) the block's moves would cut into the stock as it
   // stands, every direction's cuts counted, without cutting it or changing the interpreter's
@@ -125,7 +125,7 @@ class Session {
   SolidCache cache_;
   bool solid_valid_ = false;
   Mesh mesh_;
-  double volume_ = 0;
+  std::optional<double> stock_surface_volume_;  // the uncut stock's surface, once measured
   double removed_ = 0;
   std::vector<std::pair<Vec3, ZMap>> probes_;  // the solid's top along each axis asked
 };

@@ -160,6 +160,13 @@ bool lint_moves_z(const LintBlock& b) {
   return true;
 }
 
+// A code that applies a tool length: G43, Fanuc's TCP G43.4/G43.5, Haas's TCPC G234 (a program of
+// another control has no G234).
+bool lint_applies_length(const LintBlock& b) {
+  return b.has_code('G', 430) || b.has_code('G', 434) || b.has_code('G', 435) ||
+         b.has_code('G', 2340);
+}
+
 // G43 H after each tool change, before the tool moves along Z; and H matching the tool (when the
 // program elsewhere numbers H as its tools: some shops keep lengths in other registers).
 void lint_length_offsets(const std::vector<LintBlock>& blocks, const std::string& file, bool expect,
@@ -174,7 +181,7 @@ void lint_length_offsets(const std::vector<LintBlock>& blocks, const std::string
       needed = expect && loaded > 0;  // T0 M6 empties the spindle
       change_line = b.line;
     }
-    const bool g43 = b.has_code('G', 430) || b.has_code('G', 434) || b.has_code('G', 435);
+    const bool g43 = lint_applies_length(b);
     if (g43) {
       needed = false;
       const LintWord* h = b.find('H');
@@ -254,7 +261,7 @@ void lint_decimal_points(const std::vector<LintBlock>& blocks, const std::string
 
 bool program_uses_g43(std::string_view text) {
   for (const LintBlock& b : lint_blocks(text))
-    if (b.has_code('G', 430) || b.has_code('G', 434) || b.has_code('G', 435)) return true;
+    if (lint_applies_length(b)) return true;
   return false;
 }
 
@@ -264,8 +271,7 @@ std::vector<LintFinding> lint_text(std::string_view text, const std::string& fil
   std::vector<LintFinding> out;
   lint_units(blocks, file, settings.strict, out);
   bool uses_g43 = settings.expect_g43;
-  for (const LintBlock& b : blocks)
-    uses_g43 = uses_g43 || b.has_code('G', 430) || b.has_code('G', 434) || b.has_code('G', 435);
+  for (const LintBlock& b : blocks) uses_g43 = uses_g43 || lint_applies_length(b);
   lint_length_offsets(blocks, file, uses_g43, settings.strict, out);
   lint_decimal_points(blocks, file, settings, out);
   std::stable_sort(out.begin(), out.end(),

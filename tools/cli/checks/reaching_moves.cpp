@@ -35,6 +35,11 @@ void for_each_reaching_move(const SimulationResult& r, const std::vector<Vec3>& 
       }
     }
   }
+  // The moves whose tool turns, swept pose by pose (in no group).
+  for (const gcode::Move& m : r.simultaneous) {
+    const SimultaneousReach reach = simultaneous_reach(r, m, points, slack / 4);
+    if (reach.valid && reach.gap <= slack) visit(m);
+  }
 }
 
 std::vector<NearMove> nearest_moves(const SimulationResult& r, const std::vector<Vec3>& points,
@@ -68,6 +73,12 @@ std::vector<NearMove> nearest_moves(const SimulationResult& r, const std::vector
       }
       if (best < std::numeric_limits<double>::infinity()) all.push_back({&m, best, over});
     }
+  }
+  for (const gcode::Move& m : r.simultaneous) {
+    if (m.kind == gcode::MoveKind::rapid) continue;
+    const SimultaneousReach reach = simultaneous_reach(r, m, points, slack / 4);
+    // A turning cutter has no footprint to pass over: it reaches a point or passes beside it.
+    if (reach.valid) all.push_back({&m, std::max(0.0, reach.gap), reach.gap <= 0});
   }
   std::stable_sort(all.begin(), all.end(),
                    [](const NearMove& p, const NearMove& q) { return p.gap < q.gap; });

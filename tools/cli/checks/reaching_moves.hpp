@@ -14,7 +14,8 @@ namespace tridex::cli {
 // order) whose swept cutter reaches one of `points` (work frame): the point lies above the
 // move's swept lower surface in the group's frame, within `slack`. A move that reaches a point
 // only at its start, where the move before it left the cutter, cut nothing there (a retract from
-// the bottom of a plunge) and is not visited for it.
+// the bottom of a plunge) and is not visited for it. Then each simultaneous move (r.simultaneous)
+// whose cutter, over its poses, comes within `slack` of a point (simultaneous_reach).
 void for_each_reaching_move(const SimulationResult& r, const std::vector<Vec3>& points,
                             double slack, const std::function<void(const gcode::Move&)>& visit);
 

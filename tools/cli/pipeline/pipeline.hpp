@@ -11,6 +11,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -151,7 +152,11 @@ struct SimulationResult {
   TripleDexel result;
   Mesh mesh;
   MeshCheck mesh_check;
+  // The result's volume: the stock's less what was removed, measured as the uncut stock's surface
+  // volume less the result's (the surfaces' offset from the lattice nodes cancels: pipeline.cpp,
+  // surface_volume). The mesh's own enclosed volume differs by that offset times the uncut faces.
   double volume = 0;
+  double stock_surface_volume = 0;  // the uncut stock's surface on the lattice, mm³
   // The stock's and the result's volume on the dexel lattice: what the lattice resolves as
   // removed, never negative (the surface's volume may exceed the stock's by its rounding when
   // the cuts are finer than the lattice).
@@ -167,6 +172,10 @@ struct SimulationResult {
   // Moves whose tool turns (Move::pose ≠ fixed), in program order: in no group, cut on the triple
   // dexel after the groups' Z-maps (cut_simultaneous), summarised by tool.
   std::vector<gcode::Move> simultaneous;
+  // The turns of the rotaries between moves in raw form (G0 with rotary words, not swept: an
+  // indexing move), each as the joints move it makes from the move before to the move after
+  // (note_turning_rapid), with the line of the move after it.
+  std::vector<gcode::Move> turning_rapids;
   std::map<int, SweepSummary> sweeps;
   double sweep_tolerance = 0;  // mm: the band asked of each sub-step
   double sweep_seconds = 0;
@@ -177,6 +186,28 @@ struct SimulationResult {
 // subtracted ray by ray; fills r.sweeps and the result's dexel volume. `bodies_checked` (check's
 // collision check): warn that these moves' shanks, holders and rapids are not checked yet.
 void cut_simultaneous(const SimulateOptions& options, SimulationResult& r, bool bodies_checked);
+// Between consecutive moves `before` and `after` of a run with kinematics: when the rotaries
+// turned in between (a G0 with rotary words in raw form: the interpreter emits no move for the
+// turn and keeps the linear axes' machine coordinates) and `after` does not come from far along
+// the tool (TCP, DWO and tilted-plane indexing leave the tool far), the turn as a rapid joints
+// move in r.turning_rapids, at `after`'s line.
+void note_turning_rapid(const gcode::Move& before, const gcode::Move& after, SimulationResult& r);
+// check (RapidCheck::in_program_order): each turning rapid whose cutter, over its poses, meets
+// material of the final result (so surely material at the time of the turn) is a rapid cut, its
+// depth the deepest the cutter reaches into that material, at poses no cutter point moves more
+// than half a spacing between (so a cut of a spacing or more is not missed).
+void check_turning_rapids(SimulationResult& r);
+// How near a simultaneous move of r.simultaneous passes to `points` (simultaneous.cpp), for
+// check's gouge and excess attribution: `gap` bounds from below the least signed distance of a
+// point to the cutter over the move's poses (≤ 0: the cutter reached it), within `precision`
+// (the poses are sampled densely enough that the distance between samples cannot drop by more).
+// `valid` is false for a move with no cutter (before any tool).
+struct SimultaneousReach {
+  bool valid = false;
+  double gap = 0;
+};
+SimultaneousReach simultaneous_reach(const SimulationResult& r, const gcode::Move& m,
+                                     std::span<const Vec3> points, double precision);
 // The JSON of r.sweeps for the report and `--certify`.
 Json sweeps_json(const SimulationResult& r);
 

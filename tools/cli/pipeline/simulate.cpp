@@ -28,9 +28,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The stock less the result surface's volume. Where the surface's rounding makes that negative
-// (cuts finer than the lattice around a large stock), what the lattice resolves as removed: never
-// a negative removal.
+// The stock less the result's volume: the uncut stock's surface volume less the result's
+// (pipeline.cpp, surface_volume). Where rounding makes that negative (cuts finer than the lattice
+// around a large stock), what the lattice resolves as removed: never a negative removal.
 double removed_mm3(const SimulationResult& r) {
   const double removed = r.stock.volume - r.volume;
   return removed >= 0 ? removed : std::max(0.0, r.stock_dexel_volume - r.result_dexel_volume);

@@ -4,6 +4,7 @@
 // "Simultaneous moves"). Removal commutes with the intersection, so the order does not matter.
 #include <algorithm>
 #include <chrono>
+#include <limits>
 #include <string>
 
 #include "errors.hpp"
@@ -75,6 +76,130 @@ void cut_simultaneous(const SimulateOptions& options, SimulationResult& r, bool 
   sweep_remove(r.result, cutters, steps, options.threads, r.sweep_tolerance / 100);
   r.result_dexel_volume = tridex::volume(r.result);
   r.sweep_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+SimultaneousReach simultaneous_reach(const SimulationResult& r, const gcode::Move& m,
+                                     std::span<const Vec3> points, double precision) {
+  SimultaneousReach out;
+  auto it = r.cutter_of_tool.find(m.tool);
+  if (it == r.cutter_of_tool.end() || !r.input.machine.kinematics || points.empty()) return out;
+  const SweepCutter cutter = sweep_cutter_of(r.cutters[it->second], r.bodies[it->second]);
+  const gcode::MovePath path(*r.input.machine.kinematics, m);
+  const PoseBounds bounds = path.bounds();
+  // The signed distance to the cutter at pose s changes by at most this per unit s (a cutter
+  // point at most `reach` from the tip moves by at most tip speed + reach · turn rate).
+  const double rate = bounds.tip_speed + cutter.reach() * bounds.turn_rate;
+  long samples = 16;
+  while (samples < kMaxSubSteps && rate / (2.0 * static_cast<double>(samples)) > precision)
+    samples *= 2;
+  const double margin = rate / (2.0 * static_cast<double>(samples));
+  // A cheap rejection first: each point's distance to the box of the tip's whole path, less the
+  // cutter's reach, bounds its distance to the sweep from below.
+  Aabb tips;
+  for (long j = 0; j <= samples; ++j)
+    tips.extend(path.at(static_cast<double>(j) / static_cast<double>(samples)).tip);
+  const double slack = margin + bounds.tip_speed / static_cast<double>(samples);
+  double best = std::numeric_limits<double>::infinity();
+  std::vector<std::size_t> near;
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const Vec3 q = glm::clamp(points[k], tips.min, tips.max);
+    const double floor = glm::length(points[k] - q) - cutter.reach() - slack;
+    if (floor > 0)
+      best = std::min(best, floor);
+    else
+      near.push_back(k);
+  }
+  for (long j = 0; j <= samples && !near.empty(); ++j) {
+    const ToolPose pose = path.at(static_cast<double>(j) / static_cast<double>(samples));
+    for (std::size_t k : near)
+      best = std::min(best, cutter.distance(pose.tip, pose.axis, points[k]) - margin);
+  }
+  out.gap = best;
+  out.valid = true;
+  return out;
+}
+
+void note_turning_rapid(const gcode::Move& before, const gcode::Move& after, SimulationResult& r) {
+  const std::array<double, 3> start_rotary =
+      after.pose == gcode::PoseLaw::fixed ? after.rotary : after.rotary_start;
+  if (after.from_far || before.rotary == start_rotary || after.tool != before.tool) return;
+  gcode::Move turn = after;
+  turn.kind = gcode::MoveKind::rapid;
+  turn.pose = gcode::PoseLaw::joints;
+  turn.feed = 0;
+  turn.start = before.end;
+  turn.end = after.start;
+  turn.rotary_start = before.rotary;
+  turn.rotary = start_rotary;
+  turn.machine = before.machine;
+  r.turning_rapids.push_back(turn);
+}
+
+namespace {
+
+// The box of the cutter at `pose`: a cylinder of its radius from the tip up its axis to its height.
+Aabb cutter_box(const SweepCutter& cutter, const ToolPose& pose) {
+  const Vec3 top = pose.tip + cutter.height * pose.axis;
+  const double radius = cutter.cutter.radius();
+  Vec3 grow(0.0);
+  for (int i = 0; i < 3; ++i)
+    grow[i] = radius * std::sqrt(std::max(0.0, 1 - pose.axis[i] * pose.axis[i]));
+  return Aabb{glm::min(pose.tip, top) - grow, glm::max(pose.tip, top) + grow};
+}
+
+// The deepest the cutter reaches into the material of the Z rays of `d` at `pose` (0: none),
+// each ray's material searched for the cutter's least signed distance (convex along the ray).
+double pose_depth(const TripleDexel& d, const SweepCutter& cutter, const ToolPose& pose,
+                  const Aabb& box, double precision, Vec3& where) {
+  const double h = d.spacing;
+  const DexelGrid& g = d.grids[2];
+  const int i0 = std::max(0, static_cast<int>(std::ceil((box.min.x - d.origin.x) / h)));
+  const int i1 = std::min(g.nu - 1, static_cast<int>(std::floor((box.max.x - d.origin.x) / h)));
+  const int j0 = std::max(0, static_cast<int>(std::ceil((box.min.y - d.origin.y) / h)));
+  const int j1 = std::min(g.nv - 1, static_cast<int>(std::floor((box.max.y - d.origin.y) / h)));
+  double depth = 0;
+  for (int i = i0; i <= i1; ++i)
+    for (int j = j0; j <= j1; ++j) {
+      const double x = d.origin.x + i * h, y = d.origin.y + j * h;
+      for (const DexelInterval& s : g.ray(i, j)) {
+        const double lo = std::max(double(s.enter), box.min.z),
+                     hi = std::min(double(s.exit), box.max.z);
+        if (!(lo < hi)) continue;
+        auto f = [&](double z) { return cutter.distance(pose.tip, pose.axis, Vec3(x, y, z)); };
+        const std::pair<double, double> best = detail::convex_minimum(f, lo, hi, precision);
+        if (-best.second > depth) depth = -best.second, where = Vec3(x, y, best.first);
+      }
+    }
+  return depth;
+}
+
+}  // namespace
+
+void check_turning_rapids(SimulationResult& r) {
+  if (r.turning_rapids.empty() || !r.input.machine.kinematics) return;
+  const SweepMaterial material(r.result);
+  const double h = r.lattice.spacing;
+  for (const gcode::Move& m : r.turning_rapids) {
+    auto it = r.cutter_of_tool.find(m.tool);
+    if (it == r.cutter_of_tool.end()) continue;
+    const SweepCutter cutter = sweep_cutter_of(r.cutters[it->second], r.bodies[it->second]);
+    const gcode::MovePath path(*r.input.machine.kinematics, m);
+    const PoseBounds bounds = path.bounds();
+    // Poses close enough that no cutter point moves more than a quarter spacing between them.
+    const double rate = bounds.tip_speed + cutter.reach() * bounds.turn_rate;
+    long samples = 16;
+    while (samples < kMaxSubSteps && rate / static_cast<double>(samples) > h / 2) samples *= 2;
+    double depth = 0;
+    Vec3 where(0.0);
+    for (long k = 0; k <= samples; ++k) {
+      const ToolPose pose = path.at(static_cast<double>(k) / static_cast<double>(samples));
+      const Aabb box = cutter_box(cutter, pose);
+      if (!material.may_touch(box)) continue;
+      depth = std::max(depth, pose_depth(r.result, cutter, pose, box, h / 8, where));
+    }
+    if (depth > kRapidTolerance)
+      r.rapid_cuts.push_back(RapidFinding{m.file, m.line, m.tool, m.axis, depth, where, 0});
+  }
 }
 
 Json sweeps_json(const SimulationResult& r) {
