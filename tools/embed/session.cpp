@@ -259,7 +259,7 @@ void Session::ensure_solid() {
   const TripleDexel& stock_dexel = cache_.stock_dexel();
   mesh_ = extract_surface(solid, {.threads = threads});
   // As simulate's removed_mm3: the uncut stock's surface volume less the solid's, the surfaces'
-  // offset from the lattice nodes cancelling (pipeline.cpp, surface_volume). The stock's is
+  // offset from the lattice nodes cancelling (pipeline.cpp, stock_surface_volume). The stock's is
   // measured once: the lattice and the stock stay.
   if (!stock_surface_volume_)
     stock_surface_volume_ = extract_surface(stock_dexel, {.threads = threads}).signed_volume();

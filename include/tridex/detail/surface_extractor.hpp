@@ -117,18 +117,23 @@ struct SlabMesh {
 constexpr double kFeatureResidual = 0.1;
 constexpr double kFeatureOvershoot = 0.05;
 
+// How far crossings are kept off the nodes, in spacings: at least 32 float ulps of the lattice's
+// largest coordinate (the dexel end points are floats) and never more than 1% of a cell.
+inline double crossing_margin(const DexelLattice& l) {
+  double extent = 0;
+  for (int a = 0; a < 3; ++a)
+    extent = std::max(extent, std::abs(l.origin[a]) + l.spacing * (l.n[a] - 1));
+  return std::clamp(32.0 * double(std::numeric_limits<float>::epsilon()) * extent / l.spacing, 1e-4,
+                    1e-2);
+}
+
 class Extractor {
  public:
   Extractor(const TripleDexel& d, const SurfaceOptions& options)
       : d_(d), nx_(d.n.x), ny_(d.n.y), nz_(d.n.z), h_(d.spacing), words_((d.n.x + 63) / 64) {
     sharp_ = options.sharp_features;
     cos_feature_ = std::cos(options.feature_angle * 3.14159265358979323846 / 180.0);
-    double extent = 0;
-    for (int a = 0; a < 3; ++a)
-      extent = std::max(extent, std::abs(d.origin[a]) + h_ * (d.n[a] - 1));
-    // Keep crossings at least 32 float ulps away from nodes (and never more than 1% of a cell).
-    delta_ =
-        std::clamp(32.0 * double(std::numeric_limits<float>::epsilon()) * extent / h_, 1e-4, 1e-2);
+    delta_ = crossing_margin(d.lattice());
     build_flips();
   }
 
