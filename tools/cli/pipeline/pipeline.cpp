@@ -200,7 +200,9 @@ double fine_cell_bytes(double cells, double rows, double moves, double bands_per
   constexpr double kSubHeights = 4.0 * ZMapFineCells::kPoints;
   const double per_cell = (kSubHeights + 2 * 4 + 4) + (kSubHeights + 4 + 4);
   const double per_row = 8 + 4;  // refine's row starts, the map's
-  const double per_move = sizeof(CutMove) + 4 * bands_per_move;
+  // refine's copy of the moves, each move's place in the bands it spans and its box there
+  // (lower_fine_cells)
+  const double per_move = sizeof(CutMove) + 4 * bands_per_move + sizeof(detail::FineCellBox);
   return per_cell * cells + per_row * rows + per_move * moves;
 }
 
