@@ -317,8 +317,10 @@ ParsedProgram parse_grouped(const SimulateOptions& options, std::uint64_t max_me
       [&](const gcode::Move& m) {
         if (m.pose != gcode::PoseLaw::fixed) {  // the tool turns: cut_simultaneous's
           r.simultaneous.push_back(m);
-          cutting_bounds.extend(m.start);
-          cutting_bounds.extend(m.end);
+          if (m.kind != gcode::MoveKind::rapid) {  // a TCP rapid (LinuxCNC's) is no cut
+            cutting_bounds.extend(m.start);
+            cutting_bounds.extend(m.end);
+          }
           return;
         }
         const auto group = static_cast<std::uint32_t>(grouper.add(m));
@@ -397,11 +399,18 @@ void load_cutters(const SimulateOptions& options, const std::optional<ToolTable>
 
 // The tool a control starts with (MachineConfig::initial_tool: --initial-tool, the machine
 // file's "initial_tool", CAMotics' tool 1 for a project): when a feed move comes before any tool
-// change, every move before it is cut with that tool, with a warning. A program that changes
-// tools before it cuts keeps its positioning rapids dropped (drop_toolless_moves).
-void load_initial_tool(const std::optional<ToolTable>& table, SimulationResult& r) {
+// change, every move before it is cut with that tool, with a warning. A program that selects no
+// tool at all (no T word, no M61; LinuxCNC's impeller demo) is cut with T1 when the tool table
+// holds one and neither --initial-tool nor the machine file says otherwise, as CAMotics cuts a
+// program without a tool change. A program that changes tools before it cuts keeps its
+// positioning rapids dropped (drop_toolless_moves).
+void load_initial_tool(const std::optional<ToolTable>& table, bool selects_tool,
+                       SimulationResult& r) {
   const gcode::MachineConfig& machine = r.input.machine;
-  const int tool = machine.initial_tool;
+  const bool camotics_rule =
+      machine.initial_tool <= 0 && !machine.initial_tool_stated && !selects_tool && table &&
+      table->find(1);
+  const int tool = camotics_rule ? 1 : machine.initial_tool;
   if (tool <= 0) return;
   long long toolless = 0;
   bool feeds = false;
@@ -420,9 +429,11 @@ void load_initial_tool(const std::optional<ToolTable>& table, SimulationResult& 
       if (m.tool == 0) m.tool = tool, had = true;
     if (had) group.tools.erase(0), group.tools.insert(tool);
   }
-  const std::string source = machine.initial_tool_stated
-                                 ? "--initial-tool or the machine file's \"initial_tool\""
-                                 : "CAMotics' convention for a project";
+  const std::string source =
+      camotics_rule ? "the program selects no tool: T1 of the tool table, as CAMotics does; "
+                      "--initial-tool N to choose"
+      : machine.initial_tool_stated ? "--initial-tool or the machine file's \"initial_tool\""
+                                    : "CAMotics' convention for a project";
   r.warnings.push_back(std::to_string(toolless) +
                        " move(s) before any tool change were cut with tool " +
                        std::to_string(tool) + ", the tool the control starts with (" + source +
@@ -838,7 +849,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   // The dump files are named by the directions, known only now.
   if (!options.dump_zmaps.empty())
     check_dump_names(options.dump_zmaps, r.groups, request.outputs, run.inputs);
-  load_initial_tool(run.table, r);
+  load_initial_tool(run.table, parsed.interpreted.selects_tool, r);
   load_cutters(options, run.table, parsed.interpreted.tool_first_line, r);
   drop_toolless_moves(r);
   size_the_run(options, request, run, parsed, r);

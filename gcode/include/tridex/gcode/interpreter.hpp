@@ -96,6 +96,7 @@ class Interpreter {
   const std::set<int>& tools_used() const;            // tools of the emitted moves
   const std::map<int, int>& tool_first_line() const;  // tool -> line of the M6 that loaded it
                                                       // (its first move's line if none)
+  bool selects_tool() const;  // a T word or M61 ran (a program with none: CAMotics' tool 1)
   long long blocks() const;                           // blocks executed by the last run
                                                       // (or the pieces fed so far)
   // The files of the current (or last) run, Move::file's table: the program given to run(), then
