@@ -182,7 +182,8 @@ class Parser {
         fail(hash, "parameter #<" + as_written + "> reads HAL pin " + pin +
                        ", whose value is known only on the running machine (LinuxCNC's rs274 "
                        "run standalone refuses it too): give it in the machine file's "
-                       "\"variables\" ({\"#<_hal[" + pin +
+                       "\"variables\" ({\"#<_hal[" +
+                       pin +
                        "]>\": value}, the value the configuration's HALCMD setp or sets gives "
                        "it), or set the value in the program instead");
       }

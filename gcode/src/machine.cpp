@@ -139,14 +139,14 @@ MachineConfig with_linuxcnc_switches(MachineConfig m, bool userk) {
 // pivots; trtfuncs.c with conventional-directions 0), and its M428/M429/M430 switches. Its sample
 // configuration's pivots differ (docs/machine-files.md, "Kinematics switches").
 MachineConfig ac_trunnion() {
-  return with_linuxcnc_switches(with_parts(
-      rotary_machine(
-          MachineType::table_table,
-          {make_axis('A', false, {1, 0, 0}, {0, 0, -75}, std::array<double, 2>{-120, 120}),
-           make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{})}),
-      {built_part("platter", "C", make_frustum_mesh(100, 100, -30, 0)),
-       built_part("trunnion", "A", trunnion_cradle(0, -75)),
-       built_part("bed", "bed", make_box_mesh({-600, -400, -500}, {600, 400, -420}))}),
+  return with_linuxcnc_switches(
+      with_parts(rotary_machine(MachineType::table_table,
+                                {make_axis('A', false, {1, 0, 0}, {0, 0, -75},
+                                           std::array<double, 2>{-120, 120}),
+                                 make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{})}),
+                 {built_part("platter", "C", make_frustum_mesh(100, 100, -30, 0)),
+                  built_part("trunnion", "A", trunnion_cradle(0, -75)),
+                  built_part("bed", "bed", make_box_mesh({-600, -400, -500}, {600, 400, -420}))}),
       true);
 }
 
@@ -154,14 +154,14 @@ MachineConfig ac_trunnion() {
 // published tilt range); C turns about Z through the origin, endless. The directions of
 // LinuxCNC's xyzbc-trt kinematics, and its M428/M429/M430 switches.
 MachineConfig bc_trunnion() {
-  return with_linuxcnc_switches(with_parts(
-      rotary_machine(
-          MachineType::table_table,
-          {make_axis('B', false, {0, 1, 0}, {0, 0, -50}, std::array<double, 2>{-35, 110}),
-           make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{})}),
-      {built_part("platter", "C", make_frustum_mesh(100, 100, -30, 0)),
-       built_part("trunnion", "B", trunnion_cradle(1, -50)),
-       built_part("bed", "bed", make_box_mesh({-600, -400, -500}, {600, 400, -420}))}),
+  return with_linuxcnc_switches(
+      with_parts(rotary_machine(MachineType::table_table,
+                                {make_axis('B', false, {0, 1, 0}, {0, 0, -50},
+                                           std::array<double, 2>{-35, 110}),
+                                 make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{})}),
+                 {built_part("platter", "C", make_frustum_mesh(100, 100, -30, 0)),
+                  built_part("trunnion", "B", trunnion_cradle(1, -50)),
+                  built_part("bed", "bed", make_box_mesh({-600, -400, -500}, {600, 400, -420}))}),
       true);
 }
 
@@ -188,23 +188,27 @@ MachineConfig linuxcnc_sample(std::vector<RotaryAxis> axes, bool userk, const st
 // Rx(A)·Rz(C)) with y-offset 20, z-offset 10 and the rotation point at the origin: A about X
 // through (0, 20, 10), −100°…50°, carrying C about Z through the origin, ±36000°.
 MachineConfig xyzac_trt() {
-  return linuxcnc_sample(
-      {make_axis('A', false, {1, 0, 0}, {0, 20, 10}, Limits{{-100, 50}}),
-       make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{{-36000, 36000}})},
-      true, "xyzac-trt-kins",
-      {{"x-rot-point", 0}, {"y-rot-point", 0}, {"z-rot-point", 0}, {"y-offset", 20},
-       {"z-offset", 10}});
+  return linuxcnc_sample({make_axis('A', false, {1, 0, 0}, {0, 20, 10}, Limits{{-100, 50}}),
+                          make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{{-36000, 36000}})},
+                         true, "xyzac-trt-kins",
+                         {{"x-rot-point", 0},
+                          {"y-rot-point", 0},
+                          {"z-rot-point", 0},
+                          {"y-offset", 20},
+                          {"z-offset", 10}});
 }
 
 // xyzbc-trt.ini: xyzbc-trt-kins (part_to_machine = Ry(B)·Rz(C)) with x-offset −20, z-offset −15:
 // B about Y through (−20, 0, −15), ±36000°, carrying C about Z through the origin, ±36000°.
 MachineConfig xyzbc_trt() {
-  return linuxcnc_sample(
-      {make_axis('B', false, {0, 1, 0}, {-20, 0, -15}, Limits{{-36000, 36000}}),
-       make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{{-36000, 36000}})},
-      true, "xyzbc-trt-kins",
-      {{"x-rot-point", 0}, {"y-rot-point", 0}, {"z-rot-point", 0}, {"x-offset", -20},
-       {"z-offset", -15}});
+  return linuxcnc_sample({make_axis('B', false, {0, 1, 0}, {-20, 0, -15}, Limits{{-36000, 36000}}),
+                          make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{{-36000, 36000}})},
+                         true, "xyzbc-trt-kins",
+                         {{"x-rot-point", 0},
+                          {"y-rot-point", 0},
+                          {"z-rot-point", 0},
+                          {"x-offset", -20},
+                          {"z-offset", -15}});
 }
 
 // xyzab-tdr.ini (table-dual-rotary): xyzab_tdr_kins.comp, whose inverse is joints =
@@ -212,12 +216,14 @@ MachineConfig xyzbc_trt() {
 // −180°…180°, carrying A about X through (−20, 0, −10) (x-offset −20, z-offset −10), ±3600°. Its
 // demo reads the pins; M428 selects the TCP kinematics, M429 identity (the start); no M430.
 MachineConfig xyzab_tdr() {
-  return linuxcnc_sample(
-      {make_axis('B', false, {0, -1, 0}, {0, 0, 0}, Limits{{-180, 180}}),
-       make_axis('A', false, {-1, 0, 0}, {-20, 0, -10}, Limits{{-3600, 3600}})},
-      false, "xyzab_tdr_kins",
-      {{"x-rot-point", 0}, {"y-rot-point", 0}, {"z-rot-point", 0}, {"x-offset", -20},
-       {"z-offset", -10}});
+  return linuxcnc_sample({make_axis('B', false, {0, -1, 0}, {0, 0, 0}, Limits{{-180, 180}}),
+                          make_axis('A', false, {-1, 0, 0}, {-20, 0, -10}, Limits{{-3600, 3600}})},
+                         false, "xyzab_tdr_kins",
+                         {{"x-rot-point", 0},
+                          {"y-rot-point", 0},
+                          {"z-rot-point", 0},
+                          {"x-offset", -20},
+                          {"z-offset", -10}});
 }
 
 // Head-table: B turns the head about Y through (0, 0, 150) (pivot 150 mm above the tip),

@@ -353,7 +353,8 @@ bool read_switch_key(const std::string& key, const json& value, const std::strin
 
 void check_switches(const std::string& file, const MachineConfig& m) {
   if ((!m.kinematics_switches.empty() || m.tcp_kinematics_at_start) && !m.kinematics)
-    machine_error(file, ": \"kinematics_switches\" and \"kinematics_at_start\" need \"kinematics\"");
+    machine_error(file,
+                  ": \"kinematics_switches\" and \"kinematics_at_start\" need \"kinematics\"");
   for (const auto& [code, kind] : m.kinematics_switches)
     if (m.m_codes.count(code) || m.forbidden_m_codes.count(code))
       machine_error(file, ": M", code,
@@ -364,7 +365,8 @@ constexpr const char* kMachineFileKeys =
     "name, description, base, dialect, units, start, tool_change, tool_loads_on_t, "
     "decimal_point_input, initial_tool, "
     "arc_radius_tolerance_mm, d_offsets, home, reference2, work_offsets, m_codes, "
-    "forbidden_m_codes, kinematics_switches, kinematics_at_start, variables, far_distance, subprograms, kinematics, rapid_rate_mm_per_min, "
+    "forbidden_m_codes, kinematics_switches, kinematics_at_start, variables, far_distance, "
+    "subprograms, kinematics, rapid_rate_mm_per_min, "
     "rapid_rate_deg_per_min, max_feed_mm_per_min, components, collision, linear_axes";
 
 MachineConfig parse(const json& doc, const std::string& file) {

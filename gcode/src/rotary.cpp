@@ -54,9 +54,10 @@ void Interpreter::State::kinematics_switch_code() {
   const KinematicsSwitch kind = machine.kinematics_switches.at(code);
   if (kind == KinematicsSwitch::refuse) {
     std::string message = code_name('M', code * 10);  // (one string: GCC 12's -Wrestrict)
-    message += " switches to kinematics of this machine's own (LinuxCNC's user kinematics, "
-               "switchkins type 2), which tridex cannot know: use the machine's TCP or identity "
-               "switch, or give the machine file's \"kinematics_switches\" another meaning for it";
+    message +=
+        " switches to kinematics of this machine's own (LinuxCNC's user kinematics, "
+        "switchkins type 2), which tridex cannot know: use the machine's TCP or identity "
+        "switch, or give the machine file's \"kinematics_switches\" another meaning for it";
     error(column, message);
   }
   const bool next = kind == KinematicsSwitch::tcp;

@@ -351,6 +351,22 @@ struct Interpreter::State : ParameterReader {
     return g_group(code);
   }
 
+  // A kinematics switch of the machine (LinuxCNC's remapped M428..., modal group 10; rotary.cpp
+  // runs it): one a block.
+  bool gather_switch(int m, int column) {
+    if (!machine.kinematics_switches.count(m)) return false;
+    if (w.kinematics_switch >= 0) {
+      std::string message = code_name('M', m * 10);  // (one string: GCC 12's -Wrestrict)
+      message += " and ";
+      message += code_name('M', w.kinematics_switch * 10);
+      message += " both switch the kinematics (one a block)";
+      error(column, message);
+    }
+    w.kinematics_switch = m;
+    w.kinematics_switch_column = column;
+    return true;
+  }
+
   void gather(const Block& block) {
     w.present = w.used = 0;
     find_splines(block);
@@ -379,21 +395,8 @@ struct Interpreter::State : ParameterReader {
         if (integral && word.letter == 'M' && machine.forbidden_m_codes.count(code / 10))
           error(word.column,
                 code_name('M', code) + " is not allowed on this machine (machine file)");
-        if (group < 0 && integral && word.letter == 'M' &&
-            machine.kinematics_switches.count(code / 10)) {
-          // A kinematics switch (LinuxCNC's remapped M428..., modal group 10): one a block.
-          if (w.kinematics_switch >= 0) {
-            std::string message = code_name('M', code);
-            message += " and ";
-            message += code_name('M', w.kinematics_switch * 10);
-            message += " both switch the kinematics (one a block)";
-            error(word.column, message);
-          }
-          w.kinematics_switch = code / 10;
-          w.kinematics_switch_column = word.column;
-          continue;
-        }
         if (group < 0 && integral && word.letter == 'M') {
+          if (gather_switch(code / 10, word.column)) continue;  // a kinematics switch
           // An M-code moves no axis: accepted (once a warning per code unless the machine
           // declares it).
           int m = code / 10;

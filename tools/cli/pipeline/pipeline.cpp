@@ -407,9 +407,8 @@ void load_cutters(const SimulateOptions& options, const std::optional<ToolTable>
 void load_initial_tool(const std::optional<ToolTable>& table, bool selects_tool,
                        SimulationResult& r) {
   const gcode::MachineConfig& machine = r.input.machine;
-  const bool camotics_rule =
-      machine.initial_tool <= 0 && !machine.initial_tool_stated && !selects_tool && table &&
-      table->find(1);
+  const bool camotics_rule = machine.initial_tool <= 0 && !machine.initial_tool_stated &&
+                             !selects_tool && table && table->find(1);
   const int tool = camotics_rule ? 1 : machine.initial_tool;
   if (tool <= 0) return;
   long long toolless = 0;
@@ -417,6 +416,8 @@ void load_initial_tool(const std::optional<ToolTable>& table, bool selects_tool,
   for (const gcode::MoveGroup& group : r.groups)
     for (const gcode::Move& m : group.moves)
       if (m.tool == 0) ++toolless, feeds = feeds || m.kind != gcode::MoveKind::rapid;
+  for (const gcode::Move& m : r.simultaneous)  // the moves that turn the tool, too
+    if (m.tool == 0) ++toolless, feeds = feeds || m.kind != gcode::MoveKind::rapid;
   if (!feeds) return;
   if (!table || !table->find(tool))
     input_error(r.input.program.string(), ": the program cuts before any tool change, with tool ",
@@ -429,6 +430,8 @@ void load_initial_tool(const std::optional<ToolTable>& table, bool selects_tool,
       if (m.tool == 0) m.tool = tool, had = true;
     if (had) group.tools.erase(0), group.tools.insert(tool);
   }
+  for (gcode::Move& m : r.simultaneous)
+    if (m.tool == 0) m.tool = tool;
   const std::string source =
       camotics_rule ? "the program selects no tool: T1 of the tool table, as CAMotics does; "
                       "--initial-tool N to choose"
@@ -458,25 +461,28 @@ void drop_toolless_moves(SimulationResult& r) {
                         [](const gcode::Move& m) { return m.tool != 0; }));
       next[run.group] = end;
     }
+    auto refuse_feed = [&](const gcode::Move& m) {
+      if (m.kind != gcode::MoveKind::rapid)
+        // The file that holds the move (one of a project's files, or a called subprogram), not
+        // the project or the main program.
+        input_error(
+            r.files.at(static_cast<std::size_t>(m.file)), ":", m.line, ": a ",
+            gcode::to_string(m.kind),
+            " move with no tool loaded (T… M6; on a machine that loads the tool on T alone, give "
+            "--machine a file with \"tool_loads_on_t\": true; for a control that starts with "
+            "a tool in the spindle, --initial-tool N)");
+    };
     // In place: the groups hold every move of the program, and a copy would double that.
     for (gcode::MoveGroup& group : groups) {
       std::size_t toolless = 0;
-      for (const gcode::Move& m : group.moves) {
-        if (m.tool != 0) continue;
-        if (m.kind != gcode::MoveKind::rapid)
-          // The file that holds the move (one of a project's files, or a called subprogram), not
-          // the project or the main program.
-          input_error(
-              r.files.at(static_cast<std::size_t>(m.file)), ":", m.line, ": a ",
-              gcode::to_string(m.kind),
-              " move with no tool loaded (T… M6; on a machine that loads the tool on T alone, give "
-              "--machine a file with \"tool_loads_on_t\": true; for a control that starts with "
-              "a tool in the spindle, --initial-tool N)");
-        ++toolless;
-      }
+      for (const gcode::Move& m : group.moves)
+        if (m.tool == 0) refuse_feed(m), ++toolless;
       if (toolless > 0) erase_if(group.moves, [](const gcode::Move& m) { return m.tool == 0; });
       toolless_rapids += static_cast<long long>(toolless);
     }
+    // The moves that turn the tool likewise (cut_simultaneous skips a toolless rapid).
+    for (const gcode::Move& m : r.simultaneous)
+      if (m.tool == 0) refuse_feed(m), ++toolless_rapids;
   }
   if (toolless_rapids > 0)
     r.warnings.push_back(
