@@ -100,6 +100,26 @@ TEST_CASE("boat-xyzac.ngc on xyzac-trt: M428 is TCP, the tips on the boat; raw j
   fs::remove_all(work);
 }
 
+TEST_CASE("gmoccapy's boat-xyzac.ngc (no M428): TCP from the start, kinematics_at_start") {
+  // gmoccapy's table-rotary-tilting: KINEMATICS = xyzac-trt-kins without sparm=identityfirst.
+  const fs::path dir =
+      "/usr/share/doc/linuxcnc/examples/sample-configs/sim/gmoccapy/"
+      "non_trivial_kinematics/table-rotary-tilting";
+  const fs::path program = dir / "examples/boat-xyzac.ngc";
+  if (!present(program)) return;
+  const fs::path work = scratch("lcnc-boat-gm");
+  write_text(work / "gm.json", R"({"base": "xyzac-trt", "kinematics_at_start": "tcp"})");
+  const std::string machine = (work / "gm.json").string();
+  const json report = simulate(
+      work, {program.string(), "--machine", machine, "--tools", (dir / "xyzac-trt.tbl").string()});
+  CHECK(report["result"]["watertight"] == true);
+  const Tips tcp = feed_tips(work, {program.string(), "--machine", machine});
+  CHECK(within(tcp, Vec3(-51, -27, -13.25 - 1e-9), Vec3(47, 23, 3)));
+  CHECK_FALSE(within(feed_tips(work, {program.string(), "--machine", "xyzac-trt"}),
+                     Vec3(-51, -27, -13.25 - 1e-9), Vec3(47, 23, 3)));
+  fs::remove_all(work);
+}
+
 TEST_CASE("boat-xyzbc.ngc on xyzbc-trt: T1 without Z is length 0, G43 H1 reads it") {
   const fs::path dir = kFiveAxis / "table-rotary-tilting";
   const fs::path program = dir / "demos/boat-xyzbc.ngc";
