@@ -23,7 +23,7 @@ MAX_FUNCTION_LINES = 120
 MAX_README_LINES = 250
 SOURCE_DIRS = ("include", "gcode", "tools")
 SUFFIXES = {".hpp", ".cpp", ".h", ".cc"}
-BUNDLED_MACHINES = ("ac-trunnion", "bc-trunnion", "b-head-c-table", "head-head", "hmc-b-table")
+BUNDLED_MACHINES = ("ac-trunnion", "bc-trunnion", "xyzac-trt", "xyzbc-trt", "xyzab-tdr", "b-head-c-table", "head-head", "hmc-b-table")
 
 
 def blank_out(text, keep_strings=False):

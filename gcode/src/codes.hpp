@@ -64,7 +64,9 @@ struct Words {
   int g_count = 0;
   std::array<Code, 8> m{};
   int m_count = 0;
-  bool m_arguments = false;  // an accepted M-code that takes P Q E L R words is in the block
+  bool m_arguments = false;    // an accepted M-code that takes P Q E L R words is in the block
+  int kinematics_switch = -1;  // a machine's kinematics switch M-code in the block (or -1)
+  int kinematics_switch_column = 0;                        // and its column
   const std::vector<std::string>* vacant_words = nullptr;  // the block's (Block::vacant_words)
 
   bool has(char c) const { return (present >> letter_index(c)) & 1u; }

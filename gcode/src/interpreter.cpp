@@ -67,6 +67,7 @@ const std::set<int>& Interpreter::tools_used() const { return state_->summary.to
 const std::map<int, int>& Interpreter::tool_first_line() const {
   return state_->summary.tool_first_line;
 }
+bool Interpreter::selects_tool() const { return state_->summary.selects_tool; }
 long long Interpreter::blocks() const { return state_->summary.blocks; }
 const std::vector<std::string>& Interpreter::files() const { return state_->files; }
 
@@ -93,6 +94,7 @@ void fresh_machine(std::unique_ptr<Interpreter::State>& state) {
   s.frame.world_origin = s.frame.work_offset;
   s.modal.unit = s.machine.inch_at_start ? 25.4 : 1.0;
   s.modal.retract_to_r = s.machine.g99_at_start;
+  s.frame.tcp_kinematics = s.machine.kinematics && s.machine.tcp_kinematics_at_start;
   s.update_frame();
   if (s.machine.start_position) {
     s.tool.pos = *s.machine.start_position;

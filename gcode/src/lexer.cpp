@@ -173,14 +173,20 @@ class Parser {
       ++i_;
       if (ref.name.empty()) fail(open, "empty parameter name");
       // LinuxCNC reads #<_hal[pin]> from the running HAL (with the INI's [RS274NGC]FEATURES bit
-      // HAL_PIN_VARS); rs274 run standalone has none and refuses it, "not defined".
-      if (ref.name.starts_with("_hal["))
-        fail(hash, "parameter #<" + as_written + "> reads HAL pin " +
-                       as_written.substr(5, as_written.find(']') == std::string::npos
-                                                ? std::string::npos
-                                                : as_written.find(']') - 5) +
-                       ", whose value is known only on the running machine (LinuxCNC's rs274 run "
-                       "standalone refuses it too): set the value in the program instead");
+      // HAL_PIN_VARS); rs274 run standalone has none and refuses it, "not defined". The machine
+      // file's "variables" may give the value its configuration sets (HALCMD setp / sets).
+      if (ref.name.starts_with("_hal[") && !reader(hash).named(ref.name)) {
+        const std::size_t close = as_written.find(']');
+        const std::string pin =
+            as_written.substr(5, close == std::string::npos ? std::string::npos : close - 5);
+        fail(hash, "parameter #<" + as_written + "> reads HAL pin " + pin +
+                       ", whose value is known only on the running machine (LinuxCNC's rs274 "
+                       "run standalone refuses it too): give it in the machine file's "
+                       "\"variables\" ({\"#<_hal[" +
+                       pin +
+                       "]>\": value}, the value the configuration's HALCMD setp or sets gives "
+                       "it), or set the value in the program instead");
+      }
       return ref;
     }
     Value index = primary(hash);

@@ -123,32 +123,107 @@ Mesh trunnion_cradle(int along, double pivot) {
                        box({180, -110, bottom}, {210, 110, pivot + 30})});
 }
 
+// LinuxCNC's switchable kinematics in its sample configurations (docs/src/motion/switchkins.adoc
+// in LinuxCNC; configs/sim/axis/vismach/5axis): REMAP M428 selects the TCP kinematics
+// (xyzac-trt-kins, xyzbc-trt-kins, xyzab_tdr_kins), M429 identity kinematics (the start, with
+// sparm=identityfirst), M430 a user's own ("userk", type 2), which tridex cannot know: refused.
+MachineConfig with_linuxcnc_switches(MachineConfig m, bool userk) {
+  m.kinematics_switches = {{428, KinematicsSwitch::tcp}, {429, KinematicsSwitch::identity}};
+  if (userk) m.kinematics_switches[430] = KinematicsSwitch::refuse;
+  return m;
+}
+
 // Table-table: A tilts the trunnion about X through (0, 0, −75) (the C face 75 mm above the tilt
 // axis), −120°…120°; C turns the platter on it about Z through the origin, endless. LinuxCNC's
 // xyzac-trt kinematics with its default directions (part_to_machine = Rx(A)·Rz(C) about the
-// pivots).
+// pivots; trtfuncs.c with conventional-directions 0), and its M428/M429/M430 switches. Its sample
+// configuration's pivots differ (docs/machine-files.md, "Kinematics switches").
 MachineConfig ac_trunnion() {
-  return with_parts(
-      rotary_machine(
-          MachineType::table_table,
-          {make_axis('A', false, {1, 0, 0}, {0, 0, -75}, std::array<double, 2>{-120, 120}),
-           make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{})}),
-      {built_part("platter", "C", make_frustum_mesh(100, 100, -30, 0)),
-       built_part("trunnion", "A", trunnion_cradle(0, -75)),
-       built_part("bed", "bed", make_box_mesh({-600, -400, -500}, {600, 400, -420}))});
+  return with_linuxcnc_switches(
+      with_parts(rotary_machine(MachineType::table_table,
+                                {make_axis('A', false, {1, 0, 0}, {0, 0, -75},
+                                           std::array<double, 2>{-120, 120}),
+                                 make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{})}),
+                 {built_part("platter", "C", make_frustum_mesh(100, 100, -30, 0)),
+                  built_part("trunnion", "A", trunnion_cradle(0, -75)),
+                  built_part("bed", "bed", make_box_mesh({-600, -400, -500}, {600, 400, -420}))}),
+      true);
 }
 
 // Table-table, Haas UMC-style: B tilts about Y through (0, 0, −50), −35°…110° (a UMC-750's
-// published tilt range); C turns about Z through the origin, endless.
+// published tilt range); C turns about Z through the origin, endless. The directions of
+// LinuxCNC's xyzbc-trt kinematics, and its M428/M429/M430 switches.
 MachineConfig bc_trunnion() {
-  return with_parts(
-      rotary_machine(
-          MachineType::table_table,
-          {make_axis('B', false, {0, 1, 0}, {0, 0, -50}, std::array<double, 2>{-35, 110}),
-           make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{})}),
-      {built_part("platter", "C", make_frustum_mesh(100, 100, -30, 0)),
-       built_part("trunnion", "B", trunnion_cradle(1, -50)),
-       built_part("bed", "bed", make_box_mesh({-600, -400, -500}, {600, 400, -420}))});
+  return with_linuxcnc_switches(
+      with_parts(rotary_machine(MachineType::table_table,
+                                {make_axis('B', false, {0, 1, 0}, {0, 0, -50},
+                                           std::array<double, 2>{-35, 110}),
+                                 make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{})}),
+                 {built_part("platter", "C", make_frustum_mesh(100, 100, -30, 0)),
+                  built_part("trunnion", "B", trunnion_cradle(1, -50)),
+                  built_part("bed", "bed", make_box_mesh({-600, -400, -500}, {600, 400, -420}))}),
+      true);
+}
+
+// ---- LinuxCNC's 5-axis sample configurations (configs/sim/axis/vismach/5axis) -----------------
+// Each as its INI sets it up: LinuxCNC's dialect, tool tables in mm ([TRAJ]LINEAR_UNITS), the
+// rotary limits of its [AXIS_*] sections, the pivots its HALCMD lines give the kinematics
+// component, those HAL pins' values (for #<_hal[...]>), and its REMAP M-codes. Pivots are in
+// tip coordinates: the kinematics add the tool offset (motion.tooloffset.z) to the z offset,
+// which the tool length offset cancels. G53 goes where it says (every joint's HOME is 0). No
+// parts, no travel (its limits are joint positions).
+MachineConfig linuxcnc_sample(std::vector<RotaryAxis> axes, bool userk, const std::string& pins,
+                              std::initializer_list<std::pair<const char*, double>> values) {
+  MachineConfig m = with_linuxcnc_switches(linuxcnc_machine(), userk);
+  m.kinematics = rotary_machine(MachineType::table_table, std::move(axes)).kinematics;
+  m.tool_table_in_inches = false;
+  m.linear_units_stated = true;
+  m.g53_literal = true;
+  for (const auto& [name, value] : values)
+    m.named_variables["_hal[" + pins + "." + name + "]"] = value;
+  return m;
+}
+
+// xyzac-trt.ini: xyzac-trt-kins (trtfuncs.c, conventional-directions 0: part_to_machine =
+// Rx(A)·Rz(C)) with y-offset 20, z-offset 10 and the rotation point at the origin: A about X
+// through (0, 20, 10), −100°…50°, carrying C about Z through the origin, ±36000°.
+MachineConfig xyzac_trt() {
+  return linuxcnc_sample({make_axis('A', false, {1, 0, 0}, {0, 20, 10}, Limits{{-100, 50}}),
+                          make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{{-36000, 36000}})},
+                         true, "xyzac-trt-kins",
+                         {{"x-rot-point", 0},
+                          {"y-rot-point", 0},
+                          {"z-rot-point", 0},
+                          {"y-offset", 20},
+                          {"z-offset", 10}});
+}
+
+// xyzbc-trt.ini: xyzbc-trt-kins (part_to_machine = Ry(B)·Rz(C)) with x-offset −20, z-offset −15:
+// B about Y through (−20, 0, −15), ±36000°, carrying C about Z through the origin, ±36000°.
+MachineConfig xyzbc_trt() {
+  return linuxcnc_sample({make_axis('B', false, {0, 1, 0}, {-20, 0, -15}, Limits{{-36000, 36000}}),
+                          make_axis('C', false, {0, 0, 1}, {0, 0, 0}, Limits{{-36000, 36000}})},
+                         true, "xyzbc-trt-kins",
+                         {{"x-rot-point", 0},
+                          {"y-rot-point", 0},
+                          {"z-rot-point", 0},
+                          {"x-offset", -20},
+                          {"z-offset", -15}});
+}
+
+// xyzab-tdr.ini (table-dual-rotary): xyzab_tdr_kins.comp, whose inverse is joints =
+// Ry(−B)·Rx(−A) about the pivots (the conventional directions): B about Y through the origin,
+// −180°…180°, carrying A about X through (−20, 0, −10) (x-offset −20, z-offset −10), ±3600°. Its
+// demo reads the pins; M428 selects the TCP kinematics, M429 identity (the start); no M430.
+MachineConfig xyzab_tdr() {
+  return linuxcnc_sample({make_axis('B', false, {0, -1, 0}, {0, 0, 0}, Limits{{-180, 180}}),
+                          make_axis('A', false, {-1, 0, 0}, {-20, 0, -10}, Limits{{-3600, 3600}})},
+                         false, "xyzab_tdr_kins",
+                         {{"x-rot-point", 0},
+                          {"y-rot-point", 0},
+                          {"z-rot-point", 0},
+                          {"x-offset", -20},
+                          {"z-offset", -10}});
 }
 
 // Head-table: B turns the head about Y through (0, 0, 150) (pivot 150 mm above the tip),
@@ -194,7 +269,7 @@ struct BundledMachine {
   std::string_view name;
   MachineConfig (*build)();
 };
-constexpr std::array<BundledMachine, 9> kBundled{{
+constexpr std::array<BundledMachine, 12> kBundled{{
     {"default", default_machine},
     {"haas", haas_machine},
     {"linuxcnc", linuxcnc_machine},
@@ -204,6 +279,9 @@ constexpr std::array<BundledMachine, 9> kBundled{{
     {"b-head-c-table", b_head_c_table},
     {"head-head", head_head},
     {"hmc-b-table", hmc_b_table},
+    {"xyzac-trt", xyzac_trt},
+    {"xyzbc-trt", xyzbc_trt},
+    {"xyzab-tdr", xyzab_tdr},
 }};
 
 // ---- the machine file's "kinematics" key -------------------------------------------------

@@ -15,6 +15,7 @@
 
 #include "tridex/error.hpp"
 #include "tridex/gcode/machine.hpp"
+#include "codes.hpp"
 
 namespace tridex::gcode {
 
@@ -307,11 +308,65 @@ void check_component_links(const std::string& file, const MachineConfig& m) {
         machine_error(file, ": \"collision\".ignore: no component \"", name, "\"");
 }
 
+// ---- LinuxCNC's switchable kinematics: "kinematics_switches", "kinematics_at_start" ----------
+// (docs/src/motion/switchkins.adoc in LinuxCNC: the sample configs remap M428/M429/M430 to set
+// motion.switchkins-type; docs/machine-files.md, "Kinematics switches").
+
+KinematicsSwitch switch_kind(const json& value, const std::string& where) {
+  const std::string kind = value.is_string() ? value.get<std::string>() : std::string();
+  if (kind == "tcp") return KinematicsSwitch::tcp;
+  if (kind == "identity") return KinematicsSwitch::identity;
+  if (kind != "refuse")
+    machine_error(where, ": \"tcp\", \"identity\" or \"refuse\", got ", value.dump());
+  return KinematicsSwitch::refuse;
+}
+
+bool read_switch_key(const std::string& key, const json& value, const std::string& file,
+                     MachineConfig& m) {
+  const std::string where = cat(file, ": \"", key, "\"");
+  if (key == "kinematics_at_start") {
+    const KinematicsSwitch kind = switch_kind(value, where);
+    if (kind == KinematicsSwitch::refuse)
+      machine_error(where, ": \"tcp\" or \"identity\", got ", value.dump());
+    m.tcp_kinematics_at_start = kind == KinematicsSwitch::tcp;
+    return true;
+  }
+  if (key != "kinematics_switches") return false;
+  if (!value.is_object())
+    machine_error(where, ": must be an object such as {\"M428\": \"tcp\", \"M429\": \"identity\"}");
+  m.kinematics_switches.clear();  // this file's list replaces a base machine's
+  for (const auto& [name, kind] : value.items()) {
+    const std::string at = cat(where, ": \"", name, "\"");
+    const std::string digits = name.starts_with("M") || name.starts_with("m") ? name.substr(1) : "";
+    if (digits.empty() || digits.size() > 4 ||
+        digits.find_first_not_of("0123456789") != std::string::npos)
+      machine_error(at, ": not an M-code (\"M428\")");
+    const int code = std::stoi(digits);
+    // The codes the interpreter acts on (M0-M9, M30, M61, M97-M99) keep their meaning.
+    if (m_group(code) >= 0)
+      machine_error(at, ": M", code, " already has a meaning; a switch needs a code of its own");
+    if (!m.kinematics_switches.emplace(code, switch_kind(kind, at)).second)
+      machine_error(at, ": M", code, " given twice");
+  }
+  return true;
+}
+
+void check_switches(const std::string& file, const MachineConfig& m) {
+  if ((!m.kinematics_switches.empty() || m.tcp_kinematics_at_start) && !m.kinematics)
+    machine_error(file,
+                  ": \"kinematics_switches\" and \"kinematics_at_start\" need \"kinematics\"");
+  for (const auto& [code, kind] : m.kinematics_switches)
+    if (m.m_codes.count(code) || m.forbidden_m_codes.count(code))
+      machine_error(file, ": M", code,
+                    " is a kinematics switch and in \"m_codes\" or \"forbidden_m_codes\"");
+}
+
 constexpr const char* kMachineFileKeys =
     "name, description, base, dialect, units, start, tool_change, tool_loads_on_t, "
     "decimal_point_input, initial_tool, "
     "arc_radius_tolerance_mm, d_offsets, home, reference2, work_offsets, m_codes, "
-    "forbidden_m_codes, variables, far_distance, subprograms, kinematics, rapid_rate_mm_per_min, "
+    "forbidden_m_codes, kinematics_switches, kinematics_at_start, variables, far_distance, "
+    "subprograms, kinematics, rapid_rate_mm_per_min, "
     "rapid_rate_deg_per_min, max_feed_mm_per_min, components, collision, linear_axes";
 
 MachineConfig parse(const json& doc, const std::string& file) {
@@ -417,7 +472,7 @@ MachineConfig parse(const json& doc, const std::string& file) {
       fs::path base = fs::path(file).parent_path();
       for (const json& dir : value)
         m.subprogram_dirs.push_back((base / string_value(dir, where).get<std::string>()).string());
-    } else if (!read_parts_key(key, value, file, m)) {
+    } else if (!read_parts_key(key, value, file, m) && !read_switch_key(key, value, file, m)) {
       machine_error(where, ": unknown key (known: ", kMachineFileKeys, ")");
     }
   }
@@ -425,6 +480,7 @@ MachineConfig parse(const json& doc, const std::string& file) {
     if (m.forbidden_m_codes.count(code))
       machine_error(file, ": M", code, " is both in \"m_codes\" and in \"forbidden_m_codes\"");
   check_component_links(file, m);
+  check_switches(file, m);
   return m;
 }
 

@@ -179,7 +179,7 @@ void Interpreter::State::tool_length_entry(long long l, int column) {
 //   2. units G20/G21                                10. look-ahead and smoothing (no effect)
 //   3. feed mode G93/G94/G95, F, S                   11. cycle return G98/G99
 //   4. tool: T, M6, M61                              12. work system G54-G59.3, G54.1, G154
-//   5. spindle M3/M4/M5                              13. G52/G92 offsets and G10 tables
+//   5. spindle M3/M4/M5, kinematics switches         13. G52/G92 offsets and G10 tables
 //   6. dwell G4                                      14. tilted plane G68.x and its orienting
 //   7. plane G17/G18/G19                             15. motion mode, then the axis words' moves
 //   8. cutter compensation, distance modes           16. program flow M2/M30/M97/M98/M99
@@ -198,6 +198,7 @@ Flow Interpreter::State::execute(const Block& block) {
   feed_mode_codes();
   tool_change_codes();
   spindle_codes();
+  kinematics_switch_code();  // M428-style switches, as LinuxCNC's user M-codes (rotary.cpp)
   if (codes.nonmodal == kG4) dwell_code(codes);
   if (codes.modal_g) {
     plane_codes();
@@ -267,7 +268,10 @@ void Interpreter::State::units_codes() {
 // T selects a tool; M6 (or T alone, on a machine whose T loads the tool) loads it, LinuxCNC's
 // M61 Q says which tool the spindle holds.
 void Interpreter::State::tool_change_codes() {
-  if (w.has('T')) tool.selected = static_cast<int>(integer('T', "tool number", 0, 99'999'999));
+  if (w.has('T')) {
+    tool.selected = static_cast<int>(integer('T', "tool number", 0, 99'999'999));
+    summary.selects_tool = true;
+  }
 
   if (w.find_m(kM6) || (w.has('T') && machine.tool_loads_on_t)) {
     comp_forbid(w.find_m(kM6) ? w.find_m(kM6) : w.col('T'), "a tool change");
@@ -288,6 +292,7 @@ void Interpreter::State::tool_change_codes() {
   if (int column = w.find_m(kM61)) {  // LinuxCNC: the tool in the spindle is Q (nothing moves)
     if (!w.has('Q')) error(column, "M61 needs Q (the tool number)");
     tool.selected = static_cast<int>(integer('Q', "M61 tool number", 0, 99'999'999));
+    summary.selects_tool = true;
     load_tool(tool.selected);
   }
 }

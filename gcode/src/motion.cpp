@@ -21,7 +21,8 @@ void Interpreter::State::move_to(Vec3 target, const std::array<bool, 3>& set_abs
     return;
   }
   Vec3 current = glm::transpose(rot) * (tool.pos - org);
-  Vec3 along = glm::transpose(rot) * tool.axis;
+  const Vec3 far_axis = tool.far_axis == Vec3(0.0) ? tool.axis : tool.far_axis;
+  Vec3 along = glm::transpose(rot) * far_axis;
   bool any = false, all = true;
   for (int i = 0; i < 3; ++i) {
     if (std::abs(along[i]) <= kAxisEps) continue;
@@ -41,9 +42,10 @@ void Interpreter::State::move_to(Vec3 target, const std::array<bool, 3>& set_abs
           "the tool is retracted far along its axis and this move sets only some of the "
           "coordinates along the tool axis; set all of X, Y and Z to bring it back");
   Vec3 end = to_frame_machine(target);
-  emit(kind, end + machine.far_distance * tool.axis, end, move_feed, true);
+  emit(kind, end + machine.far_distance * far_axis, end, move_feed, true);
   tool.pos = end;
   tool.far = false;
+  tool.far_axis = Vec3(0.0);
 }
 
 Interpreter::State::Target Interpreter::State::axis_word_target(const Vec3& current) {
@@ -571,7 +573,7 @@ void Interpreter::State::cycle_hole(int code, double hole_u, double hole_v,
   }
   Vec3 out = at(hole_u, hole_v, clear);
   if (out != tool.pos) cycle_rapid(out);
-  if (clear_far) tool.far = true;
+  if (clear_far) go_far();
 }
 
 // ---- LinuxCNC polar coordinates ----
@@ -644,7 +646,7 @@ void Interpreter::State::machine_move(const Vec3& gauge, unsigned mask, MoveKind
   }
   if (((mask & 4u) && !(machine.g53_literal && along_z)) || tool.far) {
     tool.pos = end;
-    tool.far = true;
+    go_far();
     return;
   }
   if (!along_z)
@@ -725,7 +727,7 @@ void Interpreter::State::home_return(bool second) {
   }
   for (int i = 0; i < 3; ++i)
     if ((mask >> i) & 1u) tool.pos[i] = target[i];
-  tool.far = true;
+  go_far();
   if (turns) {
     // The tip goes far while the axes turn; the direction follows the kinematic model.
     tool.axis = machine.kinematics ? tool_direction(*machine.kinematics, frame.rotary_position)

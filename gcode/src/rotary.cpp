@@ -44,6 +44,30 @@ void Interpreter::State::tool_center_codes() {
     update_frame();  // the tip stays where it is on the part
 }
 
+// A kinematics switch of the machine file (LinuxCNC's switchkins, docs/src/motion/switchkins.adoc
+// in LinuxCNC: the sample configs' M428 selects the TCP kinematics, M429 identity, M430 a user's
+// own): the joints stay where they are, so the tip keeps its place on the part and later X Y Z
+// read in the new kinematics. Run with the user-defined M-codes, before the block's motion
+// (LinuxCNC's order of execution; a remap of modal group 10).
+void Interpreter::State::kinematics_switch_code() {
+  if (w.kinematics_switch < 0) return;
+  const int code = w.kinematics_switch, column = w.kinematics_switch_column;
+  const KinematicsSwitch kind = machine.kinematics_switches.at(code);
+  if (kind == KinematicsSwitch::refuse) {
+    std::string message = code_name('M', code * 10);  // (one string: GCC 12's -Wrestrict)
+    message +=
+        " switches to kinematics of this machine's own (LinuxCNC's user kinematics, "
+        "switchkins type 2), which tridex cannot know: use the machine's TCP or identity "
+        "switch, or give the machine file's \"kinematics_switches\" another meaning for it";
+    error(column, message);
+  }
+  const bool next = kind == KinematicsSwitch::tcp;
+  if (next == frame.tcp_kinematics) return;
+  comp_forbid(column, "switching the kinematics");
+  frame.tcp_kinematics = next;
+  update_frame();  // the tip stays where it is on the part
+}
+
 // A B C on a G0/G1 block (or alone under G0/G1 modal): each letter an axis of the machine, within
 // its limits; the tool direction becomes the kinematics'. An indexing move (G0) leaves the tool
 // far along its axis, except in raw form where the machine coordinates keep the tip known (the
@@ -124,9 +148,17 @@ void Interpreter::State::rotary_words() {
                           "] (machine file)");
   }
   if (next == frame.rotary_position) return;
-  if (modal.motion == kG1) {
+  // LinuxCNC plans every move, G0 too, in world coordinates and its TCP kinematics turn them into
+  // joints: under a kinematics switch's TCP a rapid that turns the rotaries moves the tip straight
+  // on the part as G1 does (a simultaneous move); Fanuc's G43.4 rapids are the machine's own.
+  const bool tcp_kinematics = frame.tcp_kinematics && !frame.tcp && !frame.tilted && !frame.dwo;
+  if (modal.motion == kG1 || (tcp_kinematics && !tool.far)) {
     simultaneous_start(first);
-  } else if (frame.tilted || frame.tcp || frame.dwo) {
+  } else if (tcp_kinematics) {
+    // Far (after a tool change): X Y Z are the part's, so the tool stays far where it was, not
+    // along its turned axis; the next Z brings it back.
+    if (tool.far_axis == Vec3(0.0)) tool.far_axis = tool.axis;
+  } else if (frame.tilted || frame.tcp_on() || frame.dwo) {
     go_far();
   }
   set_rotary(next);
@@ -149,7 +181,7 @@ void Interpreter::State::simultaneous_start(int column) {
           "rotary motion during a cut while the tool is retracted far along its axis: the "
           "cut's start is unknown; position the tool (X Y Z) before turning it");
   simultaneous.active = true;
-  simultaneous.pose = frame.tcp ? PoseLaw::tcp : PoseLaw::joints;
+  simultaneous.pose = frame.tcp_on() ? PoseLaw::tcp : PoseLaw::joints;
   simultaneous.tip = tool.pos;
   simultaneous.rotary = frame.rotary_position;
 }

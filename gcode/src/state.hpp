@@ -51,6 +51,7 @@ struct Interpreter::State : ParameterReader {
     std::vector<Diagnostic> warnings;
     std::set<int> tools_used;
     std::map<int, int> tool_first_line;
+    bool selects_tool = false;  // a T word or M61 Q ran (a program with none: CAMotics' tool 1)
     long long blocks = 0;
     std::map<std::string, Skipped> skipped;  // by cause (unsupported)
     std::map<std::string, Skipped> read_as;  // by cause (lenient_read)
@@ -137,6 +138,9 @@ struct Interpreter::State : ParameterReader {
     Vec3 axis{0.0, 0.0, 1.0};
     Vec3 pos{0.0};
     bool far = true;
+    // Where the far tool lies when not along its axis (0: along it): a table turned under TCP
+    // kinematics while the tool is far keeps it far where it was (rotary.cpp).
+    Vec3 far_axis{0.0};
     bool ambiguous = false;
     Vec3 uvw_position{0.0};  // mm, where the U/V/W words put those axes (rotary.cpp)
   };
@@ -204,6 +208,10 @@ struct Interpreter::State : ParameterReader {
     }
     bool tcp = false;
     bool dwo = false;
+    // The machine's TCP kinematics, switched on by an M-code ("kinematics_switches", rotary.cpp):
+    // X Y Z read as under G43.4, which G43/G49 do not cancel (LinuxCNC's switchkins).
+    bool tcp_kinematics = false;
+    bool tcp_on() const { return tcp || tcp_kinematics; }
   };
   ProgramFrame frame;
   // G68.2 / G68.4 P2 (three points) and P3 (two vectors) are written over consecutive blocks,
@@ -346,11 +354,28 @@ struct Interpreter::State : ParameterReader {
     return g_group(code);
   }
 
+  // A kinematics switch of the machine (LinuxCNC's remapped M428..., modal group 10; rotary.cpp
+  // runs it): one a block.
+  bool gather_switch(int m, int column) {
+    if (!machine.kinematics_switches.count(m)) return false;
+    if (w.kinematics_switch >= 0) {
+      std::string message = code_name('M', m * 10);  // (one string: GCC 12's -Wrestrict)
+      message += " and ";
+      message += code_name('M', w.kinematics_switch * 10);
+      message += " both switch the kinematics (one a block)";
+      error(column, message);
+    }
+    w.kinematics_switch = m;
+    w.kinematics_switch_column = column;
+    return true;
+  }
+
   void gather(const Block& block) {
     w.present = w.used = 0;
     find_splines(block);
     w.g_count = w.m_count = 0;
     w.m_arguments = false;
+    w.kinematics_switch = -1;
     w.vacant_words = &block.vacant_words;
     std::array<int, kGroupCount> g_seen{};
     std::array<int, kMGroupCount> m_seen{};
@@ -374,6 +399,7 @@ struct Interpreter::State : ParameterReader {
           error(word.column,
                 code_name('M', code) + " is not allowed on this machine (machine file)");
         if (group < 0 && integral && word.letter == 'M') {
+          if (gather_switch(code / 10, word.column)) continue;  // a kinematics switch
           // An M-code moves no axis: accepted (once a warning per code unless the machine
           // declares it).
           int m = code / 10;
@@ -497,7 +523,7 @@ struct Interpreter::State : ParameterReader {
   // on the part, or in raw rotary form (kinematics without TCP or DWO) the machine coordinates,
   // which differ from the tip's place on the part as soon as a table axis is turned.
   bool raw_rotary() const {
-    return machine.kinematics && !frame.tcp && !frame.dwo && !frame.tilted;
+    return machine.kinematics && !frame.tcp_on() && !frame.dwo && !frame.tilted;
   }
   Vec3 linear_axes() const {
     return raw_rotary() ? machine_from_part(*machine.kinematics, tool.pos, frame.rotary_position)
@@ -703,12 +729,16 @@ struct Interpreter::State : ParameterReader {
   void home_return(bool second);
   void tool_length_codes();    // G43 H, G43.1, G44 H, G49 (modal.cpp)
   void load_tool(int number);  // the tip moves with the tool's length (modal.cpp)
-  void go_far() { tool.far = true; }
+  void go_far() {
+    tool.far = true;
+    tool.far_axis = Vec3(0.0);
+  }
   Flow macro_call(int column);               // G65 (modal.cpp)
   void local_offsets(int code, int column);  // G52, G92, G92.1, G92.2, G92.3 (modal.cpp)
 
   // ---- rotary axes, DWO and TCP (rotary.cpp) ----
   void tool_center_codes();
+  void kinematics_switch_code();
   void rotary_words();
   void simultaneous_start(int column);
   void extra_linear_words(bool track);  // LinuxCNC's U/V/W

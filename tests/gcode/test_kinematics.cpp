@@ -63,6 +63,20 @@ Vec3 tip_by_hand(const char* name, const Vec3& x, const RotaryPositions& r) {
     return about(kZ, -c) * tip;
   }
   if (n == "hmc-b-table") return about(kY, -b) * x;  // the B table about Y through the origin
+  // LinuxCNC's sample configurations, from their kinematics' forward maps (trtfuncs.c,
+  // xyzab_tdr_kins.comp): world = Rz(−C)·Rx(−A) / Rz(−C)·Ry(−B) / Rx(A)·Ry(B) about the pivots.
+  if (n == "xyzac-trt") {
+    Vec3 pa(0, 20, 10);
+    return about(kZ, -c) * (about(kX, -a) * (x - pa) + pa);
+  }
+  if (n == "xyzbc-trt") {
+    Vec3 pb(-20, 0, -15);
+    return about(kZ, -c) * (about(kY, -b) * (x - pb) + pb);
+  }
+  if (n == "xyzab-tdr") {
+    Vec3 pa(-20, 0, -10);
+    return about(kX, a) * (about(kY, b) * x - pa) + pa;
+  }
   // head-head: A's pivot turns with C about the spindle line.
   Vec3 pa(0, 0, 150);
   return x + about(kZ, c) * (pa + about(kX, a) * (-pa));

@@ -134,10 +134,17 @@ TEST_CASE("plausibility: a program with no tool change runs with the start tool,
   std::vector<std::string> args{
       "simulate", (dir / "p.nc").string(), "--tools",     (dir / "tools.json").string(),
       "--stock",  "box:0,0,-10,50,50,0",   "--dexel-res", "64"};
+  // It selects no tool at all: cut with the table's T1, as CAMotics does (issue 34, LinuxCNC's
+  // impeller demo); --initial-tool 0 refuses it.
+  CommandResult plain = run_tridex(args, dir);
+  CHECK(plain.status == 0);
+  CHECK(has(plain.err, "the program selects no tool: T1 of the tool table, as CAMotics does"));
+  args.insert(args.end(), {"--initial-tool", "0"});
   CommandResult refused = run_tridex(args, dir);
   CHECK(refused.status == 2);
   CHECK(has(refused.err, "p.nc:3: a feed move with no tool loaded"));
   CHECK(has(refused.err, "--initial-tool N"));
+  args.resize(args.size() - 2);
   args.insert(args.end(), {"--initial-tool", "1"});
   CommandResult started = run_tridex(args, dir);
   REQUIRE(started.status == 0);

@@ -369,3 +369,12 @@ TEST_CASE("a JSON tool table's \"tool-length\" is the length for G43") {
   CHECK(error_of(R"({"1": {"shape": "cylindrical", "diameter": 6, "tool-length": "long"}})")
             .find("table: tool 1: \"tool-length\" must be a finite number") != std::string::npos);
 }
+
+TEST_CASE("LinuxCNC .tbl: an entry without Z has length 0, as LinuxCNC reads it") {
+  // xyzbc-trt.tbl (LinuxCNC's sample) is `T1 P1 D1` with G43 H1 in its demo.
+  ToolTable table = ToolTable::from_tbl("T1 P1 D1\nT2 P2 Z10 D8\nT3 P3\n", "xyzbc.tbl", 1.0);
+  REQUIRE(table.tool_lengths().size() == 3);
+  CHECK(table.tool_lengths().at(1) == 0);
+  CHECK(table.tool_lengths().at(2) == 10);
+  CHECK(table.tool_lengths().at(3) == 0);  // no D either: in the table, a length of 0
+}

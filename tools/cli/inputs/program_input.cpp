@@ -177,6 +177,7 @@ InterpretResult interpret(const ProgramInput& input, const gcode::InterpreterOpt
       result.warnings.push_back(d.to_string());
     for (const auto& [tool, line] : interpreter.tool_first_line())
       result.tool_first_line.try_emplace(tool, ToolSelection{path.string(), line});
+    result.selects_tool = result.selects_tool || interpreter.selects_tool();
   }
   return result;
 }

@@ -57,6 +57,7 @@ struct ToolSelection {
 struct InterpretResult {
   std::vector<std::string> warnings;  // "file:line:col: message"
   std::map<int, ToolSelection> tool_first_line;
+  bool selects_tool = false;  // some file ran a T word or M61 (Interpreter::selects_tool)
   long long moves = 0;
   std::vector<std::string> files;  // Move::file's table over all runs: the program's files, then
                                    // the subprogram files they called, each once

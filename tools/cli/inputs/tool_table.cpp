@@ -440,10 +440,14 @@ ToolTable ToolTable::from_tbl(const std::string& text, const std::string& source
         input_error(source, ":", line, ":", it->second.second, ": tool ", number,
                     " has a sideways offset ", c, it->second.first,
                     ", which tridex does not simulate");
+    // An entry without Z has length 0, as LinuxCNC reads it (tooldata_common.cc,
+    // tooldata_read_entry: the offset starts zeroed and only a Z word sets its z).
     if (auto z = words.find('Z'); z != words.end())
       result.tool_lengths_[number] = tool_length_mm(
           unit_mm * z->second.first,
           source + ":" + std::to_string(line) + ": tool " + std::to_string(number), "Z");
+    else
+      result.tool_lengths_[number] = 0;
     auto d = words.find('D');
     if (d == words.end() || d->second.first == 0) {
       // D0 or no D (LinuxCNC's diameter then is 0): a probe, an engraver or a tool not measured

@@ -89,7 +89,8 @@ class ToolTable {
   }
   const std::map<int, ToolSpec>& tools() const { return tools_; }
   bool empty() const { return tools_.empty(); }
-  // Tool lengths (mm, gauge point to tip) of the tools whose entry gives one.
+  // Tool lengths (mm, gauge point to tip) of the tools whose entry gives one; every entry of a
+  // LinuxCNC .tbl gives one (no Z: 0, as LinuxCNC reads it).
   const std::map<int, double>& tool_lengths() const { return tool_lengths_; }
   // The tools of a LinuxCNC table with D0 or no D: in the table, with no cutter (tools() lacks
   // them), a diameter of 0 for G41/G42.

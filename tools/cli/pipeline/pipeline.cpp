@@ -325,8 +325,10 @@ ParsedProgram parse_grouped(const SimulateOptions& options, std::uint64_t max_me
         }
         if (m.pose != gcode::PoseLaw::fixed) {  // the tool turns: cut_simultaneous's
           r.simultaneous.push_back(m);
-          cutting_bounds.extend(m.start);
-          cutting_bounds.extend(m.end);
+          if (m.kind != gcode::MoveKind::rapid) {  // a TCP rapid (LinuxCNC's) is no cut
+            cutting_bounds.extend(m.start);
+            cutting_bounds.extend(m.end);
+          }
           return;
         }
         const auto group = static_cast<std::uint32_t>(grouper.add(m));
@@ -405,17 +407,25 @@ void load_cutters(const SimulateOptions& options, const std::optional<ToolTable>
 
 // The tool a control starts with (MachineConfig::initial_tool: --initial-tool, the machine
 // file's "initial_tool", CAMotics' tool 1 for a project): when a feed move comes before any tool
-// change, every move before it is cut with that tool, with a warning. A program that changes
-// tools before it cuts keeps its positioning rapids dropped (drop_toolless_moves).
-void load_initial_tool(const std::optional<ToolTable>& table, SimulationResult& r) {
+// change, every move before it is cut with that tool, with a warning. A program that selects no
+// tool at all (no T word, no M61; LinuxCNC's impeller demo) is cut with T1 when the tool table
+// holds one and neither --initial-tool nor the machine file says otherwise, as CAMotics cuts a
+// program without a tool change. A program that changes tools before it cuts keeps its
+// positioning rapids dropped (drop_toolless_moves).
+void load_initial_tool(const std::optional<ToolTable>& table, bool selects_tool,
+                       SimulationResult& r) {
   const gcode::MachineConfig& machine = r.input.machine;
-  const int tool = machine.initial_tool;
+  const bool camotics_rule = machine.initial_tool <= 0 && !machine.initial_tool_stated &&
+                             !selects_tool && table && table->find(1);
+  const int tool = camotics_rule ? 1 : machine.initial_tool;
   if (tool <= 0) return;
   long long toolless = 0;
   bool feeds = false;
   for (const gcode::MoveGroup& group : r.groups)
     for (const gcode::Move& m : group.moves)
       if (m.tool == 0) ++toolless, feeds = feeds || m.kind != gcode::MoveKind::rapid;
+  for (const gcode::Move& m : r.simultaneous)  // the moves that turn the tool, too
+    if (m.tool == 0) ++toolless, feeds = feeds || m.kind != gcode::MoveKind::rapid;
   if (!feeds) return;
   if (!table || !table->find(tool))
     input_error(r.input.program.string(), ": the program cuts before any tool change, with tool ",
@@ -428,9 +438,13 @@ void load_initial_tool(const std::optional<ToolTable>& table, SimulationResult& 
       if (m.tool == 0) m.tool = tool, had = true;
     if (had) group.tools.erase(0), group.tools.insert(tool);
   }
-  const std::string source = machine.initial_tool_stated
-                                 ? "--initial-tool or the machine file's \"initial_tool\""
-                                 : "CAMotics' convention for a project";
+  for (gcode::Move& m : r.simultaneous)
+    if (m.tool == 0) m.tool = tool;
+  const std::string source =
+      camotics_rule ? "the program selects no tool: T1 of the tool table, as CAMotics does; "
+                      "--initial-tool N to choose"
+      : machine.initial_tool_stated ? "--initial-tool or the machine file's \"initial_tool\""
+                                    : "CAMotics' convention for a project";
   r.warnings.push_back(std::to_string(toolless) +
                        " move(s) before any tool change were cut with tool " +
                        std::to_string(tool) + ", the tool the control starts with (" + source +
@@ -455,25 +469,28 @@ void drop_toolless_moves(SimulationResult& r) {
                         [](const gcode::Move& m) { return m.tool != 0; }));
       next[run.group] = end;
     }
+    auto refuse_feed = [&](const gcode::Move& m) {
+      if (m.kind != gcode::MoveKind::rapid)
+        // The file that holds the move (one of a project's files, or a called subprogram), not
+        // the project or the main program.
+        input_error(
+            r.files.at(static_cast<std::size_t>(m.file)), ":", m.line, ": a ",
+            gcode::to_string(m.kind),
+            " move with no tool loaded (T… M6; on a machine that loads the tool on T alone, give "
+            "--machine a file with \"tool_loads_on_t\": true; for a control that starts with "
+            "a tool in the spindle, --initial-tool N)");
+    };
     // In place: the groups hold every move of the program, and a copy would double that.
     for (gcode::MoveGroup& group : groups) {
       std::size_t toolless = 0;
-      for (const gcode::Move& m : group.moves) {
-        if (m.tool != 0) continue;
-        if (m.kind != gcode::MoveKind::rapid)
-          // The file that holds the move (one of a project's files, or a called subprogram), not
-          // the project or the main program.
-          input_error(
-              r.files.at(static_cast<std::size_t>(m.file)), ":", m.line, ": a ",
-              gcode::to_string(m.kind),
-              " move with no tool loaded (T… M6; on a machine that loads the tool on T alone, give "
-              "--machine a file with \"tool_loads_on_t\": true; for a control that starts with "
-              "a tool in the spindle, --initial-tool N)");
-        ++toolless;
-      }
+      for (const gcode::Move& m : group.moves)
+        if (m.tool == 0) refuse_feed(m), ++toolless;
       if (toolless > 0) erase_if(group.moves, [](const gcode::Move& m) { return m.tool == 0; });
       toolless_rapids += static_cast<long long>(toolless);
     }
+    // The moves that turn the tool likewise (cut_simultaneous skips a toolless rapid).
+    for (const gcode::Move& m : r.simultaneous)
+      if (m.tool == 0) refuse_feed(m), ++toolless_rapids;
   }
   if (toolless_rapids > 0)
     r.warnings.push_back(
@@ -871,7 +888,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   // The dump files are named by the directions, known only now.
   if (!options.dump_zmaps.empty())
     check_dump_names(options.dump_zmaps, r.groups, request.outputs, run.inputs);
-  load_initial_tool(run.table, r);
+  load_initial_tool(run.table, parsed.interpreted.selects_tool, r);
   load_cutters(options, run.table, parsed.interpreted.tool_first_line, r);
   drop_toolless_moves(r);
   size_the_run(options, request, run, parsed, r);

@@ -96,8 +96,9 @@ class Interpreter {
   const std::set<int>& tools_used() const;            // tools of the emitted moves
   const std::map<int, int>& tool_first_line() const;  // tool -> line of the M6 that loaded it
                                                       // (its first move's line if none)
-  long long blocks() const;                           // blocks executed by the last run
-                                                      // (or the pieces fed so far)
+  bool selects_tool() const;  // a T word or M61 ran (a program with none: CAMotics' tool 1)
+  long long blocks() const;   // blocks executed by the last run
+                              // (or the pieces fed so far)
   // The files of the current (or last) run, Move::file's table: the program given to run(), then
   // each subprogram file in the order it was first called (its path as found). Grows during a run.
   const std::vector<std::string>& files() const;

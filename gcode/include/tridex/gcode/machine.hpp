@@ -7,7 +7,8 @@
 // The machine file is a JSON object; every key is optional: "name", "description", "base" (a
 // bundled machine to start from), "dialect", "units", "linear_units", "start", "tool_change",
 // "tool_loads_on_t", "decimal_point_input", "initial_tool", "arc_radius_tolerance_mm", "d_offsets",
-// "g53", "home", "reference2", "work_offsets", "m_codes", "forbidden_m_codes", "variables",
+// "g53", "home", "reference2", "work_offsets", "m_codes", "forbidden_m_codes",
+// "kinematics_switches", "kinematics_at_start", "variables",
 // "far_distance", "subprograms" (folders relative to the file), "kinematics", the speeds
 // "rapid_rate_mm_per_min", "rapid_rate_deg_per_min", "max_feed_mm_per_min", and the collision
 // check's "components", "collision" and "linear_axes" (machine_parts below).
@@ -89,6 +90,15 @@ struct CollisionSettings {
 // variables #2001–#2800, G10 L1 as wear; parameters.cpp, modal.cpp).
 enum class Dialect { fanuc, haas, linuxcnc };
 
+// What an M-code of the machine file's "kinematics_switches" does (LinuxCNC's switchable
+// kinematics, docs/src/motion/switchkins.adoc: a remapped M-code sets motion.switchkins-type).
+enum class KinematicsSwitch {
+  tcp,       // the kinematics with tool centre point control: X Y Z are the tip on the part, as
+             // under G43.4 (LinuxCNC's xyzac-trt-kins, xyzbc-trt-kins, xyzab_tdr_kins type)
+  identity,  // identity kinematics: every word is a joint (raw rotary words)
+  refuse,    // kinematics of the machine's own (LinuxCNC's "userk"): an error, no guess
+};
+
 // What M6 does with the tool tip.
 enum class ToolChange {
   retract_far,  // leaves it far along the tool axis (the default: where it goes is the machine's)
@@ -155,6 +165,11 @@ struct MachineConfig {
   // (an M-code moves no axis; the machine file says which ones exist).
   std::set<int> m_codes;
   std::set<int> forbidden_m_codes;
+  // M-codes that switch the kinematics ("kinematics_switches": {"M428": "tcp", ...}), and the
+  // kinematics at start ("kinematics_at_start": false, identity, as LinuxCNC's sample configs
+  // with sparm=identityfirst; true, TCP, as xyzac-trt-kins without it). Only with `kinematics`.
+  std::map<int, KinematicsSwitch> kinematics_switches;
+  bool tcp_kinematics_at_start = false;
 
   // Numbered variables as the program finds them when it starts: the control's persistent
   // commons (Fanuc #500-#999, kept across power-off) and the inputs a program reads (#1000...),
