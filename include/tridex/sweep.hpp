@@ -409,7 +409,19 @@ SweepPlan plan_sweep_parts(PoseAt&& pose_at, const PoseBounds& bounds, const Swe
 namespace detail {
 
 // The interval of the ray through `point` along `axis` in the sweep of `step` (part `part` of
-// cutter `c`): closed form for quadric pieces, else the search (within [lo, hi], `precision`).
+// cutter `c`) where it may meet material, which lies within [lo, hi] on this ray: closed form for
+// quadric pieces, else the search (within [lo, hi], `precision`).
+//
+// A piece between heights h0 and h1 above the tip meets the ray only where the ray's height
+// above the moving tip, w + u·axis[axis] − s·(travel·axis) for some s ∈ [0, 1], lies in
+// [h0, h1] (w: that height at u = 0): a range of u found with no root. A piece is skipped when
+// that range (grown by a margin far above the conic solve's slack) lies within the hull of the
+// pieces already cut (it cannot widen it) or misses [lo, hi] (it meets no material: the hull of
+// the others, less what lies outside the material, removes the same). Pieces are taken top first,
+// then bottom, where a ray along the axis enters and leaves, so that the middle ones are skipped.
+// Seen along the ray, a piece lies within its largest radius ρ of its axis between h0 and h1,
+// which lies within (h1 − h0)/2·|axis across the ray| of the path of its middle height: a piece
+// farther than that from the ray is skipped too.
 inline std::optional<std::pair<double, double>> sweep_step_interval(
     const SweepCutter& c, const SweepPartShape& part, const SweepStep& step, const Vec3& point,
     int axis, double lo, double hi, double precision) {
@@ -417,7 +429,42 @@ inline std::optional<std::pair<double, double>> sweep_step_interval(
     return ray_sweep_interval(c, step, point, axis, lo, hi, precision, part.lo, part.hi);
   std::optional<std::pair<double, double>> hull;
   const Vec3 travel = step.to - step.from;
-  for (const SweepPiece& piece : part.pieces) {
+  Vec3 w = point - step.from;
+  w[axis] = -step.from[axis];
+  const double w0 = glm::dot(w, step.axis), along = step.axis[axis];
+  const double shift = -glm::dot(travel, step.axis);
+  const double s_lo = std::min(0.0, shift), s_hi = std::max(0.0, shift);
+  const double margin = 1e-6 * (1 + part.top + glm::length(travel) + c.cutter.radius());
+  const bool slabs = std::abs(along) > 1e-6;
+  const std::size_t n = part.pieces.size();
+  const int iu = TripleDexel::u_axis(axis), iv = TripleDexel::v_axis(axis);
+  const double tu = travel[iu], tv = travel[iv], tt = tu * tu + tv * tv;
+  const double au = step.axis[iu], av = step.axis[iv], across = std::sqrt(au * au + av * av);
+  const double qu = point[iu] - step.from[iu], qv = point[iv] - step.from[iv];
+  // The least squared distance, seen along the ray, from the ray to the path of axis height h.
+  auto off_path2 = [&](double h) {
+    const double du = qu - h * au, dv = qv - h * av;
+    const double t = tt > 0 ? std::clamp((du * tu + dv * tv) / tt, 0.0, 1.0) : 0.0;
+    return (du - t * tu) * (du - t * tu) + (dv - t * tv) * (dv - t * tv);
+  };
+  for (std::size_t k = 0; k < n; ++k) {
+    const SweepPiece& piece = part.pieces[k == 0 ? n - 1 : k - 1];
+    {
+      const double h0 = piece.ball ? piece.centre - piece.radius : piece.lo;
+      const double h1 = piece.ball ? piece.centre + piece.radius : piece.hi;
+      const double rho =
+          piece.ball ? piece.radius : std::max(piece.rho0, piece.rho0 + piece.slope * (h1 - h0));
+      const double reach = rho + margin + 0.5 * (h1 - h0) * across;
+      if (off_path2(0.5 * (h0 + h1)) > reach * reach) continue;
+    }
+    if (slabs) {
+      const double h0 = (piece.ball ? piece.centre - piece.radius : piece.lo) - margin;
+      const double h1 = (piece.ball ? piece.centre + piece.radius : piece.hi) + margin;
+      double u0 = (h0 - w0 - s_hi) / along, u1 = (h1 - w0 - s_lo) / along;
+      if (u0 > u1) std::swap(u0, u1);
+      if (u1 < lo - margin || u0 > hi + margin) continue;
+      if (hull && hull->first <= u0 && u1 <= hull->second) continue;
+    }
     const auto cut = sweep_piece_interval(piece, step.from, travel, step.axis, point, axis);
     if (!cut) continue;
     // The part is convex, so its pieces' intervals on one ray overlap: their hull is the union.
@@ -425,6 +472,30 @@ inline std::optional<std::pair<double, double>> sweep_step_interval(
                 : *cut;
   }
   return hull;
+}
+
+// A step as sweep_ray cuts it: its box, its part, and for a ball tip (one ball piece) the capsule
+// of the ball's centre, computed once per step rather than once per ray.
+struct SweepStepCut {
+  Aabb box;
+  const SweepPartShape* part = nullptr;
+  bool capsule = false;
+  Vec3 c0{0.0}, c1{0.0};
+  double radius = 0;
+};
+
+inline SweepStepCut sweep_step_cut(const SweepCutter& c, const SweepPartShape& part,
+                                   const SweepStep& s) {
+  SweepStepCut cut;
+  cut.box = sweep_part_bounds(c, part, s.from, s.to, s.axis);
+  cut.part = &part;
+  if (part.closed && part.pieces.size() == 1 && part.pieces[0].ball) {
+    cut.capsule = true;
+    cut.c0 = s.from + part.pieces[0].centre * s.axis;
+    cut.c1 = cut.c0 + (s.to - s.from);
+    cut.radius = part.pieces[0].radius;
+  }
+  return cut;
 }
 
 // The steps of one grid listed by row (v index) and block of kBlock rays along the row.
@@ -439,7 +510,7 @@ struct SweepRows {
   }
 };
 
-inline SweepRows sweep_rows(const TripleDexel& d, int axis, std::span<const Aabb> boxes) {
+inline SweepRows sweep_rows(const TripleDexel& d, int axis, std::span<const SweepStepCut> cuts) {
   const int u = TripleDexel::u_axis(axis), v = TripleDexel::v_axis(axis);
   const DexelGrid& g = d.grids[static_cast<std::size_t>(axis)];
   SweepRows rows;
@@ -454,9 +525,9 @@ inline SweepRows sweep_rows(const TripleDexel& d, int axis, std::span<const Aabb
   };
   for (int pass = 0; pass < 2; ++pass) {
     std::vector<std::uint32_t> fill(rows.offsets.begin(), rows.offsets.end() - 1);
-    for (std::size_t s = 0; s < boxes.size(); ++s) {
-      const auto [u0, u1] = range(boxes[s], u, g.nu);
-      const auto [v0, v1] = range(boxes[s], v, g.nv);
+    for (std::size_t s = 0; s < cuts.size(); ++s) {
+      const auto [u0, u1] = range(cuts[s].box, u, g.nu);
+      const auto [v0, v1] = range(cuts[s].box, v, g.nv);
       if (u0 > u1) continue;
       for (int iv = v0; iv <= v1; ++iv)
         for (int b = u0 / SweepRows::kBlock; b <= u1 / SweepRows::kBlock; ++b) {
@@ -477,24 +548,48 @@ inline SweepRows sweep_rows(const TripleDexel& d, int axis, std::span<const Aabb
   return rows;
 }
 
+// Removes [cut.enter, cut.exit] from the sorted disjoint spans of `spans` in place, as
+// subtract_ray(spans, {cut}) would (a span touching the cut only at an end is kept whole).
+inline void subtract_one(std::vector<DexelInterval>& spans, DexelInterval cut) {
+  const std::size_t n = spans.size();
+  std::size_t i = 0;
+  while (i < n && spans[i].exit <= cut.enter) ++i;
+  std::size_t j = i;
+  while (j < n && spans[j].enter < cut.exit) ++j;
+  if (j == i) return;  // the spans i… lie above the cut
+  DexelInterval pieces[2];
+  std::size_t k = 0;
+  if (cut.enter > spans[i].enter) pieces[k++] = {spans[i].enter, cut.enter};
+  const float lo = std::max(spans[j - 1].enter, cut.exit);
+  if (lo < spans[j - 1].exit) pieces[k++] = {lo, spans[j - 1].exit};
+  const std::size_t old = j - i;
+  if (k > old) {
+    spans.insert(spans.begin() + static_cast<std::ptrdiff_t>(j), pieces[k - 1]);
+    spans[i] = pieces[0];
+    return;
+  }
+  for (std::size_t q = 0; q < k; ++q) spans[i + q] = pieces[q];
+  spans.erase(spans.begin() + static_cast<std::ptrdiff_t>(i + k),
+              spans.begin() + static_cast<std::ptrdiff_t>(j));
+}
+
 // Ray (iu, iv) of grid `axis` less the sweeps of the steps listed for it. Each sweep is
 // subtracted as soon as it is found; one whose box holds no material left is not computed.
 // Intervals are closed form (or found to `precision` within the material left), and subtraction
 // in any order gives the same set.
 inline void sweep_ray(std::span<const DexelInterval> ray, const TripleDexel& d, int axis, int iu,
                       int iv, std::span<const SweepCutter> cutters,
-                      std::span<const SweepShape> shapes, std::span<const SweepStep> steps,
-                      std::span<const Aabb> boxes, std::span<const std::uint32_t> listed,
-                      double precision, std::vector<DexelInterval>& current,
-                      std::vector<DexelInterval>& out) {
+                      std::span<const SweepStep> steps, std::span<const SweepStepCut> cuts,
+                      std::span<const std::uint32_t> listed, double precision,
+                      std::vector<DexelInterval>& current, std::vector<DexelInterval>& out) {
   const int u = TripleDexel::u_axis(axis), v = TripleDexel::v_axis(axis);
   Vec3 point = d.origin;
   point[u] += d.spacing * iu;
   point[v] += d.spacing * iv;
   current.assign(ray.begin(), ray.end());
-  thread_local std::vector<DexelInterval> next;
   for (std::uint32_t s : listed) {
-    const Aabb& box = boxes[s];
+    const SweepStepCut& cut = cuts[s];
+    const Aabb& box = cut.box;
     if (current.empty()) break;
     if (point[u] < box.min[u] || point[u] > box.max[u]) continue;
     double lo = box.max[axis], hi = box.min[axis];  // the material left within the box
@@ -505,14 +600,12 @@ inline void sweep_ray(std::span<const DexelInterval> ray, const TripleDexel& d, 
       }
     if (!(lo <= hi)) continue;
     const SweepStep& step = steps[s];
-    const auto cut = sweep_step_interval(
-        cutters[step.cutter], shapes[step.cutter].parts[static_cast<std::size_t>(step.part)], step,
-        point, axis, lo, hi, precision);
-    if (!cut) continue;
-    const DexelInterval removed{static_cast<float>(cut->first), static_cast<float>(cut->second)};
-    next.clear();
-    subtract_ray(current, {&removed, 1}, next);
-    current.swap(next);
+    const auto removed = cut.capsule ? capsule_interval(cut.c0, cut.c1, cut.radius, point, axis)
+                                     : sweep_step_interval(cutters[step.cutter], *cut.part, step,
+                                                           point, axis, lo, hi, precision);
+    if (removed)
+      subtract_one(current,
+                   {static_cast<float>(removed->first), static_cast<float>(removed->second)});
   }
   out.insert(out.end(), current.begin(), current.end());
 }
@@ -529,16 +622,16 @@ inline void sweep_remove(TripleDexel& d, std::span<const SweepCutter> cutters,
   detail::require_positive(precision, "sweep precision");
   std::vector<SweepShape> shapes;
   for (const SweepCutter& c : cutters) shapes.push_back(sweep_shape(c));
-  std::vector<Aabb> boxes;
-  boxes.reserve(steps.size());
+  std::vector<detail::SweepStepCut> cuts;
+  cuts.reserve(steps.size());
   for (const SweepStep& s : steps) {
     if (s.cutter >= cutters.size()) detail::fail("sweep_remove: step names cutter ", s.cutter);
     const SweepPartShape& part = shapes[s.cutter].parts[static_cast<std::size_t>(s.part)];
-    boxes.push_back(sweep_part_bounds(cutters[s.cutter], part, s.from, s.to, s.axis));
+    cuts.push_back(detail::sweep_step_cut(cutters[s.cutter], part, s));
   }
   for (int axis = 0; axis < 3; ++axis) {
     const DexelGrid& old = d.grids[static_cast<std::size_t>(axis)];
-    const detail::SweepRows rows = detail::sweep_rows(d, axis, boxes);
+    const detail::SweepRows rows = detail::sweep_rows(d, axis, cuts);
     DexelGrid next = detail::build_grid(
         d.lattice(), axis, threads, [&](std::size_t r, std::vector<DexelInterval>& out) {
           const int iu = static_cast<int>(r % static_cast<std::size_t>(old.nu));
@@ -550,8 +643,8 @@ inline void sweep_remove(TripleDexel& d, std::span<const SweepCutter> cutters,
             return;
           }
           thread_local std::vector<DexelInterval> scratch;
-          detail::sweep_ray(old.ray(r), d, axis, iu, iv, cutters, shapes, steps, boxes, listed,
-                            precision, scratch, out);
+          detail::sweep_ray(old.ray(r), d, axis, iu, iv, cutters, steps, cuts, listed, precision,
+                            scratch, out);
         });
     d.grids[static_cast<std::size_t>(axis)] = std::move(next);
   }

@@ -2,8 +2,10 @@
 // moves of every cutter shape, the analytic C-turning groove, and thread-count identity.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -39,6 +41,35 @@ std::vector<SweepCutter> shapes() {
           {Cutter::bull_nose(1.5, 0.5), 5},
           {Cutter::cone(1.5, 30), 5},
           {Cutter::chamfer(1.5, 0.5, 45), 5}};
+}
+
+// sweep_ray subtracts each step's interval in place (detail::subtract_one); it must give what
+// the general subtract_ray gives, on rays of 0 to 4 spans and cuts snapped to a coarse grid so
+// that ends coincide, touch and nest, and empty (point) cuts occur.
+TEST_CASE("sweep: in-place subtraction of one interval equals subtract_ray") {
+  std::mt19937 rng(34);
+  std::uniform_int_distribution<int> coord(0, 12), count(0, 4);
+  for (int trial = 0; trial < 20000; ++trial) {
+    std::vector<int> ends;
+    for (int k = 2 * count(rng); k > 0; --k) ends.push_back(coord(rng));
+    std::sort(ends.begin(), ends.end());
+    ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
+    if (ends.size() % 2) ends.pop_back();
+    std::vector<DexelInterval> ray;
+    for (std::size_t k = 0; k < ends.size(); k += 2)
+      ray.push_back({static_cast<float>(ends[k]), static_cast<float>(ends[k + 1])});
+    int a = coord(rng), b = coord(rng);
+    if (a > b) std::swap(a, b);
+    const DexelInterval cut{static_cast<float>(a), static_cast<float>(b)};
+    std::vector<DexelInterval> expected, got = ray;
+    detail::subtract_ray(ray, {&cut, 1}, expected);
+    detail::subtract_one(got, cut);
+    REQUIRE(got.size() == expected.size());
+    for (std::size_t k = 0; k < got.size(); ++k) {
+      CHECK(got[k].enter == expected[k].enter);
+      CHECK(got[k].exit == expected[k].exit);
+    }
+  }
 }
 
 TEST_CASE("sweep: the meridian distance is exact on a flat end and a ball") {
@@ -209,6 +240,89 @@ TEST_CASE("sweep: the C-turning groove's volume, and the same dexels on 1, 2 and
                          return x.enter == y.enter && x.exit == y.exit;
                        }));
     }
+}
+
+// sweep_remove skips the pieces of a part that cannot widen a ray's interval or meet its material
+// (sweep_step_interval) and subtracts in place: brute force does neither. For every step, on
+// every ray of the three grids, the hull of all its pieces' intervals is subtracted by
+// subtract_ray, in step order. Random turning moves of every closed-form cutter (the bull nose
+// as chords), planned by plan_sweep_parts (tips and shanks), deep enough for the shanks to cut,
+// and the same moves again over the material the first pass left.
+TEST_CASE("sweep: skipping pieces gives the brute-force dexels") {
+  std::mt19937 rng(3435);
+  const Aabb stock{Vec3(-4, -4, -4), Vec3(4, 4, 1)};
+  const DexelLattice lattice = DexelLattice::covering(stock, 0.25);
+  const std::vector<SweepCutter> cutters{{Cutter::bull_nose(1.5, 0.5), 5, 0.005},
+                                         {Cutter::flat(1.5), 5},
+                                         {Cutter::cone(1.5, 30), 5},
+                                         {Cutter::chamfer(1.5, 0.5, 45), 5},
+                                         {Cutter::tapered_ball(1.5, 0.5, 10), 5},
+                                         {Cutter::ball(1.5), 5}};
+  std::vector<SweepShape> shapes;
+  for (const SweepCutter& c : cutters) shapes.push_back(sweep_shape(c));
+  std::vector<SweepStep> steps;
+  for (std::uint32_t c = 0; c < cutters.size(); ++c)
+    for (int trial = 0; trial < 2; ++trial) {
+      const TurningMove m = random_move(rng, trial == 1, 1.5);
+      const SweepPlan plan =
+          plan_sweep_parts([&](double s) { return m.at(s); }, m.bounds(), cutters[c], shapes[c],
+                           0.05, c, [](const Aabb&) { return true; });
+      steps.insert(steps.end(), plan.steps.begin(), plan.steps.end());
+    }
+  TripleDexel fast = TripleDexel::box(lattice, stock), brute = fast;
+  long long cut_rays = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    sweep_remove(fast, cutters, steps, 2);
+    for (int a = 0; a < 3; ++a) {
+      DexelGrid& g = brute.grids[static_cast<std::size_t>(a)];
+      const int u = TripleDexel::u_axis(a), v = TripleDexel::v_axis(a);
+      std::vector<DexelInterval> intervals;
+      std::vector<std::uint32_t> offsets{0};
+      for (int iv = 0; iv < g.nv; ++iv)
+        for (int iu = 0; iu < g.nu; ++iu) {
+          const auto ray = g.ray(iu, iv);
+          std::vector<DexelInterval> current(ray.begin(), ray.end()), next;
+          Vec3 point = brute.origin;
+          point[u] += brute.spacing * iu, point[v] += brute.spacing * iv;
+          for (const SweepStep& step : steps) {
+            const SweepPartShape& part =
+                shapes[step.cutter].parts[static_cast<std::size_t>(step.part)];
+            REQUIRE(part.closed);
+            std::optional<std::pair<double, double>> hull;
+            for (const detail::SweepPiece& piece : part.pieces) {
+              const auto cut = detail::sweep_piece_interval(piece, step.from, step.to - step.from,
+                                                            step.axis, point, a);
+              if (cut)
+                hull = hull ? std::pair{std::min(hull->first, cut->first),
+                                        std::max(hull->second, cut->second)}
+                            : *cut;
+            }
+            if (!hull) continue;
+            const DexelInterval removed{static_cast<float>(hull->first),
+                                        static_cast<float>(hull->second)};
+            next.clear();
+            detail::subtract_ray(current, {&removed, 1}, next);
+            current.swap(next);
+          }
+          cut_rays += current.size() != ray.size();
+          intervals.insert(intervals.end(), current.begin(), current.end());
+          offsets.push_back(static_cast<std::uint32_t>(intervals.size()));
+        }
+      g.intervals = std::move(intervals);
+      g.offsets = std::move(offsets);
+    }
+    for (int a = 0; a < 3; ++a) {
+      const DexelGrid &f = fast.grids[static_cast<std::size_t>(a)],
+                      &b = brute.grids[static_cast<std::size_t>(a)];
+      REQUIRE(f.offsets == b.offsets);
+      long long differ = 0;
+      for (std::size_t k = 0; k < f.intervals.size(); ++k)
+        differ += f.intervals[k].enter != b.intervals[k].enter ||
+                  f.intervals[k].exit != b.intervals[k].exit;
+      CHECK(differ == 0);
+    }
+  }
+  CHECK(cut_rays > 500);
 }
 
 }  // namespace test_sweep

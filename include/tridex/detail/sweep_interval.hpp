@@ -88,6 +88,7 @@ inline std::optional<std::pair<double, double>> sweep_conic_range(const SweepCon
                                                                   double f_tol, double tol) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   auto consider = [&](double u, double s) {
+    if (u >= lo && u <= hi) return;  // cannot widen the extent: no need to test it
     if (!std::isfinite(u) || !std::isfinite(s)) return;
     for (const SweepSide& side : sides)
       if (side.at(u, s) < -tol) return;
