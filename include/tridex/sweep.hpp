@@ -592,17 +592,21 @@ inline void sweep_ray(std::span<const DexelInterval> ray, const TripleDexel& d, 
     const Aabb& box = cut.box;
     if (current.empty()) break;
     if (point[u] < box.min[u] || point[u] > box.max[u]) continue;
-    double lo = box.max[axis], hi = box.min[axis];  // the material left within the box
-    for (const DexelInterval& span : current)
-      if (span.exit >= box.min[axis] && span.enter <= box.max[axis]) {
-        lo = std::min(lo, std::max<double>(span.enter, box.min[axis]));
-        hi = std::max(hi, std::min<double>(span.exit, box.max[axis]));
-      }
-    if (!(lo <= hi)) continue;
-    const SweepStep& step = steps[s];
-    const auto removed = cut.capsule ? capsule_interval(cut.c0, cut.c1, cut.radius, point, axis)
-                                     : sweep_step_interval(cutters[step.cutter], *cut.part, step,
-                                                           point, axis, lo, hi, precision);
+    std::optional<std::pair<double, double>> removed;
+    if (cut.capsule) {  // as cheap as the test below, which it does not need
+      removed = capsule_interval(cut.c0, cut.c1, cut.radius, point, axis);
+    } else {
+      double lo = box.max[axis], hi = box.min[axis];  // the material left within the box
+      for (const DexelInterval& span : current)
+        if (span.exit >= box.min[axis] && span.enter <= box.max[axis]) {
+          lo = std::min(lo, std::max<double>(span.enter, box.min[axis]));
+          hi = std::max(hi, std::min<double>(span.exit, box.max[axis]));
+        }
+      if (!(lo <= hi)) continue;
+      const SweepStep& step = steps[s];
+      removed = sweep_step_interval(cutters[step.cutter], *cut.part, step, point, axis, lo, hi,
+                                    precision);
+    }
     if (removed)
       subtract_one(current,
                    {static_cast<float>(removed->first), static_cast<float>(removed->second)});
