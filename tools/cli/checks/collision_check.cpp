@@ -17,8 +17,9 @@ Segment raised(const Segment& tip, double by) {
   return Segment{tip.a + Vec3(0, 0, by), tip.b + Vec3(0, 0, by)};
 }
 
-// Keeps one finding per source line and part: the deepest collision, the closest near miss.
-void record(std::vector<BodyFinding>& list, BodyFinding f, bool keep_larger) {
+}  // namespace
+
+void record_body_finding(std::vector<BodyFinding>& list, BodyFinding f, bool keep_larger) {
   for (auto it = list.rbegin(); it != list.rend() && it->line == f.line && it->file == f.file; ++it)
     if (it->part == f.part && it->tool == f.tool && it->group == f.group) {
       if (keep_larger ? f.depth_mm > it->depth_mm : f.depth_mm < it->depth_mm) *it = f;
@@ -26,8 +27,6 @@ void record(std::vector<BodyFinding>& list, BodyFinding f, bool keep_larger) {
     }
   list.push_back(std::move(f));
 }
-
-}  // namespace
 
 BodyCheck::BodyCheck(const ZMap& map, std::span<const ToolBody> bodies, double clearance)
     : bodies_(bodies), clearance_(clearance) {
@@ -154,10 +153,10 @@ void BodyCheck::check(const ZMap& map, const gcode::Move& move, const CutMove& c
       return frame.to_world(Vec3(map.grid.x(d.i), map.grid.y(d.j), map.height(d.i, d.j)));
     };
     if (plain.depth > kCollisionTolerance) {
-      record(found.collisions,
-             BodyFinding{move.file, move.line, move.tool, part.name, plain.depth, located(plain),
-                         axis, group},
-             true);
+      record_body_finding(found.collisions,
+                          BodyFinding{move.file, move.line, move.tool, part.name, plain.depth,
+                                      located(plain), axis, group},
+                          true);
       // The holder's own sections only (the spindle's parts follow them: machine_run.hpp).
       if (body.has_holder() && part.bottom >= body.stick_out &&
           part.name.starts_with("holder section")) {
@@ -183,7 +182,7 @@ void BodyCheck::check(const ZMap& map, const gcode::Move& move, const CutMove& c
           lo = mid;
       }
     }
-    record(
+    record_body_finding(
         found.near_misses,
         BodyFinding{move.file, move.line, move.tool, part.name, hi, located(closest), axis, group},
         false);

@@ -59,6 +59,10 @@ struct BodyFindings {
   double seconds = 0;  // spent in the check itself (not in the milling it asks for)
 };
 
+// Keeps one finding per source line and part: the deepest collision (keep_larger), the closest
+// near miss (not).
+void record_body_finding(std::vector<BodyFinding>& list, BodyFinding f, bool keep_larger);
+
 class BodyCheck {
  public:
   // `bodies[c]` describes cutters[c]'s parts (empty: nothing to check). `clearance` ≥ 0 (mm).

@@ -68,11 +68,14 @@ void cut_simultaneous(const SimulateOptions& options, SimulationResult& r, bool 
                          " needed more than " + std::to_string(kMaxSubSteps) +
                          " sub-steps: their band exceeds " + std::to_string(r.sweep_tolerance) +
                          " mm (see the report's \"simultaneous\")");
-  if (bodies_checked)  // never a silent pass: the material is cut, the bodies not yet checked
-    r.warnings.push_back(std::to_string(r.simultaneous.size()) +
-                         " simultaneous 5-axis move(s) were cut, but their shanks, holders and "
-                         "rapids are not checked for collisions yet (docs/design.md, "
-                         "\"Simultaneous moves\")");
+  // Never a silent pass: a rapid whose tool turns is cut like a feed, not yet tested for cutting
+  // the stock (the shanks and holders are: check_turning_bodies).
+  long long rapids = 0;
+  for (const gcode::Move& m : r.simultaneous) rapids += m.kind == gcode::MoveKind::rapid;
+  if (bodies_checked && rapids)
+    r.not_checked.push_back(std::to_string(rapids) +
+                            " simultaneous rapid(s) (G0 whose tool axis turns) not tested for "
+                            "cutting the stock (docs/design.md, \"Simultaneous moves\")");
   sweep_remove(r.result, cutters, steps, options.threads, r.sweep_tolerance / 100);
   r.result_dexel_volume = tridex::volume(r.result);
   r.sweep_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
