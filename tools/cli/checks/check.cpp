@@ -721,10 +721,6 @@ int run_check(const CheckOptions& options) {
     r.warnings.push_back("the result mesh is not watertight (" +
                          std::to_string(r.mesh_check.boundary_edges) + " boundary, " +
                          std::to_string(r.mesh_check.non_manifold_edges) + " non-manifold edges)");
-  for (const std::string& text : r.not_checked) {
-    r.warnings.push_back(text);
-    f.not_checked.push_back(text);
-  }
   const MachineRun machine = run_machine_check(options.fixtures, r);
   if (const std::string text = machine_unchecked_text(machine); !text.empty()) {
     r.warnings.push_back(text);

@@ -187,13 +187,17 @@ void check_turning_bodies(SimulationResult& r, std::span<const ToolBody> bodies,
                           unsigned threads) {
   const auto start = std::chrono::steady_clock::now();
   const std::optional<gcode::Kinematics>& kinematics = r.input.machine.kinematics;
-  if (r.simultaneous.empty() || !kinematics) return;
+  // The moves whose tool turns, then the raw-form rapid turns between moves (note_turning_rapid).
+  std::vector<const gcode::Move*> moves;
+  for (const gcode::Move& m : r.simultaneous) moves.push_back(&m);
+  for (const gcode::Move& m : r.turning_rapids) moves.push_back(&m);
+  if (moves.empty() || !kinematics) return;
   const SweepMaterial material(r.result);
   const double step = r.lattice.spacing / 2;
-  std::vector<TbMoveResult> results(r.simultaneous.size());
-  std::vector<std::vector<TurningPart>> parts_of(r.simultaneous.size());
-  detail::for_each_chunk(r.simultaneous.size(), threads, [&](std::size_t k) {
-    const gcode::Move& m = r.simultaneous[k];
+  std::vector<TbMoveResult> results(moves.size());
+  std::vector<std::vector<TurningPart>> parts_of(moves.size());
+  detail::for_each_chunk(moves.size(), threads, [&](std::size_t k) {
+    const gcode::Move& m = *moves[k];
     auto it = r.cutter_of_tool.find(m.tool);
     if (it == r.cutter_of_tool.end() || it->second >= bodies.size()) return;
     const ToolBody& body = bodies[it->second];
@@ -205,7 +209,7 @@ void check_turning_bodies(SimulationResult& r, std::span<const ToolBody> bodies,
   long long capped = 0;
   const std::size_t no_group = r.groups.size();  // in no direction's group
   for (std::size_t k = 0; k < results.size(); ++k) {
-    const gcode::Move& m = r.simultaneous[k];
+    const gcode::Move& m = *moves[k];
     capped += results[k].capped;
     for (std::size_t p = 0; p < results[k].parts.size(); ++p) {
       const TbContact& c = results[k].parts[p];

@@ -1,6 +1,7 @@
 // tridex check — the shank, the holder and the spindle's parts of every simultaneous 5-axis move
-// (Move::pose ≠ fixed: the tool axis turns; issue 34), against the stock as a triple dexel, as
-// collision_check.hpp tests them for the 3+2 moves against the Z-maps.
+// (Move::pose ≠ fixed: the tool axis turns; issue 34) and of every raw-form rapid turn of the
+// rotaries between moves, against the stock as a triple dexel, as collision_check.hpp tests them
+// for the 3+2 moves against the Z-maps.
 //
 // The poses along a move come from the machine's interpolation (gcode/simultaneous.hpp), sampled
 // so finely that no point of the body moves more than half a dexel spacing between two samples:
@@ -29,8 +30,10 @@
 
 namespace tridex::cli {
 
-// Tests r.simultaneous's moves against r.result with `bodies` (bodies_against_stock: parallel to
-// r.cutters) and records collisions and near misses (within `clearance` mm) in r.body.
+// Tests r.simultaneous's moves, then r.turning_rapids's (a raw-form G0 turning the rotaries
+// between two moves, at the line of the move after it), against r.result with `bodies`
+// (bodies_against_stock: parallel to r.cutters) and records collisions and near misses (within
+// `clearance` mm) in r.body.
 void check_turning_bodies(SimulationResult& r, std::span<const ToolBody> bodies, double clearance,
                           unsigned threads);
 

@@ -899,7 +899,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   intersect_directions(options, request, run.max_memory, progress, r);
   if (!r.simultaneous.empty()) cut_simultaneous(options, r, request.body_clearance.has_value());
   // The simultaneous moves' shanks and holders against the final solid (turning_bodies.hpp).
-  if (!r.simultaneous.empty() && request.body_clearance)
+  if ((!r.simultaneous.empty() || !r.turning_rapids.empty()) && request.body_clearance)
     check_turning_bodies(r, bodies_against_stock(r), *request.body_clearance, options.threads);
   if (request.rapid_check == RapidCheck::in_program_order) check_turning_rapids(r);
   extract_result_surface(options, progress, r);

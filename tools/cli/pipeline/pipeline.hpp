@@ -168,9 +168,6 @@ struct SimulationResult {
   BodyFindings body;  // collisions and near misses of shanks and holders (body_clearance only)
   MachiningTimer machining;  // the program's machining time
   std::vector<std::string> warnings;
-  // What check could not test (its verdict does not cover it): check says so on the verdict line
-  // and in the report's "not_checked".
-  std::vector<std::string> not_checked;
   PipelineTimings timings;
   // Moves whose tool turns (Move::pose ≠ fixed), in program order: in no group, cut on the triple
   // dexel after the groups' Z-maps (cut_simultaneous), summarised by tool.
@@ -186,9 +183,11 @@ struct SimulationResult {
 
 // Cuts r.simultaneous from r.result (simultaneous.cpp): each move sub-stepped so that its band
 // stays within a tenth of the dexel spacing (or the sub-step cap, with a warning), its sweeps
-// subtracted ray by ray; fills r.sweeps and the result's dexel volume. `bodies_checked` (check's
-// collision check): r.not_checked names the rapids among them (not tested for cutting stock).
-void cut_simultaneous(const SimulateOptions& options, SimulationResult& r, bool bodies_checked);
+// subtracted ray by ray; fills r.sweeps and the result's dexel volume. `checked` (check): the
+// rapids among them are removed last, in program order, each first measured against r.result (the
+// stock less every other cut before it and the later feeds': a subset of what stood when it ran)
+// and listed in r.rapid_cuts where its cutter meets that material.
+void cut_simultaneous(const SimulateOptions& options, SimulationResult& r, bool checked);
 // Between consecutive moves `before` and `after` of a run with kinematics: when the rotaries
 // turned in between (a G0 with rotary words in raw form: the interpreter emits no move for the
 // turn and keeps the linear axes' machine coordinates) and `after` does not come from far along

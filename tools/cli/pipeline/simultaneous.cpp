@@ -28,9 +28,107 @@ SweepCutter sweep_cutter_of(const Cutter& cutter, const ToolBody& body) {
   return {cutter, height};
 }
 
+// The least of convex f on [lo, hi] by golden-section search to `precision`, with no early stop.
+template <class F>
+std::pair<double, double> sim_minimum(const F& f, double lo, double hi, double precision) {
+  double a = lo, b = hi;
+  double x1 = b - detail::kGolden * (b - a), x2 = a + detail::kGolden * (b - a);
+  double f1 = f(x1), f2 = f(x2);
+  std::pair<double, double> best{lo, f(lo)};
+  if (const double v = f(hi); v < best.second) best = {hi, v};
+  while (b - a > precision) {
+    if (f1 <= f2)
+      b = x2, x2 = x1, f2 = f1, x1 = b - detail::kGolden * (b - a), f1 = f(x1);
+    else
+      a = x1, x1 = x2, f1 = f2, x2 = a + detail::kGolden * (b - a), f2 = f(x2);
+  }
+  if (f1 < best.second) best = {x1, f1};
+  if (f2 < best.second) best = {x2, f2};
+  return best;
+}
+
+// The box of the cutter at `pose`: a cylinder of its radius from the tip up its axis to its height.
+Aabb cutter_box(const SweepCutter& cutter, const ToolPose& pose) {
+  const Vec3 top = pose.tip + cutter.height * pose.axis;
+  const double radius = cutter.cutter.radius();
+  Vec3 grow(0.0);
+  for (int i = 0; i < 3; ++i)
+    grow[i] = radius * std::sqrt(std::max(0.0, 1 - pose.axis[i] * pose.axis[i]));
+  return Aabb{glm::min(pose.tip, top) - grow, glm::max(pose.tip, top) + grow};
+}
+
+// The deepest the cutter reaches into the material of the Z rays of `d` at `pose` (0: none),
+// each ray's material searched for the cutter's least signed distance (convex along the ray):
+// its minimum with `deepest`, else the first value found at or below 0 (convex_minimum).
+double pose_depth(const TripleDexel& d, const SweepCutter& cutter, const ToolPose& pose,
+                  const Aabb& box, double precision, Vec3& where, bool deepest = false) {
+  const double h = d.spacing;
+  const DexelGrid& g = d.grids[2];
+  const int i0 = std::max(0, static_cast<int>(std::ceil((box.min.x - d.origin.x) / h)));
+  const int i1 = std::min(g.nu - 1, static_cast<int>(std::floor((box.max.x - d.origin.x) / h)));
+  const int j0 = std::max(0, static_cast<int>(std::ceil((box.min.y - d.origin.y) / h)));
+  const int j1 = std::min(g.nv - 1, static_cast<int>(std::floor((box.max.y - d.origin.y) / h)));
+  double depth = 0;
+  for (int i = i0; i <= i1; ++i)
+    for (int j = j0; j <= j1; ++j) {
+      const double x = d.origin.x + i * h, y = d.origin.y + j * h;
+      for (const DexelInterval& s : g.ray(i, j)) {
+        const double lo = std::max(double(s.enter), box.min.z),
+                     hi = std::min(double(s.exit), box.max.z);
+        if (!(lo < hi)) continue;
+        auto f = [&](double z) { return cutter.distance(pose.tip, pose.axis, Vec3(x, y, z)); };
+        const std::pair<double, double> best = deepest
+                                                   ? sim_minimum(f, lo, hi, precision)
+                                                   : detail::convex_minimum(f, lo, hi, precision);
+        if (-best.second > depth) depth = -best.second, where = Vec3(x, y, best.first);
+      }
+    }
+  return depth;
+}
+
+// The deepest `cutter` reaches into the material of `d` along `path`, at poses no cutter point
+// moves more than half a spacing between (so a cut of a spacing or more is not missed).
+double path_depth(const TripleDexel& d, const SweepMaterial& material, const SweepCutter& cutter,
+                  const gcode::MovePath& path, bool deepest, Vec3& where) {
+  const double h = d.spacing;
+  const PoseBounds bounds = path.bounds();
+  const double rate = bounds.tip_speed + cutter.reach() * bounds.turn_rate;
+  long samples = 16;
+  while (samples < kMaxSubSteps && rate / static_cast<double>(samples) > h / 2) samples *= 2;
+  double depth = 0;
+  for (long k = 0; k <= samples; ++k) {
+    const ToolPose pose = path.at(static_cast<double>(k) / static_cast<double>(samples));
+    const Aabb box = cutter_box(cutter, pose);
+    if (!material.may_touch(box)) continue;
+    depth = std::max(depth, pose_depth(d, cutter, pose, box, h / 8, where, deepest));
+  }
+  return depth;
+}
+
+// check: the simultaneous rapids `rapids` (indices into r.simultaneous with their sweep steps),
+// in program order, each measured against r.result before its own removal: by then r.result
+// holds the stock less every 3+2 cut, every simultaneous feed and the rapids before it, a subset
+// of what stood when it ran (removal is monotone), so a rapid found cutting it surely cut stock.
+void check_simultaneous_rapids(const SimulateOptions& options, SimulationResult& r,
+                               std::span<const SweepCutter> cutters,
+                               const std::vector<std::pair<std::size_t, SweepPlan>>& rapids) {
+  const SweepMaterial material(r.result);
+  for (const auto& [k, plan] : rapids) {
+    const gcode::Move& m = r.simultaneous[k];
+    const gcode::MovePath path(*r.input.machine.kinematics, m);
+    Vec3 where(0.0);
+    const double depth =
+        path_depth(r.result, material, cutters[r.cutter_of_tool.at(m.tool)], path, true, where);
+    if (depth > kRapidTolerance)
+      r.rapid_cuts.push_back(RapidFinding{m.file, m.line, m.tool, m.axis, depth, where, 0});
+    if (!plan.steps.empty())
+      sweep_remove(r.result, cutters, plan.steps, options.threads, r.sweep_tolerance / 100);
+  }
+}
+
 }  // namespace
 
-void cut_simultaneous(const SimulateOptions& options, SimulationResult& r, bool bodies_checked) {
+void cut_simultaneous(const SimulateOptions& options, SimulationResult& r, bool checked) {
   const auto start = std::chrono::steady_clock::now();
   const std::optional<gcode::Kinematics>& kinematics = r.input.machine.kinematics;
   if (!kinematics) detail::fail("cut_simultaneous: simultaneous moves without kinematics");
@@ -47,6 +145,7 @@ void cut_simultaneous(const SimulateOptions& options, SimulationResult& r, bool 
   const SweepMaterial material(r.result);
   auto may_touch = [&](const Aabb& box) { return material.may_touch(box); };
   std::vector<SweepStep> steps;
+  std::vector<std::pair<std::size_t, SweepPlan>> rapids;  // checked apart, in program order
   long long capped = 0;
   for (const gcode::Move& m : r.simultaneous) {
     auto it = r.cutter_of_tool.find(m.tool);
@@ -61,22 +160,18 @@ void cut_simultaneous(const SimulateOptions& options, SimulationResult& r, bool 
     summary.sub_steps += static_cast<long long>(plan.steps.size());
     summary.band = std::max(summary.band, plan.band);
     if (plan.band > r.sweep_tolerance) ++capped;
-    steps.insert(steps.end(), plan.steps.begin(), plan.steps.end());
+    if (checked && m.kind == gcode::MoveKind::rapid)
+      rapids.emplace_back(static_cast<std::size_t>(&m - r.simultaneous.data()), plan);
+    else
+      steps.insert(steps.end(), plan.steps.begin(), plan.steps.end());
   }
   if (capped)
     r.warnings.push_back(std::to_string(capped) + " simultaneous move" + (capped == 1 ? "" : "s") +
                          " needed more than " + std::to_string(kMaxSubSteps) +
                          " sub-steps: their band exceeds " + std::to_string(r.sweep_tolerance) +
                          " mm (see the report's \"simultaneous\")");
-  // Never a silent pass: a rapid whose tool turns is cut like a feed, not yet tested for cutting
-  // the stock (the shanks and holders are: check_turning_bodies).
-  long long rapids = 0;
-  for (const gcode::Move& m : r.simultaneous) rapids += m.kind == gcode::MoveKind::rapid;
-  if (bodies_checked && rapids)
-    r.not_checked.push_back(std::to_string(rapids) +
-                            " simultaneous rapid(s) (G0 whose tool axis turns) not tested for "
-                            "cutting the stock (docs/design.md, \"Simultaneous moves\")");
   sweep_remove(r.result, cutters, steps, options.threads, r.sweep_tolerance / 100);
+  if (!rapids.empty()) check_simultaneous_rapids(options, r, cutters, rapids);
   r.result_dexel_volume = tridex::volume(r.result);
   r.sweep_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -138,68 +233,16 @@ void note_turning_rapid(const gcode::Move& before, const gcode::Move& after, Sim
   r.turning_rapids.push_back(turn);
 }
 
-namespace {
-
-// The box of the cutter at `pose`: a cylinder of its radius from the tip up its axis to its height.
-Aabb cutter_box(const SweepCutter& cutter, const ToolPose& pose) {
-  const Vec3 top = pose.tip + cutter.height * pose.axis;
-  const double radius = cutter.cutter.radius();
-  Vec3 grow(0.0);
-  for (int i = 0; i < 3; ++i)
-    grow[i] = radius * std::sqrt(std::max(0.0, 1 - pose.axis[i] * pose.axis[i]));
-  return Aabb{glm::min(pose.tip, top) - grow, glm::max(pose.tip, top) + grow};
-}
-
-// The deepest the cutter reaches into the material of the Z rays of `d` at `pose` (0: none),
-// each ray's material searched for the cutter's least signed distance (convex along the ray).
-double pose_depth(const TripleDexel& d, const SweepCutter& cutter, const ToolPose& pose,
-                  const Aabb& box, double precision, Vec3& where) {
-  const double h = d.spacing;
-  const DexelGrid& g = d.grids[2];
-  const int i0 = std::max(0, static_cast<int>(std::ceil((box.min.x - d.origin.x) / h)));
-  const int i1 = std::min(g.nu - 1, static_cast<int>(std::floor((box.max.x - d.origin.x) / h)));
-  const int j0 = std::max(0, static_cast<int>(std::ceil((box.min.y - d.origin.y) / h)));
-  const int j1 = std::min(g.nv - 1, static_cast<int>(std::floor((box.max.y - d.origin.y) / h)));
-  double depth = 0;
-  for (int i = i0; i <= i1; ++i)
-    for (int j = j0; j <= j1; ++j) {
-      const double x = d.origin.x + i * h, y = d.origin.y + j * h;
-      for (const DexelInterval& s : g.ray(i, j)) {
-        const double lo = std::max(double(s.enter), box.min.z),
-                     hi = std::min(double(s.exit), box.max.z);
-        if (!(lo < hi)) continue;
-        auto f = [&](double z) { return cutter.distance(pose.tip, pose.axis, Vec3(x, y, z)); };
-        const std::pair<double, double> best = detail::convex_minimum(f, lo, hi, precision);
-        if (-best.second > depth) depth = -best.second, where = Vec3(x, y, best.first);
-      }
-    }
-  return depth;
-}
-
-}  // namespace
-
 void check_turning_rapids(SimulationResult& r) {
   if (r.turning_rapids.empty() || !r.input.machine.kinematics) return;
   const SweepMaterial material(r.result);
-  const double h = r.lattice.spacing;
   for (const gcode::Move& m : r.turning_rapids) {
     auto it = r.cutter_of_tool.find(m.tool);
     if (it == r.cutter_of_tool.end()) continue;
     const SweepCutter cutter = sweep_cutter_of(r.cutters[it->second], r.bodies[it->second]);
     const gcode::MovePath path(*r.input.machine.kinematics, m);
-    const PoseBounds bounds = path.bounds();
-    // Poses close enough that no cutter point moves more than a quarter spacing between them.
-    const double rate = bounds.tip_speed + cutter.reach() * bounds.turn_rate;
-    long samples = 16;
-    while (samples < kMaxSubSteps && rate / static_cast<double>(samples) > h / 2) samples *= 2;
-    double depth = 0;
     Vec3 where(0.0);
-    for (long k = 0; k <= samples; ++k) {
-      const ToolPose pose = path.at(static_cast<double>(k) / static_cast<double>(samples));
-      const Aabb box = cutter_box(cutter, pose);
-      if (!material.may_touch(box)) continue;
-      depth = std::max(depth, pose_depth(r.result, cutter, pose, box, h / 8, where));
-    }
+    const double depth = path_depth(r.result, material, cutter, path, false, where);
     if (depth > kRapidTolerance)
       r.rapid_cuts.push_back(RapidFinding{m.file, m.line, m.tool, m.axis, depth, where, 0});
   }
