@@ -17,6 +17,12 @@ namespace tridex::cli {
 
 namespace {
 
+// How far beyond `grow` a span's middle pose is searched (mm): a span whose body can move farther
+// is split rather than searched in a box grown by all of it (most of a move's poses are several
+// millimetres clear: found clear within this, they are skipped as soon as the span's motion is
+// less; searching the whole motion's box cost 25 times as much on tilt_turn.ngc).
+constexpr double kTbSearch = 3.0;
+
 // A part as a finite frustum about the tool axis: radii r0 at `bottom`, r1 at `top` (mm above
 // the tip).
 struct TurningPart {
@@ -51,16 +57,20 @@ Aabb tb_box(const TurningPart& p, const ToolPose& pose, double grow) {
   return box.inflated(grow);
 }
 
-// The least of convex f on [lo, hi] by golden-section search to `precision` (no early stop:
-// the depth is the minimum itself). Returns (argument, value).
+// The least of convex, 1-Lipschitz f on [lo, hi] by golden-section search to `precision` (the
+// depth is the minimum itself), or a value ≥ `bar` as soon as the values seen prove the minimum
+// is (the bracket holds it, and f drops by at most its width from any value in it). Returns
+// (argument, value).
 template <class F>
-std::pair<double, double> tb_minimum(const F& f, double lo, double hi, double precision) {
+std::pair<double, double> tb_minimum(const F& f, double lo, double hi, double precision,
+                                     double bar) {
   double a = lo, b = hi;
   double x1 = b - detail::kGolden * (b - a), x2 = a + detail::kGolden * (b - a);
   double f1 = f(x1), f2 = f(x2);
   std::pair<double, double> best{lo, f(lo)};
   if (const double v = f(hi); v < best.second) best = {hi, v};
   while (b - a > precision) {
+    if (std::min(f1, f2) - (b - a) >= bar) return {x1, std::max(f1, bar)};
     if (f1 <= f2)
       b = x2, x2 = x1, f2 = f1, x1 = b - detail::kGolden * (b - a), f1 = f(x1);
     else
@@ -78,10 +88,10 @@ struct TbContact {
 };
 
 // The least signed distance from the material on the Z rays of `d` within the part's box (grown
-// by `grow`) to the part at `pose`, where it is below `out.distance` and `grow`: each ray's
-// material searched for its minimum (convex along the ray). A ray farther across than the part's
-// widest radius from its axis's shadow on the XY plane (a lower bound of the distance from any
-// point of the ray) cannot come nearer.
+// by `grow`) to the part at `pose`, where it is below `out.distance` and `grow` (else `out` stays
+// as it was): each ray's material searched for its minimum (convex along the ray). A ray farther
+// across than the part's widest radius from its axis's shadow on the XY plane (a lower bound of
+// the distance from any point of the ray) cannot come nearer.
 void tb_contact(const TripleDexel& d, const TurningPart& p, const ToolPose& pose, double grow,
                 TbContact& out) {
   const Aabb box = tb_box(p, pose, grow);
@@ -105,8 +115,9 @@ void tb_contact(const TripleDexel& d, const TurningPart& p, const ToolPose& pose
                      hi = std::min(double(s.exit), box.max.z);
         if (!(lo <= hi)) continue;
         auto f = [&](double z) { return tb_distance(p, pose, Vec3(x, y, z)); };
-        const auto [z, value] = tb_minimum(f, lo, hi, h / 64);
-        if (value < out.distance) out = {value, Vec3(x, y, z), pose.axis};
+        const double bar = std::min(out.distance, grow);  // only a nearer value counts
+        const auto [z, value] = tb_minimum(f, lo, hi, h / 64, bar);
+        if (value < bar) out = {value, Vec3(x, y, z), pose.axis};
       }
     }
 }
@@ -121,11 +132,11 @@ struct TbMoveResult {
 // more than `step` between neighbours (the tip's speed plus the farthest point's distance from
 // the tip times the turn rate bound each point's speed: gcode/simultaneous.hpp). Branch and bound
 // over the samples, part by part: the middle sample of a span is tested against the material
-// within its distance to the span's ends' poses (`margin`) of `grow`, and the span's other samples
-// come no nearer than that distance less the margin, so a span that cannot come nearer than the
-// nearest contact found (less half a step: the sampling's own error), nor within `grow`, is
-// skipped whole. The least distance over all samples, where it is below `grow`, comes out within
-// half a step of testing every sample.
+// within `grow` plus its motion to the span's ends (`margin`, at most kTbSearch), and the span's
+// other samples come no nearer than that distance less the margin, so a span that cannot come
+// nearer than the nearest contact found (less half a step: the sampling's own error), nor within
+// `grow`, is skipped whole. The least distance over all samples, where it is below `grow`, comes
+// out within half a step of testing every sample.
 TbMoveResult tb_check_move(const gcode::MovePath& path, std::span<const TurningPart> parts,
                            const TripleDexel& result, const SweepMaterial& material, double grow,
                            double step) {
@@ -148,10 +159,13 @@ TbMoveResult tb_check_move(const gcode::MovePath& path, std::span<const TurningP
       const double margin =
           rate * static_cast<double>(std::max(mid - j0, j1 - mid)) / static_cast<double>(n);
       if (!material.may_touch(tb_box(parts[k], pose, grow + margin))) return;
+      // Searched within `grow` and at most kTbSearch more: nothing nearer bounds the distance.
+      const double search = grow + std::min(margin, kTbSearch);
       TbContact here;
-      tb_contact(result, parts[k], pose, grow + margin, here);
+      tb_contact(result, parts[k], pose, search, here);
       if (here.distance < best.distance) best = here;
-      if (here.distance - margin >= std::min(best.distance + step / 2, grow)) return;
+      if (std::min(here.distance, search) - margin >= std::min(best.distance + step / 2, grow))
+        return;
       self(self, j0, mid - 1);
       self(self, mid + 1, j1);
     };
