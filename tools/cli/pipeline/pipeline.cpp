@@ -750,7 +750,9 @@ void mill_directions(const SimulateOptions& options, const PipelineRequest& requ
     mill_against_feeds(maps.back(), group, g, zmap_backend, check_rapids, options.threads, scratch,
                        r);
   }
-  scratch.rapids = {}, scratch.rapid_moves = {};  // only `feeds` goes on to the walls
+  // Only `feeds` goes on to the walls. (Assigning `{}` would keep the capacity: an
+  // initializer_list assignment.)
+  scratch.rapids = std::vector<CutMove>(), scratch.rapid_moves = std::vector<std::size_t>();
   r.timings.zmap = seconds_since(t);
 }
 
@@ -847,7 +849,7 @@ void intersect_directions(const SimulateOptions& options, const PipelineRequest&
       raise_uncut(maps[g], r.lattice_box, options.threads);
   }
   if (request.fine_cells) refine_walls(options, max_memory, scratch.feeds, r);
-  scratch.feeds = {};
+  scratch.feeds = std::vector<CutMove>();  // freed, not only cleared
   progress.stage("dexelizing the stock");
   TripleDexel stock_dexel = stock.mesh
                                 ? dexelize(*stock.mesh, r.lattice, DexelizeOptions{options.threads})
@@ -917,7 +919,8 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   CutScratch scratch;
   mill_directions(options, request, progress, scratch, r);
   if (!options.dump_zmaps.empty()) {
-    scratch.feeds = {};  // the dump's polyhedra take the room (MemoryEstimate::dump)
+    scratch.feeds =
+        std::vector<CutMove>();  // the dump's polyhedra take the room (MemoryEstimate::dump)
     dump_zmaps(options.dump_zmaps, r, progress);
   }
   intersect_directions(options, request, run.max_memory, progress, scratch, r);
