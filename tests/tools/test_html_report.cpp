@@ -203,8 +203,9 @@ TEST_CASE(
     groups[0].moves.push_back(move(line++, MoveKind::feed, Vec3(k, 0, 1), Vec3(k + 1, 0, 1)));
   auto sub = [&](int first, int last) {
     for (int k = first; k <= last; ++k) {
-      groups[1].moves.push_back(move(k, MoveKind::feed, Vec3(-1, k, 0), Vec3(-1, k + 1, 0)));
-      groups[1].moves.back().file = 1;
+      gcode::Move m = move(k, MoveKind::feed, Vec3(-1, k, 0), Vec3(-1, k + 1, 0));
+      m.file = 1;
+      groups[1].moves.push_back(m);
     }
   };
   sub(1, 5);
@@ -223,15 +224,15 @@ TEST_CASE(
   const std::vector<GroupRun> order = {{0, 51}, {1, 5}, {0, 201}, {1, 2}};
 
   // The reference: the moves in program order and the stop of each.
-  std::vector<std::pair<const gcode::Move*, std::size_t>> program;
-  std::vector<std::pair<int, int>> stops;  // (file, line)
+  std::vector<std::pair<gcode::Move, std::size_t>> program;  // copies (MoveList reads by value)
+  std::vector<std::pair<int, int>> stops;                    // (file, line)
   std::vector<std::size_t> next(2, 0);
   for (const GroupRun& run : order)
     for (std::uint64_t k = 0; k < run.moves; ++k) {
-      const gcode::Move& m = groups[run.group].moves[next[run.group]++];
+      const gcode::Move m = groups[run.group].moves[next[run.group]++];
       if (stops.empty() || stops.back() != std::pair{m.file, m.line})
         stops.emplace_back(m.file, m.line);
-      program.emplace_back(&m, run.group);
+      program.emplace_back(m, run.group);
     }
 
   const double tolerance = 0.05;
@@ -254,18 +255,18 @@ TEST_CASE(
   std::size_t stop = 0;
   for (std::size_t k = 0; k < program.size(); ++k) {
     const auto& [m, g] = program[k];
-    while (stops[stop] != std::pair{m->file, m->line}) ++stop;
-    if (m->line == home_line) continue;
+    while (stops[stop] != std::pair{m.file, m.line}) ++stop;
+    if (m.line == home_line) continue;
     const auto s = static_cast<std::size_t>(
         std::lower_bound(path.stops.begin(), path.stops.end(), static_cast<std::uint32_t>(stop)) -
         path.stops.begin());
     REQUIRE(s < path.stops.size());
     const Vec3 a(path.ends[2 * s]), b(path.ends[2 * s + 1]);
-    CHECK(segment_distance(m->start, a, b) <= tolerance + 1e-5);
-    CHECK(segment_distance(m->end, a, b) <= tolerance + 1e-5);
-    CHECK(path.tools[s] == m->tool);
+    CHECK(segment_distance(m.start, a, b) <= tolerance + 1e-5);
+    CHECK(segment_distance(m.end, a, b) <= tolerance + 1e-5);
+    CHECK(path.tools[s] == m.tool);
     CHECK((path.flags[s] & 127) == g);
-    CHECK(((path.flags[s] & 128) != 0) == (m->kind == MoveKind::rapid));
+    CHECK(((path.flags[s] & 128) != 0) == (m.kind == MoveKind::rapid));
   }
   CHECK(path.stops.back() == stops.size() - 1);
   for (const glm::vec3& p : path.ends) CHECK(glm::length(p) < 100);

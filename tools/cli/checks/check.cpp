@@ -412,19 +412,23 @@ void list_program_findings(const SimulationResult& r, const std::optional<Aabb>&
     // Positions "far along the tool axis" (home returns, reorientations) are tridex's stand-in for
     // where the machine takes the tool, not programmed points.
     const double far = 0.5 * gcode::MachineConfig::kDefaultFar;
-    std::vector<const gcode::Move*> outside;
+    struct Outside {  // what the finding lists of a move (the groups read moves back by value)
+      int file, line;
+      Vec3 end;
+    };
+    std::vector<Outside> outside;
     for (const gcode::MoveGroup& group : r.groups)
       for (const gcode::Move& m : group.moves)
-        if (glm::length(m.end) < far && !envelope->contains(m.end)) outside.push_back(&m);
-    std::stable_sort(outside.begin(), outside.end(),
-                     [](const gcode::Move* a, const gcode::Move* b) {
-                       return std::pair(a->file, a->line) < std::pair(b->file, b->line);
-                     });
+        if (glm::length(m.end) < far && !envelope->contains(m.end))
+          outside.push_back({m.file, m.line, m.end});
+    std::stable_sort(outside.begin(), outside.end(), [](const Outside& a, const Outside& b) {
+      return std::pair(a.file, a.line) < std::pair(b.file, b.line);
+    });
     f.envelope_outside = outside.size();
     for (std::size_t k = 0; k < outside.size() && k < kFindingsListed; ++k)
-      f.envelope_list.push_back({{"file", file_name(r, outside[k]->file)},
-                                 {"line", outside[k]->line},
-                                 {"tip", to_json(outside[k]->end)}});
+      f.envelope_list.push_back({{"file", file_name(r, outside[k].file)},
+                                 {"line", outside[k].line},
+                                 {"tip", to_json(outside[k].end)}});
   }
 
   // Machine travel (the kinematics' "travel" and rotary limits): a finding per axis and move.

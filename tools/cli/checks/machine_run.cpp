@@ -6,6 +6,7 @@
 #include <limits>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <set>
 
 #include "errors.hpp"
@@ -236,12 +237,12 @@ MachineRun run_machine_check(const std::vector<std::string>& fixtures, const Sim
     touching = std::move(now);
   };
   std::vector<std::size_t> next(r.groups.size(), 0);
-  const gcode::Move* previous = nullptr;
+  std::optional<gcode::Move> previous;  // a copy: the groups read moves back by value (MoveList)
   for (const GroupRun& span : r.order)
     for (std::uint64_t k = 0; k < span.moves; ++k) {
-      const gcode::Move& m = r.groups[span.group].moves[next[span.group]++];
-      const gcode::Move* before = previous;
-      previous = &m;
+      const gcode::Move m = r.groups[span.group].moves[next[span.group]++];
+      const std::optional<gcode::Move> before = previous;
+      previous = m;
       MachineMove move;
       move.file = m.file, move.line = m.line, move.tool = m.tool;
       const std::optional<double> gauge = mr_gauge(r, m.tool);

@@ -14,10 +14,10 @@ void for_each_reaching_move(const SimulationResult& r, const std::vector<Vec3>& 
   for (const gcode::MoveGroup& group : r.groups) {
     std::vector<Vec3> local;
     for (const Vec3& p : points) local.push_back(group.frame.to_local(p));
-    const gcode::Move* previous = nullptr;
+    std::optional<Vec3> previous_end;
     for (const gcode::Move& m : group.moves) {
-      const bool continues = previous && glm::length(previous->end - m.start) < 1e-9;
-      previous = &m;
+      const bool continues = previous_end && glm::length(*previous_end - m.start) < 1e-9;
+      previous_end = m.end;
       const Cutter& cutter = r.cutters[r.cutter_of_tool.at(m.tool)];
       Segment tip{group.frame.to_local(m.start), group.frame.to_local(m.end)};
       const double radius = cutter.radius();
@@ -44,11 +44,19 @@ void for_each_reaching_move(const SimulationResult& r, const std::vector<Vec3>& 
 
 std::vector<NearMove> nearest_moves(const SimulationResult& r, const std::vector<Vec3>& points,
                                     double within, double slack, std::size_t count) {
-  std::vector<NearMove> all;
-  for (const gcode::MoveGroup& group : r.groups) {
+  // A candidate names its move: the groups read their moves back by value (MoveList).
+  struct Candidate {
+    std::size_t group, index;  // group == r.groups.size(): r.simultaneous[index]
+    double gap;
+    bool over;
+  };
+  std::vector<Candidate> all;
+  for (std::size_t g = 0; g < r.groups.size(); ++g) {
+    const gcode::MoveGroup& group = r.groups[g];
     std::vector<Vec3> local;
     for (const Vec3& p : points) local.push_back(group.frame.to_local(p));
-    for (const gcode::Move& m : group.moves) {
+    for (std::size_t k = 0; k < group.moves.size(); ++k) {
+      const gcode::Move m = group.moves[k];
       if (m.kind == gcode::MoveKind::rapid) continue;
       const Cutter& cutter = r.cutters[r.cutter_of_tool.at(m.tool)];
       const Segment tip{group.frame.to_local(m.start), group.frame.to_local(m.end)};
@@ -71,25 +79,28 @@ std::vector<NearMove> nearest_moves(const SimulationResult& r, const std::vector
         }
         best = std::min(best, gap);
       }
-      if (best < std::numeric_limits<double>::infinity()) all.push_back({&m, best, over});
+      if (best < std::numeric_limits<double>::infinity()) all.push_back({g, k, best, over});
     }
   }
-  for (const gcode::Move& m : r.simultaneous) {
+  for (std::size_t k = 0; k < r.simultaneous.size(); ++k) {
+    const gcode::Move& m = r.simultaneous[k];
     if (m.kind == gcode::MoveKind::rapid) continue;
     const SimultaneousReach reach = simultaneous_reach(r, m, points, slack / 4);
     // A turning cutter has no footprint to pass over: it reaches a point or passes beside it.
-    if (reach.valid) all.push_back({&m, std::max(0.0, reach.gap), reach.gap <= 0});
+    if (reach.valid) all.push_back({r.groups.size(), k, std::max(0.0, reach.gap), reach.gap <= 0});
   }
   std::stable_sort(all.begin(), all.end(),
-                   [](const NearMove& p, const NearMove& q) { return p.gap < q.gap; });
-  if (all.empty()) return all;
-  const double limit = all.front().gap <= within ? within : all.front().gap + slack;
+                   [](const Candidate& p, const Candidate& q) { return p.gap < q.gap; });
   std::vector<NearMove> kept;  // the nearest move of each line
+  if (all.empty()) return kept;
+  const double limit = all.front().gap <= within ? within : all.front().gap + slack;
   std::set<std::pair<int, int>> lines;
-  for (const NearMove& near : all) {
+  for (const Candidate& near : all) {
     if (kept.size() >= count) break;
-    if ((near.gap <= limit || near.over) && lines.insert({near.move->file, near.move->line}).second)
-      kept.push_back(near);
+    const gcode::Move m = near.group < r.groups.size() ? r.groups[near.group].moves[near.index]
+                                                       : r.simultaneous[near.index];
+    if ((near.gap <= limit || near.over) && lines.insert({m.file, m.line}).second)
+      kept.push_back({m, near.gap, near.over});
   }
   return kept;
 }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "pipeline/pipeline.hpp"
@@ -21,7 +22,7 @@ void for_each_reaching_move(const SimulationResult& r, const std::vector<Vec3>& 
 
 // A cutting move near a point and how far its swept cutter passes from it (mm, 0: it reaches it).
 struct NearMove {
-  const gcode::Move* move = nullptr;
+  std::optional<gcode::Move> move;  // a copy: the groups keep their moves compactly (MoveList)
   double gap = 0;
   bool over = false;  // its footprint covers a point: it passes over it, at `gap` or higher
 };

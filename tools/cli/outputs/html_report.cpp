@@ -417,13 +417,13 @@ std::vector<DirectionColumns> milled_columns(const HtmlPage& page, const Aabb& b
     for (std::size_t g = 0; g < groups.size(); ++g)
       whole.push_back({static_cast<std::uint32_t>(g), groups[g].moves.size()});
   std::vector<std::size_t> next(groups.size(), 0);
-  const gcode::Move* previous = nullptr;
+  std::optional<std::pair<int, int>> previous;  // the file and line of the move before
   std::uint32_t stop = 0;
   for (const GroupRun& run : page.order.empty() ? std::span<const GroupRun>(whole) : page.order)
     for (std::uint64_t k = 0; k < run.moves; ++k) {
-      const gcode::Move& m = groups[run.group].moves[next[run.group]++];
-      if (previous && (previous->file != m.file || previous->line != m.line)) ++stop;
-      previous = &m;
+      const gcode::Move m = groups[run.group].moves[next[run.group]++];
+      if (previous && *previous != std::pair(m.file, m.line)) ++stop;
+      previous = std::pair(m.file, m.line);
       const auto cutter = page.cutter_of_tool->find(m.tool);
       if (cutter == page.cutter_of_tool->end() || cutter->second >= page.cutters.size() ||
           glm::length(m.start) >= kFar || glm::length(m.end) >= kFar)
@@ -557,9 +557,9 @@ DisplayMesh simplify_for_display(const Mesh& mesh, std::span<const double> devia
 
 DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups,
                           std::span<const GroupRun> order, double tolerance) {
-  struct Ref {
-    const gcode::Move* move;
-    std::uint8_t group;
+  struct Ref {  // a move by place: the groups read their moves back by value (MoveList)
+    std::uint32_t group;
+    std::size_t index;
   };
   // The moves in program order: the groups keep it within each, `order` across them.
   std::vector<GroupRun> whole;
@@ -571,9 +571,7 @@ DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups,
   for (const GroupRun& run : order.empty() ? std::span<const GroupRun>(whole) : order) {
     if (run.group >= groups.size() || next[run.group] + run.moves > groups[run.group].moves.size())
       throw std::logic_error("thin_toolpath: the program order does not match the groups");
-    for (std::uint64_t k = 0; k < run.moves; ++k)
-      moves.push_back({&groups[run.group].moves[next[run.group]++],
-                       static_cast<std::uint8_t>(run.group % 128)});
+    for (std::uint64_t k = 0; k < run.moves; ++k) moves.push_back({run.group, next[run.group]++});
   }
 
   DisplayPath path;
@@ -581,22 +579,26 @@ DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups,
   path.tolerance = tolerance;
   constexpr std::size_t kLongestRun = 64;  // bounds the quadratic check of a run
   std::vector<glm::vec3> run;              // the run's points: its start, then each move's end
-  const Ref* first = nullptr;
+  struct First {                           // what the run's first move gives it
+    std::uint8_t group;
+    int tool;
+    bool rapid;
+  } first{};
   std::uint32_t run_stop = 0;  // the stop of the run's last move
   auto flush = [&] {
     if (run.size() < 2) return;
     path.ends.push_back(run.front());
     path.ends.push_back(run.back());
     path.stops.push_back(run_stop);
-    path.tools.push_back(static_cast<std::uint16_t>(std::clamp(first->move->tool, 0, 65535)));
-    path.flags.push_back(static_cast<std::uint8_t>(
-        first->group | (first->move->kind == gcode::MoveKind::rapid ? 128 : 0)));
+    path.tools.push_back(static_cast<std::uint16_t>(std::clamp(first.tool, 0, 65535)));
+    path.flags.push_back(static_cast<std::uint8_t>(first.group | (first.rapid ? 128 : 0)));
     run.clear();
   };
-  const gcode::Move* previous = nullptr;
+  std::optional<std::pair<int, int>> previous;  // the file and line of the move before
   for (const Ref& ref : moves) {
-    const gcode::Move& m = *ref.move;
-    if (!previous || previous->file != m.file || previous->line != m.line) {
+    const gcode::Move m = groups[ref.group].moves[ref.index];
+    const auto group = static_cast<std::uint8_t>(ref.group % 128);
+    if (!previous || *previous != std::pair(m.file, m.line)) {
       // A new stop: it extends the last run when it is the next line of the same file.
       std::vector<std::uint32_t>& runs = path.stop_runs;
       const auto file = static_cast<std::uint32_t>(m.file),
@@ -608,23 +610,21 @@ DisplayPath thin_toolpath(const std::vector<gcode::MoveGroup>& groups,
         runs.insert(runs.end(), {file, line, 1});
       ++path.stop_count;
     }
-    previous = &m;
+    previous = std::pair(m.file, m.line);
     if (glm::length(m.start) >= kFar || glm::length(m.end) >= kFar) {
       flush();
       continue;
     }
     const glm::vec3 start(m.start), end(m.end);
-    bool joins =
-        !run.empty() && run.size() < kLongestRun && first->group == ref.group &&
-        first->move->tool == m.tool &&
-        (first->move->kind == gcode::MoveKind::rapid) == (m.kind == gcode::MoveKind::rapid) &&
-        glm::length(run.back() - start) <= 1e-6f;
+    bool joins = !run.empty() && run.size() < kLongestRun && first.group == group &&
+                 first.tool == m.tool && first.rapid == (m.kind == gcode::MoveKind::rapid) &&
+                 glm::length(run.back() - start) <= 1e-6f;
     if (joins)
       for (std::size_t k = 1; k < run.size() && joins; ++k)
         joins = distance_to_segment(run[k], run.front(), end) <= tolerance;
     if (!joins) {
       flush();
-      first = &ref;
+      first = {group, m.tool, m.kind == gcode::MoveKind::rapid};
       run.push_back(start);
     }
     run.push_back(end);

@@ -127,7 +127,8 @@ int run_groups(const ListOptions& options) {
   ProgramInput input = resolve_program(options);
   check_output(options, input);
   // The groups hold every move, each once (MoveList).
-  MoveBudget budget(max_memory_bytes(options.max_memory), sizeof(gcode::Move));
+  MoveBudget budget(max_memory_bytes(options.max_memory),
+                    gcode::MoveList::bytes_per_move(input.machine.kinematics.has_value()));
   gcode::DirectionGrouper grouper;
   struct Extra {
     long long kinds[4] = {0, 0, 0, 0};

@@ -308,7 +308,9 @@ ParsedProgram parse_grouped(const SimulateOptions& options, std::uint64_t max_me
   // simulate must hold every move: grouped by direction (a MoveList holds no spare copies), then
   // as one direction's cutter sweeps while it is milled. What the process already holds (the
   // libraries, a design read) leaves that much less for them.
-  MoveBudget budget(max_memory, sizeof(gcode::Move) + sizeof(CutMove) + sizeof(void*));
+  MoveBudget budget(max_memory,
+                    gcode::MoveList::bytes_per_move(input.machine.kinematics.has_value()) +
+                        sizeof(CutMove) + sizeof(void*));
   Aabb& cutting_bounds = parsed.cutting_bounds;
   const std::optional<gcode::Kinematics>& kinematics = input.machine.kinematics;
   // Positions "far along the tool axis" stand in for where the machine takes the tool: no travel.
@@ -433,12 +435,11 @@ void load_initial_tool(const std::optional<ToolTable>& table, bool selects_tool,
                 tool, ", the tool the control starts with, which is ",
                 table ? "not in the tool table" : "in no tool table (give --tools FILE)",
                 "; give --initial-tool N for another");
-  for (gcode::MoveGroup& group : r.groups) {
-    bool had = false;
-    for (gcode::Move& m : group.moves)
-      if (m.tool == 0) m.tool = tool, had = true;
-    if (had) group.tools.erase(0), group.tools.insert(tool);
-  }
+  for (gcode::MoveGroup& group : r.groups)
+    if (group.tools.erase(0)) {  // a group's tools are its moves' tools
+      group.moves.replace_tool(0, tool);
+      group.tools.insert(tool);
+    }
   for (gcode::Move& m : r.simultaneous)
     if (m.tool == 0) m.tool = tool;
   const std::string source =
@@ -666,20 +667,31 @@ void size_the_run(const SimulateOptions& options, const PipelineRequest& request
                 "; use a larger --zmap-cell or --dexel-cell, or a smaller --dexel-res");
 }
 
+// The cutter sweeps of one direction at a time, kept from direction to direction and from
+// milling to refining the walls: fresh memory costs a page fault and the zeroing of each page
+// (bench/README.md, issue 37), so these buffers are sized once for the largest direction.
+struct CutScratch {
+  std::vector<CutMove> feeds, rapids;
+  std::vector<std::size_t> rapid_moves;
+};
+
 // Mills one group's moves into `map` feed moves first (RapidCheck::against_feeds): the rapids are
 // checked against what the feeds leave (when `check_rapids`), then milled too.
 void mill_against_feeds(ZMap& map, const gcode::MoveGroup& group, std::size_t g,
                         backends::ZMapBackend zmap_backend, bool check_rapids, unsigned threads,
-                        SimulationResult& r) {
+                        CutScratch& scratch, SimulationResult& r) {
   const std::vector<Cutter>& cutters = r.cutters;
-  std::vector<CutMove> feeds, rapids;
-  std::vector<const gcode::Move*> rapid_moves;
+  std::vector<CutMove>& feeds = scratch.feeds;
+  std::vector<CutMove>& rapids = scratch.rapids;
+  std::vector<std::size_t>& rapid_moves = scratch.rapid_moves;  // their indices in group.moves
+  feeds.clear(), rapids.clear(), rapid_moves.clear();
   feeds.reserve(group.moves.size());
-  for (const gcode::Move& m : group.moves) {
+  for (auto it = group.moves.begin(); it != group.moves.end(); ++it) {
+    const gcode::Move m = *it;
     CutMove cut = cut_move(group, m, r.cutter_of_tool);
     if (m.kind == gcode::MoveKind::rapid) {
       rapids.push_back(cut);
-      rapid_moves.push_back(&m);
+      rapid_moves.push_back(static_cast<std::size_t>(it - group.moves.begin()));
     } else {
       feeds.push_back(cut);
     }
@@ -687,7 +699,7 @@ void mill_against_feeds(ZMap& map, const gcode::MoveGroup& group, std::size_t g,
   backends::mill_with(zmap_backend, map, cutters, feeds, threads);
   for (const RapidCut& found :
        check_rapids ? rapid_cuts(map, cutters, rapids, kRapidTolerance) : std::vector<RapidCut>{}) {
-    const gcode::Move& m = *rapid_moves[found.index];
+    const gcode::Move m = group.moves[rapid_moves[found.index]];
     r.rapid_cuts.push_back(
         RapidFinding{m.file, m.line, m.tool, group.axis, found.depth_mm, m.end, g});
   }
@@ -696,7 +708,7 @@ void mill_against_feeds(ZMap& map, const gcode::MoveGroup& group, std::size_t g,
 
 // Step 1: one milled Z-map per direction (r.maps), its rapids checked as the request asks.
 void mill_directions(const SimulateOptions& options, const PipelineRequest& request,
-                     Progress& progress, SimulationResult& r) {
+                     Progress& progress, CutScratch& scratch, SimulationResult& r) {
   const Clock::time_point t = Clock::now();
   const std::vector<gcode::MoveGroup>& groups = r.groups;
   const Stock& stock = r.stock;
@@ -715,6 +727,10 @@ void mill_directions(const SimulateOptions& options, const PipelineRequest& requ
   // The shanks, holders and spindle parts that check tests against the stock (machine_run.hpp).
   const std::vector<ToolBody> stock_bodies =
       request.body_clearance ? bodies_against_stock(r) : std::vector<ToolBody>{};
+  std::size_t most_moves = 0;
+  for (const gcode::MoveGroup& group : groups)
+    most_moves = std::max(most_moves, group.moves.size());
+  scratch.feeds.reserve(most_moves);
   for (std::size_t g = 0; g < groups.size(); ++g) {
     const gcode::MoveGroup& group = groups[g];
     progress.stage("milling direction " + std::to_string(g + 1) + "/" +
@@ -732,8 +748,12 @@ void mill_directions(const SimulateOptions& options, const PipelineRequest& requ
                             options.threads, r.rapid_cuts, bodies ? &*bodies : nullptr, r.body);
       continue;
     }
-    mill_against_feeds(maps.back(), group, g, zmap_backend, check_rapids, options.threads, r);
+    mill_against_feeds(maps.back(), group, g, zmap_backend, check_rapids, options.threads, scratch,
+                       r);
   }
+  // Only `feeds` goes on to the walls. (Assigning `{}` would keep the capacity: an
+  // initializer_list assignment.)
+  scratch.rapids = std::vector<CutMove>(), scratch.rapid_moves = std::vector<std::size_t>();
   r.timings.zmap = seconds_since(t);
 }
 
@@ -750,7 +770,8 @@ void dump_zmaps(const std::string& directory, const SimulationResult& r, Progres
 // Walls parallel to a spindle are placed inside their cells: the steep cells take finer heights
 // from the moves (fine_cells.hpp). How many cells are steep is known only now: their sub-grids
 // are checked against --max-memory before any is allocated.
-void refine_walls(const SimulateOptions& options, std::uint64_t max_memory, SimulationResult& r) {
+void refine_walls(const SimulateOptions& options, std::uint64_t max_memory,
+                  std::vector<CutMove>& moves, SimulationResult& r) {
   std::vector<ZMap>& maps = r.maps;
   const std::vector<gcode::MoveGroup>& groups = r.groups;
   std::vector<std::vector<std::uint32_t>> steep(maps.size());
@@ -778,7 +799,7 @@ void refine_walls(const SimulateOptions& options, std::uint64_t max_memory, Simu
                 " in all without them), more than --max-memory ",
                 format_mib(static_cast<double>(max_memory)),
                 "; use a larger --zmap-cell or --dexel-cell, or a smaller --dexel-res");
-  std::vector<CutMove> moves;  // one buffer for every direction: its pages are touched once
+  // One buffer for every direction (milling's): its pages are touched once.
   moves.reserve(static_cast<std::size_t>(most_moves));
   for (std::size_t g = 0; g < maps.size(); ++g) {
     moves.clear();
@@ -812,7 +833,8 @@ double stock_surface_volume(const TripleDexel& stock, unsigned threads, const Si
 // intersect_milled() fuses the two steps ray by ray (each ray of the stock clipped by each Z-map's
 // polyhedron in turn, never storing M_i), so "intersect" times them together.
 void intersect_directions(const SimulateOptions& options, const PipelineRequest& request,
-                          std::uint64_t max_memory, Progress& progress, SimulationResult& r) {
+                          std::uint64_t max_memory, Progress& progress, CutScratch& scratch,
+                          SimulationResult& r) {
   Clock::time_point t = Clock::now();
   const Stock& stock = r.stock;
   std::vector<ZMap>& maps = r.maps;
@@ -827,7 +849,8 @@ void intersect_directions(const SimulateOptions& options, const PipelineRequest&
     else
       raise_uncut(maps[g], r.lattice_box, options.threads);
   }
-  if (request.fine_cells) refine_walls(options, max_memory, r);
+  if (request.fine_cells) refine_walls(options, max_memory, scratch.feeds, r);
+  scratch.feeds = std::vector<CutMove>();  // freed, not only cleared
   progress.stage("dexelizing the stock");
   TripleDexel stock_dexel = stock.mesh
                                 ? dexelize(*stock.mesh, r.lattice, DexelizeOptions{options.threads})
@@ -894,9 +917,14 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   drop_toolless_moves(r);
   size_the_run(options, request, run, parsed, r);
   warn_implausible_setup(options, parsed.cutting_bounds, r);
-  mill_directions(options, request, progress, r);
-  if (!options.dump_zmaps.empty()) dump_zmaps(options.dump_zmaps, r, progress);
-  intersect_directions(options, request, run.max_memory, progress, r);
+  CutScratch scratch;
+  mill_directions(options, request, progress, scratch, r);
+  if (!options.dump_zmaps.empty()) {
+    scratch.feeds =
+        std::vector<CutMove>();  // the dump's polyhedra take the room (MemoryEstimate::dump)
+    dump_zmaps(options.dump_zmaps, r, progress);
+  }
+  intersect_directions(options, request, run.max_memory, progress, scratch, r);
   if (!r.simultaneous.empty()) cut_simultaneous(options, r, request.body_clearance.has_value());
   // The simultaneous moves' shanks and holders against the final solid (turning_bodies.hpp).
   if ((!r.simultaneous.empty() || !r.turning_rapids.empty()) && request.body_clearance)

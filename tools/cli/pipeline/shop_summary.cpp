@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 namespace tridex::cli {
 
@@ -53,7 +54,8 @@ std::string directions_text(const SimulationResult& r) {
   for (const gcode::MoveGroup& group : r.groups) {
     std::string one = axis_label(group.axis);
     if (one.find('_') != std::string::npos) one = "tilted";
-    const gcode::Move* first = group.moves.empty() ? nullptr : &group.moves.front();
+    const std::optional<gcode::Move> first =
+        group.moves.empty() ? std::nullopt : std::optional<gcode::Move>(group.moves.front());
     if (r.input.machine.kinematics && first && first->rotary_axes) {
       std::string angles;
       for (int a = 0; a < 3; ++a)
