@@ -53,8 +53,8 @@ struct MemoryShape {
   bool dump_maps = false;    // --dump-zmaps: each map's polyhedron is built and written
 };
 
-inline constexpr double kTrianglesPerRay = 6;  // measured 3.4-5.1 (model D, example, 12 directions)
-inline constexpr double kSurfaceBytesPerTriangle = 72;  // measured 60-67 at extract_surface's peak
+inline constexpr double kTrianglesPerRay = 5.5;  // measured 3.4-5.1 (model D, example, 12 directions)
+inline constexpr double kSurfaceBytesPerTriangle = 68;  // measured 60-67 at extract_surface's peak
 
 // `held_bytes`: resident now; `peak_bytes`: the peak so far (ru_maxrss).
 MemoryEstimate estimate_memory(double held_bytes, double peak_bytes, const MemoryShape& shape);
