@@ -428,19 +428,19 @@ class ZMapScanner {
 
 // The highest of a map's heights, on `threads` threads: found once per map, not per family.
 inline float highest_height(const ZMap& map, unsigned threads) {
-  constexpr std::size_t kChunk = std::size_t{1} << 20, kLanes = 16;
+  constexpr std::size_t kChunk = std::size_t{1} << 20, kPartials = 16;
   const std::size_t n = map.heights.size(), chunks = (n + kChunk - 1) / kChunk;
   std::vector<float> part(chunks, -std::numeric_limits<float>::infinity());
   for_each_chunk(chunks, threads, [&](std::size_t c) {
     const float* h = map.heights.data() + c * kChunk;
     const std::size_t count = std::min(kChunk, n - c * kChunk);
-    float lane[kLanes];  // independent maxima, so that the loop vectorises
-    std::fill_n(lane, kLanes, -std::numeric_limits<float>::infinity());
+    float lane[kPartials];  // independent maxima, so that the loop vectorises
+    std::fill_n(lane, kPartials, -std::numeric_limits<float>::infinity());
     std::size_t k = 0;
-    for (; k + kLanes <= count; k += kLanes)
-      for (std::size_t l = 0; l < kLanes; ++l) lane[l] = h[k + l] > lane[l] ? h[k + l] : lane[l];
+    for (; k + kPartials <= count; k += kPartials)
+      for (std::size_t l = 0; l < kPartials; ++l) lane[l] = h[k + l] > lane[l] ? h[k + l] : lane[l];
     for (; k < count; ++k) lane[0] = h[k] > lane[0] ? h[k] : lane[0];
-    part[c] = *std::max_element(lane, lane + kLanes);
+    part[c] = *std::max_element(lane, lane + kPartials);
   });
   return *std::max_element(part.begin(), part.end());
 }

@@ -210,7 +210,7 @@ void raise_uncut_rows(ZMap& milled, float initial_empty, InitialRow&& initial_ro
                       unsigned threads) {
   const ZMapGrid& a = milled.grid;
   const std::size_t nx = static_cast<std::size_t>(a.nx);
-  constexpr std::size_t kLanes = 16;
+  constexpr std::size_t kPartials = 16;
   const auto bands = static_cast<std::size_t>((a.ny + kMapBandRows - 1) / kMapBandRows);
   std::vector<std::uint8_t> uncut(a.size());
   std::vector<float> band_top(bands, milled.empty_height);
@@ -229,17 +229,17 @@ void raise_uncut_rows(ZMap& milled, float initial_empty, InitialRow&& initial_ro
       return i >= 0 && j >= 0 && i < a.nx && j < a.ny && initial(i, j) > initial_empty;
     };
     auto cut = [&](int i, int j) { return inside(i, j) && milled.height(i, j) != initial(i, j); };
-    float top[kLanes];             // independent maxima, so that the loop below vectorises
+    float top[kPartials];          // independent maxima, so that the loop below vectorises
     const std::size_t width = nx;  // a copy: the marks are bytes, which may alias a reference
-    std::fill_n(top, kLanes, band_top[band]);
+    std::fill_n(top, kPartials, band_top[band]);
     for (int j = j0; j < j1; ++j) {
       const float* init = window.data() + static_cast<std::size_t>(j - w0) * nx;
       const float* height = milled.heights.data() + a.index(0, j);
       std::uint8_t* mark = uncut.data() + a.index(0, j);
       for (std::size_t k = 0; k < width; ++k) mark[k] = height[k] == init[k];
       std::size_t k = 0;
-      for (; k + kLanes <= width; k += kLanes)
-        for (std::size_t l = 0; l < kLanes; ++l)
+      for (; k + kPartials <= width; k += kPartials)
+        for (std::size_t l = 0; l < kPartials; ++l)
           top[l] = init[k + l] > top[l] ? init[k + l] : top[l];
       for (; k < width; ++k) top[0] = init[k] > top[0] ? init[k] : top[0];
       for (int i = 0; i < a.nx; ++i) {
@@ -257,7 +257,7 @@ void raise_uncut_rows(ZMap& milled, float initial_empty, InitialRow&& initial_ro
         if (best > -std::numeric_limits<float>::infinity()) continued[band].emplace_back(p, best);
       }
     }
-    band_top[band] = *std::max_element(top, top + kLanes);
+    band_top[band] = *std::max_element(top, top + kPartials);
   });
   const float top = *std::max_element(band_top.begin(), band_top.end());
   const float above = static_cast<float>(top + empty_margin(a.cell));
