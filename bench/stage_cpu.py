@@ -14,10 +14,12 @@ import subprocess
 import sys
 
 STAGES = [
-    ("dexelize: lower_fine_cells", r"lower_fine_cells|lower_cells_under_move"),
+    ("dexelize: lower_fine_cells",
+     r"lower_fine_cells|lower_cells_under_move|lower_band|lower_cell|near_moves_by_band|wall_tiles"),
     ("dexelize: raise_uncut", r"raise_uncut"),
     ("dexelize: steep_cells", r"steep_cells"),
     ("dexelize: refine (other)", r"refine_steep|refine_walls|moves_by_band|FineCellMove"),
+    ("box heights (from_box, raise_uncut)", r"box_top_row"),
     ("parse", r"gcode::|Parser|LineLexer|lex_line|fast_float|MoveList|Grouper|cut_move"),
     ("zmap (Step 1)", r"Miller|Lanes|from_box|mill_|MoveGeometry|rapid_cuts|TileRow"),
     ("intersect (Steps 2-3)", r"ZMapScanner|scan_|grid_from_hits|intersect|Dexel|dexel"),

@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <utility>
 #include <vector>
@@ -48,20 +49,40 @@ inline bool is_steep_cell(const ZMap& map, int i, int j, double steep_slope) {
 }
 
 // The steep cells of `map` (grid.index of their (i, j) corners), ascending. Rows are split
-// among `threads` threads (0: every hardware thread); the list is the same for any count.
+// among `threads` threads (0: every hardware thread); the list is the same for any count. Each
+// row is tested as is_steep_cell does, in float where that is exact (the corners' maximum and
+// minimum), so that the compiler can vectorise it, and its few steep cells picked out after.
 inline std::vector<std::uint32_t> steep_cells(const ZMap& map, double steep_slope,
                                               unsigned threads = 1) {
   const ZMapGrid& g = map.grid;
   const auto bands =
       static_cast<std::size_t>((g.ny - 1 + detail::kMapBandRows - 1) / detail::kMapBandRows);
+  const auto nx = static_cast<std::size_t>(g.nx), cells_x = nx - 1;  // a grid has a point
+  const double threshold = steep_slope * g.cell;
+  const float e = map.empty_height;
   std::vector<std::vector<std::uint32_t>> found(bands);
   detail::for_each_chunk(bands, threads, [&](std::size_t band) {
     const int j0 = static_cast<int>(band) * detail::kMapBandRows,
               j1 = std::min(g.ny - 1, j0 + detail::kMapBandRows);
-    for (int j = j0; j < j1; ++j)
-      for (int i = 0; i + 1 < g.nx; ++i)
-        if (is_steep_cell(map, i, j, steep_slope))
-          found[band].push_back(static_cast<std::uint32_t>(g.index(i, j)));
+    // Copies: the flags are bytes, which may alias anything captured by reference.
+    const std::size_t n = cells_x;
+    const float empty = e;
+    const double limit = threshold;
+    std::vector<std::uint8_t> steep(nx);
+    for (int j = j0; j < j1; ++j) {
+      const float* h0 = map.heights.data() + g.index(0, j);
+      const float* h1 = h0 + nx;
+      for (std::size_t i = 0; i < n; ++i) {
+        const float a = h0[i] < empty ? empty : h0[i], b = h0[i + 1] < empty ? empty : h0[i + 1];
+        const float c = h1[i] < empty ? empty : h1[i], d = h1[i + 1] < empty ? empty : h1[i + 1];
+        const float ab_hi = a < b ? b : a, cd_hi = c < d ? d : c;
+        const float ab_lo = b < a ? b : a, cd_lo = d < c ? d : c;
+        const float hi = ab_hi < cd_hi ? cd_hi : ab_hi, lo = cd_lo < ab_lo ? cd_lo : ab_lo;
+        steep[i] = double(hi) - double(lo) > limit;
+      }
+      for (std::size_t i = 0; i < n; ++i)
+        if (steep[i]) found[band].push_back(static_cast<std::uint32_t>(g.index(0, j) + i));
+    }
   });
   std::vector<std::uint32_t> cells;
   for (const auto& part : found) cells.insert(cells.end(), part.begin(), part.end());
@@ -70,59 +91,56 @@ inline std::vector<std::uint32_t> steep_cells(const ZMap& map, double steep_slop
 
 namespace detail {
 
-// The moves whose swept box reaches each band of kWallBandRows cell rows, in program order: a
-// counting sort (one pass to count, one to place), so that a band never scans the whole program.
-// Only the bands `wanted` marks get their moves (the others stay empty): those that hold a fine
-// cell, so that the lists cost in proportion to the walls, not to every move's every band.
-struct MovesByBand {
-  // Band b's moves are band_moves[band_begin[b]] up to band_moves[band_begin[b + 1]].
-  std::vector<std::size_t> band_begin;
-  std::vector<std::uint32_t> band_moves;
-};
-inline MovesByBand moves_by_band(const ZMapGrid& g, std::span<const Cutter> cutters,
-                                 std::span<const CutMove> moves, int bands,
-                                 std::span<const std::uint8_t> wanted) {
-  constexpr int kBandRows = kWallBandRows;
-  auto band_range = [&](const CutMove& m) {
-    const double r = cutters[m.cutter].radius();
-    const double lo_y = std::min(m.tip.a.y, m.tip.b.y) - r,
-                 hi_y = std::max(m.tip.a.y, m.tip.b.y) + r;
-    const double row0 = std::floor((lo_y - g.y0) / g.cell),
-                 row1 = std::floor((hi_y - g.y0) / g.cell);
-    return std::pair{
-        static_cast<int>(std::clamp(row0, 0.0, double(g.ny - 1))) / kBandRows,
-        row1 < 0 ? -1 : static_cast<int>(std::min(row1, double(g.ny - 2))) / kBandRows};
-  };
-  MovesByBand by_band;
-  std::vector<std::size_t>& band_begin = by_band.band_begin;
-  band_begin.assign(static_cast<std::size_t>(bands) + 1, 0);
-  for (const CutMove& m : moves)
-    for (auto [b0, b1] = band_range(m); b0 <= b1; ++b0)
-      band_begin[static_cast<std::size_t>(b0) + 1] += wanted[static_cast<std::size_t>(b0)];
-  for (std::size_t b = 0; b < static_cast<std::size_t>(bands); ++b)
-    band_begin[b + 1] += band_begin[b];
-  std::vector<std::uint32_t>& band_moves = by_band.band_moves;
-  band_moves.resize(band_begin.back());
-  {
-    std::vector<std::size_t> at(band_begin.begin(), band_begin.end() - 1);
-    for (std::size_t m = 0; m < moves.size(); ++m)
-      for (auto [b0, b1] = band_range(moves[m]); b0 <= b1; ++b0)
-        if (wanted[static_cast<std::size_t>(b0)])
-          band_moves[at[static_cast<std::size_t>(b0)]++] = static_cast<std::uint32_t>(m);
+// The tiles (kWallBandRows cell rows by as many columns) that hold a fine cell, listed band by
+// band and counted in a summed-area table, so that a move learns from four numbers whether its
+// swept box reaches any wall: on a whole program's map most moves' boxes reach none.
+struct WallTiles {
+  std::size_t tiles_x = 0, bands = 0;
+  // (bands + 1) × (tiles_x + 1): the wall tiles in the bands before b and the columns before t.
+  std::vector<std::uint32_t> area;
+  std::vector<std::size_t> band_begin;  // band b's: tiles[band_begin[b]] up to band_begin[b + 1]
+  std::vector<std::uint32_t> tiles;     // their tile columns, ascending within a band
+
+  // The wall tiles in bands b0..b1 and tile columns t0..t1 (none when either range is empty).
+  std::uint32_t count(std::size_t b0, std::size_t b1, std::size_t t0, std::size_t t1) const {
+    if (b0 > b1 || t0 > t1) return 0;
+    const std::size_t w = tiles_x + 1;
+    return area[(b1 + 1) * w + t1 + 1] - area[b0 * w + t1 + 1] - area[(b1 + 1) * w + t0] +
+           area[b0 * w + t0];
   }
-  return by_band;
+};
+inline WallTiles wall_tiles(const ZMapGrid& g, std::size_t bands,
+                            const std::vector<std::uint32_t>& cells) {
+  constexpr auto kWallTile = static_cast<std::uint32_t>(kWallBandRows);
+  WallTiles w;
+  w.bands = bands;
+  w.tiles_x = (static_cast<std::size_t>(g.nx) - 1 + kWallTile - 1) / kWallTile;
+  std::vector<std::uint8_t> wall(bands * w.tiles_x, 0);
+  const auto nx = static_cast<std::uint32_t>(g.nx);
+  for (std::uint32_t c : cells) wall[c / nx / kWallTile * w.tiles_x + c % nx / kWallTile] = 1;
+  const std::size_t width = w.tiles_x + 1;
+  w.area.assign((bands + 1) * width, 0);
+  w.band_begin.assign(bands + 1, 0);
+  for (std::size_t b = 0; b < bands; ++b) {
+    std::uint32_t in_row = 0;
+    for (std::size_t t = 0; t < w.tiles_x; ++t) {
+      if (wall[b * w.tiles_x + t]) w.tiles.push_back(static_cast<std::uint32_t>(t)), ++in_row;
+      w.area[(b + 1) * width + t + 1] = w.area[b * width + t + 1] + in_row;
+    }
+    w.band_begin[b + 1] = w.tiles.size();
+  }
+  return w;
 }
 
-// A move near a band's fine cells (lower_fine_cells): its lowest tip, and the cell rows and
-// columns of the band its swept box reaches.
+// A move near a band's fine cells (lower_fine_cells): its lowest tip (MoveGeometry::lowest_tip),
+// and the cell rows and columns of the band its swept box reaches.
 struct FineCellMove {
   double tip;
   std::uint32_t move, i0, i1;
   int row0, row1;
 };
 
-// The cell rows and columns a move's swept box spans (rows clamped to -1..ny, columns to 0..nx):
-// computed once per move, not in each of the (a D10 at 0.026 mm: about 26) bands it crosses.
+// The cell rows and columns a move's swept box spans (rows clamped to -1..ny, columns to 0..nx).
 struct FineCellBox {
   int row0, row1;
   std::uint32_t i0, i1;
@@ -140,47 +158,108 @@ inline FineCellBox fine_cell_box(const ZMapGrid& g, const Segment& s, double r) 
           column(std::max(s.a.x, s.b.x) + r)};
 }
 
-// Lowers the sub-points of the fine cells in rows n.row0..n.row1, columns n.i0..n.i1, to the
-// lowest point of the swept cutter of one move above them; cell_top[k] is the highest sub-point
-// of cells[k], kept so.
-inline void lower_cells_under_move(const ZMapGrid& g, const Cutter& cutter, const Segment& s,
-                                   const FineCellMove& n, const std::vector<std::uint32_t>& cells,
-                                   const std::vector<std::size_t>& row_begin,
-                                   std::vector<float>& cell_top, std::vector<float>& sub) {
+// Whether wall tile column tx of the band of cell rows j0..j1 comes within the radius r of the
+// tip path s: no sub-point of a tile that does not can be passed over by the move.
+inline bool near_wall_tile(const ZMapGrid& g, int j0, int j1, std::uint32_t tx, const Segment& s,
+                           double r) {
+  const double tile_half_diagonal = kWallBandRows * g.cell * std::sqrt(0.5) * (1 + 1e-9);
+  const double cx = g.x0 + (double(tx) + 0.5) * kWallBandRows * g.cell,
+               cy = g.y0 + 0.5 * (j0 + j1) * g.cell;
+  return distance2_point_segment(Vec2(cx, cy), Vec2(s.a.x, s.a.y), Vec2(s.b.x, s.b.y)) <=
+         (r + tile_half_diagonal) * (r + tile_half_diagonal);
+}
+
+// Each band's moves that come near one of its wall tiles, in program order (tip not yet set),
+// their columns cut to the span of the wall tiles they come near. Moves are taken in chunks on
+// `threads` threads; a move whose swept box holds no wall tile costs one look at the table.
+inline std::vector<std::vector<FineCellMove>> near_moves_by_band(const ZMapGrid& g,
+                                                                 std::span<const Cutter> cutters,
+                                                                 std::span<const CutMove> moves,
+                                                                 const WallTiles& walls,
+                                                                 unsigned threads) {
+  constexpr int kBandRows = kWallBandRows;
+  constexpr auto kWallTile = static_cast<std::uint32_t>(kWallBandRows);
+  constexpr std::size_t kChunk = 65536;
+  const std::size_t chunks = (moves.size() + kChunk - 1) / kChunk;
+  std::vector<std::vector<FineCellMove>> found(chunks);
+  for_each_chunk(chunks, threads, [&](std::size_t chunk) {
+    for (std::size_t m = chunk * kChunk; m < std::min(moves.size(), (chunk + 1) * kChunk); ++m) {
+      const Segment& s = moves[m].tip;
+      const double r = cutters[moves[m].cutter].radius();
+      const FineCellBox box = fine_cell_box(g, s, r);
+      if (box.row1 < 0 || box.row0 > g.ny - 2) continue;
+      const auto b0 = static_cast<std::size_t>(std::max(box.row0, 0) / kBandRows),
+                 b1 = static_cast<std::size_t>(std::min(box.row1, g.ny - 2) / kBandRows);
+      const std::uint32_t tx0 = box.i0 / kWallTile,
+                          tx1 = std::min(box.i1, static_cast<std::uint32_t>(g.nx - 2)) / kWallTile;
+      if (walls.count(b0, b1, tx0, tx1) == 0) continue;
+      for (std::size_t band = b0; band <= b1; ++band) {
+        if (walls.count(band, band, tx0, tx1) == 0) continue;
+        const int j0 = static_cast<int>(band) * kBandRows, j1 = std::min(g.ny - 1, j0 + kBandRows);
+        const int row0 = std::max(j0, box.row0), row1 = std::min(j1 - 1, box.row1);
+        if (row0 > row1) continue;
+        const auto begin =
+                       walls.tiles.begin() + static_cast<std::ptrdiff_t>(walls.band_begin[band]),
+                   end = walls.tiles.begin() +
+                         static_cast<std::ptrdiff_t>(walls.band_begin[band + 1]);
+        const auto first = std::lower_bound(begin, end, tx0);
+        const auto last = std::upper_bound(first, end, tx1);
+        auto lo = first;
+        while (lo != last && !near_wall_tile(g, j0, j1, *lo, s, r)) ++lo;
+        if (lo == last) continue;
+        auto hi = last - 1;
+        while (!near_wall_tile(g, j0, j1, *hi, s, r)) --hi;  // stops at lo, which passes
+        found[chunk].push_back({0.0, static_cast<std::uint32_t>(m),
+                                std::max(box.i0, *lo * kWallTile),
+                                std::min(box.i1, *hi * kWallTile + kWallTile - 1), row0, row1});
+      }
+    }
+  });
+  std::vector<std::vector<FineCellMove>> by_band(walls.bands);
+  std::vector<std::size_t> count(walls.bands, 0);
+  for (const auto& part : found)
+    for (const FineCellMove& n : part) ++count[static_cast<std::size_t>(n.row0 / kBandRows)];
+  for (std::size_t b = 0; b < walls.bands; ++b) by_band[b].reserve(count[b]);
+  for (auto& part : found) {
+    for (const FineCellMove& n : part)
+      by_band[static_cast<std::size_t>(n.row0 / kBandRows)].push_back(n);
+    part = {};
+  }
+  return by_band;
+}
+
+// Lowers the kPoints sub-point heights `h` of fine cell (i, j) under the moves `listed` (indices
+// into `near` and `geometry`, lowest tip first): to the lowest point of each swept cutter above
+// them. A move whose lowest tip is no lower than the cell's highest sub-point cannot lower one,
+// nor can any move after it in the list. Each other move gets a bound (its lowest tip plus the
+// profile's height at the cell's distance from its tip path) and waits in a heap; the moves are
+// evaluated lowest bound first, each once the list has passed its bound (no later move can have
+// a lower one), so that the deepest cuts come first and the rest mostly fail the bound, cell
+// and sub-point. `candidates` is scratch. The heights are a minimum, whatever the order.
+inline void lower_cell(const ZMapGrid& g, std::span<const CutMove> moves,
+                       const std::vector<FineCellMove>& near,
+                       const std::vector<MoveGeometry>& geometry,
+                       const std::vector<std::uint32_t>& listed, int i, int j, float* h,
+                       std::vector<std::pair<double, std::uint32_t>>& candidates) {
   constexpr int kSteps = ZMapFineCells::kSteps, kSide = ZMapFineCells::kSide;
   constexpr auto kPoints = static_cast<std::size_t>(ZMapFineCells::kPoints);
   const double step = g.cell / kSteps;  // exact: kSteps is a power of two
   const double half_diagonal = g.cell * std::sqrt(0.5) * (1 + 1e-9);
-  const double tile_half_diagonal = kWallBandRows * half_diagonal;
-  const double r = cutter.radius();
-  // Built here, for the few (band, move) pairs that come this far: kept for every move up
-  // front, the program's geometry took longer to write than the bands take to read.
-  const detail::MoveGeometry move(cutter, s);
-  const double tip = move.lowest_tip();
-  for (int j = n.row0; j <= n.row1; ++j) {
-    const auto row = static_cast<std::size_t>(j), base = row * static_cast<std::size_t>(g.nx);
-    const auto first = cells.begin() + static_cast<std::ptrdiff_t>(row_begin[row]);
-    const auto last = cells.begin() + static_cast<std::ptrdiff_t>(row_begin[row + 1]);
-    for (auto c = std::lower_bound(first, last, static_cast<std::uint32_t>(base + n.i0));
-         c != last && *c <= base + n.i1; ++c) {
-      const auto index = static_cast<std::size_t>(c - cells.begin());
-      if (tip >= double(cell_top[index])) continue;
-      const int i = static_cast<int>(*c - base);
-      // The cell's sub-points lie at least `reach` from the tip path in XY. Beyond the radius
-      // the cutter never passes over them; within it, the swept cutter stands at least the
-      // profile's height at `reach` above its lowest tip there (profiles rise outward), less a
-      // rounding margin far below float heights.
-      const double cx = g.x0 + (i + 0.5) * g.cell, cy = g.y0 + (j + 0.5) * g.cell;
-      const double reach =
-          std::sqrt(distance2_point_segment(Vec2(cx, cy), Vec2(s.a.x, s.a.y), Vec2(s.b.x, s.b.y))) -
-          half_diagonal;
-      if (reach > r + tile_half_diagonal) continue;
-      const double bound = tip + cutter.lower_height(std::max(0.0, reach)) - 1e-6;
-      if (bound >= double(cell_top[index])) continue;
+  const double cx = g.x0 + (i + 0.5) * g.cell, cy = g.y0 + (j + 0.5) * g.cell;
+  float top = *std::max_element(h, h + kPoints);
+  candidates.clear();
+  const auto later = [](const std::pair<double, std::uint32_t>& p,
+                        const std::pair<double, std::uint32_t>& q) { return p > q; };
+  const auto evaluate_below = [&](double limit) {
+    while (!candidates.empty() && candidates.front().first < limit) {
+      std::pop_heap(candidates.begin(), candidates.end(), later);
+      const double bound = candidates.back().first;
+      const MoveGeometry& move = geometry[candidates.back().second];
+      candidates.pop_back();
+      if (bound >= double(top)) continue;
       // The same bound, sub-point by sub-point: a wall cell next to uncut stock keeps its top at
       // the ceiling, so the cell's test passes for every move near it, while its sub-points
       // already cut at or below the bound cannot be lowered by this move.
-      float* h = sub.data() + index * kPoints;
       for (int b = 0; b < kSide; ++b)
         for (int a = 0; a < kSide; ++a) {
           float& to = h[a + kSide * b];
@@ -189,114 +268,107 @@ inline void lower_cells_under_move(const ZMapGrid& g, const Cutter& cutter, cons
           const double z = move.lowest(x, y).z;
           if (z < double(to)) to = static_cast<float>(z);
         }
-      cell_top[index] = *std::max_element(h, h + kPoints);
+      top = *std::max_element(h, h + kPoints);
+    }
+  };
+  for (std::uint32_t k : listed) {
+    const FineCellMove& n = near[k];
+    evaluate_below(n.tip);
+    if (n.tip >= double(top)) break;
+    if (j < n.row0 || j > n.row1 || static_cast<std::uint32_t>(i) < n.i0 ||
+        static_cast<std::uint32_t>(i) > n.i1)
+      continue;
+    const MoveGeometry& move = geometry[k];
+    const Segment& s = moves[n.move].tip;
+    // The cell's sub-points lie at least `reach` from the tip path in XY. Beyond the radius
+    // the cutter never passes over them; within it, the swept cutter stands at least the
+    // profile's height at `reach` above its lowest tip there (profiles rise outward), less a
+    // rounding margin far below float heights.
+    const double reach =
+        std::sqrt(distance2_point_segment(Vec2(cx, cy), Vec2(s.a.x, s.a.y), Vec2(s.b.x, s.b.y))) -
+        half_diagonal;
+    if (reach > move.radius) continue;
+    const double bound = n.tip + move.cutter->lower_height(std::max(0.0, reach)) - 1e-6;
+    if (bound >= double(top)) continue;
+    candidates.emplace_back(bound, k);
+    std::push_heap(candidates.begin(), candidates.end(), later);
+  }
+  evaluate_below(std::numeric_limits<double>::infinity());
+}
+
+// Lowers the fine cells of one band (lower_fine_cells) under its `near` moves: each wall tile
+// lists the moves that come within the radius of it, lowest tip first (a sub-point's height is
+// the minimum over the moves, whatever their order), and each fine cell of the tile runs down
+// its tile's list (lower_cell). A cell cut to its depth stops at the first move above it, so the
+// cost follows the walls and the moves that reach them, not every move over the band.
+inline void lower_band(const ZMapGrid& g, std::span<const Cutter> cutters,
+                       std::span<const CutMove> moves, const std::vector<std::uint32_t>& cells,
+                       const std::vector<std::size_t>& row_begin, const WallTiles& walls,
+                       std::size_t band, std::vector<FineCellMove>& near, std::vector<float>& sub) {
+  constexpr auto kWallTile = static_cast<std::uint32_t>(kWallBandRows);
+  constexpr auto kPoints = static_cast<std::size_t>(ZMapFineCells::kPoints);
+  const int j0 = static_cast<int>(band) * kWallBandRows,
+            j1 = std::min(g.ny - 1, j0 + kWallBandRows);
+  std::vector<MoveGeometry> geometry;
+  geometry.reserve(near.size());
+  for (FineCellMove& n : near) {
+    geometry.emplace_back(cutters[moves[n.move].cutter], moves[n.move].tip);
+    n.tip = geometry.back().lowest_tip();
+  }
+  std::vector<std::uint32_t> order(near.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<std::uint32_t>(k);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return near[a].tip < near[b].tip || (near[a].tip == near[b].tip && near[a].move < near[b].move);
+  });
+  const auto tiles = walls.tiles.begin() + static_cast<std::ptrdiff_t>(walls.band_begin[band]),
+             tiles_end =
+                 walls.tiles.begin() + static_cast<std::ptrdiff_t>(walls.band_begin[band + 1]);
+  std::vector<std::vector<std::uint32_t>> listed(static_cast<std::size_t>(tiles_end - tiles));
+  for (std::uint32_t k : order) {
+    const FineCellMove& n = near[k];
+    for (auto t = std::lower_bound(tiles, tiles_end, n.i0 / kWallTile);
+         t != tiles_end && *t <= n.i1 / kWallTile; ++t)
+      if (near_wall_tile(g, j0, j1, *t, moves[n.move].tip, geometry[k].radius))
+        listed[static_cast<std::size_t>(t - tiles)].push_back(k);
+  }
+  const auto nx = static_cast<std::size_t>(g.nx);
+  std::vector<std::pair<double, std::uint32_t>> candidates;
+  for (std::size_t t = 0; t < listed.size(); ++t) {
+    if (listed[t].empty()) continue;
+    const std::size_t c0 = tiles[static_cast<std::ptrdiff_t>(t)] * kWallTile,
+                      c1 = c0 + kWallTile - 1;
+    for (int j = j0; j < j1; ++j) {
+      const std::size_t base = static_cast<std::size_t>(j) * nx;
+      const auto first =
+          cells.begin() + static_cast<std::ptrdiff_t>(row_begin[static_cast<std::size_t>(j)]);
+      const auto last =
+          cells.begin() + static_cast<std::ptrdiff_t>(row_begin[static_cast<std::size_t>(j) + 1]);
+      for (auto c = std::lower_bound(first, last, static_cast<std::uint32_t>(base + c0));
+           c != last && *c <= base + c1; ++c)
+        lower_cell(g, moves, near, geometry, listed[t], static_cast<int>(*c - base), j,
+                   sub.data() + static_cast<std::size_t>(c - cells.begin()) * kPoints, candidates);
     }
   }
 }
 
 // The heart of refine_steep_cells: lowers `sub` (the fine cells' sub-point heights, kPoints per
-// cell of `cells`, all starting at `ceiling`) to the lowest point of every move's swept cutter
-// above them, band by band on `threads` threads (0: every hardware thread). row_begin[j] is the
-// first of `cells` in cell row j (cells.size() where the row has none).
+// cell of `cells`, from `ceiling` or lower: an embedder's cells already lowered by earlier moves)
+// to the lowest point of every move's swept cutter above them, band by band on `threads`
+// threads (0: every hardware thread). row_begin[j] is the first of `cells` in cell row j
+// (cells.size() where the row has none). The heights do not depend on the thread count.
 inline void lower_fine_cells(const ZMapGrid& g, std::span<const Cutter> cutters,
                              std::span<const CutMove> moves,
                              const std::vector<std::uint32_t>& cells,
-                             const std::vector<std::size_t>& row_begin, float ceiling,
+                             const std::vector<std::size_t>& row_begin, float /*ceiling*/,
                              unsigned threads, std::vector<float>& sub) {
-  // Bands of cell rows, one thread each at a time. Each band gets the moves whose swept box
-  // reaches it, in program order (a counting sort: one pass to count, one to place), so that a
-  // band never scans the whole program: a 5000-row map has 313 bands.
-  constexpr int kBandRows = kWallBandRows;
-  const int bands = (g.ny - 1 + kBandRows - 1) / kBandRows;
-  std::vector<std::uint8_t> wanted(static_cast<std::size_t>(bands));
-  for (int band = 0; band < bands; ++band)
-    wanted[static_cast<std::size_t>(band)] =
-        row_begin[static_cast<std::size_t>(band * kBandRows)] !=
-        row_begin[static_cast<std::size_t>(std::min(g.ny - 1, (band + 1) * kBandRows))];
-  const MovesByBand by_band = moves_by_band(g, cutters, moves, bands, wanted);
-  const std::vector<std::size_t>& band_begin = by_band.band_begin;
-  const std::vector<std::uint32_t>& band_moves = by_band.band_moves;
-  // The highest sub-point of each fine cell so far: a move whose swept cutter cannot reach below
-  // it over the cell cannot lower any of them, and is skipped.
-  std::vector<float> cell_top(cells.size(), ceiling);
-  const double half_diagonal = g.cell * std::sqrt(0.5) * (1 + 1e-9);
-  // Which tiles (a band's rows by as many columns) hold a fine cell.
-  constexpr std::size_t kBandTile = kBandRows;
-  const std::size_t tiles_x = (static_cast<std::size_t>(g.nx) - 1 + kBandTile - 1) / kBandTile;
-  const double tile_half_diagonal = kBandTile * half_diagonal;
-  std::vector<std::uint8_t> tile_walls(static_cast<std::size_t>(bands) * tiles_x, 0);
-  for (std::uint32_t c : cells)
-    tile_walls[c / static_cast<std::uint32_t>(g.nx) / kBandRows * tiles_x +
-               c % static_cast<std::uint32_t>(g.nx) / kBandTile] = 1;
-  // Each band's wall tiles in ascending order (band b's are wall_tiles[wall_begin[b]] up to
-  // wall_tiles[wall_begin[b + 1]]): a move's box is matched against them by binary search
-  // instead of a scan over every tile it spans (a raster line spans the whole map).
-  std::vector<std::size_t> wall_begin(static_cast<std::size_t>(bands) + 1, 0);
-  std::vector<std::uint32_t> wall_tiles;
-  for (std::size_t t = 0; t < tile_walls.size(); ++t)
-    if (tile_walls[t]) {
-      wall_tiles.push_back(static_cast<std::uint32_t>(t % tiles_x));
-      ++wall_begin[t / tiles_x + 1];
-    }
-  for (std::size_t b = 0; b < static_cast<std::size_t>(bands); ++b)
-    wall_begin[b + 1] += wall_begin[b];
-  std::vector<FineCellBox> boxes(moves.size());
-  detail::for_each_chunk((moves.size() + 65535) / 65536, threads, [&](std::size_t chunk) {
-    for (std::size_t m = chunk * 65536; m < std::min(moves.size(), (chunk + 1) * 65536); ++m)
-      boxes[m] = fine_cell_box(g, moves[m].tip, cutters[moves[m].cutter].radius());
-  });
-  detail::for_each_chunk(static_cast<std::size_t>(bands), threads, [&](std::size_t band_index) {
-    const int band = static_cast<int>(band_index);
-    const int j0 = band * kBandRows, j1 = std::min(g.ny - 1, j0 + kBandRows);
-    if (row_begin[static_cast<std::size_t>(j0)] == row_begin[static_cast<std::size_t>(j1)]) return;
-    const auto band_tiles_begin =
-                   wall_tiles.begin() + static_cast<std::ptrdiff_t>(wall_begin[band_index]),
-               band_tiles_end =
-                   wall_tiles.begin() + static_cast<std::ptrdiff_t>(wall_begin[band_index + 1]);
-    // The band's moves that come near one of its fine cells, lowest first: a sub-point's height
-    // is the minimum over the moves, whatever their order, and taken deepest first it is near
-    // its end at once, so that the moves above (a roughing program's earlier layers) fail the
-    // bound below instead of lowering it again, layer by layer.
-    std::vector<FineCellMove> near;
-    for (std::size_t at = band_begin[static_cast<std::size_t>(band)];
-         at < band_begin[static_cast<std::size_t>(band) + 1]; ++at) {
-      const std::uint32_t m = band_moves[at];
-      const FineCellBox& box = boxes[m];
-      const int row0 = std::max(j0, box.row0), row1 = std::min(j1 - 1, box.row1);
-      if (row0 > row1) continue;
-      std::uint32_t i0 = box.i0, i1 = box.i1;
-      const Segment& s = moves[m].tip;
-      const double r = cutters[moves[m].cutter].radius();
-      // Only the band's tiles that hold a fine cell and come within the radius of the tip
-      // path: most of a map has no wall, and a move's box spans many cell rows.
-      constexpr auto kWallTile = static_cast<std::uint32_t>(kBandTile);
-      const std::uint32_t tx0 = i0 / kWallTile,
-                          tx1 = std::min(i1, static_cast<std::uint32_t>(g.nx - 2)) / kWallTile;
-      auto near_tile = [&](std::uint32_t tx) {
-        const double cx = g.x0 + (double(tx) + 0.5) * kBandTile * g.cell,
-                     cy = g.y0 + 0.5 * (j0 + j1) * g.cell;
-        return distance2_point_segment(Vec2(cx, cy), Vec2(s.a.x, s.a.y), Vec2(s.b.x, s.b.y)) <=
-               (r + tile_half_diagonal) * (r + tile_half_diagonal);
-      };
-      // The first and the last of the band's wall tiles in tx0..tx1 that pass near_tile.
-      const auto first = std::lower_bound(band_tiles_begin, band_tiles_end, tx0);
-      const auto last = std::upper_bound(first, band_tiles_end, tx1);
-      auto lo = first;
-      while (lo != last && !near_tile(*lo)) ++lo;
-      if (lo == last) continue;
-      auto hi = last - 1;
-      while (!near_tile(*hi)) --hi;  // stops at lo, which passes
-      const std::size_t first_tile = *lo, last_tile = *hi;
-      i0 = std::max(i0, static_cast<std::uint32_t>(first_tile * kBandTile));
-      i1 = std::min(i1, static_cast<std::uint32_t>(last_tile * kBandTile + kBandTile - 1));
-      near.push_back({std::min(s.a.z, s.b.z), m, i0, i1, row0, row1});
-    }
-    std::sort(near.begin(), near.end(), [](const FineCellMove& a, const FineCellMove& b) {
-      return a.tip < b.tip || (a.tip == b.tip && a.move < b.move);
-    });
-    for (const FineCellMove& n : near)
-      lower_cells_under_move(g, cutters[moves[n.move].cutter], moves[n.move].tip, n, cells,
-                             row_begin, cell_top, sub);
+  const auto bands = static_cast<std::size_t>((g.ny - 1 + kWallBandRows - 1) / kWallBandRows);
+  const WallTiles walls = wall_tiles(g, bands, cells);
+  std::vector<std::vector<FineCellMove>> near =
+      near_moves_by_band(g, cutters, moves, walls, threads);
+  detail::for_each_chunk(bands, threads, [&](std::size_t band) {
+    if (!near[band].empty())
+      lower_band(g, cutters, moves, cells, row_begin, walls, band, near[band], sub);
+    near[band] = {};
   });
 }
 

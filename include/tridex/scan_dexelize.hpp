@@ -57,7 +57,9 @@ struct ScanVertex {
 // Scan-converts the polyhedron of one Z-map onto the rays of one family.
 class ZMapScanner {
  public:
-  ZMapScanner(const ZMap& map, const DexelLattice& lattice, int axis, const DexelGrid* mask)
+  // `highest` is the map's highest height (highest_height).
+  ZMapScanner(const ZMap& map, const DexelLattice& lattice, int axis, const DexelGrid* mask,
+              float highest)
       : map_(map), grid_(map.grid), lattice_(lattice), axis_(axis), mask_(mask) {
     u_ = TripleDexel::u_axis(axis), v_ = TripleDexel::v_axis(axis);
     nu_ = lattice.n[u_], nv_ = lattice.n[v_];
@@ -80,9 +82,7 @@ class ZMapScanner {
     tx_ = r[0][axis] * c / kSteps, ty_ = r[1][axis] * c / kSteps, tz_ = r[2][axis];
     // Fixed point: every |Q| below 2^61 so that differences stay below 2^62 and the edge
     // functions (sums of two products) below 2^125.
-    double top = bottom_;
-    for (float h : map.heights) top = std::max(top, double(h));
-    top = std::max(top, double(map.empty_height));
+    const double top = std::max({bottom_, double(highest), double(map.empty_height)});
     double reach = std::max(nu_, nv_) + 2.0;
     for (int ci = 0; ci < 2; ++ci)
       for (int cj = 0; cj < 2; ++cj)
@@ -104,58 +104,25 @@ class ZMapScanner {
       qx_[k] = kSteps * std::llround(bx[k] / kSteps * scale),
       qy_[k] = kSteps * std::llround(by[k] / kSteps * scale);
     }
+    // Every vertex of the top lies between these heights (fine sub-points too).
+    low_ = double(map.empty_height), high_ = top;
+    for (float h : map.fine.heights)
+      low_ = std::min(low_, double(h)), high_ = std::max(high_, double(h));
+    for (int i = 0; i + 1 < grid_.nx; ++i)
+      if (reaches_rays(std::int64_t{kSteps} * i, std::int64_t{kSteps} * (i + 1), 0,
+                       std::int64_t{kSteps} * (grid_.ny - 1)))
+        live_columns_.push_back(i);
   }
 
-  // Appends the crossings of the top triangles of cell rows [j0, j1) to `hits`.
+  // Appends the crossings of the top triangles of cell rows [j0, j1) to `hits`. Only the rows
+  // and the columns of cells whose vertices can reach a ray are visited: a family's rays cross
+  // the grid's rows (or columns) a ray spacing apart, when a lattice axis lies in the map's
+  // plane, and most cells lie between them.
   void scan_rows(int j0, int j1, std::vector<MeshHit>& hits) const {
-    const int nx = grid_.nx;
-    std::vector<ScanVertex> lower(static_cast<std::size_t>(nx)),
-        upper(static_cast<std::size_t>(nx));
-    std::vector<double> hl(static_cast<std::size_t>(nx)), hu(static_cast<std::size_t>(nx));
-    fill_row(j0, lower, hl);
-    for (int j = j0; j < j1; ++j) {
-      fill_row(j + 1, upper, hu);
-      // The row's fine cells, in ascending order: each is scanned as its sub-grid instead.
-      const std::uint32_t* fine =
-          map_.fine.empty()
-              ? nullptr
-              : map_.fine.cells.data() + map_.fine.row_begin[static_cast<std::size_t>(j)];
-      const std::uint32_t* fine_end =
-          fine ? map_.fine.cells.data() + map_.fine.row_begin[static_cast<std::size_t>(j) + 1]
-               : nullptr;
-      const std::size_t row_base = grid_.index(0, j);
-      for (int i = 0; i + 1 < nx; ++i) {
-        const auto ii = static_cast<std::size_t>(i);
-        if (fine != fine_end && *fine == row_base + ii) {
-          fine_cell(
-              i, j,
-              map_.fine.heights.data() +
-                  static_cast<std::size_t>(fine - map_.fine.cells.data()) * ZMapFineCells::kPoints,
-              hits);
-          ++fine;
-          continue;
-        }
-        const ScanVertex &p00 = lower[ii], &p10 = lower[ii + 1], &p01 = upper[ii],
-                         &p11 = upper[ii + 1];
-        std::int64_t lo_u = std::min(std::min(p00.u, p10.u), std::min(p01.u, p11.u));
-        std::int64_t hi_u = std::max(std::max(p00.u, p10.u), std::max(p01.u, p11.u));
-        std::int64_t iu0 = ceil_units(lo_u), iu1 = ceil_units(hi_u) - 1;
-        if (iu0 > iu1) continue;  // no ray column inside the cell's projection: the common case
-        std::int64_t lo_v = std::min(std::min(p00.v, p10.v), std::min(p01.v, p11.v));
-        std::int64_t hi_v = std::max(std::max(p00.v, p10.v), std::max(p01.v, p11.v));
-        std::int64_t iv0 = ceil_units(lo_v), iv1 = ceil_units(hi_v) - 1;
-        if (iv0 > iv1) continue;
-        // The t of each corner is only needed now.
-        ScanVertex a = p00, b = p10, c = p11, d = p01;
-        const std::int64_t I = std::int64_t{kSteps} * i, J = std::int64_t{kSteps} * j;
-        a.t = world_t(I, J, hl[ii]), b.t = world_t(I + kSteps, J, hl[ii + 1]);
-        c.t = world_t(I + kSteps, J + kSteps, hu[ii + 1]), d.t = world_t(I, J + kSteps, hu[ii]);
-        triangle(a, b, c, hits);
-        triangle(a, c, d, hits);
-      }
-      std::swap(lower, upper);
-      std::swap(hl, hu);
-    }
+    if (2 * live_columns_.size() < static_cast<std::size_t>(grid_.nx))
+      scan_live_columns(j0, j1, hits);
+    else
+      scan_all_columns(j0, j1, hits);
   }
 
   // Appends the crossings of the four walls and the bottom to `hits`.
@@ -183,6 +150,123 @@ class ZMapScanner {
 
  private:
   static constexpr int kSteps = ZMapFineCells::kSteps;
+
+  // Whether a ray of the family can meet a vertex rectangle: the fine sub-points I0..I1, J0..J1
+  // (grid point (i, j) is (kSteps·i, kSteps·j)) at any height of the top. Each coordinate is an
+  // affine map of (I, J) plus a rounding monotone in the height, so its extremes lie at the
+  // corners; a triangle's rays (triangle()) lie within its vertices' range.
+  bool reaches_rays(std::int64_t I0, std::int64_t I1, std::int64_t J0, std::int64_t J1) const {
+    const std::int64_t n[2] = {nu_, nv_};
+    for (int k = 0; k < 2; ++k) {
+      const std::int64_t sx = qx_[k] / kSteps, sy = qy_[k] / kSteps;
+      const std::int64_t r0 = round_fixed(low_ * qz_[k]), r1 = round_fixed(high_ * qz_[k]);
+      const std::int64_t lo =
+          q0_[k] + std::min(I0 * sx, I1 * sx) + std::min(J0 * sy, J1 * sy) + std::min(r0, r1);
+      const std::int64_t hi =
+          q0_[k] + std::max(I0 * sx, I1 * sx) + std::max(J0 * sy, J1 * sy) + std::max(r0, r1);
+      if (std::max<std::int64_t>(0, ceil_units(lo)) > std::min(n[k] - 1, ceil_units(hi) - 1))
+        return false;
+    }
+    return true;
+  }
+
+  bool row_reaches_rays(int j) const {
+    return reaches_rays(0, std::int64_t{kSteps} * (grid_.nx - 1), std::int64_t{kSteps} * j,
+                        std::int64_t{kSteps} * (j + 1));
+  }
+
+  // The fine cells of cell row j, ascending (both null when the map has none).
+  std::pair<const std::uint32_t*, const std::uint32_t*> row_fine_cells(int j) const {
+    if (map_.fine.empty()) return {nullptr, nullptr};
+    const std::uint32_t* cells = map_.fine.cells.data();
+    return {cells + map_.fine.row_begin[static_cast<std::size_t>(j)],
+            cells + map_.fine.row_begin[static_cast<std::size_t>(j) + 1]};
+  }
+
+  const float* fine_heights(const std::uint32_t* fine) const {
+    return map_.fine.heights.data() +
+           static_cast<std::size_t>(fine - map_.fine.cells.data()) * ZMapFineCells::kPoints;
+  }
+
+  // Every cell of the rows that can reach a ray, from rows of vertices filled once each.
+  void scan_all_columns(int j0, int j1, std::vector<MeshHit>& hits) const {
+    const int nx = grid_.nx;
+    std::vector<ScanVertex> lower(static_cast<std::size_t>(nx)),
+        upper(static_cast<std::size_t>(nx));
+    std::vector<double> hl(static_cast<std::size_t>(nx)), hu(static_cast<std::size_t>(nx));
+    int filled = -1;  // the row `lower` holds
+    for (int j = j0; j < j1; ++j) {
+      if (!row_reaches_rays(j)) continue;
+      if (filled != j) fill_row(j, lower, hl);
+      fill_row(j + 1, upper, hu);
+      filled = j + 1;
+      // The row's fine cells, in ascending order: each is scanned as its sub-grid instead.
+      auto [fine, fine_end] = row_fine_cells(j);
+      const std::size_t row_base = grid_.index(0, j);
+      for (int i = 0; i + 1 < nx; ++i) {
+        const auto ii = static_cast<std::size_t>(i);
+        if (fine != fine_end && *fine == row_base + ii) {
+          fine_cell(i, j, fine_heights(fine), hits);
+          ++fine;
+          continue;
+        }
+        plain_cell(i, j, lower[ii], lower[ii + 1], upper[ii], upper[ii + 1], hl[ii], hl[ii + 1],
+                   hu[ii], hu[ii + 1], hits);
+      }
+      std::swap(lower, upper);
+      std::swap(hl, hu);
+    }
+  }
+
+  // Only the columns that can reach a ray (live_columns_), their vertices computed cell by cell.
+  void scan_live_columns(int j0, int j1, std::vector<MeshHit>& hits) const {
+    for (int j = j0; j < j1; ++j) {
+      if (!row_reaches_rays(j)) continue;
+      auto [fine, fine_end] = row_fine_cells(j);
+      const std::size_t row_base = grid_.index(0, j);
+      for (int i : live_columns_) {
+        const auto ii = static_cast<std::size_t>(i);
+        while (fine != fine_end && *fine < row_base + ii) ++fine;
+        if (fine != fine_end && *fine == row_base + ii) {
+          fine_cell(i, j, fine_heights(fine), hits);
+          ++fine;
+          continue;
+        }
+        double h[4];
+        ScanVertex p[4];
+        for (int c = 0; c < 4; ++c) p[c] = grid_vertex(i + (c & 1), j + (c >> 1), h[c]);
+        plain_cell(i, j, p[0], p[1], p[2], p[3], h[0], h[1], h[2], h[3], hits);
+      }
+    }
+  }
+
+  // Grid point (i, j)'s vertex as fill_row gives it (its t unset), and its height in `h`.
+  ScanVertex grid_vertex(int i, int j, double& h) const {
+    h = std::max(double(map_.heights[grid_.index(i, j)]), double(map_.empty_height));
+    return {q0_[0] + j * qy_[0] + i * qx_[0] + round_fixed(h * qz_[0]),
+            q0_[1] + j * qy_[1] + i * qx_[1] + round_fixed(h * qz_[1]), 0};
+  }
+
+  // A plain cell: its two top triangles, from its corners' vertices (t unset) and heights.
+  void plain_cell(int i, int j, const ScanVertex& p00, const ScanVertex& p10, const ScanVertex& p01,
+                  const ScanVertex& p11, double h00, double h10, double h01, double h11,
+                  std::vector<MeshHit>& hits) const {
+    std::int64_t lo_u = std::min(std::min(p00.u, p10.u), std::min(p01.u, p11.u));
+    std::int64_t hi_u = std::max(std::max(p00.u, p10.u), std::max(p01.u, p11.u));
+    std::int64_t iu0 = ceil_units(lo_u), iu1 = ceil_units(hi_u) - 1;
+    if (iu0 > iu1) return;  // no ray column inside the cell's projection: the common case
+    std::int64_t lo_v = std::min(std::min(p00.v, p10.v), std::min(p01.v, p11.v));
+    std::int64_t hi_v = std::max(std::max(p00.v, p10.v), std::max(p01.v, p11.v));
+    std::int64_t iv0 = ceil_units(lo_v), iv1 = ceil_units(hi_v) - 1;
+    if (iv0 > iv1) return;
+    // The t of each corner is only needed now.
+    ScanVertex a = p00, b = p10, c = p11, d = p01;
+    const std::int64_t I = std::int64_t{kSteps} * i, J = std::int64_t{kSteps} * j;
+    a.t = world_t(I, J, h00), b.t = world_t(I + kSteps, J, h10);
+    c.t = world_t(I + kSteps, J + kSteps, h11), d.t = world_t(I, J + kSteps, h01);
+    triangle(a, b, c, hits);
+    triangle(a, c, d, hits);
+  }
 
   // A fine cell (ZMapFineCells): the triangles of its sub-grid, and the vertical steps along its
   // edges to plain neighbours (polyhedron.hpp, fine_cell_step).
@@ -261,14 +345,15 @@ class ZMapScanner {
   // The crossings of triangle a, b, c (counter-clockwise seen from outside) with the rays.
   void triangle(const ScanVertex& a, const ScanVertex& b, const ScanVertex& c,
                 std::vector<MeshHit>& hits) const {
-    const ScanWide area = ScanWide(b.u - a.u) * (c.v - a.v) - ScanWide(b.v - a.v) * (c.u - a.u);
-    if (area == 0) return;  // seen edge-on: the perturbed ray misses it
-    const int orientation = area > 0 ? 1 : -1;
+    // The rays within its bounding box first: most triangles of a fine cell have none.
     std::int64_t iu0 = std::max<std::int64_t>(0, ceil_units(std::min({a.u, b.u, c.u})));
     std::int64_t iu1 = std::min<std::int64_t>(nu_ - 1, ceil_units(std::max({a.u, b.u, c.u})) - 1);
     std::int64_t iv0 = std::max<std::int64_t>(0, ceil_units(std::min({a.v, b.v, c.v})));
     std::int64_t iv1 = std::min<std::int64_t>(nv_ - 1, ceil_units(std::max({a.v, b.v, c.v})) - 1);
     if (iu0 > iu1 || iv0 > iv1) return;
+    const ScanWide area = ScanWide(b.u - a.u) * (c.v - a.v) - ScanWide(b.v - a.v) * (c.u - a.u);
+    if (area == 0) return;  // seen edge-on: the perturbed ray misses it
+    const int orientation = area > 0 ? 1 : -1;
     const double lo_t = std::min({a.t, b.t, c.t}), hi_t = std::max({a.t, b.t, c.t});
     const double inverse_area = 1.0 / double(area);
     // A long thin triangle seen at a slant (a wall of a tilted map) has a bounding box of many
@@ -300,9 +385,6 @@ class ZMapScanner {
         row_u1 = std::min(iu1, static_cast<std::int64_t>(std::ceil(hi / one)) + 1);
       }
       for (std::int64_t iu = row_u0; iu <= row_u1; ++iu) {
-        auto ray = static_cast<std::uint32_t>(iu + std::int64_t{nu_} * iv);
-        if (mask_ && mask_->offsets[ray] == mask_->offsets[ray + 1])
-          continue;  // nothing left to cut
         const std::int64_t pu = iu << bits_, pv = iv << bits_;
         ScanWide wc =
             ScanWide(b.u - a.u) * (pv - a.v) - ScanWide(b.v - a.v) * (pu - a.u);  // edge a→b
@@ -313,6 +395,10 @@ class ZMapScanner {
         ScanWide wb =
             ScanWide(a.u - c.u) * (pv - c.v) - ScanWide(a.v - c.v) * (pu - c.u);  // edge c→a
         if (perturbed_sign_wide(wb, a.u - c.u, a.v - c.v) != orientation) continue;
+        auto ray = static_cast<std::uint32_t>(iu + std::int64_t{nu_} * iv);
+        // Looked up for the crossings only: the mask is large and the tests above are not.
+        if (mask_ && mask_->offsets[ray] == mask_->offsets[ray + 1])
+          continue;  // nothing left to cut
         double t = (double(wa) * a.t + double(wb) * b.t + double(wc) * c.t) * inverse_area;
         t = std::clamp(t, lo_t, hi_t);  // rounding: the crossing lies within the triangle's extent
         // Normal along +axis (counter-clockwise in (u, v)) means the ray leaves there.
@@ -336,12 +422,34 @@ class ZMapScanner {
   std::int64_t q0_[2]{}, qx_[2]{}, qy_[2]{};
   double qz_[2]{};
   double t0_ = 0, tx_ = 0, ty_ = 0, tz_ = 0;
+  double low_ = 0, high_ = 0;      // the top's lowest and highest vertex heights
+  std::vector<int> live_columns_;  // the cell columns whose vertices can reach a ray
 };
 
+// The highest of a map's heights, on `threads` threads: found once per map, not per family.
+inline float highest_height(const ZMap& map, unsigned threads) {
+  constexpr std::size_t kChunk = std::size_t{1} << 20, kPartials = 16;
+  const std::size_t n = map.heights.size(), chunks = (n + kChunk - 1) / kChunk;
+  std::vector<float> part(chunks, -std::numeric_limits<float>::infinity());
+  for_each_chunk(chunks, threads, [&](std::size_t c) {
+    const float* h = map.heights.data() + c * kChunk;
+    const std::size_t count = std::min(kChunk, n - c * kChunk);
+    float lane[kPartials];  // independent maxima, so that the loop vectorises
+    std::fill_n(lane, kPartials, -std::numeric_limits<float>::infinity());
+    std::size_t k = 0;
+    for (; k + kPartials <= count; k += kPartials)
+      for (std::size_t l = 0; l < kPartials; ++l) lane[l] = h[k + l] > lane[l] ? h[k + l] : lane[l];
+    for (; k < count; ++k) lane[0] = h[k] > lane[0] ? h[k] : lane[0];
+    part[c] = *std::max_element(lane, lane + kPartials);
+  });
+  return *std::max_element(part.begin(), part.end());
+}
+
 // One family of rays: scan on `threads` threads, counting-sort the crossings by ray, pair them.
+// `highest` is highest_height(map).
 inline DexelGrid scan_family(const ZMap& map, const DexelLattice& lattice, int axis,
-                             unsigned threads, const DexelGrid* mask) {
-  const ZMapScanner scanner(map, lattice, axis, mask);
+                             unsigned threads, const DexelGrid* mask, float highest) {
+  const ZMapScanner scanner(map, lattice, axis, mask, highest);
   threads = resolve_threads(threads);
   const int rows = map.grid.ny - 1;
   const int rows_per_item = 16;
@@ -375,8 +483,9 @@ inline TripleDexel scan_dexelize(const ZMap& map, const DexelLattice& lattice,
   detail::require_solid_zmap(map, "scan dexelize");
   TripleDexel result;
   result.origin = lattice.origin, result.spacing = lattice.spacing, result.n = lattice.n;
+  const float highest = detail::highest_height(map, threads);
   for (int axis = 0; axis < 3; ++axis)
-    result.grids[axis] = detail::scan_family(map, lattice, axis, threads, nullptr);
+    result.grids[axis] = detail::scan_family(map, lattice, axis, threads, nullptr, highest);
   return result;
 }
 
@@ -389,8 +498,10 @@ inline TripleDexel scan_intersect_milled(const TripleDexel& stock, std::span<con
   const DexelLattice lattice = stock.lattice();
   TripleDexel result = stock;
   for (const ZMap& map : milled) {
+    const float highest = detail::highest_height(map, threads);
     for (int axis = 0; axis < 3; ++axis) {
-      DexelGrid cut = detail::scan_family(map, lattice, axis, threads, &result.grids[axis]);
+      DexelGrid cut =
+          detail::scan_family(map, lattice, axis, threads, &result.grids[axis], highest);
       const DexelGrid& current = result.grids[axis];
       result.grids[axis] = detail::build_grid(
           lattice, axis, threads, [&](std::size_t r, std::vector<DexelInterval>& out) {

@@ -133,3 +133,38 @@ TEST_CASE("scan dexelize rejects bad input with clear errors") {
   DexelLattice far{Vec3(0), 1e-15, glm::ivec3(4)};
   CHECK_THROWS_WITH_AS(scan_dexelize(map, far), doctest::Contains("too far"), Error);
 }
+
+TEST_CASE(
+    "scan dexelize visiting only the rows and columns that reach a ray equals the grid tree on "
+    "frames along the lattice") {
+  // A frame whose x or y runs along a lattice axis puts the rays of two families a ray spacing
+  // apart across the grid's rows or columns, and the scanner skips the rows and columns in
+  // between (ZMapScanner::reaches_rays): on a lattice several cells apart, most of them. Turned
+  // about the lattice's axes (quarter turns, and a tilt about y as the paper-scale workload's
+  // fifth direction), with fine cells, against the grid tree ray by ray.
+  std::mt19937 rng(919);
+  std::uniform_real_distribution<double> unit(0, 1);
+  const Aabb stock{Vec3(0, 0, 0), Vec3(3, 2.5, 2)};
+  const Frame frames[] = {
+      Frame{}, Frame::from_rotation(rotation_x(90)), Frame::from_rotation(rotation_y(-90)),
+      Frame::from_rotation(rotation_y(70)), Frame::from_rotation(rotation_x(180) * rotation_z(90))};
+  RayComparison total;
+  std::size_t fine_cells = 0;
+  for (int trial = 0; trial < 10; ++trial) {
+    const Frame& frame = frames[trial % 5];
+    const double cell = 0.03 + 0.02 * unit(rng);
+    const ZMap map = random_milled_map(rng, stock, frame, cell, 10, trial % 2 == 0);
+    fine_cells += map.fine.cells.size();
+    DexelLattice l = DexelLattice::covering(stock.inflated(0.2), (3 + 4 * unit(rng)) * cell);
+    l.origin += Vec3(unit(rng), unit(rng), unit(rng)) * (0.5 * l.spacing);
+    const unsigned threads = 1 + static_cast<unsigned>(trial % 2);
+    const TripleDexel scan = scan_dexelize(map, l, threads);
+    validate(scan);
+    const RayComparison c = compare_rays(dexelize(map, l, {.threads = threads}), scan, 1e-4);
+    total.rays += c.rays, total.mismatches += c.mismatches, total.intervals += c.intervals;
+  }
+  INFO("rays ", total.rays, " intervals ", total.intervals, " mismatches ", total.mismatches);
+  CHECK(total.intervals > 5000);
+  CHECK(total.mismatches == 0);
+  CHECK(fine_cells > 200);
+}

@@ -334,3 +334,96 @@ TEST_CASE(
     for (unsigned threads : {1u, 2u, 3u}) CHECK(steep_cells(map, 1.5, threads) == want);
   }
 }
+
+namespace test_fine_cells {
+
+// A pocket roughed in layers, top down, by a raster of short flat-end moves, then its walls
+// finished by a ball end sloping down round it: the walls are cut again layer after layer, and
+// their cells next to uncut stock keep sub-points at the ceiling.
+std::vector<CutMove> raster_pocket(const Aabb& local) {
+  std::vector<CutMove> moves;
+  // Steps off the grid's: a sub-point exactly a radius from a move is a tie that the moves'
+  // boxes and MoveGeometry::lowest settle differently.
+  const double x0 = local.min.x + 1.4137, x1 = local.max.x - 1.3871;
+  const double y0 = local.min.y + 1.1173, y1 = local.max.y - 1.0919;
+  for (int layer = 1; layer <= 4; ++layer) {
+    const double z = local.max.z - 0.3 * layer;
+    for (double y = y0; y <= y1 + 1e-9; y += 0.2917)
+      for (double x = x0; x < x1 - 1e-9; x += 0.2113)
+        moves.push_back({Segment{Vec3(x, y, z), Vec3(std::min(x + 0.2113, x1), y, z)}, 0});
+  }
+  const Vec3 corners[] = {Vec3(x0, y0, 0), Vec3(x1, y0, 0), Vec3(x1, y1, 0), Vec3(x0, y1, 0)};
+  double z = local.max.z - 0.2;
+  for (int lap = 0; lap < 3; ++lap)
+    for (int side = 0; side < 4; ++side)
+      for (int k = 0; k < 8; ++k) {
+        const Vec3 a = corners[side], b = corners[(side + 1) % 4];
+        const Vec3 p = a + (b - a) * (k / 8.0), q = a + (b - a) * ((k + 1) / 8.0);
+        moves.push_back({Segment{Vec3(p.x, p.y, z), Vec3(q.x, q.y, z - 0.01)}, 1});
+        z -= 0.01;
+      }
+  return moves;
+}
+
+}  // namespace test_fine_cells
+
+TEST_CASE(
+    "refine steep cells: a raster pocket's sub-points are the brute-force lowest points, in one "
+    "call or two, on any thread count") {
+  // Each fine cell runs down its wall tile's moves lowest bound first and stops at the first
+  // move above it (lower_fine_cells): the heights are the minimum over every move, whatever
+  // the order, so lowering by the first moves and then by the rest from those heights (as an
+  // embedder does when moves come later) gives the same heights as one call.
+  const Aabb stock{Vec3(0), Vec3(6, 4.5, 3)};
+  const Frame frame = Frame::from_rotation(rotation_z(11));
+  ZMap map = ZMap::from_box(frame, stock, 0.1);
+  const ZMap initial = map;
+  const std::vector<Cutter> cutters{Cutter::flat(0.6), Cutter::ball(0.3)};
+  const std::vector<CutMove> moves = test_fine_cells::raster_pocket(local_bounds(frame, stock));
+  mill(map, cutters, moves, {.threads = 1});
+  raise_uncut(map, initial);
+  const std::vector<std::uint32_t> cells = steep_cells(map, 1.5);
+  REQUIRE(cells.size() > 150);
+  const ZMapGrid& g = map.grid;
+  std::vector<std::size_t> row_begin(static_cast<std::size_t>(g.ny), cells.size());
+  for (std::size_t k = cells.size(); k-- > 0;)
+    row_begin[cells[k] / static_cast<std::uint32_t>(g.nx)] = k;
+  for (std::size_t row = row_begin.size() - 1; row-- > 0;)
+    row_begin[row] = std::min(row_begin[row], row_begin[row + 1]);
+  const float ceiling = *std::max_element(map.heights.begin(), map.heights.end());
+  const std::size_t points = cells.size() * ZMapFineCells::kPoints;
+  auto lowered = [&](std::span<const CutMove> first, std::span<const CutMove> rest,
+                     unsigned threads) {
+    std::vector<float> sub(points, ceiling);
+    detail::lower_fine_cells(g, cutters, first, cells, row_begin, ceiling, threads, sub);
+    detail::lower_fine_cells(g, cutters, rest, cells, row_begin, ceiling, threads, sub);
+    return sub;
+  };
+  const std::span<const CutMove> all(moves);
+  const std::vector<float> once = lowered(all, {}, 2);
+  CHECK(lowered(all, {}, 1) == once);
+  CHECK(lowered(all.first(moves.size() / 3), all.subspan(moves.size() / 3), 2) == once);
+
+  std::vector<detail::MoveGeometry> geometry;
+  for (const CutMove& m : moves) geometry.emplace_back(cutters[m.cutter], m.tip);
+  const double step = g.cell / kSteps;
+  std::size_t wrong = 0, at_ceiling = 0, lowered_points = 0;
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    const int i = static_cast<int>(cells[k] % static_cast<std::uint32_t>(g.nx));
+    const int j = static_cast<int>(cells[k] / static_cast<std::uint32_t>(g.nx));
+    for (int b = 0; b < kSide; ++b)
+      for (int a = 0; a < kSide; ++a) {
+        const double x = g.x0 + (kSteps * i + a) * step, y = g.y0 + (kSteps * j + b) * step;
+        double lowest = ceiling;
+        for (const detail::MoveGeometry& m : geometry) lowest = std::min(lowest, m.lowest(x, y).z);
+        const float got =
+            once[k * ZMapFineCells::kPoints + static_cast<std::size_t>(a + kSide * b)];
+        wrong += got != static_cast<float>(lowest);
+        at_ceiling += got == ceiling;
+        lowered_points += got < ceiling;
+      }
+  }
+  CHECK(wrong == 0);
+  CHECK(at_ceiling > 100);  // cells next to uncut stock
+  CHECK(lowered_points > 1000);
+}

@@ -55,12 +55,41 @@ inline int grid_count(double extent, double cell, const char* what) {
 // Row j of ZMap::from_box's heights on `g`: the top of the box above each point, or `empty`
 // outside its projection. raise_uncut for a box computes the same rows again, so both must come
 // from here to agree bit for bit.
+// It is line_box_interval at each point, taken axis by axis over blocks of points (the same
+// arithmetic, no early exit), so that the compiler can vectorise the divisions.
 inline void box_top_row(const ZMapGrid& g, const Aabb& stock, float empty, int j, float* row) {
   const Vec3 up = g.frame.axis();
-  for (int i = 0; i < g.nx; ++i) {
-    double s0, s1;
-    const Vec3 p = g.frame.to_world(Vec3(g.x(i), g.y(j), 0));
-    row[i] = line_box_interval(p, up, stock, s0, s1) ? static_cast<float>(s1) : empty;
+  constexpr int kBlock = 256;
+  double p[3][kBlock], s0[kBlock], s1[kBlock];
+  unsigned char inside[kBlock];
+  for (int i0 = 0; i0 < g.nx; i0 += kBlock) {
+    const int n = std::min(kBlock, g.nx - i0);
+    for (int k = 0; k < n; ++k) {
+      const Vec3 w = g.frame.to_world(Vec3(g.x(i0 + k), g.y(j), 0));
+      p[0][k] = w.x, p[1][k] = w.y, p[2][k] = w.z;
+      s0[k] = -std::numeric_limits<double>::infinity();
+      s1[k] = std::numeric_limits<double>::infinity();
+      inside[k] = 1;
+    }
+    for (int a = 0; a < 3; ++a) {
+      const double lo = stock.min[a], hi = stock.max[a], d = up[a];
+      const double* pa = p[a];
+      if (std::abs(d) < 1e-15) {
+        for (int k = 0; k < n; ++k)
+          inside[k] = static_cast<unsigned char>(inside[k] & !(pa[k] < lo) & !(pa[k] > hi));
+        continue;
+      }
+      for (int k = 0; k < n; ++k) {
+        const double t0 = (lo - pa[k]) / d, t1 = (hi - pa[k]) / d;
+        const double near = t0 > t1 ? t1 : t0, far = t0 > t1 ? t0 : t1;  // the swap
+        s0[k] = s0[k] < near ? near : s0[k];                             // std::max
+        s1[k] = far < s1[k] ? far : s1[k];                               // std::min
+      }
+    }
+    for (int k = 0; k < n; ++k) {
+      const float top = static_cast<float>(s1[k]);
+      row[i0 + k] = (inside[k] & (s0[k] <= s1[k])) ? top : empty;
+    }
   }
 }
 
@@ -181,6 +210,7 @@ void raise_uncut_rows(ZMap& milled, float initial_empty, InitialRow&& initial_ro
                       unsigned threads) {
   const ZMapGrid& a = milled.grid;
   const std::size_t nx = static_cast<std::size_t>(a.nx);
+  constexpr std::size_t kPartials = 16;
   const auto bands = static_cast<std::size_t>((a.ny + kMapBandRows - 1) / kMapBandRows);
   std::vector<std::uint8_t> uncut(a.size());
   std::vector<float> band_top(bands, milled.empty_height);
@@ -199,13 +229,22 @@ void raise_uncut_rows(ZMap& milled, float initial_empty, InitialRow&& initial_ro
       return i >= 0 && j >= 0 && i < a.nx && j < a.ny && initial(i, j) > initial_empty;
     };
     auto cut = [&](int i, int j) { return inside(i, j) && milled.height(i, j) != initial(i, j); };
-    float top = band_top[band];
-    for (int j = j0; j < j1; ++j)
+    float top[kPartials];          // independent maxima, so that the loop below vectorises
+    const std::size_t width = nx;  // a copy: the marks are bytes, which may alias a reference
+    std::fill_n(top, kPartials, band_top[band]);
+    for (int j = j0; j < j1; ++j) {
+      const float* init = window.data() + static_cast<std::size_t>(j - w0) * nx;
+      const float* height = milled.heights.data() + a.index(0, j);
+      std::uint8_t* mark = uncut.data() + a.index(0, j);
+      for (std::size_t k = 0; k < width; ++k) mark[k] = height[k] == init[k];
+      std::size_t k = 0;
+      for (; k + kPartials <= width; k += kPartials)
+        for (std::size_t l = 0; l < kPartials; ++l)
+          top[l] = init[k + l] > top[l] ? init[k + l] : top[l];
+      for (; k < width; ++k) top[0] = init[k] > top[0] ? init[k] : top[0];
       for (int i = 0; i < a.nx; ++i) {
+        if (init[static_cast<std::size_t>(i)] > initial_empty) continue;  // inside the footprint
         const std::size_t p = a.index(i, j);
-        top = std::max(top, initial(i, j));
-        uncut[p] = milled.heights[p] == initial(i, j);
-        if (inside(i, j)) continue;
         float best = -std::numeric_limits<float>::infinity();
         for (int dj = -1; dj <= 1; ++dj)
           for (int di = -1; di <= 1; ++di) {
@@ -217,7 +256,8 @@ void raise_uncut_rows(ZMap& milled, float initial_empty, InitialRow&& initial_ro
           }
         if (best > -std::numeric_limits<float>::infinity()) continued[band].emplace_back(p, best);
       }
-    band_top[band] = top;
+    }
+    band_top[band] = *std::max_element(top, top + kPartials);
   });
   const float top = *std::max_element(band_top.begin(), band_top.end());
   const float above = static_cast<float>(top + empty_margin(a.cell));
@@ -225,8 +265,10 @@ void raise_uncut_rows(ZMap& milled, float initial_empty, InitialRow&& initial_ro
   for_each_chunk(bands, threads, [&](std::size_t band) {
     const std::size_t p0 = band * kMapBandRows * nx,
                       p1 = std::min(a.size(), p0 + kMapBandRows * nx);
-    for (std::size_t p = p0; p < p1; ++p)
-      if (uncut[p]) milled.heights[p] = above;
+    float* height = milled.heights.data();
+    const std::uint8_t* raise = uncut.data();
+    const float lifted = above;
+    for (std::size_t p = p0; p < p1; ++p) height[p] = raise[p] ? lifted : height[p];
     for (const auto& [p, h] : continued[band])
       milled.heights[p] = std::clamp(h, milled.empty_height, above);
   });
