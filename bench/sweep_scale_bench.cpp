@@ -94,8 +94,9 @@ double wall_now() {
 }
 
 SweepCutter scale_cutter(int shape, double chord) {
-  const Cutter c = shape == 0 ? Cutter::ball(3) : shape == 1 ? Cutter::flat(3)
-                                                             : Cutter::bull_nose(3, 1);
+  const Cutter c = shape == 0   ? Cutter::ball(3)
+                   : shape == 1 ? Cutter::flat(3)
+                                : Cutter::bull_nose(3, 1);
   return {c, c.profile_height() + 4 * c.radius(), shape == 2 ? chord : 0.0};
 }
 
@@ -119,8 +120,7 @@ void BM_sweep_scale(benchmark::State& state) {
   const std::vector<SweepCutter> cutters{scale_cutter(shape, tolerance / 4)};
   const SweepShape sweep = sweep_shape(cutters[0]);
   const double corner = shape == 0 ? 3 : shape == 1 ? 0 : 1;
-  const std::vector<ScalePose> poses =
-      scale_program(static_cast<int>(state.range(0)), 3, corner);
+  const std::vector<ScalePose> poses = scale_program(static_cast<int>(state.range(0)), 3, corner);
   const Aabb box{Vec3(-kHalf, -kHalf, 0), Vec3(kHalf, kHalf, 30)};
   const DexelLattice lattice = DexelLattice::covering(box, spacing);
   const Mesh mesh = stock_mesh(0.5);
