@@ -489,6 +489,52 @@ inline SweepStepCut sweep_step_cut(const SweepCutter& c, const SweepPartShape& p
   return cut;
 }
 
+// The bound of a group of steps (more than one) of one closed cutter part `part`
+// (detail/sweep_rows.hpp). Ball tips: the capsule around the chord of their centres, grown by
+// the members' centres' largest distance from it. Other parts: the part lies within a cylinder
+// of radius ρ (its widest piece) between heights h0 and h1 above the tip; a member's tip path lies
+// within δ of the chord of the group's tips (both ends do: distance to a segment is convex) and
+// its axis within |a − a_m| of the middle member's a_m, which moves a point at most `reach` from
+// the tip by at most reach·|a − a_m| (the part is symmetric about its axis: a rotation taking
+// a_m to a, by θ with 2 sin(θ/2) = |a − a_m|). So every member lies in the sweep, along the chord
+// with axis a_m, of that cylinder grown by e = δ + reach·max |a − a_m|: radius ρ + e, heights
+// h0 − e to h1 + e. Each gets a margin far above rounding and the conic solve's slack.
+inline void sweep_group_bound(const SweepPartShape& part, std::span<const SweepStep> steps,
+                              std::span<const SweepStepCut> cuts,
+                              std::span<const std::uint32_t> members, SweepGroup& g) {
+  const SweepStepCut& first = cuts[members.front()];
+  if (first.capsule) {
+    g.bound = SweepBound::capsule;
+    g.c0 = first.c0, g.c1 = cuts[members.back()].c1;
+    double far = 0;
+    for (std::uint32_t s : members)
+      far = std::max({far, distance_to_segment(cuts[s].c0, g.c0, g.c1),
+                      distance_to_segment(cuts[s].c1, g.c0, g.c1)});
+    g.radius = first.radius + far + 1e-6 * (1 + first.radius + far);
+    return;
+  }
+  double rho = 0, h0 = std::numeric_limits<double>::infinity(), h1 = -h0;
+  for (const SweepPiece& p : part.pieces) {
+    rho = std::max(rho, p.ball ? p.radius : std::max(p.rho0, p.rho0 + p.slope * (p.hi - p.lo)));
+    h0 = std::min(h0, p.ball ? p.centre - p.radius : p.lo);
+    h1 = std::max(h1, p.ball ? p.centre + p.radius : p.hi);
+  }
+  if (!(h0 <= h1)) return;  // no pieces: the box bound
+  g.bound = SweepBound::cylinder;
+  g.c0 = steps[members.front()].from, g.c1 = steps[members.back()].to;
+  g.axis = steps[members[members.size() / 2]].axis;
+  const double reach = std::hypot(rho, std::max(std::abs(h0), std::abs(h1)));
+  double tip = 0, turn = 0;
+  for (std::uint32_t s : members) {
+    tip = std::max({tip, distance_to_segment(steps[s].from, g.c0, g.c1),
+                    distance_to_segment(steps[s].to, g.c0, g.c1)});
+    turn = std::max(turn, glm::length(steps[s].axis - g.axis));
+  }
+  double e = tip + reach * turn;
+  e += 1e-5 * (1 + reach + e);
+  g.piece = SweepPiece{h0 - e, h1 + e, false, rho + e, 0, 0, 0};
+}
+
 // Ray (iu, iv) of grid `axis` less the sweeps of the steps of the groups listed for it
 // (detail/sweep_rows.hpp). A group whose bound cannot meet the material left is skipped whole;
 // each sweep is subtracted as soon as it is found; one whose box holds no material left is not
@@ -566,7 +612,12 @@ inline void sweep_remove(TripleDexel& d, std::span<const SweepCutter> cutters,
   const detail::SweepGroups groups = detail::sweep_groups(
       cuts, 3 * cutters.size(),
       [&](std::size_t s) { return 3 * steps[s].cutter + static_cast<std::size_t>(steps[s].part); },
-      8 * d.spacing, closed);
+      8 * d.spacing, closed,
+      [&](std::span<const std::uint32_t> members, detail::SweepGroup& g) {
+        const SweepStep& step = steps[members.front()];
+        detail::sweep_group_bound(shapes[step.cutter].parts[static_cast<std::size_t>(step.part)],
+                                  steps, cuts, members, g);
+      });
   std::vector<std::pair<int, int>> rows_of(steps.size());
   for (int axis = 0; axis < 3; ++axis) {
     const DexelGrid& old = d.grids[static_cast<std::size_t>(axis)];

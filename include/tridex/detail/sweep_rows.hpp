@@ -94,13 +94,19 @@ SweepRows sweep_rows(const TripleDexel& d, int axis, std::size_t count, BoxOf&& 
 
 inline constexpr std::uint32_t kSweepGroup = 16;
 
+// How a group bounds its members' sweeps: by the union of their boxes alone, by a capsule
+// (ball tips: the chord of their centres, c0–c1, and `radius`), or by the sweep of the solid
+// cylinder `piece` with unit axis `axis` moved from tip c0 to tip c1.
+enum class SweepBound : std::uint8_t { box, capsule, cylinder };
+
 // Steps cut together: members[first, first + count) of SweepGroups, in program order.
 struct SweepGroup {
   Aabb box;  // the union of the members' boxes
   std::uint32_t first = 0, count = 0;
-  bool capsule = false;  // every member a capsule: all lie in the capsule c0–c1 of `radius`
-  Vec3 c0{0.0}, c1{0.0};
+  SweepBound bound = SweepBound::box;
+  Vec3 c0{0.0}, c1{0.0}, axis{0.0, 0.0, 1.0};
   double radius = 0;
+  SweepPiece piece;
 };
 
 struct SweepGroups {
@@ -119,10 +125,11 @@ inline double distance_to_segment(const Vec3& x, const Vec3& a, const Vec3& b) {
 // Groups consecutive steps of one key (key_of(s): cutter and part), at most kSweepGroup, while
 // the union of their boxes is no wider on any side than `grow` past their widest member's. With
 // `group` false each step is a group of its own, in order (a searched part's interval depends
-// on the material left: its steps keep their order).
-template <class KeyOf>
+// on the material left: its steps keep their order). bound(members, group) sets the bound of a
+// group of more than one step.
+template <class KeyOf, class Bound>
 SweepGroups sweep_groups(std::span<const SweepStepCut> cuts, std::size_t keys, KeyOf&& key_of,
-                         double grow, bool group) {
+                         double grow, bool group, Bound&& bound) {
   SweepGroups out;
   out.members.reserve(cuts.size());
   struct Open {
@@ -138,17 +145,7 @@ SweepGroups sweep_groups(std::span<const SweepStepCut> cuts, std::size_t keys, K
     g.first = static_cast<std::uint32_t>(out.members.size());
     g.count = static_cast<std::uint32_t>(o.members.size());
     out.members.insert(out.members.end(), o.members.begin(), o.members.end());
-    const SweepStepCut& first = cuts[o.members.front()];
-    g.capsule = first.capsule && o.members.size() > 1;
-    if (g.capsule) {
-      g.c0 = first.c0, g.c1 = cuts[o.members.back()].c1;
-      double far = 0;
-      for (std::uint32_t s : o.members)
-        far = std::max({far, distance_to_segment(cuts[s].c0, g.c0, g.c1),
-                        distance_to_segment(cuts[s].c1, g.c0, g.c1)});
-      // A margin far above rounding, so that a member meeting a ray (even tangent) lies within.
-      g.radius = first.radius + far + 1e-6 * (1 + first.radius + far);
-    }
+    if (o.members.size() > 1) bound(std::span<const std::uint32_t>(o.members), g);
     out.groups.push_back(g);
     o.members.clear();
     o.box = Aabb{};
@@ -177,22 +174,23 @@ SweepGroups sweep_groups(std::span<const SweepStepCut> cuts, std::size_t keys, K
 }
 
 // Whether group `g` may remove anything from the spans `current` of the ray through `point`
-// along `axis` (false only if none of its members can: their boxes hold no material, or their
-// capsules' intervals, within the bound's grown for float rounding, meet none).
+// along `axis`: false only if none of its members can (their boxes hold no material, or their
+// sweeps' intervals, within the bound's grown for float rounding, meet none).
 inline bool sweep_group_may_cut(const SweepGroup& g, std::span<const DexelInterval> current,
                                 const Vec3& point, int axis) {
-  double lo = g.box.min[axis], hi = g.box.max[axis];
-  if (g.capsule) {
-    const auto bound = capsule_interval(g.c0, g.c1, g.radius, point, axis);
-    if (!bound) return false;
-    const double margin = 1e-5 * (1 + std::abs(bound->first) + std::abs(bound->second));
-    lo = bound->first - margin, hi = bound->second + margin;
-    for (const DexelInterval& span : current)
-      if (span.exit > lo && span.enter < hi) return true;
+  if (g.bound == SweepBound::box) {
+    for (const DexelInterval& span : current)  // as sweep_ray's test of a step's box
+      if (span.exit >= g.box.min[axis] && span.enter <= g.box.max[axis]) return true;
     return false;
   }
-  for (const DexelInterval& span : current)  // as sweep_ray's test of a step's box
-    if (span.exit >= lo && span.enter <= hi) return true;
+  const auto bound = g.bound == SweepBound::capsule
+                         ? capsule_interval(g.c0, g.c1, g.radius, point, axis)
+                         : sweep_piece_interval(g.piece, g.c0, g.c1 - g.c0, g.axis, point, axis);
+  if (!bound) return false;
+  const double margin = 1e-5 * (1 + std::abs(bound->first) + std::abs(bound->second));
+  const double lo = bound->first - margin, hi = bound->second + margin;
+  for (const DexelInterval& span : current)
+    if (span.exit > lo && span.enter < hi) return true;
   return false;
 }
 
