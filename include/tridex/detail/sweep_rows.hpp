@@ -178,11 +178,10 @@ SweepGroups sweep_groups(std::span<const SweepStepCut> cuts, std::size_t keys, K
 // sweeps' intervals, within the bound's grown for float rounding, meet none).
 inline bool sweep_group_may_cut(const SweepGroup& g, std::span<const DexelInterval> current,
                                 const Vec3& point, int axis) {
-  if (g.bound == SweepBound::box) {
-    for (const DexelInterval& span : current)  // as sweep_ray's test of a step's box
-      if (span.exit >= g.box.min[axis] && span.enter <= g.box.max[axis]) return true;
-    return false;
-  }
+  bool boxed = false;  // as sweep_ray's test of a step's box, cheaper than the bounds below
+  for (const DexelInterval& span : current)
+    boxed = boxed || (span.exit >= g.box.min[axis] && span.enter <= g.box.max[axis]);
+  if (!boxed || g.bound == SweepBound::box) return boxed;
   const auto bound = g.bound == SweepBound::capsule
                          ? capsule_interval(g.c0, g.c1, g.radius, point, axis)
                          : sweep_piece_interval(g.piece, g.c0, g.c1 - g.c0, g.axis, point, axis);
