@@ -498,7 +498,8 @@ inline SweepStepCut sweep_step_cut(const SweepCutter& c, const SweepPartShape& p
 // the tip by at most reach·|a − a_m| (the part is symmetric about its axis: a rotation taking
 // a_m to a, by θ with 2 sin(θ/2) = |a − a_m|). So every member lies in the sweep, along the chord
 // with axis a_m, of that cylinder grown by e = δ + reach·max |a − a_m|: radius ρ + e, heights
-// h0 − e to h1 + e. Each gets a margin far above rounding and the conic solve's slack.
+// h0 − e to h1 + e (below it a cone, where the part is all frusta). Each gets a margin far above
+// rounding and the conic solve's slack.
 inline void sweep_group_bound(const SweepPartShape& part, std::span<const SweepStep> steps,
                               std::span<const SweepStepCut> cuts,
                               std::span<const std::uint32_t> members, SweepGroup& g) {
@@ -532,7 +533,27 @@ inline void sweep_group_bound(const SweepPartShape& part, std::span<const SweepS
   }
   double e = tip + reach * turn;
   e += 1e-5 * (1 + reach + e);
-  g.piece = SweepPiece{h0 - e, h1 + e, false, rho + e, 0, 0, 0};
+  g.pieces[0] = SweepPiece{h0 - e, h1 + e, false, rho + e, 0, 0, 0};
+  g.piece_count = 1;
+  // Below the cylinder, the supporting cone of the frustum piece closest to 45° (a bull nose's
+  // mid-corner chord), grown by e (its radius by e·√(1 + m²) at each height): the part is convex,
+  // so each piece's cone bounds it. Only where the part is all frusta, ρ ≥ 0 at the bottom.
+  const SweepPiece* best = nullptr;
+  bool frusta = true;
+  for (const SweepPiece& p : part.pieces) {
+    frusta = frusta && !p.ball;
+    if (!p.ball && p.slope > 0 &&
+        (!best || std::abs(std::log(p.slope)) < std::abs(std::log(best->slope))))
+      best = &p;
+  }
+  if (!frusta || !best) return;
+  const double m = best->slope, grow = e * std::sqrt(1 + m * m);
+  const double bottom = best->rho0 + m * (h0 - e - best->lo) + grow;
+  const double split = best->lo + (rho + e - grow - best->rho0) / m;  // the cone meets ρ + e
+  if (!(bottom >= 0) || !(split > h0 - e) || !(split < h1 + e)) return;
+  g.pieces[0].lo = split;
+  g.pieces[1] = SweepPiece{h0 - e, split, false, bottom, m, 0, 0};
+  g.piece_count = 2;
 }
 
 // Ray (iu, iv) of grid `axis` less the sweeps of the steps of the groups listed for it

@@ -328,7 +328,8 @@ TEST_CASE("sweep: skipping pieces gives the brute-force dexels") {
 // A finishing program's moves are short against the cutter: sweep_remove groups consecutive steps
 // under a bound (detail/sweep_rows.hpp) that a ray skips whole. Rows of 0.1 mm moves whose axis
 // tilts along the row, for a ball, flat, bull nose and chamfer: the same dexels as the steps cut
-// one at a time (in program order, no groups), on 1, 2 and 8 threads, and groups of every bound.
+// one at a time (in program order, no groups), on 1, 2 and 8 threads, and groups of every bound
+// (a cylinder with a cone below it for the bull nose and the chamfer).
 TEST_CASE("sweep: grouped short steps give the dexels of each step cut alone") {
   const Aabb stock{Vec3(-4, -4, -4), Vec3(4, 4, 1)};
   const DexelLattice lattice = DexelLattice::covering(stock, 0.25);
@@ -377,7 +378,12 @@ TEST_CASE("sweep: grouped short steps give the dexels of each step cut alone") {
         detail::sweep_group_bound(shapes[step.cutter].parts[static_cast<std::size_t>(step.part)],
                                   steps, cuts, members, g);
       });
-  for (const detail::SweepGroup& g : groups.groups) ++bounds[static_cast<int>(g.bound)];
+  int cones = 0;
+  for (const detail::SweepGroup& g : groups.groups) {
+    ++bounds[static_cast<int>(g.bound)];
+    cones += g.piece_count == 2;
+  }
+  CHECK(cones > 0);
   CHECK(groups.groups.size() * 4 < steps.size());
   CHECK(bounds[static_cast<int>(detail::SweepBound::capsule)] > 0);
   CHECK(bounds[static_cast<int>(detail::SweepBound::cylinder)] > 0);

@@ -14,6 +14,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -96,7 +97,8 @@ inline constexpr std::uint32_t kSweepGroup = 16;
 
 // How a group bounds its members' sweeps: by the union of their boxes alone, by a capsule
 // (ball tips: the chord of their centres, c0–c1, and `radius`), or by the sweep of the solid
-// cylinder `piece` with unit axis `axis` moved from tip c0 to tip c1.
+// of revolution `pieces` (a cylinder, below it a cone's frustum) with unit axis `axis` moved
+// from tip c0 to tip c1.
 enum class SweepBound : std::uint8_t { box, capsule, cylinder };
 
 // Steps cut together: members[first, first + count) of SweepGroups, in program order.
@@ -106,7 +108,8 @@ struct SweepGroup {
   SweepBound bound = SweepBound::box;
   Vec3 c0{0.0}, c1{0.0}, axis{0.0, 0.0, 1.0};
   double radius = 0;
-  SweepPiece piece;
+  std::array<SweepPiece, 2> pieces{};
+  int piece_count = 0;
 };
 
 struct SweepGroups {
@@ -182,9 +185,19 @@ inline bool sweep_group_may_cut(const SweepGroup& g, std::span<const DexelInterv
   for (const DexelInterval& span : current)
     boxed = boxed || (span.exit >= g.box.min[axis] && span.enter <= g.box.max[axis]);
   if (!boxed || g.bound == SweepBound::box) return boxed;
-  const auto bound = g.bound == SweepBound::capsule
-                         ? capsule_interval(g.c0, g.c1, g.radius, point, axis)
-                         : sweep_piece_interval(g.piece, g.c0, g.c1 - g.c0, g.axis, point, axis);
+  std::optional<std::pair<double, double>> bound;
+  if (g.bound == SweepBound::capsule) {
+    bound = capsule_interval(g.c0, g.c1, g.radius, point, axis);
+  } else {
+    for (int k = 0; k < g.piece_count; ++k) {  // a convex union: the hull of the pieces'
+      const auto cut = sweep_piece_interval(g.pieces[static_cast<std::size_t>(k)], g.c0,
+                                            g.c1 - g.c0, g.axis, point, axis);
+      if (cut)
+        bound = bound ? std::pair{std::min(bound->first, cut->first),
+                                  std::max(bound->second, cut->second)}
+                      : *cut;
+    }
+  }
   if (!bound) return false;
   const double margin = 1e-5 * (1 + std::abs(bound->first) + std::abs(bound->second));
   const double lo = bound->first - margin, hi = bound->second + margin;
