@@ -600,9 +600,11 @@ inline void sweep_ray(std::span<const DexelInterval> ray, const TripleDexel& d, 
         removed = sweep_step_interval(cutters[step.cutter], *cut.part, step, point, axis, lo, hi,
                                       precision);
       }
-      if (removed)
-        subtract_one(current,
-                     {static_cast<float>(removed->first), static_cast<float>(removed->second)});
+      // A cut that rounds to a point removes nothing, but inside a span would split it into two
+      // touching ones (no valid dexel): in program order it may land in a gap, in another not.
+      const DexelInterval cut_out{static_cast<float>(removed ? removed->first : 0.0),
+                                  static_cast<float>(removed ? removed->second : 0.0)};
+      if (removed && cut_out.enter < cut_out.exit) subtract_one(current, cut_out);
     }
   }
   out.insert(out.end(), current.begin(), current.end());
