@@ -41,6 +41,7 @@
 #include "tridex/cutter.hpp"
 #include "tridex/detail/sweep_distance.hpp"
 #include "tridex/detail/sweep_interval.hpp"
+#include "tridex/detail/sweep_rows.hpp"
 #include "tridex/dexel.hpp"
 #include "tridex/dexel_ops.hpp"
 #include "tridex/geometry.hpp"
@@ -474,16 +475,6 @@ inline std::optional<std::pair<double, double>> sweep_step_interval(
   return hull;
 }
 
-// A step as sweep_ray cuts it: its box, its part, and for a ball tip (one ball piece) the capsule
-// of the ball's centre, computed once per step rather than once per ray.
-struct SweepStepCut {
-  Aabb box;
-  const SweepPartShape* part = nullptr;
-  bool capsule = false;
-  Vec3 c0{0.0}, c1{0.0};
-  double radius = 0;
-};
-
 inline SweepStepCut sweep_step_cut(const SweepCutter& c, const SweepPartShape& part,
                                    const SweepStep& s) {
   SweepStepCut cut;
@@ -498,88 +489,83 @@ inline SweepStepCut sweep_step_cut(const SweepCutter& c, const SweepPartShape& p
   return cut;
 }
 
-// The steps of one grid listed by row (v index) and block of kBlock rays along the row.
-struct SweepRows {
-  static constexpr int kBlock = 32;
-  int blocks = 0;
-  std::vector<std::uint32_t> offsets, steps;
-  std::span<const std::uint32_t> at(int iu, int iv) const {
-    const std::size_t k = static_cast<std::size_t>(iv) * static_cast<std::size_t>(blocks) +
-                          static_cast<std::size_t>(iu / kBlock);
-    return {steps.data() + offsets[k], steps.data() + offsets[k + 1]};
-  }
-};
-
-inline SweepRows sweep_rows(const TripleDexel& d, int axis, std::span<const SweepStepCut> cuts) {
-  const int u = TripleDexel::u_axis(axis), v = TripleDexel::v_axis(axis);
-  const DexelGrid& g = d.grids[static_cast<std::size_t>(axis)];
-  SweepRows rows;
-  rows.blocks = (g.nu + SweepRows::kBlock - 1) / SweepRows::kBlock;
-  rows.offsets.assign(static_cast<std::size_t>(g.nv) * static_cast<std::size_t>(rows.blocks) + 1,
-                      0);
-  auto range = [&](const Aabb& box, int a, int n) {
-    const double first = std::ceil((box.min[a] - d.origin[a]) / d.spacing);
-    const double last = std::floor((box.max[a] - d.origin[a]) / d.spacing);
-    return std::pair{static_cast<int>(std::max(first, 0.0)),
-                     static_cast<int>(std::min(last, n - 1.0))};
-  };
-  for (int pass = 0; pass < 2; ++pass) {
-    std::vector<std::uint32_t> fill(rows.offsets.begin(), rows.offsets.end() - 1);
-    for (std::size_t s = 0; s < cuts.size(); ++s) {
-      const auto [u0, u1] = range(cuts[s].box, u, g.nu);
-      const auto [v0, v1] = range(cuts[s].box, v, g.nv);
-      if (u0 > u1) continue;
-      for (int iv = v0; iv <= v1; ++iv)
-        for (int b = u0 / SweepRows::kBlock; b <= u1 / SweepRows::kBlock; ++b) {
-          const std::size_t k =
-              static_cast<std::size_t>(iv) * static_cast<std::size_t>(rows.blocks) +
-              static_cast<std::size_t>(b);
-          if (pass == 0)
-            ++rows.offsets[k + 1];
-          else
-            rows.steps[fill[k]++] = static_cast<std::uint32_t>(s);
-        }
-    }
-    if (pass == 0) {
-      for (std::size_t k = 1; k < rows.offsets.size(); ++k) rows.offsets[k] += rows.offsets[k - 1];
-      rows.steps.resize(rows.offsets.back());
-    }
-  }
-  return rows;
-}
-
-// Removes [cut.enter, cut.exit] from the sorted disjoint spans of `spans` in place, as
-// subtract_ray(spans, {cut}) would (a span touching the cut only at an end is kept whole).
-inline void subtract_one(std::vector<DexelInterval>& spans, DexelInterval cut) {
-  const std::size_t n = spans.size();
-  std::size_t i = 0;
-  while (i < n && spans[i].exit <= cut.enter) ++i;
-  std::size_t j = i;
-  while (j < n && spans[j].enter < cut.exit) ++j;
-  if (j == i) return;  // the spans i… lie above the cut
-  DexelInterval pieces[2];
-  std::size_t k = 0;
-  if (cut.enter > spans[i].enter) pieces[k++] = {spans[i].enter, cut.enter};
-  const float lo = std::max(spans[j - 1].enter, cut.exit);
-  if (lo < spans[j - 1].exit) pieces[k++] = {lo, spans[j - 1].exit};
-  const std::size_t old = j - i;
-  if (k > old) {
-    spans.insert(spans.begin() + static_cast<std::ptrdiff_t>(j), pieces[k - 1]);
-    spans[i] = pieces[0];
+// The bound of a group of steps (more than one) of one closed cutter part `part`
+// (detail/sweep_rows.hpp). Ball tips: the capsule around the chord of their centres, grown by
+// the members' centres' largest distance from it. Other parts: the part lies within a cylinder
+// of radius ρ (its widest piece) between heights h0 and h1 above the tip; a member's tip path lies
+// within δ of the chord of the group's tips (both ends do: distance to a segment is convex) and
+// its axis within |a − a_m| of the middle member's a_m, which moves a point at most `reach` from
+// the tip by at most reach·|a − a_m| (the part is symmetric about its axis: a rotation taking
+// a_m to a, by θ with 2 sin(θ/2) = |a − a_m|). So every member lies in the sweep, along the chord
+// with axis a_m, of that cylinder grown by e = δ + reach·max |a − a_m|: radius ρ + e, heights
+// h0 − e to h1 + e (below it a cone, where the part is all frusta). Each gets a margin far above
+// rounding and the conic solve's slack.
+inline void sweep_group_bound(const SweepPartShape& part, std::span<const SweepStep> steps,
+                              std::span<const SweepStepCut> cuts,
+                              std::span<const std::uint32_t> members, SweepGroup& g) {
+  const SweepStepCut& first = cuts[members.front()];
+  if (first.capsule) {
+    g.bound = SweepBound::capsule;
+    g.c0 = first.c0, g.c1 = cuts[members.back()].c1;
+    double far = 0;
+    for (std::uint32_t s : members)
+      far = std::max({far, distance_to_segment(cuts[s].c0, g.c0, g.c1),
+                      distance_to_segment(cuts[s].c1, g.c0, g.c1)});
+    g.radius = first.radius + far + 1e-6 * (1 + first.radius + far);
     return;
   }
-  for (std::size_t q = 0; q < k; ++q) spans[i + q] = pieces[q];
-  spans.erase(spans.begin() + static_cast<std::ptrdiff_t>(i + k),
-              spans.begin() + static_cast<std::ptrdiff_t>(j));
+  double rho = 0, h0 = std::numeric_limits<double>::infinity(), h1 = -h0;
+  for (const SweepPiece& p : part.pieces) {
+    rho = std::max(rho, p.ball ? p.radius : std::max(p.rho0, p.rho0 + p.slope * (p.hi - p.lo)));
+    h0 = std::min(h0, p.ball ? p.centre - p.radius : p.lo);
+    h1 = std::max(h1, p.ball ? p.centre + p.radius : p.hi);
+  }
+  if (!(h0 <= h1)) return;  // no pieces: the box bound
+  g.bound = SweepBound::cylinder;
+  g.c0 = steps[members.front()].from, g.c1 = steps[members.back()].to;
+  g.axis = steps[members[members.size() / 2]].axis;
+  const double reach = std::hypot(rho, std::max(std::abs(h0), std::abs(h1)));
+  double tip = 0, turn = 0;
+  for (std::uint32_t s : members) {
+    tip = std::max({tip, distance_to_segment(steps[s].from, g.c0, g.c1),
+                    distance_to_segment(steps[s].to, g.c0, g.c1)});
+    turn = std::max(turn, glm::length(steps[s].axis - g.axis));
+  }
+  double e = tip + reach * turn;
+  e += 1e-5 * (1 + reach + e);
+  g.pieces[0] = SweepPiece{h0 - e, h1 + e, false, rho + e, 0, 0, 0};
+  g.piece_count = 1;
+  // Below the cylinder, the supporting cone of the frustum piece closest to 45° (a bull nose's
+  // mid-corner chord), grown by e (its radius by e·√(1 + m²) at each height): the part is convex,
+  // so each piece's cone bounds it. Only where the part is all frusta, ρ ≥ 0 at the bottom.
+  const SweepPiece* best = nullptr;
+  bool frusta = true;
+  for (const SweepPiece& p : part.pieces) {
+    frusta = frusta && !p.ball;
+    if (!p.ball && p.slope > 0 &&
+        (!best || std::abs(std::log(p.slope)) < std::abs(std::log(best->slope))))
+      best = &p;
+  }
+  if (!frusta || !best) return;
+  const double m = best->slope, grow = e * std::sqrt(1 + m * m);
+  const double bottom = best->rho0 + m * (h0 - e - best->lo) + grow;
+  const double split = best->lo + (rho + e - grow - best->rho0) / m;  // the cone meets ρ + e
+  if (!(bottom >= 0) || !(split > h0 - e) || !(split < h1 + e)) return;
+  g.pieces[0].lo = split;
+  g.pieces[1] = SweepPiece{h0 - e, split, false, bottom, m, 0, 0};
+  g.piece_count = 2;
 }
 
-// Ray (iu, iv) of grid `axis` less the sweeps of the steps listed for it. Each sweep is
-// subtracted as soon as it is found; one whose box holds no material left is not computed.
-// Intervals are closed form (or found to `precision` within the material left), and subtraction
-// in any order gives the same set.
+// Ray (iu, iv) of grid `axis` less the sweeps of the steps of the groups listed for it
+// (detail/sweep_rows.hpp). A group whose bound cannot meet the material left is skipped whole;
+// each sweep is subtracted as soon as it is found; one whose box holds no material left is not
+// computed. Intervals are closed form (or found to `precision` within the material left), and
+// subtraction in any order gives the same set. `rows_of[s]`: the rows (v indices) step s's box
+// covers, as sweep_rows lists them (none where it covers no column).
 inline void sweep_ray(std::span<const DexelInterval> ray, const TripleDexel& d, int axis, int iu,
                       int iv, std::span<const SweepCutter> cutters,
                       std::span<const SweepStep> steps, std::span<const SweepStepCut> cuts,
+                      const SweepGroups& groups, std::span<const std::pair<int, int>> rows_of,
                       std::span<const std::uint32_t> listed, double precision,
                       std::vector<DexelInterval>& current, std::vector<DexelInterval>& out) {
   const int u = TripleDexel::u_axis(axis), v = TripleDexel::v_axis(axis);
@@ -587,29 +573,39 @@ inline void sweep_ray(std::span<const DexelInterval> ray, const TripleDexel& d, 
   point[u] += d.spacing * iu;
   point[v] += d.spacing * iv;
   current.assign(ray.begin(), ray.end());
-  for (std::uint32_t s : listed) {
-    const SweepStepCut& cut = cuts[s];
-    const Aabb& box = cut.box;
+  for (std::uint32_t g : listed) {
+    const SweepGroup& group = groups.groups[g];
     if (current.empty()) break;
-    if (point[u] < box.min[u] || point[u] > box.max[u]) continue;
-    std::optional<std::pair<double, double>> removed;
-    if (cut.capsule) {  // as cheap as the test below, which it does not need
-      removed = capsule_interval(cut.c0, cut.c1, cut.radius, point, axis);
-    } else {
-      double lo = box.max[axis], hi = box.min[axis];  // the material left within the box
-      for (const DexelInterval& span : current)
-        if (span.exit >= box.min[axis] && span.enter <= box.max[axis]) {
-          lo = std::min(lo, std::max<double>(span.enter, box.min[axis]));
-          hi = std::max(hi, std::min<double>(span.exit, box.max[axis]));
-        }
-      if (!(lo <= hi)) continue;
-      const SweepStep& step = steps[s];
-      removed = sweep_step_interval(cutters[step.cutter], *cut.part, step, point, axis, lo, hi,
-                                    precision);
+    if (point[u] < group.box.min[u] || point[u] > group.box.max[u]) continue;
+    if (group.count > 1 && !sweep_group_may_cut(group, current, point, axis)) continue;
+    for (std::uint32_t k = group.first; k < group.first + group.count; ++k) {
+      const std::uint32_t s = groups.members[k];
+      const SweepStepCut& cut = cuts[s];
+      const Aabb& box = cut.box;
+      if (current.empty()) break;
+      if (iv < rows_of[s].first || iv > rows_of[s].second) continue;
+      if (point[u] < box.min[u] || point[u] > box.max[u]) continue;
+      std::optional<std::pair<double, double>> removed;
+      if (cut.capsule) {  // as cheap as the test below, which it does not need
+        removed = capsule_interval(cut.c0, cut.c1, cut.radius, point, axis);
+      } else {
+        double lo = box.max[axis], hi = box.min[axis];  // the material left within the box
+        for (const DexelInterval& span : current)
+          if (span.exit >= box.min[axis] && span.enter <= box.max[axis]) {
+            lo = std::min(lo, std::max<double>(span.enter, box.min[axis]));
+            hi = std::max(hi, std::min<double>(span.exit, box.max[axis]));
+          }
+        if (!(lo <= hi)) continue;
+        const SweepStep& step = steps[s];
+        removed = sweep_step_interval(cutters[step.cutter], *cut.part, step, point, axis, lo, hi,
+                                      precision);
+      }
+      // A cut that rounds to a point removes nothing, but inside a span would split it into two
+      // touching ones (no valid dexel): in program order it may land in a gap, in another not.
+      const DexelInterval cut_out{static_cast<float>(removed ? removed->first : 0.0),
+                                  static_cast<float>(removed ? removed->second : 0.0)};
+      if (removed && cut_out.enter < cut_out.exit) subtract_one(current, cut_out);
     }
-    if (removed)
-      subtract_one(current,
-                   {static_cast<float>(removed->first), static_cast<float>(removed->second)});
   }
   out.insert(out.end(), current.begin(), current.end());
 }
@@ -618,8 +614,8 @@ inline void sweep_ray(std::span<const DexelInterval> ray, const TripleDexel& d, 
 
 // Removes the sweeps of `steps` (each with its cutter) from every ray of `d`, to within
 // `precision` mm where a part's interval is searched (closed-form ones are exact). Rays are
-// independent, each takes its steps in order, and the grids are rebuilt in ray order, so the
-// result does not depend on `threads`.
+// independent, each takes its steps (grouped, detail/sweep_rows.hpp) in an order fixed by the
+// steps alone, and the grids are rebuilt in ray order, so the result does not depend on `threads`.
 inline void sweep_remove(TripleDexel& d, std::span<const SweepCutter> cutters,
                          std::span<const SweepStep> steps, unsigned threads,
                          double precision = 1e-4) {
@@ -628,14 +624,35 @@ inline void sweep_remove(TripleDexel& d, std::span<const SweepCutter> cutters,
   for (const SweepCutter& c : cutters) shapes.push_back(sweep_shape(c));
   std::vector<detail::SweepStepCut> cuts;
   cuts.reserve(steps.size());
+  bool closed = true;  // every part closed form: removal in any order gives the same rays
   for (const SweepStep& s : steps) {
     if (s.cutter >= cutters.size()) detail::fail("sweep_remove: step names cutter ", s.cutter);
     const SweepPartShape& part = shapes[s.cutter].parts[static_cast<std::size_t>(s.part)];
+    closed = closed && part.closed;
     cuts.push_back(detail::sweep_step_cut(cutters[s.cutter], part, s));
   }
+  // Groups may grow a few spacings past one step's box: rays list them, not their steps.
+  const detail::SweepGroups groups = detail::sweep_groups(
+      cuts, 3 * cutters.size(),
+      [&](std::size_t s) { return 3 * steps[s].cutter + static_cast<std::size_t>(steps[s].part); },
+      8 * d.spacing, closed,
+      [&](std::span<const std::uint32_t> members, detail::SweepGroup& g) {
+        const SweepStep& step = steps[members.front()];
+        detail::sweep_group_bound(shapes[step.cutter].parts[static_cast<std::size_t>(step.part)],
+                                  steps, cuts, members, g);
+      });
+  std::vector<std::pair<int, int>> rows_of(steps.size());
   for (int axis = 0; axis < 3; ++axis) {
     const DexelGrid& old = d.grids[static_cast<std::size_t>(axis)];
-    const detail::SweepRows rows = detail::sweep_rows(d, axis, cuts);
+    const int u = TripleDexel::u_axis(axis), v = TripleDexel::v_axis(axis);
+    for (std::size_t s = 0; s < cuts.size(); ++s) {  // none where the box misses every column
+      rows_of[s] = detail::sweep_index_range(d, cuts[s].box, v, old.nv);
+      const auto [u0, u1] = detail::sweep_index_range(d, cuts[s].box, u, old.nu);
+      if (u0 > u1) rows_of[s] = {1, 0};
+    }
+    const detail::SweepRows rows =
+        detail::sweep_rows(d, axis, groups.groups.size(),
+                           [&](std::size_t g) -> const Aabb& { return groups.groups[g].box; });
     DexelGrid next = detail::build_grid(
         d.lattice(), axis, threads, [&](std::size_t r, std::vector<DexelInterval>& out) {
           const int iu = static_cast<int>(r % static_cast<std::size_t>(old.nu));
@@ -647,8 +664,8 @@ inline void sweep_remove(TripleDexel& d, std::span<const SweepCutter> cutters,
             return;
           }
           thread_local std::vector<DexelInterval> scratch;
-          detail::sweep_ray(old.ray(r), d, axis, iu, iv, cutters, steps, cuts, listed, precision,
-                            scratch, out);
+          detail::sweep_ray(old.ray(r), d, axis, iu, iv, cutters, steps, cuts, groups, rows_of,
+                            listed, precision, scratch, out);
         });
     d.grids[static_cast<std::size_t>(axis)] = std::move(next);
   }
