@@ -123,19 +123,28 @@ TEST_CASE("machining time: rapids per axis, a max feed, per tool and per directi
   timer.add(m);
   m.from_far = true;  // not timed: where it starts is a stand-in
   timer.add(m);
+  m.from_far = false;
+  m.pose = gcode::PoseLaw::tcp;  // the axis turns: no direction of its own, counted apart
+  m.axis = glm::normalize(Vec3(1, -1, 1));
+  m.feed = 300;  // 10 mm: 2 s
+  timer.add(m);
   timer.add(gcode::Dwell{7, 2, Vec3(0, 0, 1), 3.0});
   const cli::MachiningTime& t = timer.time();
   CHECK(t.rapid_s == doctest::Approx(1.2));
-  CHECK(t.feed_s == doctest::Approx(7.2));
+  CHECK(t.feed_s == doctest::Approx(7.2 + 2));
   CHECK(t.capped_feeds == 1);
   CHECK(t.untimed_approaches == 1);
   CHECK(t.by_tool.at(1) == doctest::Approx(1.2));
-  CHECK(t.by_tool.at(2) == doctest::Approx(1.2 + 6 + 3));
+  CHECK(t.by_tool.at(2) == doctest::Approx(1.2 + 6 + 2 + 3));
   REQUIRE(t.by_direction.size() == 2);
   CHECK(t.by_direction[0].second == doctest::Approx(1.2 + 1.2 + 3));
   CHECK(t.by_direction[1].second == doctest::Approx(6.0));
+  CHECK(t.simultaneous_moves == 1);
+  CHECK(t.simultaneous_s == doctest::Approx(2.0));
   json j = cli::machining_time_json(timer);
-  CHECK(j["total_s"].get<double>() == doctest::Approx(11.4));
+  CHECK(j["total_s"].get<double>() == doctest::Approx(13.4));
+  CHECK(j["simultaneous"]["moves"] == 1);
+  CHECK(j["simultaneous"]["s"].get<double>() == doctest::Approx(2.0));
   CHECK(j["rapid_rate_mm_per_min"] == json::array({6000.0, 2000.0, 1000.0}));
   CHECK(j["rapid_rate_source"] == "default");
 }
@@ -169,6 +178,7 @@ TEST_CASE("machining time: the machine file's rates, refused when bad, in the re
   CHECK(mt["by_tool"][0]["s"].get<double>() == doctest::Approx(0.1));
   CHECK(mt["total_s"].get<double>() == doctest::Approx(10.62));
   CHECK(mt["by_direction"][0]["direction"] == json::array({0.0, 0.0, 1.0}));
+  CHECK(!mt.contains("simultaneous"));  // only where the tool axis turns during a move
 
   // simulate and check report the same object and print it.
   write_text(dir / "tools.json", R"({"1": {"shape": "cylindrical", "diameter": 6}})");

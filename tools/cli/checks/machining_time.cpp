@@ -144,6 +144,12 @@ void MachiningTimer::add(const gcode::Move& move) {
     time_.rapid_s += seconds;
   }
   remember();
+  if (move.pose != gcode::PoseLaw::fixed) {
+    time_.by_tool[move.tool] += seconds;
+    time_.simultaneous_s += seconds;
+    ++time_.simultaneous_moves;
+    return;
+  }
   charge(move.tool, move.axis, seconds);
 }
 
@@ -162,6 +168,8 @@ Json machining_time_json(const MachiningTimer& timer) {
     by_direction.push_back({{"direction", to_json(axis)}, {"s", s}});
   Json j = {{"total_s", t.total_s()}, {"feed_s", t.feed_s}, {"rapid_s", t.rapid_s},
             {"dwell_s", t.dwell_s},   {"by_tool", by_tool}, {"by_direction", by_direction}};
+  if (t.simultaneous_moves > 0)
+    j["simultaneous"] = {{"moves", t.simultaneous_moves}, {"s", t.simultaneous_s}};
   j["rapid_rate_mm_per_min"] =
       rates.rapid_per_axis ? to_json(rates.rapid_mm_per_min) : Json(rates.rapid_mm_per_min.x);
   j["rapid_rate_source"] = rates.source;

@@ -30,6 +30,10 @@ struct MachiningTime {
   double feed_s = 0, rapid_s = 0, dwell_s = 0;
   std::map<int, double> by_tool;                      // tool number -> seconds
   std::vector<std::pair<Vec3, double>> by_direction;  // in order of first appearance
+  // Moves whose tool axis turns (Move::pose ≠ fixed): in no direction (each ends at its own
+  // axis: a 5-axis program would list one per move), counted apart.
+  double simultaneous_s = 0;
+  long long simultaneous_moves = 0;
   long long untimed_approaches = 0;  // moves back from "far": where they start is not known
   long long capped_feeds = 0;        // feed moves run at max_feed_mm_per_min instead
   long long untimed_turns = 0;       // rapids turning a rotary axis that has no rate
