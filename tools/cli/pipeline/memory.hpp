@@ -53,7 +53,8 @@ struct MemoryShape {
   bool dump_maps = false;    // --dump-zmaps: each map's polyhedron is built and written
 };
 
-inline constexpr double kTrianglesPerRay = 5.3;  // measured 3.4-5.1 (model D, example, 12 directions)
+inline constexpr double kTrianglesPerRay =
+    5.3;  // measured 3.4-5.1 (model D, example, 12 directions)
 inline constexpr double kSurfaceBytesPerTriangle = 68;  // measured 60-67 at extract_surface's peak
 
 // `held_bytes`: resident now; `peak_bytes`: the peak so far (ru_maxrss).
