@@ -48,14 +48,6 @@ namespace detail {
 // The 128-bit integer type of the exact edge functions (GCC and Clang).
 __extension__ using ScanWide = __int128;
 
-// double(value) without the library's 128-bit conversion (__floattidf, a call: about 1 s of CPU
-// on model-D's three per crossing) where the value fits in 64 bits, as it nearly always does: both
-// round to nearest, so the result is the same double.
-inline double wide_to_double(ScanWide value) {
-  const auto narrow = static_cast<std::int64_t>(value);
-  return narrow == value ? static_cast<double>(narrow) : static_cast<double>(value);
-}
-
 // A projected vertex: fixed-point (u, v) and the world coordinate along the ray axis.
 struct ScanVertex {
   std::int64_t u, v;
@@ -363,7 +355,7 @@ class ZMapScanner {
     if (area == 0) return;  // seen edge-on: the perturbed ray misses it
     const int orientation = area > 0 ? 1 : -1;
     const double lo_t = std::min({a.t, b.t, c.t}), hi_t = std::max({a.t, b.t, c.t});
-    const double inverse_area = 1.0 / wide_to_double(area);
+    const double inverse_area = 1.0 / double(area);
     // A long thin triangle seen at a slant (a wall of a tilted map) has a bounding box of many
     // rays and covers few: for each row of rays, only the columns within one ray spacing of its
     // u-extent on that row are tested (the exact tests below still decide).
@@ -407,9 +399,7 @@ class ZMapScanner {
         // Looked up for the crossings only: the mask is large and the tests above are not.
         if (mask_ && mask_->offsets[ray] == mask_->offsets[ray + 1])
           continue;  // nothing left to cut
-        double t =
-            (wide_to_double(wa) * a.t + wide_to_double(wb) * b.t + wide_to_double(wc) * c.t) *
-            inverse_area;
+        double t = (double(wa) * a.t + double(wb) * b.t + double(wc) * c.t) * inverse_area;
         t = std::clamp(t, lo_t, hi_t);  // rounding: the crossing lies within the triangle's extent
         // Normal along +axis (counter-clockwise in (u, v)) means the ray leaves there.
         hits.push_back({ray, static_cast<float>(t), -orientation});

@@ -1,7 +1,5 @@
 #include <doctest/doctest.h>
 
-#include <cstring>
-#include <limits>
 #include <random>
 
 #include "helpers.hpp"
@@ -169,18 +167,4 @@ TEST_CASE(
   CHECK(total.intervals > 5000);
   CHECK(total.mismatches == 0);
   CHECK(fine_cells > 200);
-}
-
-TEST_CASE("scan's 128-bit to double conversion is the library's, in and beyond 64 bits") {
-  std::mt19937_64 rng(37);
-  for (int k = 0; k < 200000; ++k) {
-    // Magnitudes from a few bits to 120, both signs, and the 64-bit edges.
-    const int shift = static_cast<int>(rng() % 120);
-    __extension__ using Wide = detail::ScanWide;
-    Wide v = (Wide(static_cast<std::int64_t>(rng())) << 56 | Wide(rng() >> 8)) >> (119 - shift);
-    if (k % 7 == 0) v = Wide(std::numeric_limits<std::int64_t>::max()) + Wide(k % 3) - 1;
-    if (k % 11 == 0) v = Wide(std::numeric_limits<std::int64_t>::min()) - Wide(k % 3) + 1;
-    const double fast = detail::wide_to_double(v), library = static_cast<double>(v);
-    REQUIRE(std::memcmp(&fast, &library, sizeof fast) == 0);
-  }
 }
