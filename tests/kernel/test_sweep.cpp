@@ -429,4 +429,27 @@ TEST_CASE("sweep: a cut that rounds to a point leaves the ray whole") {
   CHECK(ray[0].exit == 2.0f);
 }
 
+TEST_CASE(
+    "golden_minimum: the minimum of a convex 1-Lipschitz function, or a value above the bar") {
+  std::mt19937 rng(34);
+  std::uniform_real_distribution<double> u(-5, 5);
+  for (int k = 0; k < 1000; ++k) {
+    // A cone's distance along a line: convex, 1-Lipschitz, least at c.
+    const double c = u(rng), floor = u(rng), slope = 0.2 + 0.8 * std::abs(u(rng)) / 5;
+    auto f = [&](double z) { return floor + slope * std::abs(z - c); };
+    const double lo = -6, hi = 6, precision = 1e-6;
+    const auto [z, value] = detail::golden_minimum(f, lo, hi, precision);
+    CHECK(std::abs(z - c) <= precision);
+    CHECK(value == doctest::Approx(floor).epsilon(1e-6));
+    // A bar below the minimum: the search may stop early, with a value at or above the bar.
+    const double bar = floor - 0.5 * std::abs(u(rng));
+    const auto stopped = detail::golden_minimum(f, lo, hi, precision, bar);
+    CHECK(stopped.second >= bar);
+    CHECK(stopped.second <= f(stopped.first) + 1e-12);
+    // A bar above it: the true minimum is found.
+    const auto found = detail::golden_minimum(f, lo, hi, precision, floor + 1);
+    CHECK(std::abs(found.first - c) <= precision);
+  }
+}
+
 }  // namespace test_sweep

@@ -99,6 +99,32 @@ std::pair<double, double> convex_minimum(F&& f, double lo, double hi, double pre
   }
 }
 
+// The minimum of convex f on [lo, hi] to within `precision` of its argument by golden-section
+// search, without convex_minimum's stop at 0 (for the depth, which is the minimum itself). Given
+// a finite `bar` and f 1-Lipschitz, it returns a value ≥ `bar` as soon as the values seen prove
+// the minimum is (the bracket holds it, and f drops by at most its width from any value in it).
+// Returns (argument, value).
+template <class F>
+std::pair<double, double> golden_minimum(const F& f, double lo, double hi, double precision,
+                                         double bar = std::numeric_limits<double>::infinity()) {
+  const bool stop_at_bar = bar < std::numeric_limits<double>::infinity();
+  double a = lo, b = hi;
+  double x1 = b - kGolden * (b - a), x2 = a + kGolden * (b - a);
+  double f1 = f(x1), f2 = f(x2);
+  std::pair<double, double> best{lo, f(lo)};
+  if (const double v = f(hi); v < best.second) best = {hi, v};
+  while (b - a > precision) {
+    if (stop_at_bar && std::min(f1, f2) - (b - a) >= bar) return {x1, std::max(f1, bar)};
+    if (f1 <= f2)
+      b = x2, x2 = x1, f2 = f1, x1 = b - kGolden * (b - a), f1 = f(x1);
+    else
+      a = x1, x1 = x2, f1 = f2, x2 = a + kGolden * (b - a), f2 = f(x2);
+  }
+  if (f1 < best.second) best = {x1, f1};
+  if (f2 < best.second) best = {x2, f2};
+  return best;
+}
+
 // The zero of f between `inside` (f ≤ 0) and `outside` (f > 0), to within `precision`, on the
 // outside's side (so an interval from these ends covers the set f ≤ 0). `is_inside(x)`: f(x) ≤ 0.
 template <class Inside>

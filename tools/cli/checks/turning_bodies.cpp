@@ -57,30 +57,6 @@ Aabb tb_box(const TurningPart& p, const ToolPose& pose, double grow) {
   return box.inflated(grow);
 }
 
-// The least of convex, 1-Lipschitz f on [lo, hi] by golden-section search to `precision` (the
-// depth is the minimum itself), or a value ≥ `bar` as soon as the values seen prove the minimum
-// is (the bracket holds it, and f drops by at most its width from any value in it). Returns
-// (argument, value).
-template <class F>
-std::pair<double, double> tb_minimum(const F& f, double lo, double hi, double precision,
-                                     double bar) {
-  double a = lo, b = hi;
-  double x1 = b - detail::kGolden * (b - a), x2 = a + detail::kGolden * (b - a);
-  double f1 = f(x1), f2 = f(x2);
-  std::pair<double, double> best{lo, f(lo)};
-  if (const double v = f(hi); v < best.second) best = {hi, v};
-  while (b - a > precision) {
-    if (std::min(f1, f2) - (b - a) >= bar) return {x1, std::max(f1, bar)};
-    if (f1 <= f2)
-      b = x2, x2 = x1, f2 = f1, x1 = b - detail::kGolden * (b - a), f1 = f(x1);
-    else
-      a = x1, x1 = x2, f1 = f2, x2 = a + detail::kGolden * (b - a), f2 = f(x2);
-  }
-  if (f1 < best.second) best = {x1, f1};
-  if (f2 < best.second) best = {x2, f2};
-  return best;
-}
-
 struct TbContact {
   double distance = std::numeric_limits<double>::infinity();  // the least signed distance
   Vec3 where{0.0};
@@ -116,7 +92,7 @@ void tb_contact(const TripleDexel& d, const TurningPart& p, const ToolPose& pose
         if (!(lo <= hi)) continue;
         auto f = [&](double z) { return tb_distance(p, pose, Vec3(x, y, z)); };
         const double bar = std::min(out.distance, grow);  // only a nearer value counts
-        const auto [z, value] = tb_minimum(f, lo, hi, h / 64, bar);
+        const auto [z, value] = detail::golden_minimum(f, lo, hi, h / 64, bar);
         if (value < bar) out = {value, Vec3(x, y, z), pose.axis};
       }
     }

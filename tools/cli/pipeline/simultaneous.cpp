@@ -28,25 +28,6 @@ SweepCutter sweep_cutter_of(const Cutter& cutter, const ToolBody& body) {
   return {cutter, height};
 }
 
-// The least of convex f on [lo, hi] by golden-section search to `precision`, with no early stop.
-template <class F>
-std::pair<double, double> sim_minimum(const F& f, double lo, double hi, double precision) {
-  double a = lo, b = hi;
-  double x1 = b - detail::kGolden * (b - a), x2 = a + detail::kGolden * (b - a);
-  double f1 = f(x1), f2 = f(x2);
-  std::pair<double, double> best{lo, f(lo)};
-  if (const double v = f(hi); v < best.second) best = {hi, v};
-  while (b - a > precision) {
-    if (f1 <= f2)
-      b = x2, x2 = x1, f2 = f1, x1 = b - detail::kGolden * (b - a), f1 = f(x1);
-    else
-      a = x1, x1 = x2, f1 = f2, x2 = a + detail::kGolden * (b - a), f2 = f(x2);
-  }
-  if (f1 < best.second) best = {x1, f1};
-  if (f2 < best.second) best = {x2, f2};
-  return best;
-}
-
 // The box of the cutter at `pose`: a cylinder of its radius from the tip up its axis to its height.
 Aabb cutter_box(const SweepCutter& cutter, const ToolPose& pose) {
   const Vec3 top = pose.tip + cutter.height * pose.axis;
@@ -78,7 +59,7 @@ double pose_depth(const TripleDexel& d, const SweepCutter& cutter, const ToolPos
         if (!(lo < hi)) continue;
         auto f = [&](double z) { return cutter.distance(pose.tip, pose.axis, Vec3(x, y, z)); };
         const std::pair<double, double> best = deepest
-                                                   ? sim_minimum(f, lo, hi, precision)
+                                                   ? detail::golden_minimum(f, lo, hi, precision)
                                                    : detail::convex_minimum(f, lo, hi, precision);
         if (-best.second > depth) depth = -best.second, where = Vec3(x, y, best.first);
       }
