@@ -2,9 +2,7 @@
 #include "checks/machining_time.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <cstdint>
 #include <cstdio>
 #include <utility>
 
@@ -21,67 +19,23 @@ const double kSameDirection = std::cos(glm::radians(1e-3));
 MachiningTimer::MachiningTimer(const gcode::MachineConfig& machine)
     : rates_(machine.rates), kinematics_(machine.kinematics) {}
 
-namespace {
-
-// The cells of MachiningTimer::direction_cells_: a grid of unit directions, 1/4096 apart per
-// coordinate, far coarser than the 1e-3° (1.7e-5) of kSameDirection, so a direction's matches lie
-// in its cell or the 26 around it.
-constexpr double kTimerDirectionCell = 1.0 / 4096;
-
-std::array<std::int64_t, 3> timer_direction_cell(const Vec3& unit) {
-  return {static_cast<std::int64_t>(std::floor(unit.x / kTimerDirectionCell)),
-          static_cast<std::int64_t>(std::floor(unit.y / kTimerDirectionCell)),
-          static_cast<std::int64_t>(std::floor(unit.z / kTimerDirectionCell))};
-}
-
-std::uint64_t timer_direction_key(std::int64_t x, std::int64_t y, std::int64_t z) {
-  auto bits = [](std::int64_t v) { return static_cast<std::uint64_t>(v + (1 << 20)) & 0x1fffff; };
-  return bits(x) << 42 | bits(y) << 21 | bits(z);
-}
-
-}  // namespace
-
-// The first direction (in order of appearance) within kSameDirection of `axis`, or the count.
-std::size_t MachiningTimer::find_direction(const Vec3& axis) const {
+void MachiningTimer::charge(int tool, const Vec3& axis, double seconds) {
+  time_.by_tool[tool] += seconds;
   auto same = [&](std::size_t d) {
     return glm::dot(time_.by_direction[d].first, axis) >= kSameDirection;
   };
   std::size_t found = time_.by_direction.size();
-  const double length = glm::length(axis);
-  // dot(s, axis) >= kSameDirection with |s| = 1 and |axis| <= 1 + 1e-9 puts s within 5e-5 of
-  // axis / |axis|: in a neighbouring cell. Any other axis is scanned as before.
-  if (!(length >= 0.5 && length <= 1 + 1e-9)) {
-    for (std::size_t d = 0; d < found; ++d)
-      if (same(d)) return d;
-    return found;
-  }
-  const std::array<std::int64_t, 3> c = timer_direction_cell(axis / length);
-  for (std::int64_t dx = -1; dx <= 1; ++dx)
-    for (std::int64_t dy = -1; dy <= 1; ++dy)
-      for (std::int64_t dz = -1; dz <= 1; ++dz) {
-        auto it = direction_cells_.find(timer_direction_key(c[0] + dx, c[1] + dy, c[2] + dz));
-        if (it == direction_cells_.end()) continue;
-        for (std::uint32_t d : it->second)
-          if (d < found && same(d)) found = d;
-      }
-  return found;
-}
-
-void MachiningTimer::charge(int tool, const Vec3& axis, double seconds) {
-  time_.by_tool[tool] += seconds;
-  std::size_t found = time_.by_direction.size();
-  if (last_direction_ < found &&
-      glm::dot(time_.by_direction[last_direction_].first, axis) >= kSameDirection) {
+  if (last_direction_ < found && same(last_direction_)) {
     found = last_direction_;
   } else {
-    found = find_direction(axis);
+    for (std::size_t d = 0; d < time_.by_direction.size(); ++d)
+      if (same(d)) {
+        found = d;
+        break;
+      }
   }
-  if (found == time_.by_direction.size()) {
+  if (found == time_.by_direction.size())
     time_.by_direction.emplace_back(glm::normalize(axis), 0.0);
-    const std::array<std::int64_t, 3> c = timer_direction_cell(time_.by_direction.back().first);
-    direction_cells_[timer_direction_key(c[0], c[1], c[2])].push_back(
-        static_cast<std::uint32_t>(found));
-  }
   time_.by_direction[found].second += seconds;
   last_direction_ = found;
 }

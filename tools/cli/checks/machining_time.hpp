@@ -16,7 +16,6 @@
 #include <map>
 #include <optional>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 #include "json_text.hpp"
@@ -52,16 +51,12 @@ class MachiningTimer {
 
  private:
   void charge(int tool, const Vec3& axis, double seconds);
-  std::size_t find_direction(const Vec3& axis) const;
   double rapid_minutes(const gcode::Move& move);
 
   gcode::MachineRates rates_;
   std::optional<gcode::Kinematics> kinematics_;
   MachiningTime time_;
   std::size_t last_direction_ = 0;
-  // time_.by_direction's indices by the cell of a fine grid holding their unit direction: a
-  // simultaneous program turns the axis on every move, so a scan of them all would be quadratic.
-  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> direction_cells_;
   // Where the machine's axes stood after the previous move (kinematic model only): a rotary
   // turn between moves shows as this move's start differing from it.
   bool have_last_ = false;
