@@ -8,6 +8,7 @@
 #include "inputs/project.hpp"
 #include "inputs/json_input.hpp"
 #include "pipeline/memory.hpp"
+#include "tridex/parallel.hpp"
 
 namespace tridex::cli {
 
@@ -111,6 +112,7 @@ gcode::InterpreterOptions interpreter_options(const CommonOptions& options) {
   o.lenient = options.lenient;
   o.block_delete = options.block_delete == "on";
   o.max_blocks = options.max_blocks;
+  o.read_ahead = detail::resolve_threads(0) > 1;  // lexing beside interpreting (a second core)
   return o;
 }
 
