@@ -354,7 +354,7 @@ ParsedProgram parse_grouped(const SimulateOptions& options, std::uint64_t max_me
   parsed.interpreted = interpret(
       input, interpreting,
       [&](const gcode::Move& m, std::size_t file) {
-        budget.keep(m, input.files[file].string());
+        budget.keep(m, input.files[file]);
         r.machining.add(m);
         grouping.push(m);
       },
