@@ -57,7 +57,7 @@ class ReadAhead {
   // `block` as lex_line would make it of a line that lexed purely.
   void fill(const Line& line, Block& block) const;
 
-  static constexpr std::size_t kChunkBytes = 1 << 18;
+  static constexpr std::size_t kChunkBytes = 1 << 16;
   static constexpr std::size_t kChunks = 4;  // at most this many chunks read ahead
   static constexpr std::size_t kLongLine = 65536;
 

@@ -201,7 +201,7 @@ TEST_CASE("read ahead: random programs run as without it, errors mid-file includ
   int errors = 0;
   for (int program = 0; program < 40; ++program) {
     const bool jumps = program % 3 == 0, faults = program % 2 == 1;
-    const int lines = program % 8 == 0 ? 24000 : 600;  // some cross the 256 KiB chunks
+    const int lines = program % 8 == 0 ? 24000 : 600;  // some cross the 64 KiB chunks
     const std::string text = block_soup(random, lines, jumps, faults);
     const std::string expected = outcome_of_text(text, false);
     CHECK_MESSAGE(outcome_of_text(text, true) == expected, "program " << program);
