@@ -39,7 +39,7 @@ TEST_CASE("fast parse: word values equal the correctly rounded decimal, bit for 
   Block block;
   LexError error;
   int read = 0;
-  for (int i = 0; i < 100000; ++i) {
+  for (int i = 0; i < 50000; ++i) {
     const std::string number = random_decimal(random);
     const bool ok = lex_line("X-" + number + " Y" + number, block, error);
     const double expected = std::strtod(number.c_str(), nullptr);
@@ -53,7 +53,7 @@ TEST_CASE("fast parse: word values equal the correctly rounded decimal, bit for 
     CHECK_MESSAGE(block.words[0].value == -expected, number);
     ++read;
   }
-  CHECK(read > 50000);
+  CHECK(read > 25000);
   // Exact halfway and near-halfway cases, 15 and 16 digits, and malformed numbers.
   for (const std::string number :
        {"0.1", "0.3", "123456789.012345", "999999999.999999", "1000000000", "1000000000.",
@@ -199,15 +199,15 @@ std::string block_soup(std::mt19937_64& random, int lines, bool jumps, bool faul
 TEST_CASE("read ahead: random programs run as without it, errors mid-file included") {
   std::mt19937_64 random(2026);
   int errors = 0;
-  for (int program = 0; program < 40; ++program) {
+  for (int program = 0; program < 24; ++program) {
     const bool jumps = program % 3 == 0, faults = program % 2 == 1;
-    const int lines = program % 8 == 0 ? 24000 : 600;  // some cross the 64 KiB chunks
+    const int lines = program % 8 == 0 ? 12000 : 600;  // some cross the 64 KiB chunks
     const std::string text = block_soup(random, lines, jumps, faults);
     const std::string expected = outcome_of_text(text, false);
     CHECK_MESSAGE(outcome_of_text(text, true) == expected, "program " << program);
     errors += expected.find("error ") != std::string::npos;
   }
-  CHECK(errors >= 5);
+  CHECK(errors >= 3);
 }
 
 }  // namespace test_whole_parse
