@@ -17,6 +17,7 @@
 #include <set>
 
 #include "line_reader.hpp"
+#include "read_ahead.hpp"
 #include "state.hpp"
 
 namespace tridex::gcode {
@@ -92,6 +93,8 @@ class ProgramFlow {
   }
 
   void run();
+  // Reads the main program ahead on a second thread (InterpreterOptions::read_ahead).
+  void start_read_ahead(std::istream& program);
   // One piece of a longer program (Interpreter::feed): starts where the last piece stopped.
   void run_piece();
 
@@ -100,7 +103,10 @@ class ProgramFlow {
 
   bool read(std::string_view& out);
   void jump(const Position& to);
-  Position here() { return Position{current_, source().reader.offset(), line_}; }
+  Position here() { return Position{current_, offset(), line_}; }
+  // Where the next line starts in the current source (the read-ahead's, while it reads).
+  std::uint64_t offset() { return read_ahead_ ? read_ahead_->offset() : source().reader.offset(); }
+  void end_read_ahead();
   [[noreturn]] void error(int column, const std::string& message) { s_.error(column, message); }
   void count_block(int column);  // column: the statement's, named if it passes the block limit
 
@@ -146,6 +152,8 @@ class ProgramFlow {
   std::vector<Branch> branches_;
   Block block_;
   LexError lex_error_;
+  std::unique_ptr<ReadAhead> read_ahead_;        // the main program's lines, until a jump
+  const ReadAhead::Line* ahead_line_ = nullptr;  // the line read() gave from it
   bool started_ = false, percent_seen_ = false, ended_ = false;
   bool piece_ = false;                  // run_piece(): one piece of a program fed in pieces
   std::uint64_t statement_offset_ = 0;  // where the line being executed starts
@@ -157,19 +165,41 @@ class ProgramFlow {
 
 bool ProgramFlow::read(std::string_view& out) {
   Source& src = source();
-  std::uint64_t at = src.reader.offset();
-  bool too_long = false;
-  if (!src.reader.next(out, too_long)) return false;
-  ++line_;
-  s_.context.line = line_;
-  if (too_long) error(0, "line longer than 65535 characters");
-  if (line_ == 1 && out.substr(0, 3) == "\xEF\xBB\xBF") out.remove_prefix(3);  // UTF-8 BOM
+  std::uint64_t at = offset();
+  ahead_line_ = nullptr;
+  if (read_ahead_ && !read_ahead_->next(out, ahead_line_)) end_read_ahead();
+  if (ahead_line_) {
+    ++line_;
+    s_.context.line = line_;  // the BOM is gone, as below; no line is too long (read_ahead.hpp)
+  } else {
+    bool too_long = false;
+    if (!src.reader.next(out, too_long)) return false;
+    ++line_;
+    s_.context.line = line_;
+    if (too_long) error(0, "line longer than 65535 characters");
+    if (line_ == 1 && out.substr(0, 3) == "\xEF\xBB\xBF") out.remove_prefix(3);  // UTF-8 BOM
+  }
   if (at >= src.scanned_to) {  // first visit: note labels
     note_label(out, here());
-    src.scanned_to = src.reader.offset();
+    src.scanned_to = offset();
     src.scanned_line = line_;
   }
   return true;
+}
+
+// Only the main program is read ahead, only from its start (run(), not a piece) and only from a
+// stream the reader can go back into when the read-ahead ends.
+void ProgramFlow::start_read_ahead(std::istream& program) {
+  LineReader& reader = sources_[0]->reader;
+  if (s_.options.read_ahead && reader.seekable())
+    read_ahead_ = std::make_unique<ReadAhead>(program, reader.offset(), true);
+}
+
+// The main program's reader goes on after the last line the read-ahead gave.
+void ProgramFlow::end_read_ahead() {
+  const std::uint64_t at = read_ahead_->offset();
+  read_ahead_.reset();
+  if (!sources_[0]->reader.restart(at)) error(0, "the program file cannot be read again");
 }
 
 void ProgramFlow::note_label(std::string_view text, const Position& after) {
@@ -188,6 +218,7 @@ void ProgramFlow::note_label(std::string_view text, const Position& after) {
 }
 
 void ProgramFlow::jump(const Position& to) {
+  if (read_ahead_) end_read_ahead();  // lines in order only
   current_ = to.source;
   s_.context.file = &source().name;
   s_.context.file_index = static_cast<int>(current_);
@@ -742,7 +773,7 @@ void ProgramFlow::o_break(const Control& control) {
 void ProgramFlow::run() {
   std::string_view text;
   for (;;) {
-    statement_offset_ = source().reader.offset();
+    statement_offset_ = offset();
     if (!read(text)) {
       if (current_ != 0 && !calls_.empty() && calls_.back().body.source == current_ &&
           calls_.back().kind != CallKind::o_call) {
@@ -751,7 +782,9 @@ void ProgramFlow::run() {
       }
       break;
     }
-    if (!lex_line(text, block_, lex_error_, &s_))
+    if (ahead_line_ && ahead_line_->lexed)
+      read_ahead_->fill(*ahead_line_, block_);  // what lex_line makes of it (read_ahead.hpp)
+    else if (!lex_line(text, block_, lex_error_, &s_))
       throw SyntaxError(Diagnostic{source().name, line_, lex_error_.column, lex_error_.message});
     if (block_.percent) {
       if (current_ != 0) continue;  // a subprogram file's own tape marks
@@ -863,7 +896,9 @@ void ProgramFlow::run_piece() {
 }
 
 void run_program(Interpreter::State& state, std::istream& program, const std::string& file_name) {
-  ProgramFlow(state, program, file_name).run();
+  ProgramFlow flow(state, program, file_name);
+  flow.start_read_ahead(program);
+  flow.run();
 }
 
 void run_program_piece(Interpreter::State& state, std::istream& piece,

@@ -58,6 +58,18 @@ class LineReader {
   std::uint64_t offset() const { return base_ + pos_; }  // where the next line starts
   bool seekable() const { return seekable_; }
 
+  // Reads from `offset` on after someone else read the stream (ReadAhead): nothing buffered is
+  // kept. False when the stream cannot go there.
+  bool restart(std::uint64_t offset) {
+    in_.clear();
+    in_.seekg(static_cast<std::streamoff>(offset));
+    if (!in_) return false;
+    base_ = offset;
+    pos_ = end_ = 0;
+    eof_ = false;
+    return true;
+  }
+
   bool seek(std::uint64_t offset) {
     // A jump back into what the buffer holds (a loop's body) needs no I/O.
     if (offset >= base_ && offset <= base_ + end_) {

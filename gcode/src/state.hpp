@@ -51,6 +51,9 @@ struct Interpreter::State : ParameterReader {
     std::vector<Diagnostic> warnings;
     std::set<int> tools_used;
     std::map<int, int> tool_first_line;
+    // The tool of the last move emitted, in tools_used already: the next moves of the same tool
+    // skip the set (a look-up per move on the hot path of plain programs).
+    std::optional<int> last_tool_used;
     bool selects_tool = false;  // a T word or M61 Q ran (a program with none: CAMotics' tool 1)
     long long blocks = 0;
     std::map<std::string, Skipped> skipped;  // by cause (unsupported)
@@ -594,8 +597,11 @@ struct Interpreter::State : ParameterReader {
       move.rotary = frame.rotary_position;
       move.machine = machine_from_part(*machine.kinematics, b, frame.rotary_position);
     }
-    if (summary.tools_used.insert(tool.number).second)
-      summary.tool_first_line.emplace(tool.number, context.line);
+    if (summary.last_tool_used != tool.number) {
+      summary.last_tool_used = tool.number;
+      if (summary.tools_used.insert(tool.number).second)
+        summary.tool_first_line.emplace(tool.number, context.line);
+    }
     (*sink)(move);
   }
 

@@ -8,6 +8,7 @@
 #include "inputs/project.hpp"
 #include "inputs/json_input.hpp"
 #include "pipeline/memory.hpp"
+#include "tridex/parallel.hpp"
 
 namespace tridex::cli {
 
@@ -111,20 +112,21 @@ gcode::InterpreterOptions interpreter_options(const CommonOptions& options) {
   o.lenient = options.lenient;
   o.block_delete = options.block_delete == "on";
   o.max_blocks = options.max_blocks;
+  o.read_ahead = detail::resolve_threads(0) > 1;  // lexing beside interpreting (a second core)
   return o;
 }
 
-void MoveBudget::keep(const gcode::Move& move, const std::string& file) {
+void MoveBudget::keep(const gcode::Move& move, const fs::path& file) {
   ++kept_;
   if (held_ > static_cast<double>(max_bytes_))
-    input_error(file, ":", move.line, ": tridex holds ", format_mib(held_),
+    input_error(file.string(), ":", move.line, ": tridex holds ", format_mib(held_),
                 " before keeping any move (its libraries ",
                 "and the files read), more than --max-memory ",
                 format_mib(static_cast<double>(max_bytes_)), "; raise --max-memory");
   if (held_ + bytes() > static_cast<double>(max_bytes_))
     input_error(
-        file, ":", move.line, ": the program expands into more than ", kept_ - 1, " moves (",
-        format_mib(bytes()), " to keep them, with ", format_mib(held_),
+        file.string(), ":", move.line, ": the program expands into more than ", kept_ - 1,
+        " moves (", format_mib(bytes()), " to keep them, with ", format_mib(held_),
         " in use before reading), more than --max-memory ",
         format_mib(static_cast<double>(max_bytes_)),
         "; raise --max-memory, or give a larger --arc-tolerance if fine arcs make the moves");

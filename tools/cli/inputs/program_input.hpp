@@ -77,7 +77,8 @@ class MoveBudget {
   MoveBudget(std::uint64_t max_bytes, double bytes_per_move)
       : max_bytes_(max_bytes), per_move_(bytes_per_move), held_(peak_rss_bytes()) {}
   // Throws InputError, naming the file and line of the move that crosses the limit.
-  void keep(const gcode::Move& move, const std::string& file);
+  // (A path, not its string: nothing is made per move unless the limit is crossed.)
+  void keep(const gcode::Move& move, const std::filesystem::path& file);
   long long kept() const { return kept_; }
   double bytes() const { return static_cast<double>(kept_) * per_move_; }
 

@@ -144,7 +144,7 @@ int run_groups(const ListOptions& options) {
   InterpretResult result = interpret(
       input, interpreter_options(options),
       [&](const gcode::Move& m, std::size_t file) {
-        budget.keep(m, input.files[file].string());
+        budget.keep(m, input.files[file]);
         timer.add(m);
         if (m.pose != gcode::PoseLaw::fixed) {
           ++simultaneous;

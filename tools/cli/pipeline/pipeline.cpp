@@ -349,10 +349,12 @@ ParsedProgram parse_grouped(const SimulateOptions& options, std::uint64_t max_me
         }
       },
       detail::resolve_threads(options.threads) > 1);
+  gcode::InterpreterOptions interpreting = interpreter_options(options);
+  interpreting.read_ahead = detail::resolve_threads(options.threads) > 1;  // --threads 1: one
   parsed.interpreted = interpret(
-      input, interpreter_options(options),
+      input, interpreting,
       [&](const gcode::Move& m, std::size_t file) {
-        budget.keep(m, input.files[file].string());
+        budget.keep(m, input.files[file]);
         r.machining.add(m);
         grouping.push(m);
       },

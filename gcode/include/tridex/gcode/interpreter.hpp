@@ -53,6 +53,10 @@ struct InterpreterOptions {
   double peck_clearance = 0.254;  // mm, G73 back-off and G83 re-entry gap (LinuxCNC's 0.010 in)
   // Error once this many blocks ran: bounds endless loops (M98 L, WHILE, GOTO); 0 = no bound.
   long long max_blocks = 100'000'000;
+  // run() reads and lexes the program's lines on a second thread while it interprets the blocks
+  // before them (gcode/README.md, "Reading ahead"); moves, messages and errors are the same.
+  // Until the first jump (M98, GOTO, a loop, an o-word call) only: from there on, one thread.
+  bool read_ahead = false;
 };
 
 class Interpreter {
