@@ -78,7 +78,7 @@ void check_follows(const std::vector<Move>& pieces, const std::vector<ControlPoi
   }
 }
 
-const MachineConfig kLinuxcnc = *MachineConfig::bundled("rs274");
+const MachineConfig kRs274Machine = *MachineConfig::bundled("rs274");
 
 }  // namespace
 
@@ -101,7 +101,7 @@ TEST_CASE(
     }
     text += "G5.3\nG1 Z0\n";
     CAPTURE(text);
-    Result r = run_program(text, {}, kLinuxcnc);
+    Result r = run_program(text, {}, kRs274Machine);
     int line_g53 = count + 2;
     // Biarcs cut to arc_tolerance chords stayed within 0.14 mm of these curves in a 40 mm field:
     // the joins are the exact check; this bound catches a piece that leaves the curve.
@@ -117,20 +117,21 @@ TEST_CASE(
     "3") {
   // A first block without X Y: its P is the start point's weight.
   Result r = run_program("G21 G17 G90 F100\nG0 X0 Y0 Z-1\nG5.2 P3\nX10 Y10 P1\nX20 Y0 P0.5\nG5.3\n",
-                         {}, kLinuxcnc);
+                         {}, kRs274Machine);
   check_follows(moves_of_line(r, 6), {{{0, 0}, 3}, {{10, 10}, 1}, {{20, 0}, 0.5}}, 3, 0.2);
   // G91: each point is an increment from the start (the current point does not move until G5.3).
-  Result g91 = run_program(
-      "G20 G17 G91 F10\nG0 X1 Y1 Z-0.1\nG5.2 X1 Y1 P1\nX2 Y0 P2\nX3 Y1 P1\nG5.3\n", {}, kLinuxcnc);
+  Result g91 =
+      run_program("G20 G17 G91 F10\nG0 X1 Y1 Z-0.1\nG5.2 X1 Y1 P1\nX2 Y0 P2\nX3 Y1 P1\nG5.3\n", {},
+                  kRs274Machine);
   const double in = 25.4;
   check_follows(moves_of_line(g91, 6),
                 {{{in, in}, 1}, {{2 * in, 2 * in}, 1}, {{3 * in, in}, 2}, {{4 * in, 2 * in}, 1}}, 3,
                 1.0);
   // Two control points after the start and the default order 3: the quadratic Bezier, which
   // G5.1 cuts as the same pieces.
-  Result nurbs =
-      run_program("G21 G17 G90 F100\nG0 X0 Y0 Z-1\nG5.2 X2 Y4 P1\nX6 Y0 P1\nG5.3\n", {}, kLinuxcnc);
-  Result g51 = run_program("G21 G17 G90 F100\nG0 X0 Y0 Z-1\nG5.1 I2 J4 X6 Y0\n", {}, kLinuxcnc);
+  Result nurbs = run_program("G21 G17 G90 F100\nG0 X0 Y0 Z-1\nG5.2 X2 Y4 P1\nX6 Y0 P1\nG5.3\n", {},
+                             kRs274Machine);
+  Result g51 = run_program("G21 G17 G90 F100\nG0 X0 Y0 Z-1\nG5.1 I2 J4 X6 Y0\n", {}, kRs274Machine);
   std::vector<Move> a = moves_of_line(nurbs, 5), b = moves_of_line(g51, 3);
   REQUIRE(a.size() == b.size());
   for (std::size_t k = 0; k < a.size(); ++k) CHECK(near(a[k].end, b[k].end, 1e-9));
@@ -161,17 +162,17 @@ TEST_CASE("G5.2/G5.3 errors at the word, as rs274 gives them or where it would m
            {"G5.2 X1 Y1 P1\nX2 Y0 P1\nG5.3\nX4 Y4", 6, 1, "without an active motion mode"},
        }) {
     CAPTURE(c.blocks);
-    MachineConfig machine = kLinuxcnc;
+    MachineConfig machine = kRs274Machine;
     machine.tool_diameters = {{1, 2.0}};
     Diagnostic d = error_of(start + c.blocks + "\n", {}, machine);
     CHECK(d.line == c.line);
     CHECK(d.column == c.column);
     CHECK_MESSAGE(d.message.find(c.text) != std::string::npos, d.message);
   }
-  Diagnostic no_feed = error_of("G21 G17 G90\nG0 X0 Y0 Z-1\nG5.2 X1 Y1 P1\n", {}, kLinuxcnc);
+  Diagnostic no_feed = error_of("G21 G17 G90\nG0 X0 Y0 Z-1\nG5.2 X1 Y1 P1\n", {}, kRs274Machine);
   CHECK(no_feed.message.find("feed") != std::string::npos);
   // Points a G5.3 never ended are dropped, as by LinuxCNC: said, never silent.
-  Result dropped = run_program(start + "G5.2 X1 Y1 P1\nX2 Y0 P1\nG1 X5\n", {}, kLinuxcnc);
+  Result dropped = run_program(start + "G5.2 X1 Y1 P1\nX2 Y0 P1\nG1 X5\n", {}, kRs274Machine);
   CHECK(std::any_of(dropped.warnings.begin(), dropped.warnings.end(), [](const Diagnostic& d) {
     return d.line == 5 && d.message.find("no G5.3") != std::string::npos;
   }));
