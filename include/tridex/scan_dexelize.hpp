@@ -239,12 +239,26 @@ class ZMapScanner {
   }
 
   // Only the columns that can reach a ray (live_columns_), their vertices computed cell by cell.
+  // A row's vertices are kept for the next row, whose lower corners they are.
   void scan_live_columns(int j0, int j1, std::vector<MeshHit>& hits) const {
+    const std::size_t m = live_columns_.size();
+    std::vector<ScanVertex> lower(2 * m), upper(2 * m);  // columns i and i + 1 of each
+    std::vector<double> hl(2 * m), hu(2 * m);
+    auto fill = [&](int j, std::vector<ScanVertex>& row, std::vector<double>& h) {
+      for (std::size_t k = 0; k < m; ++k)
+        for (std::size_t c = 0; c < 2; ++c)
+          row[2 * k + c] = grid_vertex(live_columns_[k] + static_cast<int>(c), j, h[2 * k + c]);
+    };
+    int filled = -1;  // the row `lower` holds
     for (int j = j0; j < j1; ++j) {
       if (!row_reaches_rays(j)) continue;
+      if (filled != j) fill(j, lower, hl);
+      fill(j + 1, upper, hu);
+      filled = j + 1;
       auto [fine, fine_end] = row_fine_cells(j);
       const std::size_t row_base = grid_.index(0, j);
-      for (int i : live_columns_) {
+      for (std::size_t k = 0; k < m; ++k) {
+        const int i = live_columns_[k];
         const auto ii = static_cast<std::size_t>(i);
         while (fine != fine_end && *fine < row_base + ii) ++fine;
         if (fine != fine_end && *fine == row_base + ii) {
@@ -252,11 +266,11 @@ class ZMapScanner {
           ++fine;
           continue;
         }
-        double h[4];
-        ScanVertex p[4];
-        for (int c = 0; c < 4; ++c) p[c] = grid_vertex(i + (c & 1), j + (c >> 1), h[c]);
-        plain_cell(i, j, p[0], p[1], p[2], p[3], h[0], h[1], h[2], h[3], hits);
+        plain_cell(i, j, lower[2 * k], lower[2 * k + 1], upper[2 * k], upper[2 * k + 1], hl[2 * k],
+                   hl[2 * k + 1], hu[2 * k], hu[2 * k + 1], hits);
       }
+      std::swap(lower, upper);
+      std::swap(hl, hu);
     }
   }
 
