@@ -65,7 +65,7 @@ inline void require_valid_indices(const Mesh& mesh, const char* who) {
 
 namespace detail {
 
-// Classifies the edges of one vertex v: `entries` holds (max(a, b) << 1) | (a < b) for each of
+// Classifies the edges of one vertex v: [lo, hi) holds (max(a, b) << 1) | (a < b) for each of
 // its directed edges a→b with min(a, b) = v, and is sorted here.
 inline void classify_vertex_edges(std::uint64_t* lo, std::uint64_t* hi, MeshCheck& result) {
   std::sort(lo, hi);
@@ -100,8 +100,9 @@ void for_each_mesh_edge(const Mesh& mesh, std::size_t first, std::size_t last, V
 
 }  // namespace detail
 
-// Counts the edge defects of `mesh` on `threads` threads (0: every hardware thread; the counts
-// do not depend on it). Throws tridex::Error if a triangle names a missing vertex.
+// Counts the edge defects of `mesh` on `threads` threads (1 unless asked; 0: every hardware
+// thread; the counts do not depend on it). Throws tridex::Error if a triangle names a missing
+// vertex.
 //
 // Each directed edge a→b is filed under its lower vertex min(a, b): vertices are cut into
 // ranges, the triangles into chunks; each chunk counts its edges per range and then places them

@@ -309,10 +309,10 @@ inline void format_stl_records(const Mesh& mesh, std::size_t first, std::size_t 
 // Writes `mesh` as binary STL to a stream. Throws tridex::Error if a triangle names a missing
 // vertex, the mesh has more than 2^32 − 1 triangles, or the stream fails.
 //
-// The records are formatted on `threads` threads (0: every hardware thread), a group of batches
-// at a time, each batch into a buffer of its own; while the threads format the next group, a
-// thread of its own writes the last one's buffers in order. The bytes do not depend on the
-// thread count. One thread formats and writes by turns.
+// The records are formatted on `threads` threads (1 unless asked; 0: every hardware thread), a
+// group of batches at a time, each batch into a buffer of its own; while the threads format the
+// next group, a thread of its own writes the last one's buffers in order. The bytes do not
+// depend on the thread count. One thread formats and writes by turns.
 inline void write_stl(std::ostream& out, const Mesh& mesh, unsigned threads = 1) {
   detail::require_valid_indices(mesh, "write_stl");
   if (mesh.triangles.size() > 0xFFFFFFFFu)
