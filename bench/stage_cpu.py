@@ -22,7 +22,7 @@ STAGES = [
     ("box heights (from_box, raise_uncut)", r"box_top_row"),
     ("parse", r"gcode::|Parser|LineLexer|lex_line|fast_float|MoveList|Grouper|cut_move"),
     ("zmap (Step 1)", r"Miller|Lanes|from_box|mill_|MoveGeometry|rapid_cuts|TileRow"),
-    ("intersect (Steps 2-3)", r"ZMapScanner|scan_|grid_from_hits|intersect|Dexel|dexel"),
+    ("intersect (Steps 2-3)", r"ZMapScanner|scan_|grid_from_hits|hits_by_chunk|intersect|Dexel|dexel"),
     ("mesh", r"surface::|Extractor|check_mesh|write_stl|signed_volume"),
     ("kernel: zeroing fresh pages", r"clear_page"),
 ]

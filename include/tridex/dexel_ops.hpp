@@ -23,44 +23,64 @@ namespace tridex {
 
 namespace detail {
 
-// Builds grid `axis` of a triple dexel on `lattice` by calling per_ray(r, out) for every ray r
-// in order within a chunk; per_ray appends ray r's intervals to `out`. Chunks run on `threads`
-// threads and are concatenated in ray order, so the result is independent of the thread count.
-template <class PerRay>
-DexelGrid build_grid(const DexelLattice& lattice, int axis, unsigned threads, PerRay&& per_ray) {
+// The rays of one chunk of build_grid_chunks: every grid is built this many rays at a time.
+inline constexpr std::size_t kGridChunk = 4096;
+
+// Builds grid `axis` of a triple dexel on `lattice` chunk by chunk: per_chunk(begin, end, out,
+// counts) appends the intervals of rays [begin, end) to `out` in ray order and sets counts[r −
+// begin] to ray r's number of intervals. Chunks (kGridChunk rays) run on `threads` threads and
+// are concatenated in ray order, on the threads too, so the result is independent of the thread
+// count.
+template <class PerChunk>
+DexelGrid build_grid_chunks(const DexelLattice& lattice, int axis, unsigned threads,
+                            PerChunk&& per_chunk) {
   DexelGrid g;
   g.axis = axis;
   g.nu = lattice.n[TripleDexel::u_axis(axis)];
   g.nv = lattice.n[TripleDexel::v_axis(axis)];
   const std::size_t rays = g.ray_count();
-  g.offsets.assign(rays + 1, 0);
-  const std::size_t chunk = 4096;
-  const std::size_t chunks = (rays + chunk - 1) / chunk;
+  g.offsets.resize(rays + 1);
+  g.offsets[0] = 0;
+  const std::size_t chunks = (rays + kGridChunk - 1) / kGridChunk;
   std::vector<std::vector<DexelInterval>> parts(chunks);
   for_each_chunk(chunks, threads, [&](std::size_t c) {
-    std::vector<DexelInterval>& out = parts[c];
-    std::size_t end = std::min(rays, (c + 1) * chunk);
-    for (std::size_t r = c * chunk; r < end; ++r) {
-      std::size_t before = out.size();
-      per_ray(r, out);
-      g.offsets[r + 1] = static_cast<std::uint32_t>(out.size() - before);  // count, summed below
-    }
+    const std::size_t begin = c * kGridChunk, end = std::min(rays, begin + kGridChunk);
+    per_chunk(begin, end, parts[c], g.offsets.data() + begin + 1);  // counts, summed below
   });
-  std::size_t total = 0;
-  for (const auto& p : parts) total += p.size();
+  // Where each chunk's intervals go: a serial pass over the chunks only, then the rays' offsets
+  // and the copies on the threads (they were a serial pass over every ray and interval).
+  std::vector<std::size_t> base(chunks + 1, 0);
+  for (std::size_t c = 0; c < chunks; ++c) base[c + 1] = base[c] + parts[c].size();
+  const std::size_t total = base[chunks];
   if (total > std::numeric_limits<std::uint32_t>::max())
     fail("triple dexel: grid ", axis, " would hold ", total,
          " intervals, over the 32-bit offset limit");
-  for (std::size_t r = 0; r < rays; ++r) g.offsets[r + 1] += g.offsets[r];
   g.intervals.resize(total);
-  std::size_t at = 0;
-  for (auto& p : parts) {
+  for_each_chunk(chunks, threads, [&](std::size_t c) {
+    const std::size_t begin = c * kGridChunk, end = std::min(rays, begin + kGridChunk);
+    auto at = static_cast<std::uint32_t>(base[c]);
+    for (std::size_t r = begin; r < end; ++r) g.offsets[r + 1] = at += g.offsets[r + 1];
+    std::vector<DexelInterval>& p = parts[c];
     if (!p.empty())
-      std::memcpy(g.intervals.data() + at, p.data(), p.size() * sizeof(DexelInterval));
-    at += p.size();
+      std::memcpy(g.intervals.data() + base[c], p.data(), p.size() * sizeof(DexelInterval));
     std::vector<DexelInterval>().swap(p);
-  }
+  });
   return g;
+}
+
+// Builds grid `axis` of a triple dexel on `lattice` by calling per_ray(r, out) for every ray r
+// in order within a chunk; per_ray appends ray r's intervals to `out` (build_grid_chunks).
+template <class PerRay>
+DexelGrid build_grid(const DexelLattice& lattice, int axis, unsigned threads, PerRay&& per_ray) {
+  return build_grid_chunks(lattice, axis, threads,
+                           [&](std::size_t begin, std::size_t end, std::vector<DexelInterval>& out,
+                               std::uint32_t* counts) {
+                             for (std::size_t r = begin; r < end; ++r) {
+                               const std::size_t before = out.size();
+                               per_ray(r, out);
+                               counts[r - begin] = static_cast<std::uint32_t>(out.size() - before);
+                             }
+                           });
 }
 
 inline void require_same_lattice(const TripleDexel& a, const TripleDexel& b, const char* who) {

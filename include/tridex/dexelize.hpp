@@ -66,47 +66,98 @@ inline int perturbed_sign(std::int64_t value, std::int64_t du, std::int64_t dv) 
   return du > 0 ? 1 : (du < 0 ? -1 : 0);
 }
 
-// One ray family from its crossings (found in any order, by any number of threads): a counting
-// sort by ray, then per ray a sort by position and spans by winding number, so that overlapping
-// shells unite. `unbalanced(ray, t)` is called (and must throw) where a ray's crossings do not
-// balance: an open or inside-out solid.
+// Files each list's crossings by chunk of build_grid_chunks (ray / kGridChunk), each list on a
+// thread of its own: starts[w][c] is where list w's chunk c begins (its end: starts[w][c + 1]).
+inline std::vector<std::vector<std::size_t>> hits_by_chunk(std::vector<std::vector<MeshHit>>& found,
+                                                           std::size_t rays, unsigned threads) {
+  const std::size_t chunks = (rays + kGridChunk - 1) / kGridChunk;
+  std::vector<std::vector<std::size_t>> starts(found.size());
+  for_each_chunk(found.size(), threads, [&](std::size_t w) {
+    std::vector<MeshHit>& list = found[w];
+    std::vector<std::size_t>& start = starts[w];
+    start.assign(chunks + 1, 0);
+    for (const MeshHit& h : list) ++start[h.ray / kGridChunk + 1];
+    for (std::size_t c = 0; c < chunks; ++c) start[c + 1] += start[c];
+    std::vector<MeshHit> sorted(list.size());
+    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+    for (const MeshHit& h : list) sorted[fill[h.ray / kGridChunk]++] = h;
+    list.swap(sorted);
+  });
+  return starts;
+}
+
+// One ray family from its crossings (found in any order, by any number of threads): per ray, a
+// sort by position and spans by winding number, so that overlapping shells unite; then
+// emit(r, spans, out) appends ray r's intervals to `out` from its spans (a copy, or the spans
+// intersected with another grid's ray). The crossings are filed by chunk of rays on the threads
+// (hits_by_chunk), then each chunk sorts its own by ray (a counting sort over its rays): a
+// counting sort over every ray of the family at once ran on one thread. A ray's spans depend
+// only on its crossings, not on their order. `unbalanced(ray, t)` is called (and must throw)
+// where a ray's crossings do not balance: an open or inside-out solid.
+template <class Unbalanced, class Emit>
+DexelGrid grid_from_hits(const DexelLattice& lattice, int axis, unsigned threads,
+                         std::vector<std::vector<MeshHit>>& found, Unbalanced&& unbalanced,
+                         Emit&& emit) {
+  const std::size_t rays = static_cast<std::size_t>(lattice.n[TripleDexel::u_axis(axis)]) *
+                           static_cast<std::size_t>(lattice.n[TripleDexel::v_axis(axis)]);
+  const std::vector<std::vector<std::size_t>> starts = hits_by_chunk(found, rays, threads);
+  DexelGrid grid = build_grid_chunks(
+      lattice, axis, threads,
+      [&](std::size_t begin, std::size_t end, std::vector<DexelInterval>& out,
+          std::uint32_t* counts) {
+        const std::size_t c = begin / kGridChunk;
+        thread_local std::vector<std::uint32_t> start;
+        thread_local std::vector<MeshHit> sorted;
+        thread_local std::vector<DexelInterval> spans;
+        start.assign(end - begin + 1, 0);
+        for (std::size_t w = 0; w < found.size(); ++w)
+          for (std::size_t k = starts[w][c]; k < starts[w][c + 1]; ++k)
+            ++start[found[w][k].ray - begin + 1];
+        for (std::size_t r = 0; r < end - begin; ++r) start[r + 1] += start[r];
+        sorted.resize(start[end - begin]);
+        for (std::size_t w = 0; w < found.size(); ++w)
+          for (std::size_t k = starts[w][c]; k < starts[w][c + 1]; ++k) {
+            const MeshHit& h = found[w][k];
+            sorted[start[h.ray - begin]++] = h;
+          }
+        // `start` now holds each ray's end.
+        for (std::size_t r = begin; r < end; ++r) {
+          auto first = sorted.begin() + (r == begin ? 0 : start[r - begin - 1]);
+          auto last = sorted.begin() + start[r - begin];
+          if (last - first == 2) {  // the usual case: one span
+            if (first[1].t < first[0].t) std::swap(first[0], first[1]);
+          } else {
+            std::sort(first, last, [](const MeshHit& p, const MeshHit& q) { return p.t < q.t; });
+          }
+          spans.clear();
+          int winding = 0;
+          double enter = 0;
+          for (auto it = first; it != last;) {
+            float t = it->t;
+            int before = winding;
+            for (; it != last && it->t == t; ++it) winding += it->direction;
+            if (winding < 0 || (it == last && winding != 0)) unbalanced(r, t);
+            if (before == 0 && winding > 0) enter = t;
+            if (before > 0 && winding == 0) push_span(spans, 0, enter, t);
+          }
+          const std::size_t before = out.size();
+          emit(r, std::span<const DexelInterval>(spans), out);
+          counts[r - begin] = static_cast<std::uint32_t>(out.size() - before);
+        }
+      });
+  for (std::vector<MeshHit>& list : found) std::vector<MeshHit>().swap(list);
+  return grid;
+}
+
+// The same, the spans copied.
 template <class Unbalanced>
 DexelGrid grid_from_hits(const DexelLattice& lattice, int axis, unsigned threads,
                          std::vector<std::vector<MeshHit>>& found, Unbalanced&& unbalanced) {
-  const std::size_t rays = static_cast<std::size_t>(lattice.n[TripleDexel::u_axis(axis)]) *
-                           static_cast<std::size_t>(lattice.n[TripleDexel::v_axis(axis)]);
-  std::vector<std::size_t> start(rays + 1, 0);
-  for (const auto& list : found)
-    for (const MeshHit& h : list) ++start[h.ray + 1];
-  for (std::size_t r = 0; r < rays; ++r) start[r + 1] += start[r];
-  std::vector<MeshHit> sorted(start[rays]);
-  {
-    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
-    for (auto& list : found) {
-      for (const MeshHit& h : list) sorted[fill[h.ray]++] = h;
-      std::vector<MeshHit>().swap(list);
-    }
-  }
-  return build_grid(lattice, axis, threads, [&](std::size_t r, std::vector<DexelInterval>& out) {
-    auto first = sorted.begin() + static_cast<std::ptrdiff_t>(start[r]);
-    auto last = sorted.begin() + static_cast<std::ptrdiff_t>(start[r + 1]);
-    if (last - first == 2) {  // the usual case: one span
-      if (first[1].t < first[0].t) std::swap(first[0], first[1]);
-    } else {
-      std::sort(first, last, [](const MeshHit& p, const MeshHit& q) { return p.t < q.t; });
-    }
-    std::size_t ray_start = out.size();
-    int winding = 0;
-    double enter = 0;
-    for (auto it = first; it != last;) {
-      float t = it->t;
-      int before = winding;
-      for (; it != last && it->t == t; ++it) winding += it->direction;
-      if (winding < 0 || (it == last && winding != 0)) unbalanced(r, t);
-      if (before == 0 && winding > 0) enter = t;
-      if (before > 0 && winding == 0) push_span(out, ray_start, enter, t);
-    }
-  });
+  return grid_from_hits(
+      lattice, axis, threads, found, unbalanced,
+      [](std::size_t, std::span<const DexelInterval> spans, std::vector<DexelInterval>& out) {
+        out.insert(out.end(), spans.begin(), spans.end());
+      });
 }
 
 }  // namespace detail

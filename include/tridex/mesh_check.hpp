@@ -19,6 +19,7 @@
 
 #include "tridex/error.hpp"
 #include "tridex/mesh.hpp"
+#include "tridex/parallel.hpp"
 
 namespace tridex {
 
@@ -62,55 +63,130 @@ inline void require_valid_indices(const Mesh& mesh, const char* who) {
 
 }  // namespace detail
 
-// Counts the edge defects of `mesh`. Throws tridex::Error if a triangle names a missing vertex.
-inline MeshCheck check_mesh(const Mesh& mesh) {
+namespace detail {
+
+// Classifies the edges of one vertex v: [lo, hi) holds (max(a, b) << 1) | (a < b) for each of
+// its directed edges a→b with min(a, b) = v, and is sorted here.
+inline void classify_vertex_edges(std::uint64_t* lo, std::uint64_t* hi, MeshCheck& result) {
+  std::sort(lo, hi);
+  for (std::uint64_t* i = lo; i != hi;) {
+    std::uint64_t* j = i;
+    std::size_t forward = 0;
+    for (; j != hi && (*j >> 1) == (*i >> 1); ++j) forward += *j & 1;
+    const auto uses = j - i;
+    if (uses == 1)
+      ++result.boundary_edges;
+    else if (uses > 2)
+      ++result.non_manifold_edges;
+    else if (forward != 1)
+      ++result.misoriented_edges;
+    i = j;
+  }
+}
+
+// Calls visit(a, b) for each directed edge a→b of triangles [first, last) whose ends differ (a
+// collapsed edge joins nothing).
+template <class Visit>
+void for_each_mesh_edge(const Mesh& mesh, std::size_t first, std::size_t last, Visit&& visit) {
+  for (std::size_t k = first; k < last; ++k) {
+    const glm::uvec3& t = mesh.triangles[k];
+    const std::uint32_t v[3] = {t.x, t.y, t.z};
+    for (int e = 0; e < 3; ++e) {
+      const std::uint32_t a = v[e], b = v[(e + 1) % 3];
+      if (a != b) visit(a, b);
+    }
+  }
+}
+
+}  // namespace detail
+
+// Counts the edge defects of `mesh` on `threads` threads (1 unless asked; 0: every hardware
+// thread; the counts do not depend on it). Throws tridex::Error if a triangle names a missing
+// vertex.
+//
+// Each directed edge a→b is filed under its lower vertex min(a, b): vertices are cut into
+// ranges, the triangles into chunks; each chunk counts its edges per range and then places them
+// (a counting sort over the ranges, chunks on the threads), and each range files its edges by
+// vertex (a counting sort over the range's vertices, small enough to stay in cache) and
+// classifies each vertex's few edges, ranges on the threads. Sorting all 3·T edges at once took
+// most of the check on a surface of millions of triangles, and one pass over them all ran on one
+// thread.
+inline MeshCheck check_mesh(const Mesh& mesh, unsigned threads = 1) {
   detail::require_valid_indices(mesh, "check_mesh");
-  MeshCheck result;
-  // Each directed edge a→b is filed under its lower vertex min(a, b), as (max(a, b) << 1) | (a <
-  // b): a counting sort (count, prefix sums, place) in two linear passes, where sorting all 3·T
-  // edges took most of the check on a surface of millions of triangles. A vertex has a handful
-  // of edges, so each vertex's few entries are then sorted and classified in place.
-  const std::size_t n = mesh.positions.size();
-  std::vector<std::size_t> first(n + 1, 0);  // vertex v's entries: [first[v], first[v + 1])
-  auto for_each_edge = [&](auto&& visit) {
-    for (const glm::uvec3& t : mesh.triangles) {
-      const std::uint32_t v[3] = {t.x, t.y, t.z};
-      for (int e = 0; e < 3; ++e) {
-        const std::uint32_t a = v[e], b = v[(e + 1) % 3];
-        if (a != b) visit(a, b);  // a collapsed edge joins nothing
+  const std::size_t n = mesh.positions.size(), triangles = mesh.triangles.size();
+  constexpr std::size_t kTriangleChunk = std::size_t{1} << 16;
+  const std::size_t chunks = (triangles + kTriangleChunk - 1) / kTriangleChunk;
+  // Ranges of 2^range_bits vertices, at most about 256 of them.
+  int range_bits = 12;
+  while ((n >> range_bits) > 256) ++range_bits;
+  const std::size_t ranges = (n >> range_bits) + 1;
+  auto range_of = [&](std::uint32_t a, std::uint32_t b) { return std::min(a, b) >> range_bits; };
+  // at[c · ranges + g]: where chunk c's edges of range g go (first their counts).
+  std::vector<std::size_t> at(chunks * ranges + 1, 0);
+  std::vector<std::size_t> degenerate(chunks, 0);
+  detail::for_each_chunk(chunks, threads, [&](std::size_t c) {
+    const std::size_t first = c * kTriangleChunk,
+                      last = std::min(triangles, first + kTriangleChunk);
+    std::size_t* count = at.data() + c * ranges;
+    detail::for_each_mesh_edge(mesh, first, last,
+                               [&](std::uint32_t a, std::uint32_t b) { ++count[range_of(a, b)]; });
+    for (std::size_t k = first; k < last; ++k)
+      if (detail::is_degenerate(mesh, mesh.triangles[k])) ++degenerate[c];
+  });
+  // Range-major order: range g's edges are contiguous, chunk by chunk.
+  std::vector<std::size_t> range_start(ranges + 1, 0);
+  {
+    std::size_t sum = 0;
+    for (std::size_t g = 0; g < ranges; ++g) {
+      range_start[g] = sum;
+      for (std::size_t c = 0; c < chunks; ++c) {
+        const std::size_t count = at[c * ranges + g];
+        at[c * ranges + g] = sum;
+        sum += count;
       }
     }
-  };
-  for_each_edge(
-      [&](std::uint32_t a, std::uint32_t b) { ++first[std::min(a, b) + std::size_t{1}]; });
-  for (std::size_t v = 0; v < n; ++v) first[v + 1] += first[v];
-  std::vector<std::uint64_t> entries(first[n]);
-  {
-    std::vector<std::size_t> at(first.begin(), first.end() - 1);
-    for_each_edge([&](std::uint32_t a, std::uint32_t b) {
-      entries[at[std::min(a, b)]++] = (std::uint64_t{std::max(a, b)} << 1) | (a < b ? 1u : 0u);
+    range_start[ranges] = sum;
+  }
+  std::vector<std::uint64_t> edges(range_start[ranges]);  // directed edges (a << 32) | b
+  detail::for_each_chunk(chunks, threads, [&](std::size_t c) {
+    const std::size_t first = c * kTriangleChunk,
+                      last = std::min(triangles, first + kTriangleChunk);
+    std::size_t* fill = at.data() + c * ranges;
+    detail::for_each_mesh_edge(mesh, first, last, [&](std::uint32_t a, std::uint32_t b) {
+      edges[fill[range_of(a, b)]++] = (std::uint64_t{a} << 32) | b;
     });
-  }
-  for (std::size_t v = 0; v < n; ++v) {
-    const auto lo = entries.begin() + static_cast<std::ptrdiff_t>(first[v]);
-    const auto hi = entries.begin() + static_cast<std::ptrdiff_t>(first[v + 1]);
-    std::sort(lo, hi);
-    for (auto i = lo; i != hi;) {
-      auto j = i;
-      std::size_t forward = 0;
-      for (; j != hi && (*j >> 1) == (*i >> 1); ++j) forward += *j & 1;
-      const auto uses = j - i;
-      if (uses == 1)
-        ++result.boundary_edges;
-      else if (uses > 2)
-        ++result.non_manifold_edges;
-      else if (forward != 1)
-        ++result.misoriented_edges;
-      i = j;
+  });
+  std::vector<MeshCheck> part(ranges);
+  detail::for_each_chunk(ranges, threads, [&](std::size_t g) {
+    const std::size_t v0 = g << range_bits, v1 = std::min(n, (g + 1) << range_bits);
+    if (v0 >= v1) return;
+    const std::uint64_t* lo = edges.data() + range_start[g];
+    const std::uint64_t* hi = edges.data() + range_start[g + 1];
+    thread_local std::vector<std::size_t> first;
+    thread_local std::vector<std::uint64_t> keys;
+    first.assign(v1 - v0 + 1, 0);
+    for (const std::uint64_t* e = lo; e != hi; ++e) {
+      const auto a = static_cast<std::uint32_t>(*e >> 32), b = static_cast<std::uint32_t>(*e);
+      ++first[std::min(a, b) - v0 + 1];
     }
+    for (std::size_t v = 0; v < v1 - v0; ++v) first[v + 1] += first[v];
+    keys.resize(first[v1 - v0]);
+    for (const std::uint64_t* e = lo; e != hi; ++e) {
+      const auto a = static_cast<std::uint32_t>(*e >> 32), b = static_cast<std::uint32_t>(*e);
+      keys[first[std::min(a, b) - v0]++] = (std::uint64_t{std::max(a, b)} << 1) | (a < b ? 1u : 0u);
+    }
+    // `first` now holds each vertex's end.
+    for (std::size_t v = 0; v < v1 - v0; ++v)
+      detail::classify_vertex_edges(keys.data() + (v ? first[v - 1] : 0), keys.data() + first[v],
+                                    part[g]);
+  });
+  MeshCheck result;
+  for (const MeshCheck& p : part) {
+    result.boundary_edges += p.boundary_edges;
+    result.non_manifold_edges += p.non_manifold_edges;
+    result.misoriented_edges += p.misoriented_edges;
   }
-  for (const glm::uvec3& t : mesh.triangles)
-    if (detail::is_degenerate(mesh, t)) ++result.degenerate_triangles;
+  for (std::size_t d : degenerate) result.degenerate_triangles += d;
   return result;
 }
 

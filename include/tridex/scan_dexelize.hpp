@@ -28,6 +28,7 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -47,6 +48,25 @@ namespace detail {
 
 // The 128-bit integer type of the exact edge functions (GCC and Clang).
 __extension__ using ScanWide = __int128;
+
+// double(x) rounded to nearest, ties to even, as the compiler's conversion (__floattidf, a
+// library call that was a tenth of the scan) gives it: a value of 64 bits converts directly;
+// a wider one is shifted right to 62 or 63 bits with the bits shifted out kept as one sticky
+// bit (rounding to odd), which the 64-bit conversion then rounds correctly (Boldo & Melquiond,
+// "Emulation of FMA and correctly rounded sums: proved algorithms using rounding to odd", IEEE
+// Trans. Computers 57(4) 2008: rounding to odd at p + 2 or more bits, then to nearest at p).
+inline double wide_to_double(ScanWide x) {
+  __extension__ using Unsigned = unsigned __int128;
+  const auto low = static_cast<std::int64_t>(x);
+  if (static_cast<ScanWide>(low) == x) return static_cast<double>(low);
+  const auto high = static_cast<std::int64_t>(x >> 64);
+  const int width = 64 - std::countl_zero(static_cast<std::uint64_t>(high < 0 ? ~high : high));
+  const int shift = width + 2;  // |x >> shift| < 2^62, and at least 2^61
+  auto kept = static_cast<std::int64_t>(x >> shift);
+  kept |= (static_cast<Unsigned>(x) & ((Unsigned{1} << shift) - 1)) != 0 ? 1 : 0;
+  return static_cast<double>(kept) *
+         std::bit_cast<double>(static_cast<std::uint64_t>(1023 + shift) << 52);  // 2^shift
+}
 
 // A projected vertex: fixed-point (u, v) and the world coordinate along the ray axis.
 struct ScanVertex {
@@ -219,12 +239,26 @@ class ZMapScanner {
   }
 
   // Only the columns that can reach a ray (live_columns_), their vertices computed cell by cell.
+  // A row's vertices are kept for the next row, whose lower corners they are.
   void scan_live_columns(int j0, int j1, std::vector<MeshHit>& hits) const {
+    const std::size_t m = live_columns_.size();
+    std::vector<ScanVertex> lower(2 * m), upper(2 * m);  // columns i and i + 1 of each
+    std::vector<double> hl(2 * m), hu(2 * m);
+    auto fill = [&](int j, std::vector<ScanVertex>& row, std::vector<double>& h) {
+      for (std::size_t k = 0; k < m; ++k)
+        for (std::size_t c = 0; c < 2; ++c)
+          row[2 * k + c] = grid_vertex(live_columns_[k] + static_cast<int>(c), j, h[2 * k + c]);
+    };
+    int filled = -1;  // the row `lower` holds
     for (int j = j0; j < j1; ++j) {
       if (!row_reaches_rays(j)) continue;
+      if (filled != j) fill(j, lower, hl);
+      fill(j + 1, upper, hu);
+      filled = j + 1;
       auto [fine, fine_end] = row_fine_cells(j);
       const std::size_t row_base = grid_.index(0, j);
-      for (int i : live_columns_) {
+      for (std::size_t k = 0; k < m; ++k) {
+        const int i = live_columns_[k];
         const auto ii = static_cast<std::size_t>(i);
         while (fine != fine_end && *fine < row_base + ii) ++fine;
         if (fine != fine_end && *fine == row_base + ii) {
@@ -232,11 +266,11 @@ class ZMapScanner {
           ++fine;
           continue;
         }
-        double h[4];
-        ScanVertex p[4];
-        for (int c = 0; c < 4; ++c) p[c] = grid_vertex(i + (c & 1), j + (c >> 1), h[c]);
-        plain_cell(i, j, p[0], p[1], p[2], p[3], h[0], h[1], h[2], h[3], hits);
+        plain_cell(i, j, lower[2 * k], lower[2 * k + 1], upper[2 * k], upper[2 * k + 1], hl[2 * k],
+                   hl[2 * k + 1], hu[2 * k], hu[2 * k + 1], hits);
       }
+      std::swap(lower, upper);
+      std::swap(hl, hu);
     }
   }
 
@@ -346,45 +380,28 @@ class ZMapScanner {
   void triangle(const ScanVertex& a, const ScanVertex& b, const ScanVertex& c,
                 std::vector<MeshHit>& hits) const {
     // The rays within its bounding box first: most triangles of a fine cell have none.
-    std::int64_t iu0 = std::max<std::int64_t>(0, ceil_units(std::min({a.u, b.u, c.u})));
-    std::int64_t iu1 = std::min<std::int64_t>(nu_ - 1, ceil_units(std::max({a.u, b.u, c.u})) - 1);
-    std::int64_t iv0 = std::max<std::int64_t>(0, ceil_units(std::min({a.v, b.v, c.v})));
-    std::int64_t iv1 = std::min<std::int64_t>(nv_ - 1, ceil_units(std::max({a.v, b.v, c.v})) - 1);
-    if (iu0 > iu1 || iv0 > iv1) return;
+    const std::int64_t lo[2] = {std::max<std::int64_t>(0, ceil_units(std::min({a.u, b.u, c.u}))),
+                                std::max<std::int64_t>(0, ceil_units(std::min({a.v, b.v, c.v})))};
+    const std::int64_t hi[2] = {
+        std::min<std::int64_t>(nu_ - 1, ceil_units(std::max({a.u, b.u, c.u})) - 1),
+        std::min<std::int64_t>(nv_ - 1, ceil_units(std::max({a.v, b.v, c.v})) - 1)};
+    if (lo[0] > hi[0] || lo[1] > hi[1]) return;
     const ScanWide area = ScanWide(b.u - a.u) * (c.v - a.v) - ScanWide(b.v - a.v) * (c.u - a.u);
     if (area == 0) return;  // seen edge-on: the perturbed ray misses it
     const int orientation = area > 0 ? 1 : -1;
     const double lo_t = std::min({a.t, b.t, c.t}), hi_t = std::max({a.t, b.t, c.t});
-    const double inverse_area = 1.0 / double(area);
-    // A long thin triangle seen at a slant (a wall of a tilted map) has a bounding box of many
-    // rays and covers few: for each row of rays, only the columns within one ray spacing of its
-    // u-extent on that row are tested (the exact tests below still decide).
-    const bool scanline = (iu1 - iu0) > 2 && (iv1 - iv0) > 2;
-    const double one = std::ldexp(1.0, bits_);
-    const ScanVertex* corners[3] = {&a, &b, &c};
-    for (std::int64_t iv = iv0; iv <= iv1; ++iv) {
-      std::int64_t row_u0 = iu0, row_u1 = iu1;
-      if (scanline) {
-        const double pv = double(iv) * one;
-        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-        for (int e = 0; e < 3; ++e) {
-          const ScanVertex &p = *corners[e], &q = *corners[(e + 1) % 3];
-          double p_u = double(p.u), p_v = double(p.v), q_u = double(q.u), q_v = double(q.v);
-          if (pv < std::min(p_v, q_v) - one || pv > std::max(p_v, q_v) + one) continue;
-          double u_at = p_v == q_v
-                            ? p_u
-                            : p_u + (std::clamp(pv, std::min(p_v, q_v), std::max(p_v, q_v)) - p_v) *
-                                        (q_u - p_u) / (q_v - p_v);
-          if (p_v == q_v)
-            lo = std::min({lo, p_u, q_u}), hi = std::max({hi, p_u, q_u});
-          else
-            lo = std::min(lo, u_at), hi = std::max(hi, u_at);
-        }
-        if (!(lo <= hi)) continue;
-        row_u0 = std::max(iu0, static_cast<std::int64_t>(std::floor(lo / one)) - 1);
-        row_u1 = std::min(iu1, static_cast<std::int64_t>(std::ceil(hi / one)) + 1);
-      }
-      for (std::int64_t iu = row_u0; iu <= row_u1; ++iu) {
+    double inverse_area = 0;  // found with the first crossing: most triangles have none
+    // Lines of rays along the box's longer side, one per ray of its shorter side; where a line
+    // holds more than two rays, only those within the triangle's extent on it are tested (a
+    // long thin triangle seen at a slant, a wall of a tilted map, has a large box and covers
+    // few of its rays). The exact tests below decide.
+    const int outer = hi[0] - lo[0] < hi[1] - lo[1] ? 0 : 1, inner = 1 - outer;
+    const bool narrow = hi[inner] - lo[inner] > 1;
+    for (std::int64_t line = lo[outer]; line <= hi[outer]; ++line) {
+      std::int64_t first = lo[inner], last = hi[inner];
+      if (narrow && !line_extent(a, b, c, outer, line, first, last)) continue;
+      for (std::int64_t k = first; k <= last; ++k) {
+        const std::int64_t iu = outer == 0 ? line : k, iv = outer == 0 ? k : line;
         const std::int64_t pu = iu << bits_, pv = iv << bits_;
         ScanWide wc =
             ScanWide(b.u - a.u) * (pv - a.v) - ScanWide(b.v - a.v) * (pu - a.u);  // edge a→b
@@ -399,12 +416,52 @@ class ZMapScanner {
         // Looked up for the crossings only: the mask is large and the tests above are not.
         if (mask_ && mask_->offsets[ray] == mask_->offsets[ray + 1])
           continue;  // nothing left to cut
-        double t = (double(wa) * a.t + double(wb) * b.t + double(wc) * c.t) * inverse_area;
+        if (inverse_area == 0) inverse_area = 1.0 / wide_to_double(area);
+        double t =
+            (wide_to_double(wa) * a.t + wide_to_double(wb) * b.t + wide_to_double(wc) * c.t) *
+            inverse_area;
         t = std::clamp(t, lo_t, hi_t);  // rounding: the crossing lies within the triangle's extent
         // Normal along +axis (counter-clockwise in (u, v)) means the ray leaves there.
         hits.push_back({ray, static_cast<float>(t), -orientation});
       }
     }
+  }
+
+  // Narrows [first, last], the rays of a line (coordinate `outer` of its rays = line), to those
+  // within the triangle's extent on it, widened by a few fixed-point units for rounding; false
+  // when none is left. The extent is computed in double relative to vertex a, exactly up to the
+  // last division and addition (each rounding by at most an ulp of values below 2^53 units: 3
+  // units in all); a triangle too large for that keeps the whole line.
+  bool line_extent(const ScanVertex& a, const ScanVertex& b, const ScanVertex& c, int outer,
+                   std::int64_t line, std::int64_t& first, std::int64_t& last) const {
+    constexpr std::int64_t kExact = std::int64_t{1} << 52, kSlack = 16;
+    const ScanVertex* p[3] = {&a, &b, &c};
+    std::int64_t o[3], in[3];  // relative to a
+    for (int k = 0; k < 3; ++k) {
+      o[k] = outer == 0 ? p[k]->u - a.u : p[k]->v - a.v;
+      in[k] = outer == 0 ? p[k]->v - a.v : p[k]->u - a.u;
+      if (o[k] <= -kExact || o[k] >= kExact || in[k] <= -kExact || in[k] >= kExact) return true;
+    }
+    const std::int64_t origin_o = outer == 0 ? a.u : a.v, origin_in = outer == 0 ? a.v : a.u;
+    const auto x = static_cast<double>((line << bits_) - origin_o);
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (int e = 0; e < 3; ++e) {
+      const double p_o = double(o[e]), q_o = double(o[(e + 1) % 3]);
+      const double p_in = double(in[e]), q_in = double(in[(e + 1) % 3]);
+      if (x < std::min(p_o, q_o) || x > std::max(p_o, q_o)) continue;
+      if (p_o == q_o) {
+        lo = std::min({lo, p_in, q_in}), hi = std::max({hi, p_in, q_in});
+      } else {
+        const double at = p_in + (x - p_o) * (q_in - p_in) / (q_o - p_o);
+        lo = std::min(lo, at), hi = std::max(hi, at);
+      }
+    }
+    if (!(lo <= hi)) return false;
+    const auto lo_units = static_cast<std::int64_t>(std::floor(lo)) - kSlack + origin_in;
+    const auto hi_units = static_cast<std::int64_t>(std::ceil(hi)) + kSlack + origin_in;
+    first = std::max(first, ceil_units(lo_units));
+    last = std::min(last, hi_units >> bits_);
+    return first <= last;
   }
 
   static int perturbed_sign_wide(ScanWide value, std::int64_t du, std::int64_t dv) {
@@ -445,10 +502,12 @@ inline float highest_height(const ZMap& map, unsigned threads) {
   return *std::max_element(part.begin(), part.end());
 }
 
-// One family of rays: scan on `threads` threads, counting-sort the crossings by ray, pair them.
+// One family of rays: scan on `threads` threads, then the grid from the crossings
+// (grid_from_hits), each ray's spans handed to emit(r, spans, out) (grid_from_hits).
 // `highest` is highest_height(map).
-inline DexelGrid scan_family(const ZMap& map, const DexelLattice& lattice, int axis,
-                             unsigned threads, const DexelGrid* mask, float highest) {
+template <class Emit>
+DexelGrid scan_family(const ZMap& map, const DexelLattice& lattice, int axis, unsigned threads,
+                      const DexelGrid* mask, float highest, Emit&& emit) {
   const ZMapScanner scanner(map, lattice, axis, mask, highest);
   threads = resolve_threads(threads);
   const int rows = map.grid.ny - 1;
@@ -466,10 +525,13 @@ inline DexelGrid scan_family(const ZMap& map, const DexelLattice& lattice, int a
                             found[id]);
       });
   const std::size_t nu = static_cast<std::size_t>(lattice.n[TripleDexel::u_axis(axis)]);
-  return grid_from_hits(lattice, axis, threads, found, [&](std::size_t r, float t) {
-    fail("scan dexelize: unbalanced crossings on ray ", r % nu, ", ", r / nu, " along axis ",
-         "xyz"[axis], " at ", t, " (an internal error: please report the Z-map and lattice)");
-  });
+  return grid_from_hits(
+      lattice, axis, threads, found,
+      [&](std::size_t r, float t) {
+        fail("scan dexelize: unbalanced crossings on ray ", r % nu, ", ", r / nu, " along axis ",
+             "xyz"[axis], " at ", t, " (an internal error: please report the Z-map and lattice)");
+      },
+      emit);
 }
 
 }  // namespace detail
@@ -485,7 +547,11 @@ inline TripleDexel scan_dexelize(const ZMap& map, const DexelLattice& lattice,
   result.origin = lattice.origin, result.spacing = lattice.spacing, result.n = lattice.n;
   const float highest = detail::highest_height(map, threads);
   for (int axis = 0; axis < 3; ++axis)
-    result.grids[axis] = detail::scan_family(map, lattice, axis, threads, nullptr, highest);
+    result.grids[axis] = detail::scan_family(
+        map, lattice, axis, threads, nullptr, highest,
+        [](std::size_t, std::span<const DexelInterval> spans, std::vector<DexelInterval>& out) {
+          out.insert(out.end(), spans.begin(), spans.end());
+        });
   return result;
 }
 
@@ -499,13 +565,14 @@ inline TripleDexel scan_intersect_milled(const TripleDexel& stock, std::span<con
   TripleDexel result = stock;
   for (const ZMap& map : milled) {
     const float highest = detail::highest_height(map, threads);
+    // Each ray's cut is intersected with the ray as it stands as soon as its spans are known:
+    // the cut is never stored as a grid of its own.
     for (int axis = 0; axis < 3; ++axis) {
-      DexelGrid cut =
-          detail::scan_family(map, lattice, axis, threads, &result.grids[axis], highest);
       const DexelGrid& current = result.grids[axis];
-      result.grids[axis] = detail::build_grid(
-          lattice, axis, threads, [&](std::size_t r, std::vector<DexelInterval>& out) {
-            detail::intersect_ray(current.ray(r), cut.ray(r), out);
+      result.grids[axis] = detail::scan_family(
+          map, lattice, axis, threads, &current, highest,
+          [&](std::size_t r, std::span<const DexelInterval> cut, std::vector<DexelInterval>& out) {
+            detail::intersect_ray(current.ray(r), cut, out);
           });
     }
   }

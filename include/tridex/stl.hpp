@@ -32,6 +32,7 @@
 #include "tridex/error.hpp"
 #include "tridex/mesh.hpp"
 #include "tridex/mesh_check.hpp"
+#include "tridex/parallel.hpp"
 
 #if defined(_WIN32)
 #include <process.h>
@@ -284,9 +285,35 @@ inline Mesh read_stl(const std::string& path, StlOptions options = {}) {
   return mesh;
 }
 
+namespace detail {
+
+// The 50-byte binary STL records of triangles [first, last) into `record`, facet normals from
+// the vertex order.
+inline void format_stl_records(const Mesh& mesh, std::size_t first, std::size_t last,
+                               unsigned char* record) {
+  for (std::size_t k = first; k < last; ++k, record += 50) {
+    const glm::uvec3& t = mesh.triangles[k];
+    const glm::vec3 &a = mesh.positions[t.x], &b = mesh.positions[t.y], &c = mesh.positions[t.z];
+    Vec3 normal = glm::cross(Vec3(b) - Vec3(a), Vec3(c) - Vec3(a));
+    double length = glm::length(normal);
+    normal = length > 0 ? normal / length : Vec3(0);
+    const glm::vec3 values[4] = {glm::vec3(normal), a, b, c};
+    for (int v = 0; v < 4; ++v)
+      for (int e = 0; e < 3; ++e) store_f32_le(record + 12 * v + 4 * e, values[v][e]);
+    record[48] = record[49] = 0;
+  }
+}
+
+}  // namespace detail
+
 // Writes `mesh` as binary STL to a stream. Throws tridex::Error if a triangle names a missing
 // vertex, the mesh has more than 2^32 − 1 triangles, or the stream fails.
-inline void write_stl(std::ostream& out, const Mesh& mesh) {
+//
+// The records are formatted on `threads` threads (1 unless asked; 0: every hardware thread), a
+// group of batches at a time, each batch into a buffer of its own; while the threads format the
+// next group, a thread of its own writes the last one's buffers in order. The bytes do not
+// depend on the thread count. One thread formats and writes by turns.
+inline void write_stl(std::ostream& out, const Mesh& mesh, unsigned threads = 1) {
   detail::require_valid_indices(mesh, "write_stl");
   if (mesh.triangles.size() > 0xFFFFFFFFu)
     detail::fail("write_stl: ", mesh.triangles.size(), " triangles do not fit in STL");
@@ -295,25 +322,37 @@ inline void write_stl(std::ostream& out, const Mesh& mesh) {
   std::memcpy(header, title, sizeof title - 1);
   detail::store_u32_le(header + 80, static_cast<std::uint32_t>(mesh.triangles.size()));
   out.write(reinterpret_cast<const char*>(header), 84);
-  const std::size_t batch = 1 << 16;
-  std::vector<unsigned char> buffer(50 * batch);
-  for (std::size_t done = 0; done < mesh.triangles.size() && out;) {
-    std::size_t n = std::min(batch, mesh.triangles.size() - done);
-    for (std::size_t k = 0; k < n; ++k) {
-      const glm::uvec3& t = mesh.triangles[done + k];
-      const glm::vec3 &a = mesh.positions[t.x], &b = mesh.positions[t.y], &c = mesh.positions[t.z];
-      Vec3 normal = glm::cross(Vec3(b) - Vec3(a), Vec3(c) - Vec3(a));
-      double length = glm::length(normal);
-      normal = length > 0 ? normal / length : Vec3(0);
-      unsigned char* record = buffer.data() + 50 * k;
-      const glm::vec3 values[4] = {glm::vec3(normal), a, b, c};
-      for (int v = 0; v < 4; ++v)
-        for (int e = 0; e < 3; ++e) detail::store_f32_le(record + 12 * v + 4 * e, values[v][e]);
-      record[48] = record[49] = 0;
+  const std::size_t triangles = mesh.triangles.size(), batch = std::size_t{1} << 15;
+  const std::size_t batches = (triangles + batch - 1) / batch;
+  const unsigned workers = detail::chunk_workers(batches, threads);
+  const std::size_t group = 2 * std::size_t{workers};
+  // Two sets of buffers: one being formatted, one being written.
+  std::vector<std::vector<unsigned char>> buffers(2 * group);
+  detail::BackgroundTask writer;
+  auto write_group = [&out, triangles, batch](const std::vector<unsigned char>* set, std::size_t g0,
+                                              std::size_t count) {
+    for (std::size_t k = 0; k < count && out; ++k) {
+      const std::size_t n = std::min(batch, triangles - (g0 + k) * batch);
+      out.write(reinterpret_cast<const char*>(set[k].data()), static_cast<std::streamsize>(50 * n));
     }
-    out.write(reinterpret_cast<const char*>(buffer.data()), static_cast<std::streamsize>(50 * n));
-    done += n;
+  };
+  for (std::size_t g0 = 0, parity = 0; g0 < batches; g0 += group, parity ^= 1) {
+    std::vector<unsigned char>* set = buffers.data() + parity * group;
+    const std::size_t count = std::min(group, batches - g0);
+    detail::for_each_chunk(count, workers, [&](std::size_t k) {
+      const std::size_t first = (g0 + k) * batch, last = std::min(triangles, first + batch);
+      set[k].resize(50 * batch);
+      detail::format_stl_records(mesh, first, last, set[k].data());
+    });
+    // The stream is looked at only while no writer runs.
+    if (workers > 1) writer.join();  // the previous group is written: its buffers are free
+    if (!out) break;
+    if (workers == 1)
+      write_group(set, g0, count);
+    else
+      writer.start([&write_group, set, g0, count] { write_group(set, g0, count); });
   }
+  writer.join();
   out.flush();
   if (!out) detail::fail("write_stl: the stream failed while writing");
 }
@@ -321,7 +360,7 @@ inline void write_stl(std::ostream& out, const Mesh& mesh) {
 // Writes `mesh` as binary STL to `path`, atomically: into a temporary file in the same directory,
 // renamed over `path` once complete; on any failure the temporary is removed and tridex::Error
 // names the path.
-inline void write_stl(const std::string& path, const Mesh& mesh) {
+inline void write_stl(const std::string& path, const Mesh& mesh, unsigned threads = 1) {
   namespace fs = std::filesystem;
   static std::atomic<unsigned> counter{0};
   fs::path target(path);
@@ -332,7 +371,7 @@ inline void write_stl(const std::string& path, const Mesh& mesh) {
     {
       std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
       if (!out) detail::fail("write_stl: cannot create ", temporary.string());
-      write_stl(out, mesh);
+      write_stl(out, mesh, threads);
       out.close();
       if (!out) detail::fail("write_stl: cannot finish writing ", temporary.string());
     }

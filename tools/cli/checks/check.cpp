@@ -454,7 +454,7 @@ void write_result_files(const CheckOptions& options, SimulationResult& r, const 
   const Mesh& mesh = r.mesh;
   if (!options.output.empty()) {
     progress.stage("writing " + options.output);
-    write_stl_file(options.output, mesh);
+    write_stl_file(options.output, mesh, options.threads);
   }
   if (!options.ply.empty()) {
     progress.stage("writing " + options.ply);

@@ -12,9 +12,9 @@ namespace tridex::cli {
 
 namespace fs = std::filesystem;
 
-void write_stl_file(const fs::path& path, const Mesh& mesh) {
+void write_stl_file(const fs::path& path, const Mesh& mesh, unsigned threads) {
   AtomicOutput out(path);
-  write_stl(out.stream(), mesh);
+  write_stl(out.stream(), mesh, threads);
   out.commit();
 }
 

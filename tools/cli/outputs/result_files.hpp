@@ -10,7 +10,8 @@
 
 namespace tridex::cli {
 
-void write_stl_file(const std::filesystem::path& path, const Mesh& mesh);
+// `threads` format the records (tridex::write_stl; 0: every hardware thread).
+void write_stl_file(const std::filesystem::path& path, const Mesh& mesh, unsigned threads = 1);
 
 // Binary little-endian PLY: float x y z and uchar red green blue per vertex (`colours`, one per
 // position, 0-1), uchar-counted int index lists per face.

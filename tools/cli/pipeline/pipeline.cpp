@@ -897,7 +897,7 @@ void extract_result_surface(const SimulateOptions& options, Progress& progress,
   r.mesh = extract_surface(r.result, {.threads = options.threads});
   if (r.reach_only)
     r.mesh = stitch_into_stock(r.mesh, r.lattice_box, r.stock.box, r.lattice.spacing);
-  r.mesh_check = check_mesh(r.mesh);
+  r.mesh_check = check_mesh(r.mesh, options.threads);
   r.timings.mesh = seconds_since(t);
   // The stock's volume less the removal measured surface against surface (surface_volume).
   r.volume = r.stock.volume - (r.stock_surface_volume - r.mesh.signed_volume());

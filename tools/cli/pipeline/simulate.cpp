@@ -145,7 +145,7 @@ int run_simulate(const SimulateOptions& options) {
   bool png_written = !options.png.empty();
   if (!options.output.empty()) {
     progress.stage("writing " + options.output);
-    write_stl_file(options.output, mesh);
+    write_stl_file(options.output, mesh, options.threads);
   }
   if (!options.png.empty()) {
     progress.stage("rendering " + options.png);
