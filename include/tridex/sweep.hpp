@@ -420,9 +420,13 @@ namespace detail {
 // pieces already cut (it cannot widen it) or misses [lo, hi] (it meets no material: the hull of
 // the others, less what lies outside the material, removes the same). Pieces are taken top first,
 // then bottom, where a ray along the axis enters and leaves, so that the middle ones are skipped.
-// Seen along the ray, a piece lies within its largest radius ρ of its axis between h0 and h1,
-// which lies within (h1 − h0)/2·|axis across the ray| of the path of its middle height: a piece
-// farther than that from the ray is skipped too.
+// Seen along the ray, a piece lies within the cylinder of its largest radius ρ between h0 and h1,
+// whose shadow is an ellipse (semi-axes ρ, and ρ·|axis along the ray| along the axis's shadow)
+// moved (h1 − h0)/2·|axis across the ray| each way along that shadow, and along the travel.
+// Stretched by 1/|axis along the ray| along the shadow, that is a disc of radius ρ around a
+// segment, moved along the stretched travel (within half its length of its middle): a piece
+// farther than that from the ray is skipped too. Where the axis lies nearly across the ray the
+// stretch is ill-conditioned: the circle of radius ρ around the path of its middle height is used.
 inline std::optional<std::pair<double, double>> sweep_step_interval(
     const SweepCutter& c, const SweepPartShape& part, const SweepStep& step, const Vec3& point,
     int axis, double lo, double hi, double precision) {
@@ -442,6 +446,14 @@ inline std::optional<std::pair<double, double>> sweep_step_interval(
   const double tu = travel[iu], tv = travel[iv], tt = tu * tu + tv * tv;
   const double au = step.axis[iu], av = step.axis[iv], across = std::sqrt(au * au + av * av);
   const double qu = point[iu] - step.from[iu], qv = point[iv] - step.from[iv];
+  const double along_abs = std::abs(along);
+  const bool ellipse = along_abs > 0.05 && across > 1e-9;
+  double half_travel = 0;
+  if (ellipse) {
+    const double tx = (-tu * av + tv * au) / across,
+                 ty = (tu * au + tv * av) / (across * along_abs);
+    half_travel = 0.5 * std::sqrt(tx * tx + ty * ty);
+  }
   // The least squared distance, seen along the ray, from the ray to the path of axis height h.
   auto off_path2 = [&](double h) {
     const double du = qu - h * au, dv = qv - h * av;
@@ -455,8 +467,18 @@ inline std::optional<std::pair<double, double>> sweep_step_interval(
       const double h1 = piece.ball ? piece.centre + piece.radius : piece.hi;
       const double rho =
           piece.ball ? piece.radius : std::max(piece.rho0, piece.rho0 + piece.slope * (h1 - h0));
-      const double reach = rho + margin + 0.5 * (h1 - h0) * across;
-      if (off_path2(0.5 * (h0 + h1)) > reach * reach) continue;
+      if (ellipse) {
+        const double hm = 0.5 * (h0 + h1);
+        const double pu = qu - hm * au - 0.5 * tu, pv = qv - hm * av - 0.5 * tv;
+        const double x = (-pu * av + pv * au) / across;
+        const double y = std::max(0.0, std::abs(pu * au + pv * av) / (across * along_abs) -
+                                           0.5 * (h1 - h0) * across / along_abs);
+        const double reach = rho + half_travel + margin / along_abs;
+        if (x * x + y * y > reach * reach) continue;
+      } else {
+        const double reach = rho + margin + 0.5 * (h1 - h0) * across;
+        if (off_path2(0.5 * (h0 + h1)) > reach * reach) continue;
+      }
     }
     if (slabs) {
       const double h0 = (piece.ball ? piece.centre - piece.radius : piece.lo) - margin;
