@@ -96,10 +96,10 @@ SweepRows sweep_rows(const TripleDexel& d, int axis, std::size_t count, BoxOf&& 
 inline constexpr std::uint32_t kSweepGroup = 16;
 
 // How a group bounds its members' sweeps: by the union of their boxes alone, by a capsule
-// (ball tips: the chord of their centres, c0–c1, and `radius`), or by the sweep of the solid
-// of revolution `pieces` (a cylinder, below it a cone's frustum) with unit axis `axis` moved
-// from tip c0 to tip c1.
-enum class SweepBound : std::uint8_t { box, capsule, cylinder };
+// (ball tips: the chord of their centres, c0–c1, and `radius`), or by the pieces of their part,
+// each grown by `tip` + its reach·`turn` (sweep.hpp, sweep_group_bound), with unit axis `axis`
+// moved from tip c0 to tip c1.
+enum class SweepBound : std::uint8_t { box, capsule, pieces };
 
 // Steps cut together: members[first, first + count) of SweepGroups, in program order.
 struct SweepGroup {
@@ -108,8 +108,8 @@ struct SweepGroup {
   SweepBound bound = SweepBound::box;
   Vec3 c0{0.0}, c1{0.0}, axis{0.0, 0.0, 1.0};
   double radius = 0;
-  std::array<SweepPiece, 2> pieces{};
-  int piece_count = 0;
+  const SweepPartShape* part = nullptr;
+  double tip = 0, turn = 0;
 };
 
 struct SweepGroups {
@@ -178,31 +178,27 @@ SweepGroups sweep_groups(std::span<const SweepStepCut> cuts, std::size_t keys, K
 
 // Whether group `g` may remove anything from the spans `current` of the ray through `point`
 // along `axis`: false only if none of its members can (their boxes hold no material, or their
-// sweeps' intervals, within the bound's grown for float rounding, meet none).
-inline bool sweep_group_may_cut(const SweepGroup& g, std::span<const DexelInterval> current,
-                                const Vec3& point, int axis) {
-  bool boxed = false;  // as sweep_ray's test of a step's box, cheaper than the bounds below
+// sweeps' intervals, within the bound's grown for float rounding, meet none). pieces_hull(lo, hi):
+// the interval of a SweepBound::pieces bound where it may meet material within [lo, hi].
+template <class PiecesHull>
+bool sweep_group_may_cut(const SweepGroup& g, std::span<const DexelInterval> current,
+                         const Vec3& point, int axis, PiecesHull&& pieces_hull) {
+  double lo = g.box.max[axis], hi = g.box.min[axis];  // as sweep_ray's test of a step's box
   for (const DexelInterval& span : current)
-    boxed = boxed || (span.exit >= g.box.min[axis] && span.enter <= g.box.max[axis]);
-  if (!boxed || g.bound == SweepBound::box) return boxed;
-  std::optional<std::pair<double, double>> bound;
-  if (g.bound == SweepBound::capsule) {
-    bound = capsule_interval(g.c0, g.c1, g.radius, point, axis);
-  } else {
-    for (int k = 0; k < g.piece_count; ++k) {  // a convex union: the hull of the pieces'
-      const auto cut = sweep_piece_interval(g.pieces[static_cast<std::size_t>(k)], g.c0,
-                                            g.c1 - g.c0, g.axis, point, axis);
-      if (cut)
-        bound = bound ? std::pair{std::min(bound->first, cut->first),
-                                  std::max(bound->second, cut->second)}
-                      : *cut;
+    if (span.exit >= g.box.min[axis] && span.enter <= g.box.max[axis]) {
+      lo = std::min(lo, std::max<double>(span.enter, g.box.min[axis]));
+      hi = std::max(hi, std::min<double>(span.exit, g.box.max[axis]));
     }
-  }
+  if (!(lo <= hi)) return false;
+  if (g.bound == SweepBound::box) return true;
+  const std::optional<std::pair<double, double>> bound =
+      g.bound == SweepBound::capsule ? capsule_interval(g.c0, g.c1, g.radius, point, axis)
+                                     : pieces_hull(lo, hi);
   if (!bound) return false;
   const double margin = 1e-5 * (1 + std::abs(bound->first) + std::abs(bound->second));
-  const double lo = bound->first - margin, hi = bound->second + margin;
+  const double a = bound->first - margin, b = bound->second + margin;
   for (const DexelInterval& span : current)
-    if (span.exit > lo && span.enter < hi) return true;
+    if (span.exit > a && span.enter < b) return true;
   return false;
 }
 
