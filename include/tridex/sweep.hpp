@@ -507,7 +507,7 @@ inline void sweep_ray(std::span<const DexelInterval> ray, const TripleDexel& d, 
     if (point[u] < group.box.min[u] || point[u] > group.box.max[u]) continue;
     std::uint64_t only = ~std::uint64_t{0};
     if (group.count > 1 &&
-        !sweep_group_may_cut(group, current, point, axis, [&](double lo, double hi) {
+        !sweep_group_may_cut(group, current, point, axis, [&](double lo, double hi, auto&& enough) {
           const Vec3 travel = group.c1 - group.c0;
           const double margin = 1e-6 * (1 + group.part->top + glm::length(travel) +
                                         group.box.max[u] - group.box.min[u]);
@@ -516,7 +516,7 @@ inline void sweep_ray(std::span<const DexelInterval> ray, const TripleDexel& d, 
           return sweep_pieces_hull(
               part.pieces, part.spans, margin, group.c0, travel, group.axis, point, axis, lo, hi,
               [&](std::size_t k) { return sweep_group_grow(group, part.spans[k].reach); },
-              ~std::uint64_t{0}, &only);
+              ~std::uint64_t{0}, &only, enough);
         }))
       continue;
     for (std::uint32_t k = group.first; k < group.first + group.count; ++k) {
@@ -576,6 +576,10 @@ inline void sweep_remove(TripleDexel& d, std::span<const SweepCutter> cutters,
   const detail::SweepGroups groups = detail::sweep_groups(
       cuts, 3 * cutters.size(),
       [&](std::size_t s) { return 3 * steps[s].cutter + static_cast<std::size_t>(steps[s].part); },
+      [&](std::size_t key) {
+        return shapes[key / 3].parts[key % 3].pieces.size() > 1 ? detail::kSweepGroupPieces
+                                                                : detail::kSweepGroup;
+      },
       8 * d.spacing, closed,
       [&](std::span<const std::uint32_t> members, detail::SweepGroup& g) {
         const SweepStep& step = steps[members.front()];

@@ -372,7 +372,7 @@ TEST_CASE("sweep: grouped short steps give the dexels of each step cut alone") {
   const detail::SweepGroups groups = detail::sweep_groups(
       cuts, 3 * cutters.size(),
       [&](std::size_t k) { return 3 * steps[k].cutter + static_cast<std::size_t>(steps[k].part); },
-      8 * lattice.spacing, true,
+      [](std::size_t) { return detail::kSweepGroup; }, 8 * lattice.spacing, true,
       [&](std::span<const std::uint32_t> members, detail::SweepGroup& g) {
         const SweepStep& step = steps[members.front()];
         detail::sweep_group_bound(shapes[step.cutter].parts[static_cast<std::size_t>(step.part)],

@@ -235,12 +235,16 @@ inline SweepPieceSpan sweep_piece_span(const SweepPiece& p) {
 // segment, moved along the stretched travel (within half its length of its middle): a piece
 // farther than that from the ray is skipped too. Where the axis lies nearly across the ray the
 // stretch is ill-conditioned: the circle of radius ρ around the path of its middle height is used.
-template <class Grow>
+struct SweepNeverEnough {
+  bool operator()(const std::pair<double, double>&) const { return false; }
+};
+
+template <class Grow, class Enough = SweepNeverEnough>
 std::optional<std::pair<double, double>> sweep_pieces_hull(
     std::span<const SweepPiece> pieces, std::span<const SweepPieceSpan> spans, double margin,
     const Vec3& from, const Vec3& travel, const Vec3& axis, const Vec3& point, int ray_axis,
     double lo, double hi, Grow&& grow, std::uint64_t only = ~std::uint64_t{0},
-    std::uint64_t* met = nullptr) {
+    std::uint64_t* met = nullptr, Enough&& enough = {}) {
   std::optional<std::pair<double, double>> hull;
   Vec3 w = point - from;
   w[ray_axis] = -from[ray_axis];
@@ -267,10 +271,12 @@ std::optional<std::pair<double, double>> sweep_pieces_hull(
     const double t = tt > 0 ? std::clamp((du * tu + dv * tv) / tt, 0.0, 1.0) : 0.0;
     return (du - t * tu) * (du - t * tu) + (dv - t * tv) * (dv - t * tv);
   };
+  std::uint64_t done = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const std::size_t i = k == 0 ? n - 1 : k - 1;
     const std::uint64_t bit = i < 64 ? std::uint64_t{1} << i : 0;
     if (i < 64 && !(only & bit)) continue;
+    done |= bit;
     const double e = grow(i);
     const SweepPieceSpan& span = spans[i];
     const double h0 = span.h0 - e, h1 = span.h1 + e, rho = span.rho + e * span.widen;
@@ -296,10 +302,17 @@ std::optional<std::pair<double, double>> sweep_pieces_hull(
     if (slabs && hull && hull->first <= u0 && u1 <= hull->second) continue;
     const auto cut = sweep_piece_interval(e > 0 ? sweep_grown_piece(pieces[i], e) : pieces[i], from,
                                           travel, axis, point, ray_axis);
-    if (!cut) continue;
+    if (!cut || cut->second < lo - margin || cut->first > hi + margin) {
+      if (met) *met &= ~bit;
+      if (!cut) continue;
+    }
     // The part is convex, so its pieces' intervals on one ray overlap: their hull is the union.
     hull = hull ? std::pair{std::min(hull->first, cut->first), std::max(hull->second, cut->second)}
                 : *cut;
+    if (enough(*hull)) {  // the pieces not yet taken may meet the ray
+      if (met) *met |= only & ~done;
+      break;
+    }
   }
   return hull;
 }
