@@ -484,6 +484,24 @@ inline double sweep_group_grow(const SweepGroup& g, double reach) {
   return e + 1e-5 * (1 + reach + e);
 }
 
+// The interval of group `g`'s SweepBound::pieces bound on the ray through `point` along `axis`
+// where it may meet material within [lo, hi], or part of it that meets `current`; `only` gets the
+// bits of the pieces its members may need (detail::sweep_pieces_hull). Kept out of sweep_ray's
+// loop, which a ball's capsules run fastest alone (balls at 2·10^4 segments: 18 % slower inlined).
+[[gnu::noinline]] inline std::optional<std::pair<double, double>> sweep_group_hull(
+    const SweepGroup& g, std::span<const DexelInterval> current, const Vec3& point, int axis,
+    double lo, double hi, std::uint64_t& only) {
+  const Vec3 travel = g.c1 - g.c0;
+  const SweepPartShape& part = *g.part;
+  const double margin =
+      1e-6 * (1 + part.top + glm::length(travel) + glm::length(g.box.max - g.box.min));
+  only = 0;
+  return sweep_pieces_hull(
+      part.pieces, part.spans, margin, g.c0, travel, g.axis, point, axis, lo, hi,
+      [&](std::size_t k) { return sweep_group_grow(g, part.spans[k].reach); }, ~std::uint64_t{0},
+      &only, [&](const std::pair<double, double>& b) { return sweep_bound_meets(b, current); });
+}
+
 // Ray (iu, iv) of grid `axis` less the sweeps of the steps of the groups listed for it
 // (detail/sweep_rows.hpp). A group whose bound cannot meet the material left is skipped whole;
 // each sweep is subtracted as soon as it is found; one whose box holds no material left is not
@@ -507,16 +525,8 @@ inline void sweep_ray(std::span<const DexelInterval> ray, const TripleDexel& d, 
     if (point[u] < group.box.min[u] || point[u] > group.box.max[u]) continue;
     std::uint64_t only = ~std::uint64_t{0};
     if (group.count > 1 &&
-        !sweep_group_may_cut(group, current, point, axis, [&](double lo, double hi, auto&& enough) {
-          const Vec3 travel = group.c1 - group.c0;
-          const double margin = 1e-6 * (1 + group.part->top + glm::length(travel) +
-                                        group.box.max[u] - group.box.min[u]);
-          const SweepPartShape& part = *group.part;
-          only = 0;
-          return sweep_pieces_hull(
-              part.pieces, part.spans, margin, group.c0, travel, group.axis, point, axis, lo, hi,
-              [&](std::size_t k) { return sweep_group_grow(group, part.spans[k].reach); },
-              ~std::uint64_t{0}, &only, enough);
+        !sweep_group_may_cut(group, current, point, axis, [&](double lo, double hi) {
+          return sweep_group_hull(group, current, point, axis, lo, hi, only);
         }))
       continue;
     for (std::uint32_t k = group.first; k < group.first + group.count; ++k) {

@@ -180,33 +180,37 @@ SweepGroups sweep_groups(std::span<const SweepStepCut> cuts, std::size_t keys, K
   return out;
 }
 
+// Whether `bound` (an interval on a ray), grown for float rounding, meets the spans `current`.
+inline bool sweep_bound_meets(const std::pair<double, double>& bound,
+                              std::span<const DexelInterval> current) {
+  const double margin = 1e-5 * (1 + std::abs(bound.first) + std::abs(bound.second));
+  const double a = bound.first - margin, b = bound.second + margin;
+  for (const DexelInterval& span : current)
+    if (span.exit > a && span.enter < b) return true;
+  return false;
+}
+
 // Whether group `g` may remove anything from the spans `current` of the ray through `point`
 // along `axis`: false only if none of its members can (their boxes hold no material, or their
-// sweeps' intervals, within the bound's grown for float rounding, meet none). pieces_hull(lo, hi,
-// enough): the interval of a SweepBound::pieces bound where it may meet material within [lo, hi],
-// or part of it for which enough(part) holds.
+// sweeps' intervals, within the bound's grown for float rounding, meet none). pieces_hull(lo, hi):
+// the interval of a SweepBound::pieces bound, or part of it that meets `current`, where it may
+// meet material within [lo, hi].
 template <class PiecesHull>
 bool sweep_group_may_cut(const SweepGroup& g, std::span<const DexelInterval> current,
                          const Vec3& point, int axis, PiecesHull&& pieces_hull) {
   double lo = g.box.max[axis], hi = g.box.min[axis];  // as sweep_ray's test of a step's box
   for (const DexelInterval& span : current)
-    if (span.exit >= g.box.min[axis] && span.enter <= g.box.max[axis]) {
-      lo = std::min(lo, std::max<double>(span.enter, g.box.min[axis]));
-      hi = std::max(hi, std::min<double>(span.exit, g.box.max[axis]));
-    }
+    if (span.exit >= g.box.min[axis] && span.enter <= g.box.max[axis])
+      lo = std::min<double>(lo, span.enter), hi = std::max<double>(hi, span.exit);
   if (!(lo <= hi)) return false;
   if (g.bound == SweepBound::box) return true;
-  auto meets = [&](const std::pair<double, double>& bound) {
-    const double margin = 1e-5 * (1 + std::abs(bound.first) + std::abs(bound.second));
-    const double a = bound.first - margin, b = bound.second + margin;
-    for (const DexelInterval& span : current)
-      if (span.exit > a && span.enter < b) return true;
-    return false;
-  };
-  const std::optional<std::pair<double, double>> bound =
-      g.bound == SweepBound::capsule ? capsule_interval(g.c0, g.c1, g.radius, point, axis)
-                                     : pieces_hull(lo, hi, meets);
-  return bound && meets(*bound);
+  if (g.bound == SweepBound::capsule) {
+    const auto bound = capsule_interval(g.c0, g.c1, g.radius, point, axis);
+    return bound && sweep_bound_meets(*bound, current);
+  }
+  const auto bound =
+      pieces_hull(std::max<double>(lo, g.box.min[axis]), std::min<double>(hi, g.box.max[axis]));
+  return bound && sweep_bound_meets(*bound, current);
 }
 
 // Removes [cut.enter, cut.exit] from the sorted disjoint spans of `spans` in place, as
