@@ -198,18 +198,21 @@ inline bool sweep_bound_meets(const std::pair<double, double>& bound,
 template <class PiecesHull>
 bool sweep_group_may_cut(const SweepGroup& g, std::span<const DexelInterval> current,
                          const Vec3& point, int axis, PiecesHull&& pieces_hull) {
-  double lo = g.box.max[axis], hi = g.box.min[axis];  // as sweep_ray's test of a step's box
+  bool boxed = false;  // as sweep_ray's test of a step's box, cheaper than the bounds below
   for (const DexelInterval& span : current)
-    if (span.exit >= g.box.min[axis] && span.enter <= g.box.max[axis])
-      lo = std::min<double>(lo, span.enter), hi = std::max<double>(hi, span.exit);
-  if (!(lo <= hi)) return false;
-  if (g.bound == SweepBound::box) return true;
+    boxed = boxed || (span.exit >= g.box.min[axis] && span.enter <= g.box.max[axis]);
+  if (!boxed || g.bound == SweepBound::box) return boxed;
   if (g.bound == SweepBound::capsule) {
     const auto bound = capsule_interval(g.c0, g.c1, g.radius, point, axis);
     return bound && sweep_bound_meets(*bound, current);
   }
-  const auto bound =
-      pieces_hull(std::max<double>(lo, g.box.min[axis]), std::min<double>(hi, g.box.max[axis]));
+  double lo = g.box.max[axis], hi = g.box.min[axis];  // the material within the box
+  for (const DexelInterval& span : current)
+    if (span.exit >= g.box.min[axis] && span.enter <= g.box.max[axis]) {
+      lo = std::min(lo, std::max<double>(span.enter, g.box.min[axis]));
+      hi = std::max(hi, std::min<double>(span.exit, g.box.max[axis]));
+    }
+  const auto bound = pieces_hull(lo, hi);
   return bound && sweep_bound_meets(*bound, current);
 }
 
