@@ -329,7 +329,7 @@ TEST_CASE("sweep: skipping pieces gives the brute-force dexels") {
 // under a bound (detail/sweep_rows.hpp) that a ray skips whole. Rows of 0.1 mm moves whose axis
 // tilts along the row, for a ball, flat, bull nose and chamfer: the same dexels as the steps cut
 // one at a time (in program order, no groups), on 1, 2 and 8 threads, and groups of every bound
-// (a cylinder with a cone below it for the bull nose and the chamfer).
+// (the part's pieces, grown for the members' turn, for the flat, bull nose and chamfer).
 TEST_CASE("sweep: grouped short steps give the dexels of each step cut alone") {
   const Aabb stock{Vec3(-4, -4, -4), Vec3(4, 4, 1)};
   const DexelLattice lattice = DexelLattice::covering(stock, 0.25);
@@ -372,21 +372,21 @@ TEST_CASE("sweep: grouped short steps give the dexels of each step cut alone") {
   const detail::SweepGroups groups = detail::sweep_groups(
       cuts, 3 * cutters.size(),
       [&](std::size_t k) { return 3 * steps[k].cutter + static_cast<std::size_t>(steps[k].part); },
-      8 * lattice.spacing, true,
+      [](std::size_t) { return detail::kSweepGroup; }, 8 * lattice.spacing, true,
       [&](std::span<const std::uint32_t> members, detail::SweepGroup& g) {
         const SweepStep& step = steps[members.front()];
         detail::sweep_group_bound(shapes[step.cutter].parts[static_cast<std::size_t>(step.part)],
                                   steps, cuts, members, g);
       });
-  int cones = 0;
+  int turning = 0;  // pieces bounds grown for their members' turn
   for (const detail::SweepGroup& g : groups.groups) {
     ++bounds[static_cast<int>(g.bound)];
-    cones += g.piece_count == 2;
+    turning += g.bound == detail::SweepBound::pieces && g.turn > 0;
   }
-  CHECK(cones > 0);
+  CHECK(turning > 0);
   CHECK(groups.groups.size() * 4 < steps.size());
   CHECK(bounds[static_cast<int>(detail::SweepBound::capsule)] > 0);
-  CHECK(bounds[static_cast<int>(detail::SweepBound::cylinder)] > 0);
+  CHECK(bounds[static_cast<int>(detail::SweepBound::pieces)] > 0);
   TripleDexel alone = TripleDexel::box(lattice, stock);
   for (const SweepStep& step : steps) sweep_remove(alone, cutters, {&step, 1}, 1);
   for (unsigned threads : {1u, 2u, 8u}) {

@@ -189,6 +189,134 @@ inline std::optional<std::pair<double, double>> sweep_piece_interval(
   return sweep_conic_range(f, sides, 2 * tol * (1 + size), tol);
 }
 
+// `p` grown by e ≥ 0: a ball's radius by e; a frustum's heights by e each way and its side moved
+// e outward (its radius by e·√(1 + m²) at each height). It holds every point within e of `p`: the
+// offset of an intersection of half-spaces lies within the intersection of their offsets.
+inline SweepPiece sweep_grown_piece(const SweepPiece& p, double e) {
+  if (p.ball) return {p.lo - e, p.hi + e, true, 0, 0, p.centre, p.radius + e};
+  const double rho0 = p.rho0 - p.slope * e + e * std::sqrt(1 + p.slope * p.slope);
+  return {p.lo - e, p.hi + e, false, rho0, p.slope, 0, 0};
+}
+
+// What sweep_pieces_hull tests a piece by, computed once: its heights above the tip, its largest
+// radius, the farthest of its points from the tip, and how much its largest radius grows per
+// unit it is grown by (sweep_grown_piece).
+struct SweepPieceSpan {
+  double h0 = 0, h1 = 0, rho = 0, reach = 0, widen = 1;
+};
+
+inline SweepPieceSpan sweep_piece_span(const SweepPiece& p) {
+  SweepPieceSpan b;
+  b.h0 = p.ball ? p.centre - p.radius : p.lo, b.h1 = p.ball ? p.centre + p.radius : p.hi;
+  b.rho = p.ball ? p.radius : std::max(p.rho0, p.rho0 + p.slope * (b.h1 - b.h0));
+  b.reach = std::hypot(b.rho, std::max(std::abs(b.h0), std::abs(b.h1)));
+  if (!p.ball) b.widen = std::abs(p.slope) + std::sqrt(1 + p.slope * p.slope);
+  return b;
+}
+
+// The hull of the intervals of the ray x(u) = point + u·e_ray_axis in the sweeps of `pieces`, each
+// grown by grow(piece) ≥ 0 (sweep_grown_piece), with unit axis `axis`, tip from `from` moved by
+// `travel`, where they may meet material lying within [lo, hi]; nullopt if none may. `spans`: the
+// pieces' sweep_piece_span, grow(k) ≥ 0 how far piece k is grown. Only pieces k < 64 whose bit is
+// set in `only` are taken (and all others); `met` gets the bits of those not skipped for missing
+// the ray or the material (whatever the hull): a piece grown by e holds the piece moved by e.
+//
+// A piece between heights h0 and h1 above the tip meets the ray only where the ray's height
+// above the moving tip, w + u·axis[ray_axis] − s·(travel·axis) for some s ∈ [0, 1], lies in
+// [h0, h1] (w: that height at u = 0): a range of u found with no root. A piece is skipped when
+// that range (grown by `margin`, far above the conic solve's slack) lies within the hull of the
+// pieces already cut (it cannot widen it) or misses [lo, hi] (it meets no material: the hull of
+// the others, less what lies outside the material, removes the same). Pieces are taken top first,
+// then bottom, where a ray along the axis enters and leaves, so that the middle ones are skipped.
+// Seen along the ray, a piece lies within the cylinder of its largest radius ρ between h0 and h1,
+// whose shadow is an ellipse (semi-axes ρ, and ρ·|axis along the ray| along the axis's shadow)
+// moved (h1 − h0)/2·|axis across the ray| each way along that shadow, and along the travel.
+// Stretched by 1/|axis along the ray| along the shadow, that is a disc of radius ρ around a
+// segment, moved along the stretched travel (within half its length of its middle): a piece
+// farther than that from the ray is skipped too. Where the axis lies nearly across the ray the
+// stretch is ill-conditioned: the circle of radius ρ around the path of its middle height is used.
+struct SweepNeverEnough {
+  bool operator()(const std::pair<double, double>&) const { return false; }
+};
+
+template <class Grow, class Enough = SweepNeverEnough>
+std::optional<std::pair<double, double>> sweep_pieces_hull(
+    std::span<const SweepPiece> pieces, std::span<const SweepPieceSpan> spans, double margin,
+    const Vec3& from, const Vec3& travel, const Vec3& axis, const Vec3& point, int ray_axis,
+    double lo, double hi, Grow&& grow, std::uint64_t only = ~std::uint64_t{0},
+    std::uint64_t* met = nullptr, Enough&& enough = {}) {
+  std::optional<std::pair<double, double>> hull;
+  Vec3 w = point - from;
+  w[ray_axis] = -from[ray_axis];
+  const double w0 = glm::dot(w, axis), along = axis[ray_axis];
+  const double shift = -glm::dot(travel, axis);
+  const double s_lo = std::min(0.0, shift), s_hi = std::max(0.0, shift);
+  const bool slabs = std::abs(along) > 1e-6;
+  const std::size_t n = pieces.size();
+  const int iu = (ray_axis + 1) % 3, iv = (ray_axis + 2) % 3;
+  const double tu = travel[iu], tv = travel[iv], tt = tu * tu + tv * tv;
+  const double au = axis[iu], av = axis[iv], across = std::sqrt(au * au + av * av);
+  const double qu = point[iu] - from[iu], qv = point[iv] - from[iv];
+  const double along_abs = std::abs(along);
+  const bool ellipse = along_abs > 0.05 && across > 1e-9;
+  double half_travel = 0;
+  if (ellipse) {
+    const double tx = (-tu * av + tv * au) / across,
+                 ty = (tu * au + tv * av) / (across * along_abs);
+    half_travel = 0.5 * std::sqrt(tx * tx + ty * ty);
+  }
+  // The least squared distance, seen along the ray, from the ray to the path of axis height h.
+  auto off_path2 = [&](double h) {
+    const double du = qu - h * au, dv = qv - h * av;
+    const double t = tt > 0 ? std::clamp((du * tu + dv * tv) / tt, 0.0, 1.0) : 0.0;
+    return (du - t * tu) * (du - t * tu) + (dv - t * tv) * (dv - t * tv);
+  };
+  std::uint64_t done = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = k == 0 ? n - 1 : k - 1;
+    const std::uint64_t bit = i < 64 ? std::uint64_t{1} << i : 0;
+    if (i < 64 && !(only & bit)) continue;
+    done |= bit;
+    const double e = grow(i);
+    const SweepPieceSpan& span = spans[i];
+    const double h0 = span.h0 - e, h1 = span.h1 + e, rho = span.rho + e * span.widen;
+    if (ellipse) {
+      const double hm = 0.5 * (h0 + h1);
+      const double pu = qu - hm * au - 0.5 * tu, pv = qv - hm * av - 0.5 * tv;
+      const double x = (-pu * av + pv * au) / across;
+      const double y = std::max(0.0, std::abs(pu * au + pv * av) / (across * along_abs) -
+                                         0.5 * (h1 - h0) * across / along_abs);
+      const double reach = rho + half_travel + margin / along_abs;
+      if (x * x + y * y > reach * reach) continue;
+    } else {
+      const double reach = rho + margin + 0.5 * (h1 - h0) * across;
+      if (off_path2(0.5 * (h0 + h1)) > reach * reach) continue;
+    }
+    double u0 = 0, u1 = 0;
+    if (slabs) {
+      u0 = (h0 - margin - w0 - s_hi) / along, u1 = (h1 + margin - w0 - s_lo) / along;
+      if (u0 > u1) std::swap(u0, u1);
+      if (u1 < lo - margin || u0 > hi + margin) continue;
+    }
+    if (met) *met |= bit;
+    if (slabs && hull && hull->first <= u0 && u1 <= hull->second) continue;
+    const auto cut = sweep_piece_interval(e > 0 ? sweep_grown_piece(pieces[i], e) : pieces[i], from,
+                                          travel, axis, point, ray_axis);
+    if (!cut || cut->second < lo - margin || cut->first > hi + margin) {
+      if (met) *met &= ~bit;
+      if (!cut) continue;
+    }
+    // The part is convex, so its pieces' intervals on one ray overlap: their hull is the union.
+    hull = hull ? std::pair{std::min(hull->first, cut->first), std::max(hull->second, cut->second)}
+                : *cut;
+    if (enough(*hull)) {  // the pieces not yet taken may meet the ray
+      if (met) *met |= only & ~done;
+      break;
+    }
+  }
+  return hull;
+}
+
 // Appends the frustum between meridian points (d0, h0) and (d1, h1), h1 > h0, clipped to [lo, hi].
 inline void sweep_frustum(double d0, double h0, double d1, double h1, double lo, double hi,
                           std::vector<SweepPiece>& out) {

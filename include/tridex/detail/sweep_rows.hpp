@@ -3,11 +3,12 @@
 // A finishing program's segments are short (0.05–0.2 mm) against the cutter (6 mm), so a ray
 // lies in the boxes of thousands of steps, most of which no longer reach the material left on it
 // when their turn comes (the ray was cut lower by a nearer pass). Consecutive steps of one cutter
-// part are therefore grouped (up to kSweepGroup, while their boxes stay within a few spacings of
-// one step's) under a bound: the union of their boxes, and for ball tips the capsule around the
-// chord of their centres grown by the members' largest distance from it. A ray skips a whole
-// group when the bound cannot meet its material; otherwise its members are cut as before. Removal
-// commutes (the set difference does not depend on the order), so results are identical.
+// part are therefore grouped (up to kSweepGroup or kSweepGroupPieces, while their boxes stay within
+// a few spacings of one step's) under a bound: the union of their boxes, and for ball tips the
+// capsule around the chord of their centres grown by the members' largest distance from it. A ray
+// skips a whole group when the bound cannot meet its material; otherwise its members are cut as
+// before. Removal commutes (the set difference does not depend on the order), so results are
+// identical.
 #pragma once
 
 #include <algorithm>
@@ -93,13 +94,16 @@ SweepRows sweep_rows(const TripleDexel& d, int axis, std::size_t count, BoxOf&& 
   return rows;
 }
 
-inline constexpr std::uint32_t kSweepGroup = 16;
+// At most this many steps a group: kSweepGroup, or kSweepGroupPieces for a part of several pieces
+// (a bull nose's chords), whose members cost more each, so that a smaller group skips more of
+// them (bull nose at 2·10^4 segments: 8 % less time; a ball's capsules are cheaper at 16).
+inline constexpr std::uint32_t kSweepGroup = 16, kSweepGroupPieces = 8;
 
 // How a group bounds its members' sweeps: by the union of their boxes alone, by a capsule
-// (ball tips: the chord of their centres, c0–c1, and `radius`), or by the sweep of the solid
-// of revolution `pieces` (a cylinder, below it a cone's frustum) with unit axis `axis` moved
-// from tip c0 to tip c1.
-enum class SweepBound : std::uint8_t { box, capsule, cylinder };
+// (ball tips: the chord of their centres, c0–c1, and `radius`), or by the pieces of their part,
+// each grown by `tip` + its reach·`turn` (sweep.hpp, sweep_group_bound), with unit axis `axis`
+// moved from tip c0 to tip c1.
+enum class SweepBound : std::uint8_t { box, capsule, pieces };
 
 // Steps cut together: members[first, first + count) of SweepGroups, in program order.
 struct SweepGroup {
@@ -108,8 +112,8 @@ struct SweepGroup {
   SweepBound bound = SweepBound::box;
   Vec3 c0{0.0}, c1{0.0}, axis{0.0, 0.0, 1.0};
   double radius = 0;
-  std::array<SweepPiece, 2> pieces{};
-  int piece_count = 0;
+  const SweepPartShape* part = nullptr;
+  double tip = 0, turn = 0;
 };
 
 struct SweepGroups {
@@ -125,14 +129,14 @@ inline double distance_to_segment(const Vec3& x, const Vec3& a, const Vec3& b) {
   return glm::length(x - (a + t * d));
 }
 
-// Groups consecutive steps of one key (key_of(s): cutter and part), at most kSweepGroup, while
+// Groups consecutive steps of one key (key_of(s): cutter and part), at most limit(key), while
 // the union of their boxes is no wider on any side than `grow` past their widest member's. With
 // `group` false each step is a group of its own, in order (a searched part's interval depends
 // on the material left: its steps keep their order). bound(members, group) sets the bound of a
 // group of more than one step.
-template <class KeyOf, class Bound>
+template <class KeyOf, class Limit, class Bound>
 SweepGroups sweep_groups(std::span<const SweepStepCut> cuts, std::size_t keys, KeyOf&& key_of,
-                         double grow, bool group, Bound&& bound) {
+                         Limit&& limit, double grow, bool group, Bound&& bound) {
   SweepGroups out;
   out.members.reserve(cuts.size());
   struct Open {
@@ -164,7 +168,7 @@ SweepGroups sweep_groups(std::span<const SweepStepCut> cuts, std::size_t keys, K
     joined.extend(cuts[s].box.min);
     joined.extend(cuts[s].box.max);
     const double w = std::max(o.widest, widest(cuts[s].box));
-    if (!group || o.members.size() >= kSweepGroup || widest(joined) > w + grow) {
+    if (!group || o.members.size() >= limit(key_of(s)) || widest(joined) > w + grow) {
       close(o);
       joined = cuts[s].box;
     }
@@ -176,34 +180,40 @@ SweepGroups sweep_groups(std::span<const SweepStepCut> cuts, std::size_t keys, K
   return out;
 }
 
+// Whether `bound` (an interval on a ray), grown for float rounding, meets the spans `current`.
+inline bool sweep_bound_meets(const std::pair<double, double>& bound,
+                              std::span<const DexelInterval> current) {
+  const double margin = 1e-5 * (1 + std::abs(bound.first) + std::abs(bound.second));
+  const double a = bound.first - margin, b = bound.second + margin;
+  for (const DexelInterval& span : current)
+    if (span.exit > a && span.enter < b) return true;
+  return false;
+}
+
 // Whether group `g` may remove anything from the spans `current` of the ray through `point`
 // along `axis`: false only if none of its members can (their boxes hold no material, or their
-// sweeps' intervals, within the bound's grown for float rounding, meet none).
-inline bool sweep_group_may_cut(const SweepGroup& g, std::span<const DexelInterval> current,
-                                const Vec3& point, int axis) {
+// sweeps' intervals, within the bound's grown for float rounding, meet none). pieces_hull(lo, hi):
+// the interval of a SweepBound::pieces bound, or part of it that meets `current`, where it may
+// meet material within [lo, hi].
+template <class PiecesHull>
+bool sweep_group_may_cut(const SweepGroup& g, std::span<const DexelInterval> current,
+                         const Vec3& point, int axis, PiecesHull&& pieces_hull) {
   bool boxed = false;  // as sweep_ray's test of a step's box, cheaper than the bounds below
   for (const DexelInterval& span : current)
     boxed = boxed || (span.exit >= g.box.min[axis] && span.enter <= g.box.max[axis]);
   if (!boxed || g.bound == SweepBound::box) return boxed;
-  std::optional<std::pair<double, double>> bound;
   if (g.bound == SweepBound::capsule) {
-    bound = capsule_interval(g.c0, g.c1, g.radius, point, axis);
-  } else {
-    for (int k = 0; k < g.piece_count; ++k) {  // a convex union: the hull of the pieces'
-      const auto cut = sweep_piece_interval(g.pieces[static_cast<std::size_t>(k)], g.c0,
-                                            g.c1 - g.c0, g.axis, point, axis);
-      if (cut)
-        bound = bound ? std::pair{std::min(bound->first, cut->first),
-                                  std::max(bound->second, cut->second)}
-                      : *cut;
-    }
+    const auto bound = capsule_interval(g.c0, g.c1, g.radius, point, axis);
+    return bound && sweep_bound_meets(*bound, current);
   }
-  if (!bound) return false;
-  const double margin = 1e-5 * (1 + std::abs(bound->first) + std::abs(bound->second));
-  const double lo = bound->first - margin, hi = bound->second + margin;
+  double lo = g.box.max[axis], hi = g.box.min[axis];  // the material within the box
   for (const DexelInterval& span : current)
-    if (span.exit > lo && span.enter < hi) return true;
-  return false;
+    if (span.exit >= g.box.min[axis] && span.enter <= g.box.max[axis]) {
+      lo = std::min(lo, std::max<double>(span.enter, g.box.min[axis]));
+      hi = std::max(hi, std::min<double>(span.exit, g.box.max[axis]));
+    }
+  const auto bound = pieces_hull(lo, hi);
+  return bound && sweep_bound_meets(*bound, current);
 }
 
 // Removes [cut.enter, cut.exit] from the sorted disjoint spans of `spans` in place, as
