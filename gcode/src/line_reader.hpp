@@ -76,14 +76,7 @@ class LineReader {
       pos_ = static_cast<std::size_t>(offset - base_);
       return true;
     }
-    if (!seekable_) return false;
-    in_.clear();
-    in_.seekg(static_cast<std::streamoff>(offset));
-    if (!in_) return false;
-    base_ = offset;
-    pos_ = end_ = 0;
-    eof_ = false;
-    return true;
+    return seekable_ && restart(offset);
   }
 
  private:
