@@ -248,6 +248,19 @@ TEST_CASE("sweep: the C-turning groove's volume, and the same dexels on 1, 2 and
 // subtract_ray, in step order. Random turning moves of every closed-form cutter (the bull nose
 // as chords), planned by plan_sweep_parts (tips and shanks), deep enough for the shanks to cut,
 // and the same moves again over the material the first pass left.
+// The intervals of `f` not bit-identical to `b`'s, both of one lattice with the same rays' counts.
+long long differing_intervals(const TripleDexel& f, const TripleDexel& b) {
+  long long differ = 0;
+  for (std::size_t a = 0; a < 3; ++a) {
+    const DexelGrid &fa = f.grids[a], &ba = b.grids[a];
+    REQUIRE(fa.offsets == ba.offsets);
+    for (std::size_t k = 0; k < fa.intervals.size(); ++k)
+      differ += fa.intervals[k].enter != ba.intervals[k].enter ||
+                fa.intervals[k].exit != ba.intervals[k].exit;
+  }
+  return differ;
+}
+
 TEST_CASE("sweep: skipping pieces gives the brute-force dexels") {
   std::mt19937 rng(3435);
   const Aabb stock{Vec3(-4, -4, -4), Vec3(4, 4, 1)};
@@ -311,16 +324,7 @@ TEST_CASE("sweep: skipping pieces gives the brute-force dexels") {
       g.intervals = std::move(intervals);
       g.offsets = std::move(offsets);
     }
-    for (int a = 0; a < 3; ++a) {
-      const DexelGrid &f = fast.grids[static_cast<std::size_t>(a)],
-                      &b = brute.grids[static_cast<std::size_t>(a)];
-      REQUIRE(f.offsets == b.offsets);
-      long long differ = 0;
-      for (std::size_t k = 0; k < f.intervals.size(); ++k)
-        differ += f.intervals[k].enter != b.intervals[k].enter ||
-                  f.intervals[k].exit != b.intervals[k].exit;
-      CHECK(differ == 0);
-    }
+    CHECK(differing_intervals(fast, brute) == 0);
   }
   CHECK(cut_rays > 500);
 }
@@ -392,16 +396,7 @@ TEST_CASE("sweep: grouped short steps give the dexels of each step cut alone") {
   for (unsigned threads : {1u, 2u, 8u}) {
     TripleDexel grouped = TripleDexel::box(lattice, stock);
     sweep_remove(grouped, cutters, steps, threads);
-    for (int a = 0; a < 3; ++a) {
-      const DexelGrid &f = grouped.grids[static_cast<std::size_t>(a)],
-                      &b = alone.grids[static_cast<std::size_t>(a)];
-      REQUIRE(f.offsets == b.offsets);
-      long long differ = 0;
-      for (std::size_t k = 0; k < f.intervals.size(); ++k)
-        differ += f.intervals[k].enter != b.intervals[k].enter ||
-                  f.intervals[k].exit != b.intervals[k].exit;
-      CHECK(differ == 0);
-    }
+    CHECK(differing_intervals(grouped, alone) == 0);
   }
   CHECK(volume(alone) < volume(TripleDexel::box(lattice, stock)) - 10);
 }
