@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "reference.hpp"
@@ -619,4 +620,72 @@ TEST_CASE(
   };
   check(cutters, random_moves);
   for (const std::vector<CutMove>& moves : raster_cases) check(raster_cutters, moves);
+}
+
+TEST_CASE("sort_by_key orders as std::sort does the (value, index) pairs") {
+  // Ties, both zeros, negatives, infinities and values one ulp apart, in random order.
+  std::mt19937 rng(37);
+  const std::vector<double> pool{-std::numeric_limits<double>::infinity(),
+                                 -3.5,
+                                 -1e-300,
+                                 -0.0,
+                                 0.0,
+                                 1e-300,
+                                 2.0,
+                                 std::nextafter(2.0, 3.0),
+                                 12.25,
+                                 1e300,
+                                 std::numeric_limits<double>::infinity()};
+  for (int trial = 0; trial < 20; ++trial) {
+    std::uniform_int_distribution<std::size_t> pick(0, pool.size() - 1);
+    const std::size_t n = trial == 0 ? 0 : 1 + rng() % 3000;
+    std::vector<std::pair<double, std::uint32_t>> pairs;
+    std::vector<detail::SortKey> keys, spare;
+    for (std::size_t k = 0; k < n; ++k) {
+      const double v = trial % 2 ? pool[pick(rng)] : std::ldexp(double(rng() % 1000), -7) - 3;
+      pairs.emplace_back(v, static_cast<std::uint32_t>(k));
+      keys.push_back({detail::order_key(v), static_cast<std::uint32_t>(k)});
+    }
+    std::sort(pairs.begin(), pairs.end());
+    detail::sort_by_key(keys, spare);
+    REQUIRE(keys.size() == n);
+    for (std::size_t k = 0; k < n; ++k) CHECK(keys[k].index == pairs[k].second);
+  }
+}
+
+TEST_CASE("many moves, binned on the threads in chunks: each point at the lowest of them all") {
+  // Over 65,536 moves (bin_moves' chunks hold 32,768), spread over the grid in program order so
+  // that each work block gets moves from several chunks; some miss the grid.
+  std::vector<Cutter> cutters{Cutter::ball(0.4), Cutter::flat(0.5), Cutter::bull_nose(0.6, 0.2)};
+  ZMapGrid g;
+  g.x0 = -0.3, g.y0 = -0.2, g.cell = 0.05, g.nx = 330, g.ny = 290;
+  std::mt19937 rng(41);
+  std::uniform_real_distribution<double> x(-1, 17.5), y(-1, 15.5), z(0.5, 3), step(-0.08, 0.08);
+  std::vector<CutMove> moves;
+  for (std::uint32_t k = 0; k < 70000; ++k) {
+    const Vec3 a(x(rng), y(rng), z(rng));
+    moves.push_back({Segment{a, a + Vec3(step(rng), step(rng), 0.1 * step(rng))}, k % 3});
+  }
+  ZMap one(g, 4, -1), two(g, 4, -1), three(g, 4, -1);
+  mill(one, cutters, moves, {.threads = 1});
+  mill(two, cutters, moves, {.threads = 2});
+  mill(three, cutters, moves, {.threads = 3});
+  CHECK(two.heights == one.heights);
+  CHECK(three.heights == one.heights);
+  int mismatches = 0, lowered = 0;
+  for (int j = 0; j < g.ny; j += 13)
+    for (int i = 0; i < g.nx; i += 11) {
+      double expected = 4;
+      for (const CutMove& m : moves) {
+        const double reach = cutters[m.cutter].radius() + 0.2;
+        if (std::abs(m.tip.a.x - g.x(i)) > reach || std::abs(m.tip.a.y - g.y(j)) > reach) continue;
+        expected = std::min(
+            expected, detail::MoveGeometry(cutters[m.cutter], m.tip).lowest_above(g.x(i), g.y(j)));
+      }
+      expected = std::max(expected, -1.0);
+      if (std::abs(one.height(i, j) - expected) > 1e-5) ++mismatches;
+      if (expected < 4) ++lowered;
+    }
+  CHECK(mismatches == 0);
+  CHECK(lowered > 100);
 }

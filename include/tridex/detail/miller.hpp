@@ -31,6 +31,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <new>
 #include <span>
 #include <utility>
 #include <vector>
@@ -43,6 +44,36 @@
 #include "tridex/zmap.hpp"
 
 namespace tridex::detail {
+
+// A double's bits as an unsigned integer of the same order (−0 as +0, which compare equal; no
+// NaN), and a stable radix sort by it: for keys filled in index order, the order that std::sort
+// gives (value, index) pairs. On model-D's roughing (about 1,500 moves a block, tips in a few
+// levels) std::sort of the pairs took 2 % of Step 1.
+struct SortKey {
+  std::uint64_t key;
+  std::uint32_t index;
+};
+
+inline std::uint64_t order_key(double v) {
+  const auto bits = std::bit_cast<std::uint64_t>(v + 0.0);
+  return bits >> 63 ? ~bits : bits | (std::uint64_t{1} << 63);
+}
+
+inline void sort_by_key(std::vector<SortKey>& keys, std::vector<SortKey>& spare) {
+  constexpr int kDigits = 8;
+  std::array<std::array<std::uint32_t, 256>, kDigits> count{};
+  for (const SortKey& k : keys)
+    for (int d = 0; d < kDigits; ++d) ++count[d][(k.key >> (8 * d)) & 255];
+  spare.resize(keys.size());
+  for (int d = 0; d < kDigits; ++d) {
+    std::array<std::uint32_t, 256>& at = count[d];
+    if (keys.empty() || at[(keys.front().key >> (8 * d)) & 255] == keys.size()) continue;
+    std::uint32_t offset = 0;
+    for (std::uint32_t& c : at) offset += std::exchange(c, offset);
+    for (const SortKey& k : keys) spare[at[(k.key >> (8 * d)) & 255]++] = k;
+    keys.swap(spare);
+  }
+}
 
 constexpr int kTile = 16;     // points along each side of a tile
 constexpr int kBinTiles = 8;  // tiles along each side of a work block
@@ -63,7 +94,7 @@ class Miller {
   }
 
   void run(unsigned threads) {
-    bin_moves();
+    bin_moves(threads);
     const std::size_t bin_count =
         static_cast<std::size_t>(bins_x_) * static_cast<std::size_t>(bins_y_);
     for_each_chunk_with(
@@ -134,8 +165,11 @@ class Miller {
 
   // A ball end move's bounds over kLanes tiles of a row, from pass 1 for pass 2.
   struct BallBounds {
-    DoubleN z, gx, gy, bound;   // the plane at each tile's centre (where `has_plane`), the bound
-    MaskN has_plane, in_range;  // in_range: the move reaches that tile
+    DoubleN z, gx, gy, bound;  // the plane at each tile's centre (where `has_plane`), the bound
+    // Bit l for lane l (lane_bits; as masks they made each record 448 bytes, not 320: on model-D
+    // pass 1 writes 8 M of them for pass 2 in its first direction). in_range: the move reaches the
+    // tile.
+    std::uint32_t has_plane, in_range;
     std::uint32_t move;
     int lane0;
   };
@@ -174,20 +208,36 @@ class Miller {
     }
   }
 
+  // A move's vector form: the one of its LaneKind, or none (scalar).
+  union LaneForm {
+    BallLanes ball;
+    FlatLanes flat;
+    BullLanes bull;
+    ProfileLanes profile;
+    LaneForm() {}
+  };
+
+  struct Reach {
+    std::int8_t row0, row1, col0, col1;
+  };
+
   struct BlockScratch {
-    std::vector<BallBounds> ball_bounds;  // of the current row
-    std::vector<FarMove> far_moves;       // of the current row
-    std::vector<DeferredMove> deferred;   // of the current row
-    std::vector<std::uint32_t> by_tip;    // the other cutters' moves, lowest tip first
-    std::vector<std::pair<double, std::uint32_t>> tip_keys;  // by_tip's sort keys
+    std::vector<BallBounds> ball_bounds;        // of the current row
+    std::vector<FarMove> far_moves;             // of the current row
+    std::vector<DeferredMove> deferred;         // of the current row
+    std::vector<std::uint32_t> by_tip;          // the other cutters' moves, lowest tip first
+    std::vector<SortKey> tip_keys, spare_keys;  // by_tip's sort keys
     std::vector<MoveGeometry> moves;
-    // Parallel to `moves`: how each is evaluated, and its vector form where it has one.
+    // Parallel to `moves`: how each is evaluated, and its vector form where it has one (only
+    // that form is made: the four of every move took 584 bytes, and a block of model-D's
+    // roughing holds 6,000 moves).
     std::vector<LaneKind> kind;
-    std::vector<BallLanes> balls;
-    std::vector<FlatLanes> flats;
-    std::vector<BullLanes> bulls;
-    std::vector<ProfileLanes> profiles;
-    std::vector<IndexBox> boxes;
+    std::vector<LaneForm> forms;
+    // Which tile rows and columns of the block each move reaches (block-relative).
+    std::vector<Reach> reach;
+    // The ball end moves (in block order) and the other cutters' (in by_tip order) that reach
+    // each tile row of the block.
+    std::array<std::vector<std::uint32_t>, kBinTiles> ball_rows, other_rows;
     TileRow row;
   };
 
@@ -209,27 +259,55 @@ class Miller {
     return true;
   }
 
-  // Counting sort of move indices into blocks, keeping program order within each block.
-  void bin_moves() {
-    std::size_t bin_count = static_cast<std::size_t>(bins_x_) * static_cast<std::size_t>(bins_y_);
-    bin_start_.assign(bin_count + 1, 0);
+  // The moves' footprint boxes (boxes_, empty where a move misses the grid), and a counting sort
+  // of move indices into blocks (bin_moves_) keeping program order within each block. On the
+  // threads: the moves in chunks of program order, each chunk counted and filed by one worker at
+  // offsets that put the chunks of one block in order (about 1 % of Step 1's CPU on model-D, and
+  // it ran on one thread while the other waited).
+  void bin_moves(unsigned threads) {
+    const std::size_t bin_count =
+        static_cast<std::size_t>(bins_x_) * static_cast<std::size_t>(bins_y_);
     const int span = kTile * kBinTiles;
-    auto for_each_bin = [&](const CutMove& move, auto&& visit) {
-      IndexBox b;
-      if (!footprint_box(move, b)) return;
+    auto for_each_bin = [&](const IndexBox& b, auto&& visit) {
+      if (b.i0 > b.i1) return;
       for (int by = b.j0 / span; by <= b.j1 / span; ++by)
         for (int bx = b.i0 / span; bx <= b.i1 / span; ++bx)
           visit(static_cast<std::size_t>(bx) +
                 static_cast<std::size_t>(bins_x_) * static_cast<std::size_t>(by));
     };
-    for (const CutMove& move : moves_)
-      for_each_bin(move, [&](std::size_t b) { ++bin_start_[b + 1]; });
-    for (std::size_t b = 0; b < bin_count; ++b) bin_start_[b + 1] += bin_start_[b];
-    bin_moves_.resize(bin_start_[bin_count]);
-    std::vector<std::size_t> fill(bin_start_.begin(), bin_start_.end() - 1);
-    for (std::size_t m = 0; m < moves_.size(); ++m)
-      for_each_bin(moves_[m],
-                   [&](std::size_t b) { bin_moves_[fill[b]++] = static_cast<std::uint32_t>(m); });
+    constexpr std::size_t kChunkMoves = 1 << 15, kMostChunks = 64;
+    const std::size_t chunks =
+        std::min(kMostChunks, (moves_.size() + kChunkMoves - 1) / kChunkMoves);
+    const std::size_t per_chunk = chunks ? (moves_.size() + chunks - 1) / chunks : 0;
+    auto chunk_moves = [&](std::size_t c) {
+      return std::pair(c * per_chunk, std::min(moves_.size(), (c + 1) * per_chunk));
+    };
+    boxes_.resize(moves_.size());
+    std::vector<std::size_t> counts(chunks * bin_count, 0);
+    for_each_chunk(chunks, threads, [&](std::size_t c) {
+      std::size_t* count = &counts[c * bin_count];
+      const auto [m0, m1] = chunk_moves(c);
+      for (std::size_t m = m0; m < m1; ++m) {
+        if (!footprint_box(moves_[m], boxes_[m])) boxes_[m] = {0, 0, -1, -1};
+        for_each_bin(boxes_[m], [&](std::size_t b) { ++count[b]; });
+      }
+    });
+    bin_start_.assign(bin_count + 1, 0);
+    std::size_t total = 0;
+    for (std::size_t b = 0; b < bin_count; ++b) {
+      bin_start_[b] = total;
+      for (std::size_t c = 0; c < chunks; ++c)
+        total += std::exchange(counts[c * bin_count + b], total);
+    }
+    bin_start_[bin_count] = total;
+    bin_moves_.resize(total);
+    for_each_chunk(chunks, threads, [&](std::size_t c) {
+      std::size_t* fill = &counts[c * bin_count];
+      const auto [m0, m1] = chunk_moves(c);
+      for (std::size_t m = m0; m < m1; ++m)
+        for_each_bin(boxes_[m],
+                     [&](std::size_t b) { bin_moves_[fill[b]++] = static_cast<std::uint32_t>(m); });
+    });
   }
 
   // Mills one work block, one row of tiles at a time, in the two passes of the header comment:
@@ -240,40 +318,38 @@ class Miller {
     if (bin_start_[bin] == bin_start_[bin + 1]) return;
     scratch.moves.clear();
     scratch.kind.clear();
-    scratch.balls.clear();
-    scratch.flats.clear();
-    scratch.bulls.clear();
-    scratch.profiles.clear();
-    scratch.boxes.clear();
+    scratch.forms.clear();
     for (std::size_t k = bin_start_[bin]; k < bin_start_[bin + 1]; ++k) {
       const CutMove& move = moves_[bin_moves_[k]];
       const MoveGeometry& m = scratch.moves.emplace_back(cutters_[move.cutter], move.tip);
       const LaneKind kind = lane_kind(m);
       scratch.kind.push_back(kind);
-      scratch.balls.push_back(kind == LaneKind::ball ? BallLanes(m) : BallLanes{});
-      scratch.flats.push_back(kind == LaneKind::flat ? FlatLanes(m) : FlatLanes{});
-      scratch.bulls.push_back(kind == LaneKind::bull_nose ? BullLanes(m) : BullLanes{});
-      scratch.profiles.push_back(kind == LaneKind::profile ? ProfileLanes(m) : ProfileLanes{});
-      scratch.boxes.emplace_back();
-      footprint_box(move, scratch.boxes.back());
+      LaneForm& form = scratch.forms.emplace_back();
+      if (kind == LaneKind::ball) new (&form.ball) BallLanes(m);
+      if (kind == LaneKind::flat) new (&form.flat) FlatLanes(m);
+      if (kind == LaneKind::bull_nose) new (&form.bull) BullLanes(m);
+      if (kind == LaneKind::profile) new (&form.profile) ProfileLanes(m);
     }
-    // Sorted as (lowest tip, index) pairs: the same order as comparing the moves' tips, without
-    // reaching into a MoveGeometry (over 100 bytes each) at every comparison.
+    // Sorted by (lowest tip, index) (sort_by_key), without reaching into a MoveGeometry (over 100
+    // bytes each) at every step.
     scratch.tip_keys.clear();
     for (std::size_t k = 0; k < scratch.moves.size(); ++k)
       if (scratch.kind[k] != LaneKind::ball)
-        scratch.tip_keys.emplace_back(scratch.moves[k].lowest_tip(), static_cast<std::uint32_t>(k));
-    std::sort(scratch.tip_keys.begin(), scratch.tip_keys.end());
+        scratch.tip_keys.push_back(
+            {order_key(scratch.moves[k].lowest_tip()), static_cast<std::uint32_t>(k)});
+    sort_by_key(scratch.tip_keys, scratch.spare_keys);
     scratch.by_tip.clear();
-    for (const auto& key : scratch.tip_keys) scratch.by_tip.push_back(key.second);
+    for (const SortKey& key : scratch.tip_keys) scratch.by_tip.push_back(key.index);
     int bx = static_cast<int>(bin % static_cast<std::size_t>(bins_x_));
     int by = static_cast<int>(bin / static_cast<std::size_t>(bins_x_));
     int tx1 = std::min(tiles_x_, (bx + 1) * kBinTiles),
         ty1 = std::min(tiles_y_, (by + 1) * kBinTiles);
+    file_by_row(bin, bx * kBinTiles, tx1 - bx * kBinTiles, by * kBinTiles, ty1 - by * kBinTiles,
+                scratch);
     TileRow& row = scratch.row;
     for (int ty = by * kBinTiles; ty < ty1; ++ty) {
       start_row(row, bx * kBinTiles, tx1 - bx * kBinTiles, ty);
-      find_first_cuts(row, scratch);
+      find_first_cuts(row, ty - by * kBinTiles, scratch);
       for (int col = 0; col < row.count; ++col) cut_first(row, col, scratch);
       find_other_cuts(row, scratch);
       for (int col = 0; col < row.count; ++col)
@@ -314,23 +390,33 @@ class Miller {
     }
   }
 
-  // Calls visit(k, col0, col1) for each move k of the block that reaches the row's tiles
-  // col0..col1.
-  template <class Visit>
-  void for_each_move(const TileRow& row, const BlockScratch& scratch, Visit&& visit) const {
-    for (std::size_t k = 0; k < scratch.moves.size(); ++k) {
-      int col0, col1;
-      if (columns(row, scratch.boxes[k], col0, col1)) visit(k, col0, col1);
+  // Which of the block's tile rows and columns each of its moves reaches (from its footprint
+  // box), and the moves filed by tile row: the ball ends in block order, the others in by_tip
+  // order. Pass 1 then visits only the moves that reach a row (on model-D, 20 M visits of ball
+  // ends against 76 M tests of every move on every row of its block).
+  void file_by_row(std::size_t bin, int first_tx, int cols, int first_ty, int rows,
+                   BlockScratch& scratch) const {
+    scratch.reach.clear();
+    for (std::size_t k = bin_start_[bin]; k < bin_start_[bin + 1]; ++k) {
+      const IndexBox& b = boxes_[bin_moves_[k]];
+      // Clipped to the block, which the box reaches (bin_moves).
+      scratch.reach.push_back(
+          {static_cast<std::int8_t>(std::max(0, b.j0 / kTile - first_ty)),
+           static_cast<std::int8_t>(std::min(rows - 1, b.j1 / kTile - first_ty)),
+           static_cast<std::int8_t>(std::max(0, b.i0 / kTile - first_tx)),
+           static_cast<std::int8_t>(std::min(cols - 1, b.i1 / kTile - first_tx))});
+      Reach& reach = scratch.reach.back();
+      if (reach.col0 > reach.col1) reach.row1 = static_cast<std::int8_t>(reach.row0 - 1);
     }
-  }
-
-  // The row's tiles col0..col1 that a footprint box reaches; false if none.
-  static bool columns(const TileRow& row, const IndexBox& b, int& col0, int& col1) {
-    const IndexBox& any = row.tiles[0].box;
-    if (b.j1 < any.j0 || b.j0 > any.j1) return false;
-    col0 = std::max(0, b.i0 / kTile - row.first_tx);
-    col1 = std::min(row.count - 1, b.i1 / kTile - row.first_tx);
-    return col0 <= col1;
+    for (auto& rows_of : {&scratch.ball_rows, &scratch.other_rows})
+      for (std::vector<std::uint32_t>& filed : *rows_of) filed.clear();
+    for (std::size_t k = 0; k < scratch.moves.size(); ++k)
+      if (scratch.kind[k] == LaneKind::ball)
+        for (int r = scratch.reach[k].row0; r <= scratch.reach[k].row1; ++r)
+          scratch.ball_rows[static_cast<std::size_t>(r)].push_back(static_cast<std::uint32_t>(k));
+    for (std::uint32_t k : scratch.by_tip)
+      for (int r = scratch.reach[k].row0; r <= scratch.reach[k].row1; ++r)
+        scratch.other_rows[static_cast<std::size_t>(r)].push_back(k);
   }
 
   // A ball end move's bounds over the row's tiles lane0 .. lane0 + kLanes − 1 (those in
@@ -353,7 +439,9 @@ class Miller {
       bound = p.has_plane ? bound : far;
     }
     const DoubleN col = lane_index() + lane0;
-    return {p.z, p.gx, p.gy, bound, p.has_plane, (col >= col0) & (col <= col1), move, lane0};
+    return {
+        p.z,  p.gx, p.gy, bound, lane_bits(p.has_plane), lane_bits((col >= col0) & (col <= col1)),
+        move, lane0};
   }
 
   // Pass 1: for each tile, the move whose swept surface is lowest at its centre among those with
@@ -364,17 +452,17 @@ class Miller {
   // of its path is at least d²/2R above the tip, and a tile's surface comes within d of the move
   // only if the move passes within d of it. The first cut is only a choice (any move gives a
   // correct result); in a raster it is the nearby move a little downhill, well within R/2.
-  void find_first_cuts(TileRow& row, BlockScratch& scratch) {
+  void find_first_cuts(TileRow& row, int r, BlockScratch& scratch) {
     TileRow::Lanes& lanes = row.lanes;
     scratch.ball_bounds.clear();
     scratch.far_moves.clear();
     const Tile& last = row.tiles[static_cast<std::size_t>(row.count - 1)];
     const double row_x0 = g_.x(row.tiles[0].box.i0), row_x1 = g_.x(last.box.i1);
     const double row_y0 = g_.y(last.box.j0), row_y1 = g_.y(last.box.j1);
-    for_each_move(row, scratch, [&](std::size_t k, int col0, int col1) {
+    for (const std::uint32_t k : scratch.ball_rows[static_cast<std::size_t>(r)]) {
       const MoveGeometry& m = scratch.moves[k];
-      if (scratch.kind[k] != LaneKind::ball) return;
-      const BallLanes& ball = scratch.balls[k];
+      const BallLanes& ball = scratch.forms[k].ball;
+      const int col0 = scratch.reach[k].col0, col1 = scratch.reach[k].col1;
       // Distance between the path's bounding box and the row's rectangle.
       const double dx = std::max(
           {0.0, std::min(m.ax, m.ax + m.vx) - row_x1, row_x0 - std::max(m.ax, m.ax + m.vx)});
@@ -382,15 +470,16 @@ class Miller {
           {0.0, std::min(m.ay, m.ay + m.vy) - row_y1, row_y0 - std::max(m.ay, m.ay + m.vy)});
       const double distance = std::sqrt(dx * dx + dy * dy);
       if (distance > 0.5 * m.radius) {
-        scratch.far_moves.push_back({static_cast<std::uint32_t>(k), col0, col1, distance});
-        return;
+        scratch.far_moves.push_back({k, col0, col1, distance});
+        continue;
       }
       for (int lane0 = col0 / kLanes * kLanes; lane0 <= col1; lane0 += kLanes) {
-        const BallBounds& b = scratch.ball_bounds.emplace_back(
-            ball_bounds(ball, row, static_cast<std::uint32_t>(k), lane0, col0, col1));
+        const BallBounds& b =
+            scratch.ball_bounds.emplace_back(ball_bounds(ball, row, k, lane0, col0, col1));
         const DoubleN first_z = load_n(&lanes.first_z[lane0]),
                       first_bound = load_n(&lanes.first_bound[lane0]);
-        const MaskN better = b.in_range & b.has_plane & (b.bound < load_n(&lanes.top[lane0])) &
+        const MaskN better = bits_mask(b.in_range & b.has_plane) &
+                             (b.bound < load_n(&lanes.top[lane0])) &
                              ((load_n(&lanes.first_covers[lane0]) == 0) | (b.z < first_z) |
                               ((b.z == first_z) & (b.bound < first_bound)));
         if (!any_n(better)) continue;
@@ -402,7 +491,7 @@ class Miller {
         store_n(&lanes.first_gy[lane0], better ? b.gy : load_n(&lanes.first_gy[lane0]));
         store_n(&lanes.first_bound[lane0], better ? b.bound : first_bound);
       }
-    });
+    }
     // The other cutters' moves, lowest tip first; one whose tip is not below the lowest centre
     // height found for a tile cannot be its first cut, and waits for pass 2 (where, after the
     // first cut, most such moves fall to the same cheap test against the tile's top: the upper
@@ -415,9 +504,8 @@ class Miller {
     // flat raster, 84 moves a tile were left for pass 2, against 4 for the ball). Ball ends count
     // as covering: their first cut is chosen as before.
     scratch.deferred.clear();
-    for (std::uint32_t k : scratch.by_tip) {
-      int col0, col1;
-      if (!columns(row, scratch.boxes[k], col0, col1)) continue;
+    for (const std::uint32_t k : scratch.other_rows[static_cast<std::size_t>(r)]) {
+      const int col0 = scratch.reach[k].col0, col1 = scratch.reach[k].col1;
       const MoveGeometry& m = scratch.moves[k];
       // Which tiles the move can reach below their top, and which of those it is deferred on (its
       // near_bound not below their first cut's centre height), kLanes tiles at a time: a move
@@ -540,11 +628,11 @@ class Miller {
       const MoveGeometry& m = scratch.moves[k];
       switch (scratch.kind[k]) {
         case LaneKind::flat:
-          return flat.at(scratch.flats[k], m, row, k, col);
+          return flat.at(scratch.forms[k].flat, m, row, k, col);
         case LaneKind::bull_nose:
-          return bull.at(scratch.bulls[k], m, row, k, col);
+          return bull.at(scratch.forms[k].bull, m, row, k, col);
         case LaneKind::profile:
-          return profile.at(scratch.profiles[k], m, row, k, col);
+          return profile.at(scratch.forms[k].profile, m, row, k, col);
         default:
           return bound_at_centre(m, row.tiles[static_cast<std::size_t>(col)], k);
       }
@@ -602,6 +690,7 @@ class Miller {
   int tiles_x_, tiles_y_, bins_x_, bins_y_;
   std::vector<std::size_t> bin_start_;
   std::vector<std::uint32_t> bin_moves_;
+  std::vector<IndexBox> boxes_;  // each move's footprint_box
 };
 
 }  // namespace tridex::detail

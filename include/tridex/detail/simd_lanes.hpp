@@ -93,6 +93,12 @@ inline std::uint32_t lane_bits(MaskN m) {
   return (m[0] != 0 ? 1u : 0u) | (m[1] != 0 ? 2u : 0u);
 #endif
 }
+// The mask with lane l set where bit l is (lane_bits' inverse).
+inline MaskN bits_mask(std::uint32_t bits) {
+  MaskN bit{};
+  for (int l = 0; l < kLanes; ++l) bit[l] = 1ll << l;
+  return ((MaskN{} + static_cast<long long>(bits)) & bit) != 0;
+}
 inline double max_lane(DoubleN a) {
   double m = a[0];
   for (int l = 1; l < kLanes; ++l) m = std::max(m, a[l]);

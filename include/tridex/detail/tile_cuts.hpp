@@ -53,7 +53,7 @@ inline void Miller::find_other_cuts(TileRow& row, const BlockScratch& scratch) {
   double row_top = -kInf;
   for (int col = 0; col < row.count; ++col) row_top = std::max(row_top, lanes.top[col]);
   for (const FarMove& far : scratch.far_moves) {
-    const BallLanes& ball = scratch.balls[far.move];
+    const BallLanes& ball = scratch.forms[far.move].ball;
     if (ball.lowest_tip() + far.distance * far.distance * ball.inv_diameter >= row_top) continue;
     for (int lane0 = far.col0 / kLanes * kLanes; lane0 <= far.col1; lane0 += kLanes)
       keep_other_cuts(row, ball_bounds(ball, row, far.move, lane0, far.col0, far.col1));
@@ -70,14 +70,14 @@ inline void Miller::keep_other_cuts(TileRow& row, const BallBounds& b) const {
                 pgy = load_n(&lanes.plane_gy[lane0]);
   DoubleN with_plane = (b.z - pz) - abs_n(b.gx - pgx) * hx - abs_n(b.gy - pgy) * hy;
   DoubleN without_plane = b.bound - (pz + abs_n(pgx) * hx + abs_n(pgy) * hy);
-  DoubleN above = b.has_plane ? with_plane : without_plane;
-  MaskN cuts = b.in_range & (b.bound < load_n(&lanes.top[lane0])) &
+  DoubleN above = bits_mask(b.has_plane) ? with_plane : without_plane;
+  MaskN cuts = bits_mask(b.in_range) & (b.bound < load_n(&lanes.top[lane0])) &
                ((load_n(&lanes.plane_valid[lane0]) == 0) | (above < load_n(&lanes.excess[lane0]))) &
                (load_n(&lanes.first[lane0]) != static_cast<double>(b.move));
   if (!any_n(cuts)) return;
   for (int l = 0; l < kLanes; ++l) {
     if (!cuts[l]) continue;
-    Candidate c{b.move, b.has_plane[l] != 0, b.bound[l], kInf, Vec2(0)};
+    Candidate c{b.move, ((b.has_plane >> l) & 1) != 0, b.bound[l], kInf, Vec2(0)};
     if (c.has_plane) c.centre_z = b.z[l], c.gradient = Vec2(b.gx[l], b.gy[l]);
     row.tiles[static_cast<std::size_t>(lane0 + l)].candidates.push_back(c);
   }
@@ -131,7 +131,7 @@ inline DoubleN Miller::near_bound(const BlockScratch& scratch, const TileRow& ro
                                   int lane0) const {
   const MoveGeometry& m = scratch.moves[k];
   if (scratch.kind[k] != LaneKind::profile) return splat(m.lowest_tip());
-  const ProfileLanes& move = scratch.profiles[k];
+  const ProfileLanes& move = scratch.forms[k].profile;
   const DoubleN ux = load_n(&row.lanes.xc[lane0]) - move.ax, uy = splat(row.tiles[0].yc - move.ay);
   return off_path_bound(move, m, row, lane0, ux, uy);
 }
@@ -265,8 +265,9 @@ inline void Miller::mill_part(std::span<const Candidate> cuts, Tile& tile,
   std::array<std::uint32_t, kPart> may;
   if constexpr (kTest == RowTest::before)
     for (std::size_t k = 0; k < cuts.size(); ++k) {
-      const BallLanes* ball =
-          scratch.kind[cuts[k].move] == LaneKind::ball ? &scratch.balls[cuts[k].move] : nullptr;
+      const BallLanes* ball = scratch.kind[cuts[k].move] == LaneKind::ball
+                                  ? &scratch.forms[cuts[k].move].ball
+                                  : nullptr;
       may[k] = rows_may_cut(cuts[k], ball, tile);
     }
   const IndexBox& t = tile.box;
@@ -301,7 +302,7 @@ inline void Miller::mill_part(std::span<const Candidate> cuts, Tile& tile,
         if (!row_may_cut(c, tile, j, row_top, row_excess)) continue;
       }
       const MoveGeometry& m = scratch.moves[c.move];
-      const BallLanes* ball = kind == LaneKind::ball ? &scratch.balls[c.move] : nullptr;
+      const BallLanes* ball = kind == LaneKind::ball ? &scratch.forms[c.move].ball : nullptr;
       if (!loaded) {
         for (int g = 0; g < kGroups; ++g) h[g] = load_heights(row + g * kLanes, count - g * kLanes);
         loaded = true;
@@ -310,12 +311,12 @@ inline void Miller::mill_part(std::span<const Candidate> cuts, Tile& tile,
         const double uy = y - ball->ay;
         for (int g = 0; g < kGroups; ++g) h[g] = min_n(h[g], ball->at(x[g] - ball->ax, splat(uy)));
       } else if (kind == LaneKind::flat) {
-        const FlatLanes& flat = scratch.flats[c.move];
+        const FlatLanes& flat = scratch.forms[c.move].flat;
         const double uy = y - flat.ay;
         for (int g = 0; g < kGroups; ++g) h[g] = min_n(h[g], flat.at(x[g] - flat.ax, splat(uy)));
       } else if (kind == LaneKind::bull_nose) {
         // Halley steps and several square roots: only the points above the move's plane.
-        const BullLanes& bull = scratch.bulls[c.move];
+        const BullLanes& bull = scratch.forms[c.move].bull;
         const double move_row = (c.has_plane ? c.centre_z : -kInf) + c.gradient.y * dy,
                      uy = y - bull.ay;
         DoubleN ux[kGroups], z[kGroups];
@@ -328,7 +329,7 @@ inline void Miller::mill_part(std::span<const Candidate> cuts, Tile& tile,
         for (int g = 0; g < kGroups; ++g) h[g] = min_n(h[g], z[g]);
       } else if (kind == LaneKind::profile) {
         // As the bull nose: only the points above the move's plane.
-        const ProfileLanes& profile = scratch.profiles[c.move];
+        const ProfileLanes& profile = scratch.forms[c.move].profile;
         const double move_row = (c.has_plane ? c.centre_z : -kInf) + c.gradient.y * dy,
                      uy = y - profile.ay;
         for (int g = 0; g < kGroups; ++g)
