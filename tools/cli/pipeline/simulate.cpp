@@ -111,6 +111,12 @@ int run_simulate(const SimulateOptions& options) {
   // a triangle counted).
   if (!options.html.empty())
     request.memory_after = [](double, double triangles) { return 60.0 * triangles; };
+  // The STL is written as soon as the surface is there, beside its check (pipeline.hpp).
+  if (!options.output.empty())
+    request.surface_ready = [&](const Mesh& surface) {
+      progress.stage("writing " + options.output);
+      write_stl_file(options.output, surface, options.threads);
+    };
   SimulationResult r = simulate_program(options, progress, request);
   const ProgramInput& input = r.input;
   const std::vector<gcode::MoveGroup>& groups = r.groups;
@@ -143,10 +149,6 @@ int run_simulate(const SimulateOptions& options) {
 
   // ---- outputs ------------------------------------------------------------------------------
   bool png_written = !options.png.empty();
-  if (!options.output.empty()) {
-    progress.stage("writing " + options.output);
-    write_stl_file(options.output, mesh, options.threads);
-  }
   if (!options.png.empty()) {
     progress.stage("rendering " + options.png);
     if (mesh.triangles.empty()) {
