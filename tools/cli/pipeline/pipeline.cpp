@@ -821,6 +821,20 @@ void dump_zmaps(const std::string& directory, const SimulationResult& r, Progres
   }
 }
 
+// Every move of `group` as the kernel mills it, in order, into `moves`, converted on `threads`
+// threads: on one, the conversion of each direction's moves left the other core idle between
+// the directions' refinements (bench/README.md, issue 37).
+void cut_moves(const gcode::MoveGroup& group, const std::map<int, std::uint32_t>& cutter_of_tool,
+               unsigned threads, std::vector<CutMove>& moves) {
+  const std::size_t n = group.moves.size();
+  moves.resize(n);
+  constexpr std::size_t kChunk = std::size_t{1} << 16;
+  detail::for_each_chunk((n + kChunk - 1) / kChunk, threads, [&](std::size_t c) {
+    for (std::size_t k = c * kChunk; k < std::min(n, (c + 1) * kChunk); ++k)
+      moves[k] = cut_move(group, group.moves[k], cutter_of_tool);
+  });
+}
+
 // Walls parallel to a spindle are placed inside their cells: the steep cells take finer heights
 // from the moves (fine_cells.hpp). How many cells are steep is known only now: their sub-grids
 // are checked against --max-memory before any is allocated.
@@ -856,9 +870,7 @@ void refine_walls(const SimulateOptions& options, std::uint64_t max_memory,
   // One buffer for every direction (milling's): its pages are touched once.
   moves.reserve(static_cast<std::size_t>(most_moves));
   for (std::size_t g = 0; g < maps.size(); ++g) {
-    moves.clear();
-    for (const gcode::Move& m : groups[g].moves)
-      moves.push_back(cut_move(groups[g], m, r.cutter_of_tool));
+    cut_moves(groups[g], r.cutter_of_tool, options.threads, moves);
     refine_steep_cells(maps[g], r.cutters, moves, {.threads = options.threads},
                        std::move(steep[g]));
   }
@@ -941,6 +953,11 @@ void intersect_directions(const SimulateOptions& options, const PipelineRequest&
   maps.shrink_to_fit();
 }
 
+// The stock's volume less the removal measured surface against surface (surface_volume).
+void result_volume(SimulationResult& r) {
+  r.volume = r.stock.volume - (r.stock_surface_volume - r.mesh.signed_volume());
+}
+
 // The surface of the result (r.mesh), checked for watertightness, and the result's volume. With
 // PipelineRequest::surface_ready and a thread to spare, the surface goes to it while the check
 // runs beside (simulate's STL write): both are long passes over the whole surface, and one of
@@ -957,16 +974,16 @@ void extract_result_surface(const SimulateOptions& options, const PipelineReques
     checking.start([&] {
       r.mesh_check = check_mesh(r.mesh, options.threads);
       r.timings.mesh = seconds_since(t);
+      result_volume(r);
     });
     request.surface_ready(r.mesh);
     checking.join();
   } else {
     r.mesh_check = check_mesh(r.mesh, options.threads);
     r.timings.mesh = seconds_since(t);
+    result_volume(r);
     if (request.surface_ready) request.surface_ready(r.mesh);
   }
-  // The stock's volume less the removal measured surface against surface (surface_volume).
-  r.volume = r.stock.volume - (r.stock_surface_volume - r.mesh.signed_volume());
 }
 
 }  // namespace
