@@ -150,14 +150,14 @@ void check_reach(const std::string& what, const Aabb& box, double spacing,
 // by the largest cutter's radius, overlaps the stock across the spindle, and the stock rises above
 // its lowest tip. Then the result is the stock itself, and no cut arithmetic happens at its
 // coordinates.
-bool no_move_reaches(const std::vector<gcode::MoveGroup>& groups, std::span<const Cutter> cutters,
-                     const Aabb& stock) {
+// `paths`: the groups' local_paths (reach.hpp).
+bool no_move_reaches(const std::vector<gcode::MoveGroup>& groups, std::span<const Aabb> paths,
+                     std::span<const Cutter> cutters, const Aabb& stock) {
   double radius = 0;
   for (const Cutter& c : cutters) radius = std::max(radius, c.radius());
-  for (const gcode::MoveGroup& group : groups) {
-    Aabb path;
-    for (const gcode::Move& m : group.moves)
-      path.extend(group.frame.to_local(m.start)), path.extend(group.frame.to_local(m.end));
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const gcode::MoveGroup& group = groups[g];
+    const Aabb& path = paths[g];
     if (path.empty()) continue;
     const Aabb local = local_bounds(group.frame, stock);
     const bool apart = path.min.x - radius > local.max.x || path.max.x + radius < local.min.x ||
@@ -513,7 +513,7 @@ std::string clean_number(double v) {
 // longest side; said in a warning.
 void clip_lattice_to_reach(const SimulateOptions& options, int res, SimulationResult& r) {
   const std::optional<Aabb> reach =
-      reach_of_moves(r.groups, r.simultaneous, r.cutters, r.cutter_of_tool, r.stock.box);
+      reach_of_moves(r.groups, r.paths, r.simultaneous, r.cutters, r.cutter_of_tool, r.stock.box);
   if (!reach) return;
   const Vec3 size = reach->size();
   const double spacing =
@@ -590,6 +590,7 @@ void size_the_run(const SimulateOptions& options, const PipelineRequest& request
                   const RunInputs& run, const ParsedProgram& parsed, SimulationResult& r) {
   const StockSpec& stock_spec = run.stock_spec;
   const std::uint64_t max_memory = run.max_memory;
+  r.paths = local_paths(r.groups, options.threads);
   r.stock = load_stock(stock_spec, parsed.cutting_bounds, max_memory);
   const Stock& stock = r.stock;
   r.lattice_box = stock.box;
@@ -618,8 +619,8 @@ void size_the_run(const SimulateOptions& options, const PipelineRequest& request
                     ? "--stock " + stock_spec.mesh_path.string()
                     : (r.reach_only ? "the part of the stock the moves reach" : "the stock"),
                 box, lattice.spacing,
-                no_move_reaches(r.groups, r.cutters, stock.box) ? kMaxUncutReachSpacings
-                                                                : kMaxReachSpacings);
+                no_move_reaches(r.groups, r.paths, r.cutters, stock.box) ? kMaxUncutReachSpacings
+                                                                         : kMaxReachSpacings);
     for (const auto& [what, bounds] : request.extra_bounds)
       check_reach(what, bounds, lattice.spacing);
   };
@@ -936,7 +937,7 @@ void intersect_directions(const SimulateOptions& options, const PipelineRequest&
     // Only when no move can reach the stock is "nothing was cut" a fact; otherwise the cuts are
     // finer than the lattice resolves (a large stock around a small toolpath), and saying so
     // tells the user what to change.
-    if (no_move_reaches(r.groups, r.cutters, stock.box))
+    if (no_move_reaches(r.groups, r.paths, r.cutters, stock.box))
       r.warnings.push_back("nothing was cut: no move reaches the stock (" +
                            describe_box(stock.box) +
                            "); the result is the whole stock: check --stock against the "

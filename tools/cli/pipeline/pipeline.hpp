@@ -135,6 +135,7 @@ struct SimulationResult {
   ProgramInput input;
   std::vector<gcode::MoveGroup> groups;  // moves in program order within each group
   std::vector<GroupRun> order;           // the groups' moves in program order: what follows what
+  std::vector<Aabb> paths;               // each group's tool tips in its frame (local_paths)
   std::vector<std::string> files;        // Move::file's table (InterpretResult::files)
   std::vector<Cutter> cutters;
   std::vector<ToolBody> bodies;                 // the non-cutting parts, parallel to cutters
