@@ -573,13 +573,18 @@ inline TripleDexel scan_intersect_milled(const TripleDexel& stock, std::span<con
   validate(stock);
   for (const ZMap& map : milled) detail::require_solid_zmap(map, "scan machine");
   const DexelLattice lattice = stock.lattice();
-  TripleDexel result = stock;
+  if (milled.empty()) return stock;
+  // The first map cuts the stock's rays themselves: no copy of the stock to start from (a serial
+  // copy into fresh pages, bench/README.md, issue 37).
+  TripleDexel result;
+  result.origin = stock.origin, result.spacing = stock.spacing, result.n = stock.n;
   for (const ZMap& map : milled) {
     const float highest = detail::highest_height(map, threads);
+    const bool first = &map == milled.data();
     // Each ray's cut is intersected with the ray as it stands as soon as its spans are known:
     // the cut is never stored as a grid of its own.
     for (int axis = 0; axis < 3; ++axis) {
-      const DexelGrid& current = result.grids[axis];
+      const DexelGrid& current = first ? stock.grids[axis] : result.grids[axis];
       result.grids[axis] = detail::scan_family(
           map, lattice, axis, threads, &current, highest,
           [&](std::size_t r, std::span<const DexelInterval> cut, std::vector<DexelInterval>& out) {
