@@ -145,8 +145,8 @@ class ZMapScanner {
       scan_all_columns(j0, j1, hits);
   }
 
-  // Appends the crossings of the four walls and the bottom to `hits`.
-  void scan_walls_and_bottom(std::vector<MeshHit>& hits) const {
+  // Appends the crossings of the four walls to `hits`.
+  void scan_walls(std::vector<MeshHit>& hits) const {
     const int nx = grid_.nx, ny = grid_.ny;
     // Each border edge p0 → p1, counter-clockwise seen from above; the outside is to the right.
     auto wall = [&](int i0, int j0, int i1, int j1) {
@@ -160,6 +160,12 @@ class ZMapScanner {
     for (int j = 0; j + 1 < ny; ++j) wall(nx - 1, j, nx - 1, j + 1);
     for (int i = nx - 1; i > 0; --i) wall(i, ny - 1, i - 1, ny - 1);
     for (int j = ny - 1; j > 0; --j) wall(0, j, 0, j - 1);
+  }
+
+  // Appends the crossings of the bottom to `hits`: two triangles under the whole map, so one
+  // crossing on every ray of the family along the spindle.
+  void scan_bottom(std::vector<MeshHit>& hits) const {
+    const int nx = grid_.nx, ny = grid_.ny;
     ScanVertex c0 = vertex(0, 0, bottom_), c1 = vertex(nx - 1, 0, bottom_);
     ScanVertex c2 = vertex(nx - 1, ny - 1, bottom_), c3 = vertex(0, ny - 1, bottom_);
     triangle(c0, c2, c1, hits);  // facing down
@@ -512,14 +518,19 @@ DexelGrid scan_family(const ZMap& map, const DexelLattice& lattice, int axis, un
   threads = resolve_threads(threads);
   const int rows = map.grid.ny - 1;
   const int rows_per_item = 16;
-  const int items =
-      (rows + rows_per_item - 1) / rows_per_item + 1;  // the last item: walls and bottom
+  // The first two items: the bottom and the walls. The bottom crosses every ray along the spindle,
+  // far more work than a band of rows: handed out last (as it was), it ran on one thread while
+  // the others had finished (bench/README.md, issue 37). The crossings' order does not matter
+  // (grid_from_hits).
+  const int items = (rows + rows_per_item - 1) / rows_per_item + 2;
   std::vector<std::vector<MeshHit>> found(threads);
   for_each_chunk_indexed(
       static_cast<std::size_t>(items), threads, [&](std::size_t chunk, unsigned id) {
-        const int item = static_cast<int>(chunk);
-        if (item == items - 1)
-          scanner.scan_walls_and_bottom(found[id]);
+        const int item = static_cast<int>(chunk) - 2;
+        if (item == -2)
+          scanner.scan_bottom(found[id]);
+        else if (item == -1)
+          scanner.scan_walls(found[id]);
         else
           scanner.scan_rows(item * rows_per_item, std::min(rows, (item + 1) * rows_per_item),
                             found[id]);
@@ -562,13 +573,18 @@ inline TripleDexel scan_intersect_milled(const TripleDexel& stock, std::span<con
   validate(stock);
   for (const ZMap& map : milled) detail::require_solid_zmap(map, "scan machine");
   const DexelLattice lattice = stock.lattice();
-  TripleDexel result = stock;
+  if (milled.empty()) return stock;
+  // The first map cuts the stock's rays themselves: no copy of the stock to start from (a serial
+  // copy into fresh pages, bench/README.md, issue 37).
+  TripleDexel result;
+  result.origin = stock.origin, result.spacing = stock.spacing, result.n = stock.n;
   for (const ZMap& map : milled) {
     const float highest = detail::highest_height(map, threads);
+    const bool first = &map == milled.data();
     // Each ray's cut is intersected with the ray as it stands as soon as its spans are known:
     // the cut is never stored as a grid of its own.
     for (int axis = 0; axis < 3; ++axis) {
-      const DexelGrid& current = result.grids[axis];
+      const DexelGrid& current = first ? stock.grids[axis] : result.grids[axis];
       result.grids[axis] = detail::scan_family(
           map, lattice, axis, threads, &current, highest,
           [&](std::size_t r, std::span<const DexelInterval> cut, std::vector<DexelInterval>& out) {

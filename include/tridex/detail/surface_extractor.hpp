@@ -43,9 +43,11 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <glm/glm.hpp>
 #include <limits>
 #include <span>
+#include <type_traits>
 #include <unordered_set>
 #include <utility>
 #include <vector>
@@ -154,7 +156,7 @@ class Extractor {
           part.positions.shrink_to_fit();
           part.triangles.shrink_to_fit();
         });
-    return join(parts);
+    return join(parts, threads);
   }
 
  private:
@@ -463,14 +465,30 @@ class Extractor {
     }
   }
 
+  // Room for n elements in `v`, its pages first touched on `threads` threads. The join fills the
+  // mesh on one thread, and the kernel's zeroing of the fresh pages as it met them took most of
+  // the join (0.15-0.3 s of model-D's 150 MB surface, bench/README.md, issue 37); the pages
+  // written here are the ones the elements then take (a trivially copyable type).
+  template <class T>
+  static void reserve_touched(std::vector<T>& v, std::size_t n, unsigned threads) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    v.reserve(n);
+    auto* bytes = reinterpret_cast<unsigned char*>(v.data() + v.size());
+    const std::size_t total = (v.capacity() - v.size()) * sizeof(T);
+    constexpr std::size_t kChunk = std::size_t{2} << 20;
+    detail::for_each_chunk((total + kChunk - 1) / kChunk, threads, [&](std::size_t c) {
+      std::memset(bytes + c * kChunk, 0, std::min(kChunk, total - c * kChunk));
+    });
+  }
+
   // Concatenates the slabs in order; a slab's bottom vertices are the previous slab's top ones.
-  Mesh join(std::vector<SlabMesh>& parts) const {
+  Mesh join(std::vector<SlabMesh>& parts, unsigned threads) const {
     Mesh mesh;
     std::size_t vertices = 0, triangles = 0;
     for (const SlabMesh& p : parts)
       vertices += p.positions.size() - p.bottom.size(), triangles += p.triangles.size();
-    mesh.positions.reserve(vertices);
-    mesh.triangles.reserve(triangles);
+    reserve_touched(mesh.positions, vertices, threads);
+    reserve_touched(mesh.triangles, triangles, threads);
     std::vector<std::uint32_t> feature_triangles;
     std::vector<std::pair<std::uint64_t, std::uint32_t>> previous_top;  // key → global id
     std::vector<std::uint32_t> map;

@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -212,7 +213,10 @@ void raise_uncut_rows(ZMap& milled, float initial_empty, InitialRow&& initial_ro
   const std::size_t nx = static_cast<std::size_t>(a.nx);
   constexpr std::size_t kPartials = 16;
   const auto bands = static_cast<std::size_t>((a.ny + kMapBandRows - 1) / kMapBandRows);
-  std::vector<std::uint8_t> uncut(a.size());
+  // Every point's mark is written by the first pass (its band's rows), so the marks start
+  // uninitialised: a vector's zeroing faulted in every fresh page on the calling thread alone
+  // (bench/README.md, issue 37); here each band's worker touches its own.
+  const std::unique_ptr<std::uint8_t[]> uncut(new std::uint8_t[a.size()]);
   std::vector<float> band_top(bands, milled.empty_height);
   // Each outside point next to a cut: its index and the largest continued height (unclamped).
   std::vector<std::vector<std::pair<std::size_t, float>>> continued(bands);
@@ -235,7 +239,7 @@ void raise_uncut_rows(ZMap& milled, float initial_empty, InitialRow&& initial_ro
     for (int j = j0; j < j1; ++j) {
       const float* init = window.data() + static_cast<std::size_t>(j - w0) * nx;
       const float* height = milled.heights.data() + a.index(0, j);
-      std::uint8_t* mark = uncut.data() + a.index(0, j);
+      std::uint8_t* mark = uncut.get() + a.index(0, j);
       for (std::size_t k = 0; k < width; ++k) mark[k] = height[k] == init[k];
       std::size_t k = 0;
       for (; k + kPartials <= width; k += kPartials)
@@ -266,7 +270,7 @@ void raise_uncut_rows(ZMap& milled, float initial_empty, InitialRow&& initial_ro
     const std::size_t p0 = band * kMapBandRows * nx,
                       p1 = std::min(a.size(), p0 + kMapBandRows * nx);
     float* height = milled.heights.data();
-    const std::uint8_t* raise = uncut.data();
+    const std::uint8_t* raise = uncut.get();
     const float lifted = above;
     for (std::size_t p = p0; p < p1; ++p) height[p] = raise[p] ? lifted : height[p];
     for (const auto& [p, h] : continued[band])

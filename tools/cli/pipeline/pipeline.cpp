@@ -150,14 +150,14 @@ void check_reach(const std::string& what, const Aabb& box, double spacing,
 // by the largest cutter's radius, overlaps the stock across the spindle, and the stock rises above
 // its lowest tip. Then the result is the stock itself, and no cut arithmetic happens at its
 // coordinates.
-bool no_move_reaches(const std::vector<gcode::MoveGroup>& groups, std::span<const Cutter> cutters,
-                     const Aabb& stock) {
+// `paths`: the groups' local_paths (reach.hpp).
+bool no_move_reaches(const std::vector<gcode::MoveGroup>& groups, std::span<const Aabb> paths,
+                     std::span<const Cutter> cutters, const Aabb& stock) {
   double radius = 0;
   for (const Cutter& c : cutters) radius = std::max(radius, c.radius());
-  for (const gcode::MoveGroup& group : groups) {
-    Aabb path;
-    for (const gcode::Move& m : group.moves)
-      path.extend(group.frame.to_local(m.start)), path.extend(group.frame.to_local(m.end));
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const gcode::MoveGroup& group = groups[g];
+    const Aabb& path = paths[g];
     if (path.empty()) continue;
     const Aabb local = local_bounds(group.frame, stock);
     const bool apart = path.min.x - radius > local.max.x || path.max.x + radius < local.min.x ||
@@ -513,7 +513,7 @@ std::string clean_number(double v) {
 // longest side; said in a warning.
 void clip_lattice_to_reach(const SimulateOptions& options, int res, SimulationResult& r) {
   const std::optional<Aabb> reach =
-      reach_of_moves(r.groups, r.simultaneous, r.cutters, r.cutter_of_tool, r.stock.box);
+      reach_of_moves(r.groups, r.paths, r.simultaneous, r.cutters, r.cutter_of_tool, r.stock.box);
   if (!reach) return;
   const Vec3 size = reach->size();
   const double spacing =
@@ -590,6 +590,7 @@ void size_the_run(const SimulateOptions& options, const PipelineRequest& request
                   const RunInputs& run, const ParsedProgram& parsed, SimulationResult& r) {
   const StockSpec& stock_spec = run.stock_spec;
   const std::uint64_t max_memory = run.max_memory;
+  r.paths = local_paths(r.groups, options.threads);
   r.stock = load_stock(stock_spec, parsed.cutting_bounds, max_memory);
   const Stock& stock = r.stock;
   r.lattice_box = stock.box;
@@ -618,8 +619,8 @@ void size_the_run(const SimulateOptions& options, const PipelineRequest& request
                     ? "--stock " + stock_spec.mesh_path.string()
                     : (r.reach_only ? "the part of the stock the moves reach" : "the stock"),
                 box, lattice.spacing,
-                no_move_reaches(r.groups, r.cutters, stock.box) ? kMaxUncutReachSpacings
-                                                                : kMaxReachSpacings);
+                no_move_reaches(r.groups, r.paths, r.cutters, stock.box) ? kMaxUncutReachSpacings
+                                                                         : kMaxReachSpacings);
     for (const auto& [what, bounds] : request.extra_bounds)
       check_reach(what, bounds, lattice.spacing);
   };
@@ -677,12 +678,10 @@ struct CutScratch {
   std::vector<std::size_t> rapid_moves;
 };
 
-// Mills one group's moves into `map` feed moves first (RapidCheck::against_feeds): the rapids are
-// checked against what the feeds leave (when `check_rapids`), then milled too.
-void mill_against_feeds(ZMap& map, const gcode::MoveGroup& group, std::size_t g,
-                        backends::ZMapBackend zmap_backend, bool check_rapids, unsigned threads,
-                        CutScratch& scratch, SimulationResult& r) {
-  const std::vector<Cutter>& cutters = r.cutters;
+// Splits one group's moves into scratch's feeds and rapids (the rapids' indices in group.moves
+// kept), as the kernel mills them.
+void split_cuts(const gcode::MoveGroup& group, const std::map<int, std::uint32_t>& cutter_of_tool,
+                CutScratch& scratch) {
   std::vector<CutMove>& feeds = scratch.feeds;
   std::vector<CutMove>& rapids = scratch.rapids;
   std::vector<std::size_t>& rapid_moves = scratch.rapid_moves;  // their indices in group.moves
@@ -690,7 +689,7 @@ void mill_against_feeds(ZMap& map, const gcode::MoveGroup& group, std::size_t g,
   feeds.reserve(group.moves.size());
   for (auto it = group.moves.begin(); it != group.moves.end(); ++it) {
     const gcode::Move m = *it;
-    CutMove cut = cut_move(group, m, r.cutter_of_tool);
+    CutMove cut = cut_move(group, m, cutter_of_tool);
     if (m.kind == gcode::MoveKind::rapid) {
       rapids.push_back(cut);
       rapid_moves.push_back(static_cast<std::size_t>(it - group.moves.begin()));
@@ -698,22 +697,75 @@ void mill_against_feeds(ZMap& map, const gcode::MoveGroup& group, std::size_t g,
       feeds.push_back(cut);
     }
   }
-  backends::mill_with(zmap_backend, map, cutters, feeds, threads);
-  for (const RapidCut& found :
-       check_rapids ? rapid_cuts(map, cutters, rapids, kRapidTolerance) : std::vector<RapidCut>{}) {
-    const gcode::Move m = group.moves[rapid_moves[found.index]];
+}
+
+// Mills one group's moves, split by split_cuts into `scratch`, into `map` feed moves first
+// (RapidCheck::against_feeds): the rapids are checked against what the feeds leave (when
+// `check_rapids`), then milled too.
+void mill_against_feeds(ZMap& map, const gcode::MoveGroup& group, std::size_t g,
+                        backends::ZMapBackend zmap_backend, bool check_rapids, unsigned threads,
+                        const CutScratch& scratch, SimulationResult& r) {
+  const std::vector<Cutter>& cutters = r.cutters;
+  backends::mill_with(zmap_backend, map, cutters, scratch.feeds, threads);
+  for (const RapidCut& found : check_rapids
+                                   ? rapid_cuts(map, cutters, scratch.rapids, kRapidTolerance)
+                                   : std::vector<RapidCut>{}) {
+    const gcode::Move m = group.moves[scratch.rapid_moves[found.index]];
     r.rapid_cuts.push_back(
         RapidFinding{m.file, m.line, m.tool, group.axis, found.depth_mm, m.end, g});
   }
-  backends::mill_with(zmap_backend, map, cutters, rapids, threads);
+  backends::mill_with(zmap_backend, map, cutters, scratch.rapids, threads);
 }
+
+// Group g's Z-map before milling: the stock's top along its spindle.
+ZMap initial_map(const SimulationResult& r, std::size_t g, unsigned threads) {
+  ZMapLimits limits;
+  limits.max_points = std::numeric_limits<std::size_t>::max();  // the memory check above rules
+  const Frame& frame = r.groups[g].frame;
+  return r.stock.mesh ? ZMap::from_mesh(frame, *r.stock.mesh, r.zmap_cell, limits)
+                      : ZMap::from_box(frame, r.lattice_box, r.zmap_cell, limits, threads);
+}
+
+// The groups' initial Z-maps, each made on a thread of its own while the caller splits and mills
+// the group before it (with more than one thread). A fresh map is mostly page faults and the
+// zeroing of its pages (0.1-0.2 s for each of model-D's 100 MB maps), work on one thread that
+// left the other core idle between the directions; beside the milling it fills the miller's own
+// serial stretches instead (bench/README.md, issue 37). Every map is made alike (from_box's rows
+// do not depend on the thread count), so the maps are the same either way. The memory check
+// counts every map through the milling already (MemoryEstimate::milling).
+class InitialMaps {
+ public:
+  InitialMaps(const SimulationResult& r, unsigned threads)
+      : r_(r), threads_(threads), ahead_(detail::resolve_threads(threads) > 1) {}
+
+  // Starts making group g's map (a no-op without a thread to spare, or past the last group).
+  void prepare(std::size_t g) {
+    if (!ahead_ || g >= r_.groups.size()) return;
+    next_.reset();
+    making_.start([this, g] { next_.emplace(initial_map(r_, g, 1)); });
+  }
+  // Group g's map: the one prepare(g) made, or made now.
+  ZMap take(std::size_t g) {
+    if (!ahead_) return initial_map(r_, g, threads_);
+    making_.join();
+    ZMap map = std::move(*next_);
+    next_.reset();
+    return map;
+  }
+
+ private:
+  const SimulationResult& r_;
+  unsigned threads_;
+  bool ahead_;
+  std::optional<ZMap> next_;  // written by making_'s thread only until the join
+  detail::BackgroundTask making_;
+};
 
 // Step 1: one milled Z-map per direction (r.maps), its rapids checked as the request asks.
 void mill_directions(const SimulateOptions& options, const PipelineRequest& request,
                      Progress& progress, CutScratch& scratch, SimulationResult& r) {
   const Clock::time_point t = Clock::now();
   const std::vector<gcode::MoveGroup>& groups = r.groups;
-  const Stock& stock = r.stock;
   std::vector<ZMap>& maps = r.maps;
   maps.reserve(groups.size());
   const backends::ZMapBackend zmap_backend = backends::parse_zmap_backend(options.zmap_backend);
@@ -724,8 +776,6 @@ void mill_directions(const SimulateOptions& options, const PipelineRequest& requ
   if (!check_rapids)
     r.warnings.push_back(
         "rapid moves were not checked for cutting stock: that check needs --zmap-backend cpu");
-  ZMapLimits limits;
-  limits.max_points = std::numeric_limits<std::size_t>::max();  // the memory check above rules
   // The shanks, holders and spindle parts that check tests against the stock (machine_run.hpp).
   const std::vector<ToolBody> stock_bodies =
       request.body_clearance ? bodies_against_stock(r) : std::vector<ToolBody>{};
@@ -733,16 +783,19 @@ void mill_directions(const SimulateOptions& options, const PipelineRequest& requ
   for (const gcode::MoveGroup& group : groups)
     most_moves = std::max(most_moves, group.moves.size());
   scratch.feeds.reserve(most_moves);
+  InitialMaps initial(r, options.threads);
+  initial.prepare(0);
   for (std::size_t g = 0; g < groups.size(); ++g) {
     const gcode::MoveGroup& group = groups[g];
     progress.stage("milling direction " + std::to_string(g + 1) + "/" +
                    std::to_string(groups.size()) + " (" + axis_label(group.axis) + ", " +
                    std::to_string(group.moves.size()) + " moves)");
-    maps.push_back(stock.mesh ? ZMap::from_mesh(group.frame, *stock.mesh, r.zmap_cell, limits)
-                              : ZMap::from_box(group.frame, r.lattice_box, r.zmap_cell, limits,
-                                               options.threads));
+    const bool in_order = request.rapid_check == RapidCheck::in_program_order;
+    if (!in_order) split_cuts(group, r.cutter_of_tool, scratch);  // while map g is made
+    maps.push_back(initial.take(g));
+    initial.prepare(g + 1);  // while this group mills
     r.segments += static_cast<long long>(group.moves.size());
-    if (request.rapid_check == RapidCheck::in_program_order) {
+    if (in_order) {
       std::optional<BodyCheck> bodies;
       if (request.body_clearance)
         bodies.emplace(maps.back(), stock_bodies, *request.body_clearance);
@@ -767,6 +820,20 @@ void dump_zmaps(const std::string& directory, const SimulationResult& r, Progres
     write_stl_file(names[2 * g], polyhedrize(r.maps[g]));
     write_png_file(names[2 * g + 1], render::render_heights(r.maps[g]));
   }
+}
+
+// Every move of `group` as the kernel mills it, in order, into `moves`, converted on `threads`
+// threads: on one, the conversion of each direction's moves left the other core idle between
+// the directions' refinements (bench/README.md, issue 37).
+void cut_moves(const gcode::MoveGroup& group, const std::map<int, std::uint32_t>& cutter_of_tool,
+               unsigned threads, std::vector<CutMove>& moves) {
+  const std::size_t n = group.moves.size();
+  moves.resize(n);
+  constexpr std::size_t kChunk = std::size_t{1} << 16;
+  detail::for_each_chunk((n + kChunk - 1) / kChunk, threads, [&](std::size_t c) {
+    for (std::size_t k = c * kChunk; k < std::min(n, (c + 1) * kChunk); ++k)
+      moves[k] = cut_move(group, group.moves[k], cutter_of_tool);
+  });
 }
 
 // Walls parallel to a spindle are placed inside their cells: the steep cells take finer heights
@@ -804,9 +871,7 @@ void refine_walls(const SimulateOptions& options, std::uint64_t max_memory,
   // One buffer for every direction (milling's): its pages are touched once.
   moves.reserve(static_cast<std::size_t>(most_moves));
   for (std::size_t g = 0; g < maps.size(); ++g) {
-    moves.clear();
-    for (const gcode::Move& m : groups[g].moves)
-      moves.push_back(cut_move(groups[g], m, r.cutter_of_tool));
+    cut_moves(groups[g], r.cutter_of_tool, options.threads, moves);
     refine_steep_cells(maps[g], r.cutters, moves, {.threads = options.threads},
                        std::move(steep[g]));
   }
@@ -872,7 +937,7 @@ void intersect_directions(const SimulateOptions& options, const PipelineRequest&
     // Only when no move can reach the stock is "nothing was cut" a fact; otherwise the cuts are
     // finer than the lattice resolves (a large stock around a small toolpath), and saying so
     // tells the user what to change.
-    if (no_move_reaches(r.groups, r.cutters, stock.box))
+    if (no_move_reaches(r.groups, r.paths, r.cutters, stock.box))
       r.warnings.push_back("nothing was cut: no move reaches the stock (" +
                            describe_box(stock.box) +
                            "); the result is the whole stock: check --stock against the "
@@ -889,18 +954,37 @@ void intersect_directions(const SimulateOptions& options, const PipelineRequest&
   maps.shrink_to_fit();
 }
 
-// The surface of the result (r.mesh), checked for watertightness, and the result's volume.
-void extract_result_surface(const SimulateOptions& options, Progress& progress,
-                            SimulationResult& r) {
+// The stock's volume less the removal measured surface against surface (surface_volume).
+void result_volume(SimulationResult& r) {
+  r.volume = r.stock.volume - (r.stock_surface_volume - r.mesh.signed_volume());
+}
+
+// The surface of the result (r.mesh), checked for watertightness, and the result's volume. With
+// PipelineRequest::surface_ready and a thread to spare, the surface goes to it while the check
+// runs beside (simulate's STL write): both are long passes over the whole surface, and one of
+// them alone left a core idle (bench/README.md, issue 37).
+void extract_result_surface(const SimulateOptions& options, const PipelineRequest& request,
+                            Progress& progress, SimulationResult& r) {
   progress.stage("extracting the surface");
   const Clock::time_point t = Clock::now();
   r.mesh = extract_surface(r.result, {.threads = options.threads});
   if (r.reach_only)
     r.mesh = stitch_into_stock(r.mesh, r.lattice_box, r.stock.box, r.lattice.spacing);
-  r.mesh_check = check_mesh(r.mesh, options.threads);
-  r.timings.mesh = seconds_since(t);
-  // The stock's volume less the removal measured surface against surface (surface_volume).
-  r.volume = r.stock.volume - (r.stock_surface_volume - r.mesh.signed_volume());
+  if (request.surface_ready && detail::resolve_threads(options.threads) > 1) {
+    detail::BackgroundTask checking;  // waits for the check if the write throws
+    checking.start([&] {
+      r.mesh_check = check_mesh(r.mesh, options.threads);
+      r.timings.mesh = seconds_since(t);
+      result_volume(r);
+    });
+    request.surface_ready(r.mesh);
+    checking.join();
+  } else {
+    r.mesh_check = check_mesh(r.mesh, options.threads);
+    r.timings.mesh = seconds_since(t);
+    result_volume(r);
+    if (request.surface_ready) request.surface_ready(r.mesh);
+  }
 }
 
 }  // namespace
@@ -932,7 +1016,7 @@ SimulationResult simulate_program(const SimulateOptions& options, Progress& prog
   if ((!r.simultaneous.empty() || !r.turning_rapids.empty()) && request.body_clearance)
     check_turning_bodies(r, bodies_against_stock(r), *request.body_clearance, options.threads);
   if (request.rapid_check == RapidCheck::in_program_order) check_turning_rapids(r);
-  extract_result_surface(options, progress, r);
+  extract_result_surface(options, request, progress, r);
   return r;
 }
 

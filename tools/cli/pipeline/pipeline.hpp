@@ -85,6 +85,10 @@ struct PipelineRequest {
   // A box stock much larger than the toolpath: the lattice over the part the moves reach
   // (reach.hpp). check keeps the whole stock: it measures the design on the lattice.
   bool clip_to_reach = true;
+  // Called with the result's surface once it is extracted, before the pipeline returns (simulate
+  // writes its STL there): with more than one thread, while the surface's check runs beside it
+  // (SimulationResult::mesh_check is not yet known). What it throws ends the run.
+  std::function<void(const Mesh&)> surface_ready;
 };
 
 // A rapid that cuts: `depth_mm` below the material along the spindle at `where` (work frame).
@@ -131,6 +135,7 @@ struct SimulationResult {
   ProgramInput input;
   std::vector<gcode::MoveGroup> groups;  // moves in program order within each group
   std::vector<GroupRun> order;           // the groups' moves in program order: what follows what
+  std::vector<Aabb> paths;               // each group's tool tips in its frame (local_paths)
   std::vector<std::string> files;        // Move::file's table (InterpretResult::files)
   std::vector<Cutter> cutters;
   std::vector<ToolBody> bodies;                 // the non-cutting parts, parallel to cutters

@@ -8,24 +8,43 @@
 #include <utility>
 
 #include "tridex/error.hpp"
+#include "tridex/parallel.hpp"
 
 namespace tridex::cli {
 
+std::vector<Aabb> local_paths(const std::vector<gcode::MoveGroup>& groups, unsigned threads) {
+  std::vector<Aabb> paths(groups.size());
+  constexpr std::size_t kChunk = std::size_t{1} << 16;
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const gcode::MoveGroup& group = groups[g];
+    const std::size_t n = group.moves.size(), chunks = (n + kChunk - 1) / kChunk;
+    std::vector<Aabb> part(chunks);
+    detail::for_each_chunk(chunks, threads, [&](std::size_t c) {
+      for (std::size_t k = c * kChunk; k < std::min(n, (c + 1) * kChunk); ++k) {
+        const gcode::Move m = group.moves[k];
+        part[c].extend(group.frame.to_local(m.start)), part[c].extend(group.frame.to_local(m.end));
+      }
+    });
+    for (const Aabb& box : part) paths[g].extend(box);
+  }
+  return paths;
+}
+
 std::optional<Aabb> reach_of_moves(const std::vector<gcode::MoveGroup>& groups,
+                                   std::span<const Aabb> paths,
                                    const std::vector<gcode::Move>& simultaneous,
                                    std::span<const Cutter> cutters,
                                    const std::map<int, std::uint32_t>& cutter_of_tool,
                                    const Aabb& stock) {
   if (!simultaneous.empty()) return std::nullopt;
   Aabb reach;
-  for (const gcode::MoveGroup& group : groups) {
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const gcode::MoveGroup& group = groups[g];
     double radius = 0;
     for (int tool : group.tools)
       if (const auto found = cutter_of_tool.find(tool); found != cutter_of_tool.end())
         radius = std::max(radius, cutters[found->second].radius());
-    Aabb path;
-    for (const gcode::Move& m : group.moves)
-      path.extend(group.frame.to_local(m.start)), path.extend(group.frame.to_local(m.end));
+    const Aabb& path = paths[g];
     if (path.empty()) continue;
     // Everything above the cutter is removed: the prism goes up to the stock's top.
     const double top = local_bounds(group.frame, stock).max.z;

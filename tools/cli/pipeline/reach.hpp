@@ -33,9 +33,18 @@ namespace tridex::cli {
 // Lattice cells the reach box is grown by on each side.
 inline constexpr double kReachMarginCells = 3;
 
+// Each group's tool tips, start and end of every move, in the group's frame: the box of each
+// (empty for a group without moves), on `threads` threads (0: every hardware thread). A bound
+// is a minimum or maximum, so the boxes do not depend on the thread count. Several checks read
+// them; a pass over every move of a 5-million-move program on one thread left the other core
+// idle between the parse and the milling (bench/README.md, issue 37).
+std::vector<Aabb> local_paths(const std::vector<gcode::MoveGroup>& groups, unsigned threads);
+
 // The box of the stock the moves can cut (before the margin); nullopt when a move turns the tool
-// (those are cut on the dexels, not by a direction's Z-map) or nothing reaches.
+// (those are cut on the dexels, not by a direction's Z-map) or nothing reaches. `paths`: the
+// groups' local_paths.
 std::optional<Aabb> reach_of_moves(const std::vector<gcode::MoveGroup>& groups,
+                                   std::span<const Aabb> paths,
                                    const std::vector<gcode::Move>& simultaneous,
                                    std::span<const Cutter> cutters,
                                    const std::map<int, std::uint32_t>& cutter_of_tool,

@@ -97,11 +97,9 @@ Json simulate_report(const SimulateOptions& options, const SimulationResult& r,
   return report;
 }
 
-}  // namespace
-
-int run_simulate(const SimulateOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  Progress progress(!options.quiet && (options.progress || stderr_is_terminal()));
+// What simulate asks of the pipeline: its outputs checked up front, the HTML page's memory
+// counted, and the STL written as soon as the surface is there, beside its check (pipeline.hpp).
+PipelineRequest simulate_request(const SimulateOptions& options, Progress& progress) {
   PipelineRequest request;
   request.outputs = {{"-o", options.output},
                      {"--png", options.png},
@@ -111,7 +109,20 @@ int run_simulate(const SimulateOptions& options) {
   // a triangle counted).
   if (!options.html.empty())
     request.memory_after = [](double, double triangles) { return 60.0 * triangles; };
-  SimulationResult r = simulate_program(options, progress, request);
+  if (!options.output.empty())
+    request.surface_ready = [&options, &progress](const Mesh& surface) {
+      progress.stage("writing " + options.output);
+      write_stl_file(options.output, surface, options.threads);
+    };
+  return request;
+}
+
+}  // namespace
+
+int run_simulate(const SimulateOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  Progress progress(!options.quiet && (options.progress || stderr_is_terminal()));
+  SimulationResult r = simulate_program(options, progress, simulate_request(options, progress));
   const ProgramInput& input = r.input;
   const std::vector<gcode::MoveGroup>& groups = r.groups;
   const DexelLattice& lattice = r.lattice;
@@ -143,10 +154,6 @@ int run_simulate(const SimulateOptions& options) {
 
   // ---- outputs ------------------------------------------------------------------------------
   bool png_written = !options.png.empty();
-  if (!options.output.empty()) {
-    progress.stage("writing " + options.output);
-    write_stl_file(options.output, mesh, options.threads);
-  }
   if (!options.png.empty()) {
     progress.stage("rendering " + options.png);
     if (mesh.triangles.empty()) {
