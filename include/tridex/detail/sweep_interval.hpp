@@ -259,11 +259,18 @@ std::optional<std::pair<double, double>> sweep_pieces_hull(
   const double qu = point[iu] - from[iu], qv = point[iv] - from[iv];
   const double along_abs = std::abs(along);
   const bool ellipse = along_abs > 0.05 && across > 1e-9;
-  double half_travel = 0;
+  // The ellipse test's stretched coordinates of the ray about a piece's middle height hm: x
+  // across the axis's shadow (the same for every height) and y = |y0 − hm·k| along it.
+  double x2 = 0, y0 = 0, k = 0, slack = 0;
   if (ellipse) {
     const double tx = (-tu * av + tv * au) / across,
                  ty = (tu * au + tv * av) / (across * along_abs);
-    half_travel = 0.5 * std::sqrt(tx * tx + ty * ty);
+    slack = 0.5 * std::sqrt(tx * tx + ty * ty) + margin / along_abs;
+    const double pu = qu - 0.5 * tu, pv = qv - 0.5 * tv;
+    const double x = (-pu * av + pv * au) / across;
+    x2 = x * x;
+    y0 = (pu * au + pv * av) / (across * along_abs);
+    k = across / along_abs;
   }
   // The least squared distance, seen along the ray, from the ray to the path of axis height h.
   auto off_path2 = [&](double h) {
@@ -272,31 +279,28 @@ std::optional<std::pair<double, double>> sweep_pieces_hull(
     return (du - t * tu) * (du - t * tu) + (dv - t * tv) * (dv - t * tv);
   };
   std::uint64_t done = 0;
-  for (std::size_t k = 0; k < n; ++k) {
-    const std::size_t i = k == 0 ? n - 1 : k - 1;
+  for (std::size_t j = 0; j < n; ++j) {
+    const std::size_t i = j == 0 ? n - 1 : j - 1;
     const std::uint64_t bit = i < 64 ? std::uint64_t{1} << i : 0;
     if (i < 64 && !(only & bit)) continue;
     done |= bit;
     const double e = grow(i);
     const SweepPieceSpan& span = spans[i];
-    const double h0 = span.h0 - e, h1 = span.h1 + e, rho = span.rho + e * span.widen;
-    if (ellipse) {
-      const double hm = 0.5 * (h0 + h1);
-      const double pu = qu - hm * au - 0.5 * tu, pv = qv - hm * av - 0.5 * tv;
-      const double x = (-pu * av + pv * au) / across;
-      const double y = std::max(0.0, std::abs(pu * au + pv * av) / (across * along_abs) -
-                                         0.5 * (h1 - h0) * across / along_abs);
-      const double reach = rho + half_travel + margin / along_abs;
-      if (x * x + y * y > reach * reach) continue;
-    } else {
-      const double reach = rho + margin + 0.5 * (h1 - h0) * across;
-      if (off_path2(0.5 * (h0 + h1)) > reach * reach) continue;
-    }
+    const double h0 = span.h0 - e, h1 = span.h1 + e;
     double u0 = 0, u1 = 0;
-    if (slabs) {
+    if (slabs) {  // the cheaper test first: both only skip a piece
       u0 = (h0 - margin - w0 - s_hi) / along, u1 = (h1 + margin - w0 - s_lo) / along;
       if (u0 > u1) std::swap(u0, u1);
       if (u1 < lo - margin || u0 > hi + margin) continue;
+    }
+    const double rho = span.rho + e * span.widen;
+    if (ellipse) {
+      const double y = std::max(0.0, std::abs(y0 - 0.5 * (h0 + h1) * k) - 0.5 * (h1 - h0) * k);
+      const double reach = rho + slack;
+      if (x2 + y * y > reach * reach) continue;
+    } else {
+      const double reach = rho + margin + 0.5 * (h1 - h0) * across;
+      if (off_path2(0.5 * (h0 + h1)) > reach * reach) continue;
     }
     if (met) *met |= bit;
     if (slabs && hull && hull->first <= u0 && u1 <= hull->second) continue;
