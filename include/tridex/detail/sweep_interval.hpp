@@ -265,9 +265,40 @@ inline SweepPiece sweep_grown_piece(const SweepPiece& p, double e) {
   return {p.lo - e, p.hi + e, false, rho0, p.slope, 0, 0};
 }
 
+// A frustum of slope |m| at least this is grown with its widening end capped
+// (sweep_grown_interval).
+inline constexpr double kSweepCapSlope = 4;
+
+// The interval of the ray x(u) = point + u·e_ray_axis in the sweep of `p` grown by e > 0: the
+// offset cone of sweep_grown_piece, carried e past the piece's end heights, widens there by
+// (|m| + √(1 + m²) − 1)·e beyond rho_max + e, the largest distance from the axis of any point
+// within e of `p` (thirty times e for a bull nose's lowest, nearly flat chord: a group bound that
+// loose reaches material its members do not). For |m| ≥ kSweepCapSlope that end is capped by the
+// cylinder of radius rho_max + e: the cone where it is narrower, the cylinder beyond, two pieces
+// whose union (convex: the radius bound is the least of a linear function and a constant) still
+// holds every point within e of `p`; the interval is the hull of theirs.
+inline std::optional<std::pair<double, double>> sweep_grown_interval(
+    const SweepPiece& p, double e, const Vec3& from, const Vec3& travel, const Vec3& axis,
+    const Vec3& point, int ray_axis) {
+  const SweepPiece g = sweep_grown_piece(p, e);
+  const double m = p.slope;
+  if (p.ball || std::abs(m) < kSweepCapSlope)
+    return sweep_piece_interval(g, from, travel, axis, point, ray_axis);
+  const double cap = std::max(p.rho0, p.rho0 + m * (p.hi - p.lo)) + e;
+  const double h = g.lo + (cap - g.rho0) / m;  // where the offset cone's radius is `cap`
+  const SweepPiece cone = m > 0 ? SweepPiece{g.lo, h, false, g.rho0, m, 0, 0}
+                                : SweepPiece{h, g.hi, false, cap, m, 0, 0};
+  const SweepPiece cylinder =
+      m > 0 ? SweepPiece{h, g.hi, false, cap, 0, 0, 0} : SweepPiece{g.lo, h, false, cap, 0, 0, 0};
+  const auto a = sweep_piece_interval(cone, from, travel, axis, point, ray_axis);
+  const auto b = sweep_piece_interval(cylinder, from, travel, axis, point, ray_axis);
+  if (!a || !b) return a ? a : b;
+  return std::pair{std::min(a->first, b->first), std::max(a->second, b->second)};
+}
+
 // What sweep_pieces_hull tests a piece by, computed once: its heights above the tip, its largest
 // radius, the farthest of its points from the tip, and how much its largest radius grows per
-// unit it is grown by (sweep_grown_piece).
+// unit it is grown by (sweep_grown_interval).
 struct SweepPieceSpan {
   double h0 = 0, h1 = 0, rho = 0, reach = 0, widen = 1;
 };
@@ -277,12 +308,13 @@ inline SweepPieceSpan sweep_piece_span(const SweepPiece& p) {
   b.h0 = p.ball ? p.centre - p.radius : p.lo, b.h1 = p.ball ? p.centre + p.radius : p.hi;
   b.rho = p.ball ? p.radius : std::max(p.rho0, p.rho0 + p.slope * (b.h1 - b.h0));
   b.reach = std::hypot(b.rho, std::max(std::abs(b.h0), std::abs(b.h1)));
-  if (!p.ball) b.widen = std::abs(p.slope) + std::sqrt(1 + p.slope * p.slope);
+  if (!p.ball && std::abs(p.slope) < kSweepCapSlope)
+    b.widen = std::abs(p.slope) + std::sqrt(1 + p.slope * p.slope);
   return b;
 }
 
 // The hull of the intervals of the ray x(u) = point + u·e_ray_axis in the sweeps of `pieces`, each
-// grown by grow(piece) ≥ 0 (sweep_grown_piece), with unit axis `axis`, tip from `from` moved by
+// grown by grow(piece) ≥ 0 (sweep_grown_interval), with unit axis `axis`, tip from `from` moved by
 // `travel`, where they may meet material lying within [lo, hi]; nullopt if none may. `spans`: the
 // pieces' sweep_piece_span, grow(k) ≥ 0 how far piece k is grown. Only pieces k < 64 whose bit is
 // set in `only` are taken (and all others); `met` gets the bits of those not skipped for missing
@@ -371,8 +403,8 @@ std::optional<std::pair<double, double>> sweep_pieces_hull(
     }
     if (met) *met |= bit;
     if (slabs && hull && hull->first <= u0 && u1 <= hull->second) continue;
-    const auto cut = sweep_piece_interval(e > 0 ? sweep_grown_piece(pieces[i], e) : pieces[i], from,
-                                          travel, axis, point, ray_axis);
+    const auto cut = e > 0 ? sweep_grown_interval(pieces[i], e, from, travel, axis, point, ray_axis)
+                           : sweep_piece_interval(pieces[i], from, travel, axis, point, ray_axis);
     if (!cut || cut->second < lo - margin || cut->first > hi + margin) {
       if (met) *met &= ~bit;
       if (!cut) continue;
