@@ -266,7 +266,9 @@ inline SweepPiece sweep_grown_piece(const SweepPiece& p, double e) {
 }
 
 // A frustum of slope |m| at least this is grown with its widening end capped
-// (sweep_grown_interval).
+// (sweep_grown_interval). A cap costs a second solve; a bull nose's chords of slope 1–4 capped as
+// well let as many of its groups through (2·10^4 segments: 670 k against 674 k, 733 k with no cap)
+// for 4 % more solves.
 inline constexpr double kSweepCapSlope = 4;
 
 // The interval of the ray x(u) = point + u·e_ray_axis in the sweep of `p` grown by e > 0: the
