@@ -424,6 +424,116 @@ TEST_CASE("sweep: a cut that rounds to a point leaves the ray whole") {
   CHECK(ray[0].exit == 2.0f);
 }
 
+// A random frustum piece: cylinders, cones widening or narrowing upward, and nearly flat ones
+// (a bull nose's lowest chord has slope ~15).
+detail::SweepPiece random_frustum(std::mt19937& rng) {
+  std::uniform_real_distribution<double> unit(0, 1);
+  const double slopes[] = {0, 0.3, -0.6, 1.5, 4.5, 15.3, -15.3, 40};
+  const double slope = slopes[rng() % 8] * (0.5 + unit(rng));
+  const double lo = 2 * unit(rng), hi = lo + (std::abs(slope) > 4 ? 0.02 : 1) * (0.1 + unit(rng));
+  const double rho0 = slope < 0 ? -slope * (hi - lo) + 0.5 * unit(rng) : 2 * unit(rng);
+  return {lo, hi, false, rho0, slope, 0, 0};
+}
+
+Vec3 random_unit(std::mt19937& rng) {
+  std::normal_distribution<double> n(0, 1);
+  return glm::normalize(Vec3(n(rng), n(rng), n(rng)));
+}
+
+// The interval of a ray in a swept frustum as sweep_conic_range finds it with the four sides
+// (0 ≤ s ≤ 1, lo ≤ h ≤ hi): what sweep_frustum_range must reproduce.
+std::optional<std::pair<double, double>> general_frustum_interval(const detail::SweepPiece& piece,
+                                                                  const Vec3& from,
+                                                                  const Vec3& travel,
+                                                                  const Vec3& axis,
+                                                                  const Vec3& point, int ray_axis) {
+  Vec3 w = point - from;
+  w[ray_axis] = -from[ray_axis];
+  const double hw = glm::dot(w, axis), hu = axis[ray_axis], hs = -glm::dot(travel, axis);
+  detail::SweepConic f;
+  for (int i = 0; i < 3; ++i) f.add_square(w[i], i == ray_axis ? 1.0 : 0.0, -travel[i], 1);
+  f.add_square(hw, hu, hs, -1);
+  const double m = piece.slope;
+  f.add_square(piece.rho0 + m * (hw - piece.lo), m * hu, m * hs, -1);
+  const double size = piece.hi + glm::length(travel) + piece.rho0 + m * (piece.hi - piece.lo);
+  const detail::SweepSide sides[4] = {
+      {0, 1, 0}, {0, -1, 1}, {hu, hs, hw - piece.lo}, {-hu, -hs, piece.hi - hw}};
+  const double tol = 1e-9 * (1 + size);
+  return detail::sweep_conic_range(f, sides, 2 * tol * (1 + size), tol);
+}
+
+// sweep_piece_interval solves a frustum with sweep_frustum_range, which tests each candidate of
+// the general conic only against the sides it does not lie on: the same intervals on rays near
+// random swept frusta (axes along and across the rays included).
+TEST_CASE("sweep: a frustum's own range gives the general conic's intervals") {
+  std::mt19937 rng(3434);
+  std::uniform_real_distribution<double> u(-3, 3);
+  int met = 0, differ = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const detail::SweepPiece piece = random_frustum(rng);
+    Vec3 axis = random_unit(rng);
+    if (k % 5 == 0) axis = Vec3(0, 0, k % 10 == 0 ? 1.0 : -1.0);
+    if (k % 7 == 0) axis = glm::normalize(Vec3(axis.x, axis.y, 0));
+    const Vec3 from(u(rng), u(rng), u(rng));
+    const Vec3 travel = (k % 3 == 0 ? 0.05 : 2.0) * Vec3(u(rng), u(rng), u(rng));
+    const Vec3 point(u(rng), u(rng), u(rng));
+    const int ray_axis = static_cast<int>(rng() % 3);
+    const auto fast = detail::sweep_piece_interval(piece, from, travel, axis, point, ray_axis);
+    const auto general = general_frustum_interval(piece, from, travel, axis, point, ray_axis);
+    met += general.has_value();
+    // The same candidates from the same formulas: equal but for rounding (the compiler may fuse
+    // multiply-adds differently in the two, which a ray nearly tangent to the sweep magnifies),
+    // and a tangent ray's point of contact either way.
+    if (fast && general) {
+      const double slack = 1e-7 * (1 + std::abs(general->first) + std::abs(general->second));
+      differ += std::abs(fast->first - general->first) > slack ||
+                std::abs(fast->second - general->second) > slack;
+    } else if (fast || general) {
+      const auto& one = fast ? fast : general;
+      differ += one->second - one->first > 1e-6;
+    }
+  }
+  CHECK(differ == 0);
+  CHECK(met > 2000);
+}
+
+// A group bound grows its pieces (sweep_grown_interval); a nearly flat frustum's wide end is
+// capped by the cylinder of its largest radius + e. Points within e of random frusta, on rays
+// through them, lie within the grown interval; and the cap makes it narrower on some rays.
+TEST_CASE("sweep: a grown frustum, capped, holds every point within e of it") {
+  std::mt19937 rng(3436);
+  std::uniform_real_distribution<double> unit(0, 1);
+  int narrower = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const detail::SweepPiece piece = random_frustum(rng);
+    const double e = 0.05 * unit(rng);
+    const Vec3 axis = random_unit(rng), from(0.0), travel = 0.3 * unit(rng) * random_unit(rng);
+    const Vec3 b1 =
+        glm::normalize(glm::cross(axis, std::abs(axis.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0)));
+    const Vec3 b2 = glm::cross(axis, b1);
+    // A point of the piece (swept by s), moved by at most e.
+    const double h = piece.lo + unit(rng) * (piece.hi - piece.lo);
+    const double r = (piece.rho0 + piece.slope * (h - piece.lo)) * std::sqrt(unit(rng));
+    const double angle = 2 * std::numbers::pi * unit(rng);
+    const Vec3 x = from + unit(rng) * travel + h * axis +
+                   r * (std::cos(angle) * b1 + std::sin(angle) * b2) +
+                   e * std::cbrt(unit(rng)) * random_unit(rng);
+    const int ray_axis = static_cast<int>(rng() % 3);
+    const auto grown = detail::sweep_grown_interval(piece, e, from, travel, axis, x, ray_axis);
+    REQUIRE(grown);
+    const double slack = 1e-9 * (1 + std::abs(x[ray_axis]));
+    CHECK(grown->first <= x[ray_axis] + slack);
+    CHECK(grown->second >= x[ray_axis] - slack);
+    const auto uncapped = detail::sweep_piece_interval(detail::sweep_grown_piece(piece, e), from,
+                                                       travel, axis, x, ray_axis);
+    REQUIRE(uncapped);
+    CHECK(grown->first >= uncapped->first - slack);
+    CHECK(grown->second <= uncapped->second + slack);
+    narrower += grown->second - grown->first < uncapped->second - uncapped->first - 1e-6;
+  }
+  CHECK(narrower > 100);
+}
+
 TEST_CASE(
     "golden_minimum: the minimum of a convex 1-Lipschitz function, or a value above the bar") {
   std::mt19937 rng(34);
