@@ -68,6 +68,15 @@ void push(std::vector<Point>& points, const Point& point) {
 const std::map<int, double> kRs274ToolLengths{
     {1, 0.511 * 25.4}, {2, 0.1 * 25.4}, {3, 1.273 * 25.4}, {98876, 0.1 * 25.4}};
 
+// rs274 keeps its tool table in $HOME/.tool.mmap (LinuxCNC 2.9 tooldata_mmap.cc): two runs at
+// once under one HOME (ctest runs test processes side by side) read each other's tools or die of
+// a bus error and print nothing, so each test process gives it a HOME of its own.
+fs::path rs274_home() {
+  fs::path home = fs::temp_directory_path() / ("tridex_rs274_home_" + std::to_string(::getpid()));
+  fs::create_directories(home);
+  return home;
+}
+
 // `tool_table`: a LinuxCNC tool table for -t (standalone rs274 reads its diameters in inches);
 // `tool_lengths` (mm) the lengths it holds. rs274 prints the controlled point: the tip of a tool
 // as long as the active offset (USE_TOOL_LENGTH_OFFSET, program units). tridex follows the tip of
@@ -78,11 +87,7 @@ std::vector<Point> run_rs274(const fs::path& program, std::string& log,
   fs::path out = fs::temp_directory_path() /
                  ("tridex_rs274_" + std::to_string(::getpid()) + "_" + program.filename().string());
   std::string tools = tool_table.empty() ? "" : "-t '" + tool_table.string() + "' ";
-  // rs274 keeps its tool table in $HOME/.tool.mmap (LinuxCNC 2.9 tooldata_mmap.cc): two runs at
-  // once under one HOME read each other's tools or die of a bus error, so each test process
-  // gives it a HOME of its own.
-  fs::path home = fs::temp_directory_path() / ("tridex_rs274_home_" + std::to_string(::getpid()));
-  fs::create_directories(home);
+  const fs::path home = rs274_home();
   std::string command = "HOME='" + home.string() + "' rs274 " + tools + "-g '" + program.string() +
                         "' '" + out.string() + "' < /dev/null > '" + out.string() + ".log' 2>&1";
   int status = std::system(command.c_str());
@@ -569,9 +574,11 @@ TEST_CASE("differential: feed rates in G93, G94 and G95 agree with rs274") {
   const fs::path program = fs::path(TRIDEX_TEST_DATA) / "gcode" / "linuxcnc" / "feed_modes.ngc";
   const fs::path out =
       fs::temp_directory_path() / ("tridex_rs274_feeds_" + std::to_string(::getpid()));
-  std::string command =
-      "rs274 -g '" + program.string() + "' '" + out.string() + "' < /dev/null > /dev/null 2>&1";
+  const fs::path home = rs274_home();
+  std::string command = "HOME='" + home.string() + "' rs274 -g '" + program.string() + "' '" +
+                        out.string() + "' < /dev/null > /dev/null 2>&1";
   (void)std::system(command.c_str());
+  fs::remove_all(home);
   std::vector<std::pair<double, double>> theirs;  // mm/min, tolerance
   {
     std::ifstream in(out);

@@ -31,7 +31,10 @@ std::optional<std::string> rs274_output(const std::string& program) {
   const fs::path dir = fs::temp_directory_path() / ("tridex-posts-" + std::to_string(::getpid()));
   fs::create_directories(dir);
   std::ofstream(dir / "p.ngc") << program;
-  const std::string command = "cd '" + dir.string() + "' && rs274 -g p.ngc > out.txt 2>&1";
+  // rs274 keeps its tool table in $HOME/.tool.mmap: runs of other test processes at the same time
+  // under one HOME would share it (test_linuxcnc_diff.cpp's run_rs274), so this one gets its own.
+  const std::string command =
+      "cd '" + dir.string() + "' && HOME='" + dir.string() + "' rs274 -g p.ngc > out.txt 2>&1";
   [[maybe_unused]] int status = std::system(command.c_str());
   std::ifstream in(dir / "out.txt");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
