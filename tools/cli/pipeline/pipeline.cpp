@@ -970,19 +970,18 @@ void extract_result_surface(const SimulateOptions& options, const PipelineReques
   r.mesh = extract_surface(r.result, {.threads = options.threads});
   if (r.reach_only)
     r.mesh = stitch_into_stock(r.mesh, r.lattice_box, r.stock.box, r.lattice.spacing);
-  if (request.surface_ready && detail::resolve_threads(options.threads) > 1) {
-    detail::BackgroundTask checking;  // waits for the check if the write throws
-    checking.start([&] {
-      r.mesh_check = check_mesh(r.mesh, options.threads);
-      r.timings.mesh = seconds_since(t);
-      result_volume(r);
-    });
-    request.surface_ready(r.mesh);
-    checking.join();
-  } else {
+  auto check = [&] {
     r.mesh_check = check_mesh(r.mesh, options.threads);
     r.timings.mesh = seconds_since(t);
     result_volume(r);
+  };
+  if (request.surface_ready && detail::resolve_threads(options.threads) > 1) {
+    detail::BackgroundTask checking;  // waits for the check if the write throws
+    checking.start(check);
+    request.surface_ready(r.mesh);
+    checking.join();
+  } else {
+    check();
     if (request.surface_ready) request.surface_ready(r.mesh);
   }
 }
